@@ -1,0 +1,145 @@
+//! The numeric CSV both `tactile kernels` and trajectory files use: a header row naming
+//! the columns, then rows of finite numbers. Errors name the line and the column, so a
+//! user can find the bad cell; blank lines are skipped.
+
+use thiserror::Error;
+
+/// A CSV problem, located.
+#[derive(Debug, Error, PartialEq, Eq)]
+pub enum CsvError {
+    /// No header at all.
+    #[error("line 1: empty input, expected the header {expected}")]
+    Empty {
+        /// The expected header.
+        expected: String,
+    },
+    /// The header names other columns.
+    #[error("line {line}: header is {found:?}, expected {expected}")]
+    Header {
+        /// 1-based line number.
+        line: usize,
+        /// What the header said.
+        found: String,
+        /// What it should say.
+        expected: String,
+    },
+    /// A row with too few or too many cells (a truncated line, for example).
+    #[error("line {line}: expected {expected} columns ({names}), found {found}")]
+    Columns {
+        /// 1-based line number.
+        line: usize,
+        /// Columns expected.
+        expected: usize,
+        /// Their names, comma separated.
+        names: String,
+        /// Columns found.
+        found: usize,
+    },
+    /// A cell that is not a finite number.
+    #[error("line {line}, column {column} ({name}): {text:?} is not a {what}")]
+    Cell {
+        /// 1-based line number.
+        line: usize,
+        /// 1-based column number.
+        column: usize,
+        /// Column name.
+        name: String,
+        /// The cell's text.
+        text: String,
+        /// "number" or "finite number".
+        what: &'static str,
+    },
+}
+
+/// Checks a header line (already known to be line `line`) against `columns`.
+pub fn check_header(line: usize, text: &str, columns: &[&str]) -> Result<(), CsvError> {
+    let got: Vec<&str> = text.split(',').map(str::trim).collect();
+    if got != columns {
+        return Err(CsvError::Header {
+            line,
+            found: text.trim().to_string(),
+            expected: columns.join(","),
+        });
+    }
+    Ok(())
+}
+
+/// Parses one data row into `out` (cleared first).
+pub fn parse_row(
+    line: usize,
+    text: &str,
+    columns: &[&str],
+    out: &mut Vec<f64>,
+) -> Result<(), CsvError> {
+    out.clear();
+    let cells: Vec<&str> = text.split(',').map(str::trim).collect();
+    if cells.len() != columns.len() {
+        return Err(CsvError::Columns {
+            line,
+            expected: columns.len(),
+            names: columns.join(","),
+            found: cells.len(),
+        });
+    }
+    for (k, (cell, name)) in cells.iter().zip(columns).enumerate() {
+        let bad = |what| CsvError::Cell {
+            line,
+            column: k + 1,
+            name: (*name).to_string(),
+            text: (*cell).to_string(),
+            what,
+        };
+        match cell.parse::<f64>() {
+            Ok(v) if v.is_finite() => out.push(v),
+            Ok(_) => return Err(bad("finite number")),
+            Err(_) => return Err(bad("number")),
+        }
+    }
+    Ok(())
+}
+
+/// Parses a whole document with header `columns` into rows.
+pub fn parse(text: &str, columns: &[&str]) -> Result<Vec<Vec<f64>>, CsvError> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l))
+        .filter(|(_, l)| !l.trim().is_empty());
+    let (hl, header) = lines.next().ok_or_else(|| CsvError::Empty {
+        expected: columns.join(","),
+    })?;
+    check_header(hl, header, columns)?;
+    let mut rows = Vec::new();
+    let mut row = Vec::with_capacity(columns.len());
+    for (line, text) in lines {
+        parse_row(line, text, columns, &mut row)?;
+        rows.push(row.clone());
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_locates_errors() {
+        let cols = ["x", "y", "z"];
+        assert_eq!(
+            parse("x,y,z\n1,2,3\n\n4, 5 ,6\n", &cols),
+            Ok(vec![vec![1.0, 2.0, 3.0], vec![4.0, 5.0, 6.0]])
+        );
+        let e = parse("x,y,z\n1,2,3\n1,zz,3\n", &cols).expect_err("malformed");
+        assert_eq!(
+            e.to_string(),
+            "line 3, column 2 (y): \"zz\" is not a number"
+        );
+        let e = parse("x,y,z\n1,2\n", &cols).expect_err("malformed");
+        assert_eq!(e.to_string(), "line 2: expected 3 columns (x,y,z), found 2");
+        let e = parse("x,y,z\n1,NaN,2\n", &cols).expect_err("malformed");
+        assert!(e.to_string().contains("not a finite number"));
+        let e = parse("a,b,c\n", &cols).expect_err("malformed");
+        assert!(matches!(e, CsvError::Header { line: 1, .. }));
+        assert!(matches!(parse("\n\n", &cols), Err(CsvError::Empty { .. })));
+    }
+}

@@ -1,0 +1,315 @@
+//! The one edge in `common`: iceoryx2 wiring shared by the three processes.
+//!
+//! Every other module here is pure; this one opens shared memory. It lives in `common`
+//! because all three processes must agree on service names, buffer sizes and overflow
+//! policy, or they cannot connect. Each stream is a publish-subscribe service plus an
+//! event service of the same name: the sender publishes then notifies, the receiver
+//! spins for a short budget and then blocks on the event.
+//!
+//! Isolation: every run (and every test) uses its own `prefix`, which names both the
+//! shared-memory objects and the folder of node and service files, so runs never see
+//! each other.
+
+use iceoryx2::config::Config;
+use iceoryx2::node::NodeWaitFailure;
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::{
+    ipc, FileName, Node, NodeBuilder, NodeName, SemanticString, ServiceName, ZeroCopySend,
+};
+use std::fmt::Debug;
+use std::time::{Duration, Instant};
+use thiserror::Error;
+
+/// A process's iceoryx2 node.
+pub type IpcNode = Node<ipc::Service>;
+
+/// Samples a subscriber buffers before the oldest is overwritten (safe overflow). A
+/// lost sample shows as a gap in the sequence numbers and is counted.
+pub const SUBSCRIBER_BUFFER: usize = 64;
+
+/// Root folder of the node and service files of all runs.
+pub const ROOT: &str = "/tmp/tactile-iox2";
+
+/// Stream names shared by the three processes.
+pub mod streams {
+    /// c(n): master to emulator.
+    pub const C: &str = "forward/c";
+    /// v(n): emulator to slave.
+    pub const V: &str = "forward/v";
+    /// h(n): slave to emulator.
+    pub const H: &str = "backward/h";
+    /// q(n): emulator to master.
+    pub const Q: &str = "backward/q";
+    /// Wake-up event of the master.
+    pub const WAKE_MASTER: &str = "master";
+    /// Wake-up event of the emulator.
+    pub const WAKE_EMULATOR: &str = "emulator";
+    /// Wake-up event of the slave.
+    pub const WAKE_SLAVE: &str = "slave";
+}
+
+/// How a process waits for its next sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WaitPolicy {
+    /// Busy-poll this long before blocking on the wake-up event.
+    pub spin: Duration,
+}
+
+/// An iceoryx2 failure, with what was being done.
+#[derive(Debug, Error)]
+#[error("{context}: {detail}")]
+pub struct IpcError {
+    /// What was being done.
+    pub context: String,
+    /// iceoryx2's description.
+    pub detail: String,
+}
+
+fn err(context: impl Into<String>) -> impl FnOnce(&dyn Debug) -> IpcError {
+    let context = context.into();
+    move |e| IpcError {
+        context,
+        detail: format!("{e:?}"),
+    }
+}
+
+/// Maps any iceoryx2 error to [`IpcError`].
+fn map<T, E: Debug>(r: Result<T, E>, context: impl Into<String>) -> Result<T, IpcError> {
+    r.map_err(|e| err(context)(&e))
+}
+
+/// The iceoryx2 configuration of one run: its own prefix and root folder.
+pub fn config(prefix: &str) -> Result<Config, IpcError> {
+    let mut cfg = Config::default();
+    let root = format!("{ROOT}/{prefix}/");
+    cfg.global.set_root_path(&map(
+        iceoryx2::prelude::Path::new(root.as_bytes()),
+        format!("root path {root}"),
+    )?);
+    cfg.global.prefix = map(
+        FileName::new(format!("{prefix}_").as_bytes()),
+        format!("prefix {prefix:?}"),
+    )?;
+    Ok(cfg)
+}
+
+/// Creates this process's node; dead nodes of an earlier crashed run with the same
+/// prefix are cleaned up on creation.
+pub fn node(prefix: &str, name: &str) -> Result<Node<ipc::Service>, IpcError> {
+    let cfg = config(prefix)?;
+    let node_name = map(NodeName::new(name), format!("node name {name:?}"))?;
+    let node = map(
+        NodeBuilder::new()
+            .name(&node_name)
+            .config(&cfg)
+            .create::<ipc::Service>(),
+        format!("creating node {name}"),
+    )?;
+    // iceoryx2 installs its SIGINT/SIGTERM handlers on the first wait: do it now, so
+    // a stop request is never fatal.
+    let _ = node.wait(Duration::ZERO);
+    Ok(node)
+}
+
+/// True once SIGINT or SIGTERM was received (consumes the request).
+pub fn termination_requested(node: &Node<ipc::Service>) -> bool {
+    matches!(
+        node.wait(Duration::ZERO),
+        Err(NodeWaitFailure::TerminationRequest)
+    )
+}
+
+fn service_name(stream: &str) -> Result<ServiceName, IpcError> {
+    let name = format!("tactile/{stream}");
+    map(ServiceName::new(&name), format!("service name {name}"))
+}
+
+/// Sending end of a stream: a publisher, and a notifier that wakes the receiving
+/// process (each process has one wake-up event, whichever stream the sample is on).
+#[derive(Debug)]
+pub struct Outbox<T: Debug + ZeroCopySend + 'static> {
+    publisher: Publisher<ipc::Service, T, ()>,
+    notifier: Notifier<ipc::Service>,
+    stream: String,
+}
+
+/// Receiving end of a stream.
+#[derive(Debug)]
+pub struct Inbox<T: Debug + ZeroCopySend + 'static> {
+    subscriber: Subscriber<ipc::Service, T, ()>,
+    stream: String,
+}
+
+/// A process's wake-up event: every stream into the process notifies it.
+#[derive(Debug)]
+pub struct Waker {
+    listener: Listener<ipc::Service>,
+    name: String,
+}
+
+fn open_pubsub<T: Debug + ZeroCopySend + 'static>(
+    node: &Node<ipc::Service>,
+    stream: &str,
+) -> Result<
+    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>,
+    IpcError,
+> {
+    map(
+        node.service_builder(&service_name(stream)?)
+            .publish_subscribe::<T>()
+            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
+            .history_size(0)
+            .max_publishers(2)
+            .max_subscribers(4)
+            .max_nodes(8)
+            .enable_safe_overflow(true)
+            .open_or_create(),
+        format!("opening stream {stream}"),
+    )
+}
+
+fn open_event(
+    node: &Node<ipc::Service>,
+    name: &str,
+) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, IpcError> {
+    map(
+        node.service_builder(&service_name(&format!("wake/{name}"))?)
+            .event()
+            .max_notifiers(8)
+            .max_listeners(4)
+            .max_nodes(8)
+            .open_or_create(),
+        format!("opening wake-up event {name}"),
+    )
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> Outbox<T> {
+    /// Opens (or creates) `stream` for sending; each send wakes process `wake`.
+    pub fn open(node: &Node<ipc::Service>, stream: &str, wake: &str) -> Result<Self, IpcError> {
+        let svc = open_pubsub::<T>(node, stream)?;
+        let ev = open_event(node, wake)?;
+        Ok(Outbox {
+            publisher: map(
+                svc.publisher_builder().max_loaned_samples(2).create(),
+                format!("publisher on {stream}"),
+            )?,
+            notifier: map(
+                ev.notifier_builder().create(),
+                format!("notifier for {wake}"),
+            )?,
+            stream: stream.to_string(),
+        })
+    }
+
+    /// Publishes a copy of `value` and wakes the receiver; returns how many subscribers
+    /// it reached.
+    pub fn send(&self, value: T) -> Result<usize, IpcError> {
+        let n = map(
+            self.publisher.send_copy(value),
+            format!("sending on {}", self.stream),
+        )?;
+        map(self.notifier.notify(), format!("notifying {}", self.stream))?;
+        Ok(n)
+    }
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> Inbox<T> {
+    /// Opens (or creates) `stream` for receiving.
+    pub fn open(node: &Node<ipc::Service>, stream: &str) -> Result<Self, IpcError> {
+        let svc = open_pubsub::<T>(node, stream)?;
+        Ok(Inbox {
+            subscriber: map(
+                svc.subscriber_builder()
+                    .buffer_size(SUBSCRIBER_BUFFER)
+                    .create(),
+                format!("subscriber on {stream}"),
+            )?,
+            stream: stream.to_string(),
+        })
+    }
+
+    /// A sample if one is waiting.
+    pub fn try_recv(&self) -> Result<Option<T>, IpcError> {
+        Ok(map(
+            self.subscriber.receive(),
+            format!("receiving on {}", self.stream),
+        )?
+        .map(|s| *s))
+    }
+}
+
+/// Why [`Waker::wait`] returned without the awaited condition.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Idle {
+    /// The deadline passed.
+    Timeout,
+    /// SIGINT or SIGTERM arrived.
+    Terminate,
+}
+
+impl Waker {
+    /// Opens this process's wake-up event `name`.
+    pub fn open(node: &Node<ipc::Service>, name: &str) -> Result<Self, IpcError> {
+        let ev = open_event(node, name)?;
+        Ok(Waker {
+            listener: map(
+                ev.listener_builder().create(),
+                format!("listener for {name}"),
+            )?,
+            name: name.to_string(),
+        })
+    }
+
+    /// Calls `poll` until it yields a value: busily for `spin`, then blocking on the
+    /// wake-up event, until `deadline`. Returns [`Idle`] on timeout or a stop request.
+    pub fn wait<V>(
+        &self,
+        node: &Node<ipc::Service>,
+        spin: Duration,
+        deadline: Instant,
+        mut poll: impl FnMut() -> Result<Option<V>, IpcError>,
+    ) -> Result<Result<V, Idle>, IpcError> {
+        let start = Instant::now();
+        loop {
+            if let Some(v) = poll()? {
+                return Ok(Ok(v));
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Ok(Err(Idle::Timeout));
+            }
+            if now.duration_since(start) < spin {
+                std::hint::spin_loop();
+                continue;
+            }
+            if termination_requested(node) {
+                return Ok(Err(Idle::Terminate));
+            }
+            match self.listener.timed_wait(|_| {}, deadline - now) {
+                Ok(_) => {}
+                Err(ListenerWaitError::InterruptSignal) => {
+                    if termination_requested(node) {
+                        return Ok(Err(Idle::Terminate));
+                    }
+                }
+                Err(e) => return Err(err(format!("waiting on {}", self.name))(&e)),
+            }
+        }
+    }
+}
+
+/// Removes the shared-memory objects and files of a run (after all its processes ended).
+pub fn remove_run_files(prefix: &str) {
+    let shm_prefix = format!("{prefix}_");
+    if let Ok(dir) = std::fs::read_dir("/dev/shm") {
+        for entry in dir.flatten() {
+            if entry.file_name().to_string_lossy().starts_with(&shm_prefix) {
+                let _ = std::fs::remove_file(entry.path());
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(format!("{ROOT}/{prefix}"));
+}

@@ -1,0 +1,162 @@
+//! The samples that cross process boundaries, laid out for zero-copy shared memory.
+//!
+//! Every type is `#[repr(C)]`, holds only plain numbers, and carries an explicit
+//! iceoryx2 type name, so separately built binaries agree on the layout. A sample
+//! carries, for each of its three values, the master sample it originates from, that
+//! sample's timestamp and the delay injected on purpose, so the master can measure the
+//! round trip on its own clock and subtract the injected delay. Each sample also
+//! carries a timestamp per stage it passed.
+
+use iceoryx2::prelude::ZeroCopySend;
+use serde::{Deserialize, Serialize};
+
+/// Stages a sample passes, in order; indices into `stamps`.
+pub mod stage {
+    /// Sample n's instant: its scheduled tick in realtime (so a late wake-up counts as
+    /// overhead), the moment it starts in lockstep.
+    pub const MASTER_TICK: usize = 0;
+    /// Master publishes c(n) (after MD model and FK-HMD).
+    pub const MASTER_SEND: usize = 1;
+    /// Emulator takes c(n).
+    pub const EMU_FWD_RECV: usize = 2;
+    /// Emulator publishes v(n).
+    pub const EMU_FWD_SEND: usize = 3;
+    /// Slave takes v(n).
+    pub const SLAVE_RECV: usize = 4;
+    /// Slave publishes h(n) (after IK, controller, dynamics, FK, ENV, FBF).
+    pub const SLAVE_SEND: usize = 5;
+    /// Emulator takes h(n).
+    pub const EMU_BWD_RECV: usize = 6;
+    /// Emulator publishes q(n).
+    pub const EMU_BWD_SEND: usize = 7;
+    /// Master takes q(n).
+    pub const MASTER_RECV: usize = 8;
+    /// Master has the torques p(n) (after KFF-HMD).
+    pub const MASTER_DONE: usize = 9;
+    /// Number of stages.
+    pub const COUNT: usize = 10;
+    /// Names for reports, in index order.
+    pub const NAMES: [&str; COUNT] = [
+        "master_tick",
+        "master_send",
+        "emu_fwd_recv",
+        "emu_fwd_send",
+        "slave_recv",
+        "slave_send",
+        "emu_bwd_recv",
+        "emu_bwd_send",
+        "master_recv",
+        "master_done",
+    ];
+}
+
+/// Flag: a value stood in for one the channel did not have (start-up of a delay, gap).
+pub const FLAG_SUBSTITUTED: u32 = 1;
+/// Flag: the slave's IK target was outside the workspace (clamped).
+pub const FLAG_IK_CLAMPED: u32 = 2;
+/// Flag: a received value was NaN or infinite and was rejected.
+pub const FLAG_REJECTED: u32 = 4;
+/// Flag: the tool is in contact with an object.
+pub const FLAG_CONTACT: u32 = 8;
+/// Flag: a start-up probe; passes every process untouched and comes back to the master.
+pub const FLAG_PROBE: u32 = 16;
+/// Flag: the run is over; each process passes it on and exits.
+pub const FLAG_END: u32 = 32;
+
+/// Three signal values with their provenance.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("tactile::Signal/1")]
+pub struct Signal {
+    /// Values: position in metres (forward) or force in newtons (backward).
+    pub value: [f64; 3],
+    /// Master sample each value originates from.
+    pub origin_seq: [u64; 3],
+    /// Master timestamp of that sample (CLOCK_MONOTONIC, ns).
+    pub origin_ns: [u64; 3],
+    /// Delay injected on purpose along the path so far, samples.
+    pub delay_samples: [u32; 3],
+    /// `FLAG_*` bits.
+    pub flags: u32,
+    /// Noise the emulator added to each value on the last hop.
+    pub noise: [f64; 3],
+}
+
+/// Forward stream: c(n) from the master, v(n) from the emulator.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("tactile::Forward/1")]
+pub struct Forward {
+    /// Sample number n on this stream.
+    pub seq: u64,
+    /// Tool position.
+    pub signal: Signal,
+    /// The operator's target a(n), for tracking-error accounting.
+    pub target: [f64; 3],
+    /// Timestamps per stage (`stage::*`), ns; zero where not passed yet.
+    pub stamps: [u64; stage::COUNT],
+}
+
+/// The slave's state at the step that produced a backward sample, for the trace.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("tactile::SlaveState/1")]
+pub struct SlaveState {
+    /// The v(n) the slave received.
+    pub received: Signal,
+    /// IK-HSD reference angles, rad.
+    pub theta_ref: [f64; 3],
+    /// Slave joint angles after the step, rad.
+    pub theta: [f64; 3],
+    /// Controller torques after clamping, N m.
+    pub torque: [f64; 3],
+    /// FK-HSD tool position l(n), m.
+    pub tool: [f64; 3],
+    /// Nearest surface point s^OBJ(n), m (zero without contact).
+    pub surface: [f64; 3],
+    /// h(n) before the backward channel, N.
+    pub force: [f64; 3],
+    /// Torque clamps this step.
+    pub clamps: u32,
+    /// Object index in contact, or u32::MAX.
+    pub contact_object: u32,
+}
+
+/// Backward stream: h(n) from the slave, q(n) from the emulator.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("tactile::Backward/1")]
+pub struct Backward {
+    /// Sample number n on this stream (the forward sample that triggered it).
+    pub seq: u64,
+    /// Contact force.
+    pub signal: Signal,
+    /// Stamps of the triggering forward sample, then the backward stages.
+    pub stamps: [u64; stage::COUNT],
+    /// The slave's state at step n.
+    pub slave: SlaveState,
+}
+
+/// Sequence accounting of one input stream.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct StreamCount {
+    /// Samples received.
+    pub received: u64,
+    /// Sequence numbers skipped: samples that never arrived.
+    pub gaps: u64,
+    /// Samples published onwards.
+    pub sent: u64,
+    #[serde(skip)]
+    next: Option<u64>,
+}
+
+impl StreamCount {
+    /// Counts a received sample number.
+    pub fn saw(&mut self, seq: u64) {
+        self.received += 1;
+        if let Some(next) = self.next {
+            self.gaps += seq.saturating_sub(next);
+        }
+        self.next = Some(seq + 1);
+    }
+}

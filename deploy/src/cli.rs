@@ -1,0 +1,267 @@
+//! Command-line parsing and dispatch for `tactile`.
+
+use crate::error::{Error, EXIT_BAD_INPUT};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use tactile_common::arith::ArithKind;
+use tactile_common::cordic::{CordicConfig, Rounding};
+use tactile_common::geometry::Geometry;
+
+/// Tactile: runtime and testbed for bilateral tactile-internet teleoperation.
+#[derive(Debug, Parser)]
+#[command(name = "tactile", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Evaluate one kernel over CSV rows from stdin, writing CSV to stdout.
+    Kernels(KernelsArgs),
+    /// Reproduce the paper's MSE table (hybrid against f32 on its validation run).
+    Paper(PaperArgs),
+    /// Run a scenario: start master, network emulator and slave, and report.
+    Run(RunArgs),
+    /// One process of a run (started by `tactile run`).
+    #[command(hide = true)]
+    Role(RoleArgs),
+}
+
+/// Arguments of `tactile run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Scenario file (TOML); without one, the built-in paper scenario
+    /// (deploy/scenarios/paper.toml).
+    pub scenario: Option<PathBuf>,
+    /// Folder for summary.json, trace.csv, histograms and plots.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// iceoryx2 prefix isolating this run's shared memory (default: one per launcher).
+    #[arg(long)]
+    pub prefix: Option<String>,
+    /// Microseconds each process busy-polls before blocking on its wake-up event.
+    /// Default 0: on two cores a spinning process takes the core the next stage needs
+    /// (see README, "Waiting").
+    #[arg(long, default_value_t = 0)]
+    pub spin_us: u64,
+    /// Run master, emulator and slave in this process, without shared memory.
+    #[arg(long)]
+    pub in_process: bool,
+    /// No progress line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Which process a role runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RoleName {
+    /// OP, MD, HMD.
+    Master,
+    /// NW.
+    Emulator,
+    /// HSD, SD, ENV.
+    Slave,
+}
+
+/// Arguments of `tactile role`.
+#[derive(Debug, Args)]
+pub struct RoleArgs {
+    /// The role.
+    #[arg(value_enum)]
+    pub role: RoleName,
+    /// Scenario file written by the launcher.
+    #[arg(long)]
+    pub scenario: PathBuf,
+    /// Folder the scenario's relative paths are resolved against.
+    #[arg(long)]
+    pub base_dir: PathBuf,
+    /// iceoryx2 prefix of the run.
+    #[arg(long)]
+    pub prefix: String,
+    /// Output folder.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Busy-poll budget, microseconds.
+    #[arg(long, default_value_t = 0)]
+    pub spin_us: u64,
+}
+
+/// The kernel a `kernels` run evaluates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Module {
+    /// Forward kinematics: theta1,theta2,theta3 -> x,y,z.
+    Fk,
+    /// Inverse kinematics: x,y,z -> theta1,theta2,theta3,reachable.
+    Ik,
+    /// Kinesthetic feedback force: theta1..3,fx,fy,fz -> tau1,tau2,tau3.
+    Kff,
+    /// Feedback force: x_obj..z_obj,x_env..z_env,hx,hy,hz -> fx,fy,fz.
+    Fbf,
+}
+
+/// CLI spelling of [`ArithKind`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ArithArg {
+    /// f64 reference.
+    F64,
+    /// f32 software model.
+    F32,
+    /// f32 with CORDIC in fixed point (the FPGA datapath).
+    Hybrid,
+}
+
+impl From<ArithArg> for ArithKind {
+    fn from(a: ArithArg) -> Self {
+        match a {
+            ArithArg::F64 => ArithKind::F64,
+            ArithArg::F32 => ArithKind::F32,
+            ArithArg::Hybrid => ArithKind::Hybrid,
+        }
+    }
+}
+
+/// CLI spelling of [`Rounding`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RoundingArg {
+    /// Floor, what a plain arithmetic shift does.
+    Truncate,
+    /// Round half up.
+    Nearest,
+}
+
+impl From<RoundingArg> for Rounding {
+    fn from(r: RoundingArg) -> Self {
+        match r {
+            RoundingArg::Truncate => Rounding::Truncate,
+            RoundingArg::Nearest => Rounding::Nearest,
+        }
+    }
+}
+
+/// Fixed-point format of the CORDIC block and the device geometry.
+#[derive(Debug, Clone, Args)]
+pub struct DatapathArgs {
+    /// Word length V of the signed fixed-point format [sV.N].
+    #[arg(long, default_value_t = CordicConfig::S16_13.word)]
+    pub word: u32,
+    /// Fractional bits N of [sV.N].
+    #[arg(long, default_value_t = CordicConfig::S16_13.frac)]
+    pub frac: u32,
+    /// CORDIC iterations (default derived from --frac).
+    #[arg(long)]
+    pub iterations: Option<u32>,
+    /// Rounding in the float-to-fixed conversion and every shift.
+    #[arg(long, value_enum)]
+    pub rounding: Option<RoundingArg>,
+    /// Device geometry: `paper`, `omni`, or a TOML file with l1, l2, l3, a (metres).
+    #[arg(long, default_value = "paper")]
+    pub device: String,
+}
+
+impl DatapathArgs {
+    /// The validated CORDIC configuration.
+    pub fn cordic(&self) -> Result<CordicConfig, Error> {
+        let rounding = self
+            .rounding
+            .map(Rounding::from)
+            .unwrap_or(CordicConfig::S16_13.rounding);
+        CordicConfig::new(self.word, self.frac, self.iterations, rounding)
+            .map_err(|e| Error::BadInput(format!("bad fixed-point format: {e}")))
+    }
+
+    /// The device geometry: a preset or a validated file.
+    pub fn geometry(&self) -> Result<Geometry, Error> {
+        if let Some(g) = Geometry::preset(&self.device) {
+            return Ok(g);
+        }
+        let path = PathBuf::from(&self.device);
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            Error::BadInput(format!(
+                "--device {}: not a preset (paper, omni) and cannot read it as a file: {e}",
+                self.device
+            ))
+        })?;
+        Geometry::from_toml_str(&text)
+            .map_err(|e| Error::BadInput(format!("{}: {e}", path.display())))
+    }
+}
+
+/// Arguments of `tactile kernels`.
+#[derive(Debug, Args)]
+pub struct KernelsArgs {
+    /// Which kernel to evaluate.
+    #[arg(value_enum)]
+    pub module: Module,
+    /// Arithmetic to evaluate in.
+    #[arg(long, value_enum, default_value_t = ArithArg::F64)]
+    pub arith: ArithArg,
+    /// Datapath format and device.
+    #[command(flatten)]
+    pub datapath: DatapathArgs,
+}
+
+/// Arguments of `tactile paper`.
+#[derive(Debug, Args)]
+pub struct PaperArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Datapath format and device.
+    #[command(flatten)]
+    pub datapath: DatapathArgs,
+}
+
+/// Parses the command line, runs it, and maps the outcome to an exit status with one
+/// readable line on stderr.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() { EXIT_BAD_INPUT } else { 0 });
+        }
+    };
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let _ = writeln!(std::io::stderr(), "tactile: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
+
+/// Runs a parsed command line against the process's stdin and stdout.
+pub fn run(cli: Cli) -> Result<(), Error> {
+    match cli.command {
+        Command::Kernels(args) => {
+            let stdin = std::io::stdin().lock();
+            let mut stdout = std::io::stdout().lock();
+            crate::kernels_cmd::run(&args, stdin, &mut stdout)
+        }
+        Command::Paper(args) => {
+            let mut stdout = std::io::stdout().lock();
+            crate::paper_cmd::run(&args, &mut stdout)
+        }
+        Command::Run(args) => crate::run_cmd::main(&args),
+        Command::Role(args) => {
+            let (scenario, _) = crate::run_cmd::load_scenario(Some(&args.scenario))?;
+            let opts = crate::roles::RoleOptions {
+                scenario,
+                base_dir: args.base_dir,
+                prefix: args.prefix,
+                out: args.out,
+                spin: std::time::Duration::from_micros(args.spin_us),
+            };
+            match args.role {
+                RoleName::Master => crate::roles::master(&opts),
+                RoleName::Emulator => crate::roles::emulator(&opts),
+                RoleName::Slave => crate::roles::slave(&opts),
+            }
+        }
+    }
+}

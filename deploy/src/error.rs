@@ -1,0 +1,43 @@
+//! The launcher's errors and the exit status each one maps to.
+
+use thiserror::Error;
+
+/// Exit status for bad input: a malformed file, row or argument. Nothing was run.
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit status for a failure while running.
+pub const EXIT_FAILURE: u8 = 1;
+
+/// Everything the launcher can fail with.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// Bad input named by file, line, column or field.
+    #[error("{0}")]
+    BadInput(String),
+    /// Reading input or writing output failed.
+    #[error("{context}: {source}")]
+    Io {
+        /// What was being read or written.
+        context: String,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// A failure while running.
+    #[error("{0}")]
+    Failed(String),
+}
+
+impl Error {
+    /// The process exit status for this error.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::BadInput(_) => EXIT_BAD_INPUT,
+            Error::Io { .. } | Error::Failed(_) => EXIT_FAILURE,
+        }
+    }
+
+    /// Wraps an I/O error with what was being done.
+    pub fn io(context: impl Into<String>) -> impl FnOnce(std::io::Error) -> Error {
+        let context = context.into();
+        move |source| Error::Io { context, source }
+    }
+}

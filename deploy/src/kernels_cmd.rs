@@ -1,0 +1,117 @@
+//! `tactile kernels`: one kernel over CSV rows.
+//!
+//! A public interface users script against. Input: a header naming the module's
+//! columns, then one row of numbers per sample. Output: a header, then one row per
+//! input row. The whole output is built in memory and written only when every row
+//! parsed, so a bad row leaves stdout empty rather than half written.
+
+use crate::cli::{KernelsArgs, Module};
+use crate::error::Error;
+use std::io::{BufRead, Write};
+use tactile_common::arith::ArithKind;
+use tactile_common::csv;
+use tactile_common::engine::Engine;
+use tactile_common::kernels::IkStatus;
+
+impl Module {
+    /// Input column names, in order.
+    pub fn input_columns(self) -> &'static [&'static str] {
+        match self {
+            Module::Fk => &["theta1", "theta2", "theta3"],
+            Module::Ik => &["x", "y", "z"],
+            Module::Kff => &["theta1", "theta2", "theta3", "fx", "fy", "fz"],
+            Module::Fbf => &[
+                "x_obj", "y_obj", "z_obj", "x_env", "y_env", "z_env", "hx", "hy", "hz",
+            ],
+        }
+    }
+
+    /// Output column names, in order.
+    pub fn output_columns(self) -> &'static [&'static str] {
+        match self {
+            Module::Fk => &["x", "y", "z"],
+            Module::Ik => &["theta1", "theta2", "theta3", "reachable"],
+            Module::Kff => &["tau1", "tau2", "tau3"],
+            Module::Fbf => &["fx", "fy", "fz"],
+        }
+    }
+}
+
+/// Formats a kernel output so it reads back to the same value: shortest round-trip
+/// form of the arithmetic's own precision (an f32 result prints as an f32).
+fn push_float(out: &mut String, v: f64, kind: ArithKind) {
+    use std::fmt::Write as _;
+    // Writing into a String cannot fail.
+    let _ = match kind {
+        ArithKind::F64 => write!(out, "{v:?}"),
+        ArithKind::F32 | ArithKind::Hybrid => write!(out, "{:?}", v as f32),
+    };
+}
+
+/// Evaluates `args.module` over the CSV on `input`, writing CSV to `output`.
+pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> Result<(), Error> {
+    let kind = ArithKind::from(args.arith);
+    let engine = Engine::new(kind, args.datapath.geometry()?, args.datapath.cordic()?)
+        .map_err(|e| Error::BadInput(format!("bad fixed-point format: {e}")))?;
+    let module = args.module;
+    let in_cols = module.input_columns();
+
+    let mut lines = input.lines().enumerate();
+    let mut header = None;
+    for (i, line) in lines.by_ref() {
+        let line = line.map_err(Error::io(format!("reading line {} of stdin", i + 1)))?;
+        if !line.trim().is_empty() {
+            header = Some((i + 1, line));
+            break;
+        }
+    }
+    let Some((hl, header)) = header else {
+        return Err(Error::BadInput(
+            csv::CsvError::Empty {
+                expected: in_cols.join(","),
+            }
+            .to_string(),
+        ));
+    };
+    csv::check_header(hl, &header, in_cols).map_err(|e| Error::BadInput(e.to_string()))?;
+
+    let mut out = String::with_capacity(4096);
+    out.push_str(&module.output_columns().join(","));
+    out.push('\n');
+    let mut v = Vec::with_capacity(in_cols.len());
+    for (i, line) in lines {
+        let lineno = i + 1;
+        let line = line.map_err(Error::io(format!("reading line {lineno} of stdin")))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        csv::parse_row(lineno, &line, in_cols, &mut v)
+            .map_err(|e| Error::BadInput(e.to_string()))?;
+        let (values, reachable): ([f64; 3], Option<bool>) = match module {
+            Module::Fk => (engine.fk([v[0], v[1], v[2]]), None),
+            Module::Ik => {
+                let s = engine.ik([v[0], v[1], v[2]]);
+                (s.theta, Some(s.status == IkStatus::Reachable))
+            }
+            Module::Kff => (engine.kff([v[0], v[1], v[2]], [v[3], v[4], v[5]]), None),
+            Module::Fbf => (
+                engine.fbf([v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]),
+                None,
+            ),
+        };
+        for (k, x) in values.iter().enumerate() {
+            if k > 0 {
+                out.push(',');
+            }
+            push_float(&mut out, *x, kind);
+        }
+        if let Some(r) = reachable {
+            out.push_str(if r { ",1" } else { ",0" });
+        }
+        out.push('\n');
+    }
+    output
+        .write_all(out.as_bytes())
+        .and_then(|()| output.flush())
+        .map_err(Error::io("writing stdout"))
+}

@@ -1,0 +1,12 @@
+//! The Tactile launcher as a library: the `tactile` binary is a thin wrapper around
+//! [`cli::main`], so every subcommand can also be driven in-process.
+
+pub mod cli;
+pub mod error;
+pub mod kernels_cmd;
+pub mod paper_cmd;
+pub mod plots;
+pub mod report;
+pub mod roles;
+pub mod run_cmd;
+pub mod sim;

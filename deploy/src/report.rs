@@ -1,0 +1,263 @@
+//! The run report: latency histograms, per-stage times, channel accounting, tracking
+//! and force statistics, computed from the master's trace rows.
+//!
+//! The same function reports a process run and an in-process simulation. Latencies go
+//! into HdrHistograms (1 ns to 60 s, 3 significant digits) and are reported as count,
+//! p50, p90, p99, p99.9 and max; the full distribution is written in HdrHistogram's
+//! percentile-file form (`*.hgrm`, microseconds) so standard tools can plot it.
+
+use hdrhistogram::Histogram;
+use serde::Serialize;
+use std::fmt::Write as _;
+use tactile_common::samples::stage;
+use tactile_common::trace::TraceRow;
+
+/// Percentiles of one latency distribution, nanoseconds.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct Percentiles {
+    /// Values recorded.
+    pub count: u64,
+    /// Median.
+    pub p50: u64,
+    /// 90th percentile.
+    pub p90: u64,
+    /// 99th percentile.
+    pub p99: u64,
+    /// 99.9th percentile.
+    pub p999: u64,
+    /// Largest value.
+    pub max: u64,
+    /// Mean.
+    pub mean: f64,
+}
+
+/// A latency distribution being collected.
+#[derive(Debug, Clone)]
+pub struct Latency {
+    hist: Histogram<u64>,
+    /// Values below zero clamped to zero (possible for overhead, see README).
+    pub negative: u64,
+}
+
+impl Default for Latency {
+    fn default() -> Self {
+        Latency {
+            // 1 ns .. 60 s at 3 significant digits: bounds are constants, always valid.
+            hist: Histogram::new_with_bounds(1, 60_000_000_000, 3)
+                .expect("constant histogram bounds are valid"),
+            negative: 0,
+        }
+    }
+}
+
+impl Latency {
+    /// Records one value in ns; negatives are clamped to 0 and counted.
+    pub fn record(&mut self, ns: i64) {
+        if ns < 0 {
+            self.negative += 1;
+        }
+        self.hist.saturating_record(ns.max(0) as u64);
+    }
+
+    /// The summary percentiles.
+    pub fn percentiles(&self) -> Percentiles {
+        let h = &self.hist;
+        if h.is_empty() {
+            return Percentiles::default();
+        }
+        Percentiles {
+            count: h.len(),
+            p50: h.value_at_quantile(0.50),
+            p90: h.value_at_quantile(0.90),
+            p99: h.value_at_quantile(0.99),
+            p999: h.value_at_quantile(0.999),
+            max: h.max(),
+            mean: h.mean(),
+        }
+    }
+
+    /// HdrHistogram percentile distribution text, values in microseconds.
+    pub fn hgrm(&self) -> String {
+        let mut s = String::from("       Value     Percentile TotalCount 1/(1-Percentile)\n\n");
+        let h = &self.hist;
+        if h.is_empty() {
+            return s;
+        }
+        for v in h.iter_quantiles(5) {
+            let q = v.quantile_iterated_to();
+            let inv = if q < 1.0 {
+                format!("{:.2}", 1.0 / (1.0 - q))
+            } else {
+                String::from("inf")
+            };
+            let _ = writeln!(
+                s,
+                "{:12.3} {:14.12} {:10} {:>14}",
+                v.value_iterated_to() as f64 / 1000.0,
+                q,
+                v.count_since_last_iteration(),
+                inv
+            );
+        }
+        let _ = writeln!(
+            s,
+            "#[Mean    = {:12.3}, StdDeviation   = {:12.3}]\n#[Max     = {:12.3}, Total count    = {:12}]",
+            h.mean() / 1000.0,
+            h.stdev() / 1000.0,
+            h.max() as f64 / 1000.0,
+            h.len()
+        );
+        s
+    }
+}
+
+/// Per-stage times of the loop, ns: compute in each process and each transport hop.
+pub const STAGES: [(&str, usize, usize); 9] = [
+    (
+        "master_tick_to_send",
+        stage::MASTER_TICK,
+        stage::MASTER_SEND,
+    ),
+    (
+        "hop_master_to_emulator",
+        stage::MASTER_SEND,
+        stage::EMU_FWD_RECV,
+    ),
+    ("emulator_forward", stage::EMU_FWD_RECV, stage::EMU_FWD_SEND),
+    (
+        "hop_emulator_to_slave",
+        stage::EMU_FWD_SEND,
+        stage::SLAVE_RECV,
+    ),
+    ("slave_compute", stage::SLAVE_RECV, stage::SLAVE_SEND),
+    (
+        "hop_slave_to_emulator",
+        stage::SLAVE_SEND,
+        stage::EMU_BWD_RECV,
+    ),
+    (
+        "emulator_backward",
+        stage::EMU_BWD_RECV,
+        stage::EMU_BWD_SEND,
+    ),
+    (
+        "hop_emulator_to_master",
+        stage::EMU_BWD_SEND,
+        stage::MASTER_RECV,
+    ),
+    ("master_compute_bwd", stage::MASTER_RECV, stage::MASTER_DONE),
+];
+
+/// Tracking and force statistics.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct Motion {
+    /// RMS distance of the slave's tool from the operator's target, m.
+    pub tracking_rms_m: f64,
+    /// Largest such distance, m.
+    pub tracking_max_m: f64,
+    /// Largest contact force magnitude the slave produced, N.
+    pub force_max_n: f64,
+    /// RMS force the operator felt over the run, N.
+    pub felt_rms_n: f64,
+    /// Largest force the operator felt, N.
+    pub felt_max_n: f64,
+    /// Samples with the tool in contact.
+    pub contact_samples: u64,
+    /// Largest master joint torque, N m.
+    pub tau_max_nm: f64,
+}
+
+/// What the trace rows say, before the processes' own counters are merged in.
+#[derive(Debug, Clone)]
+pub struct RowReport {
+    /// Round trip, origin to torques out, on the master's clock.
+    pub round_trip: Latency,
+    /// Round trip minus injected delay.
+    pub overhead: Latency,
+    /// Per stage, in [`STAGES`] order.
+    pub stages: Vec<Latency>,
+    /// Tracking and forces.
+    pub motion: Motion,
+    /// Rows with a backward sample.
+    pub received: u64,
+    /// Rows in all.
+    pub rows: u64,
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// Computes the row statistics. `with_stages`: stamps are real (process run).
+pub fn analyse(rows: &[TraceRow], with_stages: bool) -> RowReport {
+    let mut r = RowReport {
+        round_trip: Latency::default(),
+        overhead: Latency::default(),
+        stages: vec![Latency::default(); STAGES.len()],
+        motion: Motion::default(),
+        received: 0,
+        rows: rows.len() as u64,
+    };
+    let mut track_sq = 0.0;
+    let mut felt_sq = 0.0;
+    for row in rows {
+        let Some(b) = row.backward else { continue };
+        r.received += 1;
+        let substituted = (b.signal.flags | b.slave.received.flags)
+            & tactile_common::samples::FLAG_SUBSTITUTED
+            != 0;
+        if !substituted {
+            r.round_trip.record(row.round_trip_ns as i64);
+            r.overhead.record(row.overhead_ns);
+        }
+        if with_stages {
+            for (k, (_, from, to)) in STAGES.iter().enumerate() {
+                let (a, z) = (b.stamps[*from], b.stamps[*to]);
+                if a != 0 && z != 0 {
+                    r.stages[k].record(z as i64 - a as i64);
+                }
+            }
+        }
+        let d = norm([0, 1, 2].map(|i| b.slave.tool[i] - row.target[i]));
+        track_sq += d * d;
+        let m = &mut r.motion;
+        m.tracking_max_m = m.tracking_max_m.max(d);
+        m.force_max_n = m.force_max_n.max(norm(b.slave.force));
+        let felt = norm(row.felt);
+        felt_sq += felt * felt;
+        m.felt_max_n = m.felt_max_n.max(felt);
+        if b.slave.contact_object != u32::MAX {
+            m.contact_samples += 1;
+        }
+        m.tau_max_nm = m
+            .tau_max_nm
+            .max(row.tau.iter().fold(0.0f64, |a, t| a.max(t.abs())));
+    }
+    if r.received > 0 {
+        r.motion.tracking_rms_m = (track_sq / r.received as f64).sqrt();
+        r.motion.felt_rms_n = (felt_sq / r.received as f64).sqrt();
+    }
+    r
+}
+
+/// Renders percentiles in microseconds for the terminal.
+pub fn us_line(name: &str, p: &Percentiles) -> String {
+    let us = |v: u64| v as f64 / 1000.0;
+    format!(
+        "{name:<24} {:>8} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
+        p.count,
+        us(p.p50),
+        us(p.p90),
+        us(p.p99),
+        us(p.p999),
+        us(p.max)
+    )
+}
+
+/// Header matching [`us_line`].
+pub fn us_header() -> String {
+    format!(
+        "{:<24} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10}",
+        "latency (us)", "count", "p50", "p90", "p99", "p99.9", "max"
+    )
+}

@@ -1,0 +1,6 @@
+//! The master side of the loop (the paper's OP, MD and HMD), as a library so the same
+//! code runs in the `tactile master` process and in the in-process simulation.
+
+pub mod hmd;
+pub mod operator;
+pub mod process;

@@ -1,0 +1,224 @@
+//! The operator (OP): where the hand puts the master's handle at each sample, a(n).
+//!
+//! Sources are the paper's validation path (joint angles), a circle or figure-eight in
+//! the workspace, or positions from a CSV file. The file is read at the edge
+//! ([`OperatorSource::load`]); everything after that is pure and indexed by sample, so
+//! a run repeats exactly.
+
+use std::path::Path;
+use tactile_common::csv;
+use tactile_common::scenario::Operator;
+use tactile_common::validation::{paper_joint_path, MOVE_S};
+use thiserror::Error;
+
+/// What the operator commands at one sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Target {
+    /// Joint angles of the master device, rad (the paper's path is given this way).
+    Joints([f64; 3]),
+    /// Tool position, m.
+    Position([f64; 3]),
+}
+
+/// A trajectory file that cannot be used.
+#[derive(Debug, Error)]
+pub enum OperatorError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Read {
+        /// The file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file's content is malformed.
+    #[error("{path}: {source}")]
+    Csv {
+        /// The file.
+        path: String,
+        /// Where and what.
+        source: csv::CsvError,
+    },
+    /// The file has a header but no rows.
+    #[error("{path}: no positions after the header")]
+    NoRows {
+        /// The file.
+        path: String,
+    },
+}
+
+/// A ready trajectory.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OperatorSource {
+    /// The paper's three joint moves, played forwards then backwards if the run is longer.
+    Paper,
+    /// Closed curves: centre, size, period and the two axes of their plane.
+    Curve {
+        /// Circle or figure-eight.
+        eight: bool,
+        /// Centre, m.
+        center: [f64; 3],
+        /// Radius or half width, m.
+        size: f64,
+        /// Seconds per revolution.
+        period_s: f64,
+        /// Indices of the plane's two axes.
+        axes: (usize, usize),
+    },
+    /// Positions from a file, looped.
+    Positions(Vec<[f64; 3]>),
+}
+
+fn plane_axes(plane: &str) -> (usize, usize) {
+    match plane {
+        "yz" => (1, 2),
+        "xz" => (0, 2),
+        _ => (0, 1),
+    }
+}
+
+impl OperatorSource {
+    /// Builds the source; a CSV path is relative to `base_dir` (the scenario's folder).
+    pub fn load(op: &Operator, base_dir: &Path) -> Result<OperatorSource, OperatorError> {
+        Ok(match op {
+            Operator::Paper => OperatorSource::Paper,
+            Operator::Circle {
+                center,
+                radius,
+                period_s,
+                plane,
+            } => OperatorSource::Curve {
+                eight: false,
+                center: *center,
+                size: *radius,
+                period_s: *period_s,
+                axes: plane_axes(plane),
+            },
+            Operator::FigureEight {
+                center,
+                size,
+                period_s,
+                plane,
+            } => OperatorSource::Curve {
+                eight: true,
+                center: *center,
+                size: *size,
+                period_s: *period_s,
+                axes: plane_axes(plane),
+            },
+            Operator::Csv { path } => {
+                let full = base_dir.join(path);
+                let shown = full.display().to_string();
+                let text =
+                    std::fs::read_to_string(&full).map_err(|source| OperatorError::Read {
+                        path: shown.clone(),
+                        source,
+                    })?;
+                let rows =
+                    csv::parse(&text, &["x", "y", "z"]).map_err(|source| OperatorError::Csv {
+                        path: shown.clone(),
+                        source,
+                    })?;
+                if rows.is_empty() {
+                    return Err(OperatorError::NoRows { path: shown });
+                }
+                OperatorSource::Positions(rows.iter().map(|r| [r[0], r[1], r[2]]).collect())
+            }
+        })
+    }
+
+    /// The target at sample `n` with sampling period `t_s`.
+    pub fn target(&self, n: u64, t_s: f64) -> Target {
+        let t = n as f64 * t_s;
+        match self {
+            OperatorSource::Paper => {
+                // Forwards over the three moves, then back, so a long run stays smooth.
+                let span = 3.0 * MOVE_S;
+                let phase = t % (2.0 * span);
+                let tp = if phase <= span {
+                    phase
+                } else {
+                    2.0 * span - phase
+                };
+                Target::Joints(paper_joint_path(tp))
+            }
+            OperatorSource::Curve {
+                eight,
+                center,
+                size,
+                period_s,
+                axes,
+            } => {
+                let w = 2.0 * std::f64::consts::PI * t / period_s;
+                let (u, v) = if *eight {
+                    (size * w.sin(), size * w.sin() * w.cos())
+                } else {
+                    (size * w.cos(), size * w.sin())
+                };
+                let mut p = *center;
+                p[axes.0] += u;
+                p[axes.1] += v;
+                Target::Position(p)
+            }
+            OperatorSource::Positions(rows) => {
+                Target::Position(rows[(n % rows.len() as u64) as usize])
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_path_returns_smoothly() {
+        let s = OperatorSource::Paper;
+        assert_eq!(s.target(0, 0.01), Target::Joints([0.0; 3]));
+        let Target::Joints(end) = s.target(1200, 0.01) else {
+            panic!("joints")
+        };
+        let Target::Joints(back) = s.target(1201, 0.01) else {
+            panic!("joints")
+        };
+        assert!((end[2] - back[2]).abs() < 0.01);
+        assert_eq!(s.target(2400, 0.01), Target::Joints([0.0; 3]));
+    }
+
+    #[test]
+    fn circle_and_csv() {
+        let op = Operator::Circle {
+            center: [0.0, -0.05, -0.1],
+            radius: 0.02,
+            period_s: 1.0,
+            plane: "xz".into(),
+        };
+        let s = OperatorSource::load(&op, Path::new(".")).expect("circle");
+        assert_eq!(s.target(0, 0.01), Target::Position([0.02, -0.05, -0.1]));
+        let dir = std::env::temp_dir().join(format!("tactile-op-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        std::fs::write(dir.join("p.csv"), "x,y,z\n0,0,0\n1,1,1\n").expect("write");
+        let s = OperatorSource::load(
+            &Operator::Csv {
+                path: "p.csv".into(),
+            },
+            &dir,
+        )
+        .expect("csv");
+        assert_eq!(s.target(3, 0.01), Target::Position([1.0; 3]));
+        std::fs::write(dir.join("bad.csv"), "x,y,z\n0,0\n").expect("write");
+        let e = OperatorSource::load(
+            &Operator::Csv {
+                path: "bad.csv".into(),
+            },
+            &dir,
+        )
+        .expect_err("truncated");
+        assert!(
+            e.to_string()
+                .contains("bad.csv: line 2: expected 3 columns"),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -1,0 +1,261 @@
+//! The master process's edge: paces the loop, moves samples through iceoryx2, stamps
+//! times, and keeps one trace row per sample. All signal computation is in [`Master`].
+//!
+//! Realtime: sample n starts at t0 + n t_s (absolute sleep, so no drift), c(n) goes
+//! out, and the master waits for q(n) until the next tick; a q(n) that has not come by
+//! then is a deadline miss (if it comes later its round trip is still recorded).
+//! Lockstep: c(n + 1) goes out as soon as q(n) is back.
+
+use crate::hmd::{Master, MasterCounters};
+use crate::operator::{OperatorError, OperatorSource};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+use tactile_common::clock::{now_ns, sleep_until_ns};
+use tactile_common::ipc::{
+    self, streams, Idle, Inbox, IpcError, IpcNode, Outbox, WaitPolicy, Waker,
+};
+use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
+use tactile_common::scenario::{Mode, Scenario, ScenarioError};
+use tactile_common::trace::TraceRow;
+use thiserror::Error;
+
+/// What the master process needs to run.
+#[derive(Debug, Clone)]
+pub struct MasterOptions {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Folder the scenario's relative paths are resolved against.
+    pub base_dir: PathBuf,
+    /// iceoryx2 prefix of this run.
+    pub prefix: String,
+    /// Waiting for q(n).
+    pub wait: WaitPolicy,
+    /// How long to wait for the other two processes to answer at start-up.
+    pub startup_timeout: Duration,
+    /// In lockstep, how long without an answer before the run fails.
+    pub answer_timeout: Duration,
+    /// Called after each sample with (n, samples); for progress display.
+    pub progress_every: u64,
+}
+
+/// What went wrong in the master process.
+#[derive(Debug, Error)]
+pub enum MasterError {
+    /// The scenario is invalid.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// The trajectory file is unusable.
+    #[error(transparent)]
+    Operator(#[from] OperatorError),
+    /// Shared memory failed.
+    #[error(transparent)]
+    Ipc(#[from] IpcError),
+    /// The other processes did not answer.
+    #[error("{0}")]
+    NoAnswer(String),
+}
+
+/// Everything the master measured.
+#[derive(Debug)]
+pub struct MasterRun {
+    /// One row per sample sent.
+    pub rows: Vec<TraceRow>,
+    /// Counters of the state machine.
+    pub counters: MasterCounters,
+    /// Samples whose q(n) was not back by the next tick (realtime only).
+    pub deadline_misses: u64,
+    /// Backward samples that arrived after their deadline.
+    pub late: u64,
+    /// Backward samples never received.
+    pub missing: u64,
+    /// Backward samples received out of the expected order or duplicated.
+    pub unexpected: u64,
+    /// Monotonic time of the first tick, ns.
+    pub t0_ns: u64,
+    /// True if SIGINT/SIGTERM stopped the run early.
+    pub interrupted: bool,
+}
+
+struct Ports {
+    node: IpcNode,
+    out: Outbox<Forward>,
+    inbox: Inbox<Backward>,
+    waker: Waker,
+}
+
+fn probe(ports: &Ports, timeout: Duration) -> Result<bool, MasterError> {
+    let start = Instant::now();
+    let mut k = 0u64;
+    while start.elapsed() < timeout {
+        let mut p = Forward {
+            seq: k,
+            ..Forward::default()
+        };
+        p.signal.flags = FLAG_PROBE;
+        ports.out.send(p)?;
+        k += 1;
+        let deadline = Instant::now() + Duration::from_millis(20);
+        let got = ports
+            .waker
+            .wait(&ports.node, Duration::ZERO, deadline, || {
+                while let Some(b) = ports.inbox.try_recv()? {
+                    if b.signal.flags & FLAG_PROBE != 0 {
+                        return Ok(Some(()));
+                    }
+                }
+                Ok(None)
+            })?;
+        match got {
+            Ok(()) => return Ok(true),
+            Err(Idle::Terminate) => return Ok(false),
+            Err(Idle::Timeout) => {}
+        }
+    }
+    Err(MasterError::NoAnswer(format!(
+        "no answer from the emulator and slave within {:.1} s: are both running with the same prefix?",
+        timeout.as_secs_f64()
+    )))
+}
+
+/// Runs the master process until the scenario's samples are sent (or a stop request).
+pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
+    let sc = &opts.scenario;
+    let source = OperatorSource::load(&sc.operator, &opts.base_dir)?;
+    let mut master = Master::new(sc, source)?;
+    let node = ipc::node(&opts.prefix, "master")?;
+    let ports = Ports {
+        out: Outbox::open(&node, streams::C, streams::WAKE_EMULATOR)?,
+        inbox: Inbox::open(&node, streams::Q)?,
+        waker: Waker::open(&node, streams::WAKE_MASTER)?,
+        node,
+    };
+    let mut result = MasterRun {
+        rows: Vec::with_capacity(usize::try_from(sc.samples).unwrap_or(0)),
+        counters: MasterCounters::default(),
+        deadline_misses: 0,
+        late: 0,
+        missing: 0,
+        unexpected: 0,
+        t0_ns: 0,
+        interrupted: false,
+    };
+    if !probe(&ports, opts.startup_timeout)? {
+        result.interrupted = true;
+        return Ok(result);
+    }
+    // Drain probe echoes still in flight.
+    std::thread::sleep(Duration::from_millis(5));
+    while ports.inbox.try_recv()?.is_some() {}
+
+    let t_s = sc.t_s_ns();
+    let realtime = sc.mode == Mode::Realtime;
+    // First tick a little ahead so every process is settled.
+    let t0 = now_ns() + 2_000_000;
+    result.t0_ns = t0;
+    for n in 0..sc.samples {
+        // The sample's origin is its scheduled instant, not the moment the master woke:
+        // a late wake-up is overhead the loop adds and must show in the round trip.
+        let origin = if realtime {
+            let tick = t0 + n * t_s;
+            sleep_until_ns(tick);
+            tick
+        } else {
+            now_ns()
+        };
+        let (mut c, _) = master.forward(n, origin);
+        c.stamps[stage::MASTER_SEND] = now_ns();
+        ports.out.send(c)?;
+        result.rows.push(master.missing(&c));
+
+        let deadline = if realtime {
+            instant_at(t0 + (n + 1) * t_s)
+        } else {
+            Instant::now() + opts.answer_timeout
+        };
+        let mut done = false;
+        while !done {
+            let got = ports
+                .waker
+                .wait(&ports.node, opts.wait.spin, deadline, || {
+                    ports.inbox.try_recv()
+                })?;
+            match got {
+                Ok(q) => match absorb(&mut master, &mut result.rows, q) {
+                    Some(seq) if seq == n => done = true,
+                    Some(_) => result.late += 1,
+                    None => result.unexpected += 1,
+                },
+                Err(Idle::Timeout) => {
+                    if !realtime {
+                        return Err(MasterError::NoAnswer(format!(
+                            "no answer for sample {n} within {:.1} s",
+                            opts.answer_timeout.as_secs_f64()
+                        )));
+                    }
+                    result.deadline_misses += 1;
+                    break;
+                }
+                Err(Idle::Terminate) => {
+                    result.interrupted = true;
+                    break;
+                }
+            }
+        }
+        if result.interrupted {
+            break;
+        }
+        if opts.progress_every > 0 && (n + 1) % opts.progress_every == 0 {
+            eprint!("\r  master: {}/{} samples", n + 1, sc.samples);
+        }
+    }
+    if opts.progress_every > 0 {
+        eprintln!();
+    }
+    // Collect stragglers, then tell the others to stop.
+    let grace = Instant::now() + Duration::from_millis(50);
+    while let Ok(Ok(q)) = ports.waker.wait(&ports.node, Duration::ZERO, grace, || {
+        ports.inbox.try_recv()
+    }) {
+        match absorb(&mut master, &mut result.rows, q) {
+            Some(_) => result.late += 1,
+            None => result.unexpected += 1,
+        }
+    }
+    let mut end = Forward::default();
+    end.signal.flags = FLAG_END;
+    ports.out.send(end)?;
+    result.missing = result.rows.iter().filter(|r| r.backward.is_none()).count() as u64;
+    result.counters = master.counters();
+    Ok(result)
+}
+
+/// Stamps q's arrival, applies KFF-HMD and fills the row of the sample it answers.
+/// Returns that sample's number, or None for a sample that answers nothing (a probe, a
+/// duplicate, a number never sent).
+fn absorb(master: &mut Master, rows: &mut [TraceRow], mut q: Backward) -> Option<u64> {
+    q.stamps[stage::MASTER_RECV] = now_ns();
+    let index = usize::try_from(q.seq).ok().filter(|&i| {
+        i < rows.len() && rows[i].backward.is_none() && q.signal.flags & FLAG_PROBE == 0
+    })?;
+    let sent = rows[index].forward;
+    let mut row = master.backward(&sent, &q);
+    if let Some(b) = row.backward.as_mut() {
+        b.stamps[stage::MASTER_DONE] = now_ns();
+    }
+    master.account(&mut row);
+    rows[index] = row;
+    Some(q.seq)
+}
+
+/// The `Instant` corresponding to a CLOCK_MONOTONIC time (both are monotonic clocks).
+fn instant_at(t_ns: u64) -> Instant {
+    let now_i = Instant::now();
+    let now = now_ns();
+    if t_ns >= now {
+        now_i + Duration::from_nanos(t_ns - now)
+    } else {
+        now_i
+            .checked_sub(Duration::from_nanos(now - t_ns))
+            .unwrap_or(now_i)
+    }
+}

@@ -1,0 +1,148 @@
+//! The slave's environment (ENV): rigid objects and the contact they make with the tool.
+//!
+//! The environment stands in for the paper's sensors "spread in the ENV": given the
+//! tool's true position it reports the nearest surface point s^OBJ(n) of the object
+//! the tool penetrates, with that object's stiffness (h_x, h_y, h_z). Pure geometry in
+//! f64: this is the physical world, not the HSD's datapath.
+
+use tactile_common::scenario::Object;
+
+/// The tool inside an object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    /// Index of the object in the scenario's list.
+    pub object: usize,
+    /// Nearest point on that object's surface, metres.
+    pub surface: [f64; 3],
+    /// Stiffness per axis, N/m.
+    pub stiffness: [f64; 3],
+    /// Penetration depth, metres (> 0).
+    pub depth: f64,
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn contact_with(index: usize, object: &Object, p: [f64; 3]) -> Option<Contact> {
+    let (surface, depth) = match object {
+        Object::Plane { point, normal, .. } => {
+            let len = dot(*normal, *normal).sqrt();
+            let n = normal.map(|v| v / len);
+            let s = dot(sub(p, *point), n);
+            if s >= 0.0 {
+                return None;
+            }
+            ([p[0] - s * n[0], p[1] - s * n[1], p[2] - s * n[2]], -s)
+        }
+        Object::Sphere { center, radius, .. } => {
+            let d = sub(p, *center);
+            let dist = dot(d, d).sqrt();
+            if dist >= *radius {
+                return None;
+            }
+            // At the very centre every direction is nearest: push out along +y (up).
+            let u = if dist > 0.0 {
+                d.map(|v| v / dist)
+            } else {
+                [0.0, 1.0, 0.0]
+            };
+            (
+                [
+                    center[0] + radius * u[0],
+                    center[1] + radius * u[1],
+                    center[2] + radius * u[2],
+                ],
+                radius - dist,
+            )
+        }
+        Object::Box {
+            center,
+            half_extents,
+            ..
+        } => {
+            let local = sub(p, *center);
+            let mut best: Option<(usize, f64)> = None;
+            for k in 0..3 {
+                let pen = half_extents[k] - local[k].abs();
+                if pen <= 0.0 {
+                    return None;
+                }
+                if best.is_none_or(|(_, b)| pen < b) {
+                    best = Some((k, pen));
+                }
+            }
+            let (k, pen) = best?;
+            let mut s = p;
+            s[k] = center[k] + half_extents[k].copysign(local[k]);
+            (s, pen)
+        }
+    };
+    Some(Contact {
+        object: index,
+        surface,
+        stiffness: object.stiffness(),
+        depth,
+    })
+}
+
+/// The deepest contact of the tool at `p` with any object, if it touches one.
+pub fn deepest_contact(objects: &[Object], p: [f64; 3]) -> Option<Contact> {
+    objects
+        .iter()
+        .enumerate()
+        .filter_map(|(i, o)| contact_with(i, o, p))
+        .max_by(|a, b| a.depth.total_cmp(&b.depth))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const K: [f64; 3] = [100.0, 200.0, 300.0];
+
+    #[test]
+    fn plane_contact() {
+        let o = [Object::Plane {
+            point: [0.0, 0.0, -0.16],
+            normal: [0.0, 0.0, 2.0],
+            stiffness: K,
+        }];
+        assert_eq!(deepest_contact(&o, [0.1, 0.2, -0.15]), None);
+        let c = deepest_contact(&o, [0.1, 0.2, -0.17]).expect("inside");
+        assert!((c.depth - 0.01).abs() < 1e-12);
+        assert!((c.surface[2] + 0.16).abs() < 1e-12);
+        assert_eq!(c.surface[0], 0.1);
+        assert_eq!(c.stiffness, K);
+    }
+
+    #[test]
+    fn sphere_and_box_contact_pick_the_deepest() {
+        let o = [
+            Object::Sphere {
+                center: [0.0; 3],
+                radius: 0.05,
+                stiffness: K,
+            },
+            Object::Box {
+                center: [0.0, 0.0, 0.0],
+                half_extents: [0.1, 0.02, 0.1],
+                stiffness: [1.0; 3],
+            },
+        ];
+        // 1 cm from the centre: sphere depth 4 cm, box depth (y) 1 cm.
+        let c = deepest_contact(&o, [0.0, 0.01, 0.0]).expect("inside");
+        assert_eq!(c.object, 0);
+        assert!((c.depth - 0.04).abs() < 1e-12);
+        assert!((c.surface[1] - 0.05).abs() < 1e-12);
+        // Outside the sphere, inside the box: pushed out through the nearest (y) face.
+        let c = deepest_contact(&o, [0.08, -0.015, 0.0]).expect("inside box");
+        assert_eq!(c.object, 1);
+        assert_eq!(c.surface, [0.08, -0.02, 0.0]);
+        assert_eq!(deepest_contact(&o, [0.2, 0.0, 0.0]), None);
+    }
+}

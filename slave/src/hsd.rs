@@ -1,0 +1,182 @@
+//! The slave side's per-sample logic (HSD + SD + ENV) as a pure state machine.
+//!
+//! [`Slave::step`] takes the forward sample v(n) and returns the backward sample h(n).
+//! The process edge (`process.rs`) only moves samples and stamps times, and the
+//! in-process simulation calls the same function, so both compute identical values.
+//!
+//! One step: CPD (pass-through) -> IK-HSD -> JPD (pass-through) -> FCS (PID) -> SD joint
+//! dynamics over t_s, with the contact force of the environment acting on the joints
+//! -> FK-HSD -> ENV nearest surface point -> FBF-HSD.
+//! The HSD kernels (IK, FK, FBF) run in the scenario's arithmetic; the physical world
+//! (the device's true tool position and the contact force on it) is f64.
+
+use crate::device::{Controller, Dynamics, JointState};
+use crate::environment::{deepest_contact, Contact};
+use serde::{Deserialize, Serialize};
+use tactile_common::arith::StdTrig;
+use tactile_common::engine::Engine;
+use tactile_common::geometry::Lengths;
+use tactile_common::kernels::{self, IkStatus};
+use tactile_common::samples::{
+    Backward, Forward, SlaveState, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED,
+};
+use tactile_common::scenario::{Object, Scenario, ScenarioError};
+
+/// What the slave counted over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SlaveCounters {
+    /// Steps taken.
+    pub steps: u64,
+    /// Targets outside the workspace: IK clamped.
+    pub ik_clamped: u64,
+    /// Samples with a NaN or infinite value, rejected (previous reference held).
+    pub rejected: u64,
+    /// Joint torque clamps (one per joint per step).
+    pub torque_clamps: u64,
+    /// Steps in contact with an object.
+    pub contact_steps: u64,
+}
+
+/// The slave: HSD kernels, controller, device and environment.
+#[derive(Debug)]
+pub struct Slave {
+    engine: Engine,
+    truth: Lengths<f64>,
+    controller: Controller,
+    dynamics: Dynamics,
+    objects: Vec<Object>,
+    t_s: f64,
+    reference: [f64; 3],
+    counters: SlaveCounters,
+}
+
+impl Slave {
+    /// A slave at rest (zero joint angles) for the scenario.
+    pub fn new(scenario: &Scenario) -> Result<Slave, ScenarioError> {
+        let geometry = scenario.device.geometry()?;
+        let engine = Engine::new(scenario.arithmetic, geometry, scenario.cordic.config()?)
+            .map_err(|e| ScenarioError::Invalid {
+                field: "cordic".into(),
+                problem: e.to_string(),
+            })?;
+        Ok(Slave {
+            engine,
+            truth: geometry.lengths(),
+            controller: Controller::new(scenario.slave.controller.clone()),
+            dynamics: Dynamics::new(scenario.slave.dynamics.clone(), [0.0; 3]),
+            objects: scenario.environment.objects.clone(),
+            t_s: scenario.t_s(),
+            reference: [0.0; 3],
+            counters: SlaveCounters::default(),
+        })
+    }
+
+    /// Counters so far.
+    pub fn counters(&self) -> SlaveCounters {
+        self.counters
+    }
+
+    /// The device's joint state.
+    pub fn joints(&self) -> JointState {
+        self.dynamics.state
+    }
+
+    /// The environment's contact with the tool at joint angles `theta` (true, f64).
+    fn contact_at(&self, theta: [f64; 3]) -> (Option<Contact>, [f64; 3]) {
+        let tool = kernels::fk(&self.truth, &StdTrig, theta);
+        (deepest_contact(&self.objects, tool), tool)
+    }
+
+    /// One sample: v(n) in, h(n) out. Stamps are copied from `v`; the edge sets its own.
+    pub fn step(&mut self, v: &Forward) -> Backward {
+        self.counters.steps += 1;
+        let mut flags = 0;
+        // CPD-HSD: pass-through. A non-finite value never reaches IK or a torque.
+        let target = v.signal.value;
+        if target.iter().all(|x| x.is_finite()) {
+            // IK-HSD, then JPD-HSD: pass-through.
+            let ik = self.engine.ik(target);
+            match ik.status {
+                IkStatus::Reachable => {}
+                IkStatus::Clamped => {
+                    flags |= FLAG_IK_CLAMPED;
+                    self.counters.ik_clamped += 1;
+                }
+                IkStatus::Invalid => {
+                    flags |= FLAG_REJECTED;
+                    self.counters.rejected += 1;
+                }
+            }
+            if ik.status != IkStatus::Invalid {
+                self.reference = ik.theta;
+            }
+        } else {
+            flags |= FLAG_REJECTED;
+            self.counters.rejected += 1;
+        }
+
+        // FCS: joint controller.
+        let state = self.dynamics.state;
+        let cmd = self
+            .controller
+            .update(self.reference, state.theta, state.velocity, self.t_s);
+        self.counters.torque_clamps += u64::from(cmd.clamped);
+
+        // SD: joint dynamics, pushed back by whatever the tool touches.
+        let truth = self.truth;
+        let objects = &self.objects;
+        self.dynamics.advance(cmd.torque, self.t_s, |s| {
+            let tool = kernels::fk(&truth, &StdTrig, s.theta);
+            match deepest_contact(objects, tool) {
+                Some(c) => {
+                    let f = kernels::fbf(c.surface, tool, c.stiffness);
+                    let j = kernels::jacobian(&truth, &StdTrig, s.theta);
+                    [0, 1, 2].map(|k| j[0][k] * f[0] + j[1][k] * f[1] + j[2][k] * f[2])
+                }
+                None => [0.0; 3],
+            }
+        });
+        let theta = self.dynamics.state.theta;
+
+        // FK-HSD in the HSD's arithmetic; ENV sensors report the surface point.
+        let tool = self.engine.fk(theta);
+        let (contact, _) = self.contact_at(theta);
+        let (force, surface, contact_object) = match contact {
+            Some(c) => {
+                flags |= FLAG_CONTACT;
+                self.counters.contact_steps += 1;
+                (
+                    self.engine.fbf(c.surface, tool, c.stiffness),
+                    c.surface,
+                    c.object as u32,
+                )
+            }
+            None => ([0.0; 3], [0.0; 3], u32::MAX),
+        };
+
+        // h(n): the force takes the provenance of the oldest position value it used.
+        let oldest = (0..3).min_by_key(|&i| v.signal.origin_seq[i]).unwrap_or(0);
+        let mut out = Backward {
+            seq: v.seq,
+            stamps: v.stamps,
+            ..Backward::default()
+        };
+        out.signal.value = force;
+        out.signal.origin_seq = [v.signal.origin_seq[oldest]; 3];
+        out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
+        out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
+        out.signal.flags = flags;
+        out.slave = SlaveState {
+            received: v.signal,
+            theta_ref: self.reference,
+            theta,
+            torque: cmd.torque,
+            tool,
+            surface,
+            force,
+            clamps: cmd.clamped,
+            contact_object,
+        };
+        out
+    }
+}

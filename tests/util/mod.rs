@@ -1,0 +1,133 @@
+//! Shared helpers of the integration tests: each test gets its own temporary folder and
+//! its own iceoryx2 prefix, so tests run in parallel without seeing each other, and
+//! every test checks that no process of its run is left behind.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+static COUNTER: AtomicU32 = AtomicU32::new(0);
+
+/// One test's sandbox.
+pub struct Sandbox {
+    /// Temporary folder, removed on drop.
+    pub dir: tempfile::TempDir,
+    /// iceoryx2 prefix unique to this test.
+    pub prefix: String,
+}
+
+impl Sandbox {
+    /// A fresh sandbox named after the test.
+    pub fn new(name: &str) -> Sandbox {
+        let n = COUNTER.fetch_add(1, Ordering::SeqCst);
+        let prefix = format!("tt{}x{n}{}", std::process::id(), &name[..name.len().min(8)]);
+        Sandbox {
+            dir: tempfile::Builder::new()
+                .prefix(&format!("tactile-{name}-"))
+                .tempdir()
+                .expect("temp dir"),
+            prefix,
+        }
+    }
+
+    /// Path inside the sandbox.
+    pub fn path(&self, name: &str) -> PathBuf {
+        self.dir.path().join(name)
+    }
+
+    /// Writes a file into the sandbox and returns its path.
+    pub fn write(&self, name: &str, text: &str) -> PathBuf {
+        let p = self.path(name);
+        std::fs::write(&p, text).expect("write file");
+        p
+    }
+
+    /// Runs `tactile` with `args`.
+    pub fn tactile(&self, args: &[&str]) -> Output {
+        Command::new(env!("CARGO_BIN_EXE_tactile"))
+            .args(args)
+            .current_dir(self.dir.path())
+            .output()
+            .expect("start tactile")
+    }
+
+    /// `tactile run SCENARIO --out OUT --prefix PREFIX -q`; asserts success and that no
+    /// process of the run survives.
+    pub fn run(&self, scenario: &Path, out: &str) -> Output {
+        let out_dir = self.path(out);
+        let o = self.tactile(&[
+            "run",
+            scenario.to_str().expect("utf-8 path"),
+            "--out",
+            out_dir.to_str().expect("utf-8 path"),
+            "--prefix",
+            &self.prefix,
+            "-q",
+        ]);
+        assert!(
+            o.status.success(),
+            "tactile run failed: {}\nstdout:\n{}\nstderr:\n{}",
+            o.status,
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        self.assert_no_leftover_processes();
+        o
+    }
+
+    /// Fails if any process started with this sandbox's prefix is still alive.
+    pub fn assert_no_leftover_processes(&self) {
+        let needle = format!("--prefix\0{}\0", self.prefix);
+        let mut alive = Vec::new();
+        for entry in std::fs::read_dir("/proc").expect("/proc").flatten() {
+            let Ok(cmd) = std::fs::read(entry.path().join("cmdline")) else {
+                continue;
+            };
+            let cmd = String::from_utf8_lossy(&cmd).to_string();
+            if cmd.contains(&needle) && cmd.contains("role") {
+                // A zombie has an empty cmdline, so anything here is really running.
+                alive.push(cmd.replace('\0', " "));
+            }
+        }
+        assert!(alive.is_empty(), "processes left behind: {alive:?}");
+    }
+
+    /// Reads a JSON file of a run.
+    pub fn json(&self, out: &str, file: &str) -> serde_json::Value {
+        let text = std::fs::read_to_string(self.path(out).join(file)).expect("read json");
+        serde_json::from_str(&text).expect("parse json")
+    }
+
+    /// Reads a run's trace.
+    pub fn trace(&self, out: &str) -> String {
+        std::fs::read_to_string(self.path(out).join("trace.csv")).expect("read trace")
+    }
+}
+
+impl Drop for Sandbox {
+    fn drop(&mut self) {
+        tactile_common::ipc::remove_run_files(&self.prefix);
+    }
+}
+
+/// Column `name` of a CSV text as numbers.
+pub fn column(csv: &str, name: &str) -> Vec<f64> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name}"));
+    lines
+        .map(|l| l.split(',').nth(k).expect("cell").parse().expect("number"))
+        .collect()
+}
+
+/// Sample standard deviation.
+pub fn std_dev(v: &[f64]) -> f64 {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+}
