@@ -90,6 +90,14 @@ pub trait Trig<R: Real> {
     fn atan2(&self, y: R, x: R) -> R;
     /// Arccosine; the argument is in [-1, 1] by the caller's contract.
     fn acos(&self, a: R) -> R;
+    /// sin and cos of three angles at once (FK, the Jacobian and KFF need exactly
+    /// three). The default is three calls; the CORDIC model runs the three rotations
+    /// side by side so their dependency chains overlap, as the FPGA's parallel TFBs do.
+    #[inline(always)]
+    fn sin_cos3(&self, x: [R; 3]) -> ([R; 3], [R; 3]) {
+        let (a, b, c) = (self.sin_cos(x[0]), self.sin_cos(x[1]), self.sin_cos(x[2]));
+        ([a.0, b.0, c.0], [a.1, b.1, c.1])
+    }
     /// sin and cos over a slice. The default is the scalar loop; the CORDIC model
     /// overrides it with a structure-of-arrays version the compiler vectorises.
     fn sin_cos_batch(&self, x: &[R], sin: &mut [R], cos: &mut [R]) {
@@ -136,6 +144,10 @@ impl Trig<f32> for Cordic {
     #[inline(always)]
     fn acos(&self, a: f32) -> f32 {
         Cordic::acos(self, a)
+    }
+    #[inline(always)]
+    fn sin_cos3(&self, x: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+        Cordic::sin_cos3(self, x)
     }
     fn sin_cos_batch(&self, x: &[f32], sin: &mut [f32], cos: &mut [f32]) {
         Cordic::sin_cos_batch(self, x, sin, cos);

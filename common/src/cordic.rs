@@ -291,6 +291,28 @@ impl Cordic {
         (s as f32 * self.xy_out, c as f32 * self.xy_out)
     }
 
+    /// [`Self::sin_cos`] of three angles, bit-identical per angle, with the three
+    /// rotations interleaved (what FK, the Jacobian and KFF need).
+    #[inline]
+    pub fn sin_cos3(&self, angles: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+        if !angles.iter().all(|a| fast_path(*a)) {
+            let r = angles.map(|a| self.sin_cos(a));
+            return (r.map(|v| v.0), r.map(|v| v.1));
+        }
+        let mut z = [0i64; 3];
+        let mut flip = [0i64; 3];
+        for k in 0..3 {
+            (z[k], flip[k]) = self.fold(i64::from(floor_code(
+                self.angle_prefloor(f64::from(angles[k])),
+            )));
+        }
+        let (s, c) = self.rotate3(z, flip);
+        (
+            s.map(|v| v as f32 * self.xy_out),
+            c.map(|v| v as f32 * self.xy_out),
+        )
+    }
+
     #[cold]
     #[inline(never)]
     fn sin_cos_cold(&self, angle: f32) -> (f32, f32) {
@@ -514,6 +536,40 @@ impl Cordic {
         let one = self.one_xy;
         let s = (((y - bn) ^ flip) - flip).clamp(-one, one);
         let c = (((x - bn) ^ flip) - flip).clamp(-one, one);
+        (s, c)
+    }
+
+    /// [`Self::rotate`] on three angles at once. The three dependency chains are
+    /// independent, so interleaving them lets the core overlap their latencies (the
+    /// FPGA computes the three in parallel TFBs). Same integers, lane by lane.
+    #[allow(unused_assignments)] // the last unrolled step's z is not read
+    fn rotate3(&self, z: [i64; 3], flip: [i64; 3]) -> ([i64; 3], [i64; 3]) {
+        let (n, t) = (self.n, &self.atan);
+        let (mut x, mut y, mut z) = ([self.gain; 3], [0i64; 3], z);
+        macro_rules! steps {
+            ($($i:literal)*) => {'run: {$(
+                if n == $i {
+                    break 'run;
+                }
+                let db = self.dbias[$i];
+                for k in 0..3 {
+                    let m = z[k] >> 63;
+                    let (xs, ys) = (x[k] >> $i, y[k] >> $i);
+                    x[k] = (x[k] + db + m) - (ys ^ m);
+                    y[k] = (y[k] + db - m) + (xs ^ m);
+                    z[k] -= if z[k] < 0 { -t[$i] } else { t[$i] };
+                }
+            )*}};
+        }
+        steps!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31);
+        let bn = self.bias[n];
+        let one = self.one_xy;
+        let mut s = [0i64; 3];
+        let mut c = [0i64; 3];
+        for k in 0..3 {
+            s[k] = (((y[k] - bn) ^ flip[k]) - flip[k]).clamp(-one, one);
+            c[k] = (((x[k] - bn) ^ flip[k]) - flip[k]).clamp(-one, one);
+        }
         (s, c)
     }
 

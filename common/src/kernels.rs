@@ -17,9 +17,7 @@ use crate::geometry::Lengths;
 /// z = L2 cos t1 sin t3 + L1 cos t1 cos t2 - L4.
 #[inline(always)]
 pub fn fk<R: Real, T: Trig<R>>(g: &Lengths<R>, trig: &T, theta: [R; 3]) -> [R; 3] {
-    let (s1, c1) = trig.sin_cos(theta[0]);
-    let (s2, c2) = trig.sin_cos(theta[1]);
-    let (s3, c3) = trig.sin_cos(theta[2]);
+    let ([s1, s2, s3], [c1, c2, c3]) = trig.sin_cos3(theta);
     fk_from_trig(g, s1, c1, s2, c2, s3, c3)
 }
 
@@ -34,9 +32,7 @@ fn fk_from_trig<R: Real>(g: &Lengths<R>, s1: R, c1: R, s2: R, c2: R, s3: R, c3: 
 /// The Jacobian of [`fk`], `J[i][j] = d pos_i / d theta_j`, as the paper's JM block.
 #[inline(always)]
 pub fn jacobian<R: Real, T: Trig<R>>(g: &Lengths<R>, trig: &T, theta: [R; 3]) -> [[R; 3]; 3] {
-    let (s1, c1) = trig.sin_cos(theta[0]);
-    let (s2, c2) = trig.sin_cos(theta[1]);
-    let (s3, c3) = trig.sin_cos(theta[2]);
+    let ([s1, s2, s3], [c1, c2, c3]) = trig.sin_cos3(theta);
     jacobian_from_trig(g, s1, c1, s2, c2, s3, c3)
 }
 
@@ -65,9 +61,7 @@ fn jacobian_from_trig<R: Real>(
 /// Kinesthetic feedback force (KFF-HMD): joint torques `tau = J(theta)^T F`, in N m.
 #[inline(always)]
 pub fn kff<R: Real, T: Trig<R>>(g: &Lengths<R>, trig: &T, theta: [R; 3], f: [R; 3]) -> [R; 3] {
-    let (s1, c1) = trig.sin_cos(theta[0]);
-    let (s2, c2) = trig.sin_cos(theta[1]);
-    let (s3, c3) = trig.sin_cos(theta[2]);
+    let ([s1, s2, s3], [c1, c2, c3]) = trig.sin_cos3(theta);
     kff_from_trig(g, s1, c1, s2, c2, s3, c3, f)
 }
 

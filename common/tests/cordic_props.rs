@@ -489,6 +489,22 @@ proptest! {
     }
 
     #[test]
+    fn sin_cos3_is_bit_identical(
+        cfg in any_config(),
+        a in any_input(),
+        b in any_input(),
+        d in any_input(),
+    ) {
+        let c = Cordic::new(cfg).expect("strategy yields valid configs");
+        let (s, co) = c.sin_cos3([a, b, d]);
+        for (k, x) in [a, b, d].into_iter().enumerate() {
+            let (ws, wc) = c.sin_cos(x);
+            prop_assert_eq!(s[k].to_bits(), ws.to_bits(), "sin {} at {}", name(&c), x);
+            prop_assert_eq!(co[k].to_bits(), wc.to_bits(), "cos {} at {}", name(&c), x);
+        }
+    }
+
+    #[test]
     fn atan2_batch_is_bit_identical(
         cfg in any_config(),
         points in prop::collection::vec((any_input(), any_input()), 0..200),
