@@ -1,5 +1,8 @@
 //! The Tactile launcher as a library: the `tactile` binary is a thin wrapper around
 //! [`cli::main`], so every subcommand can also be driven in-process.
+//!
+//! The README follows; its Rust examples run as doctests.
+#![doc = include_str!("../../README.md")]
 
 pub mod cli;
 pub mod error;

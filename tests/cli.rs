@@ -1,0 +1,203 @@
+//! The `tactile kernels` and `tactile paper` interfaces, as users script them.
+
+mod util;
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+use util::Sandbox;
+
+fn kernels(args: &[&str], stdin: &str) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tactile"))
+        .arg("kernels")
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start tactile");
+    // A command that fails on its arguments exits without reading stdin: a broken
+    // pipe here is expected then.
+    let written = child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(stdin.as_bytes());
+    if let Err(e) = written {
+        assert_eq!(e.kind(), std::io::ErrorKind::BrokenPipe, "write stdin: {e}");
+    }
+    child.wait_with_output().expect("wait")
+}
+
+fn ok_stdout(o: &Output) -> String {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8(o.stdout.clone()).expect("utf-8")
+}
+
+#[test]
+fn fk_of_the_paper_waypoint_in_each_arithmetic() {
+    let input = "theta1,theta2,theta3\n1.5707963267948966,0,0\n";
+    let f64_out = ok_stdout(&kernels(&["fk"], input));
+    assert_eq!(f64_out, "x,y,z\n-0.132,-0.10700000000000001,-0.167\n");
+    for arith in ["f32", "hybrid"] {
+        let out = ok_stdout(&kernels(&["fk", "--arith", arith], input));
+        let row: Vec<f64> = out
+            .lines()
+            .nth(1)
+            .expect("row")
+            .split(',')
+            .map(|v| v.parse().expect("num"))
+            .collect();
+        assert!(
+            (row[0] + 0.132).abs() < 1e-3 && (row[2] + 0.167).abs() < 1e-3,
+            "{arith}: {out}"
+        );
+    }
+}
+
+#[test]
+fn outputs_read_back_to_the_same_value() {
+    let input = "theta1,theta2,theta3\n0.1,0.2,0.3\n-1.2,0.9,0.05\n";
+    for arith in ["f64", "f32", "hybrid"] {
+        let out = ok_stdout(&kernels(&["fk", "--arith", arith], input));
+        let again = ok_stdout(&kernels(&["fk", "--arith", arith], input));
+        assert_eq!(out, again);
+        for line in out.lines().skip(1) {
+            for cell in line.split(',') {
+                if arith == "f64" {
+                    let v: f64 = cell.parse().expect("f64");
+                    assert_eq!(format!("{v:?}"), cell);
+                } else {
+                    let v: f32 = cell.parse().expect("f32");
+                    assert_eq!(format!("{v:?}"), cell);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn ik_flags_unreachable_rows() {
+    let out = ok_stdout(&kernels(
+        &["ik"],
+        "x,y,z\n-0.132,-0.107,-0.167\n0,0.025,0.6\n",
+    ));
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "theta1,theta2,theta3,reachable");
+    assert!(lines[1].ends_with(",1"), "{out}");
+    assert!(lines[2].ends_with(",0"), "{out}");
+    assert!(!out.contains("NaN"));
+}
+
+#[test]
+fn kff_and_fbf_columns() {
+    let out = ok_stdout(&kernels(
+        &["kff"],
+        "theta1,theta2,theta3,fx,fy,fz\n0,0,0,0,1,0\n",
+    ));
+    // At rest J22 = L1 and J23 = L2 sin 0 = 0, so tau = (0, 0.132, 0).
+    assert_eq!(out, "tau1,tau2,tau3\n0.0,0.132,0.0\n");
+    let out = ok_stdout(&kernels(
+        &["fbf", "--arith", "f32"],
+        "x_obj,y_obj,z_obj,x_env,y_env,z_env,hx,hy,hz\n0,0,-0.16,0,0,-0.17,300,300,300\n",
+    ));
+    let fz: f32 = out
+        .lines()
+        .nth(1)
+        .expect("row")
+        .split(',')
+        .nth(2)
+        .expect("fz")
+        .parse()
+        .expect("num");
+    assert!((fz - 3.0).abs() < 1e-5, "{out}");
+}
+
+#[test]
+fn bad_rows_name_line_and_column_and_print_nothing() {
+    let cases = [
+        (
+            "theta1,theta2,theta3\n0,0,0\n0,abc,0\n",
+            "line 3, column 2 (theta2): \"abc\" is not a number",
+        ),
+        (
+            "theta1,theta2,theta3\n0,0,0\n0,0\n",
+            "line 3: expected 3 columns",
+        ),
+        (
+            "theta1,theta2,theta3\n0,0,0,0\n",
+            "line 2: expected 3 columns",
+        ),
+        (
+            "theta1,theta2,theta3\nNaN,0,0\n",
+            "line 2, column 1 (theta1): \"NaN\" is not a finite number",
+        ),
+        (
+            "x,y,z\n0,0,0\n",
+            "line 1: header is \"x,y,z\", expected theta1,theta2,theta3",
+        ),
+        ("", "empty input"),
+    ];
+    for (input, message) in cases {
+        let o = kernels(&["fk"], input);
+        assert_eq!(o.status.code(), Some(2), "{input:?}");
+        assert!(o.stdout.is_empty(), "partial output for {input:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(message), "{input:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "one readable line: {err}");
+    }
+}
+
+#[test]
+fn bad_options_and_device_files_exit_2() {
+    let sb = Sandbox::new("device");
+    let input = "theta1,theta2,theta3\n0,0,0\n";
+    let o = kernels(
+        &["fk", "--arith", "hybrid", "--word", "16", "--frac", "14"],
+        input,
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("integer bits"));
+    let o = kernels(&["fk", "--arith", "quad"], input);
+    assert_eq!(o.status.code(), Some(2));
+    let missing = sb.path("missing.toml");
+    let o = kernels(&["fk", "--device", missing.to_str().expect("utf-8")], input);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing.toml"));
+    let mm = sb.write("mm.toml", "l1 = 132\nl2 = 132\nl3 = 25\na = 35\n");
+    let o = kernels(&["fk", "--device", mm.to_str().expect("utf-8")], input);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("`l1`"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let good = sb.write("d.toml", "l1 = 0.135\nl2 = 0.135\nl3 = 0.025\na = 0.035\n");
+    let out = ok_stdout(&kernels(
+        &["fk", "--device", good.to_str().expect("utf-8")],
+        "theta1,theta2,theta3\n1.5707963267948966,0,0\n",
+    ));
+    assert!(out.contains("-0.135"), "{out}");
+}
+
+#[test]
+fn paper_table_as_json() {
+    let o = Command::new(env!("CARGO_BIN_EXE_tactile"))
+        .args(["paper", "--json"])
+        .output()
+        .expect("run");
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert_eq!(v["samples"], 1200);
+    assert_eq!(v["all_within_paper"], true);
+    let rows = v["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 15);
+    assert_eq!(rows[9]["module"], "IK-HSD");
+    let table = Command::new(env!("CARGO_BIN_EXE_tactile"))
+        .arg("paper")
+        .output()
+        .expect("run");
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(
+        text.contains("FK-HMD") && text.contains("paper MSE"),
+        "{text}"
+    );
+}
