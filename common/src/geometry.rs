@@ -78,7 +78,8 @@ impl Geometry {
 
     /// Parses and validates a TOML document with keys `l1`, `l2`, `l3`, `a`.
     pub fn from_toml_str(text: &str) -> Result<Geometry, GeometryError> {
-        let g: Geometry = toml::from_str(text).map_err(|e| GeometryError::Parse(e.to_string()))?;
+        let g: Geometry = toml::from_str(text)
+            .map_err(|e| GeometryError::Parse(crate::scenario::one_line(text, &e)))?;
         g.validate()?;
         Ok(g)
     }

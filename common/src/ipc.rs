@@ -10,6 +10,7 @@
 //! shared-memory objects and the folder of node and service files, so runs never see
 //! each other.
 
+use crate::samples::Sequenced;
 use iceoryx2::config::Config;
 use iceoryx2::node::NodeWaitFailure;
 use iceoryx2::port::listener::{Listener, ListenerWaitError};
@@ -19,9 +20,14 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::{
     ipc, FileName, Node, NodeBuilder, NodeName, SemanticString, ServiceName, ZeroCopySend,
 };
+use serde::{Deserialize, Serialize};
+use std::cell::Cell;
 use std::fmt::Debug;
 use std::time::{Duration, Instant};
 use thiserror::Error;
+
+/// `hop_seq` of control samples, which no counter sees.
+pub const CONTROL_HOP_SEQ: u64 = u64::MAX;
 
 /// A process's iceoryx2 node.
 pub type IpcNode = Node<ipc::Service>;
@@ -134,6 +140,16 @@ pub struct Outbox<T: Debug + ZeroCopySend + 'static> {
     publisher: Publisher<ipc::Service, T, ()>,
     notifier: Notifier<ipc::Service>,
     stream: String,
+    stats: Cell<OutboxStats>,
+}
+
+/// What a sending end counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OutboxStats {
+    /// Samples published.
+    pub published: u64,
+    /// Published while no subscriber was connected (the receiver was dead): lost.
+    pub no_receiver: u64,
 }
 
 /// Receiving end of a stream.
@@ -141,6 +157,20 @@ pub struct Outbox<T: Debug + ZeroCopySend + 'static> {
 pub struct Inbox<T: Debug + ZeroCopySend + 'static> {
     subscriber: Subscriber<ipc::Service, T, ()>,
     stream: String,
+    stats: Cell<InboxStats>,
+    next_hop_seq: Cell<Option<u64>>,
+}
+
+/// What a receiving end counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct InboxStats {
+    /// Samples taken.
+    pub received: u64,
+    /// Samples overwritten in the full buffer before they were taken (gaps in the
+    /// publisher's counter; the buffer's overflow policy is safe overflow).
+    pub overwritten: u64,
+    /// Times the publisher's counter started again (the sender was restarted).
+    pub publisher_restarts: u64,
 }
 
 /// A process's wake-up event: every stream into the process notifies it.
@@ -186,7 +216,7 @@ fn open_event(
     )
 }
 
-impl<T: Debug + ZeroCopySend + Copy + 'static> Outbox<T> {
+impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Outbox<T> {
     /// Opens (or creates) `stream` for sending; each send wakes process `wake`.
     pub fn open(node: &Node<ipc::Service>, stream: &str, wake: &str) -> Result<Self, IpcError> {
         let svc = open_pubsub::<T>(node, stream)?;
@@ -201,12 +231,32 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Outbox<T> {
                 format!("notifier for {wake}"),
             )?,
             stream: stream.to_string(),
+            stats: Cell::new(OutboxStats::default()),
         })
     }
 
-    /// Publishes a copy of `value` and wakes the receiver; returns how many subscribers
-    /// it reached.
-    pub fn send(&self, value: T) -> Result<usize, IpcError> {
+    /// Publishes a copy of `value` (stamped with this hop's publish counter) and wakes
+    /// the receiver; returns how many subscribers it reached.
+    pub fn send(&self, mut value: T) -> Result<usize, IpcError> {
+        let mut st = self.stats.get();
+        value.set_hop_seq(st.published);
+        let n = map(
+            self.publisher.send_copy(value),
+            format!("sending on {}", self.stream),
+        )?;
+        st.published += 1;
+        if n == 0 {
+            st.no_receiver += 1;
+        }
+        self.stats.set(st);
+        map(self.notifier.notify(), format!("notifying {}", self.stream))?;
+        Ok(n)
+    }
+
+    /// Publishes a control sample (start-up probe, end of run): not counted, and
+    /// marked so the receiver does not count it either.
+    pub fn send_control(&self, mut value: T) -> Result<usize, IpcError> {
+        value.set_hop_seq(CONTROL_HOP_SEQ);
         let n = map(
             self.publisher.send_copy(value),
             format!("sending on {}", self.stream),
@@ -214,9 +264,14 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Outbox<T> {
         map(self.notifier.notify(), format!("notifying {}", self.stream))?;
         Ok(n)
     }
+
+    /// Counters so far.
+    pub fn stats(&self) -> OutboxStats {
+        self.stats.get()
+    }
 }
 
-impl<T: Debug + ZeroCopySend + Copy + 'static> Inbox<T> {
+impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Inbox<T> {
     /// Opens (or creates) `stream` for receiving.
     pub fn open(node: &Node<ipc::Service>, stream: &str) -> Result<Self, IpcError> {
         let svc = open_pubsub::<T>(node, stream)?;
@@ -228,16 +283,36 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Inbox<T> {
                 format!("subscriber on {stream}"),
             )?,
             stream: stream.to_string(),
+            stats: Cell::new(InboxStats::default()),
+            next_hop_seq: Cell::new(None),
         })
     }
 
-    /// A sample if one is waiting.
+    /// A sample if one is waiting; counts it, and any overwritten before it.
     pub fn try_recv(&self) -> Result<Option<T>, IpcError> {
-        Ok(map(
+        let got = map(
             self.subscriber.receive(),
             format!("receiving on {}", self.stream),
         )?
-        .map(|s| *s))
+        .map(|s| *s);
+        if let Some(v) = got.as_ref().filter(|v| v.hop_seq() != CONTROL_HOP_SEQ) {
+            let mut st = self.stats.get();
+            st.received += 1;
+            let h = v.hop_seq();
+            match self.next_hop_seq.get() {
+                Some(next) if h >= next => st.overwritten += h - next,
+                Some(_) => st.publisher_restarts += 1,
+                None => {}
+            }
+            self.next_hop_seq.set(Some(h + 1));
+            self.stats.set(st);
+        }
+        Ok(got)
+    }
+
+    /// Counters so far.
+    pub fn stats(&self) -> InboxStats {
+        self.stats.get()
     }
 }
 
@@ -299,6 +374,30 @@ impl Waker {
             }
         }
     }
+}
+
+/// Names of the nodes of run `prefix` whose process died; their stale resources are
+/// removed on the way, so a restarted process can take their place.
+pub fn dead_nodes(prefix: &str) -> Result<Vec<String>, IpcError> {
+    use iceoryx2::node::{NodeState, NodeView};
+    let cfg = config(prefix)?;
+    let mut dead = Vec::new();
+    map(
+        Node::<ipc::Service>::list(&cfg, |state| {
+            if let NodeState::Dead(view) = state {
+                let name = view
+                    .details()
+                    .as_ref()
+                    .map(|d| d.name().as_str().to_string())
+                    .unwrap_or_else(|| "unnamed node".into());
+                let _ = view.try_remove_stale_resources();
+                dead.push(name);
+            }
+            iceoryx2::prelude::CallbackProgression::Continue
+        }),
+        "listing nodes",
+    )?;
+    Ok(dead)
 }
 
 /// Removes the shared-memory objects and files of a run (after all its processes ended).

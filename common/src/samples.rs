@@ -8,7 +8,6 @@
 //! carries a timestamp per stage it passed.
 
 use iceoryx2::prelude::ZeroCopySend;
-use serde::{Deserialize, Serialize};
 
 /// Stages a sample passes, in order; indices into `stamps`.
 pub mod stage {
@@ -62,6 +61,40 @@ pub const FLAG_CONTACT: u32 = 8;
 pub const FLAG_PROBE: u32 = 16;
 /// Flag: the run is over; each process passes it on and exits.
 pub const FLAG_END: u32 = 32;
+/// Flag (trace): no answer this sample; the master held its last torque.
+pub const FLAG_HELD: u32 = 64;
+/// Flag (trace): the loop is broken (a peer is silent past the timeout); zero torque.
+pub const FLAG_PEER_LOST: u32 = 128;
+/// Flag: a value was corrupted to NaN on purpose by the emulator (fault injection).
+pub const FLAG_CORRUPTED: u32 = 256;
+/// Flag: a force or torque was clamped to the device's limit.
+pub const FLAG_CLAMPED: u32 = 512;
+
+/// A sample that carries a per-hop publish counter.
+pub trait Sequenced {
+    /// Sets the publish counter of the hop about to be crossed.
+    fn set_hop_seq(&mut self, n: u64);
+    /// The publish counter of the last hop crossed.
+    fn hop_seq(&self) -> u64;
+}
+
+impl Sequenced for Forward {
+    fn set_hop_seq(&mut self, n: u64) {
+        self.hop_seq = n;
+    }
+    fn hop_seq(&self) -> u64 {
+        self.hop_seq
+    }
+}
+
+impl Sequenced for Backward {
+    fn set_hop_seq(&mut self, n: u64) {
+        self.hop_seq = n;
+    }
+    fn hop_seq(&self) -> u64 {
+        self.hop_seq
+    }
+}
 
 /// Three signal values with their provenance.
 #[repr(C)]
@@ -89,6 +122,9 @@ pub struct Signal {
 pub struct Forward {
     /// Sample number n on this stream.
     pub seq: u64,
+    /// Publish counter of the hop this sample last crossed (set by [`crate::ipc::Outbox`]);
+    /// a gap at the receiver is a sample overwritten in its buffer.
+    pub hop_seq: u64,
     /// Tool position.
     pub signal: Signal,
     /// The operator's target a(n), for tracking-error accounting.
@@ -129,34 +165,12 @@ pub struct SlaveState {
 pub struct Backward {
     /// Sample number n on this stream (the forward sample that triggered it).
     pub seq: u64,
+    /// Publish counter of the last hop, as in [`Forward::hop_seq`].
+    pub hop_seq: u64,
     /// Contact force.
     pub signal: Signal,
     /// Stamps of the triggering forward sample, then the backward stages.
     pub stamps: [u64; stage::COUNT],
     /// The slave's state at step n.
     pub slave: SlaveState,
-}
-
-/// Sequence accounting of one input stream.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct StreamCount {
-    /// Samples received.
-    pub received: u64,
-    /// Sequence numbers skipped: samples that never arrived.
-    pub gaps: u64,
-    /// Samples published onwards.
-    pub sent: u64,
-    #[serde(skip)]
-    next: Option<u64>,
-}
-
-impl StreamCount {
-    /// Counts a received sample number.
-    pub fn saw(&mut self, seq: u64) {
-        self.received += 1;
-        if let Some(next) = self.next {
-            self.gaps += seq.saturating_sub(next);
-        }
-        self.next = Some(seq + 1);
-    }
 }

@@ -80,9 +80,15 @@ pub struct Scenario {
     /// The emulated network.
     #[serde(default)]
     pub network: Network,
+    /// The master side: device limits.
+    #[serde(default)]
+    pub master: MasterConfig,
     /// The slave side: controller and device dynamics.
     #[serde(default)]
     pub slave: SlaveConfig,
+    /// Fault handling shared by the processes.
+    #[serde(default)]
+    pub faults: FaultConfig,
     /// Objects in the slave's environment.
     #[serde(default)]
     pub environment: Environment,
@@ -248,6 +254,13 @@ pub struct ChannelConfig {
     /// Standard deviation of the zero-mean Gaussian noise per signal (m forward, N back).
     #[serde(default)]
     pub noise_std: [f64; 3],
+    /// Probability that the emulator drops a sample on purpose, 0 to 1 (seeded).
+    #[serde(default)]
+    pub loss: f64,
+    /// Fault injection: probability that the emulator replaces a sample's values with
+    /// NaN, 0 to 1 (seeded), to prove the receivers reject them.
+    #[serde(default)]
+    pub corrupt: f64,
 }
 
 /// Largest delay accepted, in samples: ten seconds at the highest rate.
@@ -286,6 +299,14 @@ impl ChannelConfig {
                 check_delay(e[i + 1], format!("{field}.schedule[{k}][{}]", i + 1))?;
             }
         }
+        for (name, p) in [("loss", self.loss), ("corrupt", self.corrupt)] {
+            if !p.is_finite() || !(0.0..=1.0).contains(&p) {
+                return Err(invalid(
+                    format!("{field}.{name}"),
+                    format!("{p} is not a probability in [0, 1]"),
+                ));
+            }
+        }
         for (i, s) in self.noise_std.iter().enumerate() {
             if !s.is_finite() || *s < 0.0 {
                 return Err(invalid(
@@ -295,6 +316,57 @@ impl ChannelConfig {
             }
         }
         Ok(())
+    }
+}
+
+/// The master device's limits (PHANToM Omni class by default).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MasterConfig {
+    /// Largest force the operator is made to feel, N, per axis (the Omni: ~3.3 N).
+    #[serde(default = "default_force_limit")]
+    pub force_limit: f64,
+    /// Largest torque commanded on a master joint, N m.
+    #[serde(default = "default_master_torque_limit")]
+    pub torque_limit: [f64; 3],
+}
+
+fn default_force_limit() -> f64 {
+    3.3
+}
+fn default_master_torque_limit() -> [f64; 3] {
+    [0.45; 3]
+}
+
+impl Default for MasterConfig {
+    fn default() -> Self {
+        MasterConfig {
+            force_limit: default_force_limit(),
+            torque_limit: default_master_torque_limit(),
+        }
+    }
+}
+
+/// How the processes notice a dead peer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaultConfig {
+    /// Consecutive samples without an answer after which the master declares the loop
+    /// broken, commands zero torque and marks the samples; and without input after
+    /// which the slave holds its position.
+    #[serde(default = "default_peer_timeout")]
+    pub peer_timeout_samples: u64,
+}
+
+fn default_peer_timeout() -> u64 {
+    10
+}
+
+impl Default for FaultConfig {
+    fn default() -> Self {
+        FaultConfig {
+            peer_timeout_samples: default_peer_timeout(),
+        }
     }
 }
 
@@ -426,8 +498,11 @@ pub enum Object {
     },
 }
 
-/// The PHANToM Omni's nominal maximum stiffness, N/m (0.7 N/mm).
+/// The PHANToM Omni's nominal maximum stiffness, N/m (0.7 N/mm): above it a scenario
+/// loads with a warning (the device cannot render it without buzzing).
 pub const NOMINAL_MAX_STIFFNESS: f64 = 700.0;
+/// Stiffness refused outright, N/m: ten times the nominal maximum.
+pub const MAX_STIFFNESS: f64 = 10.0 * NOMINAL_MAX_STIFFNESS;
 
 impl Object {
     /// Stiffness per axis.
@@ -470,6 +545,20 @@ fn positive3(v: &[f64; 3], field: &str, allow_zero: bool) -> Result<(), Scenario
     Ok(())
 }
 
+/// A TOML error as one line: `line L, column C: message`.
+pub fn one_line(text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+    match e.span() {
+        Some(span) => {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            format!("line {line}, column {column}: {msg}")
+        }
+        None => msg,
+    }
+}
+
 impl Scenario {
     /// The paper scenario (`deploy/scenarios/paper.toml` holds the same values).
     pub fn paper() -> Scenario {
@@ -484,7 +573,9 @@ impl Scenario {
             seed: 1,
             operator: Operator::Paper,
             network: Network::default(),
+            master: MasterConfig::default(),
             slave: SlaveConfig::default(),
+            faults: FaultConfig::default(),
             environment: Environment {
                 objects: vec![Object::Plane {
                     point: [0.0, 0.0, -0.16],
@@ -497,9 +588,26 @@ impl Scenario {
 
     /// Parses TOML and validates every range.
     pub fn from_toml_str(text: &str) -> Result<Scenario, ScenarioError> {
-        let s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse(e.to_string()))?;
+        let s: Scenario =
+            toml::from_str(text).map_err(|e| ScenarioError::Parse(one_line(text, &e)))?;
         s.validate()?;
         Ok(s)
+    }
+
+    /// Things that load but deserve a word: stiffness above the device's nominal
+    /// maximum.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        for (k, o) in self.environment.objects.iter().enumerate() {
+            for (i, h) in o.stiffness().iter().enumerate() {
+                if *h > NOMINAL_MAX_STIFFNESS {
+                    w.push(format!(
+                        "environment.objects[{k}].stiffness[{i}] = {h} N/m is above the device's nominal {NOMINAL_MAX_STIFFNESS} N/m: contact may buzz"
+                    ));
+                }
+            }
+        }
+        w
     }
 
     /// Sampling period t_s in seconds.
@@ -588,9 +696,27 @@ impl Scenario {
                 ),
             ));
         }
+        if !self.master.force_limit.is_finite() || self.master.force_limit <= 0.0 {
+            return Err(invalid(
+                "master.force_limit",
+                format!("{} N must be positive", self.master.force_limit),
+            ));
+        }
+        positive3(&self.master.torque_limit, "master.torque_limit", false)?;
+        if self.faults.peer_timeout_samples == 0 {
+            return Err(invalid("faults.peer_timeout_samples", "must be at least 1"));
+        }
         for (k, o) in self.environment.objects.iter().enumerate() {
             let f = format!("environment.objects[{k}]");
             positive3(&o.stiffness(), &format!("{f}.stiffness"), true)?;
+            for (i, h) in o.stiffness().iter().enumerate() {
+                if *h > MAX_STIFFNESS {
+                    return Err(invalid(
+                        format!("{f}.stiffness[{i}]"),
+                        format!("{h} N/m is above {MAX_STIFFNESS} N/m, ten times the device's nominal maximum"),
+                    ));
+                }
+            }
             match o {
                 Object::Plane { point, normal, .. } => {
                     finite3(point, &format!("{f}.point"))?;

@@ -40,7 +40,7 @@ pub fn header() -> String {
             let _ = write!(h, ",{s}_{axis}");
         }
     }
-    h.push_str(",flags_f,flags_b,contact_object,round_trip_ns,overhead_ns");
+    h.push_str(",flags_f,flags_b,flags_m,contact_object,round_trip_ns,overhead_ns");
     for name in stage::NAMES {
         let _ = write!(h, ",t_{name}");
     }
@@ -68,6 +68,8 @@ pub struct TraceRow {
     pub round_trip_ns: u64,
     /// Round trip minus injected delay, ns.
     pub overhead_ns: i64,
+    /// The master's `FLAG_*` bits for this sample (held, peer lost, clamped, rejected).
+    pub master_flags: u32,
 }
 
 fn push3(line: &mut String, v: [f64; 3]) {
@@ -112,8 +114,12 @@ impl TraceRow {
         };
         let _ = write!(
             line,
-            ",{},{},{contact},{},{}",
-            s.received.flags, b.signal.flags, self.round_trip_ns, self.overhead_ns
+            ",{},{},{},{contact},{},{}",
+            s.received.flags,
+            b.signal.flags,
+            self.master_flags,
+            self.round_trip_ns,
+            self.overhead_ns
         );
         for k in 0..stage::COUNT {
             let t = if self.backward.is_some() {

@@ -55,6 +55,9 @@ pub struct RunArgs {
     /// No progress line.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Times the emulator or the slave is restarted if it dies mid-run.
+    #[arg(long, default_value_t = 3)]
+    pub max_restarts: u32,
 }
 
 /// Which process a role runs.

@@ -6,6 +6,8 @@ use thiserror::Error;
 pub const EXIT_BAD_INPUT: u8 = 2;
 /// Exit status for a failure while running.
 pub const EXIT_FAILURE: u8 = 1;
+/// Exit status when SIGINT or SIGTERM stopped a run (128 + SIGINT, by convention).
+pub const EXIT_INTERRUPTED: u8 = 130;
 
 /// Everything the launcher can fail with.
 #[derive(Debug, Error)]
@@ -24,6 +26,9 @@ pub enum Error {
     /// A failure while running.
     #[error("{0}")]
     Failed(String),
+    /// SIGINT or SIGTERM stopped the run; its report was written.
+    #[error("stopped by a signal; the report of what ran was written")]
+    Interrupted,
 }
 
 impl Error {
@@ -32,6 +37,7 @@ impl Error {
         match self {
             Error::BadInput(_) => EXIT_BAD_INPUT,
             Error::Io { .. } | Error::Failed(_) => EXIT_FAILURE,
+            Error::Interrupted => EXIT_INTERRUPTED,
         }
     }
 

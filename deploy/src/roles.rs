@@ -66,6 +66,12 @@ pub struct MasterSummary {
     pub counters: MasterCounters,
     /// True if a stop request cut the run short.
     pub interrupted: bool,
+    /// What happened to the loop (breaks, resumes), in order.
+    pub events: Vec<tactile_master::process::Event>,
+    /// c(n) as published.
+    pub c_out: tactile_common::ipc::OutboxStats,
+    /// q(n) as received.
+    pub q_in: tactile_common::ipc::InboxStats,
 }
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
@@ -139,6 +145,9 @@ fn master_summary(run: &MasterRun, r: &RowReport) -> MasterSummary {
         unexpected: run.unexpected,
         counters: run.counters,
         interrupted: run.interrupted,
+        events: run.events.clone(),
+        c_out: run.c_out,
+        q_in: run.q_in,
     }
 }
 
@@ -149,10 +158,13 @@ pub fn master_summary_from(sim: &crate::sim::SimRun, r: &RowReport) -> MasterSum
         counters: sim.master,
         deadline_misses: 0,
         late: 0,
-        missing: 0,
+        missing: sim.rows.iter().filter(|r| r.backward.is_none()).count() as u64,
         unexpected: 0,
         t0_ns: 0,
         interrupted: false,
+        events: Vec::new(),
+        c_out: Default::default(),
+        q_in: Default::default(),
     };
     master_summary(&run, r)
 }
@@ -165,7 +177,7 @@ pub fn master(o: &RoleOptions) -> Result<(), Error> {
         prefix: o.prefix.clone(),
         wait: WaitPolicy { spin: o.spin },
         startup_timeout: Duration::from_secs(10),
-        answer_timeout: Duration::from_secs(2),
+        answer_timeout: Duration::from_millis(100),
         progress_every: 0,
         wake_early_ns: WAKE_EARLY_NS,
     };

@@ -10,6 +10,8 @@ use std::collections::BTreeMap;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_common::scenario::{Mode, Scenario};
 use tactile_master::operator::OperatorSource;
@@ -47,23 +49,45 @@ pub fn load_scenario(path: Option<&Path>) -> Result<(Scenario, PathBuf), Error> 
     Ok((scenario, base))
 }
 
-/// Sent, received and lost on one stream.
+/// Accounting of one stream: every sample offered is received or lost, and every
+/// loss has a cause.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct ChannelCount {
-    /// Published by the sender.
+    /// Samples the sender had for this stream.
+    pub offered: u64,
+    /// Published (offered minus dropped on purpose).
     pub sent: u64,
     /// Taken by the receiver.
     pub received: u64,
-    /// sent - received.
+    /// offered - received = dropped + overwritten + dead_peer.
     pub lost: u64,
+    /// Dropped by the emulator on purpose (loss model).
+    pub lost_dropped: u64,
+    /// Overwritten in the receiver's full buffer (safe overflow, 64 samples).
+    pub lost_overwritten: u64,
+    /// Lost to a dead peer: published with no receiver connected, or taken by a
+    /// receiver that was killed before it could report (its counts die with it).
+    pub lost_dead_peer: u64,
 }
 
 impl ChannelCount {
-    fn new(sent: u64, received: u64) -> Self {
+    fn new(
+        out: tactile_common::ipc::OutboxStats,
+        dropped: u64,
+        inn: tactile_common::ipc::InboxStats,
+    ) -> Self {
+        let offered = out.published + dropped;
+        let received = inn.received;
+        let lost = offered.saturating_sub(received);
+        let overwritten = inn.overwritten.min(lost.saturating_sub(dropped));
         ChannelCount {
-            sent,
+            offered,
+            sent: out.published,
             received,
-            lost: sent.saturating_sub(received),
+            lost,
+            lost_dropped: dropped,
+            lost_overwritten: overwritten,
+            lost_dead_peer: lost - dropped.min(lost) - overwritten,
         }
     }
 }
@@ -105,6 +129,12 @@ pub struct Summary {
     pub emulator: Option<EmulatorRun>,
     /// The slave's counters.
     pub slave: Option<SlaveRun>,
+    /// What happened: processes that died and were restarted, loop breaks, resumes.
+    pub events: Vec<String>,
+    /// True if a process died during the run.
+    pub failed: bool,
+    /// True if SIGINT/SIGTERM cut the run short.
+    pub interrupted: bool,
 }
 
 /// Merges the three roles' results.
@@ -117,15 +147,13 @@ pub fn summarise(
 ) -> Summary {
     let mut channels = BTreeMap::new();
     if let (Some(e), Some(s)) = (&emulator, &slave) {
-        channels.insert(
-            "c",
-            ChannelCount::new(master.samples_sent, e.forward.received),
-        );
-        channels.insert("v", ChannelCount::new(e.forward.sent, s.stream.received));
-        channels.insert("h", ChannelCount::new(s.stream.sent, e.backward.received));
+        let c = &e.counters;
+        channels.insert("c", ChannelCount::new(master.c_out, 0, e.c_in));
+        channels.insert("v", ChannelCount::new(e.v_out, c.forward_dropped, s.v_in));
+        channels.insert("h", ChannelCount::new(s.h_out, 0, e.h_in));
         channels.insert(
             "q",
-            ChannelCount::new(e.backward.sent, master.samples_received),
+            ChannelCount::new(e.q_out, c.backward_dropped, master.q_in),
         );
     }
     Summary {
@@ -146,6 +174,9 @@ pub fn summarise(
         channels,
         emulator,
         slave,
+        events: Vec::new(),
+        failed: false,
+        interrupted: false,
     }
 }
 
@@ -175,8 +206,8 @@ pub fn render(s: &Summary, out: &Path) -> String {
     for (name, c) in &s.channels {
         let _ = writeln!(
             t,
-            "  stream {name}: sent {}, received {}, lost {}",
-            c.sent, c.received, c.lost
+            "  stream {name}: sent {}, received {}, lost {} (dropped {}, overwritten {}, dead peer {})",
+            c.offered, c.received, c.lost, c.lost_dropped, c.lost_overwritten, c.lost_dead_peer
         );
     }
     let mo = &m.motion;
@@ -191,13 +222,22 @@ pub fn render(s: &Summary, out: &Path) -> String {
         "forces: {} samples in contact, slave max {:.3} N, felt rms {:.3} N max {:.3} N, master torque max {:.4} N m",
         mo.contact_samples, mo.force_max_n, mo.felt_rms_n, mo.felt_max_n, mo.tau_max_nm
     );
+    let mc = &m.counters;
+    let _ = writeln!(
+        t,
+        "master: {} force clamps, {} torque clamps, {} rejected, {} held, {} peer-lost samples",
+        mc.force_clamps, mc.torque_clamps, mc.rejected, mc.held_samples, mc.peer_lost_samples
+    );
     if let Some(sl) = &s.slave {
         let c = &sl.counters;
         let _ = writeln!(
             t,
-            "slave: {} IK targets clamped, {} samples rejected, {} torque clamps",
-            c.ik_clamped, c.rejected, c.torque_clamps
+            "slave: {} IK targets clamped, {} samples rejected, {} torque clamps, {} holds",
+            c.ik_clamped, c.rejected, c.torque_clamps, c.holds
         );
+    }
+    for e in &s.events {
+        let _ = writeln!(t, "event: {e}");
     }
     let _ = writeln!(
         t,
@@ -226,7 +266,15 @@ struct Proc {
     role: &'static str,
     child: Child,
     status: Option<ExitStatus>,
+    restarts: u32,
+    /// Set while a dead process waits out the restart backoff.
+    restart_at: Option<Instant>,
 }
+
+/// Wait before restarting a dead process: a process that dies at once again must not
+/// spin the launcher, and the peers see a clear break (longer than the peer timeout
+/// of 10 samples at 100 Hz) rather than a flicker.
+pub const RESTART_BACKOFF: Duration = Duration::from_millis(200);
 
 fn stop(p: &mut Proc, grace: Duration) {
     if p.status.is_some() {
@@ -254,14 +302,46 @@ fn log_tail(out: &Path, role: &str) -> String {
     lines[lines.len().saturating_sub(5)..].join("\n")
 }
 
-/// Runs the scenario's three processes; returns the summary.
+/// How `tactile run` supervises its processes.
+#[derive(Debug, Clone)]
+pub struct Supervision {
+    /// iceoryx2 prefix of the run.
+    pub prefix: String,
+    /// Busy-poll budget of every process.
+    pub spin: Duration,
+    /// Progress line on a terminal.
+    pub progress: bool,
+    /// Restarts allowed per process (emulator, slave) when one dies mid-run.
+    pub max_restarts: u32,
+}
+
+/// Removes the shared memory of earlier runs whose launcher is gone (a crashed or
+/// killed run leaves it behind; iceoryx2 would clean it only for the same prefix).
+pub fn clean_stale_runs() {
+    let Ok(dir) = std::fs::read_dir(tactile_common::ipc::ROOT) else {
+        return;
+    };
+    for entry in dir.flatten() {
+        let name = entry.file_name().to_string_lossy().to_string();
+        let Some(pid) = name
+            .strip_prefix("tactile")
+            .and_then(|p| p.parse::<i32>().ok())
+        else {
+            continue;
+        };
+        if !Path::new(&format!("/proc/{pid}")).exists() {
+            tactile_common::ipc::remove_run_files(&name);
+        }
+    }
+}
+
+/// Runs the scenario's three processes; returns the summary (which says whether the
+/// run failed: a process died, or a stop request cut it short).
 pub fn run_processes(
     scenario: &Scenario,
     base_dir: &Path,
     out: &Path,
-    prefix: &str,
-    spin: Duration,
-    progress: bool,
+    sup: &Supervision,
 ) -> Result<Summary, Error> {
     let exe = std::env::current_exe().map_err(Error::io("locating the tactile executable"))?;
     let scenario_file = out.join("scenario.toml");
@@ -272,11 +352,20 @@ pub fn run_processes(
     for f in ["master.json", "emulator.json", "slave.json", "summary.json"] {
         let _ = std::fs::remove_file(out.join(f));
     }
-    let mut procs = Vec::new();
-    for role in ["emulator", "slave", "master"] {
-        let log = std::fs::File::create(out.join(format!("{role}.log")))
+    // SIGINT and SIGTERM stop the run cleanly: the master is asked to stop, the
+    // others follow its end-of-run sample, and the report of what ran is written.
+    let stop_requested = Arc::new(AtomicBool::new(false));
+    for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register(sig, Arc::clone(&stop_requested))
+            .map_err(Error::io("installing signal handlers"))?;
+    }
+    let spawn = |role: &'static str| -> Result<Child, Error> {
+        let log = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(out.join(format!("{role}.log")))
             .map_err(Error::io(format!("creating {role}.log")))?;
-        let child = Command::new(&exe)
+        Command::new(&exe)
             .arg("role")
             .arg(role)
             .arg("--scenario")
@@ -284,29 +373,35 @@ pub fn run_processes(
             .arg("--base-dir")
             .arg(base_dir)
             .arg("--prefix")
-            .arg(prefix)
+            .arg(&sup.prefix)
             .arg("--out")
             .arg(out)
             .arg("--spin-us")
-            .arg(spin.as_micros().to_string())
+            .arg(sup.spin.as_micros().to_string())
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(log)
-            .spawn();
-        match child {
+            .spawn()
+            .map_err(|e| Error::Failed(format!("cannot start {} as {role}: {e}", exe.display())))
+    };
+    for role in ["master", "emulator", "slave"] {
+        let _ = std::fs::remove_file(out.join(format!("{role}.log")));
+    }
+    let mut procs: Vec<Proc> = Vec::new();
+    for role in ["emulator", "slave", "master"] {
+        match spawn(role) {
             Ok(child) => procs.push(Proc {
                 role,
                 child,
                 status: None,
+                restarts: 0,
+                restart_at: None,
             }),
             Err(e) => {
                 for p in &mut procs {
                     stop(p, Duration::from_secs(1));
                 }
-                return Err(Error::Failed(format!(
-                    "cannot start {} as {role}: {e}",
-                    exe.display()
-                )));
+                return Err(e);
             }
         }
     }
@@ -315,28 +410,77 @@ pub fn run_processes(
         Mode::Realtime => Some(scenario.samples as f64 * scenario.t_s()),
         Mode::Lockstep => None,
     };
-    let mut failure: Option<String> = None;
-    loop {
-        for p in procs.iter_mut().filter(|p| p.status.is_none()) {
-            if let Ok(Some(s)) = p.child.try_wait() {
-                p.status = Some(s);
-                if !s.success() && failure.is_none() {
-                    failure = Some(format!(
-                        "{} {}; its last words:\n{}",
-                        p.role,
-                        describe(s),
-                        log_tail(out, p.role)
-                    ));
+    let mut events: Vec<String> = Vec::new();
+    let mut failed = false;
+    let mut interrupted = false;
+    let mut master_status = None;
+    while master_status.is_none() {
+        if stop_requested.swap(false, Ordering::SeqCst) && !interrupted {
+            interrupted = true;
+            events.push(format!(
+                "stop requested after {:.2} s: stopping the master",
+                started.elapsed().as_secs_f64()
+            ));
+            if let Some(m) = procs.iter().find(|p| p.role == "master") {
+                if let Some(pid) = rustix::process::Pid::from_raw(m.child.id() as i32) {
+                    let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
                 }
             }
         }
-        let master_done = procs
-            .iter()
-            .any(|p| p.role == "master" && p.status.is_some());
-        if failure.is_some() || master_done {
-            break;
+        let mut stop_master = false;
+        for p in procs.iter_mut() {
+            if let Some(at) = p.restart_at {
+                if Instant::now() >= at {
+                    p.restart_at = None;
+                    p.child = spawn(p.role)?;
+                    events.push(format!(
+                        "{} restarted after {:.2} s",
+                        p.role,
+                        started.elapsed().as_secs_f64()
+                    ));
+                }
+                continue;
+            }
+            if p.status.is_some() {
+                continue;
+            }
+            let Ok(Some(status)) = p.child.try_wait() else {
+                continue;
+            };
+            if p.role == "master" {
+                master_status = Some(status);
+                continue;
+            }
+            if status.success() {
+                // Passed on the master's end-of-run sample: finished, not dead.
+                p.status = Some(status);
+                continue;
+            }
+            // The emulator or the slave died while the master runs.
+            failed = true;
+            let at = started.elapsed().as_secs_f64();
+            let how = describe(status);
+            if p.restarts < sup.max_restarts {
+                p.restarts += 1;
+                p.restart_at = Some(Instant::now() + RESTART_BACKOFF);
+                events.push(format!("{} {how} after {at:.2} s; restarting", p.role));
+            } else {
+                p.status = Some(status);
+                events.push(format!(
+                    "{} {how} after {at:.2} s; no restarts left, stopping the run; its last words:\n{}",
+                    p.role,
+                    log_tail(out, p.role)
+                ));
+                stop_master = true;
+            }
         }
-        if progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        if stop_master {
+            if let Some(m) = procs.iter_mut().find(|m| m.role == "master") {
+                stop(m, Duration::from_secs(2));
+                master_status = m.status;
+            }
+        }
+        if sup.progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
             let el = started.elapsed().as_secs_f64();
             match expected {
                 Some(total) => eprint!("\r  running: {el:5.1} s of {total:.1} s"),
@@ -344,40 +488,76 @@ pub fn run_processes(
             }
             let _ = std::io::stderr().flush();
         }
-        std::thread::sleep(Duration::from_millis(50));
+        std::thread::sleep(Duration::from_millis(20));
     }
-    if progress {
+    if sup.progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         eprintln!();
     }
-    // The master's end-of-run sample stops the others; give them a moment, then insist.
-    let until = Instant::now() + Duration::from_secs(3);
-    while Instant::now() < until && procs.iter().any(|p| p.status.is_none()) {
-        for p in procs.iter_mut().filter(|p| p.status.is_none()) {
+    let master_ok = master_status.is_some_and(|s| s.success());
+    if let Some(s) = master_status.filter(|s| !s.success()) {
+        failed = true;
+        events.push(format!(
+            "master {} after {:.2} s; its last words:\n{}",
+            describe(s),
+            started.elapsed().as_secs_f64(),
+            log_tail(out, "master")
+        ));
+        // Let the survivors notice (the slave holds its position), then stop them.
+        let grace = crate::run_cmd::survivor_grace(scenario);
+        std::thread::sleep(grace);
+    }
+    // After a clean master the end-of-run sample stops the others; give them a moment.
+    let until = Instant::now() + Duration::from_secs(if master_ok { 3 } else { 0 });
+    while Instant::now() < until
+        && procs
+            .iter_mut()
+            .any(|p| p.status.is_none() && !matches!(p.child.try_wait(), Ok(Some(_))))
+    {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    for p in &mut procs {
+        if p.status.is_none() {
             if let Ok(Some(s)) = p.child.try_wait() {
                 p.status = Some(s);
             }
         }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    for p in &mut procs {
         stop(p, Duration::from_secs(2));
     }
-    tactile_common::ipc::remove_run_files(prefix);
-    if let Some(f) = failure {
-        return Err(Error::Failed(f));
-    }
-    let master: MasterSummary = read_json(&out.join("master.json"))
-        .ok_or_else(|| Error::Failed("the master wrote no master.json".into()))?;
+    tactile_common::ipc::remove_run_files(&sup.prefix);
     let emulator = read_json(&out.join("emulator.json"));
     let slave = read_json(&out.join("slave.json"));
-    let summary = summarise(scenario, "processes", master, emulator, slave);
+    let Some(master) = read_json::<MasterSummary>(&out.join("master.json")) else {
+        return Err(Error::Failed(format!(
+            "the run failed, no report from the master:\n{}",
+            events.join("\n")
+        )));
+    };
+    events.extend(
+        master
+            .events
+            .iter()
+            .map(|e| format!("sample {}: {}", e.sample, e.what)),
+    );
+    let mut summary = summarise(scenario, "processes", master, emulator, slave);
+    summary.events = events;
+    summary.failed = failed;
+    summary.interrupted = interrupted;
     write_json(&out.join("summary.json"), &summary)?;
     Ok(summary)
+}
+
+/// How long the launcher lets the emulator and slave run on after the master died:
+/// long enough for the slave to notice and hold (its peer timeout) and to be seen.
+pub fn survivor_grace(scenario: &Scenario) -> Duration {
+    tactile_slave::process::hold_timeout(scenario) + Duration::from_millis(500)
 }
 
 /// `tactile run`.
 pub fn main(args: &RunArgs) -> Result<(), Error> {
     let (scenario, base_dir) = load_scenario(args.scenario.as_deref())?;
+    for w in scenario.warnings() {
+        eprintln!("tactile: warning: {w}");
+    }
     std::fs::create_dir_all(&args.out)
         .map_err(Error::io(format!("creating {}", args.out.display())))?;
     let summary = if args.in_process {
@@ -388,19 +568,30 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
         write_json(&args.out.join("summary.json"), &s)?;
         s
     } else {
-        let prefix = args
-            .prefix
-            .clone()
-            .unwrap_or_else(|| format!("tactile{}", std::process::id()));
-        run_processes(
-            &scenario,
-            &base_dir,
-            &args.out,
-            &prefix,
-            Duration::from_micros(args.spin_us),
-            !args.quiet,
-        )?
+        clean_stale_runs();
+        let sup = Supervision {
+            prefix: args
+                .prefix
+                .clone()
+                .unwrap_or_else(|| format!("tactile{}", std::process::id())),
+            spin: Duration::from_micros(args.spin_us),
+            progress: !args.quiet,
+            max_restarts: args.max_restarts,
+        };
+        run_processes(&scenario, &base_dir, &args.out, &sup)?
     };
     print!("{}", render(&summary, &args.out));
+    if summary.interrupted {
+        return Err(Error::Interrupted);
+    }
+    if summary.failed {
+        return Err(Error::Failed(format!(
+            "the run failed: {}",
+            summary
+                .events
+                .first()
+                .map_or("", |e| e.lines().next().unwrap_or(""))
+        )));
+    }
     Ok(())
 }

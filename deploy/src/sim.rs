@@ -42,12 +42,19 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path) -> Result<SimRun, Error> {
     for n in 0..scenario.samples {
         let now = n * t_s_ns;
         let (c, _) = master.forward(n, now);
-        let v = emulator.forward(&c);
-        let h = slave.step(&v);
-        let mut q = emulator.backward(&h);
-        q.stamps[stage::MASTER_DONE] = now;
-        let mut row = master.backward(&c, &q);
-        master.account(&mut row);
+        let answer = emulator
+            .forward(&c)
+            .map(|v| slave.step(&v))
+            .and_then(|h| emulator.backward(&h));
+        let row = match answer {
+            Some(mut q) => {
+                q.stamps[stage::MASTER_DONE] = now;
+                let mut row = master.backward(&c, &q);
+                master.account(&mut row);
+                row
+            }
+            None => master.missing(&c),
+        };
         rows.push(row);
     }
     Ok(SimRun {

@@ -11,8 +11,10 @@ use tactile_common::arith::StdTrig;
 use tactile_common::engine::Engine;
 use tactile_common::geometry::Lengths;
 use tactile_common::kernels::{self, IkStatus};
-use tactile_common::samples::{stage, Backward, Forward, FLAG_REJECTED};
-use tactile_common::scenario::{Scenario, ScenarioError};
+use tactile_common::samples::{
+    stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_REJECTED,
+};
+use tactile_common::scenario::{MasterConfig, Scenario, ScenarioError};
 use tactile_common::trace::TraceRow;
 
 /// What the master counted over a run.
@@ -24,8 +26,20 @@ pub struct MasterCounters {
     pub received: u64,
     /// Operator targets outside the master's workspace (MD angles clamped).
     pub operator_clamped: u64,
-    /// Backward samples with a NaN or infinite force, rejected (zero torque).
+    /// Backward samples with a NaN or infinite force, rejected (torque held).
     pub rejected: u64,
+    /// Force components clamped to the device's force limit.
+    pub force_clamps: u64,
+    /// Joint torques clamped to the device's torque limit.
+    pub torque_clamps: u64,
+    /// Samples without an answer on which the last torque was held.
+    pub held_samples: u64,
+    /// Samples without an answer past the peer timeout: zero torque.
+    pub peer_lost_samples: u64,
+    /// Times the loop broke (a peer silent past the timeout).
+    pub loop_breaks: u64,
+    /// Times answers came back after a break.
+    pub resumes: u64,
 }
 
 /// The master: operator source, device model and HMD kernels.
@@ -39,6 +53,11 @@ pub struct Master {
     t_s_ns: u64,
     theta_md: [f64; 3],
     counters: MasterCounters,
+    limits: MasterConfig,
+    peer_timeout: u64,
+    silent: u64,
+    last_tau: [f64; 3],
+    last_felt: [f64; 3],
 }
 
 impl Master {
@@ -60,6 +79,11 @@ impl Master {
             t_s_ns: scenario.t_s_ns(),
             theta_md: [0.0; 3],
             counters: MasterCounters::default(),
+            limits: scenario.master.clone(),
+            peer_timeout: scenario.faults.peer_timeout_samples,
+            silent: 0,
+            last_tau: [0.0; 3],
+            last_felt: [0.0; 3],
         })
     }
 
@@ -105,44 +129,90 @@ impl Master {
         (f, self.theta_md)
     }
 
-    /// q(n) back: KFF-HMD torques on the current master angles, and the trace row.
-    /// `forward` is the sample this tick sent; `q` has its `MASTER_DONE` stamp set by
-    /// the caller after this returns (the row's round trip is filled in then).
+    /// True while the loop is broken (no answer for the peer timeout).
+    pub fn peer_lost(&self) -> bool {
+        self.silent >= self.peer_timeout
+    }
+
+    /// q(n) back: clamp the force to the device's limit, KFF-HMD torques on the current
+    /// master angles, clamp them, and the trace row. A NaN or infinite force never
+    /// reaches a torque: it is rejected and the last torque held.
     pub fn backward(&mut self, forward: &Forward, q: &Backward) -> TraceRow {
         self.counters.received += 1;
-        let mut felt = q.signal.value;
-        let mut tau = [0.0; 3];
-        if felt.iter().all(|f| f.is_finite()) {
-            tau = self.engine.kff(self.theta_md, felt);
+        if self.peer_lost() {
+            self.counters.resumes += 1;
+        }
+        self.silent = 0;
+        let mut flags = 0;
+        let force = q.signal.value;
+        if force.iter().all(|f| f.is_finite()) {
+            let lim = self.limits.force_limit;
+            let felt = force.map(|f| f.clamp(-lim, lim));
+            let clamped = felt.iter().zip(&force).filter(|(a, b)| a != b).count() as u64;
+            let raw = self.engine.kff(self.theta_md, felt);
+            let tau: [f64; 3] = [0, 1, 2].map(|j| {
+                let l = self.limits.torque_limit[j];
+                raw[j].clamp(-l, l)
+            });
+            let tau_clamped = tau.iter().zip(&raw).filter(|(a, b)| a != b).count() as u64;
+            self.counters.force_clamps += clamped;
+            self.counters.torque_clamps += tau_clamped;
+            if clamped + tau_clamped > 0 {
+                flags |= FLAG_CLAMPED;
+            }
+            self.last_felt = felt;
+            self.last_tau = tau;
         } else {
             self.counters.rejected += 1;
-            felt = [0.0; 3];
-        }
-        let mut q = *q;
-        if !q.signal.value.iter().all(|f| f.is_finite()) {
-            q.signal.flags |= FLAG_REJECTED;
+            flags |= FLAG_REJECTED;
         }
         TraceRow {
             n: forward.seq,
             target: forward.target,
             theta_md: self.theta_md,
             forward: *forward,
-            backward: Some(q),
-            tau,
-            felt,
+            backward: Some(*q),
+            tau: self.last_tau,
+            felt: self.last_felt,
+            master_flags: flags,
             round_trip_ns: 0,
             overhead_ns: 0,
         }
     }
 
-    /// A row for a sample whose backward sample never came (deadline missed or lost).
-    pub fn missing(&self, forward: &Forward) -> TraceRow {
+    /// The row of a sample just sent, before its answer is in.
+    pub fn pending(&self, forward: &Forward) -> TraceRow {
         TraceRow {
             n: forward.seq,
             target: forward.target,
             theta_md: self.theta_md,
             forward: *forward,
+            tau: self.last_tau,
+            felt: self.last_felt,
             ..TraceRow::default()
+        }
+    }
+
+    /// The row of a sample whose answer did not come in time. Within the peer timeout
+    /// the last torque is held (one lost sample must not jerk the operator's hand);
+    /// past it the loop is broken and the master commands zero torque.
+    pub fn missing(&mut self, forward: &Forward) -> TraceRow {
+        self.silent += 1;
+        let flags = if self.peer_lost() {
+            if self.silent == self.peer_timeout {
+                self.counters.loop_breaks += 1;
+            }
+            self.counters.peer_lost_samples += 1;
+            self.last_tau = [0.0; 3];
+            self.last_felt = [0.0; 3];
+            FLAG_PEER_LOST
+        } else {
+            self.counters.held_samples += 1;
+            FLAG_HELD
+        };
+        TraceRow {
+            master_flags: flags,
+            ..self.pending(forward)
         }
     }
 

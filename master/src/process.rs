@@ -8,11 +8,13 @@
 
 use crate::hmd::{Master, MasterCounters};
 use crate::operator::{OperatorError, OperatorSource};
+use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tactile_common::clock::{now_ns, sleep_until_ns};
 use tactile_common::ipc::{
-    self, streams, Idle, Inbox, IpcError, IpcNode, Outbox, WaitPolicy, Waker,
+    self, streams, Idle, Inbox, InboxStats, IpcError, IpcNode, Outbox, OutboxStats, WaitPolicy,
+    Waker,
 };
 use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::{Mode, Scenario, ScenarioError};
@@ -32,7 +34,7 @@ pub struct MasterOptions {
     pub wait: WaitPolicy,
     /// How long to wait for the other two processes to answer at start-up.
     pub startup_timeout: Duration,
-    /// In lockstep, how long without an answer before the run fails.
+    /// In lockstep, how long to wait for an answer before counting it missing.
     pub answer_timeout: Duration,
     /// Progress on stderr every this many samples (0: none).
     pub progress_every: u64,
@@ -76,6 +78,25 @@ pub struct MasterRun {
     pub t0_ns: u64,
     /// True if SIGINT/SIGTERM stopped the run early.
     pub interrupted: bool,
+    /// What happened to the loop, in order.
+    pub events: Vec<Event>,
+    /// c(n) as published.
+    pub c_out: OutboxStats,
+    /// q(n) as received.
+    pub q_in: InboxStats,
+}
+
+/// Something that happened to the loop during a run.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Event {
+    /// Sample number when it happened.
+    pub sample: u64,
+    /// What happened.
+    pub what: String,
+}
+
+fn index_of(n: u64) -> usize {
+    usize::try_from(n).unwrap_or(usize::MAX)
 }
 
 struct Ports {
@@ -94,7 +115,7 @@ fn probe(ports: &Ports, timeout: Duration) -> Result<bool, MasterError> {
             ..Forward::default()
         };
         p.signal.flags = FLAG_PROBE;
-        ports.out.send(p)?;
+        ports.out.send_control(p)?;
         k += 1;
         let deadline = Instant::now() + Duration::from_millis(20);
         let got = ports
@@ -140,6 +161,9 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
         unexpected: 0,
         t0_ns: 0,
         interrupted: false,
+        events: Vec::new(),
+        c_out: OutboxStats::default(),
+        q_in: InboxStats::default(),
     };
     if !probe(&ports, opts.startup_timeout)? {
         result.interrupted = true;
@@ -173,7 +197,7 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
         let (mut c, _) = master.forward(n, origin);
         c.stamps[stage::MASTER_SEND] = now_ns();
         ports.out.send(c)?;
-        result.rows.push(master.missing(&c));
+        result.rows.push(master.pending(&c));
 
         let deadline = if realtime {
             instant_at(t0 + (n + 1) * t_s)
@@ -188,19 +212,35 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
                     ports.inbox.try_recv()
                 })?;
             match got {
-                Ok(q) => match absorb(&mut master, &mut result.rows, q) {
+                Ok(q) => match absorb(&mut master, &mut result.rows, q, &mut result.events) {
                     Some(seq) if seq == n => done = true,
                     Some(_) => result.late += 1,
                     None => result.unexpected += 1,
                 },
                 Err(Idle::Timeout) => {
-                    if !realtime {
-                        return Err(MasterError::NoAnswer(format!(
-                            "no answer for sample {n} within {:.1} s",
-                            opts.answer_timeout.as_secs_f64()
-                        )));
+                    let was_lost = master.peer_lost();
+                    result.rows[index_of(n)] = master.missing(&c);
+                    if realtime {
+                        result.deadline_misses += 1;
                     }
-                    result.deadline_misses += 1;
+                    if master.peer_lost() && !was_lost {
+                        let dead = ipc::dead_nodes(&opts.prefix).unwrap_or_default();
+                        result.events.push(Event {
+                            sample: n,
+                            what: if dead.is_empty() {
+                                format!(
+                                    "loop broken: no answer for {} samples; zero torque",
+                                    sc.faults.peer_timeout_samples
+                                )
+                            } else {
+                                format!(
+                                    "loop broken: no answer for {} samples, dead: {}; zero torque",
+                                    sc.faults.peer_timeout_samples,
+                                    dead.join(", ")
+                                )
+                            },
+                        });
+                    }
                     break;
                 }
                 Err(Idle::Terminate) => {
@@ -224,27 +264,40 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
     while let Ok(Ok(q)) = ports.waker.wait(&ports.node, Duration::ZERO, grace, || {
         ports.inbox.try_recv()
     }) {
-        match absorb(&mut master, &mut result.rows, q) {
+        match absorb(&mut master, &mut result.rows, q, &mut result.events) {
             Some(_) => result.late += 1,
             None => result.unexpected += 1,
         }
     }
     let mut end = Forward::default();
     end.signal.flags = FLAG_END;
-    ports.out.send(end)?;
+    ports.out.send_control(end)?;
     result.missing = result.rows.iter().filter(|r| r.backward.is_none()).count() as u64;
     result.counters = master.counters();
+    result.c_out = ports.out.stats();
+    result.q_in = ports.inbox.stats();
     Ok(result)
 }
 
 /// Stamps q's arrival, applies KFF-HMD and fills the row of the sample it answers.
 /// Returns that sample's number, or None for a sample that answers nothing (a probe, a
 /// duplicate, a number never sent).
-fn absorb(master: &mut Master, rows: &mut [TraceRow], mut q: Backward) -> Option<u64> {
+fn absorb(
+    master: &mut Master,
+    rows: &mut [TraceRow],
+    mut q: Backward,
+    events: &mut Vec<Event>,
+) -> Option<u64> {
     q.stamps[stage::MASTER_RECV] = now_ns();
     let index = usize::try_from(q.seq).ok().filter(|&i| {
         i < rows.len() && rows[i].backward.is_none() && q.signal.flags & FLAG_PROBE == 0
     })?;
+    if master.peer_lost() {
+        events.push(Event {
+            sample: q.seq,
+            what: "loop resumed: answers are back".into(),
+        });
+    }
     let sent = rows[index].forward;
     let mut row = master.backward(&sent, &q);
     if let Some(b) = row.backward.as_mut() {

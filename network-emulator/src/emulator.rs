@@ -6,10 +6,12 @@
 //! their provenance) taken from the delayed one. The noise added is recorded in the
 //! sample so reports can separate it from the signal.
 
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use tactile_common::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
-use tactile_common::samples::{Backward, Forward, Signal, FLAG_SUBSTITUTED};
-use tactile_common::scenario::Scenario;
+use tactile_common::samples::{Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED};
+use tactile_common::scenario::{ChannelConfig, Scenario};
 
 /// What the emulator counted over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -22,6 +24,54 @@ pub struct EmulatorCounters {
     pub forward_substituted: u64,
     /// Backward samples with a value substituted.
     pub backward_substituted: u64,
+    /// Forward samples dropped on purpose (loss model).
+    pub forward_dropped: u64,
+    /// Backward samples dropped on purpose.
+    pub backward_dropped: u64,
+    /// Forward samples corrupted to NaN on purpose (fault injection).
+    pub forward_corrupted: u64,
+    /// Backward samples corrupted to NaN on purpose.
+    pub backward_corrupted: u64,
+}
+
+/// The seeded drop and corruption decisions of one channel. A random stream of its
+/// own, so enabling loss does not change the noise a run sees.
+#[derive(Debug)]
+struct Faults {
+    loss: f64,
+    corrupt: f64,
+    rng: ChaCha8Rng,
+}
+
+/// What the fault model decided for one sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Fate {
+    Deliver,
+    Corrupt,
+    Drop,
+}
+
+impl Faults {
+    fn new(cfg: &ChannelConfig, seed: u64, stream: u64) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        rng.set_stream(stream + 100);
+        Faults {
+            loss: cfg.loss,
+            corrupt: cfg.corrupt,
+            rng,
+        }
+    }
+
+    fn fate(&mut self) -> Fate {
+        // Draw only for enabled faults, so a run without them draws nothing.
+        if self.loss > 0.0 && self.rng.random::<f64>() < self.loss {
+            return Fate::Drop;
+        }
+        if self.corrupt > 0.0 && self.rng.random::<f64>() < self.corrupt {
+            return Fate::Corrupt;
+        }
+        Fate::Deliver
+    }
 }
 
 /// Both channels.
@@ -29,6 +79,8 @@ pub struct EmulatorCounters {
 pub struct Emulator {
     forward: Channel,
     backward: Channel,
+    forward_faults: Faults,
+    backward_faults: Faults,
     counters: EmulatorCounters,
 }
 
@@ -57,9 +109,12 @@ fn apply(s: &mut Signal, e: &tactile_common::channel::Emitted) {
 impl Emulator {
     /// Channels as the scenario configures them, seeded from its seed.
     pub fn new(scenario: &Scenario) -> Emulator {
+        let (f, b) = (&scenario.network.forward, &scenario.network.backward);
         Emulator {
-            forward: Channel::new(&scenario.network.forward, scenario.seed, FORWARD_STREAM),
-            backward: Channel::new(&scenario.network.backward, scenario.seed, BACKWARD_STREAM),
+            forward: Channel::new(f, scenario.seed, FORWARD_STREAM),
+            backward: Channel::new(b, scenario.seed, BACKWARD_STREAM),
+            forward_faults: Faults::new(f, scenario.seed, FORWARD_STREAM),
+            backward_faults: Faults::new(b, scenario.seed, BACKWARD_STREAM),
             counters: EmulatorCounters::default(),
         }
     }
@@ -69,23 +124,50 @@ impl Emulator {
         self.counters
     }
 
-    /// c(n) in, v(n) out.
-    pub fn forward(&mut self, c: &Forward) -> Forward {
-        let e = self.forward.push(c.seq, values(&c.signal));
+    /// c(n) in, v(n) out; `None` when the loss model drops it.
+    pub fn forward(&mut self, c: &Forward) -> Option<Forward> {
         let mut v = *c;
-        apply(&mut v.signal, &e);
-        self.counters.forward += 1;
-        self.counters.forward_substituted += u64::from(e.substituted);
-        v
+        let keep = pass(
+            &mut self.forward,
+            &mut self.forward_faults,
+            c.seq,
+            &mut v.signal,
+        );
+        let k = &mut self.counters;
+        k.forward += 1;
+        k.forward_substituted += u64::from(v.signal.flags & FLAG_SUBSTITUTED != 0);
+        k.forward_corrupted += u64::from(keep == Fate::Corrupt);
+        k.forward_dropped += u64::from(keep == Fate::Drop);
+        (keep != Fate::Drop).then_some(v)
     }
 
-    /// h(n) in, q(n) out.
-    pub fn backward(&mut self, h: &Backward) -> Backward {
-        let e = self.backward.push(h.seq, values(&h.signal));
+    /// h(n) in, q(n) out; `None` when the loss model drops it.
+    pub fn backward(&mut self, h: &Backward) -> Option<Backward> {
         let mut q = *h;
-        apply(&mut q.signal, &e);
-        self.counters.backward += 1;
-        self.counters.backward_substituted += u64::from(e.substituted);
-        q
+        let keep = pass(
+            &mut self.backward,
+            &mut self.backward_faults,
+            h.seq,
+            &mut q.signal,
+        );
+        let k = &mut self.counters;
+        k.backward += 1;
+        k.backward_substituted += u64::from(q.signal.flags & FLAG_SUBSTITUTED != 0);
+        k.backward_corrupted += u64::from(keep == Fate::Corrupt);
+        k.backward_dropped += u64::from(keep == Fate::Drop);
+        (keep != Fate::Drop).then_some(q)
     }
+}
+
+/// One sample through one channel: delay and noise into `signal`, then the fault
+/// model's decision (a corrupted signal is already NaN when this returns).
+fn pass(channel: &mut Channel, faults: &mut Faults, seq: u64, signal: &mut Signal) -> Fate {
+    let e = channel.push(seq, values(signal));
+    apply(signal, &e);
+    let fate = faults.fate();
+    if fate == Fate::Corrupt {
+        signal.value = [f64::NAN; 3];
+        signal.flags |= FLAG_CORRUPTED;
+    }
+    fate
 }

@@ -5,8 +5,10 @@ use crate::emulator::{Emulator, EmulatorCounters};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 use tactile_common::clock::now_ns;
-use tactile_common::ipc::{self, streams, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
-use tactile_common::samples::{stage, Backward, Forward, StreamCount, FLAG_END, FLAG_PROBE};
+use tactile_common::ipc::{
+    self, streams, Idle, Inbox, InboxStats, IpcError, Outbox, OutboxStats, WaitPolicy, Waker,
+};
+use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::Scenario;
 
 /// What the emulator process needs to run.
@@ -23,12 +25,16 @@ pub struct EmulatorOptions {
 /// Everything the emulator measured.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 pub struct EmulatorRun {
-    /// Channel counters.
+    /// Channel counters (including drops and corruptions on purpose).
     pub counters: EmulatorCounters,
-    /// c(n) in, v(n) out.
-    pub forward: StreamCount,
-    /// h(n) in, q(n) out.
-    pub backward: StreamCount,
+    /// c(n) as received from the master.
+    pub c_in: InboxStats,
+    /// v(n) as published to the slave.
+    pub v_out: OutboxStats,
+    /// h(n) as received from the slave.
+    pub h_in: InboxStats,
+    /// q(n) as published to the master.
+    pub q_out: OutboxStats,
     /// True if SIGINT/SIGTERM stopped it.
     pub interrupted: bool,
 }
@@ -49,12 +55,7 @@ pub fn run(opts: &EmulatorOptions) -> Result<EmulatorRun, IpcError> {
     let in_h: Inbox<Backward> = Inbox::open(&node, streams::H)?;
     let out_q: Outbox<Backward> = Outbox::open(&node, streams::Q, streams::WAKE_MASTER)?;
     let waker = Waker::open(&node, streams::WAKE_EMULATOR)?;
-    let mut run = EmulatorRun {
-        counters: EmulatorCounters::default(),
-        forward: StreamCount::default(),
-        backward: StreamCount::default(),
-        interrupted: false,
-    };
+    let mut interrupted = false;
     loop {
         let deadline = Instant::now() + Duration::from_secs(3600);
         let got = waker.wait(&node, opts.wait.spin, deadline, || {
@@ -68,38 +69,42 @@ pub fn run(opts: &EmulatorOptions) -> Result<EmulatorRun, IpcError> {
             Ok(Arrival::Forward(mut c)) => {
                 let flags = c.signal.flags;
                 if flags & (FLAG_PROBE | FLAG_END) != 0 {
-                    out_v.send(c)?;
+                    out_v.send_control(c)?;
                     if flags & FLAG_END != 0 {
                         break;
                     }
                     continue;
                 }
                 c.stamps[stage::EMU_FWD_RECV] = now_ns();
-                run.forward.saw(c.seq);
-                let mut v = emu.forward(&c);
-                v.stamps[stage::EMU_FWD_SEND] = now_ns();
-                out_v.send(v)?;
-                run.forward.sent += 1;
+                if let Some(mut v) = emu.forward(&c) {
+                    v.stamps[stage::EMU_FWD_SEND] = now_ns();
+                    out_v.send(v)?;
+                }
             }
             Ok(Arrival::Backward(mut h)) => {
                 if h.signal.flags & FLAG_PROBE != 0 {
-                    out_q.send(h)?;
+                    out_q.send_control(h)?;
                     continue;
                 }
                 h.stamps[stage::EMU_BWD_RECV] = now_ns();
-                run.backward.saw(h.seq);
-                let mut q = emu.backward(&h);
-                q.stamps[stage::EMU_BWD_SEND] = now_ns();
-                out_q.send(q)?;
-                run.backward.sent += 1;
+                if let Some(mut q) = emu.backward(&h) {
+                    q.stamps[stage::EMU_BWD_SEND] = now_ns();
+                    out_q.send(q)?;
+                }
             }
             Err(Idle::Timeout) => {}
             Err(Idle::Terminate) => {
-                run.interrupted = true;
+                interrupted = true;
                 break;
             }
         }
     }
-    run.counters = emu.counters();
-    Ok(run)
+    Ok(EmulatorRun {
+        counters: emu.counters(),
+        c_in: in_c.stats(),
+        v_out: out_v.stats(),
+        h_in: in_h.stats(),
+        q_out: out_q.stats(),
+        interrupted,
+    })
 }

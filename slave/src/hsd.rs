@@ -11,7 +11,7 @@
 //! (the device's true tool position and the contact force on it) is f64.
 
 use crate::device::{Controller, Dynamics, JointState};
-use crate::environment::{deepest_contact, Contact};
+use crate::environment::deepest_contact;
 use serde::{Deserialize, Serialize};
 use tactile_common::arith::StdTrig;
 use tactile_common::engine::Engine;
@@ -23,7 +23,7 @@ use tactile_common::samples::{
 use tactile_common::scenario::{Object, Scenario, ScenarioError};
 
 /// What the slave counted over a run.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct SlaveCounters {
     /// Steps taken.
     pub steps: u64,
@@ -35,6 +35,12 @@ pub struct SlaveCounters {
     pub torque_clamps: u64,
     /// Steps in contact with an object.
     pub contact_steps: u64,
+    /// Steps taken holding position because the input went silent.
+    pub held_steps: u64,
+    /// Times the input went silent and the slave started holding.
+    pub holds: u64,
+    /// Largest distance the tool moved while holding, m.
+    pub hold_drift_max_m: f64,
 }
 
 /// The slave: HSD kernels, controller, device and environment.
@@ -48,6 +54,7 @@ pub struct Slave {
     t_s: f64,
     reference: [f64; 3],
     counters: SlaveCounters,
+    hold_from: Option<[f64; 3]>,
 }
 
 impl Slave {
@@ -68,6 +75,7 @@ impl Slave {
             t_s: scenario.t_s(),
             reference: [0.0; 3],
             counters: SlaveCounters::default(),
+            hold_from: None,
         })
     }
 
@@ -81,15 +89,53 @@ impl Slave {
         self.dynamics.state
     }
 
-    /// The environment's contact with the tool at joint angles `theta` (true, f64).
-    fn contact_at(&self, theta: [f64; 3]) -> (Option<Contact>, [f64; 3]) {
-        let tool = kernels::fk(&self.truth, &StdTrig, theta);
-        (deepest_contact(&self.objects, tool), tool)
+    /// One sample of t_s with no input: hold the joints where they were when the input
+    /// went silent (the master or the network is gone; the device must not wander).
+    pub fn hold(&mut self) {
+        let theta_now = self.dynamics.state.theta;
+        let from = *self.hold_from.get_or_insert_with(|| {
+            self.counters.holds += 1;
+            theta_now
+        });
+        self.reference = from;
+        self.counters.held_steps += 1;
+        let cmd = self.controller.update(
+            from,
+            self.dynamics.state.theta,
+            self.dynamics.state.velocity,
+            self.t_s,
+        );
+        self.counters.torque_clamps += u64::from(cmd.clamped);
+        self.advance(cmd.torque);
+        let p0 = kernels::fk(&self.truth, &StdTrig, from);
+        let p = kernels::fk(&self.truth, &StdTrig, self.dynamics.state.theta);
+        let drift =
+            ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2) + (p[2] - p0[2]).powi(2)).sqrt();
+        self.counters.hold_drift_max_m = self.counters.hold_drift_max_m.max(drift);
+    }
+
+    /// Integrates the device over one sample under `torque`, pushed back by whatever the
+    /// tool touches (true tool position, f64).
+    fn advance(&mut self, torque: [f64; 3]) {
+        let truth = self.truth;
+        let objects = &self.objects;
+        self.dynamics.advance(torque, self.t_s, |s| {
+            let tool = kernels::fk(&truth, &StdTrig, s.theta);
+            match deepest_contact(objects, tool) {
+                Some(c) => {
+                    let f = kernels::fbf(c.surface, tool, c.stiffness);
+                    let j = kernels::jacobian(&truth, &StdTrig, s.theta);
+                    [0, 1, 2].map(|k| j[0][k] * f[0] + j[1][k] * f[1] + j[2][k] * f[2])
+                }
+                None => [0.0; 3],
+            }
+        });
     }
 
     /// One sample: v(n) in, h(n) out. Stamps are copied from `v`; the edge sets its own.
     pub fn step(&mut self, v: &Forward) -> Backward {
         self.counters.steps += 1;
+        self.hold_from = None;
         let mut flags = 0;
         // CPD-HSD: pass-through. A non-finite value never reaches IK or a torque.
         let target = v.signal.value;
@@ -122,25 +168,14 @@ impl Slave {
             .update(self.reference, state.theta, state.velocity, self.t_s);
         self.counters.torque_clamps += u64::from(cmd.clamped);
 
-        // SD: joint dynamics, pushed back by whatever the tool touches.
-        let truth = self.truth;
-        let objects = &self.objects;
-        self.dynamics.advance(cmd.torque, self.t_s, |s| {
-            let tool = kernels::fk(&truth, &StdTrig, s.theta);
-            match deepest_contact(objects, tool) {
-                Some(c) => {
-                    let f = kernels::fbf(c.surface, tool, c.stiffness);
-                    let j = kernels::jacobian(&truth, &StdTrig, s.theta);
-                    [0, 1, 2].map(|k| j[0][k] * f[0] + j[1][k] * f[1] + j[2][k] * f[2])
-                }
-                None => [0.0; 3],
-            }
-        });
+        // SD: joint dynamics.
+        self.advance(cmd.torque);
         let theta = self.dynamics.state.theta;
 
-        // FK-HSD in the HSD's arithmetic; ENV sensors report the surface point.
+        // FK-HSD in the HSD's arithmetic; ENV sensors report the surface point of the
+        // object the true tool is in.
         let tool = self.engine.fk(theta);
-        let (contact, _) = self.contact_at(theta);
+        let contact = deepest_contact(&self.objects, kernels::fk(&self.truth, &StdTrig, theta));
         let (force, surface, contact_object) = match contact {
             Some(c) => {
                 flags |= FLAG_CONTACT;

@@ -1,11 +1,15 @@
 //! The slave process's edge: takes v(n), runs one step of [`Slave`], publishes h(n).
+//! When v(n) stops coming for the peer timeout, the slave holds its position, one
+//! step per t_s, until input returns.
 
 use crate::hsd::{Slave, SlaveCounters};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 use tactile_common::clock::now_ns;
-use tactile_common::ipc::{self, streams, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
-use tactile_common::samples::{stage, Backward, Forward, StreamCount, FLAG_END, FLAG_PROBE};
+use tactile_common::ipc::{
+    self, streams, Idle, Inbox, InboxStats, IpcError, Outbox, OutboxStats, WaitPolicy, Waker,
+};
+use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::{Scenario, ScenarioError};
 use thiserror::Error;
 
@@ -36,10 +40,20 @@ pub enum SlaveError {
 pub struct SlaveRun {
     /// State-machine counters.
     pub counters: SlaveCounters,
-    /// v(n) in, h(n) out.
-    pub stream: StreamCount,
+    /// v(n) as received.
+    pub v_in: InboxStats,
+    /// h(n) as published.
+    pub h_out: OutboxStats,
     /// True if SIGINT/SIGTERM stopped it.
     pub interrupted: bool,
+}
+
+/// How long without input before the slave holds: the scenario's peer timeout in
+/// samples, but never under 50 ms (a lockstep master may pause that long for its own
+/// reasons).
+pub fn hold_timeout(scenario: &Scenario) -> Duration {
+    let t = Duration::from_nanos(scenario.faults.peer_timeout_samples * scenario.t_s_ns());
+    t.max(Duration::from_millis(50))
 }
 
 /// Runs until the end-of-run sample or a stop request.
@@ -49,14 +63,14 @@ pub fn run(opts: &SlaveOptions) -> Result<SlaveRun, SlaveError> {
     let inbox: Inbox<Forward> = Inbox::open(&node, streams::V)?;
     let out: Outbox<Backward> = Outbox::open(&node, streams::H, streams::WAKE_EMULATOR)?;
     let waker = Waker::open(&node, streams::WAKE_SLAVE)?;
-    let mut run = SlaveRun {
-        counters: SlaveCounters::default(),
-        stream: StreamCount::default(),
-        interrupted: false,
-    };
+    let timeout = hold_timeout(&opts.scenario);
+    let t_s = Duration::from_nanos(opts.scenario.t_s_ns());
+    let mut interrupted = false;
+    // No input yet: wait as long as it takes for the first sample.
+    let mut deadline: Option<Instant> = None;
     loop {
-        let deadline = Instant::now() + Duration::from_secs(3600);
-        match waker.wait(&node, opts.wait.spin, deadline, || inbox.try_recv())? {
+        let until = deadline.unwrap_or_else(|| Instant::now() + Duration::from_secs(3600));
+        match waker.wait(&node, opts.wait.spin, until, || inbox.try_recv())? {
             Ok(mut v) => {
                 let flags = v.signal.flags;
                 if flags & FLAG_END != 0 {
@@ -68,23 +82,32 @@ pub fn run(opts: &SlaveOptions) -> Result<SlaveRun, SlaveError> {
                         ..Backward::default()
                     };
                     echo.signal.flags = FLAG_PROBE;
-                    out.send(echo)?;
+                    out.send_control(echo)?;
                     continue;
                 }
                 v.stamps[stage::SLAVE_RECV] = now_ns();
-                run.stream.saw(v.seq);
                 let mut h = slave.step(&v);
                 h.stamps[stage::SLAVE_SEND] = now_ns();
                 out.send(h)?;
-                run.stream.sent += 1;
+                deadline = Some(Instant::now() + timeout);
             }
-            Err(Idle::Timeout) => {}
+            Err(Idle::Timeout) => {
+                if deadline.is_some() {
+                    // Input went silent: hold, one step per t_s, until it returns.
+                    slave.hold();
+                    deadline = Some(Instant::now() + t_s);
+                }
+            }
             Err(Idle::Terminate) => {
-                run.interrupted = true;
+                interrupted = true;
                 break;
             }
         }
     }
-    run.counters = slave.counters();
-    Ok(run)
+    Ok(SlaveRun {
+        counters: slave.counters(),
+        v_in: inbox.stats(),
+        h_out: out.stats(),
+        interrupted,
+    })
 }

@@ -1,0 +1,371 @@
+//! Faults done for real: processes killed with SIGKILL mid-run, a stop signal to the
+//! launcher, a crashed run followed by a new one, a full subscriber buffer, corrupted
+//! and dropped samples, forces past the device's limit.
+
+mod util;
+
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+use tactile_common::ipc::{self, Inbox, Outbox};
+use tactile_common::samples::{Forward, FLAG_PEER_LOST};
+use util::{column, Sandbox};
+
+/// A 1 kHz realtime scenario of `samples` samples.
+fn realtime(samples: u64) -> String {
+    tactile::run_cmd::PAPER_SCENARIO
+        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
+        .replace("samples = 1200", &format!("samples = {samples}"))
+}
+
+fn spawn_run(sb: &Sandbox, scenario: &std::path::Path, out: &str) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_tactile"))
+        .args(["run", scenario.to_str().expect("utf-8"), "--out"])
+        .arg(sb.path(out))
+        .args(["--prefix", &sb.prefix, "-q"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start tactile run")
+}
+
+/// PID of the running `tactile role <role>` of this sandbox's run.
+fn pid_of(sb: &Sandbox, role: &str) -> Option<i32> {
+    let needle = format!("role\0{role}\0");
+    let prefix = format!("--prefix\0{}\0", sb.prefix);
+    std::fs::read_dir("/proc").ok()?.flatten().find_map(|e| {
+        let pid: i32 = e.file_name().to_str()?.parse().ok()?;
+        let cmd =
+            String::from_utf8_lossy(&std::fs::read(e.path().join("cmdline")).ok()?).to_string();
+        (cmd.contains(&needle) && cmd.contains(&prefix)).then_some(pid)
+    })
+}
+
+fn kill(pid: i32, signal: rustix::process::Signal) {
+    let pid = rustix::process::Pid::from_raw(pid).expect("pid");
+    rustix::process::kill_process(pid, signal).expect("kill");
+}
+
+/// Waits until the run's master process is up.
+fn wait_for_master(sb: &Sandbox) {
+    let start = Instant::now();
+    while pid_of(sb, "master").is_none() && start.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// Waits until the run's master has got going, then kills `role` with SIGKILL.
+fn kill_mid_run(sb: &Sandbox, role: &str, after: Duration) {
+    wait_for_master(sb);
+    std::thread::sleep(after);
+    let pid = pid_of(sb, role).unwrap_or_else(|| panic!("no {role} running"));
+    kill(pid, rustix::process::Signal::KILL);
+}
+
+fn finish(child: Child) -> (Option<i32>, String, String) {
+    let o = child.wait_with_output().expect("wait");
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stdout).to_string(),
+        String::from_utf8_lossy(&o.stderr).to_string(),
+    )
+}
+
+/// Kills `role` mid-run; the launcher restarts it and the loop must break, command
+/// zero torque, and resume.
+fn peer_dies_and_the_loop_resumes(role: &str) {
+    let sb = Sandbox::new(role);
+    let scenario = sb.write("s.toml", &realtime(4000));
+    let child = spawn_run(&sb, &scenario, "run");
+    kill_mid_run(&sb, role, Duration::from_millis(1500));
+    let (code, stdout, stderr) = finish(child);
+    sb.assert_no_leftover_processes();
+    assert_eq!(
+        code,
+        Some(1),
+        "a run with a dead process fails\n{stdout}\n{stderr}"
+    );
+    assert!(
+        stderr.contains(&format!("{role} was killed by signal 9")),
+        "{stderr}"
+    );
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["failed"], true);
+    let events: Vec<String> = s["events"]
+        .as_array()
+        .expect("events")
+        .iter()
+        .map(|e| e.as_str().expect("text").to_string())
+        .collect();
+    let joined = events.join("\n");
+    assert!(
+        joined.contains(&format!("{role} was killed by signal 9")),
+        "{joined}"
+    );
+    assert!(joined.contains(&format!("{role} restarted")), "{joined}");
+    assert!(joined.contains("loop broken"), "{joined}");
+    assert!(joined.contains("loop resumed"), "{joined}");
+    let m = &s["master"]["counters"];
+    assert!(m["peer_lost_samples"].as_u64() > Some(0), "{m}");
+    assert!(m["loop_breaks"].as_u64() >= Some(1));
+    assert!(m["resumes"].as_u64() >= Some(1));
+    // Every sample past the timeout is marked and commands zero torque.
+    let trace = sb.trace("run");
+    let flags = column(&trace, "flags_m");
+    let taus: Vec<Vec<f64>> = (1..=3)
+        .map(|j| column(&trace, &format!("tau_{j}")))
+        .collect();
+    let lost: Vec<usize> = (0..flags.len())
+        .filter(|&n| flags[n] as u32 & FLAG_PEER_LOST != 0)
+        .collect();
+    assert!(!lost.is_empty());
+    for &n in &lost {
+        assert!(taus.iter().all(|t| t[n] == 0.0), "sample {n} has torque");
+    }
+    // The loop broke within the timeout: the first lost sample is 10 samples after the
+    // last answered one.
+    let received = column(&trace, "received");
+    let first = lost[0];
+    assert!(received[first - 10] == 1.0 || flags[first - 10] as u32 != 0);
+    assert!(
+        received[first - 11] == 1.0,
+        "detection took longer than 10 samples"
+    );
+    // And it resumed: answers again after the lost stretch.
+    let last_lost = *lost.last().expect("lost");
+    assert!(
+        received[last_lost + 1..]
+            .iter()
+            .filter(|r| **r == 1.0)
+            .count()
+            > 100
+    );
+}
+
+#[test]
+fn slave_killed_the_master_zeroes_torque_and_resumes_after_restart() {
+    peer_dies_and_the_loop_resumes("slave");
+}
+
+#[test]
+fn emulator_killed_the_master_zeroes_torque_and_resumes_after_restart() {
+    peer_dies_and_the_loop_resumes("emulator");
+}
+
+#[test]
+fn master_killed_the_slave_holds_and_the_launcher_fails_cleanly() {
+    let sb = Sandbox::new("master");
+    let scenario = sb.write("s.toml", &realtime(5000));
+    let child = spawn_run(&sb, &scenario, "run");
+    kill_mid_run(&sb, "master", Duration::from_millis(1500));
+    let (code, _stdout, stderr) = finish(child);
+    sb.assert_no_leftover_processes();
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(stderr.contains("master was killed by signal 9"), "{stderr}");
+    let slave = sb.json("run", "slave.json");
+    let c = &slave["counters"];
+    assert!(c["holds"].as_u64() >= Some(1), "{c}");
+    assert!(c["held_steps"].as_u64() > Some(10), "{c}");
+    // Holding means staying put: under a millimetre of drift.
+    assert!(c["hold_drift_max_m"].as_f64() < Some(0.001), "{c}");
+}
+
+#[test]
+fn sigterm_to_the_launcher_stops_everything_and_writes_the_report() {
+    let sb = Sandbox::new("sigterm");
+    let scenario = sb.write("s.toml", &realtime(20_000));
+    let child = spawn_run(&sb, &scenario, "run");
+    wait_for_master(&sb);
+    std::thread::sleep(Duration::from_millis(1000));
+    kill(child.id() as i32, rustix::process::Signal::TERM);
+    let (code, stdout, stderr) = finish(child);
+    sb.assert_no_leftover_processes();
+    assert_eq!(code, Some(130), "{stdout}\n{stderr}");
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["interrupted"], true);
+    let sent = s["samples_sent"].as_u64().expect("sent");
+    assert!(sent > 100 && sent < 20_000, "sent {sent}");
+    assert!(s["round_trip_ns"]["count"].as_u64() > Some(100));
+    assert!(sb.path("run").join("trace.csv").exists());
+}
+
+#[test]
+fn a_new_run_after_a_crash_starts_cleanly() {
+    let sb = Sandbox::new("crash");
+    let scenario = sb.write("s.toml", &realtime(20_000));
+    let child = spawn_run(&sb, &scenario, "first");
+    kill_mid_run(&sb, "master", Duration::from_millis(500));
+    // Kill the launcher first, so nobody cleans up, then every process of the run.
+    let launcher = child.id() as i32;
+    let (m, e, s) = (
+        pid_of(&sb, "master"),
+        pid_of(&sb, "emulator"),
+        pid_of(&sb, "slave"),
+    );
+    kill(launcher, rustix::process::Signal::KILL);
+    for pid in [m, e, s].into_iter().flatten() {
+        kill(pid, rustix::process::Signal::KILL);
+    }
+    let _ = finish(child);
+    std::thread::sleep(Duration::from_millis(100));
+    sb.assert_no_leftover_processes();
+    // Stale shared memory of the crashed run is still there; the same prefix must work.
+    let again = sb.write("again.toml", &realtime(500));
+    sb.run(&again, "second");
+    let s = sb.json("second", "summary.json");
+    assert_eq!(s["samples_received"], 500);
+    assert_eq!(s["failed"], false);
+}
+
+#[test]
+fn a_full_subscriber_buffer_loses_exactly_the_overwritten_samples() {
+    let sb = Sandbox::new("overflow");
+    let node = ipc::node(&sb.prefix, "test").expect("node");
+    let out: Outbox<Forward> = Outbox::open(&node, "overflow", "nobody").expect("outbox");
+    let inbox: Inbox<Forward> = Inbox::open(&node, "overflow").expect("inbox");
+    let total = 200u64;
+    for n in 0..total {
+        let reached = out
+            .send(Forward {
+                seq: n,
+                ..Forward::default()
+            })
+            .expect("send");
+        assert_eq!(reached, 1);
+    }
+    let mut got = Vec::new();
+    while let Some(f) = inbox.try_recv().expect("recv") {
+        got.push(f.seq);
+    }
+    let buffer = ipc::SUBSCRIBER_BUFFER as u64;
+    // Safe overflow keeps the newest samples.
+    assert_eq!(got, (total - buffer..total).collect::<Vec<_>>());
+    let st = inbox.stats();
+    assert_eq!(st.received, buffer);
+    // The first sample taken has nothing before it to compare with; from there on
+    // every gap is counted.
+    assert_eq!(st.overwritten, 0);
+    // Now a second burst with the receiver established: every overwrite is counted.
+    for n in total..total + 100 {
+        out.send(Forward {
+            seq: n,
+            ..Forward::default()
+        })
+        .expect("send");
+    }
+    while inbox.try_recv().expect("recv").is_some() {}
+    let st = inbox.stats();
+    assert_eq!(st.received, 2 * buffer);
+    assert_eq!(st.overwritten, 100 - buffer);
+    assert_eq!(out.stats().published, total + 100);
+    assert_eq!(out.stats().no_receiver, 0);
+}
+
+#[test]
+fn corrupted_samples_never_reach_a_torque() {
+    let sb = Sandbox::new("corrupt");
+    let text = tactile::run_cmd::PAPER_SCENARIO
+        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        .replace("[network.forward]\n", "[network.forward]\ncorrupt = 0.05\n")
+        .replace(
+            "[network.backward]\n",
+            "[network.backward]\ncorrupt = 0.05\n",
+        );
+    let scenario = sb.write("s.toml", &text);
+    sb.run(&scenario, "run");
+    let s = sb.json("run", "summary.json");
+    let e = &s["emulator"]["counters"];
+    let f_bad = e["forward_corrupted"].as_u64().expect("count");
+    let b_bad = e["backward_corrupted"].as_u64().expect("count");
+    assert!(f_bad > 20 && b_bad > 20, "{e}");
+    assert_eq!(s["slave"]["counters"]["rejected"].as_u64(), Some(f_bad));
+    assert_eq!(s["master"]["counters"]["rejected"].as_u64(), Some(b_bad));
+    let trace = sb.trace("run");
+    for col in [
+        "tau_1",
+        "tau_2",
+        "tau_3",
+        "u_1",
+        "u_2",
+        "u_3",
+        "felt_1",
+        "theta_sd_1",
+    ] {
+        assert!(column(&trace, col).iter().all(|v| v.is_finite()), "{col}");
+    }
+}
+
+#[test]
+fn dropped_samples_are_counted_and_every_stream_reconciles() {
+    let sb = Sandbox::new("loss");
+    let text = realtime(3000)
+        .replace("[network.forward]\n", "[network.forward]\nloss = 0.03\n")
+        .replace("[network.backward]\n", "[network.backward]\nloss = 0.02\n");
+    let scenario = sb.write("s.toml", &text);
+    sb.run(&scenario, "run");
+    let s = sb.json("run", "summary.json");
+    let e = &s["emulator"]["counters"];
+    let channels = &s["channels"];
+    assert_eq!(channels["v"]["lost_dropped"], e["forward_dropped"]);
+    assert_eq!(channels["q"]["lost_dropped"], e["backward_dropped"]);
+    assert!(e["forward_dropped"].as_u64() > Some(30));
+    for stream in ["c", "v", "h", "q"] {
+        let c = &channels[stream];
+        let get = |k: &str| c[k].as_u64().expect("count");
+        assert_eq!(
+            get("offered"),
+            get("received") + get("lost"),
+            "{stream}: {c}"
+        );
+        assert_eq!(
+            get("lost"),
+            get("lost_dropped") + get("lost_overwritten") + get("lost_dead_peer"),
+            "{stream}: {c}"
+        );
+        assert_eq!(get("lost_dead_peer"), 0, "{stream}: {c}");
+        assert_eq!(get("lost_overwritten"), 0, "{stream}: {c}");
+    }
+    // End to end: a sample lost on either stream never comes back.
+    let dropped =
+        e["forward_dropped"].as_u64().expect("n") + e["backward_dropped"].as_u64().expect("n");
+    assert_eq!(s["samples_lost"].as_u64(), Some(dropped));
+}
+
+#[test]
+fn forces_and_torques_are_clamped_to_the_device_limits() {
+    let sb = Sandbox::new("clamp");
+    // A stiff wall (above the Omni's nominal 700 N/m: loads with a warning) that the
+    // tool is driven deep into.
+    let text = tactile::run_cmd::PAPER_SCENARIO
+        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        .replace(
+            "stiffness = [300.0, 300.0, 300.0]",
+            "stiffness = [3000.0, 3000.0, 3000.0]",
+        )
+        .replace("point = [0.0, 0.0, -0.16]", "point = [0.0, 0.0, -0.14]")
+        .replace(
+            "[slave.controller]\nkp = [6.0, 6.0, 6.0]",
+            "[slave.controller]\nkp = [40.0, 40.0, 40.0]",
+        );
+    let scenario = sb.write("s.toml", &text);
+    let o = sb.run(&scenario, "run");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("warning"));
+    let s = sb.json("run", "summary.json");
+    assert!(
+        s["master"]["motion"]["force_max_n"].as_f64() > Some(3.3),
+        "{}",
+        s["master"]["motion"]
+    );
+    assert!(s["master"]["counters"]["force_clamps"].as_u64() > Some(0));
+    let trace = sb.trace("run");
+    for j in 1..=3 {
+        assert!(column(&trace, &format!("felt_{j}"))
+            .iter()
+            .all(|f| f.abs() <= 3.3));
+        assert!(column(&trace, &format!("tau_{j}"))
+            .iter()
+            .all(|t| t.abs() <= 0.45));
+        assert!(column(&trace, &format!("u_{j}"))
+            .iter()
+            .all(|t| t.abs() <= 0.45));
+    }
+}
