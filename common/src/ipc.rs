@@ -26,8 +26,7 @@ use std::fmt::Debug;
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
-/// `hop_seq` of control samples, which no counter sees.
-pub const CONTROL_HOP_SEQ: u64 = u64::MAX;
+pub use crate::link::CONTROL_HOP_SEQ;
 
 /// A process's iceoryx2 node.
 pub type IpcNode = Node<ipc::Service>;
@@ -237,30 +236,26 @@ impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Outbox<T> {
 
     /// Publishes a copy of `value` (stamped with this hop's publish counter) and wakes
     /// the receiver; returns how many subscribers it reached.
-    pub fn send(&self, mut value: T) -> Result<usize, IpcError> {
-        let mut st = self.stats.get();
-        value.set_hop_seq(st.published);
-        let n = map(
-            self.publisher.send_copy(value),
-            format!("sending on {}", self.stream),
-        )?;
-        st.published += 1;
-        if n == 0 {
-            st.no_receiver += 1;
-        }
-        self.stats.set(st);
-        map(self.notifier.notify(), format!("notifying {}", self.stream))?;
-        Ok(n)
+    pub fn send(&self, value: T) -> Result<usize, IpcError> {
+        self.publish(value, false)
     }
 
     /// Publishes a control sample (start-up probe, end of run): not counted, and
     /// marked so the receiver does not count it either.
-    pub fn send_control(&self, mut value: T) -> Result<usize, IpcError> {
-        value.set_hop_seq(CONTROL_HOP_SEQ);
+    pub fn send_control(&self, value: T) -> Result<usize, IpcError> {
+        self.publish(value, true)
+    }
+
+    /// Publishes, counted unless `control`.
+    pub fn publish(&self, mut value: T, control: bool) -> Result<usize, IpcError> {
+        let mut st = self.stats.get();
+        st.stamp(&mut value, control);
         let n = map(
             self.publisher.send_copy(value),
             format!("sending on {}", self.stream),
         )?;
+        st.count(n, control);
+        self.stats.set(st);
         map(self.notifier.notify(), format!("notifying {}", self.stream))?;
         Ok(n)
     }
@@ -295,16 +290,11 @@ impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Inbox<T> {
             format!("receiving on {}", self.stream),
         )?
         .map(|s| *s);
-        if let Some(v) = got.as_ref().filter(|v| v.hop_seq() != CONTROL_HOP_SEQ) {
+        if let Some(v) = &got {
             let mut st = self.stats.get();
-            st.received += 1;
-            let h = v.hop_seq();
-            match self.next_hop_seq.get() {
-                Some(next) if h >= next => st.overwritten += h - next,
-                Some(_) => st.publisher_restarts += 1,
-                None => {}
-            }
-            self.next_hop_seq.set(Some(h + 1));
+            let mut next = self.next_hop_seq.get();
+            st.count(v, &mut next);
+            self.next_hop_seq.set(next);
             self.stats.set(st);
         }
         Ok(got)
@@ -411,4 +401,141 @@ pub fn remove_run_files(prefix: &str) {
         }
     }
     let _ = std::fs::remove_dir_all(format!("{ROOT}/{prefix}"));
+}
+
+/// The master's end of the loop over iceoryx2.
+#[derive(Debug)]
+pub struct IoxMaster {
+    node: IpcNode,
+    out: Outbox<crate::samples::Forward>,
+    inbox: Inbox<crate::samples::Backward>,
+    waker: Waker,
+    spin: Duration,
+    prefix: String,
+}
+
+impl IoxMaster {
+    /// Opens the master's streams of run `prefix`.
+    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
+        let node = node(prefix, "master")?;
+        Ok(IoxMaster {
+            out: Outbox::open(&node, streams::C, streams::WAKE_EMULATOR)?,
+            inbox: Inbox::open(&node, streams::Q)?,
+            waker: Waker::open(&node, streams::WAKE_MASTER)?,
+            node,
+            spin: wait.spin,
+            prefix: prefix.to_string(),
+        })
+    }
+}
+
+impl crate::link::MasterLink for IoxMaster {
+    fn send(&self, c: crate::samples::Forward) -> Result<(), IpcError> {
+        self.out.publish(c, false).map(|_| ())
+    }
+    fn send_control(&self, c: crate::samples::Forward) -> Result<(), IpcError> {
+        self.out.publish(c, true).map(|_| ())
+    }
+    fn recv(&self, deadline: Instant) -> crate::link::Wait<crate::samples::Backward> {
+        self.waker
+            .wait(&self.node, self.spin, deadline, || self.inbox.try_recv())
+    }
+    fn dead_peers(&self) -> Vec<String> {
+        dead_nodes(&self.prefix).unwrap_or_default()
+    }
+    fn stats(&self) -> (OutboxStats, InboxStats) {
+        (self.out.stats(), self.inbox.stats())
+    }
+}
+
+/// The emulator's ends of the loop over iceoryx2.
+#[derive(Debug)]
+pub struct IoxEmulator {
+    node: IpcNode,
+    in_c: Inbox<crate::samples::Forward>,
+    out_v: Outbox<crate::samples::Forward>,
+    in_h: Inbox<crate::samples::Backward>,
+    out_q: Outbox<crate::samples::Backward>,
+    waker: Waker,
+    spin: Duration,
+}
+
+impl IoxEmulator {
+    /// Opens the emulator's streams of run `prefix`.
+    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
+        let node = node(prefix, "emulator")?;
+        Ok(IoxEmulator {
+            in_c: Inbox::open(&node, streams::C)?,
+            out_v: Outbox::open(&node, streams::V, streams::WAKE_SLAVE)?,
+            in_h: Inbox::open(&node, streams::H)?,
+            out_q: Outbox::open(&node, streams::Q, streams::WAKE_MASTER)?,
+            waker: Waker::open(&node, streams::WAKE_EMULATOR)?,
+            node,
+            spin: wait.spin,
+        })
+    }
+}
+
+impl crate::link::EmulatorLink for IoxEmulator {
+    fn recv(&self, deadline: Instant) -> crate::link::Wait<crate::link::Arrival> {
+        use crate::link::Arrival;
+        self.waker.wait(&self.node, self.spin, deadline, || {
+            // Backward first: it completes a round trip the master is waiting for.
+            if let Some(h) = self.in_h.try_recv()? {
+                return Ok(Some(Arrival::Backward(h)));
+            }
+            Ok(self.in_c.try_recv()?.map(Arrival::Forward))
+        })
+    }
+    fn send_v(&self, v: crate::samples::Forward, control: bool) -> Result<(), IpcError> {
+        self.out_v.publish(v, control).map(|_| ())
+    }
+    fn send_q(&self, q: crate::samples::Backward, control: bool) -> Result<(), IpcError> {
+        self.out_q.publish(q, control).map(|_| ())
+    }
+    fn stats(&self) -> crate::link::EmulatorStats {
+        crate::link::EmulatorStats {
+            c_in: self.in_c.stats(),
+            v_out: self.out_v.stats(),
+            h_in: self.in_h.stats(),
+            q_out: self.out_q.stats(),
+        }
+    }
+}
+
+/// The slave's ends of the loop over iceoryx2.
+#[derive(Debug)]
+pub struct IoxSlave {
+    node: IpcNode,
+    inbox: Inbox<crate::samples::Forward>,
+    out: Outbox<crate::samples::Backward>,
+    waker: Waker,
+    spin: Duration,
+}
+
+impl IoxSlave {
+    /// Opens the slave's streams of run `prefix`.
+    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
+        let node = node(prefix, "slave")?;
+        Ok(IoxSlave {
+            inbox: Inbox::open(&node, streams::V)?,
+            out: Outbox::open(&node, streams::H, streams::WAKE_EMULATOR)?,
+            waker: Waker::open(&node, streams::WAKE_SLAVE)?,
+            node,
+            spin: wait.spin,
+        })
+    }
+}
+
+impl crate::link::SlaveLink for IoxSlave {
+    fn recv(&self, deadline: Instant) -> crate::link::Wait<crate::samples::Forward> {
+        self.waker
+            .wait(&self.node, self.spin, deadline, || self.inbox.try_recv())
+    }
+    fn send_h(&self, h: crate::samples::Backward, control: bool) -> Result<(), IpcError> {
+        self.out.publish(h, control).map(|_| ())
+    }
+    fn stats(&self) -> (InboxStats, OutboxStats) {
+        (self.inbox.stats(), self.out.stats())
+    }
 }

@@ -12,6 +12,7 @@ pub mod engine;
 pub mod geometry;
 pub mod ipc;
 pub mod kernels;
+pub mod link;
 pub mod samples;
 pub mod scenario;
 pub mod trace;

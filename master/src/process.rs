@@ -12,10 +12,8 @@ use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tactile_common::clock::{now_ns, sleep_until_ns};
-use tactile_common::ipc::{
-    self, streams, Idle, Inbox, InboxStats, IpcError, IpcNode, Outbox, OutboxStats, WaitPolicy,
-    Waker,
-};
+use tactile_common::ipc::{Idle, InboxStats, IoxMaster, IpcError, OutboxStats, WaitPolicy};
+use tactile_common::link::MasterLink;
 use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::{Mode, Scenario, ScenarioError};
 use tactile_common::trace::TraceRow;
@@ -99,14 +97,7 @@ fn index_of(n: u64) -> usize {
     usize::try_from(n).unwrap_or(usize::MAX)
 }
 
-struct Ports {
-    node: IpcNode,
-    out: Outbox<Forward>,
-    inbox: Inbox<Backward>,
-    waker: Waker,
-}
-
-fn probe(ports: &Ports, timeout: Duration) -> Result<bool, MasterError> {
+fn probe(link: &impl MasterLink, timeout: Duration) -> Result<bool, MasterError> {
     let start = Instant::now();
     let mut k = 0u64;
     while start.elapsed() < timeout {
@@ -115,23 +106,16 @@ fn probe(ports: &Ports, timeout: Duration) -> Result<bool, MasterError> {
             ..Forward::default()
         };
         p.signal.flags = FLAG_PROBE;
-        ports.out.send_control(p)?;
+        link.send_control(p)?;
         k += 1;
         let deadline = Instant::now() + Duration::from_millis(20);
-        let got = ports
-            .waker
-            .wait(&ports.node, Duration::ZERO, deadline, || {
-                while let Some(b) = ports.inbox.try_recv()? {
-                    if b.signal.flags & FLAG_PROBE != 0 {
-                        return Ok(Some(()));
-                    }
-                }
-                Ok(None)
-            })?;
-        match got {
-            Ok(()) => return Ok(true),
-            Err(Idle::Terminate) => return Ok(false),
-            Err(Idle::Timeout) => {}
+        loop {
+            match link.recv(deadline)? {
+                Ok(b) if b.signal.flags & FLAG_PROBE != 0 => return Ok(true),
+                Ok(_) => {}
+                Err(Idle::Terminate) => return Ok(false),
+                Err(Idle::Timeout) => break,
+            }
         }
     }
     Err(MasterError::NoAnswer(format!(
@@ -140,18 +124,18 @@ fn probe(ports: &Ports, timeout: Duration) -> Result<bool, MasterError> {
     )))
 }
 
-/// Runs the master process until the scenario's samples are sent (or a stop request).
+/// Runs the master process over iceoryx2 until the scenario's samples are sent (or a
+/// stop request).
 pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
+    let link = IoxMaster::open(&opts.prefix, opts.wait)?;
+    run_with(opts, &link)
+}
+
+/// Runs the master loop over any transport.
+pub fn run_with(opts: &MasterOptions, link: &impl MasterLink) -> Result<MasterRun, MasterError> {
     let sc = &opts.scenario;
     let source = OperatorSource::load(&sc.operator, &opts.base_dir)?;
     let mut master = Master::new(sc, source)?;
-    let node = ipc::node(&opts.prefix, "master")?;
-    let ports = Ports {
-        out: Outbox::open(&node, streams::C, streams::WAKE_EMULATOR)?,
-        inbox: Inbox::open(&node, streams::Q)?,
-        waker: Waker::open(&node, streams::WAKE_MASTER)?,
-        node,
-    };
     let mut result = MasterRun {
         rows: Vec::with_capacity(usize::try_from(sc.samples).unwrap_or(0)),
         counters: MasterCounters::default(),
@@ -165,13 +149,13 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
         c_out: OutboxStats::default(),
         q_in: InboxStats::default(),
     };
-    if !probe(&ports, opts.startup_timeout)? {
+    if !probe(link, opts.startup_timeout)? {
         result.interrupted = true;
         return Ok(result);
     }
     // Drain probe echoes still in flight.
-    std::thread::sleep(Duration::from_millis(5));
-    while ports.inbox.try_recv()?.is_some() {}
+    let drain = Instant::now() + Duration::from_millis(5);
+    while link.recv(drain)?.is_ok() {}
 
     let t_s = sc.t_s_ns();
     let realtime = sc.mode == Mode::Realtime;
@@ -196,7 +180,7 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
         };
         let (mut c, _) = master.forward(n, origin);
         c.stamps[stage::MASTER_SEND] = now_ns();
-        ports.out.send(c)?;
+        link.send(c)?;
         result.rows.push(master.pending(&c));
 
         let deadline = if realtime {
@@ -206,11 +190,7 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
         };
         let mut done = false;
         while !done {
-            let got = ports
-                .waker
-                .wait(&ports.node, opts.wait.spin, deadline, || {
-                    ports.inbox.try_recv()
-                })?;
+            let got = link.recv(deadline)?;
             match got {
                 Ok(q) => match absorb(&mut master, &mut result.rows, q, &mut result.events) {
                     Some(seq) if seq == n => done = true,
@@ -224,7 +204,7 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
                         result.deadline_misses += 1;
                     }
                     if master.peer_lost() && !was_lost {
-                        let dead = ipc::dead_nodes(&opts.prefix).unwrap_or_default();
+                        let dead = link.dead_peers();
                         result.events.push(Event {
                             sample: n,
                             what: if dead.is_empty() {
@@ -261,9 +241,7 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
     }
     // Collect stragglers, then tell the others to stop.
     let grace = Instant::now() + Duration::from_millis(50);
-    while let Ok(Ok(q)) = ports.waker.wait(&ports.node, Duration::ZERO, grace, || {
-        ports.inbox.try_recv()
-    }) {
+    while let Ok(Ok(q)) = link.recv(grace) {
         match absorb(&mut master, &mut result.rows, q, &mut result.events) {
             Some(_) => result.late += 1,
             None => result.unexpected += 1,
@@ -271,11 +249,10 @@ pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
     }
     let mut end = Forward::default();
     end.signal.flags = FLAG_END;
-    ports.out.send_control(end)?;
+    link.send_control(end)?;
     result.missing = result.rows.iter().filter(|r| r.backward.is_none()).count() as u64;
     result.counters = master.counters();
-    result.c_out = ports.out.stats();
-    result.q_in = ports.inbox.stats();
+    (result.c_out, result.q_in) = link.stats();
     Ok(result)
 }
 

@@ -5,10 +5,9 @@ use crate::emulator::{Emulator, EmulatorCounters};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 use tactile_common::clock::now_ns;
-use tactile_common::ipc::{
-    self, streams, Idle, Inbox, InboxStats, IpcError, Outbox, OutboxStats, WaitPolicy, Waker,
-};
-use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
+use tactile_common::ipc::{Idle, InboxStats, IoxEmulator, IpcError, OutboxStats, WaitPolicy};
+use tactile_common::link::{Arrival, EmulatorLink};
+use tactile_common::samples::{stage, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::Scenario;
 
 /// What the emulator process needs to run.
@@ -39,37 +38,22 @@ pub struct EmulatorRun {
     pub interrupted: bool,
 }
 
-// Lives on the stack for one sample; boxing the larger variant would allocate per sample.
-#[allow(clippy::large_enum_variant)]
-enum Arrival {
-    Forward(Forward),
-    Backward(Backward),
+/// Runs over iceoryx2 until the master's end-of-run sample or a stop request.
+pub fn run(opts: &EmulatorOptions) -> Result<EmulatorRun, IpcError> {
+    run_with(opts, &IoxEmulator::open(&opts.prefix, opts.wait)?)
 }
 
-/// Runs until the master's end-of-run sample or a stop request.
-pub fn run(opts: &EmulatorOptions) -> Result<EmulatorRun, IpcError> {
+/// Runs the emulator loop over any transport.
+pub fn run_with(opts: &EmulatorOptions, link: &impl EmulatorLink) -> Result<EmulatorRun, IpcError> {
     let mut emu = Emulator::new(&opts.scenario);
-    let node = ipc::node(&opts.prefix, "emulator")?;
-    let in_c: Inbox<Forward> = Inbox::open(&node, streams::C)?;
-    let out_v: Outbox<Forward> = Outbox::open(&node, streams::V, streams::WAKE_SLAVE)?;
-    let in_h: Inbox<Backward> = Inbox::open(&node, streams::H)?;
-    let out_q: Outbox<Backward> = Outbox::open(&node, streams::Q, streams::WAKE_MASTER)?;
-    let waker = Waker::open(&node, streams::WAKE_EMULATOR)?;
     let mut interrupted = false;
     loop {
         let deadline = Instant::now() + Duration::from_secs(3600);
-        let got = waker.wait(&node, opts.wait.spin, deadline, || {
-            // Backward first: it completes a round trip the master is waiting for.
-            if let Some(h) = in_h.try_recv()? {
-                return Ok(Some(Arrival::Backward(h)));
-            }
-            Ok(in_c.try_recv()?.map(Arrival::Forward))
-        })?;
-        match got {
+        match link.recv(deadline)? {
             Ok(Arrival::Forward(mut c)) => {
                 let flags = c.signal.flags;
                 if flags & (FLAG_PROBE | FLAG_END) != 0 {
-                    out_v.send_control(c)?;
+                    link.send_v(c, true)?;
                     if flags & FLAG_END != 0 {
                         break;
                     }
@@ -78,18 +62,18 @@ pub fn run(opts: &EmulatorOptions) -> Result<EmulatorRun, IpcError> {
                 c.stamps[stage::EMU_FWD_RECV] = now_ns();
                 if let Some(mut v) = emu.forward(&c) {
                     v.stamps[stage::EMU_FWD_SEND] = now_ns();
-                    out_v.send(v)?;
+                    link.send_v(v, false)?;
                 }
             }
             Ok(Arrival::Backward(mut h)) => {
                 if h.signal.flags & FLAG_PROBE != 0 {
-                    out_q.send_control(h)?;
+                    link.send_q(h, true)?;
                     continue;
                 }
                 h.stamps[stage::EMU_BWD_RECV] = now_ns();
                 if let Some(mut q) = emu.backward(&h) {
                     q.stamps[stage::EMU_BWD_SEND] = now_ns();
-                    out_q.send(q)?;
+                    link.send_q(q, false)?;
                 }
             }
             Err(Idle::Timeout) => {}
@@ -99,12 +83,13 @@ pub fn run(opts: &EmulatorOptions) -> Result<EmulatorRun, IpcError> {
             }
         }
     }
+    let st = link.stats();
     Ok(EmulatorRun {
         counters: emu.counters(),
-        c_in: in_c.stats(),
-        v_out: out_v.stats(),
-        h_in: in_h.stats(),
-        q_out: out_q.stats(),
+        c_in: st.c_in,
+        v_out: st.v_out,
+        h_in: st.h_in,
+        q_out: st.q_out,
         interrupted,
     })
 }

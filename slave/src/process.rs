@@ -6,10 +6,9 @@ use crate::hsd::{Slave, SlaveCounters};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 use tactile_common::clock::now_ns;
-use tactile_common::ipc::{
-    self, streams, Idle, Inbox, InboxStats, IpcError, Outbox, OutboxStats, WaitPolicy, Waker,
-};
-use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
+use tactile_common::ipc::{Idle, InboxStats, IoxSlave, IpcError, OutboxStats, WaitPolicy};
+use tactile_common::link::SlaveLink;
+use tactile_common::samples::{stage, Backward, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::{Scenario, ScenarioError};
 use thiserror::Error;
 
@@ -56,13 +55,14 @@ pub fn hold_timeout(scenario: &Scenario) -> Duration {
     t.max(Duration::from_millis(50))
 }
 
-/// Runs until the end-of-run sample or a stop request.
+/// Runs over iceoryx2 until the end-of-run sample or a stop request.
 pub fn run(opts: &SlaveOptions) -> Result<SlaveRun, SlaveError> {
+    run_with(opts, &IoxSlave::open(&opts.prefix, opts.wait)?)
+}
+
+/// Runs the slave loop over any transport.
+pub fn run_with(opts: &SlaveOptions, link: &impl SlaveLink) -> Result<SlaveRun, SlaveError> {
     let mut slave = Slave::new(&opts.scenario)?;
-    let node = ipc::node(&opts.prefix, "slave")?;
-    let inbox: Inbox<Forward> = Inbox::open(&node, streams::V)?;
-    let out: Outbox<Backward> = Outbox::open(&node, streams::H, streams::WAKE_EMULATOR)?;
-    let waker = Waker::open(&node, streams::WAKE_SLAVE)?;
     let timeout = hold_timeout(&opts.scenario);
     let t_s = Duration::from_nanos(opts.scenario.t_s_ns());
     let mut interrupted = false;
@@ -70,7 +70,7 @@ pub fn run(opts: &SlaveOptions) -> Result<SlaveRun, SlaveError> {
     let mut deadline: Option<Instant> = None;
     loop {
         let until = deadline.unwrap_or_else(|| Instant::now() + Duration::from_secs(3600));
-        match waker.wait(&node, opts.wait.spin, until, || inbox.try_recv())? {
+        match link.recv(until)? {
             Ok(mut v) => {
                 let flags = v.signal.flags;
                 if flags & FLAG_END != 0 {
@@ -82,13 +82,13 @@ pub fn run(opts: &SlaveOptions) -> Result<SlaveRun, SlaveError> {
                         ..Backward::default()
                     };
                     echo.signal.flags = FLAG_PROBE;
-                    out.send_control(echo)?;
+                    link.send_h(echo, true)?;
                     continue;
                 }
                 v.stamps[stage::SLAVE_RECV] = now_ns();
                 let mut h = slave.step(&v);
                 h.stamps[stage::SLAVE_SEND] = now_ns();
-                out.send(h)?;
+                link.send_h(h, false)?;
                 deadline = Some(Instant::now() + timeout);
             }
             Err(Idle::Timeout) => {
@@ -104,10 +104,11 @@ pub fn run(opts: &SlaveOptions) -> Result<SlaveRun, SlaveError> {
             }
         }
     }
+    let (v_in, h_out) = link.stats();
     Ok(SlaveRun {
         counters: slave.counters(),
-        v_in: inbox.stats(),
-        h_out: out.stats(),
+        v_in,
+        h_out,
         interrupted,
     })
 }

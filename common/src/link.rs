@@ -1,0 +1,117 @@
+//! What each process needs from its transport, as one trait per role.
+//!
+//! The process loops (in the master, emulator and slave crates) are written against
+//! these traits, so the same loop runs over iceoryx2 shared memory (the product,
+//! [`crate::ipc`]) or over UDP (the reference a user would pick instead, measured
+//! beside it by `tactile bench`). Every implementation stamps the per-hop publish
+//! counter and counts what it sends and receives the same way.
+
+use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats};
+use crate::samples::{Backward, Forward, Sequenced};
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// The outcome of a wait: a value, or why none came.
+pub type Wait<T> = Result<Result<T, Idle>, IpcError>;
+
+/// The master's view: c(n) out, q(n) in.
+pub trait MasterLink {
+    /// Publishes c(n).
+    fn send(&self, c: Forward) -> Result<(), IpcError>;
+    /// Publishes a control sample (probe, end of run), uncounted.
+    fn send_control(&self, c: Forward) -> Result<(), IpcError>;
+    /// Waits for the next q until `deadline`.
+    fn recv(&self, deadline: Instant) -> Wait<Backward>;
+    /// Names of peers known to have died (and cleans up after them).
+    fn dead_peers(&self) -> Vec<String>;
+    /// What c-out and q-in counted.
+    fn stats(&self) -> (OutboxStats, InboxStats);
+}
+
+/// A sample arriving at the emulator.
+// Lives on the stack for one sample; boxing the larger variant would allocate per sample.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy)]
+pub enum Arrival {
+    /// c(n) from the master.
+    Forward(Forward),
+    /// h(n) from the slave.
+    Backward(Backward),
+}
+
+/// What the emulator's four stream ends counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EmulatorStats {
+    /// c(n) received.
+    pub c_in: InboxStats,
+    /// v(n) published.
+    pub v_out: OutboxStats,
+    /// h(n) received.
+    pub h_in: InboxStats,
+    /// q(n) published.
+    pub q_out: OutboxStats,
+}
+
+/// The emulator's view: c and h in, v and q out.
+pub trait EmulatorLink {
+    /// Waits for the next c or h until `deadline` (h first when both wait).
+    fn recv(&self, deadline: Instant) -> Wait<Arrival>;
+    /// Publishes v(n); `control` leaves it uncounted.
+    fn send_v(&self, v: Forward, control: bool) -> Result<(), IpcError>;
+    /// Publishes q(n); `control` leaves it uncounted.
+    fn send_q(&self, q: Backward, control: bool) -> Result<(), IpcError>;
+    /// What the four ends counted.
+    fn stats(&self) -> EmulatorStats;
+}
+
+/// The slave's view: v(n) in, h(n) out.
+pub trait SlaveLink {
+    /// Waits for the next v until `deadline`.
+    fn recv(&self, deadline: Instant) -> Wait<Forward>;
+    /// Publishes h(n); `control` leaves it uncounted.
+    fn send_h(&self, h: Backward, control: bool) -> Result<(), IpcError>;
+    /// What v-in and h-out counted.
+    fn stats(&self) -> (InboxStats, OutboxStats);
+}
+
+/// `hop_seq` of control samples, which no counter sees.
+pub const CONTROL_HOP_SEQ: u64 = u64::MAX;
+
+impl OutboxStats {
+    /// Stamps `value` with this hop's next publish counter (or the control marker).
+    pub fn stamp<T: Sequenced>(&mut self, value: &mut T, control: bool) {
+        if control {
+            value.set_hop_seq(CONTROL_HOP_SEQ);
+        } else {
+            value.set_hop_seq(self.published);
+        }
+    }
+
+    /// Counts a publish of a counted sample that reached `receivers` subscribers.
+    pub fn count(&mut self, receivers: usize, control: bool) {
+        if !control {
+            self.published += 1;
+            if receivers == 0 {
+                self.no_receiver += 1;
+            }
+        }
+    }
+}
+
+impl InboxStats {
+    /// Counts a received sample and any overwritten before it; `next` is the publish
+    /// counter expected next from this stream's sender.
+    pub fn count<T: Sequenced>(&mut self, value: &T, next: &mut Option<u64>) {
+        let h = value.hop_seq();
+        if h == CONTROL_HOP_SEQ {
+            return;
+        }
+        self.received += 1;
+        match *next {
+            Some(n) if h >= n => self.overwritten += h - n,
+            Some(_) => self.publisher_restarts += 1,
+            None => {}
+        }
+        *next = Some(h + 1);
+    }
+}
