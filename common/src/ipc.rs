@@ -346,12 +346,14 @@ impl Waker {
             if now >= deadline {
                 return Ok(Err(Idle::Timeout));
             }
-            if now.duration_since(start) < spin {
-                std::hint::spin_loop();
-                continue;
-            }
             if termination_requested(node) {
                 return Ok(Err(Idle::Terminate));
+            }
+            if now.duration_since(start) < spin {
+                // Yield rather than burn: on two cores three polling processes would
+                // otherwise hold the core the next stage of the chain needs.
+                std::thread::yield_now();
+                continue;
             }
             match self.listener.timed_wait(|_| {}, deadline - now) {
                 Ok(_) => {}

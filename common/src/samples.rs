@@ -8,6 +8,7 @@
 //! carries a timestamp per stage it passed.
 
 use iceoryx2::prelude::ZeroCopySend;
+use serde::{Deserialize, Serialize};
 
 /// Stages a sample passes, in order; indices into `stamps`.
 pub mod stage {
@@ -98,7 +99,7 @@ impl Sequenced for Backward {
 
 /// Three signal values with their provenance.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
 #[type_name("tactile::Signal/1")]
 pub struct Signal {
     /// Values: position in metres (forward) or force in newtons (backward).
@@ -117,7 +118,7 @@ pub struct Signal {
 
 /// Forward stream: c(n) from the master, v(n) from the emulator.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
 #[type_name("tactile::Forward/1")]
 pub struct Forward {
     /// Sample number n on this stream.
@@ -135,7 +136,7 @@ pub struct Forward {
 
 /// The slave's state at the step that produced a backward sample, for the trace.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
 #[type_name("tactile::SlaveState/1")]
 pub struct SlaveState {
     /// The v(n) the slave received.
@@ -160,7 +161,7 @@ pub struct SlaveState {
 
 /// Backward stream: h(n) from the slave, q(n) from the emulator.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
 #[type_name("tactile::Backward/1")]
 pub struct Backward {
     /// Sample number n on this stream (the forward sample that triggered it).

@@ -44,11 +44,11 @@ pub struct RunArgs {
     /// iceoryx2 prefix isolating this run's shared memory (default: one per launcher).
     #[arg(long)]
     pub prefix: Option<String>,
-    /// Microseconds each process busy-polls before blocking on its wake-up event.
-    /// Default 0: on two cores a spinning process takes the core the next stage needs
-    /// (see README, "Waiting").
-    #[arg(long, default_value_t = 0)]
-    pub spin_us: u64,
+    /// Microseconds each process polls (yielding the core between polls) before it
+    /// blocks on its wake-up event. Default: two sampling periods, so a running loop
+    /// never sleeps (chosen by measurement, see README "Waiting"); 0 blocks at once.
+    #[arg(long)]
+    pub spin_us: Option<u64>,
     /// Run master, emulator and slave in this process, without shared memory.
     #[arg(long)]
     pub in_process: bool,
@@ -58,6 +58,16 @@ pub struct RunArgs {
     /// Times the emulator or the slave is restarted if it dies mid-run.
     #[arg(long, default_value_t = 3)]
     pub max_restarts: u32,
+    /// Carry the samples over UDP on loopback instead of iceoryx2 (the reference).
+    #[arg(long)]
+    pub udp: bool,
+    /// Do not pin the processes (by default the master runs on CPU 0 and the emulator
+    /// and slave on CPU 1, via taskset, where the machine has two CPUs).
+    #[arg(long)]
+    pub no_pin: bool,
+    /// Run the three processes SCHED_FIFO (chrt), where permitted.
+    #[arg(long)]
+    pub rt: bool,
 }
 
 /// Which process a role runs.
@@ -92,6 +102,9 @@ pub struct RoleArgs {
     /// Busy-poll budget, microseconds.
     #[arg(long, default_value_t = 0)]
     pub spin_us: u64,
+    /// UDP ports `master,emulator,slave`: run over UDP instead of iceoryx2.
+    #[arg(long)]
+    pub udp_ports: Option<String>,
 }
 
 /// The kernel a `kernels` run evaluates.
@@ -253,12 +266,21 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Run(args) => crate::run_cmd::main(&args),
         Command::Role(args) => {
             let (scenario, _) = crate::run_cmd::load_scenario(Some(&args.scenario))?;
+            let transport = match &args.udp_ports {
+                None => crate::roles::Transport::Iceoryx2,
+                Some(p) => crate::roles::Transport::Udp(
+                    crate::udp::UdpPorts::parse(p).ok_or_else(|| {
+                        Error::BadInput(format!("--udp-ports {p:?}: expected three ports m,e,s"))
+                    })?,
+                ),
+            };
             let opts = crate::roles::RoleOptions {
                 scenario,
                 base_dir: args.base_dir,
                 prefix: args.prefix,
                 out: args.out,
                 spin: std::time::Duration::from_micros(args.spin_us),
+                transport,
             };
             match args.role {
                 RoleName::Master => crate::roles::master(&opts),

@@ -13,3 +13,4 @@ pub mod report;
 pub mod roles;
 pub mod run_cmd;
 pub mod sim;
+pub mod udp;

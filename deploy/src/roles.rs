@@ -35,6 +35,17 @@ pub struct RoleOptions {
     pub out: PathBuf,
     /// Busy-poll budget before blocking.
     pub spin: Duration,
+    /// The transport between the processes.
+    pub transport: Transport,
+}
+
+/// What carries the samples between the three processes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Transport {
+    /// iceoryx2 zero-copy shared memory: the product.
+    Iceoryx2,
+    /// UDP on loopback at these ports: the reference.
+    Udp(crate::udp::UdpPorts),
 }
 
 /// The master's part of the summary.
@@ -181,7 +192,13 @@ pub fn master(o: &RoleOptions) -> Result<(), Error> {
         progress_every: 0,
         wake_early_ns: WAKE_EARLY_NS,
     };
-    let run = tactile_master::process::run(&opts).map_err(|e| Error::Failed(e.to_string()))?;
+    let run = match o.transport {
+        Transport::Iceoryx2 => tactile_master::process::run(&opts),
+        Transport::Udp(ports) => crate::udp::UdpMaster::open(ports)
+            .map_err(Into::into)
+            .and_then(|link| tactile_master::process::run_with(&opts, &link)),
+    }
+    .map_err(|e| Error::Failed(e.to_string()))?;
     let r = write_artifacts(&run.rows, run.t0_ns, o.scenario.t_s(), true, &o.out)?;
     write_json(&o.out.join("master.json"), &master_summary(&run, &r))
 }
@@ -193,8 +210,12 @@ pub fn emulator(o: &RoleOptions) -> Result<(), Error> {
         prefix: o.prefix.clone(),
         wait: WaitPolicy { spin: o.spin },
     };
-    let run =
-        tactile_network_emulator::process::run(&opts).map_err(|e| Error::Failed(e.to_string()))?;
+    let run = match o.transport {
+        Transport::Iceoryx2 => tactile_network_emulator::process::run(&opts),
+        Transport::Udp(ports) => crate::udp::UdpEmulator::open(ports)
+            .and_then(|link| tactile_network_emulator::process::run_with(&opts, &link)),
+    }
+    .map_err(|e| Error::Failed(e.to_string()))?;
     write_json(&o.out.join("emulator.json"), &run)
 }
 
@@ -205,6 +226,12 @@ pub fn slave(o: &RoleOptions) -> Result<(), Error> {
         prefix: o.prefix.clone(),
         wait: WaitPolicy { spin: o.spin },
     };
-    let run = tactile_slave::process::run(&opts).map_err(|e| Error::Failed(e.to_string()))?;
+    let run = match o.transport {
+        Transport::Iceoryx2 => tactile_slave::process::run(&opts),
+        Transport::Udp(ports) => crate::udp::UdpSlave::open(ports)
+            .map_err(Into::into)
+            .and_then(|link| tactile_slave::process::run_with(&opts, &link)),
+    }
+    .map_err(|e| Error::Failed(e.to_string()))?;
     write_json(&o.out.join("slave.json"), &run)
 }

@@ -313,6 +313,45 @@ pub struct Supervision {
     pub progress: bool,
     /// Restarts allowed per process (emulator, slave) when one dies mid-run.
     pub max_restarts: u32,
+    /// What carries the samples.
+    pub transport: crate::roles::Transport,
+    /// Pin master to CPU 0, emulator and slave to CPU 1.
+    pub pin: bool,
+    /// SCHED_FIFO priority for the three processes, if permitted.
+    pub rt: bool,
+}
+
+/// Wraps a role's command in taskset and chrt as the supervision asks; falls back to
+/// the plain command (with a note) when a tool is missing or refuses.
+fn wrapped(sup: &Supervision, role: &str, exe: &Path, notes: &mut Vec<String>) -> Vec<String> {
+    let mut argv: Vec<String> = Vec::new();
+    if sup.pin {
+        let cpu = if role == "master" { "0" } else { "1" };
+        if tool_works(&["taskset", "-c", cpu, "true"]) {
+            argv.extend(["taskset", "-c", cpu].map(String::from));
+        } else if !notes.iter().any(|n| n.contains("taskset")) {
+            notes.push("taskset unavailable: processes not pinned".into());
+        }
+    }
+    if sup.rt {
+        if tool_works(&["chrt", "-f", "10", "true"]) {
+            argv.extend(["chrt", "-f", "10"].map(String::from));
+        } else if !notes.iter().any(|n| n.contains("chrt")) {
+            notes.push("SCHED_FIFO not permitted: processes run SCHED_OTHER".into());
+        }
+    }
+    argv.push(exe.display().to_string());
+    argv.extend(["role".to_string(), role.to_string()]);
+    argv
+}
+
+fn tool_works(argv: &[&str]) -> bool {
+    Command::new(argv[0])
+        .args(&argv[1..])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
 }
 
 /// Removes the shared memory of earlier runs whose launcher is gone (a crashed or
@@ -359,16 +398,32 @@ pub fn run_processes(
         signal_hook::flag::register(sig, Arc::clone(&stop_requested))
             .map_err(Error::io("installing signal handlers"))?;
     }
+    let mut notes = Vec::new();
+    let commands: Vec<(&'static str, Vec<String>)> = ["emulator", "slave", "master"]
+        .into_iter()
+        .map(|role| (role, wrapped(sup, role, &exe, &mut notes)))
+        .collect();
+    let udp_arg = match sup.transport {
+        crate::roles::Transport::Udp(p) => Some(p.arg()),
+        crate::roles::Transport::Iceoryx2 => None,
+    };
     let spawn = |role: &'static str| -> Result<Child, Error> {
         let log = std::fs::OpenOptions::new()
             .create(true)
             .append(true)
             .open(out.join(format!("{role}.log")))
             .map_err(Error::io(format!("creating {role}.log")))?;
-        Command::new(&exe)
-            .arg("role")
-            .arg(role)
-            .arg("--scenario")
+        let argv = &commands
+            .iter()
+            .find(|(r, _)| *r == role)
+            .ok_or_else(|| Error::Failed(format!("no command for {role}")))?
+            .1;
+        let mut cmd = Command::new(&argv[0]);
+        cmd.args(&argv[1..]);
+        if let Some(p) = &udp_arg {
+            cmd.arg("--udp-ports").arg(p);
+        }
+        cmd.arg("--scenario")
             .arg(&scenario_file)
             .arg("--base-dir")
             .arg(base_dir)
@@ -410,7 +465,7 @@ pub fn run_processes(
         Mode::Realtime => Some(scenario.samples as f64 * scenario.t_s()),
         Mode::Lockstep => None,
     };
-    let mut events: Vec<String> = Vec::new();
+    let mut events: Vec<String> = notes;
     let mut failed = false;
     let mut interrupted = false;
     let mut master_status = None;
@@ -546,6 +601,12 @@ pub fn run_processes(
     Ok(summary)
 }
 
+/// The measured default wait: poll (yielding) for two sampling periods before
+/// blocking, so the processes of a running loop never pay a wake-up.
+pub fn default_spin(scenario: &Scenario) -> Duration {
+    Duration::from_nanos(2 * scenario.t_s_ns())
+}
+
 /// How long the launcher lets the emulator and slave run on after the master died:
 /// long enough for the slave to notice and hold (its peer timeout) and to be seen.
 pub fn survivor_grace(scenario: &Scenario) -> Duration {
@@ -574,9 +635,20 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
                 .prefix
                 .clone()
                 .unwrap_or_else(|| format!("tactile{}", std::process::id())),
-            spin: Duration::from_micros(args.spin_us),
+            spin: args
+                .spin_us
+                .map_or_else(|| default_spin(&scenario), Duration::from_micros),
             progress: !args.quiet,
             max_restarts: args.max_restarts,
+            transport: if args.udp {
+                crate::roles::Transport::Udp(
+                    crate::udp::UdpPorts::free().map_err(|e| Error::Failed(e.to_string()))?,
+                )
+            } else {
+                crate::roles::Transport::Iceoryx2
+            },
+            pin: !args.no_pin,
+            rt: args.rt,
         };
         run_processes(&scenario, &base_dir, &args.out, &sup)?
     };
