@@ -26,14 +26,7 @@ fn lockstep_trio_equals_the_in_process_simulation_bit_for_bit() {
     let sb = Sandbox::new("lockstep");
     let scenario = sb.write("s.toml", &paper_with_network("lockstep", 100.0, 1200));
     sb.run(&scenario, "trio");
-    let o = sb.tactile(&[
-        "run",
-        scenario.to_str().expect("utf-8"),
-        "--in-process",
-        "--out",
-        sb.path("sim").to_str().expect("utf-8"),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    sb.simulate(&scenario, "sim");
     let trio = signal_columns(&sb.trace("trio"));
     let sim = signal_columns(&sb.trace("sim"));
     assert_eq!(trio.lines().count(), 1201);

@@ -27,9 +27,38 @@ pub enum Command {
     Paper(PaperArgs),
     /// Run a scenario: start master, network emulator and slave, and report.
     Run(RunArgs),
+    /// Measure the loop's own overhead at 1 and 10 kHz beside UDP and a bare iceoryx2
+    /// hop, and the lockstep throughput.
+    Bench(BenchArgs),
     /// One process of a run (started by `tactile run`).
     #[command(hide = true)]
     Role(RoleArgs),
+}
+
+/// Arguments of `tactile bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Samples per run (each rate, each transport).
+    #[arg(long, default_value_t = 60_000)]
+    pub samples: u64,
+    /// Rates to measure, Hz.
+    #[arg(long, value_delimiter = ',', default_values_t = [1000.0, 10000.0])]
+    pub rates: Vec<f64>,
+    /// Samples of the lockstep throughput run.
+    #[arg(long, default_value_t = 20_000)]
+    pub lockstep_samples: u64,
+    /// Output folder (bench.json and each run's report).
+    #[arg(long, default_value = "bench-out")]
+    pub out: PathBuf,
+    /// Poll budget of the iceoryx2 processes, microseconds (default: two periods).
+    #[arg(long)]
+    pub spin_us: Option<u64>,
+    /// Do not pin the iceoryx2 processes to CPUs.
+    #[arg(long)]
+    pub no_pin: bool,
+    /// iceoryx2 prefix of the bench's runs (default: one per invocation).
+    #[arg(long)]
+    pub prefix: Option<String>,
 }
 
 /// Arguments of `tactile run`.
@@ -79,6 +108,8 @@ pub enum RoleName {
     Emulator,
     /// HSD, SD, ENV.
     Slave,
+    /// The echo side of `tactile bench`'s bare iceoryx2 hop.
+    Echo,
 }
 
 /// Arguments of `tactile role`.
@@ -264,6 +295,14 @@ pub fn run(cli: Cli) -> Result<(), Error> {
             crate::paper_cmd::run(&args, &mut stdout)
         }
         Command::Run(args) => crate::run_cmd::main(&args),
+        Command::Bench(args) => crate::bench_cmd::main(&args),
+        Command::Role(args) if args.role == RoleName::Echo => crate::bench_cmd::echo(
+            &args.prefix,
+            tactile_common::ipc::WaitPolicy {
+                spin: std::time::Duration::from_micros(args.spin_us),
+            },
+        )
+        .map_err(|e| Error::Failed(e.to_string())),
         Command::Role(args) => {
             let (scenario, _) = crate::run_cmd::load_scenario(Some(&args.scenario))?;
             let transport = match &args.udp_ports {
@@ -285,7 +324,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
             match args.role {
                 RoleName::Master => crate::roles::master(&opts),
                 RoleName::Emulator => crate::roles::emulator(&opts),
-                RoleName::Slave => crate::roles::slave(&opts),
+                RoleName::Slave | RoleName::Echo => crate::roles::slave(&opts),
             }
         }
     }

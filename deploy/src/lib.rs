@@ -4,6 +4,7 @@
 //! The README follows; its Rust examples run as doctests.
 #![doc = include_str!("../../README.md")]
 
+pub mod bench_cmd;
 pub mod cli;
 pub mod error;
 pub mod kernels_cmd;

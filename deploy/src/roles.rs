@@ -83,6 +83,8 @@ pub struct MasterSummary {
     pub c_out: tactile_common::ipc::OutboxStats,
     /// q(n) as received.
     pub q_in: tactile_common::ipc::InboxStats,
+    /// Samples sent per second of wall-clock time (the lockstep throughput).
+    pub samples_per_s: f64,
 }
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
@@ -159,6 +161,11 @@ fn master_summary(run: &MasterRun, r: &RowReport) -> MasterSummary {
         events: run.events.clone(),
         c_out: run.c_out,
         q_in: run.q_in,
+        samples_per_s: if run.elapsed_ns > 0 {
+            r.rows as f64 * 1e9 / run.elapsed_ns as f64
+        } else {
+            0.0
+        },
     }
 }
 
@@ -176,6 +183,7 @@ pub fn master_summary_from(sim: &crate::sim::SimRun, r: &RowReport) -> MasterSum
         events: Vec::new(),
         c_out: Default::default(),
         q_in: Default::default(),
+        elapsed_ns: 0,
     };
     master_summary(&run, r)
 }

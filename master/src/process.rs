@@ -82,6 +82,8 @@ pub struct MasterRun {
     pub c_out: OutboxStats,
     /// q(n) as received.
     pub q_in: InboxStats,
+    /// From the first tick to the end of the last sample, ns.
+    pub elapsed_ns: u64,
 }
 
 /// Something that happened to the loop during a run.
@@ -148,6 +150,7 @@ pub fn run_with(opts: &MasterOptions, link: &impl MasterLink) -> Result<MasterRu
         events: Vec::new(),
         c_out: OutboxStats::default(),
         q_in: InboxStats::default(),
+        elapsed_ns: 0,
     };
     if !probe(link, opts.startup_timeout)? {
         result.interrupted = true;
@@ -172,7 +175,7 @@ pub fn run_with(opts: &MasterOptions, link: &impl MasterLink) -> Result<MasterRu
             // other two processes are idle at that moment, so the spin steals nothing.
             sleep_until_ns(tick.saturating_sub(opts.wake_early_ns));
             while now_ns() < tick {
-                std::hint::spin_loop();
+                std::thread::yield_now();
             }
             tick
         } else {
@@ -239,6 +242,7 @@ pub fn run_with(opts: &MasterOptions, link: &impl MasterLink) -> Result<MasterRu
     if opts.progress_every > 0 {
         eprintln!();
     }
+    result.elapsed_ns = now_ns().saturating_sub(t0);
     // Collect stragglers, then tell the others to stop.
     let grace = Instant::now() + Duration::from_millis(50);
     while let Ok(Ok(q)) = link.recv(grace) {

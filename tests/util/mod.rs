@@ -77,9 +77,23 @@ impl Sandbox {
         o
     }
 
+    /// `tactile run SCENARIO --in-process --out OUT`: the reference the process runs are
+    /// compared against; asserts success.
+    pub fn simulate(&self, scenario: &Path, out: &str) {
+        let o = self.tactile(&[
+            "run",
+            scenario.to_str().expect("utf-8 path"),
+            "--in-process",
+            "--out",
+            self.path(out).to_str().expect("utf-8 path"),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+
     /// Fails if any process started with this sandbox's prefix is still alive.
     pub fn assert_no_leftover_processes(&self) {
-        let needle = format!("--prefix\0{}\0", self.prefix);
+        // Bench runs use the prefix as a stem (prefix + run name).
+        let needle = format!("--prefix\0{}", self.prefix);
         let mut alive = Vec::new();
         for entry in std::fs::read_dir("/proc").expect("/proc").flatten() {
             let Ok(cmd) = std::fs::read(entry.path().join("cmdline")) else {

@@ -1,0 +1,94 @@
+//! `tactile bench` end to end, small: every part runs and reports, and the same loop
+//! over UDP is the same loop.
+
+mod util;
+
+use tactile_common::trace::signal_columns;
+use util::Sandbox;
+
+#[test]
+fn bench_reports_both_transports_the_floor_and_the_throughput() {
+    let sb = Sandbox::new("bench");
+    let out = sb.path("bench");
+    let o = sb.tactile(&[
+        "bench",
+        "--samples",
+        "400",
+        "--rates",
+        "1000",
+        "--lockstep-samples",
+        "400",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--prefix",
+        &sb.prefix,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for needle in [
+        "iceoryx2 loop",
+        "UDP loop",
+        "bare iceoryx2",
+        "iceoryx2 / UDP",
+        "lockstep throughput",
+    ] {
+        assert!(text.contains(needle), "{needle}: {text}");
+    }
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("bench.json")).expect("json"))
+            .expect("parse");
+    let r = &v["rates"][0];
+    for key in [
+        "iceoryx2_overhead_ns",
+        "udp_overhead_ns",
+        "bare_hop_round_trip_ns",
+    ] {
+        assert!(r[key]["count"].as_u64() >= Some(390), "{key}: {r}");
+        assert!(r[key]["p50"].as_u64() > Some(0), "{key}");
+    }
+    assert!(r["ratio_p50"].as_f64().is_some_and(f64::is_finite));
+    assert_eq!(
+        r["iceoryx2_stages_ns"].as_object().map(|m| m.len()),
+        Some(9)
+    );
+    assert!(v["lockstep_samples_per_s"].as_f64() > Some(100.0));
+    // Each trio left its own full report.
+    for run in ["iox-1000", "udp-1000", "lockstep"] {
+        assert!(out.join(run).join("summary.json").exists(), "{run}");
+    }
+    sb.assert_no_leftover_processes();
+}
+
+#[test]
+fn lockstep_over_udp_equals_the_in_process_simulation() {
+    let sb = Sandbox::new("udplock");
+    let text = tactile::run_cmd::PAPER_SCENARIO
+        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        .replace(
+            "noise_std = [0.0, 0.0, 0.0]\n\n[network.backward]",
+            "noise_std = [0.001, 0.0, 0.0005]\n\n[network.backward]",
+        );
+    let scenario = sb.write("s.toml", &text);
+    let o = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--udp",
+        "-q",
+        "--prefix",
+        &sb.prefix,
+        "--out",
+        sb.path("udp").to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    sb.simulate(&scenario, "sim");
+    assert_eq!(
+        signal_columns(&sb.trace("udp")),
+        signal_columns(&sb.trace("sim"))
+    );
+    let s = sb.json("udp", "summary.json");
+    assert_eq!(s["samples_lost"], 0);
+    for stream in ["c", "v", "h", "q"] {
+        assert_eq!(s["channels"][stream]["received"], 1200, "{stream}");
+    }
+    sb.assert_no_leftover_processes();
+}
