@@ -296,36 +296,6 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         }
         Command::Run(args) => crate::run_cmd::main(&args),
         Command::Bench(args) => crate::bench_cmd::main(&args),
-        Command::Role(args) if args.role == RoleName::Echo => crate::bench_cmd::echo(
-            &args.prefix,
-            tactile_common::ipc::WaitPolicy {
-                spin: std::time::Duration::from_micros(args.spin_us),
-            },
-        )
-        .map_err(|e| Error::Failed(e.to_string())),
-        Command::Role(args) => {
-            let (scenario, _) = crate::run_cmd::load_scenario(Some(&args.scenario))?;
-            let transport = match &args.udp_ports {
-                None => crate::roles::Transport::Iceoryx2,
-                Some(p) => crate::roles::Transport::Udp(
-                    crate::udp::UdpPorts::parse(p).ok_or_else(|| {
-                        Error::BadInput(format!("--udp-ports {p:?}: expected three ports m,e,s"))
-                    })?,
-                ),
-            };
-            let opts = crate::roles::RoleOptions {
-                scenario,
-                base_dir: args.base_dir,
-                prefix: args.prefix,
-                out: args.out,
-                spin: std::time::Duration::from_micros(args.spin_us),
-                transport,
-            };
-            match args.role {
-                RoleName::Master => crate::roles::master(&opts),
-                RoleName::Emulator => crate::roles::emulator(&opts),
-                RoleName::Slave | RoleName::Echo => crate::roles::slave(&opts),
-            }
-        }
+        Command::Role(args) => crate::roles::dispatch(args),
     }
 }

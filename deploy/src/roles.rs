@@ -188,6 +188,36 @@ pub fn master_summary_from(sim: &crate::sim::SimRun, r: &RowReport) -> MasterSum
     master_summary(&run, r)
 }
 
+/// `tactile role ROLE ...`: runs one process of a run (or the bench's echo).
+pub fn dispatch(args: crate::cli::RoleArgs) -> Result<(), Error> {
+    use crate::cli::RoleName;
+    let spin = Duration::from_micros(args.spin_us);
+    let run: fn(&RoleOptions) -> Result<(), Error> = match args.role {
+        RoleName::Echo => {
+            return crate::bench_cmd::echo(&args.prefix, WaitPolicy { spin })
+                .map_err(|e| Error::Failed(e.to_string()))
+        }
+        RoleName::Master => master,
+        RoleName::Emulator => emulator,
+        RoleName::Slave => slave,
+    };
+    let (scenario, _) = crate::run_cmd::load_scenario(Some(&args.scenario))?;
+    let transport = match &args.udp_ports {
+        None => Transport::Iceoryx2,
+        Some(p) => Transport::Udp(crate::udp::UdpPorts::parse(p).ok_or_else(|| {
+            Error::BadInput(format!("--udp-ports {p:?}: expected three ports m,e,s"))
+        })?),
+    };
+    run(&RoleOptions {
+        scenario,
+        base_dir: args.base_dir,
+        prefix: args.prefix,
+        out: args.out,
+        spin,
+        transport,
+    })
+}
+
 /// `tactile role master`.
 pub fn master(o: &RoleOptions) -> Result<(), Error> {
     let opts = MasterOptions {
