@@ -33,8 +33,9 @@ pub fn overhead_histogram(rows: &[TraceRow], path: &Path) -> PlotResult {
     }
     let mut sorted = us.clone();
     sorted.sort_by(f64::total_cmp);
-    // Cut the axis at p99.9 so the body of the distribution stays visible.
-    let hi = sorted[((sorted.len() - 1) as f64 * 0.999) as usize].max(1.0) * 1.05;
+    // Cut the axis at 1.5 x p99 so the body of the distribution stays visible; the
+    // tail goes into the last bin (and is in the percentiles and the .hgrm file).
+    let hi = sorted[((sorted.len() - 1) as f64 * 0.99) as usize].max(1.0) * 1.5;
     let bins = 100usize;
     let width = hi / bins as f64;
     let mut counts = vec![0u64; bins];
@@ -55,7 +56,7 @@ pub fn overhead_histogram(rows: &[TraceRow], path: &Path) -> PlotResult {
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc("overhead (us); last bin holds everything above p99.9")
+        .x_desc("overhead (us); the last bin holds everything above 1.5 x p99")
         .y_desc("samples")
         .draw()
         .map_err(err)?;
@@ -103,22 +104,21 @@ fn time_series(
         .draw()
         .map_err(err)?;
     for (label, colour, dashed, v) in series {
-        let style = ShapeStyle::from(colour).stroke_width(if *dashed { 1 } else { 2 });
-        let points = t.iter().copied().zip(v.iter().copied());
-        let colour = *colour;
-        if *dashed {
-            chart
-                .draw_series(DashedLineSeries::new(points, 6, 4, style))
-                .map_err(err)?
-                .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+        // Dashed series (the reference: target, felt force) are drawn lighter and
+        // thinner, so they read apart from the solid ones in the legend too.
+        let style = if *dashed {
+            ShapeStyle::from(colour.mix(0.55)).stroke_width(1)
         } else {
-            chart
-                .draw_series(LineSeries::new(points, style))
-                .map_err(err)?
-                .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
-        }
+            ShapeStyle::from(colour).stroke_width(2)
+        };
+        let points = t.iter().copied().zip(v.iter().copied());
+        let legend = move |(x, y): (i32, i32)| PathElement::new(vec![(x, y), (x + 20, y)], style);
+        let drawn = if *dashed {
+            chart.draw_series(DashedLineSeries::new(points, 6, 4, style))
+        } else {
+            chart.draw_series(LineSeries::new(points, style))
+        };
+        drawn.map_err(err)?.label(label.as_str()).legend(legend);
     }
     chart
         .configure_series_labels()
