@@ -14,4 +14,5 @@ pub mod report;
 pub mod roles;
 pub mod run_cmd;
 pub mod sim;
+pub mod summary;
 pub mod udp;
