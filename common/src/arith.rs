@@ -47,6 +47,15 @@ pub trait Real:
     fn is_finite(self) -> bool;
     /// Absolute value.
     fn abs(self) -> Self;
+    /// The larger of two values (the first if they compare equal or unordered).
+    #[inline(always)]
+    fn max_of(self, other: Self) -> Self {
+        if other > self {
+            other
+        } else {
+            self
+        }
+    }
 }
 
 macro_rules! impl_real {

@@ -134,8 +134,12 @@ fn clamp_unit<R: Real>(a: R, clamped: &mut bool) -> R {
     } else if a < -R::ONE {
         *clamped |= a < -R::ONE - tol;
         -R::ONE
-    } else {
+    } else if a.is_finite() {
         a
+    } else {
+        // NaN: no acos argument can be trusted; flag it and take the stretched arm.
+        *clamped = true;
+        R::ONE
     }
 }
 
@@ -158,15 +162,24 @@ pub fn ik<R: Real, T: Trig<R>>(g: &Lengths<R>, trig: &T, p: [R; 3]) -> IkSolutio
             status: IkStatus::Invalid,
         };
     }
-    let zl = z + g.l4;
-    let yl = y - g.l3;
+    let (mut x, mut yl, mut zl) = (x, y - g.l3, z + g.l4);
+    let mut clamped = false;
+    // A target far beyond reach, possibly so far that squaring it overflows, is pulled
+    // in along the same direction from the shoulder to twice the reach: the clamped
+    // angles are the same and every intermediate stays finite.
+    let reach = g.l1 + g.l2;
+    let far = x.abs().max_of(yl.abs()).max_of(zl.abs());
+    if far > reach + reach + reach + reach {
+        let k = (reach + reach) / far;
+        (x, yl, zl) = (x * k, yl * k, zl * k);
+        clamped = true;
+    }
     let theta1 = -trig.atan2(x, zl);
     let rr2 = x * x + zl * zl;
     let big_r = rr2.sqrt();
     let r2 = rr2 + yl * yl;
     let r = r2.sqrt();
     let two = R::ONE + R::ONE;
-    let mut clamped = false;
     // At r = 0 (target on the shoulder joint) gamma is undefined; with L1 = L2 it is the
     // boundary of the workspace, otherwise outside it. Treat it as the limit r -> 0+.
     let cos_gamma = if r > R::ZERO {

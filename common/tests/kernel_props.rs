@@ -165,6 +165,24 @@ proptest! {
     }
 
     #[test]
+    fn ik_of_huge_targets_is_finite_and_flagged(
+        dir in prop::array::uniform3(-1.0f64..1.0),
+        exp in 0i32..300,
+    ) {
+        // Magnitudes up to 1e300: squaring overflows f64 from 1e155 and f32 from 1e19;
+        // past f32's range the f32 input itself is infinite (Invalid).
+        let scale = 10f64.powi(exp);
+        let p = dir.map(|d| d * scale);
+        for kind in ArithKind::ALL {
+            let s = engine(kind).ik(p);
+            prop_assert!(s.theta.iter().all(|v| v.is_finite()), "{kind} {p:?}: {s:?}");
+            if dir.iter().map(|d| d * d).sum::<f64>().sqrt() * scale > 1.0 {
+                prop_assert!(s.status != IkStatus::Reachable, "{kind} {p:?}: {s:?}");
+            }
+        }
+    }
+
+    #[test]
     fn batch_kernels_equal_scalar_kernels(
         rows in prop::collection::vec((prop::array::uniform3(-3.0f32..3.0), prop::array::uniform3(-4.0f32..4.0)), 0..700)
     ) {
