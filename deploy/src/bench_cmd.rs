@@ -44,6 +44,8 @@ pub struct RateResult {
     pub udp_stages_ns: BTreeMap<String, Percentiles>,
     /// Round trip of the bare iceoryx2 hop pair (two hops), ns.
     pub bare_hop_round_trip_ns: Percentiles,
+    /// Bare-hop round trips not back within their sampling period.
+    pub bare_hop_deadline_misses: u64,
     /// iceoryx2 overhead / UDP overhead at p50.
     pub ratio_p50: f64,
     /// iceoryx2 overhead / UDP overhead at p99.
@@ -271,7 +273,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             Transport::Udp(ports),
         )?;
         eprintln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
-        let (hop, _) = bare_hop(rate, args.samples, &sup)?;
+        let (hop, hop_misses) = bare_hop(rate, args.samples, &sup)?;
         let ratio = |a: u64, b: u64| if b > 0 { a as f64 / b as f64 } else { f64::NAN };
         rates.push(RateResult {
             rate_hz: rate,
@@ -285,6 +287,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             udp_deadline_misses: udp.deadline_misses,
             udp_stages_ns: udp.stages_ns,
             bare_hop_round_trip_ns: hop.percentiles(),
+            bare_hop_deadline_misses: hop_misses,
         });
     }
     eprintln!("tactile bench: lockstep throughput");
@@ -347,8 +350,9 @@ fn render(r: &BenchReport) -> String {
         );
         let _ = writeln!(
             t,
-            "{}",
-            us_line("bare iceoryx2 (2 hops)", &x.bare_hop_round_trip_ns)
+            "{}  {}",
+            us_line("bare iceoryx2 (2 hops)", &x.bare_hop_round_trip_ns),
+            x.bare_hop_deadline_misses
         );
         let _ = writeln!(
             t,
