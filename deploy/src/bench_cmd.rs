@@ -225,6 +225,20 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
     result
 }
 
+/// How the bench supervises its iceoryx2 runs: no restarts (a death fails the bench),
+/// no progress line, pinned unless `--no-pin`.
+fn supervision(args: &BenchArgs, prefix: &str, spin: Duration) -> Supervision {
+    Supervision {
+        prefix: prefix.to_string(),
+        spin,
+        progress: false,
+        max_restarts: 0,
+        transport: Transport::Iceoryx2,
+        pin: !args.no_pin,
+        rt: false,
+    }
+}
+
 /// `tactile bench`.
 pub fn main(args: &BenchArgs) -> Result<(), Error> {
     std::fs::create_dir_all(&args.out)
@@ -240,15 +254,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
         let spin = args
             .spin_us
             .map_or_else(|| default_spin(&sc), Duration::from_micros);
-        let sup = Supervision {
-            prefix: prefix.clone(),
-            spin,
-            progress: false,
-            max_restarts: 0,
-            transport: Transport::Iceoryx2,
-            pin: !args.no_pin,
-            rt: false,
-        };
+        let sup = supervision(args, &prefix, spin);
         eprintln!(
             "tactile bench: {rate} Hz, {} samples: iceoryx2 trio",
             args.samples
@@ -293,17 +299,10 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     eprintln!("tactile bench: lockstep throughput");
     let n = args.lockstep_samples;
     let sc = scenario(1000.0, n, Mode::Lockstep)?;
-    let sup = Supervision {
-        prefix: prefix.clone(),
-        spin: args
-            .spin_us
-            .map_or_else(|| Duration::from_millis(2), Duration::from_micros),
-        progress: false,
-        max_restarts: 0,
-        transport: Transport::Iceoryx2,
-        pin: !args.no_pin,
-        rt: false,
-    };
+    let spin = args
+        .spin_us
+        .map_or_else(|| Duration::from_millis(2), Duration::from_micros);
+    let sup = supervision(args, &prefix, spin);
     let lock = trio(&sc, &args.out.join("lockstep"), &sup, Transport::Iceoryx2)?;
     let report = BenchReport {
         lockstep_samples_per_s: lock.master.samples_per_s,
@@ -336,24 +335,21 @@ fn render(r: &BenchReport) -> String {
             x.rate_hz, x.samples
         );
         let _ = writeln!(t, "{}  misses", us_header());
-        let _ = writeln!(
-            t,
-            "{}  {}",
-            us_line("iceoryx2 loop", &x.iceoryx2_overhead_ns),
-            x.iceoryx2_deadline_misses
-        );
-        let _ = writeln!(
-            t,
-            "{}  {}",
-            us_line("UDP loop", &x.udp_overhead_ns),
-            x.udp_deadline_misses
-        );
-        let _ = writeln!(
-            t,
-            "{}  {}",
-            us_line("bare iceoryx2 (2 hops)", &x.bare_hop_round_trip_ns),
-            x.bare_hop_deadline_misses
-        );
+        for (name, p, misses) in [
+            (
+                "iceoryx2 loop",
+                &x.iceoryx2_overhead_ns,
+                x.iceoryx2_deadline_misses,
+            ),
+            ("UDP loop", &x.udp_overhead_ns, x.udp_deadline_misses),
+            (
+                "bare iceoryx2 (2 hops)",
+                &x.bare_hop_round_trip_ns,
+                x.bare_hop_deadline_misses,
+            ),
+        ] {
+            let _ = writeln!(t, "{}  {misses}", us_line(name, p));
+        }
         let _ = writeln!(
             t,
             "iceoryx2 / UDP: p50 {:.2}, p99 {:.2}",

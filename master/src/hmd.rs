@@ -7,10 +7,8 @@
 
 use crate::operator::{OperatorSource, Target};
 use serde::{Deserialize, Serialize};
-use tactile_common::arith::StdTrig;
 use tactile_common::engine::Engine;
-use tactile_common::geometry::Lengths;
-use tactile_common::kernels::{self, IkStatus};
+use tactile_common::kernels::IkStatus;
 use tactile_common::samples::{
     stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_REJECTED,
 };
@@ -46,8 +44,8 @@ pub struct MasterCounters {
 #[derive(Debug)]
 pub struct Master {
     engine: Engine,
-    truth: Lengths<f64>,
-    truth_engine: Engine,
+    /// The physical master device: f64 kernels (encoders read the true angles).
+    truth: Engine,
     source: OperatorSource,
     t_s: f64,
     t_s_ns: u64,
@@ -71,8 +69,7 @@ impl Master {
         };
         Ok(Master {
             engine: Engine::new(scenario.arithmetic, geometry, cordic).map_err(bad)?,
-            truth: geometry.lengths(),
-            truth_engine: Engine::new(tactile_common::arith::ArithKind::F64, geometry, cordic)
+            truth: Engine::new(tactile_common::arith::ArithKind::F64, geometry, cordic)
                 .map_err(bad)?,
             source,
             t_s: scenario.t_s(),
@@ -98,12 +95,12 @@ impl Master {
         let target = match self.source.target(n, self.t_s) {
             Target::Joints(theta) => {
                 self.theta_md = theta;
-                kernels::fk(&self.truth, &StdTrig, theta)
+                self.truth.fk(theta)
             }
             Target::Position(p) => {
                 // The hand puts the handle at p; the encoders read the joint angles the
                 // real device takes there (f64: physics, not the HMD datapath).
-                let s = self.truth_engine.ik(p);
+                let s = self.truth.ik(p);
                 match s.status {
                     IkStatus::Reachable => self.theta_md = s.theta,
                     IkStatus::Clamped => {
