@@ -1,7 +1,8 @@
 //! Pure code shared by every Tactile process: device geometry, the paper's kernels in
 //! three arithmetics, the CORDIC model of the FPGA's trigonometric block, and the
 //! statistics used by reports. Nothing here performs I/O, so every function can be
-//! called from a process, a test or a benchmark alike.
+//! called from a process, a test or a benchmark alike; the edges (links, records,
+//! logging) are in `tactile-node`.
 
 pub mod arith;
 pub mod channel;
@@ -10,9 +11,7 @@ pub mod cordic;
 pub mod csv;
 pub mod engine;
 pub mod geometry;
-pub mod ipc;
 pub mod kernels;
-pub mod link;
 pub mod samples;
 pub mod scenario;
 pub mod trace;

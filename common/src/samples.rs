@@ -100,7 +100,7 @@ impl Sequenced for Backward {
 /// Three signal values with their provenance.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Signal/1")]
+#[type_name("tactile::Signal/2")]
 pub struct Signal {
     /// Values: position in metres (forward) or force in newtons (backward).
     pub value: [f64; 3],
@@ -112,66 +112,65 @@ pub struct Signal {
     pub delay_samples: [u32; 3],
     /// `FLAG_*` bits.
     pub flags: u32,
-    /// Noise the emulator added to each value on the last hop.
-    pub noise: [f64; 3],
 }
 
-/// Forward stream: c(n) from the master, v(n) from the emulator.
+/// Forward stream: c(n) from the master, v(n) from the emulator. Carries only what the
+/// loop needs; what each node did with it is in that node's own record.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Forward/1")]
+#[type_name("tactile::Forward/2")]
 pub struct Forward {
     /// Sample number n on this stream.
     pub seq: u64,
-    /// Publish counter of the hop this sample last crossed (set by [`crate::ipc::Outbox`]);
+    /// Publish counter of the hop this sample last crossed (set by the link's outbox);
     /// a gap at the receiver is a sample overwritten in its buffer.
     pub hop_seq: u64,
+    /// The run this sample belongs to (chosen by the master at start; 0 = unknown).
+    /// A node drops and counts samples of another run.
+    pub run: u64,
     /// Tool position.
     pub signal: Signal,
-    /// The operator's target a(n), for tracking-error accounting.
-    pub target: [f64; 3],
     /// Timestamps per stage (`stage::*`), ns; zero where not passed yet.
     pub stamps: [u64; stage::COUNT],
-}
-
-/// The slave's state at the step that produced a backward sample, for the trace.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::SlaveState/1")]
-pub struct SlaveState {
-    /// The v(n) the slave received.
-    pub received: Signal,
-    /// IK-HSD reference angles, rad.
-    pub theta_ref: [f64; 3],
-    /// Slave joint angles after the step, rad.
-    pub theta: [f64; 3],
-    /// Controller torques after clamping, N m.
-    pub torque: [f64; 3],
-    /// FK-HSD tool position l(n), m.
-    pub tool: [f64; 3],
-    /// Nearest surface point s^OBJ(n), m (zero without contact).
-    pub surface: [f64; 3],
-    /// h(n) before the backward channel, N.
-    pub force: [f64; 3],
-    /// Torque clamps this step.
-    pub clamps: u32,
-    /// Object index in contact, or u32::MAX.
-    pub contact_object: u32,
 }
 
 /// Backward stream: h(n) from the slave, q(n) from the emulator.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Backward/1")]
+#[type_name("tactile::Backward/2")]
 pub struct Backward {
     /// Sample number n on this stream (the forward sample that triggered it).
     pub seq: u64,
     /// Publish counter of the last hop, as in [`Forward::hop_seq`].
     pub hop_seq: u64,
+    /// The run this sample belongs to, copied from the forward sample.
+    pub run: u64,
     /// Contact force.
     pub signal: Signal,
     /// Stamps of the triggering forward sample, then the backward stages.
     pub stamps: [u64; stage::COUNT],
-    /// The slave's state at step n.
-    pub slave: SlaveState,
 }
+
+/// A sample that belongs to a run.
+pub trait OfRun {
+    /// The run token carried.
+    fn run(&self) -> u64;
+}
+
+impl OfRun for Forward {
+    fn run(&self) -> u64 {
+        self.run
+    }
+}
+
+impl OfRun for Backward {
+    fn run(&self) -> u64 {
+        self.run
+    }
+}
+
+/// How many samples back an answer may still be matched to the sample it answers. The
+/// master keeps this window of samples awaiting answers, and the report joins records
+/// within it; an answer older than this counts as unexpected. Bounded, so memory does
+/// not grow with the run's length.
+pub const LATE_WINDOW: u64 = 1024;

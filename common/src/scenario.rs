@@ -595,6 +595,24 @@ impl Scenario {
         Ok(s)
     }
 
+    /// The same scenario with every relative path made absolute against `base_dir`
+    /// (the scenario file's folder), so a copy of it runs from any folder.
+    pub fn resolved(&self, base_dir: &std::path::Path) -> Scenario {
+        let mut s = self.clone();
+        if let Operator::Csv { path } = &mut s.operator {
+            let p = std::path::Path::new(path.as_str());
+            if p.is_relative() {
+                *path = base_dir.join(p).display().to_string();
+            }
+        }
+        s
+    }
+
+    /// The scenario as TOML text (what a run's `scenario.toml` holds).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_else(|e| format!("# cannot encode the scenario: {e}\n"))
+    }
+
     /// Things that load but deserve a word: stiffness above the device's nominal
     /// maximum.
     pub fn warnings(&self) -> Vec<String> {

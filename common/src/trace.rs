@@ -5,7 +5,7 @@
 //! the timing columns off by name. Floats are written in shortest round-trip form, so
 //! equal values give equal text and the file reads back exactly.
 
-use crate::samples::{stage, Backward, Forward};
+use crate::samples::stage;
 use std::fmt::Write;
 
 /// Three-valued signal columns, in order, with their prefix.
@@ -47,29 +47,67 @@ pub fn header() -> String {
     h
 }
 
-/// What the master knows about sample n once it is done with it.
+/// Sample n as the report joins it from the nodes' records: the master's part (target,
+/// encoders, c, q, torques, round trip), the emulator's (noise injected) and the
+/// slave's (what it received and did). A part whose node recorded nothing for n stays
+/// zero, and `received` says whether the answer came back.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TraceRow {
     /// Sample number.
     pub n: u64,
+    /// True if q(n) came back to the master.
+    pub received: bool,
     /// The operator's target a(n), m.
     pub target: [f64; 3],
     /// Master joint angles b(n), rad.
     pub theta_md: [f64; 3],
-    /// The forward sample c(n) as sent.
-    pub forward: Forward,
-    /// The backward sample q(n) as received, if it came.
-    pub backward: Option<Backward>,
+    /// c(n) as sent, m.
+    pub c: [f64; 3],
+    /// v(n) as the slave received it, m.
+    pub v: [f64; 3],
+    /// Noise the emulator added to v(n).
+    pub noise_f: [f64; 3],
+    /// Delay injected into v(n), samples.
+    pub delay_f: [u32; 3],
+    /// IK-HSD reference angles, rad.
+    pub theta_ref: [f64; 3],
+    /// Slave joint angles after the step, rad.
+    pub theta_sd: [f64; 3],
+    /// Slave controller torques, N m.
+    pub u: [f64; 3],
+    /// FK-HSD tool position l(n), m.
+    pub tool: [f64; 3],
+    /// Nearest surface point, m (zero without contact).
+    pub surface: [f64; 3],
+    /// h(n), N.
+    pub h: [f64; 3],
+    /// q(n) as the master received it, N.
+    pub q: [f64; 3],
+    /// Noise the emulator added to q(n).
+    pub noise_b: [f64; 3],
+    /// Delay injected into q(n), samples.
+    pub delay_b: [u32; 3],
     /// KFF-HMD torques p(n), N m.
     pub tau: [f64; 3],
-    /// The force the operator feels (q after the master's limits), N.
+    /// The force the operator feels, N.
     pub felt: [f64; 3],
-    /// Round trip, ns (0 if no backward sample).
+    /// Flags of v(n) as received.
+    pub flags_f: u32,
+    /// Flags of q(n) as received.
+    pub flags_b: u32,
+    /// The master's flags for this sample (held, peer lost, clamped, rejected).
+    pub flags_m: u32,
+    /// Object in contact, or -1.
+    pub contact_object: i64,
+    /// Round trip, ns (0 if no answer).
     pub round_trip_ns: u64,
     /// Round trip minus injected delay, ns.
     pub overhead_ns: i64,
-    /// The master's `FLAG_*` bits for this sample (held, peer lost, clamped, rejected).
-    pub master_flags: u32,
+    /// Stamps per stage, ns (zero where not passed).
+    pub stamps: [u64; stage::COUNT],
+    /// True if the slave recorded a step on v(n) (not a trace column: it says whether
+    /// the slave's columns hold data).
+    pub stepped: bool,
 }
 
 fn push3(line: &mut String, v: [f64; 3]) {
@@ -87,46 +125,37 @@ fn push3u(line: &mut String, v: [u32; 3]) {
 impl TraceRow {
     /// Appends this row as one CSV line (with newline); `t0` is subtracted from stamps.
     pub fn write_csv(&self, line: &mut String, t0: u64) {
-        let b = self.backward.unwrap_or_default();
-        let s = &b.slave;
-        let _ = write!(line, "{},{}", self.n, u8::from(self.backward.is_some()));
-        push3(line, self.target);
-        push3(line, self.theta_md);
-        push3(line, self.forward.signal.value);
-        push3(line, s.received.value);
-        push3(line, s.received.noise);
-        push3u(line, s.received.delay_samples);
-        push3(line, s.theta_ref);
-        push3(line, s.theta);
-        push3(line, s.torque);
-        push3(line, s.tool);
-        push3(line, s.surface);
-        push3(line, s.force);
-        push3(line, b.signal.value);
-        push3(line, b.signal.noise);
-        push3u(line, b.signal.delay_samples);
+        let _ = write!(line, "{},{}", self.n, u8::from(self.received));
+        for v in [self.target, self.theta_md, self.c, self.v, self.noise_f] {
+            push3(line, v);
+        }
+        push3u(line, self.delay_f);
+        for v in [
+            self.theta_ref,
+            self.theta_sd,
+            self.u,
+            self.tool,
+            self.surface,
+            self.h,
+            self.q,
+            self.noise_b,
+        ] {
+            push3(line, v);
+        }
+        push3u(line, self.delay_b);
         push3(line, self.tau);
         push3(line, self.felt);
-        let contact = if s.contact_object == u32::MAX || self.backward.is_none() {
-            -1
-        } else {
-            i64::from(s.contact_object)
-        };
         let _ = write!(
             line,
-            ",{},{},{},{contact},{},{}",
-            s.received.flags,
-            b.signal.flags,
-            self.master_flags,
+            ",{},{},{},{},{},{}",
+            self.flags_f,
+            self.flags_b,
+            self.flags_m,
+            self.contact_object,
             self.round_trip_ns,
             self.overhead_ns
         );
-        for k in 0..stage::COUNT {
-            let t = if self.backward.is_some() {
-                b.stamps[k]
-            } else {
-                self.forward.stamps[k]
-            };
+        for t in self.stamps {
             let _ = write!(line, ",{}", t.saturating_sub(t0));
         }
         line.push('\n');

@@ -10,8 +10,8 @@
 use crate::cli::BenchArgs;
 use crate::error::Error;
 use crate::report::{us_header, us_line, Latency, Percentiles};
-use crate::roles::{write_json, Transport};
-use crate::run_cmd::{default_spin, run_processes, Supervision, PAPER_SCENARIO};
+use crate::report_cmd::write_json;
+use crate::run_cmd::{default_spin, run_processes, Loaded, Supervision, PAPER_SCENARIO};
 use crate::summary::Summary;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -19,9 +19,10 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tactile_common::clock::{now_ns, sleep_until_ns};
-use tactile_common::ipc::{self, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
 use tactile_common::samples::{Forward, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::{Mode, Scenario};
+use tactile_node::ipc::{self, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
+use tactile_node::runtime::LinkKind;
 
 /// One rate's results.
 #[derive(Debug, Clone, Serialize)]
@@ -31,19 +32,19 @@ pub struct RateResult {
     /// Samples per run.
     pub samples: u64,
     /// System overhead of the iceoryx2 trio, ns.
-    pub iceoryx2_overhead_ns: Percentiles,
+    pub iceoryx2_overhead_ns: Option<Percentiles>,
     /// Its deadline misses.
     pub iceoryx2_deadline_misses: u64,
     /// Its per-stage times (compute per process, transport per hop), ns.
     pub iceoryx2_stages_ns: BTreeMap<String, Percentiles>,
     /// System overhead of the UDP trio, ns.
-    pub udp_overhead_ns: Percentiles,
+    pub udp_overhead_ns: Option<Percentiles>,
     /// Its deadline misses.
     pub udp_deadline_misses: u64,
     /// Its per-stage times, ns.
     pub udp_stages_ns: BTreeMap<String, Percentiles>,
     /// Round trip of the bare iceoryx2 hop pair (two hops), ns.
-    pub bare_hop_round_trip_ns: Percentiles,
+    pub bare_hop_round_trip_ns: Option<Percentiles>,
     /// Bare-hop round trips not back within their sampling period.
     pub bare_hop_deadline_misses: u64,
     /// iceoryx2 overhead / UDP overhead at p50.
@@ -77,15 +78,18 @@ fn scenario(rate: f64, samples: u64, mode: Mode) -> Result<Scenario, Error> {
     Ok(s)
 }
 
-fn trio(
-    sc: &Scenario,
-    out: &Path,
-    sup: &Supervision,
-    transport: Transport,
-) -> Result<Summary, Error> {
-    std::fs::create_dir_all(out).map_err(Error::io(format!("creating {}", out.display())))?;
+fn trio(sc: &Scenario, out: &Path, sup: &Supervision, link: LinkKind) -> Result<Summary, Error> {
+    let udp_ports = match link {
+        LinkKind::Udp => Some(
+            tactile_node::udp::UdpPorts::free()
+                .map_err(|e| Error::Failed(e.to_string()))?
+                .arg(),
+        ),
+        LinkKind::Iceoryx2 => None,
+    };
     let sup = Supervision {
-        transport,
+        link,
+        udp_ports,
         prefix: format!(
             "{}{}",
             sup.prefix,
@@ -93,8 +97,12 @@ fn trio(
         ),
         ..sup.clone()
     };
-    let cwd = std::env::current_dir().unwrap_or_else(|_| ".".into());
-    run_processes(sc, &cwd, out, &sup)
+    let loaded = Loaded {
+        scenario: sc.clone(),
+        base_dir: std::env::current_dir().unwrap_or_else(|_| ".".into()),
+        inputs: Vec::new(),
+    };
+    run_processes(&loaded, out, &sup)
 }
 
 /// The echo side of the bare hop: sends back every sample it gets, until the end mark.
@@ -112,6 +120,18 @@ pub fn echo(prefix: &str, wait: WaitPolicy) -> Result<(), IpcError> {
             }
             Err(Idle::Terminate) => return Ok(()),
             Err(Idle::Timeout) => {}
+        }
+    }
+}
+
+/// Puts back the CPU affinity the bench had, so the bare hop's pinning does not leak
+/// into the next step of the bench.
+struct Restore(Option<rustix::thread::CpuSet>);
+
+impl Drop for Restore {
+    fn drop(&mut self) {
+        if let Some(set) = &self.0 {
+            let _ = rustix::thread::sched_setaffinity(None, set);
         }
     }
 }
@@ -134,27 +154,20 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
         Command::new(&exe)
     };
     let mut child = cmd
-        .args([
-            "role",
-            "echo",
-            "--scenario",
-            "-",
-            "--base-dir",
-            ".",
-            "--out",
-            ".",
-        ])
+        .arg("bench-echo")
         .args(["--prefix", &prefix, "--spin-us"])
         .arg(sup.spin.as_micros().to_string())
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .spawn()
         .map_err(|e| Error::Failed(format!("starting the echo process: {e}")))?;
+    let saved_affinity = rustix::thread::sched_getaffinity(None).ok();
     let result = (|| -> Result<(Latency, u64), Error> {
         let fail = |e: IpcError| Error::Failed(e.to_string());
         if sup.pin {
             pin_self(0);
         }
+        let _restore = Restore(saved_affinity);
         let node = ipc::node(&prefix, "bench").map_err(fail)?;
         let out: Outbox<Forward> = Outbox::open(&node, "hop/ping", "echo").map_err(fail)?;
         let inbox: Inbox<Forward> = Inbox::open(&node, "hop/pong").map_err(fail)?;
@@ -187,7 +200,7 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
         let mut misses = 0;
         for i in 0..n {
             let tick = t0 + i * t_s;
-            sleep_until_ns(tick.saturating_sub(crate::roles::WAKE_EARLY_NS));
+            sleep_until_ns(tick.saturating_sub(tactile_master::node::WAKE_EARLY_NS));
             while now_ns() < tick {
                 std::hint::spin_loop();
             }
@@ -233,9 +246,11 @@ fn supervision(args: &BenchArgs, prefix: &str, spin: Duration) -> Supervision {
         spin,
         progress: false,
         max_restarts: 0,
-        transport: Transport::Iceoryx2,
+        link: LinkKind::Iceoryx2,
+        udp_ports: None,
         pin: !args.no_pin,
         rt: false,
+        no_trace: false,
     }
 }
 
@@ -263,7 +278,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             &sc,
             &args.out.join(format!("iox-{rate}")),
             &sup,
-            Transport::Iceoryx2,
+            LinkKind::Iceoryx2,
         )?;
         eprintln!("tactile bench: {rate} Hz: UDP trio");
         let udp_sup = Supervision {
@@ -271,21 +286,29 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             pin: false,
             ..sup.clone()
         };
-        let ports = crate::udp::UdpPorts::free().map_err(|e| Error::Failed(e.to_string()))?;
         let udp = trio(
             &sc,
             &args.out.join(format!("udp-{rate}")),
             &udp_sup,
-            Transport::Udp(ports),
+            LinkKind::Udp,
         )?;
         eprintln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
         let (hop, hop_misses) = bare_hop(rate, args.samples, &sup)?;
-        let ratio = |a: u64, b: u64| if b > 0 { a as f64 / b as f64 } else { f64::NAN };
+        let ratio = |a: Option<u64>, b: Option<u64>| match (a, b) {
+            (Some(a), Some(b)) if b > 0 => a as f64 / b as f64,
+            _ => f64::NAN,
+        };
         rates.push(RateResult {
             rate_hz: rate,
             samples: args.samples,
-            ratio_p50: ratio(iox.overhead_ns.p50, udp.overhead_ns.p50),
-            ratio_p99: ratio(iox.overhead_ns.p99, udp.overhead_ns.p99),
+            ratio_p50: ratio(
+                iox.overhead_ns.map(|p| p.p50),
+                udp.overhead_ns.map(|p| p.p50),
+            ),
+            ratio_p99: ratio(
+                iox.overhead_ns.map(|p| p.p99),
+                udp.overhead_ns.map(|p| p.p99),
+            ),
             iceoryx2_overhead_ns: iox.overhead_ns,
             iceoryx2_deadline_misses: iox.deadline_misses,
             iceoryx2_stages_ns: iox.stages_ns,
@@ -303,7 +326,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
         .spin_us
         .map_or_else(|| Duration::from_millis(2), Duration::from_micros);
     let sup = supervision(args, &prefix, spin);
-    let lock = trio(&sc, &args.out.join("lockstep"), &sup, Transport::Iceoryx2)?;
+    let lock = trio(&sc, &args.out.join("lockstep"), &sup, LinkKind::Iceoryx2)?;
     let report = BenchReport {
         lockstep_samples_per_s: lock.master.samples_per_s,
         lockstep_samples: n,
@@ -348,7 +371,7 @@ fn render(r: &BenchReport) -> String {
                 x.bare_hop_deadline_misses,
             ),
         ] {
-            let _ = writeln!(t, "{}  {misses}", us_line(name, p));
+            let _ = writeln!(t, "{}  {misses}", us_line(name, p.as_ref()));
         }
         let _ = writeln!(
             t,
@@ -357,7 +380,7 @@ fn render(r: &BenchReport) -> String {
         );
         let _ = writeln!(t, "iceoryx2 loop stages:");
         for (name, p) in &x.iceoryx2_stages_ns {
-            let _ = writeln!(t, "{}", us_line(&format!("  {name}"), p));
+            let _ = writeln!(t, "{}", us_line(&format!("  {name}"), Some(p)));
         }
     }
     let _ = writeln!(

@@ -25,14 +25,42 @@ pub enum Command {
     Kernels(KernelsArgs),
     /// Reproduce the paper's MSE table (hybrid against f32 on its validation run).
     Paper(PaperArgs),
-    /// Run a scenario: start master, network emulator and slave, and report.
+    /// Run a scenario: start the master, emulator and slave programs, and report.
     Run(RunArgs),
     /// Measure the loop's own overhead at 1 and 10 kHz beside UDP and a bare iceoryx2
     /// hop, and the lockstep throughput.
     Bench(BenchArgs),
-    /// One process of a run (started by `tactile run`).
+    /// Join the nodes' records (one folder, or one folder per node) into the run's
+    /// report: summary, trace, histograms, plots.
+    Report(ReportArgs),
+    /// The echo side of `tactile bench`'s bare iceoryx2 hop (started by the bench).
     #[command(hide = true)]
-    Role(RoleArgs),
+    BenchEcho(EchoArgs),
+}
+
+/// Arguments of `tactile report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Folders holding the nodes' records (master.rec, emulator.rec, slave.rec).
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Folder for the report (default: the master's folder).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Write no trace.csv (a long run's trace is about 1 kB per sample).
+    #[arg(long)]
+    pub no_trace: bool,
+}
+
+/// Arguments of `tactile bench-echo`.
+#[derive(Debug, Args)]
+pub struct EchoArgs {
+    /// iceoryx2 prefix of the hop.
+    #[arg(long)]
+    pub prefix: String,
+    /// Busy-poll budget, microseconds.
+    #[arg(long, default_value_t = 0)]
+    pub spin_us: u64,
 }
 
 /// Arguments of `tactile bench`.
@@ -91,51 +119,16 @@ pub struct RunArgs {
     #[arg(long)]
     pub udp: bool,
     /// Do not pin the processes (by default the master runs on CPU 0 and the emulator
-    /// and slave on CPU 1, via taskset, where the machine has two CPUs).
+    /// and slave on CPU 1, where the machine has two CPUs).
     #[arg(long)]
     pub no_pin: bool,
     /// Run the three processes SCHED_FIFO (chrt), where permitted.
     #[arg(long)]
     pub rt: bool,
-}
-
-/// Which process a role runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum RoleName {
-    /// OP, MD, HMD.
-    Master,
-    /// NW.
-    Emulator,
-    /// HSD, SD, ENV.
-    Slave,
-    /// The echo side of `tactile bench`'s bare iceoryx2 hop.
-    Echo,
-}
-
-/// Arguments of `tactile role`.
-#[derive(Debug, Args)]
-pub struct RoleArgs {
-    /// The role.
-    #[arg(value_enum)]
-    pub role: RoleName,
-    /// Scenario file written by the launcher.
+    /// Write no trace.csv (a long run's trace is about 1 kB per sample); everything
+    /// else is reported.
     #[arg(long)]
-    pub scenario: PathBuf,
-    /// Folder the scenario's relative paths are resolved against.
-    #[arg(long)]
-    pub base_dir: PathBuf,
-    /// iceoryx2 prefix of the run.
-    #[arg(long)]
-    pub prefix: String,
-    /// Output folder.
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Busy-poll budget, microseconds.
-    #[arg(long, default_value_t = 0)]
-    pub spin_us: u64,
-    /// UDP ports `master,emulator,slave`: run over UDP instead of iceoryx2.
-    #[arg(long)]
-    pub udp_ports: Option<String>,
+    pub no_trace: bool,
 }
 
 /// The kernel a `kernels` run evaluates.
@@ -227,9 +220,14 @@ impl DatapathArgs {
             return Ok(g);
         }
         let path = PathBuf::from(&self.device);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
+        let text = tactile_node::files::read_text(
+            &path,
+            "device file",
+            tactile_node::files::MAX_DEVICE_BYTES,
+        )
+        .map_err(|e| {
             Error::BadInput(format!(
-                "--device {}: not a preset (paper, omni) and cannot read it as a file: {e}",
+                "--device {}: not a preset (paper, omni); {e}",
                 self.device
             ))
         })?;
@@ -296,6 +294,13 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         }
         Command::Run(args) => crate::run_cmd::main(&args),
         Command::Bench(args) => crate::bench_cmd::main(&args),
-        Command::Role(args) => crate::roles::dispatch(args),
+        Command::Report(args) => crate::report_cmd::main(&args),
+        Command::BenchEcho(args) => crate::bench_cmd::echo(
+            &args.prefix,
+            tactile_node::ipc::WaitPolicy {
+                spin: std::time::Duration::from_micros(args.spin_us),
+            },
+        )
+        .map_err(|e| Error::Failed(e.to_string())),
     }
 }

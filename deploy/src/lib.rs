@@ -7,12 +7,13 @@
 pub mod bench_cmd;
 pub mod cli;
 pub mod error;
+pub mod join;
 pub mod kernels_cmd;
+pub mod nodes;
 pub mod paper_cmd;
 pub mod plots;
 pub mod report;
-pub mod roles;
+pub mod report_cmd;
 pub mod run_cmd;
 pub mod sim;
 pub mod summary;
-pub mod udp;

@@ -1,7 +1,13 @@
 //! SVG plots of a run: the overhead histogram, master and slave positions over time,
 //! and forces over time. Written with plotters' SVG backend, which needs no system
 //! library or font file.
+//!
+//! Time series are thinned as they are gathered: each series keeps, per bucket of
+//! consecutive samples, the smallest and the largest value, and doubles the bucket when
+//! there are more buckets than pixel columns. A plot of a million samples is
+//! then as small and as readable as one of a thousand, and no spike is lost.
 
+use crate::report::Latency;
 use plotters::prelude::*;
 use std::path::Path;
 use tactile_common::trace::TraceRow;
@@ -19,29 +25,152 @@ const COLOURS: [RGBColor; 3] = [
     RGBColor(44, 160, 44),
 ];
 
+/// Width of the time-series plots, pixels.
+pub const WIDTH: u32 = 1000;
+
+/// One series thinned to the pixel width, keeping the extremes of each bucket.
+#[derive(Debug, Clone)]
+pub struct Thinned {
+    bucket: u64,
+    in_bucket: u64,
+    cur: Option<(f64, f64, f64)>,
+    points: Vec<(f64, f64, f64)>,
+}
+
+impl Default for Thinned {
+    fn default() -> Self {
+        Thinned {
+            bucket: 1,
+            in_bucket: 0,
+            cur: None,
+            points: Vec::new(),
+        }
+    }
+}
+
+impl Thinned {
+    /// Adds the value at time `t`; NaN leaves a gap in the bucket's extremes.
+    pub fn push(&mut self, t: f64, v: f64) {
+        if v.is_finite() {
+            self.cur = Some(match self.cur {
+                None => (t, v, v),
+                Some((t0, lo, hi)) => (t0, lo.min(v), hi.max(v)),
+            });
+        }
+        self.in_bucket += 1;
+        if self.in_bucket < self.bucket {
+            return;
+        }
+        self.in_bucket = 0;
+        if let Some(p) = self.cur.take() {
+            self.points.push(p);
+        }
+        if self.points.len() >= WIDTH as usize {
+            self.points = self
+                .points
+                .chunks(2)
+                .map(|c| {
+                    c.iter()
+                        .skip(1)
+                        .fold(c[0], |(t, lo, hi), &(_, l, h)| (t, lo.min(l), hi.max(h)))
+                })
+                .collect();
+            self.bucket *= 2;
+        }
+    }
+
+    /// The points to draw: each bucket's minimum then maximum.
+    pub fn points(&self) -> Vec<(f64, f64)> {
+        let mut out = Vec::with_capacity(2 * self.points.len() + 2);
+        for &(t, lo, hi) in self.points.iter().chain(self.cur.iter()) {
+            out.push((t, lo));
+            if hi != lo {
+                out.push((t, hi));
+            }
+        }
+        out
+    }
+}
+
+/// The time series of a run, gathered row by row.
+#[derive(Debug, Clone, Default)]
+pub struct Series {
+    target: [Thinned; 3],
+    tool: [Thinned; 3],
+    force: [Thinned; 3],
+    felt: [Thinned; 3],
+}
+
+impl Series {
+    /// Adds one row at its time.
+    pub fn add(&mut self, row: &TraceRow, t_s: f64) {
+        let t = row.n as f64 * t_s;
+        for i in 0..3 {
+            self.target[i].push(t, row.target[i]);
+            self.tool[i].push(t, if row.stepped { row.tool[i] } else { f64::NAN });
+            self.force[i].push(t, if row.stepped { row.h[i] } else { f64::NAN });
+            self.felt[i].push(t, row.felt[i]);
+        }
+    }
+
+    /// Writes `positions.svg` and `forces.svg` into `out`.
+    pub fn write(&self, out: &Path) -> PlotResult {
+        let series = |a: &[Thinned; 3], b: &[Thinned; 3], la: &str, lb: &str, pre: &str| {
+            let mut v = Vec::new();
+            for i in 0..3 {
+                v.push((
+                    format!("{pre}{} {la}", AXES[i]),
+                    COLOURS[i],
+                    true,
+                    a[i].points(),
+                ));
+                v.push((
+                    format!("{pre}{} {lb}", AXES[i]),
+                    COLOURS[i],
+                    false,
+                    b[i].points(),
+                ));
+            }
+            v
+        };
+        time_series(
+            &out.join("positions.svg"),
+            "Master target and slave tool position",
+            "position (m)",
+            &series(
+                &self.target,
+                &self.tool,
+                "operator target",
+                "slave tool",
+                "",
+            ),
+        )?;
+        time_series(
+            &out.join("forces.svg"),
+            "Contact force (slave) and feedback force (master)",
+            "force (N)",
+            &series(&self.felt, &self.force, "felt q(n)", "slave h(n)", "F"),
+        )
+    }
+}
+
 /// Histogram of the system overhead per round trip, in microseconds.
-pub fn overhead_histogram(rows: &[TraceRow], path: &Path) -> PlotResult {
-    let us: Vec<f64> = rows
-        .iter()
-        .filter(|r| r.backward.is_some())
-        .map(|r| r.overhead_ns.max(0) as f64 / 1000.0)
-        .collect();
+pub fn overhead_histogram(lat: &Latency, path: &Path) -> PlotResult {
     let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
-    if us.is_empty() {
+    let Some(p) = lat.percentiles() else {
         return root.present().map_err(err);
-    }
-    let mut sorted = us.clone();
-    sorted.sort_by(f64::total_cmp);
+    };
     // Cut the axis at 1.5 x p99 so the body of the distribution stays visible; the
     // tail goes into the last bin (and is in the percentiles and the .hgrm file).
-    let hi = sorted[((sorted.len() - 1) as f64 * 0.99) as usize].max(1.0) * 1.5;
+    let hi = (p.p99 as f64 / 1000.0).max(1.0) * 1.5;
     let bins = 100usize;
     let width = hi / bins as f64;
     let mut counts = vec![0u64; bins];
-    for v in &us {
-        let k = ((v / width) as usize).min(bins - 1);
-        counts[k] += 1;
+    for v in lat.histogram().iter_recorded() {
+        let us = v.value_iterated_to() as f64 / 1000.0;
+        let k = ((us / width) as usize).min(bins - 1);
+        counts[k] += v.count_at_value();
     }
     let top = counts.iter().copied().max().unwrap_or(1) as f64 * 1.1;
     let mut chart = ChartBuilder::on(&root)
@@ -69,27 +198,24 @@ pub fn overhead_histogram(rows: &[TraceRow], path: &Path) -> PlotResult {
     root.present().map_err(err)
 }
 
-fn time_series(
-    path: &Path,
-    title: &str,
-    y_desc: &str,
-    t: &[f64],
-    series: &[(String, RGBColor, bool, Vec<f64>)],
-) -> PlotResult {
-    let root = SVGBackend::new(path, (1000, 560)).into_drawing_area();
+type Line = (String, RGBColor, bool, Vec<(f64, f64)>);
+
+fn time_series(path: &Path, title: &str, y_desc: &str, series: &[Line]) -> PlotResult {
+    let root = SVGBackend::new(path, (WIDTH, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut lo, mut hi, mut t_end) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
     for (_, _, _, v) in series {
-        for x in v.iter().filter(|x| x.is_finite()) {
+        for (t, x) in v {
             lo = lo.min(*x);
             hi = hi.max(*x);
+            t_end = t_end.max(*t);
         }
     }
-    if !lo.is_finite() || t.is_empty() {
+    if !lo.is_finite() {
         return root.present().map_err(err);
     }
     let pad = ((hi - lo) * 0.05).max(1e-6);
-    let t_end = t.last().copied().unwrap_or(1.0).max(1e-3);
+    let t_end = t_end.max(1e-3);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
         .margin(10)
@@ -103,22 +229,22 @@ fn time_series(
         .y_desc(y_desc)
         .draw()
         .map_err(err)?;
-    for (label, colour, dashed, v) in series {
-        // Dashed series (the reference: target, felt force) are drawn lighter and
-        // thinner, so they read apart from the solid ones in the legend too.
-        let style = if *dashed {
-            ShapeStyle::from(colour.mix(0.55)).stroke_width(1)
+    for (label, colour, reference, v) in series {
+        // The reference series (target, felt force) are drawn lighter and thinner, so
+        // they read apart from the measured ones, in the legend too. Not dashed: a
+        // thinned series zig-zags between each bucket's extremes, and dashing that
+        // path would write thousands of dashes.
+        let style = if *reference {
+            ShapeStyle::from(colour.mix(0.45)).stroke_width(1)
         } else {
             ShapeStyle::from(colour).stroke_width(2)
         };
-        let points = t.iter().copied().zip(v.iter().copied());
         let legend = move |(x, y): (i32, i32)| PathElement::new(vec![(x, y), (x + 20, y)], style);
-        let drawn = if *dashed {
-            chart.draw_series(DashedLineSeries::new(points, 6, 4, style))
-        } else {
-            chart.draw_series(LineSeries::new(points, style))
-        };
-        drawn.map_err(err)?.label(label.as_str()).legend(legend);
+        chart
+            .draw_series(LineSeries::new(v.iter().copied(), style))
+            .map_err(err)?
+            .label(label.as_str())
+            .legend(legend);
     }
     chart
         .configure_series_labels()
@@ -129,60 +255,28 @@ fn time_series(
     root.present().map_err(err)
 }
 
-/// Operator target (dashed) and slave tool (solid) per axis over time.
-pub fn positions(rows: &[TraceRow], t_s: f64, path: &Path) -> PlotResult {
-    let t: Vec<f64> = rows.iter().map(|r| r.n as f64 * t_s).collect();
-    let mut series = Vec::new();
-    for i in 0..3 {
-        series.push((
-            format!("{} operator target", AXES[i]),
-            COLOURS[i],
-            true,
-            rows.iter().map(|r| r.target[i]).collect(),
-        ));
-        series.push((
-            format!("{} slave tool", AXES[i]),
-            COLOURS[i],
-            false,
-            rows.iter()
-                .map(|r| r.backward.map_or(f64::NAN, |b| b.slave.tool[i]))
-                .collect(),
-        ));
-    }
-    time_series(
-        path,
-        "Master target and slave tool position",
-        "position (m)",
-        &t,
-        &series,
-    )
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// Contact force at the slave (solid) and force felt at the master (dashed).
-pub fn forces(rows: &[TraceRow], t_s: f64, path: &Path) -> PlotResult {
-    let t: Vec<f64> = rows.iter().map(|r| r.n as f64 * t_s).collect();
-    let mut series = Vec::new();
-    for i in 0..3 {
-        series.push((
-            format!("F{} slave h(n)", AXES[i]),
-            COLOURS[i],
-            false,
-            rows.iter()
-                .map(|r| r.backward.map_or(f64::NAN, |b| b.slave.force[i]))
-                .collect(),
-        ));
-        series.push((
-            format!("F{} felt q(n)", AXES[i]),
-            COLOURS[i],
-            true,
-            rows.iter().map(|r| r.felt[i]).collect(),
-        ));
+    #[test]
+    fn thinning_keeps_the_extremes_and_bounds_the_points() {
+        let mut s = Thinned::default();
+        let n = 1_000_000u64;
+        for k in 0..n {
+            let v = if k == 777_777 {
+                50.0
+            } else if k == 123_456 {
+                -9.0
+            } else {
+                (k as f64 * 1e-3).sin()
+            };
+            s.push(k as f64, v);
+        }
+        let p = s.points();
+        assert!(p.len() <= 2 * WIDTH as usize + 2, "{} points", p.len());
+        let max = p.iter().map(|x| x.1).fold(f64::MIN, f64::max);
+        let min = p.iter().map(|x| x.1).fold(f64::MAX, f64::min);
+        assert_eq!((min, max), (-9.0, 50.0));
     }
-    time_series(
-        path,
-        "Contact force (slave) and feedback force (master)",
-        "force (N)",
-        &t,
-        &series,
-    )
 }

@@ -1,7 +1,8 @@
-//! The run report: latency histograms, per-stage times, channel accounting, tracking
-//! and force statistics, computed from the master's trace rows.
+//! The run report's statistics: latency histograms, per-stage times, tracking and force
+//! statistics, gathered row by row from the joined records (so a run of any length is
+//! reported in bounded memory).
 //!
-//! The same function reports a process run and an in-process simulation. Latencies go
+//! The same code reports a process run and an in-process simulation. Latencies go
 //! into HdrHistograms (1 ns to 60 s, 3 significant digits) and are reported as count,
 //! p50, p90, p99, p99.9 and max; the full distribution is written in HdrHistogram's
 //! percentile-file form (`*.hgrm`, microseconds) so standard tools can plot it.
@@ -9,7 +10,7 @@
 use hdrhistogram::Histogram;
 use serde::Serialize;
 use std::fmt::Write as _;
-use tactile_common::samples::stage;
+use tactile_common::samples::{stage, FLAG_REJECTED, FLAG_SUBSTITUTED};
 use tactile_common::trace::TraceRow;
 
 /// Percentiles of one latency distribution, nanoseconds.
@@ -59,13 +60,13 @@ impl Latency {
         self.hist.saturating_record(ns.max(0) as u64);
     }
 
-    /// The summary percentiles.
-    pub fn percentiles(&self) -> Percentiles {
+    /// The summary percentiles; `None` when nothing was recorded.
+    pub fn percentiles(&self) -> Option<Percentiles> {
         let h = &self.hist;
         if h.is_empty() {
-            return Percentiles::default();
+            return None;
         }
-        Percentiles {
+        Some(Percentiles {
             count: h.len(),
             p50: h.value_at_quantile(0.50),
             p90: h.value_at_quantile(0.90),
@@ -73,7 +74,12 @@ impl Latency {
             p999: h.value_at_quantile(0.999),
             max: h.max(),
             mean: h.mean(),
-        }
+        })
+    }
+
+    /// The histogram itself (for plots).
+    pub fn histogram(&self) -> &Histogram<u64> {
+        &self.hist
     }
 
     /// HdrHistogram percentile distribution text, values in microseconds.
@@ -151,14 +157,15 @@ pub const STAGES: [(&str, usize, usize); 9] = [
 /// Tracking and force statistics.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Motion {
-    /// RMS distance of the slave's tool from the operator's target, m.
-    pub tracking_rms_m: f64,
+    /// RMS distance of the slave's tool from the position it was asked to reach (v(n),
+    /// the master's c after the network), m; `None` when the slave recorded no step.
+    pub tracking_rms_m: Option<f64>,
     /// Largest such distance, m.
-    pub tracking_max_m: f64,
+    pub tracking_max_m: Option<f64>,
     /// Largest contact force magnitude the slave produced, N.
     pub force_max_n: f64,
-    /// RMS force the operator felt over the run, N.
-    pub felt_rms_n: f64,
+    /// RMS force the operator felt over the answered samples, N; `None` without one.
+    pub felt_rms_n: Option<f64>,
     /// Largest force the operator felt, N.
     pub felt_max_n: f64,
     /// Samples with the tool in contact.
@@ -167,9 +174,9 @@ pub struct Motion {
     pub tau_max_nm: f64,
 }
 
-/// What the trace rows say, before the processes' own counters are merged in.
+/// The statistics of a run's rows, gathered one row at a time (bounded memory).
 #[derive(Debug, Clone)]
-pub struct RowReport {
+pub struct Analysis {
     /// Round trip, origin to torques out, on the master's clock.
     pub round_trip: Latency,
     /// Round trip minus injected delay.
@@ -178,80 +185,106 @@ pub struct RowReport {
     pub stages: Vec<Latency>,
     /// Tracking and forces.
     pub motion: Motion,
-    /// Rows with a backward sample.
+    /// Rows with an answer.
     pub received: u64,
     /// Rows in all.
     pub rows: u64,
+    with_stages: bool,
+    track_sq: f64,
+    tracked: u64,
+    felt_sq: f64,
 }
 
 fn norm(v: [f64; 3]) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
-/// Computes the row statistics. `with_stages`: stamps are real (process run).
-pub fn analyse(rows: &[TraceRow], with_stages: bool) -> RowReport {
-    let mut r = RowReport {
-        round_trip: Latency::default(),
-        overhead: Latency::default(),
-        stages: vec![Latency::default(); STAGES.len()],
-        motion: Motion::default(),
-        received: 0,
-        rows: rows.len() as u64,
-    };
-    let mut track_sq = 0.0;
-    let mut felt_sq = 0.0;
-    for row in rows {
-        let Some(b) = row.backward else { continue };
-        r.received += 1;
-        let substituted = (b.signal.flags | b.slave.received.flags)
-            & tactile_common::samples::FLAG_SUBSTITUTED
-            != 0;
-        if !substituted {
-            r.round_trip.record(row.round_trip_ns as i64);
-            r.overhead.record(row.overhead_ns);
+impl Analysis {
+    /// An empty analysis; `with_stages`: the stamps are real (a process run).
+    pub fn new(with_stages: bool) -> Self {
+        Analysis {
+            round_trip: Latency::default(),
+            overhead: Latency::default(),
+            stages: vec![Latency::default(); STAGES.len()],
+            motion: Motion::default(),
+            received: 0,
+            rows: 0,
+            with_stages,
+            track_sq: 0.0,
+            tracked: 0,
+            felt_sq: 0.0,
         }
-        if with_stages {
-            for (k, (_, from, to)) in STAGES.iter().enumerate() {
-                let (a, z) = (b.stamps[*from], b.stamps[*to]);
-                if a != 0 && z != 0 {
-                    r.stages[k].record(z as i64 - a as i64);
-                }
-            }
-        }
-        let d = norm([0, 1, 2].map(|i| b.slave.tool[i] - row.target[i]));
-        track_sq += d * d;
-        let m = &mut r.motion;
-        m.tracking_max_m = m.tracking_max_m.max(d);
-        m.force_max_n = m.force_max_n.max(norm(b.slave.force));
-        let felt = norm(row.felt);
-        felt_sq += felt * felt;
-        m.felt_max_n = m.felt_max_n.max(felt);
-        if b.slave.contact_object != u32::MAX {
+    }
+
+    /// Adds one row.
+    pub fn add(&mut self, row: &TraceRow) {
+        self.rows += 1;
+        let m = &mut self.motion;
+        m.force_max_n = m.force_max_n.max(norm(row.h));
+        if row.contact_object >= 0 {
             m.contact_samples += 1;
+        }
+        // Tracking against what the slave was asked to reach; a rejected (non-finite)
+        // reference asked nothing.
+        if row.stepped && row.flags_f & FLAG_REJECTED == 0 && row.v.iter().all(|x| x.is_finite()) {
+            let d = norm([0, 1, 2].map(|i| row.tool[i] - row.v[i]));
+            self.track_sq += d * d;
+            self.tracked += 1;
+            m.tracking_max_m = Some(m.tracking_max_m.unwrap_or(0.0).max(d));
         }
         m.tau_max_nm = m
             .tau_max_nm
             .max(row.tau.iter().fold(0.0f64, |a, t| a.max(t.abs())));
+        if !row.received {
+            return;
+        }
+        self.received += 1;
+        let felt = norm(row.felt);
+        self.felt_sq += felt * felt;
+        m.felt_max_n = m.felt_max_n.max(felt);
+        if (row.flags_b | row.flags_f) & FLAG_SUBSTITUTED == 0 {
+            self.round_trip.record(row.round_trip_ns as i64);
+            self.overhead.record(row.overhead_ns);
+        }
+        if self.with_stages {
+            for (k, (_, from, to)) in STAGES.iter().enumerate() {
+                let (a, z) = (row.stamps[*from], row.stamps[*to]);
+                if a != 0 && z != 0 {
+                    self.stages[k].record(z as i64 - a as i64);
+                }
+            }
+        }
     }
-    if r.received > 0 {
-        r.motion.tracking_rms_m = (track_sq / r.received as f64).sqrt();
-        r.motion.felt_rms_n = (felt_sq / r.received as f64).sqrt();
+
+    /// Closes the running sums into the motion statistics.
+    pub fn finish(&mut self) {
+        if self.tracked > 0 {
+            self.motion.tracking_rms_m = Some((self.track_sq / self.tracked as f64).sqrt());
+        }
+        if self.received > 0 {
+            self.motion.felt_rms_n = Some((self.felt_sq / self.received as f64).sqrt());
+        }
     }
-    r
 }
 
-/// Renders percentiles in microseconds for the terminal.
-pub fn us_line(name: &str, p: &Percentiles) -> String {
-    let us = |v: u64| v as f64 / 1000.0;
-    format!(
-        "{name:<24} {:>8} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
-        p.count,
-        us(p.p50),
-        us(p.p90),
-        us(p.p99),
-        us(p.p999),
-        us(p.max)
-    )
+/// Renders percentiles in microseconds for the terminal; "n/a" when none.
+pub fn us_line(name: &str, p: Option<&Percentiles>) -> String {
+    let us = |v: u64| format!("{:.1}", v as f64 / 1000.0);
+    match p {
+        Some(p) => format!(
+            "{name:<24} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10}",
+            p.count,
+            us(p.p50),
+            us(p.p90),
+            us(p.p99),
+            us(p.p999),
+            us(p.max)
+        ),
+        None => format!(
+            "{name:<24} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10}",
+            0, "n/a", "n/a", "n/a", "n/a", "n/a"
+        ),
+    }
 }
 
 /// Header matching [`us_line`].

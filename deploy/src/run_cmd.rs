@@ -1,48 +1,99 @@
-//! `tactile run`: starts the three processes for a scenario, watches them, and merges
-//! their results into one report.
+//! `tactile run`: starts the three node programs for a scenario, watches them, and
+//! writes the report from their records.
 
 use crate::cli::RunArgs;
 use crate::error::Error;
-use crate::roles::{write_json, MasterSummary};
-use crate::summary::{read_json, render, summarise, Summary};
+use crate::nodes;
+use crate::report_cmd::{write_report, Launch, REPORT_FILES};
+use crate::summary::{render, Summary};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tactile_common::scenario::{Mode, Scenario};
+use tactile_common::scenario::{Mode, Operator, Scenario};
 use tactile_master::operator::OperatorSource;
+use tactile_node::files::{self, same_file};
+use tactile_node::runtime::{LinkKind, EXIT_BAD_INPUT, EXIT_INTERRUPTED};
 
 /// The paper scenario, built into the executable so `tactile run` works from any folder.
 pub const PAPER_SCENARIO: &str = include_str!("../scenarios/paper.toml");
 
-/// Reads and validates a scenario; `None` is the built-in paper scenario. Returns the
-/// scenario and the folder its relative paths are resolved against.
-pub fn load_scenario(path: Option<&Path>) -> Result<(Scenario, PathBuf), Error> {
-    let (text, name, base) = match path {
+/// A scenario ready to run: validated, its trajectory checked, and where it came from.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Folder its relative paths are resolved against.
+    pub base_dir: PathBuf,
+    /// The files it was read from (the scenario, a trajectory), which a run must never
+    /// overwrite.
+    pub inputs: Vec<PathBuf>,
+}
+
+/// Reads and validates a scenario; `None` is the built-in paper scenario. A trajectory
+/// file is read too, so a bad one stops the run before anything starts.
+pub fn load_scenario(path: Option<&Path>) -> Result<Loaded, Error> {
+    let (scenario, base_dir, name) = match path {
         None => (
-            PAPER_SCENARIO.to_string(),
-            "deploy/scenarios/paper.toml (built in)".to_string(),
+            Scenario::from_toml_str(PAPER_SCENARIO)
+                .map_err(|e| Error::Failed(format!("built-in scenario: {e}")))?,
             std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+            "deploy/scenarios/paper.toml (built in)".to_string(),
         ),
         Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|e| {
-                Error::BadInput(format!("cannot read scenario {}: {e}", p.display()))
-            })?;
-            let base = p
-                .parent()
-                .filter(|d| !d.as_os_str().is_empty())
-                .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-            (text, p.display().to_string(), base)
+            let (s, base) = files::load_scenario(p).map_err(Error::BadInput)?;
+            (s, base, p.display().to_string())
         }
     };
-    let scenario = Scenario::from_toml_str(&text)
-        .map_err(|e| Error::BadInput(format!("{name}: {}", e.to_string().trim_end())))?;
-    // A trajectory file is read now, so a bad one stops the run before anything starts.
-    OperatorSource::load(&scenario.operator, &base)
+    OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
-    Ok((scenario, base))
+    let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
+    if let Operator::Csv { path } = &scenario.operator {
+        inputs.push(base_dir.join(path));
+    }
+    Ok(Loaded {
+        scenario,
+        base_dir,
+        inputs,
+    })
+}
+
+/// Every file a run writes into its output folder.
+pub fn output_files(out: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = REPORT_FILES.iter().map(|f| out.join(f)).collect();
+    for role in crate::join::ROLES {
+        v.push(out.join(format!("{role}.rec")));
+        v.push(out.join(format!("{role}.log")));
+    }
+    v
+}
+
+/// Makes `out` ready for a new run: refuses if a file the run would write is one of
+/// its inputs, then removes the files of an earlier run, so the folder never mixes
+/// two runs' files.
+pub fn prepare_out(out: &Path, inputs: &[PathBuf]) -> Result<(), Error> {
+    std::fs::create_dir_all(out).map_err(Error::io(format!("creating {}", out.display())))?;
+    let outputs = output_files(out);
+    for i in inputs {
+        if let Some(o) = outputs.iter().find(|o| same_file(o, i)) {
+            return Err(Error::BadInput(format!(
+                "--out {}: the run would overwrite its input {} (as {}); choose another output folder",
+                out.display(),
+                i.display(),
+                o.display()
+            )));
+        }
+    }
+    for o in outputs {
+        match std::fs::remove_file(&o) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(Error::io(format!("removing {}", o.display()))(e)),
+        }
+    }
+    Ok(())
 }
 
 /// How a child process ended, in words.
@@ -69,14 +120,17 @@ struct Proc {
 /// of 10 samples at 100 Hz) rather than a flicker.
 pub const RESTART_BACKOFF: Duration = Duration::from_millis(200);
 
+fn signal(child: &Child, sig: rustix::process::Signal) {
+    if let Some(pid) = rustix::process::Pid::from_raw(child.id() as i32) {
+        let _ = rustix::process::kill_process(pid, sig);
+    }
+}
+
 fn stop(p: &mut Proc, grace: Duration) {
     if p.status.is_some() {
         return;
     }
-    let pid = rustix::process::Pid::from_raw(p.child.id() as i32);
-    if let Some(pid) = pid {
-        let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
-    }
+    signal(&p.child, rustix::process::Signal::TERM);
     let until = Instant::now() + grace;
     while Instant::now() < until {
         if let Ok(Some(s)) = p.child.try_wait() {
@@ -89,8 +143,16 @@ fn stop(p: &mut Proc, grace: Duration) {
     p.status = p.child.wait().ok();
 }
 
+/// The last lines of a node's log, bounded: the log of a long run can be large.
 fn log_tail(out: &Path, role: &str) -> String {
-    let text = std::fs::read_to_string(out.join(format!("{role}.log"))).unwrap_or_default();
+    use std::io::{Read, Seek, SeekFrom};
+    let Ok(mut f) = std::fs::File::open(out.join(format!("{role}.log"))) else {
+        return String::new();
+    };
+    let len = f.metadata().map_or(0, |m| m.len());
+    let _ = f.seek(SeekFrom::Start(len.saturating_sub(4096)));
+    let mut text = String::new();
+    let _ = f.take(4096).read_to_string(&mut text);
     let lines: Vec<&str> = text.lines().collect();
     lines[lines.len().saturating_sub(5)..].join("\n")
 }
@@ -107,35 +169,61 @@ pub struct Supervision {
     /// Restarts allowed per process (emulator, slave) when one dies mid-run.
     pub max_restarts: u32,
     /// What carries the samples.
-    pub transport: crate::roles::Transport,
+    pub link: LinkKind,
+    /// UDP ports `m,e,s` with the UDP link.
+    pub udp_ports: Option<String>,
     /// Pin master to CPU 0, emulator and slave to CPU 1.
     pub pin: bool,
     /// SCHED_FIFO priority for the three processes, if permitted.
     pub rt: bool,
+    /// Write no trace.csv.
+    pub no_trace: bool,
 }
 
-/// Wraps a role's command in taskset and chrt as the supervision asks; falls back to
-/// the plain command (with a note) when a tool is missing or refuses.
-fn wrapped(sup: &Supervision, role: &str, exe: &Path, notes: &mut Vec<String>) -> Vec<String> {
-    let mut argv: Vec<String> = Vec::new();
+/// The command line of one node.
+fn node_command(
+    sup: &Supervision,
+    exe: &Path,
+    role: &str,
+    scenario_file: &Path,
+    out: &Path,
+    append: bool,
+) -> Command {
+    let mut cmd = if sup.rt {
+        let mut c = Command::new("chrt");
+        c.args(["-f", "10"]).arg(exe);
+        c
+    } else {
+        Command::new(exe)
+    };
+    cmd.arg("--scenario")
+        .arg(scenario_file)
+        .arg("--out")
+        .arg(out)
+        .args(["--prefix", &sup.prefix])
+        .args(["--spin-us", &sup.spin.as_micros().to_string()])
+        .args(["--supervised", &std::process::id().to_string()]);
+    match sup.link {
+        LinkKind::Iceoryx2 => {
+            cmd.args(["--link", "iceoryx2"]);
+        }
+        LinkKind::Udp => {
+            cmd.args(["--link", "udp"]);
+            if let Some(p) = &sup.udp_ports {
+                cmd.args(["--udp-ports", p]);
+            }
+        }
+    }
     if sup.pin {
-        let cpu = if role == "master" { "0" } else { "1" };
-        if tool_works(&["taskset", "-c", cpu, "true"]) {
-            argv.extend(["taskset", "-c", cpu].map(String::from));
-        } else if !notes.iter().any(|n| n.contains("taskset")) {
-            notes.push("taskset unavailable: processes not pinned".into());
-        }
+        cmd.args(["--cpu", if role == "master" { "0" } else { "1" }]);
     }
-    if sup.rt {
-        if tool_works(&["chrt", "-f", "10", "true"]) {
-            argv.extend(["chrt", "-f", "10"].map(String::from));
-        } else if !notes.iter().any(|n| n.contains("chrt")) {
-            notes.push("SCHED_FIFO not permitted: processes run SCHED_OTHER".into());
-        }
+    if role == "master" {
+        cmd.args(["--startup-timeout-s", "10"]);
     }
-    argv.push(exe.display().to_string());
-    argv.extend(["role".to_string(), role.to_string()]);
-    argv
+    if append {
+        cmd.arg("--append");
+    }
+    cmd
 }
 
 fn tool_works(argv: &[&str]) -> bool {
@@ -147,10 +235,15 @@ fn tool_works(argv: &[&str]) -> bool {
         .is_ok_and(|s| s.success())
 }
 
+/// True if this machine lets the process use CPUs 0 and 1.
+fn two_cpus() -> bool {
+    rustix::thread::sched_getaffinity(None).is_ok_and(|s| s.is_set(0) && s.is_set(1))
+}
+
 /// Removes the shared memory of earlier runs whose launcher is gone (a crashed or
 /// killed run leaves it behind; iceoryx2 would clean it only for the same prefix).
 pub fn clean_stale_runs() {
-    let Ok(dir) = std::fs::read_dir(tactile_common::ipc::ROOT) else {
+    let Ok(dir) = std::fs::read_dir(tactile_node::ipc::ROOT) else {
         return;
     };
     for entry in dir.flatten() {
@@ -162,28 +255,30 @@ pub fn clean_stale_runs() {
             continue;
         };
         if !Path::new(&format!("/proc/{pid}")).exists() {
-            tactile_common::ipc::remove_run_files(&name);
+            tactile_node::ipc::remove_run_files(&name);
         }
     }
 }
 
-/// Runs the scenario's three processes; returns the summary (which says whether the
-/// run failed: a process died, or a stop request cut it short).
-pub fn run_processes(
-    scenario: &Scenario,
-    base_dir: &Path,
-    out: &Path,
+/// What the supervision loop saw.
+struct Watch {
+    events: Vec<String>,
+    failed: bool,
+    interrupted: bool,
+    master_ok: bool,
+    /// A node refused its configuration (exit 2): its message.
+    config_error: Option<String>,
+}
+
+/// Starts the nodes and watches them until the master ends; restarts the emulator or
+/// the slave when one dies, as `sup` allows.
+fn supervise(
     sup: &Supervision,
-) -> Result<Summary, Error> {
-    let exe = std::env::current_exe().map_err(Error::io("locating the tactile executable"))?;
-    let scenario_file = out.join("scenario.toml");
-    let text = toml::to_string(scenario)
-        .map_err(|e| Error::Failed(format!("encoding the scenario: {e}")))?;
-    std::fs::write(&scenario_file, text)
-        .map_err(Error::io(format!("writing {}", scenario_file.display())))?;
-    for f in ["master.json", "emulator.json", "slave.json", "summary.json"] {
-        let _ = std::fs::remove_file(out.join(f));
-    }
+    scenario: &Scenario,
+    spawn: &dyn Fn(&'static str, bool) -> Result<Child, Error>,
+    out: &Path,
+    notes: Vec<String>,
+) -> Result<(Vec<Proc>, Watch), Error> {
     // SIGINT and SIGTERM stop the run cleanly: the master is asked to stop, the
     // others follow its end-of-run sample, and the report of what ran is written.
     let stop_requested = Arc::new(AtomicBool::new(false));
@@ -191,53 +286,9 @@ pub fn run_processes(
         signal_hook::flag::register(sig, Arc::clone(&stop_requested))
             .map_err(Error::io("installing signal handlers"))?;
     }
-    let mut notes = Vec::new();
-    let commands: Vec<(&'static str, Vec<String>)> = ["emulator", "slave", "master"]
-        .into_iter()
-        .map(|role| (role, wrapped(sup, role, &exe, &mut notes)))
-        .collect();
-    let udp_arg = match sup.transport {
-        crate::roles::Transport::Udp(p) => Some(p.arg()),
-        crate::roles::Transport::Iceoryx2 => None,
-    };
-    let spawn = |role: &'static str| -> Result<Child, Error> {
-        let log = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(out.join(format!("{role}.log")))
-            .map_err(Error::io(format!("creating {role}.log")))?;
-        let argv = &commands
-            .iter()
-            .find(|(r, _)| *r == role)
-            .ok_or_else(|| Error::Failed(format!("no command for {role}")))?
-            .1;
-        let mut cmd = Command::new(&argv[0]);
-        cmd.args(&argv[1..]);
-        if let Some(p) = &udp_arg {
-            cmd.arg("--udp-ports").arg(p);
-        }
-        cmd.arg("--scenario")
-            .arg(&scenario_file)
-            .arg("--base-dir")
-            .arg(base_dir)
-            .arg("--prefix")
-            .arg(&sup.prefix)
-            .arg("--out")
-            .arg(out)
-            .arg("--spin-us")
-            .arg(sup.spin.as_micros().to_string())
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(log)
-            .spawn()
-            .map_err(|e| Error::Failed(format!("cannot start {} as {role}: {e}", exe.display())))
-    };
-    for role in ["master", "emulator", "slave"] {
-        let _ = std::fs::remove_file(out.join(format!("{role}.log")));
-    }
     let mut procs: Vec<Proc> = Vec::new();
     for role in ["emulator", "slave", "master"] {
-        match spawn(role) {
+        match spawn(role, false) {
             Ok(child) => procs.push(Proc {
                 role,
                 child,
@@ -258,21 +309,23 @@ pub fn run_processes(
         Mode::Realtime => Some(scenario.samples as f64 * scenario.t_s()),
         Mode::Lockstep => None,
     };
-    let mut events: Vec<String> = notes;
-    let mut failed = false;
-    let mut interrupted = false;
+    let mut w = Watch {
+        events: notes,
+        failed: false,
+        interrupted: false,
+        master_ok: false,
+        config_error: None,
+    };
     let mut master_status = None;
     while master_status.is_none() {
-        if stop_requested.swap(false, Ordering::SeqCst) && !interrupted {
-            interrupted = true;
-            events.push(format!(
+        if stop_requested.swap(false, Ordering::SeqCst) && !w.interrupted {
+            w.interrupted = true;
+            w.events.push(format!(
                 "stop requested after {:.2} s: stopping the master",
                 started.elapsed().as_secs_f64()
             ));
             if let Some(m) = procs.iter().find(|p| p.role == "master") {
-                if let Some(pid) = rustix::process::Pid::from_raw(m.child.id() as i32) {
-                    let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
-                }
+                signal(&m.child, rustix::process::Signal::TERM);
             }
         }
         let mut stop_master = false;
@@ -280,8 +333,8 @@ pub fn run_processes(
             if let Some(at) = p.restart_at {
                 if Instant::now() >= at {
                     p.restart_at = None;
-                    p.child = spawn(p.role)?;
-                    events.push(format!(
+                    p.child = spawn(p.role, true)?;
+                    w.events.push(format!(
                         "{} restarted after {:.2} s",
                         p.role,
                         started.elapsed().as_secs_f64()
@@ -295,6 +348,16 @@ pub fn run_processes(
             let Ok(Some(status)) = p.child.try_wait() else {
                 continue;
             };
+            if status.code() == Some(i32::from(EXIT_BAD_INPUT)) {
+                // A configuration error: restarting would fail the same way.
+                p.status = Some(status);
+                w.config_error = Some(format!("{}: {}", p.role, log_tail(out, p.role)));
+                stop_master = p.role != "master";
+                if p.role == "master" {
+                    master_status = Some(status);
+                }
+                continue;
+            }
             if p.role == "master" {
                 master_status = Some(status);
                 continue;
@@ -305,16 +368,17 @@ pub fn run_processes(
                 continue;
             }
             // The emulator or the slave died while the master runs.
-            failed = true;
+            w.failed = true;
             let at = started.elapsed().as_secs_f64();
             let how = describe(status);
             if p.restarts < sup.max_restarts {
                 p.restarts += 1;
                 p.restart_at = Some(Instant::now() + RESTART_BACKOFF);
-                events.push(format!("{} {how} after {at:.2} s; restarting", p.role));
+                w.events
+                    .push(format!("{} {how} after {at:.2} s; restarting", p.role));
             } else {
                 p.status = Some(status);
-                events.push(format!(
+                w.events.push(format!(
                     "{} {how} after {at:.2} s; no restarts left, stopping the run; its last words:\n{}",
                     p.role,
                     log_tail(out, p.role)
@@ -341,21 +405,73 @@ pub fn run_processes(
     if sup.progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         eprintln!();
     }
-    let master_ok = master_status.is_some_and(|s| s.success());
-    if let Some(s) = master_status.filter(|s| !s.success()) {
-        failed = true;
-        events.push(format!(
-            "master {} after {:.2} s; its last words:\n{}",
-            describe(s),
-            started.elapsed().as_secs_f64(),
-            log_tail(out, "master")
-        ));
-        // Let the survivors notice (the slave holds its position), then stop them.
-        let grace = crate::run_cmd::survivor_grace(scenario);
-        std::thread::sleep(grace);
+    w.master_ok = master_status.is_some_and(|s| s.success());
+    if let Some(s) = master_status.filter(|s| !s.success() && w.config_error.is_none()) {
+        let interrupted = s.code() == Some(i32::from(EXIT_INTERRUPTED)) && w.interrupted;
+        if !interrupted {
+            w.failed = true;
+            w.events.push(format!(
+                "master {} after {:.2} s; its last words:\n{}",
+                describe(s),
+                started.elapsed().as_secs_f64(),
+                log_tail(out, "master")
+            ));
+            // Let the survivors notice (the slave holds its position), then stop them.
+            std::thread::sleep(survivor_grace(scenario));
+        }
     }
+    Ok((procs, w))
+}
+
+/// Runs the scenario's three node programs; returns the summary (which says whether
+/// the run failed: a process died, or a stop request cut it short).
+pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<Summary, Error> {
+    let dir = nodes::node_dir()?;
+    tactile_node::lock::check_prefix(&sup.prefix).map_err(Error::BadInput)?;
+    prepare_out(out, &loaded.inputs)?;
+    let holder = format!(
+        "tactile run (pid {}, writing to {})",
+        std::process::id(),
+        out.display()
+    );
+    let _lock = tactile_node::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
+    // The nodes run the scenario as written here, relative paths made absolute, so
+    // the copy also runs again as it is from any folder.
+    let scenario_file = out.join("scenario.toml");
+    let text = loaded.scenario.resolved(&loaded.base_dir).to_toml();
+    std::fs::write(&scenario_file, text)
+        .map_err(Error::io(format!("writing {}", scenario_file.display())))?;
+    let mut notes = Vec::new();
+    let pin = sup.pin && two_cpus();
+    if sup.pin && !pin {
+        notes.push("fewer than two CPUs: processes not pinned".to_string());
+    }
+    let rt = sup.rt && tool_works(&["chrt", "-f", "10", "true"]);
+    if sup.rt && !rt {
+        notes.push("SCHED_FIFO not permitted: processes run SCHED_OTHER".to_string());
+    }
+    let sup = Supervision {
+        pin,
+        rt,
+        ..sup.clone()
+    };
+    let spawn = |role: &'static str, append: bool| -> Result<Child, Error> {
+        let log = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(out.join(format!("{role}.log")))
+            .map_err(Error::io(format!("creating {role}.log")))?;
+        let exe = nodes::exe(&dir, role);
+        node_command(&sup, &exe, role, &scenario_file, out, append)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(log)
+            .spawn()
+            .map_err(|e| Error::Failed(format!("cannot start {}: {e}", exe.display())))
+    };
+    let (mut procs, w) = supervise(&sup, &loaded.scenario, &spawn, out, notes)?;
     // After a clean master the end-of-run sample stops the others; give them a moment.
-    let until = Instant::now() + Duration::from_secs(if master_ok { 3 } else { 0 });
+    let until = Instant::now() + Duration::from_secs(if w.master_ok { 3 } else { 0 });
     while Instant::now() < until
         && procs
             .iter_mut()
@@ -371,27 +487,23 @@ pub fn run_processes(
         }
         stop(p, Duration::from_secs(2));
     }
-    tactile_common::ipc::remove_run_files(&sup.prefix);
-    let emulator = read_json(&out.join("emulator.json"));
-    let slave = read_json(&out.join("slave.json"));
-    let Some(master) = read_json::<MasterSummary>(&out.join("master.json")) else {
+    tactile_node::ipc::remove_run_files(&sup.prefix);
+    if let Some(msg) = w.config_error {
+        return Err(Error::BadInput(msg));
+    }
+    if !out.join("master.rec").exists() {
         return Err(Error::Failed(format!(
-            "the run failed, no report from the master:\n{}",
-            events.join("\n")
+            "the run failed, no record from the master:\n{}",
+            w.events.join("\n")
         )));
+    }
+    let launch = Launch {
+        events: w.events,
+        failed: w.failed,
+        interrupted: w.interrupted,
+        no_trace: sup.no_trace,
     };
-    events.extend(
-        master
-            .events
-            .iter()
-            .map(|e| format!("sample {}: {}", e.sample, e.what)),
-    );
-    let mut summary = summarise(scenario, "processes", master, emulator, slave);
-    summary.events = events;
-    summary.failed = failed;
-    summary.interrupted = interrupted;
-    write_json(&out.join("summary.json"), &summary)?;
-    Ok(summary)
+    write_report(&[out.to_path_buf()], out, &launch)
 }
 
 /// The measured default wait: poll (yielding) for two sampling periods before
@@ -408,19 +520,18 @@ pub fn survivor_grace(scenario: &Scenario) -> Duration {
 
 /// `tactile run`.
 pub fn main(args: &RunArgs) -> Result<(), Error> {
-    let (scenario, base_dir) = load_scenario(args.scenario.as_deref())?;
-    for w in scenario.warnings() {
+    let loaded = load_scenario(args.scenario.as_deref())?;
+    for w in loaded.scenario.warnings() {
         eprintln!("tactile: warning: {w}");
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(Error::io(format!("creating {}", args.out.display())))?;
     let summary = if args.in_process {
-        let sim = crate::sim::simulate(&scenario, &base_dir)?;
-        let r = crate::roles::write_artifacts(&sim.rows, 0, scenario.t_s(), false, &args.out)?;
-        let master = crate::roles::master_summary_from(&sim, &r);
-        let s = summarise(&scenario, "in-process", master, None, None);
-        write_json(&args.out.join("summary.json"), &s)?;
-        s
+        prepare_out(&args.out, &loaded.inputs)?;
+        crate::sim::simulate(&loaded.scenario, &loaded.base_dir, &args.out)?;
+        let launch = Launch {
+            no_trace: args.no_trace,
+            ..Launch::default()
+        };
+        write_report(std::slice::from_ref(&args.out), &args.out, &launch)?
     } else {
         clean_stale_runs();
         let sup = Supervision {
@@ -430,20 +541,28 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
                 .unwrap_or_else(|| format!("tactile{}", std::process::id())),
             spin: args
                 .spin_us
-                .map_or_else(|| default_spin(&scenario), Duration::from_micros),
+                .map_or_else(|| default_spin(&loaded.scenario), Duration::from_micros),
             progress: !args.quiet,
             max_restarts: args.max_restarts,
-            transport: if args.udp {
-                crate::roles::Transport::Udp(
-                    crate::udp::UdpPorts::free().map_err(|e| Error::Failed(e.to_string()))?,
+            link: if args.udp {
+                LinkKind::Udp
+            } else {
+                LinkKind::Iceoryx2
+            },
+            udp_ports: if args.udp {
+                Some(
+                    tactile_node::udp::UdpPorts::free()
+                        .map_err(|e| Error::Failed(e.to_string()))?
+                        .arg(),
                 )
             } else {
-                crate::roles::Transport::Iceoryx2
+                None
             },
             pin: !args.no_pin,
             rt: args.rt,
+            no_trace: args.no_trace,
         };
-        run_processes(&scenario, &base_dir, &args.out, &sup)?
+        run_processes(&loaded, &args.out, &sup)?
     };
     print!("{}", render(&summary, &args.out));
     if summary.interrupted {

@@ -1,66 +1,118 @@
 //! The in-process simulation: the same master, emulator and slave code as the three
-//! processes, called in sequence with no shared memory and no clock.
+//! node programs, called in sequence with no shared memory and no clock, each writing
+//! its record through the same recorder as its program does.
 //!
-//! It is the reference the process tests compare against: a lockstep run of the trio
+//! It is the reference the process tests compare against: a lockstep run of the nodes
 //! must produce the same signals, bit for bit. Time stamps here are synthetic
 //! (n * t_s), so round trips equal the injected delay and overheads are zero.
 
+use crate::error::Error;
+use crate::report_cmd::IN_PROCESS;
 use std::path::Path;
+use tactile_common::clock::now_ns;
 use tactile_common::samples::stage;
 use tactile_common::scenario::Scenario;
-use tactile_common::trace::TraceRow;
-use tactile_master::hmd::{Master, MasterCounters};
+use tactile_master::hmd::Master;
 use tactile_master::operator::OperatorSource;
-use tactile_network_emulator::emulator::{Emulator, EmulatorCounters};
-use tactile_slave::hsd::{Slave, SlaveCounters};
+use tactile_master::process::MasterRecorder;
+use tactile_master::record::{MasterSample, MasterTotals};
+use tactile_network_emulator::emulator::Emulator;
+use tactile_network_emulator::process::{EmulatorRecorder, EmulatorTotals};
+use tactile_node::record::Start;
+use tactile_node::runtime::{NodeError, Recorder};
+use tactile_slave::hsd::Slave;
+use tactile_slave::process::SlaveRecorder;
+use tactile_slave::record::{SlaveSample, SlaveTotals};
 
-use crate::error::Error;
+/// The run token of a simulation (there is no master process to choose one).
+pub const SIM_RUN: u64 = 1;
 
-/// Everything a simulated run produced.
-#[derive(Debug)]
-pub struct SimRun {
-    /// One row per sample.
-    pub rows: Vec<TraceRow>,
-    /// Master counters.
-    pub master: MasterCounters,
-    /// Emulator counters.
-    pub emulator: EmulatorCounters,
-    /// Slave counters.
-    pub slave: SlaveCounters,
+fn start(role: &str, scenario: &Scenario, base_dir: &Path) -> Start {
+    Start {
+        role: role.into(),
+        version: env!("CARGO_PKG_VERSION").into(),
+        pid: std::process::id(),
+        host: "in-process".into(),
+        prefix: String::new(),
+        link: IN_PROCESS.into(),
+        scenario: scenario.name.clone(),
+        scenario_toml: scenario.resolved(base_dir).to_toml(),
+        samples: scenario.samples,
+        rate_hz: scenario.rate_hz,
+        spin_us: 0,
+        cpu: None,
+        unix_ms: 0,
+        mono_ns: 0,
+    }
 }
 
-/// Runs `scenario` in-process; `base_dir` resolves a trajectory file's path.
-pub fn simulate(scenario: &Scenario, base_dir: &Path) -> Result<SimRun, Error> {
+fn failed(e: NodeError) -> Error {
+    Error::Failed(e.to_string())
+}
+
+/// Runs `scenario` in-process, writing the three records into `out`; `base_dir`
+/// resolves a trajectory file's path.
+pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<(), Error> {
     let source = OperatorSource::load(&scenario.operator, base_dir)
         .map_err(|e| Error::BadInput(e.to_string()))?;
     let bad = |e: tactile_common::scenario::ScenarioError| Error::BadInput(e.to_string());
     let mut master = Master::new(scenario, source).map_err(bad)?;
     let mut emulator = Emulator::new(scenario);
     let mut slave = Slave::new(scenario).map_err(bad)?;
+    let mut mrec: MasterRecorder = Recorder::open(out, "master", false).map_err(failed)?;
+    let mut erec: EmulatorRecorder = Recorder::open(out, "emulator", false).map_err(failed)?;
+    let mut srec: SlaveRecorder = Recorder::open(out, "slave", false).map_err(failed)?;
+    mrec.start(start("master", scenario, base_dir))
+        .map_err(failed)?;
+    erec.start(start("emulator", scenario, base_dir))
+        .map_err(failed)?;
+    srec.start(start("slave", scenario, base_dir))
+        .map_err(failed)?;
+    mrec.run(SIM_RUN).map_err(failed)?;
+    erec.run(SIM_RUN).map_err(failed)?;
+    srec.run(SIM_RUN).map_err(failed)?;
     let t_s_ns = scenario.t_s_ns();
-    let mut rows = Vec::with_capacity(usize::try_from(scenario.samples).unwrap_or(0));
+    let began = now_ns();
     for n in 0..scenario.samples {
         let now = n * t_s_ns;
-        let (c, _) = master.forward(n, now);
-        let answer = emulator
-            .forward(&c)
-            .map(|v| slave.step(&v))
-            .and_then(|h| emulator.backward(&h));
-        let row = match answer {
+        let (c, sent) = master.forward(n, now);
+        mrec.sample(MasterSample::Sent(sent)).map_err(failed)?;
+        let (v, passage) = emulator.forward(&c);
+        erec.sample(passage).map_err(failed)?;
+        let mut q = None;
+        if let Some(v) = v {
+            let (h, step) = slave.step(&v);
+            srec.sample(SlaveSample::Step(step)).map_err(failed)?;
+            let (out, passage) = emulator.backward(&h);
+            erec.sample(passage).map_err(failed)?;
+            q = out;
+        }
+        let record = match q {
             Some(mut q) => {
                 q.stamps[stage::MASTER_DONE] = now;
-                let mut row = master.backward(&c, &q);
-                master.account(&mut row);
-                row
+                let mut a = master.backward(&q);
+                master.account(&mut a);
+                MasterSample::Answer(a)
             }
-            None => master.missing(&c),
+            None => MasterSample::Miss(master.missing(n)),
         };
-        rows.push(row);
+        mrec.sample(record).map_err(failed)?;
     }
-    Ok(SimRun {
-        rows,
-        master: master.counters(),
-        emulator: emulator.counters(),
-        slave: slave.counters(),
-    })
+    let totals = MasterTotals {
+        counters: master.counters(),
+        elapsed_ns: now_ns().saturating_sub(began),
+        ..MasterTotals::default()
+    };
+    mrec.stop(totals, "completed").map_err(failed)?;
+    let et = EmulatorTotals {
+        counters: emulator.counters(),
+        ..EmulatorTotals::default()
+    };
+    erec.stop(et, "completed").map_err(failed)?;
+    let st = SlaveTotals {
+        counters: slave.counters(),
+        ..SlaveTotals::default()
+    };
+    srec.stop(st, "completed").map_err(failed)?;
+    Ok(())
 }

@@ -1,14 +1,14 @@
-//! `summary.json` and the terminal summary: the three processes' results merged, with
-//! each stream's accounting.
+//! `summary.json` and the terminal summary: a view of the nodes' records, with each
+//! stream's accounting.
 
-use crate::report::{us_header, us_line, Percentiles};
-use crate::roles::MasterSummary;
-use serde::{Deserialize, Serialize};
+use crate::report::{us_header, us_line, Motion, Percentiles};
+use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
-use tactile_common::scenario::{Mode, Scenario};
-use tactile_network_emulator::process::EmulatorRun;
-use tactile_slave::process::SlaveRun;
+use tactile_common::scenario::Mode;
+use tactile_master::record::MasterTotals;
+use tactile_network_emulator::process::EmulatorTotals;
+use tactile_slave::record::SlaveTotals;
 
 /// Accounting of one stream: every sample offered is received or lost, and every
 /// loss has a cause.
@@ -32,10 +32,11 @@ pub struct ChannelCount {
 }
 
 impl ChannelCount {
-    fn new(
-        out: tactile_common::ipc::OutboxStats,
+    /// The accounting of a stream from its sender's and receiver's counts.
+    pub fn new(
+        out: tactile_node::ipc::OutboxStats,
         dropped: u64,
-        inn: tactile_common::ipc::InboxStats,
+        inn: tactile_node::ipc::InboxStats,
     ) -> Self {
         let offered = out.published + dropped;
         let received = inn.received;
@@ -53,7 +54,41 @@ impl ChannelCount {
     }
 }
 
-/// `summary.json`.
+/// The master's part of the summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct MasterPart {
+    /// The master's counters (its last record of them).
+    #[serde(flatten)]
+    pub totals: MasterTotals,
+    /// Tracking and forces.
+    pub motion: Motion,
+    /// Samples sent per second of the master's running time (the lockstep throughput).
+    pub samples_per_s: f64,
+}
+
+/// One node as its record describes it.
+#[derive(Debug, Clone, Serialize)]
+pub struct NodeSummary {
+    /// The record file.
+    pub record: String,
+    /// Host each segment ran on.
+    pub hosts: Vec<String>,
+    /// Process id of each segment (more than one: the node was restarted).
+    pub pids: Vec<u32>,
+    /// The link it used.
+    pub link: String,
+    /// Peak resident set size, kB (the largest over its segments).
+    pub peak_rss_kb: u64,
+    /// The last sample number in its record.
+    pub last_sample: Option<u64>,
+    /// How its record ends: `completed`, `interrupted`, or where a killed node's
+    /// record stops.
+    pub ended: String,
+    /// Sample records that matched no sample of the master.
+    pub unjoined: u64,
+}
+
+/// `summary.json`: a view of the nodes' records.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
     /// Scenario name.
@@ -66,11 +101,15 @@ pub struct Summary {
     pub arithmetic: String,
     /// `processes` or `in-process`.
     pub runner: &'static str,
-    /// Round trip on the master's clock, ns.
-    pub round_trip_ns: Percentiles,
-    /// Round trip minus the injected delay, ns.
-    pub overhead_ns: Percentiles,
-    /// Per-stage times, ns.
+    /// The run token the master chose.
+    pub run: Option<String>,
+    /// Round trip on the master's clock, ns; null when nothing came back.
+    pub round_trip_ns: Option<Percentiles>,
+    /// Round trip minus the injected delay, ns; null when nothing came back.
+    pub overhead_ns: Option<Percentiles>,
+    /// Overheads below zero (tick jitter), clamped to zero in the histogram.
+    pub overhead_negative: u64,
+    /// Per-stage times, ns (stages with no data are left out).
     pub stages_ns: BTreeMap<String, Percentiles>,
     /// Forward samples the master sent.
     pub samples_sent: u64,
@@ -80,65 +119,26 @@ pub struct Summary {
     pub samples_lost: u64,
     /// Answers not back by the next tick.
     pub deadline_misses: u64,
-    /// RMS distance of slave tool from operator target, m.
-    pub tracking_rms_m: f64,
+    /// RMS distance of the slave's tool from the position it was asked to reach, m.
+    pub tracking_rms_m: Option<f64>,
     /// Everything the master reported.
-    pub master: MasterSummary,
+    pub master: MasterPart,
     /// Per stream: c (master to emulator), v (emulator to slave), h, q.
     pub channels: BTreeMap<&'static str, ChannelCount>,
-    /// The emulator's counters.
-    pub emulator: Option<EmulatorRun>,
-    /// The slave's counters.
-    pub slave: Option<SlaveRun>,
+    /// The emulator's counters (summed over its segments).
+    pub emulator: Option<EmulatorTotals>,
+    /// The slave's counters (summed over its segments).
+    pub slave: Option<SlaveTotals>,
+    /// Each node: where it ran, its memory, how its record ends.
+    pub nodes: BTreeMap<&'static str, NodeSummary>,
     /// What happened: processes that died and were restarted, loop breaks, resumes.
     pub events: Vec<String>,
+    /// Events left out of `events` (a node keeps at most 200).
+    pub events_omitted: u64,
     /// True if a process died during the run.
     pub failed: bool,
     /// True if SIGINT/SIGTERM cut the run short.
     pub interrupted: bool,
-}
-
-/// Merges the three roles' results.
-pub fn summarise(
-    scenario: &Scenario,
-    runner: &'static str,
-    master: MasterSummary,
-    emulator: Option<EmulatorRun>,
-    slave: Option<SlaveRun>,
-) -> Summary {
-    let mut channels = BTreeMap::new();
-    if let (Some(e), Some(s)) = (&emulator, &slave) {
-        let c = &e.counters;
-        channels.insert("c", ChannelCount::new(master.c_out, 0, e.c_in));
-        channels.insert("v", ChannelCount::new(e.v_out, c.forward_dropped, s.v_in));
-        channels.insert("h", ChannelCount::new(s.h_out, 0, e.h_in));
-        channels.insert(
-            "q",
-            ChannelCount::new(e.q_out, c.backward_dropped, master.q_in),
-        );
-    }
-    Summary {
-        scenario: scenario.name.clone(),
-        mode: scenario.mode,
-        rate_hz: scenario.rate_hz,
-        arithmetic: scenario.arithmetic.to_string(),
-        runner,
-        round_trip_ns: master.round_trip_ns,
-        overhead_ns: master.overhead_ns,
-        stages_ns: master.stages_ns.clone(),
-        samples_sent: master.samples_sent,
-        samples_received: master.samples_received,
-        samples_lost: master.samples_lost,
-        deadline_misses: master.deadline_misses,
-        tracking_rms_m: master.motion.tracking_rms_m,
-        master,
-        channels,
-        emulator,
-        slave,
-        events: Vec::new(),
-        failed: false,
-        interrupted: false,
-    }
 }
 
 /// The summary as the terminal shows it.
@@ -152,17 +152,15 @@ pub fn render(s: &Summary, out: &Path) -> String {
         s.scenario, s.mode, s.rate_hz, s.arithmetic, s.runner
     );
     let _ = writeln!(t, "{}", us_header());
-    let _ = writeln!(t, "{}", us_line("round trip", &s.round_trip_ns));
-    let _ = writeln!(t, "{}", us_line("system overhead", &s.overhead_ns));
+    let _ = writeln!(t, "{}", us_line("round trip", s.round_trip_ns.as_ref()));
+    let _ = writeln!(t, "{}", us_line("system overhead", s.overhead_ns.as_ref()));
     for (name, p) in &s.stages_ns {
-        if p.count > 0 {
-            let _ = writeln!(t, "{}", us_line(&format!("  {name}"), p));
-        }
+        let _ = writeln!(t, "{}", us_line(&format!("  {name}"), Some(p)));
     }
     let _ = writeln!(
         t,
         "samples: sent {}, received {}, lost {}; deadline misses {}, late {}",
-        s.samples_sent, s.samples_received, s.samples_lost, s.deadline_misses, m.late
+        s.samples_sent, s.samples_received, s.samples_lost, s.deadline_misses, m.totals.late
     );
     for (name, c) in &s.channels {
         let _ = writeln!(
@@ -171,19 +169,24 @@ pub fn render(s: &Summary, out: &Path) -> String {
             c.offered, c.received, c.lost, c.lost_dropped, c.lost_overwritten, c.lost_dead_peer
         );
     }
+    let mm = |v: Option<f64>| v.map_or("n/a".to_string(), |x| format!("{:.2} mm", x * 1e3));
     let mo = &m.motion;
     let _ = writeln!(
         t,
-        "tracking error: rms {:.2} mm, max {:.2} mm",
-        mo.tracking_rms_m * 1e3,
-        mo.tracking_max_m * 1e3
+        "tracking error (slave tool against the v(n) it was sent): rms {}, max {}",
+        mm(mo.tracking_rms_m),
+        mm(mo.tracking_max_m)
     );
     let _ = writeln!(
         t,
-        "forces: {} samples in contact, slave max {:.3} N, felt rms {:.3} N max {:.3} N, master torque max {:.4} N m",
-        mo.contact_samples, mo.force_max_n, mo.felt_rms_n, mo.felt_max_n, mo.tau_max_nm
+        "forces: {} samples in contact, slave max {:.3} N, felt rms {} max {:.3} N, master torque max {:.4} N m",
+        mo.contact_samples,
+        mo.force_max_n,
+        mo.felt_rms_n.map_or("n/a".to_string(), |f| format!("{f:.3} N")),
+        mo.felt_max_n,
+        mo.tau_max_nm
     );
-    let mc = &m.counters;
+    let mc = &m.totals.counters;
     let _ = writeln!(
         t,
         "master: {} force clamps, {} torque clamps, {} rejected, {} held, {} peer-lost samples",
@@ -197,20 +200,25 @@ pub fn render(s: &Summary, out: &Path) -> String {
             c.ik_clamped, c.rejected, c.torque_clamps, c.holds
         );
     }
+    for (role, n) in &s.nodes {
+        let _ = writeln!(
+            t,
+            "node {role}: peak RSS {:.1} MB, {}",
+            n.peak_rss_kb as f64 / 1024.0,
+            n.ended
+        );
+    }
     for e in &s.events {
         let _ = writeln!(t, "event: {e}");
     }
-    let _ = writeln!(
-        t,
-        "wrote {}: summary.json trace.csv round_trip.hgrm overhead.hgrm latency.svg positions.svg forces.svg",
-        out.display()
-    );
+    if s.events_omitted > 0 {
+        let _ = writeln!(t, "({} more events in the records)", s.events_omitted);
+    }
+    let files: Vec<&str> = crate::report_cmd::REPORT_FILES
+        .iter()
+        .copied()
+        .filter(|f| out.join(f).exists())
+        .collect();
+    let _ = writeln!(t, "wrote {}: {}", out.display(), files.join(" "));
     t
-}
-
-/// Reads a JSON report a process wrote; `None` if it is missing or unreadable (a
-/// killed process writes none).
-pub fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Option<T> {
-    let text = std::fs::read_to_string(path).ok()?;
-    serde_json::from_str(&text).ok()
 }

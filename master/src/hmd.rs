@@ -2,10 +2,12 @@
 //!
 //! [`Master::forward`] turns sample n of the operator's motion into c(n): the master
 //! device's joint encoders b(n) (the MD model), then FK-HMD. [`Master::backward`] turns
-//! a received q(n) into joint torques p(n) = J(b)^T q (KFF-HMD) and builds the trace
-//! row. The process edge and the in-process simulation call the same functions.
+//! a received q(n) into joint torques p(n) = J(b)^T q (KFF-HMD). Each returns the
+//! sample for the wire and the master's record of it. The process edge and the
+//! in-process simulation call the same functions.
 
 use crate::operator::{OperatorSource, Target};
+use crate::record::{Answer, Miss, Sent};
 use serde::{Deserialize, Serialize};
 use tactile_common::engine::Engine;
 use tactile_common::kernels::IkStatus;
@@ -13,7 +15,6 @@ use tactile_common::samples::{
     stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_REJECTED,
 };
 use tactile_common::scenario::{MasterConfig, Scenario, ScenarioError};
-use tactile_common::trace::TraceRow;
 
 /// What the master counted over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -91,7 +92,7 @@ impl Master {
 
     /// Sample n forward: operator a(n) -> MD encoders b(n) -> FK-HMD c(n).
     /// `now_ns` is the tick time; it becomes the origin timestamp of all three values.
-    pub fn forward(&mut self, n: u64, now_ns: u64) -> (Forward, [f64; 3]) {
+    pub fn forward(&mut self, n: u64, now_ns: u64) -> (Forward, Sent) {
         let target = match self.source.target(n, self.t_s) {
             Target::Joints(theta) => {
                 self.theta_md = theta;
@@ -115,7 +116,6 @@ impl Master {
         let c = self.engine.fk(self.theta_md);
         let mut f = Forward {
             seq: n,
-            target,
             ..Forward::default()
         };
         f.signal.value = c;
@@ -123,7 +123,15 @@ impl Master {
         f.signal.origin_ns = [now_ns; 3];
         f.stamps[stage::MASTER_TICK] = now_ns;
         self.counters.sent += 1;
-        (f, self.theta_md)
+        let sent = Sent {
+            n,
+            target,
+            theta_md: self.theta_md,
+            c,
+            tick_ns: now_ns,
+            send_ns: 0,
+        };
+        (f, sent)
     }
 
     /// True while the loop is broken (no answer for the peer timeout).
@@ -132,9 +140,10 @@ impl Master {
     }
 
     /// q(n) back: clamp the force to the device's limit, KFF-HMD torques on the current
-    /// master angles, clamp them, and the trace row. A NaN or infinite force never
-    /// reaches a torque: it is rejected and the last torque held.
-    pub fn backward(&mut self, forward: &Forward, q: &Backward) -> TraceRow {
+    /// master angles, clamp them. A NaN or infinite force never reaches a torque: it is
+    /// rejected and the last torque held. The edge stamps `MASTER_DONE` and then calls
+    /// [`Master::account`].
+    pub fn backward(&mut self, q: &Backward) -> Answer {
         self.counters.received += 1;
         if self.peer_lost() {
             self.counters.resumes += 1;
@@ -163,37 +172,23 @@ impl Master {
             self.counters.rejected += 1;
             flags |= FLAG_REJECTED;
         }
-        TraceRow {
-            n: forward.seq,
-            target: forward.target,
-            theta_md: self.theta_md,
-            forward: *forward,
-            backward: Some(*q),
+        Answer {
+            n: q.seq,
+            q: q.signal,
+            stamps: q.stamps,
             tau: self.last_tau,
             felt: self.last_felt,
-            master_flags: flags,
+            flags,
             round_trip_ns: 0,
             overhead_ns: 0,
+            late: false,
         }
     }
 
-    /// The row of a sample just sent, before its answer is in.
-    pub fn pending(&self, forward: &Forward) -> TraceRow {
-        TraceRow {
-            n: forward.seq,
-            target: forward.target,
-            theta_md: self.theta_md,
-            forward: *forward,
-            tau: self.last_tau,
-            felt: self.last_felt,
-            ..TraceRow::default()
-        }
-    }
-
-    /// The row of a sample whose answer did not come in time. Within the peer timeout
-    /// the last torque is held (one lost sample must not jerk the operator's hand);
-    /// past it the loop is broken and the master commands zero torque.
-    pub fn missing(&mut self, forward: &Forward) -> TraceRow {
+    /// Sample n got no answer in time. Within the peer timeout the last torque is held
+    /// (one lost sample must not jerk the operator's hand); past it the loop is broken
+    /// and the master commands zero torque.
+    pub fn missing(&mut self, n: u64) -> Miss {
         self.silent += 1;
         let flags = if self.peer_lost() {
             if self.silent == self.peer_timeout {
@@ -207,23 +202,24 @@ impl Master {
             self.counters.held_samples += 1;
             FLAG_HELD
         };
-        TraceRow {
-            master_flags: flags,
-            ..self.pending(forward)
+        Miss {
+            n,
+            tau: self.last_tau,
+            felt: self.last_felt,
+            flags,
         }
     }
 
-    /// Fills the row's round trip and overhead from its final stamps: round trip is
+    /// Fills the answer's round trip and overhead from its final stamps: round trip is
     /// done-time minus the oldest origin among q's values, on the master's clock alone.
-    pub fn account(&self, row: &mut TraceRow) {
-        let Some(b) = row.backward else { return };
-        let done = b.stamps[stage::MASTER_DONE];
+    pub fn account(&self, a: &mut Answer) {
+        let done = a.stamps[stage::MASTER_DONE];
         let (i, origin) = (0..3)
-            .map(|i| (i, b.signal.origin_ns[i]))
+            .map(|i| (i, a.q.origin_ns[i]))
             .min_by_key(|&(_, t)| t)
             .unwrap_or((0, 0));
-        row.round_trip_ns = done.saturating_sub(origin);
-        let injected = u64::from(b.signal.delay_samples[i]) * self.t_s_ns;
-        row.overhead_ns = row.round_trip_ns as i64 - injected as i64;
+        a.round_trip_ns = done.saturating_sub(origin);
+        let injected = u64::from(a.q.delay_samples[i]) * self.t_s_ns;
+        a.overhead_ns = a.round_trip_ns as i64 - injected as i64;
     }
 }

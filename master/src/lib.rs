@@ -1,6 +1,8 @@
 //! The master side of the loop (the paper's OP, MD and HMD), as a library so the same
-//! code runs in the `tactile master` process and in the in-process simulation.
+//! code runs in the `tactile-master` program and in the in-process simulation.
 
 pub mod hmd;
+pub mod node;
 pub mod operator;
 pub mod process;
+pub mod record;

@@ -23,14 +23,9 @@ pub enum Target {
 /// A trajectory file that cannot be used.
 #[derive(Debug, Error)]
 pub enum OperatorError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
-    Read {
-        /// The file.
-        path: String,
-        /// Why.
-        source: std::io::Error,
-    },
+    /// The file could not be read (missing, not a regular file, too large).
+    #[error("{0}")]
+    Read(String),
     /// The file's content is malformed.
     #[error("{path}: {source}")]
     Csv {
@@ -109,11 +104,12 @@ impl OperatorSource {
             Operator::Csv { path } => {
                 let full = base_dir.join(path);
                 let shown = full.display().to_string();
-                let text =
-                    std::fs::read_to_string(&full).map_err(|source| OperatorError::Read {
-                        path: shown.clone(),
-                        source,
-                    })?;
+                let text = tactile_node::files::read_text(
+                    &full,
+                    "trajectory",
+                    tactile_node::files::MAX_TRAJECTORY_BYTES,
+                )
+                .map_err(OperatorError::Read)?;
                 let rows =
                     csv::parse(&text, &["x", "y", "z"]).map_err(|source| OperatorError::Csv {
                         path: shown.clone(),

@@ -1,22 +1,24 @@
-//! The master process's edge: paces the loop, moves samples through iceoryx2, stamps
-//! times, and keeps one trace row per sample. All signal computation is in [`Master`].
+//! The master process's edge: paces the loop, moves samples over its link, stamps
+//! times, and writes its record as it goes (what it sent, what came back, what it
+//! commanded). All signal computation is in [`Master`]; memory is bounded: only the
+//! last [`LATE_WINDOW`] samples are remembered, to match late answers.
 //!
 //! Realtime: sample n starts at t0 + n t_s (absolute sleep, so no drift), c(n) goes
 //! out, and the master waits for q(n) until the next tick; a q(n) that has not come by
 //! then is a deadline miss (if it comes later its round trip is still recorded).
 //! Lockstep: c(n + 1) goes out as soon as q(n) is back.
 
-use crate::hmd::{Master, MasterCounters};
+use crate::hmd::Master;
 use crate::operator::{OperatorError, OperatorSource};
-use serde::{Deserialize, Serialize};
+use crate::record::{MasterSample, MasterTotals};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tactile_common::clock::{now_ns, sleep_until_ns};
-use tactile_common::ipc::{Idle, InboxStats, IoxMaster, IpcError, OutboxStats, WaitPolicy};
-use tactile_common::link::MasterLink;
-use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
+use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, LATE_WINDOW};
 use tactile_common::scenario::{Mode, Scenario, ScenarioError};
-use tactile_common::trace::TraceRow;
+use tactile_node::ipc::{Idle, IpcError};
+use tactile_node::link::MasterLink;
+use tactile_node::runtime::{NodeError, Recorder};
 use thiserror::Error;
 
 /// What the master process needs to run.
@@ -26,18 +28,14 @@ pub struct MasterOptions {
     pub scenario: Scenario,
     /// Folder the scenario's relative paths are resolved against.
     pub base_dir: PathBuf,
-    /// iceoryx2 prefix of this run.
-    pub prefix: String,
-    /// Waiting for q(n).
-    pub wait: WaitPolicy,
     /// How long to wait for the other two processes to answer at start-up.
     pub startup_timeout: Duration,
     /// In lockstep, how long to wait for an answer before counting it missing.
     pub answer_timeout: Duration,
-    /// Progress on stderr every this many samples (0: none).
-    pub progress_every: u64,
     /// Realtime: wake this long before each tick and spin to it, ns.
     pub wake_early_ns: u64,
+    /// The run token this master puts on every sample.
+    pub run: u64,
 }
 
 /// What went wrong in the master process.
@@ -49,62 +47,89 @@ pub enum MasterError {
     /// The trajectory file is unusable.
     #[error(transparent)]
     Operator(#[from] OperatorError),
-    /// Shared memory failed.
+    /// The link failed.
     #[error(transparent)]
     Ipc(#[from] IpcError),
     /// The other processes did not answer.
     #[error("{0}")]
     NoAnswer(String),
+    /// The record could not be written.
+    #[error("{0}")]
+    Record(String),
 }
 
-/// Everything the master measured.
+impl From<NodeError> for MasterError {
+    fn from(e: NodeError) -> Self {
+        MasterError::Record(e.to_string())
+    }
+}
+
+/// The master's recorder.
+pub type MasterRecorder = Recorder<MasterSample, MasterTotals>;
+
+/// Samples waiting for their answer: the last [`LATE_WINDOW`] sent, each answered or
+/// not. Bounded, so a run of any length keeps the same memory.
 #[derive(Debug)]
-pub struct MasterRun {
-    /// One row per sample sent.
-    pub rows: Vec<TraceRow>,
-    /// Counters of the state machine.
-    pub counters: MasterCounters,
-    /// Samples whose q(n) was not back by the next tick (realtime only).
-    pub deadline_misses: u64,
-    /// Backward samples that arrived after their deadline.
-    pub late: u64,
-    /// Backward samples never received.
-    pub missing: u64,
-    /// Backward samples received out of the expected order or duplicated.
-    pub unexpected: u64,
-    /// Monotonic time of the first tick, ns.
-    pub t0_ns: u64,
-    /// True if SIGINT/SIGTERM stopped the run early.
-    pub interrupted: bool,
-    /// What happened to the loop, in order.
-    pub events: Vec<Event>,
-    /// c(n) as published.
-    pub c_out: OutboxStats,
-    /// q(n) as received.
-    pub q_in: InboxStats,
-    /// From the first tick to the end of the last sample, ns.
-    pub elapsed_ns: u64,
+struct Window {
+    answered: Vec<bool>,
+    sent: u64,
 }
 
-/// Something that happened to the loop during a run.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Event {
-    /// Sample number when it happened.
-    pub sample: u64,
-    /// What happened.
-    pub what: String,
+impl Window {
+    fn new() -> Self {
+        Window {
+            answered: vec![true; LATE_WINDOW as usize],
+            sent: 0,
+        }
+    }
+
+    fn slot(n: u64) -> usize {
+        (n % LATE_WINDOW) as usize
+    }
+
+    fn send(&mut self, n: u64) {
+        self.answered[Self::slot(n)] = false;
+        self.sent = n + 1;
+    }
+
+    /// Marks `n` answered; false if it was never sent, already answered, or too old.
+    fn answer(&mut self, n: u64) -> bool {
+        let fresh = n < self.sent && n + LATE_WINDOW >= self.sent && !self.answered[Self::slot(n)];
+        if fresh {
+            self.answered[Self::slot(n)] = true;
+        }
+        fresh
+    }
+
+    fn unanswered(&self) -> u64 {
+        let from = self.sent.saturating_sub(LATE_WINDOW);
+        (from..self.sent)
+            .filter(|&n| !self.answered[Self::slot(n)])
+            .count() as u64
+    }
 }
 
-fn index_of(n: u64) -> usize {
-    usize::try_from(n).unwrap_or(usize::MAX)
+/// How the master loop ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ending {
+    /// Every sample was sent.
+    Completed,
+    /// SIGINT or SIGTERM stopped it.
+    Interrupted,
 }
 
-fn probe(link: &impl MasterLink, timeout: Duration) -> Result<bool, MasterError> {
+fn probe<L: MasterLink + ?Sized>(
+    link: &L,
+    run: u64,
+    timeout: Duration,
+) -> Result<bool, MasterError> {
     let start = Instant::now();
     let mut k = 0u64;
+    let mut next_note = Duration::from_secs(5);
     while start.elapsed() < timeout {
         let mut p = Forward {
             seq: k,
+            run,
             ..Forward::default()
         };
         p.signal.flags = FLAG_PROBE;
@@ -113,49 +138,158 @@ fn probe(link: &impl MasterLink, timeout: Duration) -> Result<bool, MasterError>
         let deadline = Instant::now() + Duration::from_millis(20);
         loop {
             match link.recv(deadline)? {
-                Ok(b) if b.signal.flags & FLAG_PROBE != 0 => return Ok(true),
+                Ok(b) if b.signal.flags & FLAG_PROBE != 0 && b.run == run => return Ok(true),
                 Ok(_) => {}
                 Err(Idle::Terminate) => return Ok(false),
                 Err(Idle::Timeout) => break,
             }
         }
+        if start.elapsed() > next_note {
+            tracing::info!(
+                "still waiting for the emulator and slave ({:.0} s of {:.0} s)",
+                start.elapsed().as_secs_f64(),
+                timeout.as_secs_f64()
+            );
+            next_note += Duration::from_secs(5);
+        }
     }
     Err(MasterError::NoAnswer(format!(
-        "no answer from the emulator and slave within {:.1} s: are both running with the same prefix?",
+        "no answer from the emulator and slave within {:.1} s: are both running with the same prefix and link?",
         timeout.as_secs_f64()
     )))
 }
 
-/// Runs the master process over iceoryx2 until the scenario's samples are sent (or a
-/// stop request).
-pub fn run(opts: &MasterOptions) -> Result<MasterRun, MasterError> {
-    let link = IoxMaster::open(&opts.prefix, opts.wait)?;
-    run_with(opts, &link)
+/// The master loop and what it keeps between samples.
+struct Loop<'a, L: MasterLink + ?Sized> {
+    master: Master,
+    link: &'a L,
+    rec: &'a mut MasterRecorder,
+    totals: MasterTotals,
+    window: Window,
+    run: u64,
+    peer_timeout: u64,
+    t0: u64,
 }
 
-/// Runs the master loop over any transport.
-pub fn run_with(opts: &MasterOptions, link: &impl MasterLink) -> Result<MasterRun, MasterError> {
+impl<L: MasterLink + ?Sized> Loop<'_, L> {
+    fn totals(&self) -> MasterTotals {
+        let mut t = self.totals;
+        t.counters = self.master.counters();
+        (t.c_out, t.q_in) = self.link.stats();
+        t.q_in.foreign += self.totals.q_in.foreign;
+        t.elapsed_ns = now_ns().saturating_sub(self.t0);
+        t
+    }
+
+    /// Stamps q's arrival, applies KFF-HMD and records the answer. Returns the sample
+    /// it answers, or None for one that answers nothing (a probe, another run, a
+    /// duplicate, a number never sent or too old).
+    fn absorb(&mut self, mut q: Backward, current: u64) -> Result<Option<u64>, MasterError> {
+        q.stamps[stage::MASTER_RECV] = now_ns();
+        if q.signal.flags & FLAG_PROBE != 0 {
+            return Ok(None);
+        }
+        if q.run != self.run {
+            self.totals.q_in.foreign += 1;
+            return Ok(None);
+        }
+        if !self.window.answer(q.seq) {
+            self.totals.unexpected += 1;
+            return Ok(None);
+        }
+        if self.master.peer_lost() {
+            self.rec.event(current, "loop resumed: answers are back")?;
+        }
+        let mut a = self.master.backward(&q);
+        a.stamps[stage::MASTER_DONE] = now_ns();
+        self.master.account(&mut a);
+        a.late = q.seq != current;
+        if a.late {
+            self.totals.late += 1;
+        }
+        self.rec.sample(MasterSample::Answer(a))?;
+        Ok(Some(q.seq))
+    }
+
+    /// Sample n had no answer by its deadline: hold or zero the torque, and say so
+    /// when the loop breaks.
+    fn miss(&mut self, n: u64, realtime: bool) -> Result<(), MasterError> {
+        let was_lost = self.master.peer_lost();
+        let m = self.master.missing(n);
+        self.rec.sample(MasterSample::Miss(m))?;
+        if realtime {
+            self.totals.deadline_misses += 1;
+        }
+        if self.master.peer_lost() && !was_lost {
+            let dead = self.link.dead_peers();
+            let what = if dead.is_empty() {
+                format!(
+                    "loop broken: no answer for {} samples; zero torque",
+                    self.peer_timeout
+                )
+            } else {
+                format!(
+                    "loop broken: no answer for {} samples, dead: {}; zero torque",
+                    self.peer_timeout,
+                    dead.join(", ")
+                )
+            };
+            tracing::warn!("{what}");
+            self.rec.event(n, what)?;
+        }
+        Ok(())
+    }
+
+    /// Sends sample n and waits for its answer until `deadline`; false if a stop
+    /// request came.
+    fn sample(
+        &mut self,
+        n: u64,
+        origin: u64,
+        deadline: Instant,
+        realtime: bool,
+    ) -> Result<bool, MasterError> {
+        let (mut c, mut sent) = self.master.forward(n, origin);
+        c.run = self.run;
+        c.stamps[stage::MASTER_SEND] = now_ns();
+        sent.send_ns = c.stamps[stage::MASTER_SEND];
+        self.link.send(c)?;
+        self.window.send(n);
+        self.rec.sample(MasterSample::Sent(sent))?;
+        loop {
+            match self.link.recv(deadline)? {
+                Ok(q) => {
+                    if self.absorb(q, n)? == Some(n) {
+                        return Ok(true);
+                    }
+                }
+                Err(Idle::Timeout) => {
+                    self.miss(n, realtime)?;
+                    return Ok(true);
+                }
+                Err(Idle::Terminate) => return Ok(false),
+            }
+        }
+    }
+}
+
+/// Runs the master loop over any link until the scenario's samples are sent (or a stop
+/// request), writing its record as it goes.
+pub fn run_with<L: MasterLink + ?Sized>(
+    opts: &MasterOptions,
+    link: &L,
+    rec: &mut MasterRecorder,
+) -> Result<Ending, MasterError> {
     let sc = &opts.scenario;
     let source = OperatorSource::load(&sc.operator, &opts.base_dir)?;
-    let mut master = Master::new(sc, source)?;
-    let mut result = MasterRun {
-        rows: Vec::with_capacity(usize::try_from(sc.samples).unwrap_or(0)),
-        counters: MasterCounters::default(),
-        deadline_misses: 0,
-        late: 0,
-        missing: 0,
-        unexpected: 0,
-        t0_ns: 0,
-        interrupted: false,
-        events: Vec::new(),
-        c_out: OutboxStats::default(),
-        q_in: InboxStats::default(),
-        elapsed_ns: 0,
-    };
-    if !probe(link, opts.startup_timeout)? {
-        result.interrupted = true;
-        return Ok(result);
+    let master = Master::new(sc, source)?;
+    rec.run(opts.run)?;
+    tracing::info!("waiting for the emulator and slave");
+    if !probe(link, opts.run, opts.startup_timeout)? {
+        rec.stop(MasterTotals::default(), "interrupted")?;
+        return Ok(Ending::Interrupted);
     }
+    rec.event(0, "peers found: the emulator and slave answer")?;
     // Drain probe echoes still in flight.
     let drain = Instant::now() + Duration::from_millis(5);
     while link.recv(drain)?.is_ok() {}
@@ -164,11 +298,22 @@ pub fn run_with(opts: &MasterOptions, link: &impl MasterLink) -> Result<MasterRu
     let realtime = sc.mode == Mode::Realtime;
     // First tick a little ahead so every process is settled.
     let t0 = now_ns() + 2_000_000;
-    result.t0_ns = t0;
+    let mut lp = Loop {
+        master,
+        link,
+        rec,
+        totals: MasterTotals::default(),
+        window: Window::new(),
+        run: opts.run,
+        peer_timeout: sc.faults.peer_timeout_samples,
+        t0,
+    };
+    let mut ending = Ending::Completed;
+    let mut clamps = (0, 0);
     for n in 0..sc.samples {
         // The sample's origin is its scheduled instant, not the moment the master woke:
         // a late wake-up is overhead the loop adds and must show in the round trip.
-        let origin = if realtime {
+        let (origin, deadline) = if realtime {
             let tick = t0 + n * t_s;
             // Timer wake-ups here are late by ~100 us (timer slack plus the VM's wake
             // cost), so sleep until shortly before the tick and spin the rest; the
@@ -177,116 +322,60 @@ pub fn run_with(opts: &MasterOptions, link: &impl MasterLink) -> Result<MasterRu
             while now_ns() < tick {
                 std::thread::yield_now();
             }
-            tick
+            (tick, instant_at(t0 + (n + 1) * t_s))
         } else {
-            now_ns()
+            (now_ns(), Instant::now() + opts.answer_timeout)
         };
-        let (mut c, _) = master.forward(n, origin);
-        c.stamps[stage::MASTER_SEND] = now_ns();
-        link.send(c)?;
-        result.rows.push(master.pending(&c));
-
-        let deadline = if realtime {
-            instant_at(t0 + (n + 1) * t_s)
-        } else {
-            Instant::now() + opts.answer_timeout
-        };
-        let mut done = false;
-        while !done {
-            let got = link.recv(deadline)?;
-            match got {
-                Ok(q) => match absorb(&mut master, &mut result.rows, q, &mut result.events) {
-                    Some(seq) if seq == n => done = true,
-                    Some(_) => result.late += 1,
-                    None => result.unexpected += 1,
-                },
-                Err(Idle::Timeout) => {
-                    let was_lost = master.peer_lost();
-                    result.rows[index_of(n)] = master.missing(&c);
-                    if realtime {
-                        result.deadline_misses += 1;
-                    }
-                    if master.peer_lost() && !was_lost {
-                        let dead = link.dead_peers();
-                        result.events.push(Event {
-                            sample: n,
-                            what: if dead.is_empty() {
-                                format!(
-                                    "loop broken: no answer for {} samples; zero torque",
-                                    sc.faults.peer_timeout_samples
-                                )
-                            } else {
-                                format!(
-                                    "loop broken: no answer for {} samples, dead: {}; zero torque",
-                                    sc.faults.peer_timeout_samples,
-                                    dead.join(", ")
-                                )
-                            },
-                        });
-                    }
-                    break;
-                }
-                Err(Idle::Terminate) => {
-                    result.interrupted = true;
-                    break;
-                }
-            }
-        }
-        if result.interrupted {
+        if !lp.sample(n, origin, deadline, realtime)? {
+            ending = Ending::Interrupted;
             break;
         }
-        if opts.progress_every > 0 && (n + 1) % opts.progress_every == 0 {
-            eprint!("\r  master: {}/{} samples", n + 1, sc.samples);
+        if lp.rec.counters_due() {
+            let t = lp.totals();
+            log_clamps(&mut clamps, &t.counters);
+            lp.rec.counters(t)?;
         }
     }
-    if opts.progress_every > 0 {
-        eprintln!();
-    }
-    result.elapsed_ns = now_ns().saturating_sub(t0);
     // Collect stragglers, then tell the others to stop.
+    let last = lp.window.sent;
     let grace = Instant::now() + Duration::from_millis(50);
     while let Ok(Ok(q)) = link.recv(grace) {
-        match absorb(&mut master, &mut result.rows, q, &mut result.events) {
-            Some(_) => result.late += 1,
-            None => result.unexpected += 1,
-        }
+        lp.absorb(q, last)?;
     }
-    let mut end = Forward::default();
+    let mut end = Forward {
+        run: opts.run,
+        ..Forward::default()
+    };
     end.signal.flags = FLAG_END;
     link.send_control(end)?;
-    result.missing = result.rows.iter().filter(|r| r.backward.is_none()).count() as u64;
-    result.counters = master.counters();
-    (result.c_out, result.q_in) = link.stats();
-    Ok(result)
+    let unanswered = lp.window.unanswered();
+    let totals = lp.totals();
+    let reason = match ending {
+        Ending::Completed => "completed",
+        Ending::Interrupted => "interrupted",
+    };
+    lp.rec.event(
+        last,
+        format!("{reason}: {last} samples sent, {unanswered} of the last {LATE_WINDOW} without an answer"),
+    )?;
+    lp.rec.stop(totals, reason)?;
+    Ok(ending)
 }
 
-/// Stamps q's arrival, applies KFF-HMD and fills the row of the sample it answers.
-/// Returns that sample's number, or None for a sample that answers nothing (a probe, a
-/// duplicate, a number never sent).
-fn absorb(
-    master: &mut Master,
-    rows: &mut [TraceRow],
-    mut q: Backward,
-    events: &mut Vec<Event>,
-) -> Option<u64> {
-    q.stamps[stage::MASTER_RECV] = now_ns();
-    let index = usize::try_from(q.seq).ok().filter(|&i| {
-        i < rows.len() && rows[i].backward.is_none() && q.signal.flags & FLAG_PROBE == 0
-    })?;
-    if master.peer_lost() {
-        events.push(Event {
-            sample: q.seq,
-            what: "loop resumed: answers are back".into(),
-        });
+/// Logs the force and torque clamps of the last second, if any (at most one line a
+/// second, however often the device saturates).
+fn log_clamps(seen: &mut (u64, u64), c: &crate::hmd::MasterCounters) {
+    let now = (c.force_clamps, c.torque_clamps);
+    if now != *seen {
+        tracing::info!(
+            "clamped to the device limits: {} force and {} torque components in the last second ({} and {} in all)",
+            now.0 - seen.0,
+            now.1 - seen.1,
+            now.0,
+            now.1
+        );
+        *seen = now;
     }
-    let sent = rows[index].forward;
-    let mut row = master.backward(&sent, &q);
-    if let Some(b) = row.backward.as_mut() {
-        b.stamps[stage::MASTER_DONE] = now_ns();
-    }
-    master.account(&mut row);
-    rows[index] = row;
-    Some(q.seq)
 }
 
 /// The `Instant` corresponding to a CLOCK_MONOTONIC time (both are monotonic clocks).

@@ -3,8 +3,8 @@
 //! Forward, v_i(n) = c_i(n - d^f_i(n)) + r^f_i(n); backward, q_i(n) = h_i(n - d^b_i(n)) +
 //! r^b_i(n). Each arriving sample is pushed through its [`Channel`]; what comes out
 //! keeps the sample number and stamps of the sample that triggered it, with values (and
-//! their provenance) taken from the delayed one. The noise added is recorded in the
-//! sample so reports can separate it from the signal.
+//! their provenance) taken from the delayed one. What was done to each sample (noise
+//! added, delay, drop or corruption) is returned as the emulator's record of it.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -44,11 +44,41 @@ struct Faults {
 }
 
 /// What the fault model decided for one sample.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Fate {
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Fate {
+    /// Passed on.
     Deliver,
+    /// Passed on with its values replaced by NaN (fault injection).
     Corrupt,
+    /// Dropped on purpose (loss model).
     Drop,
+}
+
+/// Which channel a sample crossed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Direction {
+    /// Master to slave: c(n) in, v(n) out.
+    Forward,
+    /// Slave to master: h(n) in, q(n) out.
+    Backward,
+}
+
+/// The emulator's record of one sample it passed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Passage {
+    /// Which channel.
+    pub dir: Direction,
+    /// Sample number.
+    pub n: u64,
+    /// The values that arrived.
+    pub input: [f64; 3],
+    /// What left (values, provenance, injected delay, flags); values as sent even when
+    /// dropped.
+    pub out: Signal,
+    /// Noise added to each value.
+    pub noise: [f64; 3],
+    /// Delivered, corrupted or dropped.
+    pub fate: Fate,
 }
 
 impl Faults {
@@ -100,7 +130,6 @@ fn apply(s: &mut Signal, e: &tactile_common::channel::Emitted) {
         s.origin_ns[i] = e.values[i].origin_ns;
         s.delay_samples[i] = e.values[i].delay_samples;
     }
-    s.noise = e.noise;
     if e.substituted {
         s.flags |= FLAG_SUBSTITUTED;
     }
@@ -124,10 +153,10 @@ impl Emulator {
         self.counters
     }
 
-    /// c(n) in, v(n) out; `None` when the loss model drops it.
-    pub fn forward(&mut self, c: &Forward) -> Option<Forward> {
+    /// c(n) in, v(n) out (`None` when the loss model drops it), and the record of it.
+    pub fn forward(&mut self, c: &Forward) -> (Option<Forward>, Passage) {
         let mut v = *c;
-        let keep = pass(
+        let (fate, noise) = pass(
             &mut self.forward,
             &mut self.forward_faults,
             c.seq,
@@ -136,15 +165,23 @@ impl Emulator {
         let k = &mut self.counters;
         k.forward += 1;
         k.forward_substituted += u64::from(v.signal.flags & FLAG_SUBSTITUTED != 0);
-        k.forward_corrupted += u64::from(keep == Fate::Corrupt);
-        k.forward_dropped += u64::from(keep == Fate::Drop);
-        (keep != Fate::Drop).then_some(v)
+        k.forward_corrupted += u64::from(fate == Fate::Corrupt);
+        k.forward_dropped += u64::from(fate == Fate::Drop);
+        let record = Passage {
+            dir: Direction::Forward,
+            n: c.seq,
+            input: c.signal.value,
+            out: v.signal,
+            noise,
+            fate,
+        };
+        ((fate != Fate::Drop).then_some(v), record)
     }
 
-    /// h(n) in, q(n) out; `None` when the loss model drops it.
-    pub fn backward(&mut self, h: &Backward) -> Option<Backward> {
+    /// h(n) in, q(n) out (`None` when the loss model drops it), and the record of it.
+    pub fn backward(&mut self, h: &Backward) -> (Option<Backward>, Passage) {
         let mut q = *h;
-        let keep = pass(
+        let (fate, noise) = pass(
             &mut self.backward,
             &mut self.backward_faults,
             h.seq,
@@ -153,15 +190,29 @@ impl Emulator {
         let k = &mut self.counters;
         k.backward += 1;
         k.backward_substituted += u64::from(q.signal.flags & FLAG_SUBSTITUTED != 0);
-        k.backward_corrupted += u64::from(keep == Fate::Corrupt);
-        k.backward_dropped += u64::from(keep == Fate::Drop);
-        (keep != Fate::Drop).then_some(q)
+        k.backward_corrupted += u64::from(fate == Fate::Corrupt);
+        k.backward_dropped += u64::from(fate == Fate::Drop);
+        let record = Passage {
+            dir: Direction::Backward,
+            n: h.seq,
+            input: h.signal.value,
+            out: q.signal,
+            noise,
+            fate,
+        };
+        ((fate != Fate::Drop).then_some(q), record)
     }
 }
 
 /// One sample through one channel: delay and noise into `signal`, then the fault
-/// model's decision (a corrupted signal is already NaN when this returns).
-fn pass(channel: &mut Channel, faults: &mut Faults, seq: u64, signal: &mut Signal) -> Fate {
+/// model's decision (a corrupted signal is already NaN when this returns). Returns the
+/// decision and the noise added.
+fn pass(
+    channel: &mut Channel,
+    faults: &mut Faults,
+    seq: u64,
+    signal: &mut Signal,
+) -> (Fate, [f64; 3]) {
     let e = channel.push(seq, values(signal));
     apply(signal, &e);
     let fate = faults.fate();
@@ -169,5 +220,5 @@ fn pass(channel: &mut Channel, faults: &mut Faults, seq: u64, signal: &mut Signa
         signal.value = [f64::NAN; 3];
         signal.flags |= FLAG_CORRUPTED;
     }
-    fate
+    (fate, e.noise)
 }

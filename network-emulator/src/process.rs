@@ -1,95 +1,132 @@
 //! The emulator process's edge: takes c(n) and h(n) as they arrive, passes them through
-//! the channels and publishes v(n) and q(n). All channel computation is in [`Emulator`].
+//! the channels, publishes v(n) and q(n), and records every passage. All channel
+//! computation is in [`Emulator`].
 
-use crate::emulator::{Emulator, EmulatorCounters};
+use crate::emulator::{Emulator, EmulatorCounters, Passage};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 use tactile_common::clock::now_ns;
-use tactile_common::ipc::{Idle, InboxStats, IoxEmulator, IpcError, OutboxStats, WaitPolicy};
-use tactile_common::link::{Arrival, EmulatorLink};
 use tactile_common::samples::{stage, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::Scenario;
+use tactile_node::ipc::{Idle, IpcError};
+use tactile_node::link::{Arrival, EmulatorLink, EmulatorStats, RunFilter};
+use tactile_node::runtime::{NodeError, Recorder};
 
-/// What the emulator process needs to run.
-#[derive(Debug, Clone)]
-pub struct EmulatorOptions {
-    /// The scenario.
-    pub scenario: Scenario,
-    /// iceoryx2 prefix of this run.
-    pub prefix: String,
-    /// Waiting for the next sample.
-    pub wait: WaitPolicy,
-}
-
-/// Everything the emulator measured.
-#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
-pub struct EmulatorRun {
+/// The emulator's counters.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EmulatorTotals {
     /// Channel counters (including drops and corruptions on purpose).
     pub counters: EmulatorCounters,
-    /// c(n) as received from the master.
-    pub c_in: InboxStats,
-    /// v(n) as published to the slave.
-    pub v_out: OutboxStats,
-    /// h(n) as received from the slave.
-    pub h_in: InboxStats,
-    /// q(n) as published to the master.
-    pub q_out: OutboxStats,
-    /// True if SIGINT/SIGTERM stopped it.
-    pub interrupted: bool,
+    /// What the four stream ends counted.
+    pub links: EmulatorStats,
 }
 
-/// Runs over iceoryx2 until the master's end-of-run sample or a stop request.
-pub fn run(opts: &EmulatorOptions) -> Result<EmulatorRun, IpcError> {
-    run_with(opts, &IoxEmulator::open(&opts.prefix, opts.wait)?)
+/// The emulator's recorder.
+pub type EmulatorRecorder = Recorder<Passage, EmulatorTotals>;
+/// The emulator's record type.
+pub type EmulatorRecord = tactile_node::record::Record<Passage, EmulatorTotals>;
+
+/// Why the emulator loop stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum EmulatorError {
+    /// The link failed.
+    #[error(transparent)]
+    Ipc(#[from] IpcError),
+    /// The record could not be written.
+    #[error("{0}")]
+    Record(String),
 }
 
-/// Runs the emulator loop over any transport.
-pub fn run_with(opts: &EmulatorOptions, link: &impl EmulatorLink) -> Result<EmulatorRun, IpcError> {
-    let mut emu = Emulator::new(&opts.scenario);
-    let mut interrupted = false;
-    loop {
+impl From<NodeError> for EmulatorError {
+    fn from(e: NodeError) -> Self {
+        EmulatorError::Record(e.to_string())
+    }
+}
+
+/// Runs the emulator loop over any link until the master's end-of-run sample (true) or
+/// a stop request (false).
+pub fn run_with<L: EmulatorLink + ?Sized>(
+    scenario: &Scenario,
+    link: &L,
+    rec: &mut EmulatorRecorder,
+) -> Result<bool, EmulatorError> {
+    let mut emu = Emulator::new(scenario);
+    let mut filter = RunFilter::default();
+    let mut seen_first = false;
+    let mut last_seq = 0;
+    let totals = |emu: &Emulator, filter: &RunFilter| {
+        let mut links = link.stats();
+        links.c_in.foreign += filter.foreign;
+        EmulatorTotals {
+            counters: emu.counters(),
+            links,
+        }
+    };
+    let completed = loop {
         let deadline = Instant::now() + Duration::from_secs(3600);
-        match link.recv(deadline)? {
-            Ok(Arrival::Forward(mut c)) => {
+        let arrival = match link.recv(deadline)? {
+            Ok(a) => a,
+            Err(Idle::Timeout) => continue,
+            Err(Idle::Terminate) => break false,
+        };
+        let (token, seq) = match &arrival {
+            Arrival::Forward(c) => (c.run, c.seq),
+            Arrival::Backward(h) => (h.run, h.seq),
+        };
+        let mut joined = None;
+        if !filter.admit(token, &mut joined) {
+            continue;
+        }
+        if let Some(t) = joined {
+            rec.run(t)?;
+        }
+        match arrival {
+            Arrival::Forward(mut c) => {
                 let flags = c.signal.flags;
                 if flags & (FLAG_PROBE | FLAG_END) != 0 {
                     link.send_v(c, true)?;
                     if flags & FLAG_END != 0 {
-                        break;
+                        rec.event(last_seq, "end of run from the master")?;
+                        break true;
                     }
                     continue;
                 }
+                if !seen_first {
+                    seen_first = true;
+                    rec.event(seq, "first sample from the master")?;
+                }
+                last_seq = seq;
                 c.stamps[stage::EMU_FWD_RECV] = now_ns();
-                if let Some(mut v) = emu.forward(&c) {
+                let (out, passage) = emu.forward(&c);
+                if let Some(mut v) = out {
                     v.stamps[stage::EMU_FWD_SEND] = now_ns();
                     link.send_v(v, false)?;
                 }
+                rec.sample(passage)?;
             }
-            Ok(Arrival::Backward(mut h)) => {
+            Arrival::Backward(mut h) => {
                 if h.signal.flags & FLAG_PROBE != 0 {
                     link.send_q(h, true)?;
                     continue;
                 }
                 h.stamps[stage::EMU_BWD_RECV] = now_ns();
-                if let Some(mut q) = emu.backward(&h) {
+                let (out, passage) = emu.backward(&h);
+                if let Some(mut q) = out {
                     q.stamps[stage::EMU_BWD_SEND] = now_ns();
                     link.send_q(q, false)?;
                 }
-            }
-            Err(Idle::Timeout) => {}
-            Err(Idle::Terminate) => {
-                interrupted = true;
-                break;
+                rec.sample(passage)?;
             }
         }
-    }
-    let st = link.stats();
-    Ok(EmulatorRun {
-        counters: emu.counters(),
-        c_in: st.c_in,
-        v_out: st.v_out,
-        h_in: st.h_in,
-        q_out: st.q_out,
-        interrupted,
-    })
+        if rec.counters_due() {
+            rec.counters(totals(&emu, &filter))?;
+        }
+    };
+    let reason = if completed {
+        "completed"
+    } else {
+        "interrupted"
+    };
+    rec.stop(totals(&emu, &filter), reason)?;
+    Ok(completed)
 }

@@ -12,14 +12,13 @@
 
 use crate::device::{Controller, Dynamics, JointState};
 use crate::environment::deepest_contact;
+use crate::record::{HoldStep, Step};
 use serde::{Deserialize, Serialize};
 use tactile_common::arith::StdTrig;
 use tactile_common::engine::Engine;
 use tactile_common::geometry::Lengths;
 use tactile_common::kernels::{self, IkStatus};
-use tactile_common::samples::{
-    Backward, Forward, SlaveState, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED,
-};
+use tactile_common::samples::{Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED};
 use tactile_common::scenario::{Object, Scenario, ScenarioError};
 
 /// What the slave counted over a run.
@@ -91,7 +90,7 @@ impl Slave {
 
     /// One sample of t_s with no input: hold the joints where they were when the input
     /// went silent (the master or the network is gone; the device must not wander).
-    pub fn hold(&mut self) {
+    pub fn hold(&mut self) -> HoldStep {
         let theta_now = self.dynamics.state.theta;
         let from = *self.hold_from.get_or_insert_with(|| {
             self.counters.holds += 1;
@@ -112,6 +111,13 @@ impl Slave {
         let drift =
             ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2) + (p[2] - p0[2]).powi(2)).sqrt();
         self.counters.hold_drift_max_m = self.counters.hold_drift_max_m.max(drift);
+        HoldStep {
+            step: self.counters.held_steps,
+            theta_ref: from,
+            theta: self.dynamics.state.theta,
+            torque: cmd.torque,
+            tool: p,
+        }
     }
 
     /// Integrates the device over one sample under `torque`, pushed back by whatever the
@@ -133,7 +139,7 @@ impl Slave {
     }
 
     /// One sample: v(n) in, h(n) out. Stamps are copied from `v`; the edge sets its own.
-    pub fn step(&mut self, v: &Forward) -> Backward {
+    pub fn step(&mut self, v: &Forward) -> (Backward, Step) {
         self.counters.steps += 1;
         self.hold_from = None;
         let mut flags = 0;
@@ -201,7 +207,8 @@ impl Slave {
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
         out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
         out.signal.flags = flags;
-        out.slave = SlaveState {
+        let step = Step {
+            n: v.seq,
             received: v.signal,
             theta_ref: self.reference,
             theta,
@@ -211,7 +218,8 @@ impl Slave {
             force,
             clamps: cmd.clamped,
             contact_object,
+            flags,
         };
-        out
+        (out, step)
     }
 }

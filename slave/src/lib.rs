@@ -1,7 +1,9 @@
 //! The slave side of the loop (the paper's HSD, SD and ENV), as a library so the same
-//! code runs in the `tactile slave` process and in the in-process simulation.
+//! code runs in the `tactile-slave` program and in the in-process simulation.
 
 pub mod device;
 pub mod environment;
 pub mod hsd;
+pub mod node;
 pub mod process;
+pub mod record;

@@ -1,27 +1,17 @@
-//! The slave process's edge: takes v(n), runs one step of [`Slave`], publishes h(n).
-//! When v(n) stops coming for the peer timeout, the slave holds its position, one
-//! step per t_s, until input returns.
+//! The slave process's edge: takes v(n), runs one step of [`Slave`], publishes h(n) and
+//! records the step. When v(n) stops coming for the peer timeout, the slave holds its
+//! position, one step per t_s, until input returns.
 
-use crate::hsd::{Slave, SlaveCounters};
-use serde::{Deserialize, Serialize};
+use crate::hsd::Slave;
+use crate::record::{SlaveSample, SlaveTotals};
 use std::time::{Duration, Instant};
 use tactile_common::clock::now_ns;
-use tactile_common::ipc::{Idle, InboxStats, IoxSlave, IpcError, OutboxStats, WaitPolicy};
-use tactile_common::link::SlaveLink;
 use tactile_common::samples::{stage, Backward, FLAG_END, FLAG_PROBE};
 use tactile_common::scenario::{Scenario, ScenarioError};
+use tactile_node::ipc::{Idle, IpcError};
+use tactile_node::link::{RunFilter, SlaveLink};
+use tactile_node::runtime::{NodeError, Recorder};
 use thiserror::Error;
-
-/// What the slave process needs to run.
-#[derive(Debug, Clone)]
-pub struct SlaveOptions {
-    /// The scenario.
-    pub scenario: Scenario,
-    /// iceoryx2 prefix of this run.
-    pub prefix: String,
-    /// Waiting for the next sample.
-    pub wait: WaitPolicy,
-}
 
 /// What went wrong in the slave process.
 #[derive(Debug, Error)]
@@ -29,23 +19,22 @@ pub enum SlaveError {
     /// The scenario is invalid.
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
-    /// Shared memory failed.
+    /// The link failed.
     #[error(transparent)]
     Ipc(#[from] IpcError),
+    /// The record could not be written.
+    #[error("{0}")]
+    Record(String),
 }
 
-/// Everything the slave measured.
-#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
-pub struct SlaveRun {
-    /// State-machine counters.
-    pub counters: SlaveCounters,
-    /// v(n) as received.
-    pub v_in: InboxStats,
-    /// h(n) as published.
-    pub h_out: OutboxStats,
-    /// True if SIGINT/SIGTERM stopped it.
-    pub interrupted: bool,
+impl From<NodeError> for SlaveError {
+    fn from(e: NodeError) -> Self {
+        SlaveError::Record(e.to_string())
+    }
 }
+
+/// The slave's recorder.
+pub type SlaveRecorder = Recorder<SlaveSample, SlaveTotals>;
 
 /// How long without input before the slave holds: the scenario's peer timeout in
 /// samples, but never under 50 ms (a lockstep master may pause that long for its own
@@ -55,60 +44,108 @@ pub fn hold_timeout(scenario: &Scenario) -> Duration {
     t.max(Duration::from_millis(50))
 }
 
-/// Runs over iceoryx2 until the end-of-run sample or a stop request.
-pub fn run(opts: &SlaveOptions) -> Result<SlaveRun, SlaveError> {
-    run_with(opts, &IoxSlave::open(&opts.prefix, opts.wait)?)
-}
-
-/// Runs the slave loop over any transport.
-pub fn run_with(opts: &SlaveOptions, link: &impl SlaveLink) -> Result<SlaveRun, SlaveError> {
-    let mut slave = Slave::new(&opts.scenario)?;
-    let timeout = hold_timeout(&opts.scenario);
-    let t_s = Duration::from_nanos(opts.scenario.t_s_ns());
-    let mut interrupted = false;
+/// Runs the slave loop over any link until the end-of-run sample (true) or a stop
+/// request (false).
+pub fn run_with<L: SlaveLink + ?Sized>(
+    scenario: &Scenario,
+    link: &L,
+    rec: &mut SlaveRecorder,
+) -> Result<bool, SlaveError> {
+    let mut slave = Slave::new(scenario)?;
+    let timeout = hold_timeout(scenario);
+    let t_s = Duration::from_nanos(scenario.t_s_ns());
+    let mut filter = RunFilter::default();
+    let mut last_seq = 0;
+    let totals = |slave: &Slave, filter: &RunFilter| {
+        let (mut v_in, h_out) = link.stats();
+        v_in.foreign += filter.foreign;
+        SlaveTotals {
+            counters: slave.counters(),
+            v_in,
+            h_out,
+        }
+    };
     // No input yet: wait as long as it takes for the first sample.
     let mut deadline: Option<Instant> = None;
-    loop {
+    let mut holding = false;
+    let mut clamps = (0, 0);
+    let completed = loop {
         let until = deadline.unwrap_or_else(|| Instant::now() + Duration::from_secs(3600));
         match link.recv(until)? {
             Ok(mut v) => {
+                let mut joined = None;
+                if !filter.admit(v.run, &mut joined) {
+                    continue;
+                }
+                if let Some(t) = joined {
+                    rec.run(t)?;
+                }
                 let flags = v.signal.flags;
                 if flags & FLAG_END != 0 {
-                    break;
+                    rec.event(last_seq, "end of run from the master")?;
+                    break true;
                 }
                 if flags & FLAG_PROBE != 0 {
                     let mut echo = Backward {
                         seq: v.seq,
+                        run: v.run,
                         ..Backward::default()
                     };
                     echo.signal.flags = FLAG_PROBE;
                     link.send_h(echo, true)?;
                     continue;
                 }
+                if deadline.is_none() {
+                    rec.event(v.seq, "first sample: following the master")?;
+                } else if holding {
+                    rec.event(v.seq, "input back: following the master again")?;
+                }
+                holding = false;
+                last_seq = v.seq;
                 v.stamps[stage::SLAVE_RECV] = now_ns();
-                let mut h = slave.step(&v);
+                let (mut h, step) = slave.step(&v);
+                h.run = v.run;
                 h.stamps[stage::SLAVE_SEND] = now_ns();
                 link.send_h(h, false)?;
+                rec.sample(SlaveSample::Step(step))?;
                 deadline = Some(Instant::now() + timeout);
             }
             Err(Idle::Timeout) => {
                 if deadline.is_some() {
                     // Input went silent: hold, one step per t_s, until it returns.
-                    slave.hold();
+                    if !holding {
+                        holding = true;
+                        tracing::warn!("input silent for {timeout:?}: holding position");
+                        rec.event(last_seq, "input silent: holding position")?;
+                    }
+                    let held = slave.hold();
+                    rec.sample(SlaveSample::Hold(held))?;
                     deadline = Some(Instant::now() + t_s);
                 }
             }
-            Err(Idle::Terminate) => {
-                interrupted = true;
-                break;
-            }
+            Err(Idle::Terminate) => break false,
         }
-    }
-    let (v_in, h_out) = link.stats();
-    Ok(SlaveRun {
-        counters: slave.counters(),
-        v_in,
-        h_out,
-        interrupted,
-    })
+        if rec.counters_due() {
+            let t = totals(&slave, &filter);
+            let now = (t.counters.torque_clamps, t.counters.ik_clamped);
+            if now != clamps {
+                tracing::info!(
+                    "clamped: {} joint torques to the limit and {} IK targets to the workspace in the last second ({} and {} in all)",
+                    now.0 - clamps.0,
+                    now.1 - clamps.1,
+                    now.0,
+                    now.1
+                );
+                clamps = now;
+            }
+            rec.counters(t)?;
+        }
+    };
+    let reason = if completed {
+        "completed"
+    } else {
+        "interrupted"
+    };
+    rec.stop(totals(&slave, &filter), reason)?;
+    Ok(completed)
 }

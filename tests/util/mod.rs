@@ -44,13 +44,25 @@ impl Sandbox {
         p
     }
 
+    /// `tactile` with `args`, in the sandbox, finding the node programs beside it.
+    pub fn command(&self, args: &[&str]) -> Command {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_tactile"));
+        c.args(args)
+            .current_dir(self.dir.path())
+            .env("TACTILE_NODE_DIR", node_dir());
+        c
+    }
+
+    /// A node program (`tactile-master`, ...) with `args`, in the sandbox.
+    pub fn node(&self, program: &str, args: &[&str]) -> Command {
+        let mut c = Command::new(node_dir().join(program));
+        c.args(args).current_dir(self.dir.path());
+        c
+    }
+
     /// Runs `tactile` with `args`.
     pub fn tactile(&self, args: &[&str]) -> Output {
-        Command::new(env!("CARGO_BIN_EXE_tactile"))
-            .args(args)
-            .current_dir(self.dir.path())
-            .output()
-            .expect("start tactile")
+        self.command(args).output().expect("start tactile")
     }
 
     /// `tactile run SCENARIO --out OUT --prefix PREFIX -q`; asserts success and that no
@@ -100,7 +112,7 @@ impl Sandbox {
                 continue;
             };
             let cmd = String::from_utf8_lossy(&cmd).to_string();
-            if cmd.contains(&needle) && cmd.contains("role") {
+            if cmd.contains(&needle) && cmd.contains("tactile-") {
                 // A zombie has an empty cmdline, so anything here is really running.
                 alive.push(cmd.replace('\0', " "));
             }
@@ -122,8 +134,29 @@ impl Sandbox {
 
 impl Drop for Sandbox {
     fn drop(&mut self) {
-        tactile_common::ipc::remove_run_files(&self.prefix);
+        tactile_node::ipc::remove_run_files(&self.prefix);
     }
+}
+
+/// The folder of the node programs: beside the `tactile` binary Cargo built for the
+/// tests (`cargo test --workspace` builds them: each node package has tests of its own).
+pub fn node_dir() -> PathBuf {
+    Path::new(env!("CARGO_BIN_EXE_tactile"))
+        .parent()
+        .expect("bin folder")
+        .to_path_buf()
+}
+
+/// PID of the running node `role` (`master`, `emulator`, `slave`) of run `prefix`.
+pub fn pid_of(prefix: &str, role: &str) -> Option<i32> {
+    let program = format!("tactile-{role}\0");
+    let prefix = format!("--prefix\0{prefix}\0");
+    std::fs::read_dir("/proc").ok()?.flatten().find_map(|e| {
+        let pid: i32 = e.file_name().to_str()?.parse().ok()?;
+        let cmd =
+            String::from_utf8_lossy(&std::fs::read(e.path().join("cmdline")).ok()?).to_string();
+        (cmd.contains(&program) && cmd.contains(&prefix)).then_some(pid)
+    })
 }
 
 /// Column `name` of a CSV text as numbers.

@@ -7,9 +7,9 @@
 //! counter and counts what it sends and receives the same way.
 
 use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats};
-use crate::samples::{Backward, Forward, Sequenced};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
+use tactile_common::samples::{Backward, Forward, Sequenced};
 
 /// The outcome of a wait: a value, or why none came.
 pub type Wait<T> = Result<Result<T, Idle>, IpcError>;
@@ -113,5 +113,30 @@ impl InboxStats {
             None => {}
         }
         *next = Some(h + 1);
+    }
+}
+
+/// The run this node serves: learned from the master's first sample (probe or data);
+/// samples of another run are dropped and counted.
+#[derive(Debug, Default)]
+pub struct RunFilter {
+    run: u64,
+    /// Samples of another run dropped.
+    pub foreign: u64,
+}
+
+impl RunFilter {
+    /// True if a sample of run `token` belongs to this run; the first token seen is
+    /// adopted (and returned in `joined`).
+    pub fn admit(&mut self, token: u64, joined: &mut Option<u64>) -> bool {
+        if self.run == 0 && token != 0 {
+            self.run = token;
+            *joined = Some(token);
+        }
+        let ok = token == self.run && token != 0;
+        if !ok {
+            self.foreign += 1;
+        }
+        ok
     }
 }

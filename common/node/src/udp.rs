@@ -7,6 +7,8 @@
 //! the operating system (no socket bound at the peer's port) counts as published with
 //! no receiver; UDP cannot tell a dead peer otherwise.
 
+use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats};
+use crate::link::{Arrival, EmulatorLink, EmulatorStats, MasterLink, SlaveLink, Wait};
 use serde::{de::DeserializeOwned, Serialize};
 use std::cell::{Cell, RefCell};
 use std::io::ErrorKind;
@@ -14,8 +16,6 @@ use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tactile_common::ipc::{Idle, InboxStats, IpcError, OutboxStats};
-use tactile_common::link::{Arrival, EmulatorLink, EmulatorStats, MasterLink, SlaveLink, Wait};
 use tactile_common::samples::{Backward, Forward, Sequenced};
 
 const TAG_FORWARD: u8 = 0;
@@ -172,19 +172,30 @@ impl Endpoint {
     }
 }
 
+/// Decodes one datagram body and counts it; a body that is not a whole sample (garbage,
+/// truncated, another format) is counted as malformed and dropped, never an error:
+/// nothing the network delivers may stop a node.
 fn decode<T: DeserializeOwned + Sequenced>(
     body: &[u8],
     stats: &Cell<InboxStats>,
     next: &Cell<Option<u64>>,
-) -> Result<T, IpcError> {
-    let (v, _): (T, usize) = bincode::serde::decode_from_slice(body, bincode::config::legacy())
-        .map_err(|e| err("decoding a sample", e))?;
+) -> Option<T> {
     let mut st = stats.get();
-    let mut n = next.get();
-    st.count(&v, &mut n);
+    let decoded = bincode::serde::decode_from_slice::<T, _>(body, bincode::config::legacy());
+    let v = match decoded {
+        Ok((v, used)) if used == body.len() => Some(v),
+        _ => {
+            st.malformed += 1;
+            None
+        }
+    };
+    if let Some(v) = &v {
+        let mut n = next.get();
+        st.count(v, &mut n);
+        next.set(n);
+    }
     stats.set(st);
-    next.set(n);
-    Ok(v)
+    v
 }
 
 /// The master's end over UDP.
@@ -221,9 +232,9 @@ impl MasterLink for UdpMaster {
     }
     fn recv(&self, deadline: Instant) -> Wait<Backward> {
         self.ep.recv(deadline, |tag, body| {
-            (tag == TAG_BACKWARD)
+            Ok((tag == TAG_BACKWARD)
                 .then(|| decode(body, &self.inn, &self.next))
-                .transpose()
+                .flatten())
         })
     }
     fn dead_peers(&self) -> Vec<String> {
@@ -260,11 +271,16 @@ impl UdpEmulator {
 impl EmulatorLink for UdpEmulator {
     fn recv(&self, deadline: Instant) -> Wait<Arrival> {
         self.ep.recv(deadline, |tag, body| {
-            Ok(Some(if tag == TAG_FORWARD {
-                Arrival::Forward(decode(body, &self.inn[0], &self.next[0])?)
-            } else {
-                Arrival::Backward(decode(body, &self.inn[1], &self.next[1])?)
-            }))
+            Ok(match tag {
+                TAG_FORWARD => decode(body, &self.inn[0], &self.next[0]).map(Arrival::Forward),
+                TAG_BACKWARD => decode(body, &self.inn[1], &self.next[1]).map(Arrival::Backward),
+                _ => {
+                    let mut st = self.inn[0].get();
+                    st.malformed += 1;
+                    self.inn[0].set(st);
+                    None
+                }
+            })
         })
     }
     fn send_v(&self, v: Forward, control: bool) -> Result<(), IpcError> {
@@ -311,9 +327,9 @@ impl UdpSlave {
 impl SlaveLink for UdpSlave {
     fn recv(&self, deadline: Instant) -> Wait<Forward> {
         self.ep.recv(deadline, |tag, body| {
-            (tag == TAG_FORWARD)
+            Ok((tag == TAG_FORWARD)
                 .then(|| decode(body, &self.inn, &self.next))
-                .transpose()
+                .flatten())
         })
     }
     fn send_h(&self, h: Backward, control: bool) -> Result<(), IpcError> {

@@ -10,7 +10,6 @@
 //! shared-memory objects and the folder of node and service files, so runs never see
 //! each other.
 
-use crate::samples::Sequenced;
 use iceoryx2::config::Config;
 use iceoryx2::node::NodeWaitFailure;
 use iceoryx2::port::listener::{Listener, ListenerWaitError};
@@ -24,6 +23,7 @@ use serde::{Deserialize, Serialize};
 use std::cell::Cell;
 use std::fmt::Debug;
 use std::time::{Duration, Instant};
+use tactile_common::samples::Sequenced;
 use thiserror::Error;
 
 pub use crate::link::CONTROL_HOP_SEQ;
@@ -170,6 +170,12 @@ pub struct InboxStats {
     pub overwritten: u64,
     /// Times the publisher's counter started again (the sender was restarted).
     pub publisher_restarts: u64,
+    /// Payloads that were not a whole sample (garbage, truncated), dropped.
+    #[serde(default)]
+    pub malformed: u64,
+    /// Samples of another run (a different run token), dropped.
+    #[serde(default)]
+    pub foreign: u64,
 }
 
 /// A process's wake-up event: every stream into the process notifies it.
@@ -409,8 +415,8 @@ pub fn remove_run_files(prefix: &str) {
 #[derive(Debug)]
 pub struct IoxMaster {
     node: IpcNode,
-    out: Outbox<crate::samples::Forward>,
-    inbox: Inbox<crate::samples::Backward>,
+    out: Outbox<tactile_common::samples::Forward>,
+    inbox: Inbox<tactile_common::samples::Backward>,
     waker: Waker,
     spin: Duration,
     prefix: String,
@@ -432,13 +438,13 @@ impl IoxMaster {
 }
 
 impl crate::link::MasterLink for IoxMaster {
-    fn send(&self, c: crate::samples::Forward) -> Result<(), IpcError> {
+    fn send(&self, c: tactile_common::samples::Forward) -> Result<(), IpcError> {
         self.out.publish(c, false).map(|_| ())
     }
-    fn send_control(&self, c: crate::samples::Forward) -> Result<(), IpcError> {
+    fn send_control(&self, c: tactile_common::samples::Forward) -> Result<(), IpcError> {
         self.out.publish(c, true).map(|_| ())
     }
-    fn recv(&self, deadline: Instant) -> crate::link::Wait<crate::samples::Backward> {
+    fn recv(&self, deadline: Instant) -> crate::link::Wait<tactile_common::samples::Backward> {
         self.waker
             .wait(&self.node, self.spin, deadline, || self.inbox.try_recv())
     }
@@ -454,10 +460,10 @@ impl crate::link::MasterLink for IoxMaster {
 #[derive(Debug)]
 pub struct IoxEmulator {
     node: IpcNode,
-    in_c: Inbox<crate::samples::Forward>,
-    out_v: Outbox<crate::samples::Forward>,
-    in_h: Inbox<crate::samples::Backward>,
-    out_q: Outbox<crate::samples::Backward>,
+    in_c: Inbox<tactile_common::samples::Forward>,
+    out_v: Outbox<tactile_common::samples::Forward>,
+    in_h: Inbox<tactile_common::samples::Backward>,
+    out_q: Outbox<tactile_common::samples::Backward>,
     waker: Waker,
     spin: Duration,
 }
@@ -489,10 +495,10 @@ impl crate::link::EmulatorLink for IoxEmulator {
             Ok(self.in_c.try_recv()?.map(Arrival::Forward))
         })
     }
-    fn send_v(&self, v: crate::samples::Forward, control: bool) -> Result<(), IpcError> {
+    fn send_v(&self, v: tactile_common::samples::Forward, control: bool) -> Result<(), IpcError> {
         self.out_v.publish(v, control).map(|_| ())
     }
-    fn send_q(&self, q: crate::samples::Backward, control: bool) -> Result<(), IpcError> {
+    fn send_q(&self, q: tactile_common::samples::Backward, control: bool) -> Result<(), IpcError> {
         self.out_q.publish(q, control).map(|_| ())
     }
     fn stats(&self) -> crate::link::EmulatorStats {
@@ -509,8 +515,8 @@ impl crate::link::EmulatorLink for IoxEmulator {
 #[derive(Debug)]
 pub struct IoxSlave {
     node: IpcNode,
-    inbox: Inbox<crate::samples::Forward>,
-    out: Outbox<crate::samples::Backward>,
+    inbox: Inbox<tactile_common::samples::Forward>,
+    out: Outbox<tactile_common::samples::Backward>,
     waker: Waker,
     spin: Duration,
 }
@@ -530,11 +536,11 @@ impl IoxSlave {
 }
 
 impl crate::link::SlaveLink for IoxSlave {
-    fn recv(&self, deadline: Instant) -> crate::link::Wait<crate::samples::Forward> {
+    fn recv(&self, deadline: Instant) -> crate::link::Wait<tactile_common::samples::Forward> {
         self.waker
             .wait(&self.node, self.spin, deadline, || self.inbox.try_recv())
     }
-    fn send_h(&self, h: crate::samples::Backward, control: bool) -> Result<(), IpcError> {
+    fn send_h(&self, h: tactile_common::samples::Backward, control: bool) -> Result<(), IpcError> {
         self.out.publish(h, control).map(|_| ())
     }
     fn stats(&self) -> (InboxStats, OutboxStats) {

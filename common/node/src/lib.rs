@@ -1,0 +1,13 @@
+//! What every Tactile node program shares, and the only place that touches the world:
+//! the links between nodes (traits, iceoryx2 shared memory, UDP), each node's record,
+//! its log, the locks that keep runs apart, and the command line of the three node
+//! programs. The loops themselves are in the master, emulator and slave crates.
+
+pub mod files;
+pub mod ipc;
+pub mod link;
+pub mod lock;
+pub mod logging;
+pub mod record;
+pub mod runtime;
+pub mod udp;

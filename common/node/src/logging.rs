@@ -1,0 +1,37 @@
+//! A node's log: `tracing` events into `<role>.log` in the node's output folder, and,
+//! when the node runs by hand on a terminal, also to stderr. `RUST_LOG` sets the level
+//! (default `info`).
+
+use std::path::Path;
+use tracing_subscriber::layer::SubscriberExt;
+use tracing_subscriber::util::SubscriberInitExt;
+use tracing_subscriber::{fmt, EnvFilter, Layer};
+
+/// Installs the node's logger; `to_stderr` adds a terminal copy. Returns an error line
+/// if the log file cannot be opened.
+pub fn init(dir: &Path, role: &str, to_stderr: bool) -> Result<(), String> {
+    let path = dir.join(format!("{role}.log"));
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .map_err(|e| format!("opening {}: {e}", path.display()))?;
+    let filter = || EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info"));
+    let file_layer = fmt::layer()
+        .with_writer(std::sync::Mutex::new(file))
+        .with_ansi(false)
+        .with_target(false)
+        .with_filter(filter());
+    let stderr_layer = to_stderr.then(|| {
+        fmt::layer()
+            .with_writer(std::io::stderr)
+            .with_target(false)
+            .with_filter(filter())
+    });
+    // A second init in one process (tests) keeps the first logger.
+    let _ = tracing_subscriber::registry()
+        .with(file_layer)
+        .with(stderr_layer)
+        .try_init();
+    Ok(())
+}

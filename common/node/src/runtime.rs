@@ -1,0 +1,413 @@
+//! What the three node programs share: their command line, their start-up checks, their
+//! record and the mapping of their outcome to an exit status.
+//!
+//! A node's `main.rs` is one call into its crate; the crate parses [`NodeArgs`], calls
+//! [`prepare`] (which checks everything a user controls before anything starts), runs
+//! its loop against a link and a [`Recorder`], and returns a [`NodeError`] or the
+//! reason it stopped. [`exit`] turns that into one line on stderr and the status.
+
+use crate::lock::{self, Lock};
+use crate::record::{peak_rss_kb, Event, Record, RecordWriter, Start, Stop, Totals};
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+use tactile_common::clock::now_ns;
+use tactile_common::scenario::Scenario;
+
+/// Exit status: the run completed.
+pub const EXIT_OK: u8 = 0;
+/// Exit status: a failure while running.
+pub const EXIT_FAILURE: u8 = 1;
+/// Exit status: bad input (arguments, scenario, prefix in use); nothing was started.
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit status: SIGINT or SIGTERM stopped the node; its record is complete.
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// What carries the samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LinkKind {
+    /// iceoryx2 zero-copy shared memory (one host).
+    Iceoryx2,
+    /// UDP datagrams on loopback (the reference most stacks use).
+    Udp,
+}
+
+/// The command line every node takes.
+#[derive(Debug, Clone, Args)]
+pub struct NodeArgs {
+    /// Scenario file (TOML); its relative paths are resolved against its own folder.
+    #[arg(long)]
+    pub scenario: PathBuf,
+    /// Folder for this node's record (`ROLE.rec`) and log (`ROLE.log`).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Name of the run: nodes with the same prefix find each other. 1 to 32 characters
+    /// from A-Z a-z 0-9 _ -.
+    #[arg(long, default_value = "tactile")]
+    pub prefix: String,
+    /// Transport between the nodes.
+    #[arg(long, value_enum, default_value_t = LinkKind::Iceoryx2)]
+    pub link: LinkKind,
+    /// UDP ports of master, emulator and slave on loopback, as `m,e,s` (with --link udp).
+    #[arg(long, default_value = "47501,47502,47503")]
+    pub udp_ports: String,
+    /// Microseconds to poll (yielding the CPU) before blocking on the wake-up event.
+    /// Default: two sampling periods, so a running loop never sleeps (measured, see
+    /// the README's "Waiting"); 0 blocks at once.
+    #[arg(long)]
+    pub spin_us: Option<u64>,
+    /// Pin this node to one CPU.
+    #[arg(long)]
+    pub cpu: Option<usize>,
+    /// Continue this node's record in --out instead of starting it afresh (a node
+    /// restarted into a run that is still going).
+    #[arg(long)]
+    pub append: bool,
+    /// Started by `tactile run` (process id of the launcher): stop when it dies, log
+    /// to the file only.
+    #[arg(long, hide = true)]
+    pub supervised: Option<u32>,
+}
+
+/// Why a node stopped without completing.
+#[derive(Debug)]
+pub enum NodeError {
+    /// Bad input; nothing was started (exit 2).
+    BadInput(String),
+    /// A failure while running (exit 1).
+    Failed(String),
+}
+
+impl NodeError {
+    /// The exit status.
+    pub fn code(&self) -> u8 {
+        match self {
+            NodeError::BadInput(_) => EXIT_BAD_INPUT,
+            NodeError::Failed(_) => EXIT_FAILURE,
+        }
+    }
+}
+
+impl std::fmt::Display for NodeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NodeError::BadInput(m) | NodeError::Failed(m) => f.write_str(m),
+        }
+    }
+}
+
+/// Maps a node's outcome to its exit status and one line on stderr.
+pub fn exit(role: &str, outcome: Result<bool, NodeError>) -> ExitCode {
+    match outcome {
+        Ok(true) => ExitCode::from(EXIT_OK),
+        Ok(false) => ExitCode::from(EXIT_INTERRUPTED),
+        Err(e) => {
+            tracing::error!("{e}");
+            eprintln!("tactile-{role}: {e}");
+            ExitCode::from(e.code())
+        }
+    }
+}
+
+/// Everything a node has after its start-up checks.
+#[derive(Debug)]
+pub struct Prepared {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Folder its relative paths are resolved against.
+    pub base_dir: PathBuf,
+    /// Poll budget before blocking.
+    pub spin: Duration,
+    /// The run's lock for this role, held while the node lives.
+    pub lock: Lock,
+}
+
+/// Checks the arguments, the scenario and the prefix, creates the output folder, takes
+/// the role's lock, installs the logger and pins the CPU. Nothing is started when it
+/// fails: the error is bad input (exit 2).
+pub fn prepare(role: &str, args: &NodeArgs) -> Result<Prepared, NodeError> {
+    let bad = NodeError::BadInput;
+    lock::check_prefix(&args.prefix).map_err(bad)?;
+    let (scenario, base_dir) = crate::files::load_scenario(&args.scenario).map_err(bad)?;
+    if args.link == LinkKind::Udp {
+        crate::udp::UdpPorts::parse(&args.udp_ports).ok_or_else(|| {
+            bad(format!(
+                "--udp-ports {:?}: expected three ports m,e,s",
+                args.udp_ports
+            ))
+        })?;
+    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| bad(format!("creating {}: {e}", args.out.display())))?;
+    for file in [
+        record_path(&args.out, role),
+        args.out.join(format!("{role}.log")),
+    ] {
+        if crate::files::same_file(&file, &args.scenario) {
+            return Err(bad(format!(
+                "--out {}: writing {} would overwrite the scenario; choose another folder",
+                args.out.display(),
+                file.display()
+            )));
+        }
+    }
+    let holder = format!(
+        "the {role} of pid {} (writing to {})",
+        std::process::id(),
+        args.out.display()
+    );
+    let lock = lock::take(&args.prefix, role, &holder).map_err(bad)?;
+    crate::logging::init(&args.out, role, args.supervised.is_none()).map_err(bad)?;
+    if let Some(parent) = args.supervised {
+        supervise(parent)?;
+    }
+    if let Some(cpu) = args.cpu {
+        pin(cpu).map_err(bad)?;
+    }
+    let spin = args.spin_us.map_or_else(
+        || Duration::from_nanos(2 * scenario.t_s_ns()),
+        Duration::from_micros,
+    );
+    Ok(Prepared {
+        scenario,
+        base_dir,
+        spin,
+        lock,
+    })
+}
+
+/// Asks the kernel to send SIGTERM when the launcher dies (even by SIGKILL), and stops
+/// at once if it is already gone.
+fn supervise(parent: u32) -> Result<(), NodeError> {
+    use rustix::process::{getppid, set_parent_process_death_signal, Signal};
+    set_parent_process_death_signal(Some(Signal::TERM))
+        .map_err(|e| NodeError::Failed(format!("setting the parent-death signal: {e}")))?;
+    let now = getppid().map_or(0, |p| p.as_raw_nonzero().get() as u32);
+    if now != parent {
+        return Err(NodeError::Failed(format!(
+            "the launcher (pid {parent}) is gone; not starting"
+        )));
+    }
+    Ok(())
+}
+
+/// Pins the calling thread (the node's only thread) to `cpu`.
+pub fn pin(cpu: usize) -> Result<(), String> {
+    use rustix::thread::{sched_getaffinity, sched_setaffinity, CpuSet};
+    let allowed = sched_getaffinity(None).map_err(|e| format!("reading CPU affinity: {e}"))?;
+    if cpu >= CpuSet::MAX_CPU || !allowed.is_set(cpu) {
+        return Err(format!("--cpu {cpu}: not a CPU this process may use"));
+    }
+    let mut set = CpuSet::new();
+    set.set(cpu);
+    sched_setaffinity(None, &set).map_err(|e| format!("pinning to CPU {cpu}: {e}"))
+}
+
+/// The record file of `role` in `dir`.
+pub fn record_path(dir: &Path, role: &str) -> PathBuf {
+    dir.join(format!("{role}.rec"))
+}
+
+/// A node's record writer with its bookkeeping: events go to the log as well, and the
+/// counters are written every second, so a node killed at any moment leaves counters
+/// at most a second old.
+#[derive(Debug)]
+pub struct Recorder<S, C> {
+    writer: RecordWriter<Record<S, C>>,
+    next_counters_ns: u64,
+}
+
+/// Counters are written this often, ns.
+pub const COUNTERS_EVERY_NS: u64 = 1_000_000_000;
+
+impl<S: Serialize, C: Serialize> Recorder<S, C> {
+    /// Opens `ROLE.rec` in `dir` (afresh, or appended to with `append`).
+    pub fn open(dir: &Path, role: &str, append: bool) -> Result<Self, NodeError> {
+        let path = record_path(dir, role);
+        let writer = RecordWriter::create(&path, append)
+            .map_err(|e| NodeError::Failed(format!("opening {}: {e}", path.display())))?;
+        Ok(Recorder {
+            writer,
+            next_counters_ns: now_ns() + COUNTERS_EVERY_NS,
+        })
+    }
+
+    fn put(&mut self, r: &Record<S, C>) -> Result<(), NodeError> {
+        self.writer.write(r).map_err(|e| {
+            NodeError::Failed(format!("writing {}: {e}", self.writer.path().display()))
+        })
+    }
+
+    /// The start of a segment.
+    pub fn start(&mut self, start: Start) -> Result<(), NodeError> {
+        tracing::info!(
+            "start: {} of run {:?} ({} link, scenario {:?}, {} samples at {} Hz, poll {} us{})",
+            start.role,
+            start.prefix,
+            start.link,
+            start.scenario,
+            start.samples,
+            start.rate_hz,
+            start.spin_us,
+            start.cpu.map_or(String::new(), |c| format!(", CPU {c}"))
+        );
+        self.put(&Record::Start(start))
+    }
+
+    /// The run token this node joined.
+    pub fn run(&mut self, token: u64) -> Result<(), NodeError> {
+        tracing::info!("joined run {token:016x}");
+        self.put(&Record::Run(token))
+    }
+
+    /// One sample's record.
+    pub fn sample(&mut self, s: S) -> Result<(), NodeError> {
+        self.put(&Record::Sample(s))
+    }
+
+    /// An event, logged and recorded.
+    pub fn event(&mut self, sample: u64, what: impl Into<String>) -> Result<(), NodeError> {
+        let what = what.into();
+        tracing::info!("sample {sample}: {what}");
+        self.put(&Record::Event(Event {
+            sample,
+            mono_ns: now_ns(),
+            what,
+        }))
+    }
+
+    /// True once a second has passed since the counters were last written (then the
+    /// node writes them with [`Recorder::counters`]).
+    pub fn counters_due(&mut self) -> bool {
+        let now = now_ns();
+        if now < self.next_counters_ns {
+            return false;
+        }
+        self.next_counters_ns = now + COUNTERS_EVERY_NS;
+        true
+    }
+
+    /// Writes the counters now.
+    pub fn counters(&mut self, counters: C) -> Result<(), NodeError> {
+        self.put(&Record::Counters(Totals {
+            counters,
+            peak_rss_kb: peak_rss_kb(),
+        }))
+    }
+
+    /// The end of the segment: final counters, then `Stop`.
+    pub fn stop(&mut self, counters: C, reason: &str) -> Result<(), NodeError> {
+        self.counters(counters)?;
+        tracing::info!("stop: {reason} (peak RSS {} kB)", peak_rss_kb());
+        self.put(&Record::Stop(Stop {
+            reason: reason.to_string(),
+            mono_ns: now_ns(),
+        }))
+    }
+}
+
+/// The `Start` of a node's record from its arguments.
+pub fn start_record(role: &str, args: &NodeArgs, p: &Prepared) -> Start {
+    let unix_ms = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_millis() as u64);
+    Start {
+        role: role.to_string(),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        pid: std::process::id(),
+        host: rustix::system::uname()
+            .nodename()
+            .to_string_lossy()
+            .into_owned(),
+        prefix: args.prefix.clone(),
+        link: match args.link {
+            LinkKind::Iceoryx2 => "iceoryx2".into(),
+            LinkKind::Udp => format!("udp {}", args.udp_ports),
+        },
+        scenario: p.scenario.name.clone(),
+        scenario_toml: p.scenario.resolved(&p.base_dir).to_toml(),
+        samples: p.scenario.samples,
+        rate_hz: p.scenario.rate_hz,
+        spin_us: p.spin.as_micros() as u64,
+        cpu: args.cpu,
+        unix_ms,
+        mono_ns: now_ns(),
+    }
+}
+
+/// The exit statuses, for each node's `--help`.
+pub const EXIT_CODES_HELP: &str = "Exit status: 0 the run completed; 1 a failure while running; \
+2 bad input (arguments, scenario, a prefix in use), nothing started; 130 stopped by SIGINT or \
+SIGTERM (the record is complete).\n\nThe record (ROLE.rec) and log (ROLE.log) go to --out; \
+`tactile report DIR...` joins the nodes' folders into the run's report.";
+
+/// Parses a node's command line; on an error prints clap's message and returns the
+/// exit status (2 for bad arguments, 0 for --help and --version).
+pub fn parse<T: clap::Parser>() -> Result<T, ExitCode> {
+    T::try_parse().map_err(|e| {
+        let _ = e.print();
+        ExitCode::from(if e.use_stderr() {
+            EXIT_BAD_INPUT
+        } else {
+            EXIT_OK
+        })
+    })
+}
+
+/// A fresh run token: random, never zero (zero means "unknown").
+pub fn new_run_token() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u64(now_ns());
+    h.write_u32(std::process::id());
+    h.finish().max(1)
+}
+
+fn udp_ports(a: &NodeArgs) -> Result<crate::udp::UdpPorts, NodeError> {
+    crate::udp::UdpPorts::parse(&a.udp_ports).ok_or_else(|| {
+        NodeError::BadInput(format!("--udp-ports {:?}: expected m,e,s", a.udp_ports))
+    })
+}
+
+fn opened<T>(r: Result<T, crate::ipc::IpcError>) -> Result<T, NodeError> {
+    r.map_err(|e| NodeError::Failed(e.to_string()))
+}
+
+/// The master's link as the arguments choose it.
+pub fn master_link(
+    a: &NodeArgs,
+    spin: Duration,
+) -> Result<Box<dyn crate::link::MasterLink>, NodeError> {
+    let wait = crate::ipc::WaitPolicy { spin };
+    Ok(match a.link {
+        LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxMaster::open(&a.prefix, wait))?),
+        LinkKind::Udp => Box::new(opened(crate::udp::UdpMaster::open(udp_ports(a)?))?),
+    })
+}
+
+/// The emulator's link as the arguments choose it.
+pub fn emulator_link(
+    a: &NodeArgs,
+    spin: Duration,
+) -> Result<Box<dyn crate::link::EmulatorLink>, NodeError> {
+    let wait = crate::ipc::WaitPolicy { spin };
+    Ok(match a.link {
+        LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxEmulator::open(&a.prefix, wait))?),
+        LinkKind::Udp => Box::new(opened(crate::udp::UdpEmulator::open(udp_ports(a)?))?),
+    })
+}
+
+/// The slave's link as the arguments choose it.
+pub fn slave_link(
+    a: &NodeArgs,
+    spin: Duration,
+) -> Result<Box<dyn crate::link::SlaveLink>, NodeError> {
+    let wait = crate::ipc::WaitPolicy { spin };
+    Ok(match a.link {
+        LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxSlave::open(&a.prefix, wait))?),
+        LinkKind::Udp => Box::new(opened(crate::udp::UdpSlave::open(udp_ports(a)?))?),
+    })
+}

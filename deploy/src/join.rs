@@ -1,0 +1,421 @@
+//! Joins the nodes' records into one row per sample.
+//!
+//! The master's record is the spine: one `Sent` per sample, then an `Answer` or a
+//! `Miss`. The emulator's passages and the slave's steps for the same sample number
+//! are matched to it. Every file is read front to back once, each through a look-ahead
+//! window of [`LATE_WINDOW`] samples (the same window inside which the master matches
+//! late answers), so joining a run of any length takes bounded memory. The records may
+//! come from one folder or one folder per node, as they would from different hosts.
+
+use crate::error::Error;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use tactile_common::samples::{stage, LATE_WINDOW};
+use tactile_common::trace::TraceRow;
+use tactile_master::record::{Answer, MasterRecord, MasterSample, MasterTotals, Miss, Sent};
+use tactile_network_emulator::emulator::{Direction, Passage};
+use tactile_network_emulator::process::EmulatorTotals;
+use tactile_node::record::{Record, RecordReader, Start, Totals};
+use tactile_node::runtime::record_path;
+use tactile_slave::record::{SlaveSample, SlaveTotals, Step};
+
+/// The roles whose records are joined.
+pub const ROLES: [&str; 3] = ["master", "emulator", "slave"];
+
+/// Events kept per node in the report; further ones are counted, not kept, so a node
+/// that broke a million times still gives a readable report.
+pub const MAX_EVENTS: usize = 200;
+
+/// What one node's record says about the node (everything but the samples).
+#[derive(Debug, Clone)]
+pub struct NodeLog<C> {
+    /// The record file.
+    pub path: PathBuf,
+    /// One `Start` per segment (a restarted node appends a segment).
+    pub starts: Vec<Start>,
+    /// Run tokens the node joined.
+    pub runs: Vec<u64>,
+    /// Events, as `(sample, what)`, at most [`MAX_EVENTS`].
+    pub events: Vec<(u64, String)>,
+    /// Events not kept.
+    pub events_omitted: u64,
+    /// Last counters of each segment.
+    pub counters: Vec<Totals<C>>,
+    /// How each segment ended: the `Stop` reason, or `None` where the file ends
+    /// without one (the node was killed).
+    pub stops: Vec<Option<String>>,
+    /// Highest sample number in the record.
+    pub last_sample: Option<u64>,
+    /// Byte offset of a torn last frame, if any.
+    pub truncated_at: Option<u64>,
+    /// Sample records that matched no sample of the master (outside the window).
+    pub unjoined: u64,
+}
+
+impl<C> Default for NodeLog<C> {
+    fn default() -> Self {
+        NodeLog {
+            path: PathBuf::new(),
+            starts: Vec::new(),
+            runs: Vec::new(),
+            events: Vec::new(),
+            events_omitted: 0,
+            counters: Vec::new(),
+            stops: Vec::new(),
+            last_sample: None,
+            truncated_at: None,
+            unjoined: 0,
+        }
+    }
+}
+
+impl<C: Clone> NodeLog<C> {
+    fn take<S>(&mut self, r: Record<S, C>) -> Option<S> {
+        match r {
+            Record::Start(s) => {
+                self.starts.push(s);
+                self.stops.push(None);
+            }
+            Record::Run(t) => {
+                if !self.runs.contains(&t) {
+                    self.runs.push(t);
+                }
+            }
+            Record::Sample(s) => return Some(s),
+            Record::Event(e) => {
+                if self.events.len() < MAX_EVENTS {
+                    self.events.push((e.sample, e.what));
+                } else {
+                    self.events_omitted += 1;
+                }
+            }
+            Record::Counters(c) => {
+                // The last counters of the current segment replace the earlier ones.
+                if self.counters.len() < self.starts.len() {
+                    self.counters.push(c);
+                } else if let Some(last) = self.counters.last_mut() {
+                    *last = c;
+                }
+            }
+            Record::Stop(s) => {
+                if let Some(last) = self.stops.last_mut() {
+                    *last = Some(s.reason);
+                }
+            }
+        }
+        None
+    }
+
+    /// Peak RSS over the segments, kB.
+    pub fn peak_rss_kb(&self) -> u64 {
+        self.counters
+            .iter()
+            .map(|c| c.peak_rss_kb)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// How the node's record ends, in words.
+    pub fn ending(&self) -> String {
+        let last = self
+            .last_sample
+            .map_or("before any sample".to_string(), |n| {
+                format!("after sample {n}")
+            });
+        match self.stops.last() {
+            None => "no start recorded".into(),
+            Some(Some(reason)) => format!("{reason}, {last}"),
+            Some(None) => format!(
+                "record ends {last} without a stop: the node was killed or crashed{}",
+                self.truncated_at
+                    .map_or(String::new(), |b| format!(" (torn frame at byte {b})"))
+            ),
+        }
+    }
+}
+
+/// One record file read through a look-ahead window, keyed by sample number.
+struct Source<S, C> {
+    reader: Option<RecordReader<Record<S, C>>>,
+    log: NodeLog<C>,
+    ahead: BTreeMap<u64, Vec<S>>,
+    /// Highest key read so far.
+    front: Option<u64>,
+    key: fn(&S) -> Option<u64>,
+}
+
+impl<S, C: Clone + serde::de::DeserializeOwned> Source<S, C>
+where
+    S: serde::de::DeserializeOwned,
+{
+    fn open(path: Option<PathBuf>, key: fn(&S) -> Option<u64>) -> Result<Self, Error> {
+        let mut log = NodeLog::default();
+        let reader = match path {
+            Some(p) => {
+                log.path = p.clone();
+                Some(RecordReader::open(&p).map_err(|e| Error::BadInput(e.to_string()))?)
+            }
+            None => None,
+        };
+        Ok(Source {
+            reader,
+            log,
+            ahead: BTreeMap::new(),
+            front: None,
+            key,
+        })
+    }
+
+    /// Reads until a record past `n + LATE_WINDOW` is in, or the file ends.
+    fn fill_to(&mut self, n: u64) -> Result<(), Error> {
+        while self.front.is_none_or(|f| f <= n + LATE_WINDOW) {
+            let Some(reader) = self.reader.as_mut() else {
+                return Ok(());
+            };
+            let next = reader
+                .next_record()
+                .map_err(|e| Error::Failed(e.to_string()))?;
+            let Some(rec) = next else {
+                self.log.truncated_at = reader.truncated_at;
+                self.reader = None;
+                return Ok(());
+            };
+            if let Some(s) = self.log.take(rec) {
+                if let Some(k) = (self.key)(&s) {
+                    self.front = Some(self.front.map_or(k, |f| f.max(k)));
+                    self.log.last_sample = Some(self.log.last_sample.map_or(k, |l| l.max(k)));
+                    self.ahead.entry(k).or_default().push(s);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The records of sample `n`; records of earlier samples are counted as unjoined.
+    fn take(&mut self, n: u64) -> Result<Vec<S>, Error> {
+        self.fill_to(n)?;
+        while let Some(entry) = self.ahead.first_entry() {
+            if *entry.key() >= n {
+                break;
+            }
+            self.log.unjoined += entry.remove().len() as u64;
+        }
+        Ok(self.ahead.remove(&n).unwrap_or_default())
+    }
+
+    /// Reads the rest of the file (for its events and counters).
+    fn finish(mut self) -> Result<NodeLog<C>, Error> {
+        self.fill_to(u64::MAX - LATE_WINDOW)?;
+        self.log.unjoined += self.ahead.values().map(|v| v.len() as u64).sum::<u64>();
+        Ok(self.log)
+    }
+}
+
+/// The three nodes' logs after a join.
+#[derive(Debug, Clone)]
+pub struct Logs {
+    /// The master's.
+    pub master: NodeLog<MasterTotals>,
+    /// The emulator's (empty if it left no record).
+    pub emulator: NodeLog<EmulatorTotals>,
+    /// The slave's (empty if it left no record).
+    pub slave: NodeLog<SlaveTotals>,
+}
+
+/// Finds each role's record in `dirs`: every role at most once, the master's required.
+pub fn locate(dirs: &[PathBuf]) -> Result<[Option<PathBuf>; 3], Error> {
+    let mut found: [Option<PathBuf>; 3] = [None, None, None];
+    for dir in dirs {
+        if !dir.is_dir() {
+            return Err(Error::BadInput(format!(
+                "{} is not a folder",
+                dir.display()
+            )));
+        }
+        for (k, role) in ROLES.iter().enumerate() {
+            let p = record_path(dir, role);
+            if p.exists() {
+                if let Some(other) = &found[k] {
+                    return Err(Error::BadInput(format!(
+                        "two {role} records, {} and {}: give the folders of one run",
+                        other.display(),
+                        p.display()
+                    )));
+                }
+                found[k] = Some(p);
+            }
+        }
+    }
+    if found[0].is_none() {
+        let shown: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
+        return Err(Error::BadInput(format!(
+            "no master.rec in {}: the master's record is the spine of a report",
+            shown.join(", ")
+        )));
+    }
+    Ok(found)
+}
+
+/// The master's `Start` (first segment) in `path`, read without joining.
+pub fn master_start(path: &Path) -> Result<Start, Error> {
+    let mut r =
+        RecordReader::<MasterRecord>::open(path).map_err(|e| Error::BadInput(e.to_string()))?;
+    match r.next_record() {
+        Ok(Some(Record::Start(s))) => Ok(s),
+        _ => Err(Error::BadInput(format!(
+            "{}: the record does not begin with the master's start",
+            path.display()
+        ))),
+    }
+}
+
+fn master_key(s: &MasterSample) -> Option<u64> {
+    Some(match s {
+        MasterSample::Sent(x) => x.n,
+        MasterSample::Answer(x) => x.n,
+        MasterSample::Miss(x) => x.n,
+    })
+}
+
+fn passage_key(p: &Passage) -> Option<u64> {
+    Some(p.n)
+}
+
+fn slave_key(s: &SlaveSample) -> Option<u64> {
+    match s {
+        SlaveSample::Step(x) => Some(x.n),
+        SlaveSample::Hold(_) => None,
+    }
+}
+
+/// Builds sample n's row from what each node recorded for it.
+fn row(
+    sent: &Sent,
+    answer: Option<&Answer>,
+    miss: Option<&Miss>,
+    passages: &[Passage],
+    step: Option<&Step>,
+) -> TraceRow {
+    let mut r = TraceRow {
+        n: sent.n,
+        target: sent.target,
+        theta_md: sent.theta_md,
+        c: sent.c,
+        contact_object: -1,
+        ..TraceRow::default()
+    };
+    r.stamps[stage::MASTER_TICK] = sent.tick_ns;
+    r.stamps[stage::MASTER_SEND] = sent.send_ns;
+    if let Some(a) = answer {
+        r.received = true;
+        r.q = a.q.value;
+        r.delay_b = a.q.delay_samples;
+        r.flags_b = a.q.flags;
+        r.tau = a.tau;
+        r.felt = a.felt;
+        r.flags_m = a.flags;
+        r.round_trip_ns = a.round_trip_ns;
+        r.overhead_ns = a.overhead_ns;
+        r.stamps = a.stamps;
+    } else if let Some(m) = miss {
+        r.tau = m.tau;
+        r.felt = m.felt;
+        r.flags_m = m.flags;
+    }
+    for p in passages {
+        match p.dir {
+            Direction::Forward => {
+                r.noise_f = p.noise;
+                r.delay_f = p.out.delay_samples;
+            }
+            Direction::Backward => r.noise_b = p.noise,
+        }
+    }
+    if let Some(s) = step {
+        r.stepped = true;
+        r.v = s.received.value;
+        r.delay_f = s.received.delay_samples;
+        r.flags_f = s.received.flags;
+        r.theta_ref = s.theta_ref;
+        r.theta_sd = s.theta;
+        r.u = s.torque;
+        r.tool = s.tool;
+        r.surface = s.surface;
+        r.h = s.force;
+        r.contact_object = if s.contact_object == u32::MAX {
+            -1
+        } else {
+            i64::from(s.contact_object)
+        };
+    }
+    r
+}
+
+/// Joins the records found in `dirs`, handing each sample's row to `each` in order.
+pub fn join(
+    dirs: &[PathBuf],
+    mut each: impl FnMut(&TraceRow) -> Result<(), Error>,
+) -> Result<Logs, Error> {
+    let [m, e, s] = locate(dirs)?;
+    let mut master = Source::<MasterSample, MasterTotals>::open(m, master_key)?;
+    let mut emulator = Source::<Passage, EmulatorTotals>::open(e, passage_key)?;
+    let mut slave = Source::<SlaveSample, SlaveTotals>::open(s, slave_key)?;
+    let mut n = 0u64;
+    loop {
+        let items = master.take(n)?;
+        let Some(sent) = items.iter().find_map(|x| match x {
+            MasterSample::Sent(s) => Some(*s),
+            _ => None,
+        }) else {
+            break;
+        };
+        let answer = items.iter().find_map(|x| match x {
+            MasterSample::Answer(a) => Some(*a),
+            _ => None,
+        });
+        let miss = items.iter().find_map(|x| match x {
+            MasterSample::Miss(m) => Some(*m),
+            _ => None,
+        });
+        let passages = emulator.take(n)?;
+        let steps = slave.take(n)?;
+        let step = steps.iter().find_map(|x| match x {
+            SlaveSample::Step(s) => Some(*s),
+            SlaveSample::Hold(_) => None,
+        });
+        each(&row(
+            &sent,
+            answer.as_ref(),
+            miss.as_ref(),
+            &passages,
+            step.as_ref(),
+        ))?;
+        n += 1;
+    }
+    let logs = Logs {
+        master: master.finish()?,
+        emulator: emulator.finish()?,
+        slave: slave.finish()?,
+    };
+    check_one_run(&logs)?;
+    Ok(logs)
+}
+
+/// Refuses records of different runs: the nodes of one run share the master's token.
+fn check_one_run(logs: &Logs) -> Result<(), Error> {
+    let Some(&token) = logs.master.runs.first() else {
+        return Ok(());
+    };
+    for (role, runs, path) in [
+        ("emulator", &logs.emulator.runs, &logs.emulator.path),
+        ("slave", &logs.slave.runs, &logs.slave.path),
+    ] {
+        if let Some(other) = runs.iter().find(|&&t| t != token) {
+            return Err(Error::BadInput(format!(
+                "the {role}'s record {} belongs to run {other:016x}, the master's to run {token:016x}: not one run",
+                path.display()
+            )));
+        }
+    }
+    Ok(())
+}

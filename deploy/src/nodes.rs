@@ -1,0 +1,126 @@
+//! Finding the node programs (`tactile-master`, `tactile-emulator`, `tactile-slave`).
+//!
+//! `cargo run` builds only the `tactile` package, so on a fresh clone the node programs
+//! do not exist yet. When the launcher runs from a Cargo target folder of its source
+//! tree, it asks Cargo to build them in the same profile (a no-op when they are up to
+//! date, so they never lag behind the launcher). Otherwise it takes them from beside
+//! its own executable or from `PATH`, and says what to do when they are in neither.
+//! `TACTILE_NODE_DIR` names their folder outright (the tests use it).
+
+use crate::error::Error;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The program names, by role.
+pub const PROGRAMS: [(&str, &str); 3] = [
+    ("master", "tactile-master"),
+    ("emulator", "tactile-emulator"),
+    ("slave", "tactile-slave"),
+];
+
+/// The executable of `role` in `dir`.
+pub fn exe(dir: &Path, role: &str) -> PathBuf {
+    let name = PROGRAMS
+        .iter()
+        .find(|(r, _)| *r == role)
+        .map_or("tactile-master", |(_, n)| n);
+    dir.join(name)
+}
+
+fn all_in(dir: &Path) -> bool {
+    PROGRAMS.iter().all(|(_, n)| dir.join(n).is_file())
+}
+
+/// The Cargo profile a target folder holds (`debug` is the dev profile).
+fn profile_args(dir: &Path) -> Option<Vec<String>> {
+    let name = dir.file_name()?.to_str()?;
+    Some(match name {
+        "debug" => vec![],
+        "release" => vec!["--release".into()],
+        other => vec!["--profile".into(), other.into()],
+    })
+}
+
+/// Builds the node programs into `dir` (a Cargo target profile folder) from the
+/// source tree this launcher was built from.
+fn cargo_build(dir: &Path) -> Result<(), String> {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("../Cargo.toml");
+    if !manifest.is_file() {
+        return Err(format!("the source tree {} is gone", manifest.display()));
+    }
+    let target = dir.parent().ok_or("no target folder")?;
+    let profile = profile_args(dir).ok_or("no profile folder")?;
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let out = Command::new(cargo)
+        .arg("build")
+        .arg("--quiet")
+        .arg("--manifest-path")
+        .arg(&manifest)
+        .arg("--target-dir")
+        .arg(target)
+        .args(profile)
+        .args([
+            "-p",
+            "tactile-master",
+            "-p",
+            "tactile-network-emulator",
+            "-p",
+            "tactile-slave",
+            "--bins",
+        ])
+        .output()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if out.status.success() {
+        Ok(())
+    } else {
+        let err = String::from_utf8_lossy(&out.stderr);
+        let tail: Vec<&str> = err.lines().rev().take(8).collect();
+        Err(tail.into_iter().rev().collect::<Vec<_>>().join("\n"))
+    }
+}
+
+/// The folder holding all three node programs, built first where that is possible.
+pub fn node_dir() -> Result<PathBuf, Error> {
+    if let Some(d) = std::env::var_os("TACTILE_NODE_DIR") {
+        let d = PathBuf::from(d);
+        return if all_in(&d) {
+            Ok(d)
+        } else {
+            Err(Error::Failed(format!(
+                "TACTILE_NODE_DIR={} does not hold tactile-master, tactile-emulator and tactile-slave",
+                d.display()
+            )))
+        };
+    }
+    let me = std::env::current_exe().map_err(Error::io("locating the tactile executable"))?;
+    let dir = me
+        .parent()
+        .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+    let in_cargo_target = dir.join(".fingerprint").is_dir();
+    let mut why = None;
+    if in_cargo_target {
+        if !all_in(&dir) {
+            eprintln!("tactile: building the node programs (once)...");
+        }
+        why = cargo_build(&dir).err();
+    }
+    if all_in(&dir) {
+        if let Some(w) = &why {
+            eprintln!(
+                "tactile: warning: could not rebuild the node programs, using those in {}: {w}",
+                dir.display()
+            );
+        }
+        return Ok(dir);
+    }
+    if let Some(path) = std::env::var_os("PATH") {
+        if let Some(d) = std::env::split_paths(&path).find(|d| all_in(d)) {
+            return Ok(d);
+        }
+    }
+    Err(Error::Failed(format!(
+        "cannot find tactile-master, tactile-emulator and tactile-slave beside {} or on PATH{}; build them with `cargo build --release --workspace` (or set TACTILE_NODE_DIR to their folder)",
+        me.display(),
+        why.map_or(String::new(), |w| format!(" (building them failed: {w})"))
+    )))
+}

@@ -1,0 +1,291 @@
+//! `tactile report DIR...`: the run's report from the nodes' records, and the files it
+//! writes. `tactile run` calls the same [`write_report`] when its nodes have stopped.
+
+use crate::error::Error;
+use crate::join::{self, Logs, NodeLog};
+use crate::plots::{self, Series};
+use crate::report::{Analysis, STAGES};
+use crate::summary::{render, ChannelCount, MasterPart, NodeSummary, Summary};
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use tactile_common::scenario::Scenario;
+use tactile_common::trace;
+
+/// Files a report writes into its folder.
+pub const REPORT_FILES: [&str; 8] = [
+    "summary.json",
+    "trace.csv",
+    "round_trip.hgrm",
+    "overhead.hgrm",
+    "latency.svg",
+    "positions.svg",
+    "forces.svg",
+    "scenario.toml",
+];
+
+/// The link name an in-process simulation records.
+pub const IN_PROCESS: &str = "in-process";
+
+/// What the launcher adds to a report (nothing, for `tactile report`).
+#[derive(Debug, Clone, Default)]
+pub struct Launch {
+    /// The launcher's own events (deaths, restarts, stop requests), first in the list.
+    pub events: Vec<String>,
+    /// A node died during the run.
+    pub failed: bool,
+    /// A stop request cut the run short.
+    pub interrupted: bool,
+    /// Write no trace.csv (long runs).
+    pub no_trace: bool,
+}
+
+fn write_file(path: &Path, text: &str) -> Result<(), Error> {
+    std::fs::write(path, text).map_err(Error::io(format!("writing {}", path.display())))
+}
+
+/// Writes `value` as pretty JSON to `path`.
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), Error> {
+    let mut text = serde_json::to_string_pretty(value)
+        .map_err(|e| Error::Failed(format!("encoding {}: {e}", path.display())))?;
+    text.push('\n');
+    write_file(path, &text)
+}
+
+/// Adds the counters of a later segment to `acc`: every number is summed, except the
+/// maxima (a key with `max` in its name), which take the larger value.
+fn add_json(acc: &mut serde_json::Value, more: &serde_json::Value, key: &str) {
+    use serde_json::Value;
+    match (acc, more) {
+        (Value::Object(a), Value::Object(b)) => {
+            for (k, v) in b {
+                if let Some(x) = a.get_mut(k) {
+                    add_json(x, v, k);
+                }
+            }
+        }
+        (x @ Value::Number(_), Value::Number(b)) => {
+            let sum = if let (Some(p), Some(q)) = (x.as_u64(), b.as_u64()) {
+                if key.contains("max") {
+                    Value::from(p.max(q))
+                } else {
+                    Value::from(p.saturating_add(q))
+                }
+            } else {
+                let (p, q) = (x.as_f64().unwrap_or(0.0), b.as_f64().unwrap_or(0.0));
+                Value::from(if key.contains("max") { p.max(q) } else { p + q })
+            };
+            *x = sum;
+        }
+        _ => {}
+    }
+}
+
+/// A node's counters summed over its segments (a restarted node has several).
+fn summed<C: Serialize + DeserializeOwned + Clone>(log: &NodeLog<C>) -> Option<C> {
+    let mut it = log.counters.iter();
+    let first = it.next()?.counters.clone();
+    let mut acc = serde_json::to_value(&first).ok()?;
+    for c in it {
+        let v = serde_json::to_value(&c.counters).ok()?;
+        add_json(&mut acc, &v, "");
+    }
+    serde_json::from_value(acc).ok().or(Some(first))
+}
+
+fn node_summary<C>(log: &NodeLog<C>) -> Option<NodeSummary>
+where
+    C: Clone,
+{
+    let first = log.starts.first()?;
+    Some(NodeSummary {
+        record: log.path.display().to_string(),
+        hosts: log.starts.iter().map(|s| s.host.clone()).collect(),
+        pids: log.starts.iter().map(|s| s.pid).collect(),
+        link: first.link.clone(),
+        peak_rss_kb: log.peak_rss_kb(),
+        last_sample: log.last_sample,
+        ended: log.ending(),
+        unjoined: log.unjoined,
+    })
+}
+
+fn events<C: Clone>(role: &str, log: &NodeLog<C>, out: &mut Vec<String>) -> u64 {
+    out.extend(
+        log.events
+            .iter()
+            .map(|(n, what)| format!("{role}, sample {n}: {what}")),
+    );
+    log.events_omitted
+}
+
+/// The summary from the joined statistics and the nodes' logs.
+fn summarise(
+    scenario: &Scenario,
+    runner: &'static str,
+    a: &Analysis,
+    logs: &Logs,
+    launch: &Launch,
+) -> Summary {
+    let master_totals = summed(&logs.master).unwrap_or_default();
+    let emulator = summed(&logs.emulator);
+    let slave = summed(&logs.slave);
+    let mut channels = BTreeMap::new();
+    let (mo, mi) = (master_totals.c_out, master_totals.q_in);
+    if let Some(e) = &emulator {
+        let k = &e.counters;
+        channels.insert("c", ChannelCount::new(mo, 0, e.links.c_in));
+        channels.insert(
+            "q",
+            ChannelCount::new(e.links.q_out, k.backward_dropped, mi),
+        );
+        if let Some(s) = &slave {
+            channels.insert(
+                "v",
+                ChannelCount::new(e.links.v_out, k.forward_dropped, s.v_in),
+            );
+            channels.insert("h", ChannelCount::new(s.h_out, 0, e.links.h_in));
+        }
+    }
+    let mut nodes = BTreeMap::new();
+    for (role, n) in [
+        ("master", node_summary(&logs.master)),
+        ("emulator", node_summary(&logs.emulator)),
+        ("slave", node_summary(&logs.slave)),
+    ] {
+        if let Some(n) = n {
+            nodes.insert(role, n);
+        }
+    }
+    let mut ev = launch.events.clone();
+    let omitted = events("master", &logs.master, &mut ev)
+        + events("emulator", &logs.emulator, &mut ev)
+        + events("slave", &logs.slave, &mut ev);
+    let elapsed = master_totals.elapsed_ns;
+    Summary {
+        scenario: scenario.name.clone(),
+        mode: scenario.mode,
+        rate_hz: scenario.rate_hz,
+        arithmetic: scenario.arithmetic.to_string(),
+        runner,
+        run: logs.master.runs.first().map(|t| format!("{t:016x}")),
+        round_trip_ns: a.round_trip.percentiles(),
+        overhead_ns: a.overhead.percentiles(),
+        overhead_negative: a.overhead.negative,
+        stages_ns: STAGES
+            .iter()
+            .zip(&a.stages)
+            .filter_map(|((name, _, _), l)| Some(((*name).to_string(), l.percentiles()?)))
+            .collect(),
+        samples_sent: a.rows,
+        samples_received: a.received,
+        samples_lost: a.rows - a.received,
+        deadline_misses: master_totals.deadline_misses,
+        tracking_rms_m: a.motion.tracking_rms_m,
+        master: MasterPart {
+            totals: master_totals,
+            motion: a.motion,
+            samples_per_s: if elapsed > 0 {
+                a.rows as f64 * 1e9 / elapsed as f64
+            } else {
+                0.0
+            },
+        },
+        channels,
+        emulator,
+        slave,
+        nodes,
+        events: ev,
+        events_omitted: omitted,
+        failed: launch.failed,
+        interrupted: launch.interrupted,
+    }
+}
+
+/// Joins the records in `dirs` and writes the report into `out`: summary, trace,
+/// histograms, plots and the scenario as run. Returns the summary.
+pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Summary, Error> {
+    let [master, _, _] = join::locate(dirs)?;
+    let master = master.ok_or_else(|| Error::BadInput("no master record".into()))?;
+    let start = join::master_start(&master)?;
+    let scenario = Scenario::from_toml_str(&start.scenario_toml).map_err(|e| {
+        Error::BadInput(format!(
+            "{}: the scenario recorded is not valid: {e}",
+            master.display()
+        ))
+    })?;
+    std::fs::create_dir_all(out).map_err(Error::io(format!("creating {}", out.display())))?;
+    let t_s = scenario.t_s();
+    // The in-process simulation's stamps are synthetic: no stage times from them.
+    let runner = if start.link == IN_PROCESS {
+        IN_PROCESS
+    } else {
+        "processes"
+    };
+    let mut analysis = Analysis::new(runner != IN_PROCESS);
+    let mut series = Series::default();
+    let trace_path = out.join("trace.csv");
+    let mut trace = if launch.no_trace {
+        let _ = std::fs::remove_file(&trace_path);
+        None
+    } else {
+        let f = std::fs::File::create(&trace_path)
+            .map_err(Error::io(format!("writing {}", trace_path.display())))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
+        writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
+        Some(w)
+    };
+    let mut line = String::with_capacity(2048);
+    let mut t0 = None;
+    let logs = join::join(dirs, |row| {
+        analysis.add(row);
+        series.add(row, t_s);
+        if let Some(w) = trace.as_mut() {
+            let t0 = *t0.get_or_insert(row.stamps[0]);
+            line.clear();
+            row.write_csv(&mut line, t0);
+            w.write_all(line.as_bytes())
+                .map_err(Error::io("writing trace.csv"))?;
+        }
+        Ok(())
+    })?;
+    if let Some(mut w) = trace {
+        w.flush().map_err(Error::io("writing trace.csv"))?;
+    }
+    analysis.finish();
+    write_file(&out.join("round_trip.hgrm"), &analysis.round_trip.hgrm())?;
+    write_file(&out.join("overhead.hgrm"), &analysis.overhead.hgrm())?;
+    let plot = |name: &str, res: Result<(), String>| {
+        res.map_err(|e| Error::Failed(format!("plotting {name}: {e}")))
+    };
+    plot(
+        "latency",
+        plots::overhead_histogram(&analysis.overhead, &out.join("latency.svg")),
+    )?;
+    plot("positions and forces", series.write(out))?;
+    write_file(&out.join("scenario.toml"), &start.scenario_toml)?;
+    let summary = summarise(&scenario, runner, &analysis, &logs, launch);
+    write_json(&out.join("summary.json"), &summary)?;
+    Ok(summary)
+}
+
+/// `tactile report DIR... [--out OUT]`.
+pub fn main(args: &crate::cli::ReportArgs) -> Result<(), Error> {
+    let [master, _, _] = join::locate(&args.dirs)?;
+    let out = match &args.out {
+        Some(o) => o.clone(),
+        None => master
+            .as_deref()
+            .and_then(Path::parent)
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+    };
+    let launch = Launch {
+        no_trace: args.no_trace,
+        ..Launch::default()
+    };
+    let summary = write_report(&args.dirs, &out, &launch)?;
+    print!("{}", render(&summary, &out));
+    Ok(())
+}

@@ -1,0 +1,72 @@
+//! The `tactile-master` program (HMD): its command line and its run, as a library so
+//! that `tactile run` and the tests can also call it.
+
+use crate::operator::OperatorSource;
+use crate::process::{run_with, Ending, MasterOptions};
+use clap::Parser;
+use std::process::ExitCode;
+use std::time::Duration;
+use tactile_node::runtime::{
+    exit, master_link, new_run_token, parse, prepare, start_record, NodeArgs, NodeError, Recorder,
+    EXIT_CODES_HELP,
+};
+
+/// How long before each realtime tick the master wakes and spins: covers the ~100 us
+/// lateness of timer wake-ups measured on these machines (see README, "Waiting").
+pub const WAKE_EARLY_NS: u64 = 200_000;
+
+/// tactile-master: the operator's side (OP, MD, HMD). Sends c(n), takes q(n) back,
+/// commands the master device's torques, and records every sample.
+#[derive(Debug, Parser)]
+#[command(name = "tactile-master", version, about, after_help = EXIT_CODES_HELP)]
+pub struct Cli {
+    /// Options every node takes.
+    #[command(flatten)]
+    pub node: NodeArgs,
+    /// Seconds to wait for the emulator and slave to answer before giving up.
+    #[arg(long, default_value_t = 60.0)]
+    pub startup_timeout_s: f64,
+}
+
+/// The program: parse, run, exit status.
+pub fn main() -> ExitCode {
+    match parse::<Cli>() {
+        Ok(cli) => exit("master", run(&cli)),
+        Err(code) => code,
+    }
+}
+
+/// Runs the master; `Ok(true)` when every sample was sent, `Ok(false)` when a stop
+/// request ended it early.
+pub fn run(cli: &Cli) -> Result<bool, NodeError> {
+    let a = &cli.node;
+    if !(cli.startup_timeout_s.is_finite() && cli.startup_timeout_s > 0.0) {
+        return Err(NodeError::BadInput(format!(
+            "--startup-timeout-s {}: must be a positive number of seconds",
+            cli.startup_timeout_s
+        )));
+    }
+    let p = prepare("master", a)?;
+    OperatorSource::load(&p.scenario.operator, &p.base_dir)
+        .map_err(|e| NodeError::BadInput(format!("{}: operator: {e}", a.scenario.display())))?;
+    let mut rec = Recorder::open(&a.out, "master", a.append)?;
+    rec.start(start_record("master", a, &p))?;
+    let opts = MasterOptions {
+        scenario: p.scenario.clone(),
+        base_dir: p.base_dir.clone(),
+        startup_timeout: Duration::from_secs_f64(cli.startup_timeout_s.min(1e6)),
+        answer_timeout: Duration::from_millis(100),
+        wake_early_ns: WAKE_EARLY_NS,
+        run: new_run_token(),
+    };
+    let ended = master_link(a, p.spin).and_then(|link| {
+        run_with(&opts, link.as_ref(), &mut rec).map_err(|e| NodeError::Failed(e.to_string()))
+    });
+    match ended {
+        Ok(e) => Ok(e == Ending::Completed),
+        Err(e) => {
+            let _ = rec.event(0, format!("failed: {e}"));
+            Err(e)
+        }
+    }
+}

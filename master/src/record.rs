@@ -1,0 +1,94 @@
+//! The master's record: one schema for what it sent, what came back and what it did.
+//! The report joins these with the emulator's and the slave's records by sample number.
+
+use crate::hmd::MasterCounters;
+use serde::{Deserialize, Serialize};
+use tactile_common::samples::{stage, Signal};
+use tactile_node::ipc::{InboxStats, OutboxStats};
+
+/// Sample n as it left the master.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Sent {
+    /// Sample number.
+    pub n: u64,
+    /// The operator's target a(n), m.
+    pub target: [f64; 3],
+    /// Master joint angles b(n), rad.
+    pub theta_md: [f64; 3],
+    /// c(n), m.
+    pub c: [f64; 3],
+    /// The sample's instant (its scheduled tick in realtime), ns.
+    pub tick_ns: u64,
+    /// When c(n) was published, ns.
+    pub send_ns: u64,
+}
+
+/// q(n) as it came back and the torques it produced.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Answer {
+    /// The sample it answers.
+    pub n: u64,
+    /// q(n) as received.
+    pub q: Signal,
+    /// Every stage's stamp, ns.
+    pub stamps: [u64; stage::COUNT],
+    /// KFF-HMD torques p(n), N m.
+    pub tau: [f64; 3],
+    /// The force the operator feels, N.
+    pub felt: [f64; 3],
+    /// `FLAG_*` bits of the master (clamped, rejected).
+    pub flags: u32,
+    /// Round trip on the master's clock, ns.
+    pub round_trip_ns: u64,
+    /// Round trip minus injected delay, ns.
+    pub overhead_ns: i64,
+    /// True if it came after its deadline.
+    pub late: bool,
+}
+
+/// Sample n had no answer by its deadline.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Miss {
+    /// The sample.
+    pub n: u64,
+    /// Torques commanded instead (held, or zero once the loop is broken), N m.
+    pub tau: [f64; 3],
+    /// Force felt instead, N.
+    pub felt: [f64; 3],
+    /// `FLAG_HELD` or `FLAG_PEER_LOST`.
+    pub flags: u32,
+}
+
+/// One entry per thing the master did with a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum MasterSample {
+    /// c(n) sent.
+    Sent(Sent),
+    /// q(n) came back.
+    Answer(Answer),
+    /// q(n) did not come by its deadline.
+    Miss(Miss),
+}
+
+/// The master's counters.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct MasterTotals {
+    /// The state machine's counters.
+    pub counters: MasterCounters,
+    /// Answers not back by the next tick (realtime).
+    pub deadline_misses: u64,
+    /// Answers that came after their deadline.
+    pub late: u64,
+    /// Backward samples that answered nothing (a duplicate, a number never sent, or
+    /// older than the late window).
+    pub unexpected: u64,
+    /// c(n) as published.
+    pub c_out: OutboxStats,
+    /// q(n) as received.
+    pub q_in: InboxStats,
+    /// From the first tick to now, ns.
+    pub elapsed_ns: u64,
+}
+
+/// The master's record type.
+pub type MasterRecord = tactile_node::record::Record<MasterSample, MasterTotals>;

@@ -1,0 +1,43 @@
+//! The `tactile-emulator` program (NW): its command line and its run.
+
+use crate::process::run_with;
+use clap::Parser;
+use std::process::ExitCode;
+use tactile_node::runtime::{
+    emulator_link, exit, parse, prepare, start_record, NodeArgs, NodeError, Recorder,
+    EXIT_CODES_HELP,
+};
+
+/// tactile-emulator: the network between master and slave. Delays, perturbs, drops
+/// and corrupts c(n) and h(n) as the scenario says (seeded), and records every sample.
+#[derive(Debug, Parser)]
+#[command(name = "tactile-emulator", version, about, after_help = EXIT_CODES_HELP)]
+pub struct Cli {
+    /// Options every node takes.
+    #[command(flatten)]
+    pub node: NodeArgs,
+}
+
+/// The program: parse, run, exit status.
+pub fn main() -> ExitCode {
+    match parse::<Cli>() {
+        Ok(cli) => exit("emulator", run(&cli)),
+        Err(code) => code,
+    }
+}
+
+/// Runs the emulator until the master's end-of-run sample (`Ok(true)`) or a stop
+/// request (`Ok(false)`).
+pub fn run(cli: &Cli) -> Result<bool, NodeError> {
+    let a = &cli.node;
+    let p = prepare("emulator", a)?;
+    let mut rec = Recorder::open(&a.out, "emulator", a.append)?;
+    rec.start(start_record("emulator", a, &p))?;
+    tracing::info!("waiting for the master");
+    let ended = emulator_link(a, p.spin).and_then(|link| {
+        run_with(&p.scenario, link.as_ref(), &mut rec).map_err(|e| NodeError::Failed(e.to_string()))
+    });
+    ended.inspect_err(|e| {
+        let _ = rec.event(0, format!("failed: {e}"));
+    })
+}

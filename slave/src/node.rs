@@ -1,0 +1,42 @@
+//! The `tactile-slave` program (HSD): its command line and its run.
+
+use crate::process::run_with;
+use clap::Parser;
+use std::process::ExitCode;
+use tactile_node::runtime::{
+    exit, parse, prepare, slave_link, start_record, NodeArgs, NodeError, Recorder, EXIT_CODES_HELP,
+};
+
+/// tactile-slave: the remote side (HSD, SD, ENV). Follows v(n) with the slave arm,
+/// senses contact, sends the force h(n) back, and records every step.
+#[derive(Debug, Parser)]
+#[command(name = "tactile-slave", version, about, after_help = EXIT_CODES_HELP)]
+pub struct Cli {
+    /// Options every node takes.
+    #[command(flatten)]
+    pub node: NodeArgs,
+}
+
+/// The program: parse, run, exit status.
+pub fn main() -> ExitCode {
+    match parse::<Cli>() {
+        Ok(cli) => exit("slave", run(&cli)),
+        Err(code) => code,
+    }
+}
+
+/// Runs the emulator until the master's end-of-run sample (`Ok(true)`) or a stop
+/// request (`Ok(false)`).
+pub fn run(cli: &Cli) -> Result<bool, NodeError> {
+    let a = &cli.node;
+    let p = prepare("slave", a)?;
+    let mut rec = Recorder::open(&a.out, "slave", a.append)?;
+    rec.start(start_record("slave", a, &p))?;
+    tracing::info!("waiting for the master");
+    let ended = slave_link(a, p.spin).and_then(|link| {
+        run_with(&p.scenario, link.as_ref(), &mut rec).map_err(|e| NodeError::Failed(e.to_string()))
+    });
+    ended.inspect_err(|e| {
+        let _ = rec.event(0, format!("failed: {e}"));
+    })
+}

@@ -1,0 +1,547 @@
+//! The node programs as a user runs them: started by hand in any order, each writing
+//! its own record, joined by `tactile report`; killed mid-run; long runs in bounded
+//! memory; and what a launcher does when it dies.
+
+mod util;
+
+use std::path::Path;
+use std::process::{Child, Stdio};
+use std::time::{Duration, Instant};
+use tactile_common::trace::signal_columns;
+use util::{column, pid_of, Sandbox};
+
+/// The paper scenario in lockstep with a noisy, delayed network.
+fn lockstep(samples: u64) -> String {
+    tactile::run_cmd::PAPER_SCENARIO
+        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        .replace("samples = 1200", &format!("samples = {samples}"))
+        .replace(
+            "[network.forward]\ndelay = [0, 0, 0]\nnoise_std = [0.0, 0.0, 0.0]",
+            "[network.forward]\ndelay = [2, 3, 1]\nnoise_std = [0.0005, 0.001, 0.0]",
+        )
+}
+
+/// The paper scenario at 1 kHz in real time.
+fn realtime(samples: u64) -> String {
+    tactile::run_cmd::PAPER_SCENARIO
+        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
+        .replace("samples = 1200", &format!("samples = {samples}"))
+}
+
+/// Starts node `role` by hand with its own output folder `dir`.
+fn start_node(sb: &Sandbox, role: &str, scenario: &Path, dir: &str, extra: &[&str]) -> Child {
+    let mut args = vec![
+        "--scenario",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        dir,
+        "--prefix",
+        &sb.prefix,
+    ];
+    args.extend_from_slice(extra);
+    sb.node(&format!("tactile-{role}"), &args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start node")
+}
+
+fn finish(child: Child) -> (Option<i32>, String) {
+    let o = child.wait_with_output().expect("wait");
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn report(sb: &Sandbox, dirs: &[&str], out: &str) -> std::process::Output {
+    let out = sb.path(out);
+    let mut args = vec!["report"];
+    args.extend_from_slice(dirs);
+    args.extend(["--out", out.to_str().expect("utf-8")]);
+    sb.tactile(&args)
+}
+
+#[test]
+fn hand_started_nodes_in_any_order_match_tactile_run_and_the_simulation() {
+    let sb = Sandbox::new("byhand");
+    let scenario = sb.write("s.toml", &lockstep(1200));
+    // Slave first, then the master (which waits for its peers), then the emulator.
+    let slave = start_node(&sb, "slave", &scenario, "h-slave", &[]);
+    std::thread::sleep(Duration::from_millis(300));
+    let master = start_node(&sb, "master", &scenario, "h-master", &[]);
+    std::thread::sleep(Duration::from_millis(500));
+    let emulator = start_node(&sb, "emulator", &scenario, "h-emulator", &[]);
+    for (name, child) in [("master", master), ("emulator", emulator), ("slave", slave)] {
+        let (code, err) = finish(child);
+        assert_eq!(code, Some(0), "{name}: {err}");
+    }
+    // Each node wrote its own record and log into its own folder.
+    for role in ["master", "emulator", "slave"] {
+        let dir = sb.path(&format!("h-{role}"));
+        assert!(dir.join(format!("{role}.rec")).is_file(), "{role}");
+        let log = std::fs::read_to_string(dir.join(format!("{role}.log"))).expect("log");
+        assert!(
+            log.contains("start:") && log.contains("stop: completed"),
+            "{role}:\n{log}"
+        );
+    }
+    let o = report(&sb, &["h-master", "h-emulator", "h-slave"], "joined");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    sb.run(&scenario, "launched");
+    sb.simulate(&scenario, "sim");
+    let joined = signal_columns(&sb.trace("joined"));
+    assert_eq!(joined.lines().count(), 1201);
+    assert_eq!(
+        joined,
+        signal_columns(&sb.trace("launched")),
+        "by hand vs tactile run"
+    );
+    assert_eq!(
+        joined,
+        signal_columns(&sb.trace("sim")),
+        "by hand vs in-process"
+    );
+    // The same summary: counts, accounting and motion (latencies differ run to run).
+    let a = sb.json("joined", "summary.json");
+    let b = sb.json("launched", "summary.json");
+    for key in [
+        "samples_sent",
+        "samples_received",
+        "samples_lost",
+        "tracking_rms_m",
+        "channels",
+    ] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+    assert_eq!(a["master"]["motion"], b["master"]["motion"]);
+    assert_eq!(a["slave"]["counters"], b["slave"]["counters"]);
+    assert_eq!(a["emulator"]["counters"], b["emulator"]["counters"]);
+    for role in ["master", "emulator", "slave"] {
+        let n = &a["nodes"][role];
+        assert!(
+            n["ended"].as_str().expect("ended").starts_with("completed"),
+            "{n}"
+        );
+        assert!(n["peak_rss_kb"].as_u64() > Some(0), "{n}");
+    }
+    sb.assert_no_leftover_processes();
+}
+
+#[test]
+fn a_killed_slave_leaves_every_sample_it_took_in_its_record() {
+    let sb = Sandbox::new("slavekill");
+    let scenario = sb.write("s.toml", &realtime(3000));
+    let master = start_node(&sb, "master", &scenario, "m", &[]);
+    let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
+    let slave = start_node(&sb, "slave", &scenario, "s", &[]);
+    // Kill the slave (SIGKILL: no chance to flush anything) once it is well under way.
+    let rec = sb.path("s").join("slave.rec");
+    let start = Instant::now();
+    while std::fs::metadata(&rec).map_or(0, |m| m.len()) < 100_000 {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "the slave never got going"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let pid = slave.id() as i32;
+    let _ = rustix::process::kill_process(
+        rustix::process::Pid::from_raw(pid).expect("pid"),
+        rustix::process::Signal::KILL,
+    );
+    let (code, _) = finish(slave);
+    assert_eq!(code, None, "killed by a signal");
+    // The master breaks, runs to its end with zero torque; the emulator follows it.
+    let (code, err) = finish(master);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = finish(emulator);
+    assert_eq!(code, Some(0), "{err}");
+    let o = report(&sb, &["m", "e", "s"], "report");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = sb.json("report", "summary.json");
+    let node = &s["nodes"]["slave"];
+    let last = node["last_sample"]
+        .as_u64()
+        .expect("the slave recorded samples");
+    let ended = node["ended"].as_str().expect("ended");
+    assert!(
+        ended.contains(&format!("after sample {last}")) && ended.contains("killed"),
+        "{ended}"
+    );
+    // Every sample up to the slave's death is in its record (v(n) recorded: the
+    // paper path's z is never 0), none after it, and every answer the master got
+    // came from a recorded step.
+    let trace = sb.trace("report");
+    let v3 = column(&trace, "v_3");
+    let received = column(&trace, "received");
+    let last = usize::try_from(last).expect("index");
+    assert!(last > 50 && last < 2900, "killed at {last}");
+    assert!(
+        v3[..=last].iter().all(|v| *v != 0.0),
+        "a gap in the slave's record"
+    );
+    assert!(v3[last + 1..].iter().all(|v| *v == 0.0));
+    assert!(received[last + 1..].iter().all(|r| *r == 0.0));
+    assert_eq!(node["unjoined"], 0);
+    assert!(s["master"]["counters"]["loop_breaks"].as_u64() >= Some(1));
+    sb.assert_no_leftover_processes();
+}
+
+#[test]
+fn a_long_run_keeps_every_node_in_bounded_memory() {
+    // 100,000 samples: a node that kept even 100 bytes per sample would grow by
+    // 10 MB, a trace row per sample (the old master) by about 100 MB. The nodes start
+    // at about 8 MB; 24 MB leaves room for the allocator and nothing for growth.
+    let sb = Sandbox::new("longrun");
+    let scenario = sb.write("s.toml", &lockstep(100_000));
+    let out = sb.path("run");
+    let o = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--prefix",
+        &sb.prefix,
+        "--no-trace",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["samples_received"], 100_000);
+    assert!(!out.join("trace.csv").exists());
+    for role in ["master", "emulator", "slave"] {
+        let kb = s["nodes"][role]["peak_rss_kb"].as_u64().expect("rss");
+        assert!(kb > 1000 && kb < 24 * 1024, "{role}: peak RSS {kb} kB");
+    }
+    // The plots are thinned to the pixel width: small whatever the length.
+    for plot in ["positions.svg", "forces.svg"] {
+        let size = std::fs::metadata(out.join(plot)).expect("plot").len();
+        assert!(size < 600_000, "{plot}: {size} bytes");
+    }
+    sb.assert_no_leftover_processes();
+}
+
+#[test]
+fn nodes_stop_within_a_second_when_the_launcher_is_killed() {
+    let sb = Sandbox::new("orphans");
+    let scenario = sb.write("s.toml", &realtime(60_000));
+    let mut launcher = sb
+        .command(&[
+            "run",
+            scenario.to_str().expect("utf-8"),
+            "--out",
+            "run",
+            "--prefix",
+            &sb.prefix,
+            "-q",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start");
+    let start = Instant::now();
+    while ["master", "emulator", "slave"]
+        .iter()
+        .any(|r| pid_of(&sb.prefix, r).is_none())
+    {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "nodes did not start"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    launcher.kill().expect("SIGKILL the launcher");
+    let _ = launcher.wait();
+    let killed = Instant::now();
+    while ["master", "emulator", "slave"]
+        .iter()
+        .any(|r| pid_of(&sb.prefix, r).is_some())
+    {
+        assert!(
+            killed.elapsed() < Duration::from_secs(1),
+            "nodes still running {:?} after the launcher died",
+            killed.elapsed()
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // They stopped cleanly: each record ends with a stop, readable by the report.
+    let o = report(&sb, &["run"], "report");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = sb.json("report", "summary.json");
+    for role in ["master", "emulator", "slave"] {
+        let ended = s["nodes"][role]["ended"]
+            .as_str()
+            .expect("ended")
+            .to_string();
+        assert!(ended.starts_with("interrupted"), "{role}: {ended}");
+    }
+}
+
+#[test]
+fn a_prefix_in_use_is_refused_and_names_its_holder() {
+    let sb = Sandbox::new("prefix");
+    let scenario = sb.write("s.toml", &realtime(1000));
+    // A slave started by hand holds the prefix.
+    let slave = start_node(&sb, "slave", &scenario, "hand", &[]);
+    std::thread::sleep(Duration::from_millis(300));
+    // A second slave by hand is refused before it starts.
+    let o = sb
+        .node(
+            "tactile-slave",
+            &[
+                "--scenario",
+                "s.toml",
+                "--out",
+                "second",
+                "--prefix",
+                &sb.prefix,
+            ],
+        )
+        .output()
+        .expect("start");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("in use") && err.contains(&format!("pid {}", slave.id())),
+        "{err}"
+    );
+    assert!(!sb.path("second").join("slave.rec").exists());
+    // A launcher on the same prefix: its own slave refuses, and the run stops with
+    // that node's message (exit 2), without restarting it.
+    let o = sb.tactile(&[
+        "run", "s.toml", "--out", "run", "--prefix", &sb.prefix, "-q",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("slave") && err.contains("in use"), "{err}");
+    assert!(!err.contains("restarted"), "{err}");
+    let mut slave = slave;
+    let _ = slave.kill();
+    let _ = slave.wait();
+    sb.assert_no_leftover_processes();
+    // Two launchers: the second refuses and names the first.
+    let mut first = sb
+        .command(&[
+            "run", "s.toml", "--out", "first", "--prefix", &sb.prefix, "-q",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start");
+    let start = Instant::now();
+    while pid_of(&sb.prefix, "master").is_none() {
+        assert!(start.elapsed() < Duration::from_secs(20));
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let o = sb.tactile(&[
+        "run",
+        "s.toml",
+        "--out",
+        "second-run",
+        "--prefix",
+        &sb.prefix,
+        "-q",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&format!("tactile run (pid {},", first.id())),
+        "{err}"
+    );
+    assert!(first.wait().expect("wait").success());
+    sb.assert_no_leftover_processes();
+}
+
+#[test]
+fn bad_prefixes_are_refused_before_anything_starts() {
+    let sb = Sandbox::new("badprefix");
+    let scenario = sb.write("s.toml", &realtime(100));
+    let long = "p".repeat(33);
+    for bad in ["a/b", "../x", "-x", "a b", long.as_str()] {
+        let prefix = format!("--prefix={bad}");
+        let o = sb.tactile(&[
+            "run",
+            scenario.to_str().expect("utf-8"),
+            "--out",
+            "out",
+            &prefix,
+            "-q",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {err}");
+        assert!(err.contains("--prefix"), "{bad}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(!sb.path("out").join("scenario.toml").exists(), "{bad}");
+    }
+}
+
+#[test]
+fn relative_paths_and_the_copied_scenario_work_in_every_mode() {
+    let sb = Sandbox::new("paths");
+    std::fs::create_dir(sb.path("sub")).expect("mkdir");
+    sb.write(
+        "sub/traj.csv",
+        "x,y,z\n0.05,0.02,-0.12\n0.06,0.02,-0.12\n0.07,0.03,-0.11\n",
+    );
+    let text = lockstep(300).replace(
+        "[operator]\nkind = \"paper\"",
+        "[operator]\nkind = \"csv\"\npath = \"traj.csv\"",
+    );
+    let scenario = sb.write("sub/s.toml", &text);
+    // From the sandbox, the scenario one folder down: processes and in-process.
+    sb.run(&scenario, "a");
+    sb.simulate(&scenario, "b");
+    assert_eq!(
+        signal_columns(&sb.trace("a")),
+        signal_columns(&sb.trace("b"))
+    );
+    // The copy in the output folder runs again as it is, from another folder.
+    let copy = sb.path("a").join("scenario.toml");
+    std::fs::create_dir(sb.path("elsewhere")).expect("mkdir");
+    let o = sb
+        .command(&[
+            "run",
+            copy.to_str().expect("utf-8"),
+            "--out",
+            "again",
+            "--prefix",
+            &sb.prefix,
+            "-q",
+        ])
+        .current_dir(sb.path("elsewhere"))
+        .output()
+        .expect("run");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let again = std::fs::read_to_string(sb.path("elsewhere/again/trace.csv")).expect("trace");
+    assert_eq!(signal_columns(&again), signal_columns(&sb.trace("a")));
+}
+
+#[test]
+fn a_run_never_overwrites_its_input_nor_mixes_two_runs_in_a_folder() {
+    let sb = Sandbox::new("inputs");
+    let scenario = sb.write("s.toml", &lockstep(200));
+    sb.run(&scenario, "out");
+    // Running the copy in the output folder into the same folder would overwrite it.
+    let copy = sb.path("out").join("scenario.toml");
+    let before = std::fs::read(&copy).expect("read");
+    let o = sb.tactile(&["run", copy.to_str().expect("utf-8"), "--out", "out", "-q"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("overwrite"), "{err}");
+    assert_eq!(std::fs::read(&copy).expect("read"), before);
+    // A second run in the same folder leaves none of the first run's files: the
+    // in-process run writes no logs, so the first run's logs must be gone.
+    assert!(sb.path("out").join("master.log").exists());
+    sb.simulate(&scenario, "out");
+    for role in ["master", "emulator", "slave"] {
+        assert!(
+            !sb.path("out").join(format!("{role}.log")).exists(),
+            "{role}.log"
+        );
+    }
+    // Records of two runs are never joined.
+    sb.run(&scenario, "other");
+    let o = report(&sb, &["out", "other"], "mixed");
+    assert_eq!(o.status.code(), Some(2));
+    std::fs::remove_file(sb.path("other").join("master.rec")).expect("rm");
+    let o = report(&sb, &["out", "other"], "mixed");
+    assert_eq!(o.status.code(), Some(2), "two slave records");
+    std::fs::create_dir(sb.path("x")).expect("mkdir");
+    std::fs::rename(
+        sb.path("other").join("slave.rec"),
+        sb.path("x").join("slave.rec"),
+    )
+    .expect("mv");
+    std::fs::remove_file(sb.path("out").join("slave.rec")).expect("rm");
+    let o = report(&sb, &["out", "x"], "mixed");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("not one run"), "{err}");
+}
+
+#[test]
+fn statistics_say_na_when_nothing_came_back() {
+    let sb = Sandbox::new("nothing");
+    let text = realtime(300).replace("[network.backward]\n", "[network.backward]\nloss = 1.0\n");
+    let scenario = sb.write("s.toml", &text);
+    let o = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        "run",
+        "--prefix",
+        &sb.prefix,
+        "-q",
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["samples_received"], 0);
+    assert!(
+        s["round_trip_ns"].is_null() && s["overhead_ns"].is_null(),
+        "{s}"
+    );
+    assert!(s["master"]["motion"]["felt_rms_n"].is_null());
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("round trip"))
+        .expect("line");
+    assert!(line.contains("n/a"), "{line}");
+    // The slave did follow: its tracking is measured against what it was sent.
+    assert!(
+        s["tracking_rms_m"].as_f64().is_some_and(|t| t < 0.01),
+        "{}",
+        s["tracking_rms_m"]
+    );
+}
+
+#[test]
+fn unreadable_and_absurd_input_files_are_refused() {
+    let sb = Sandbox::new("files");
+    std::fs::create_dir(sb.path("folder.toml")).expect("mkdir");
+    let big = sb.path("big.toml");
+    let f = std::fs::File::create(&big).expect("create");
+    f.set_len(2 << 20).expect("grow");
+    for (scenario, want) in [
+        ("folder.toml", "is a folder"),
+        ("/dev/zero", "not a regular file"),
+        ("big.toml", "more than"),
+    ] {
+        let o = sb.tactile(&["run", scenario, "--out", "out", "-q"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{scenario}: {err}");
+        assert!(
+            err.contains(want) && err.lines().count() == 1,
+            "{scenario}: {err}"
+        );
+        assert!(!sb.path("out").exists());
+    }
+    // A trajectory that is a device or absurdly large.
+    let csv = sb.path("huge.csv");
+    std::fs::File::create(&csv)
+        .expect("create")
+        .set_len(200 << 20)
+        .expect("grow");
+    for path in ["/dev/zero", "huge.csv"] {
+        let text = lockstep(10).replace(
+            "[operator]\nkind = \"paper\"",
+            &format!("[operator]\nkind = \"csv\"\npath = \"{path}\""),
+        );
+        let s = sb.write("t.toml", &text);
+        let o = sb.tactile(&["run", s.to_str().expect("utf-8"), "--out", "out", "-q"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{path}: {err}");
+        assert!(
+            err.contains(path) && err.lines().count() == 1,
+            "{path}: {err}"
+        );
+    }
+    // A device file for the kernels that is not a regular file.
+    let o = sb.tactile(&["kernels", "fk", "--device", "/dev/zero"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a regular file"), "{err}");
+}
