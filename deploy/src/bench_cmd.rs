@@ -79,17 +79,8 @@ fn scenario(rate: f64, samples: u64, mode: Mode) -> Result<Scenario, Error> {
 }
 
 fn trio(sc: &Scenario, out: &Path, sup: &Supervision, link: LinkKind) -> Result<Summary, Error> {
-    let udp_ports = match link {
-        LinkKind::Udp => Some(
-            tactile_node::udp::UdpPorts::free()
-                .map_err(|e| Error::Failed(e.to_string()))?
-                .arg(),
-        ),
-        LinkKind::Iceoryx2 => None,
-    };
     let sup = Supervision {
-        link,
-        udp_ports,
+        link: crate::run_cmd::Links::on_this_host(link)?,
         prefix: format!(
             "{}{}",
             sup.prefix,
@@ -246,8 +237,10 @@ fn supervision(args: &BenchArgs, prefix: &str, spin: Duration) -> Supervision {
         spin,
         progress: false,
         max_restarts: 0,
-        link: LinkKind::Iceoryx2,
-        udp_ports: None,
+        link: crate::run_cmd::Links {
+            kind: LinkKind::Iceoryx2,
+            args: Default::default(),
+        },
         pin: !args.no_pin,
         rt: false,
         no_trace: false,

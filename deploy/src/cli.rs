@@ -115,8 +115,13 @@ pub struct RunArgs {
     /// Times the emulator or the slave is restarted if it dies mid-run.
     #[arg(long, default_value_t = 3)]
     pub max_restarts: u32,
-    /// Carry the samples over UDP on loopback instead of iceoryx2 (the reference).
-    #[arg(long)]
+    /// What carries the samples between the nodes on this host: iceoryx2 (shared
+    /// memory), udp (loopback datagrams, the reference) or zenoh (loopback TCP; across
+    /// hosts, start the nodes by hand, see the README's "Across hosts").
+    #[arg(long, value_enum, default_value_t = tactile_node::runtime::LinkKind::Iceoryx2)]
+    pub link: tactile_node::runtime::LinkKind,
+    /// Shorthand for --link udp.
+    #[arg(long, conflicts_with = "link")]
     pub udp: bool,
     /// Do not pin the processes (by default the master runs on CPU 0 and the emulator
     /// and slave on CPU 1, where the machine has two CPUs).

@@ -168,16 +168,59 @@ pub struct Supervision {
     pub progress: bool,
     /// Restarts allowed per process (emulator, slave) when one dies mid-run.
     pub max_restarts: u32,
-    /// What carries the samples.
-    pub link: LinkKind,
-    /// UDP ports `m,e,s` with the UDP link.
-    pub udp_ports: Option<String>,
+    /// What carries the samples, and the link options of each node.
+    pub link: Links,
     /// Pin master to CPU 0, emulator and slave to CPU 1.
     pub pin: bool,
     /// SCHED_FIFO priority for the three processes, if permitted.
     pub rt: bool,
     /// Write no trace.csv.
     pub no_trace: bool,
+}
+
+/// The link of a run on one host, with the options each node needs for it.
+#[derive(Debug, Clone)]
+pub struct Links {
+    /// The link.
+    pub kind: LinkKind,
+    /// Options of the master, the emulator and the slave.
+    pub args: [Vec<String>; 3],
+}
+
+impl Links {
+    /// Every node on `kind`, on this host: UDP on three free ports; Zenoh with the
+    /// emulator listening on a free loopback TCP port and the others connecting to it.
+    pub fn on_this_host(kind: LinkKind) -> Result<Links, Error> {
+        let failed = |e: std::io::Error| Error::Failed(format!("picking a free port: {e}"));
+        let args = match kind {
+            LinkKind::Iceoryx2 => Default::default(),
+            LinkKind::Udp => {
+                let p = tactile_node::udp::UdpPorts::free()
+                    .map_err(|e| Error::Failed(e.to_string()))?
+                    .arg();
+                let a = vec!["--udp-ports".to_string(), p];
+                [a.clone(), a.clone(), a]
+            }
+            LinkKind::Zenoh => {
+                let l = std::net::TcpListener::bind("127.0.0.1:0").map_err(failed)?;
+                let port = l.local_addr().map_err(failed)?.port();
+                let at = format!("tcp/127.0.0.1:{port}");
+                let connect = vec!["--connect".to_string(), at.clone()];
+                [connect.clone(), vec!["--listen".to_string(), at], connect]
+            }
+        };
+        Ok(Links { kind, args })
+    }
+
+    /// The link options of `role`.
+    pub fn args(&self, role: &str) -> &[String] {
+        let k = match role {
+            "master" => 0,
+            "emulator" => 1,
+            _ => 2,
+        };
+        &self.args[k]
+    }
 }
 
 /// The command line of one node.
@@ -203,17 +246,8 @@ fn node_command(
         .args(["--prefix", &sup.prefix])
         .args(["--spin-us", &sup.spin.as_micros().to_string()])
         .args(["--supervised", &std::process::id().to_string()]);
-    match sup.link {
-        LinkKind::Iceoryx2 => {
-            cmd.args(["--link", "iceoryx2"]);
-        }
-        LinkKind::Udp => {
-            cmd.args(["--link", "udp"]);
-            if let Some(p) = &sup.udp_ports {
-                cmd.args(["--udp-ports", p]);
-            }
-        }
-    }
+    cmd.args(["--link", sup.link.kind.name()]);
+    cmd.args(sup.link.args(role));
     if sup.pin {
         cmd.args(["--cpu", if role == "master" { "0" } else { "1" }]);
     }
@@ -544,20 +578,11 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
                 .map_or_else(|| default_spin(&loaded.scenario), Duration::from_micros),
             progress: !args.quiet,
             max_restarts: args.max_restarts,
-            link: if args.udp {
+            link: Links::on_this_host(if args.udp {
                 LinkKind::Udp
             } else {
-                LinkKind::Iceoryx2
-            },
-            udp_ports: if args.udp {
-                Some(
-                    tactile_node::udp::UdpPorts::free()
-                        .map_err(|e| Error::Failed(e.to_string()))?
-                        .arg(),
-                )
-            } else {
-                None
-            },
+                args.link
+            })?,
             pin: !args.no_pin,
             rt: args.rt,
             no_trace: args.no_trace,

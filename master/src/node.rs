@@ -26,6 +26,10 @@ pub struct Cli {
     /// Seconds to wait for the emulator and slave to answer before giving up.
     #[arg(long, default_value_t = 60.0)]
     pub startup_timeout_s: f64,
+    /// No emulator: talk to the slave directly, the real network being the delay
+    /// (with --link zenoh).
+    #[arg(long)]
+    pub direct: bool,
 }
 
 /// The program: parse, run, exit status.
@@ -46,6 +50,11 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
             cli.startup_timeout_s
         )));
     }
+    if cli.direct && a.link != tactile_node::runtime::LinkKind::Zenoh {
+        return Err(NodeError::BadInput(
+            "--direct (no emulator) needs --link zenoh".into(),
+        ));
+    }
     let p = prepare("master", a)?;
     OperatorSource::load(&p.scenario.operator, &p.base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: operator: {e}", a.scenario.display())))?;
@@ -59,7 +68,7 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
         wake_early_ns: WAKE_EARLY_NS,
         run: new_run_token(),
     };
-    let ended = master_link(a, p.spin).and_then(|link| {
+    let ended = master_link(a, p.spin, cli.direct).and_then(|link| {
         run_with(&opts, link.as_ref(), &mut rec).map_err(|e| NodeError::Failed(e.to_string()))
     });
     match ended {

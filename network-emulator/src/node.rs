@@ -4,8 +4,8 @@ use crate::process::run_with;
 use clap::Parser;
 use std::process::ExitCode;
 use tactile_node::runtime::{
-    emulator_link, exit, parse, prepare, start_record, NodeArgs, NodeError, Recorder,
-    EXIT_CODES_HELP,
+    check_link_args, emulator_link, exit, parse, prepare, start_record, LinkKind, NodeArgs,
+    NodeError, Recorder, EXIT_CODES_HELP,
 };
 
 /// tactile-emulator: the network between master and slave. Delays, perturbs, drops
@@ -16,6 +16,13 @@ pub struct Cli {
     /// Options every node takes.
     #[command(flatten)]
     pub node: NodeArgs,
+    /// The link towards the master (default: --link), so the emulator can sit on the
+    /// slave's host (--master-link zenoh --slave-link iceoryx2) or the master's.
+    #[arg(long, value_enum)]
+    pub master_link: Option<LinkKind>,
+    /// The link towards the slave (default: --link).
+    #[arg(long, value_enum)]
+    pub slave_link: Option<LinkKind>,
 }
 
 /// The program: parse, run, exit status.
@@ -30,11 +37,14 @@ pub fn main() -> ExitCode {
 /// request (`Ok(false)`).
 pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let a = &cli.node;
+    let towards_master = cli.master_link.unwrap_or(a.link);
+    let towards_slave = cli.slave_link.unwrap_or(a.link);
     let p = prepare("emulator", a)?;
+    check_link_args(a, &[towards_master, towards_slave])?;
     let mut rec = Recorder::open(&a.out, "emulator", a.append)?;
     rec.start(start_record("emulator", a, &p))?;
     tracing::info!("waiting for the master");
-    let ended = emulator_link(a, p.spin).and_then(|link| {
+    let ended = emulator_link(a, p.spin, towards_master, towards_slave).and_then(|link| {
         run_with(&p.scenario, link.as_ref(), &mut rec).map_err(|e| NodeError::Failed(e.to_string()))
     });
     ended.inspect_err(|e| {

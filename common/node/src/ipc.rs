@@ -176,6 +176,9 @@ pub struct InboxStats {
     /// Samples of another run (a different run token), dropped.
     #[serde(default)]
     pub foreign: u64,
+    /// Frames of another wire-format version (another build), dropped.
+    #[serde(default)]
+    pub wrong_version: u64,
 }
 
 /// A process's wake-up event: every stream into the process notifies it.
@@ -545,5 +548,97 @@ impl crate::link::SlaveLink for IoxSlave {
     }
     fn stats(&self) -> (InboxStats, OutboxStats) {
         (self.inbox.stats(), self.out.stats())
+    }
+}
+
+/// One side of an emulator whose other side is on another link: towards the master
+/// (c in, q out) or towards the slave (v out, h in), over iceoryx2. The emulator polls
+/// it beside its other link.
+#[derive(Debug)]
+pub struct IoxHalf {
+    node: IpcNode,
+    half: Half,
+}
+
+#[derive(Debug)]
+enum Half {
+    Master {
+        c: Inbox<tactile_common::samples::Forward>,
+        q: Outbox<tactile_common::samples::Backward>,
+    },
+    Slave {
+        v: Outbox<tactile_common::samples::Forward>,
+        h: Inbox<tactile_common::samples::Backward>,
+    },
+}
+
+impl IoxHalf {
+    /// Opens the master side (`master_side`) or the slave side of run `prefix`.
+    pub fn open(prefix: &str, master_side: bool) -> Result<Self, IpcError> {
+        let node = node(prefix, "emulator")?;
+        let half = if master_side {
+            Half::Master {
+                c: Inbox::open(&node, streams::C)?,
+                q: Outbox::open(&node, streams::Q, streams::WAKE_MASTER)?,
+            }
+        } else {
+            Half::Slave {
+                v: Outbox::open(&node, streams::V, streams::WAKE_SLAVE)?,
+                h: Inbox::open(&node, streams::H)?,
+            }
+        };
+        Ok(IoxHalf { node, half })
+    }
+
+    /// A sample if one waits.
+    pub fn try_recv(&self) -> Result<Option<crate::link::Arrival>, IpcError> {
+        use crate::link::Arrival;
+        Ok(match &self.half {
+            Half::Master { c, .. } => c.try_recv()?.map(Arrival::Forward),
+            Half::Slave { h, .. } => h.try_recv()?.map(Arrival::Backward),
+        })
+    }
+
+    /// Publishes v(n) (slave side only).
+    pub fn send_forward(
+        &self,
+        v: tactile_common::samples::Forward,
+        control: bool,
+    ) -> Result<(), IpcError> {
+        match &self.half {
+            Half::Slave { v: out, .. } => out.publish(v, control).map(|_| ()),
+            Half::Master { .. } => Err(IpcError {
+                context: "sending v".into(),
+                detail: "this side faces the master".into(),
+            }),
+        }
+    }
+
+    /// Publishes q(n) (master side only).
+    pub fn send_backward(
+        &self,
+        q: tactile_common::samples::Backward,
+        control: bool,
+    ) -> Result<(), IpcError> {
+        match &self.half {
+            Half::Master { q: out, .. } => out.publish(q, control).map(|_| ()),
+            Half::Slave { .. } => Err(IpcError {
+                context: "sending q".into(),
+                detail: "this side faces the slave".into(),
+            }),
+        }
+    }
+
+    /// True once SIGINT or SIGTERM arrived.
+    pub fn stopping(&self) -> bool {
+        termination_requested(&self.node)
+    }
+
+    /// What the side's receiving and sending ends counted.
+    pub fn stats(&self) -> (InboxStats, OutboxStats) {
+        match &self.half {
+            Half::Master { c, q } => (c.stats(), q.stats()),
+            Half::Slave { v, h } => (h.stats(), v.stats()),
+        }
     }
 }

@@ -11,3 +11,5 @@ pub mod logging;
 pub mod record;
 pub mod runtime;
 pub mod udp;
+pub mod wire;
+pub mod zlink;

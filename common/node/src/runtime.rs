@@ -31,8 +31,21 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 pub enum LinkKind {
     /// iceoryx2 zero-copy shared memory (one host).
     Iceoryx2,
-    /// UDP datagrams on loopback (the reference most stacks use).
+    /// UDP datagrams (the reference most stacks use); loopback unless --udp-hosts.
     Udp,
+    /// Zenoh (across hosts): --listen and --connect name the endpoints.
+    Zenoh,
+}
+
+impl LinkKind {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            LinkKind::Iceoryx2 => "iceoryx2",
+            LinkKind::Udp => "udp",
+            LinkKind::Zenoh => "zenoh",
+        }
+    }
 }
 
 /// The command line every node takes.
@@ -51,9 +64,22 @@ pub struct NodeArgs {
     /// Transport between the nodes.
     #[arg(long, value_enum, default_value_t = LinkKind::Iceoryx2)]
     pub link: LinkKind,
-    /// UDP ports of master, emulator and slave on loopback, as `m,e,s` (with --link udp).
+    /// UDP ports of master, emulator and slave, as `m,e,s` (with --link udp).
     #[arg(long, default_value = "47501,47502,47503")]
     pub udp_ports: String,
+    /// Addresses of the master's, emulator's and slave's hosts, as `a,b,c` (with --link
+    /// udp).
+    #[arg(long, default_value = "127.0.0.1,127.0.0.1,127.0.0.1")]
+    pub udp_hosts: String,
+    /// Zenoh endpoint to listen on, e.g. `tcp/198.18.0.1:7447` (repeatable).
+    #[arg(long)]
+    pub listen: Vec<String>,
+    /// Zenoh endpoint of a peer to connect to, e.g. `tcp/198.18.0.1:7447` (repeatable).
+    #[arg(long)]
+    pub connect: Vec<String>,
+    /// Let Zenoh find peers by multicast scouting too (off: only the endpoints given).
+    #[arg(long)]
+    pub scout: bool,
     /// Microseconds to poll (yielding the CPU) before blocking on the wake-up event.
     /// Default: two sampling periods, so a running loop never sleeps (measured, see
     /// the README's "Waiting"); 0 blocks at once.
@@ -132,14 +158,7 @@ pub fn prepare(role: &str, args: &NodeArgs) -> Result<Prepared, NodeError> {
     let bad = NodeError::BadInput;
     lock::check_prefix(&args.prefix).map_err(bad)?;
     let (scenario, base_dir) = crate::files::load_scenario(&args.scenario).map_err(bad)?;
-    if args.link == LinkKind::Udp {
-        crate::udp::UdpPorts::parse(&args.udp_ports).ok_or_else(|| {
-            bad(format!(
-                "--udp-ports {:?}: expected three ports m,e,s",
-                args.udp_ports
-            ))
-        })?;
-    }
+    check_link_args(args, &[args.link])?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| bad(format!("creating {}: {e}", args.out.display())))?;
     for file in [
@@ -309,6 +328,20 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
     }
 }
 
+/// The link in words, for the record and the log.
+pub fn describe_link(a: &NodeArgs) -> String {
+    match a.link {
+        LinkKind::Iceoryx2 => "iceoryx2".into(),
+        LinkKind::Udp => format!("udp ports {} on {}", a.udp_ports, a.udp_hosts),
+        LinkKind::Zenoh => format!(
+            "zenoh (listen {:?}, connect {:?}{})",
+            a.listen,
+            a.connect,
+            if a.scout { ", scouting" } else { "" }
+        ),
+    }
+}
+
 /// The `Start` of a node's record from its arguments.
 pub fn start_record(role: &str, args: &NodeArgs, p: &Prepared) -> Start {
     let unix_ms = std::time::SystemTime::now()
@@ -323,10 +356,7 @@ pub fn start_record(role: &str, args: &NodeArgs, p: &Prepared) -> Start {
             .to_string_lossy()
             .into_owned(),
         prefix: args.prefix.clone(),
-        link: match args.link {
-            LinkKind::Iceoryx2 => "iceoryx2".into(),
-            LinkKind::Udp => format!("udp {}", args.udp_ports),
-        },
+        link: describe_link(args),
         scenario: p.scenario.name.clone(),
         scenario_toml: p.scenario.resolved(&p.base_dir).to_toml(),
         samples: p.scenario.samples,
@@ -367,36 +397,115 @@ pub fn new_run_token() -> u64 {
 }
 
 fn udp_ports(a: &NodeArgs) -> Result<crate::udp::UdpPorts, NodeError> {
-    crate::udp::UdpPorts::parse(&a.udp_ports).ok_or_else(|| {
-        NodeError::BadInput(format!("--udp-ports {:?}: expected m,e,s", a.udp_ports))
+    let ports = crate::udp::UdpPorts::parse(&a.udp_ports).ok_or_else(|| {
+        NodeError::BadInput(format!(
+            "--udp-ports {:?}: expected three ports m,e,s",
+            a.udp_ports
+        ))
+    })?;
+    ports.on_hosts(&a.udp_hosts).ok_or_else(|| {
+        NodeError::BadInput(format!(
+            "--udp-hosts {:?}: expected three IP addresses a,b,c",
+            a.udp_hosts
+        ))
     })
+}
+
+/// The Zenoh endpoints of the arguments.
+pub fn zenoh_options(a: &NodeArgs) -> crate::zlink::ZenohOptions {
+    crate::zlink::ZenohOptions {
+        listen: a.listen.clone(),
+        connect: a.connect.clone(),
+        scout: a.scout,
+    }
+}
+
+/// Checks the options of the links in use, before anything starts.
+pub fn check_link_args(a: &NodeArgs, links: &[LinkKind]) -> Result<(), NodeError> {
+    if links.contains(&LinkKind::Udp) {
+        udp_ports(a)?;
+    }
+    if links.contains(&LinkKind::Zenoh) {
+        if a.listen.is_empty() && a.connect.is_empty() && !a.scout {
+            return Err(NodeError::BadInput(
+                "--link zenoh: give --listen ENDPOINT and/or --connect ENDPOINT (or --scout) so the nodes can meet".into(),
+            ));
+        }
+        for e in a.listen.iter().chain(&a.connect) {
+            let ok = e.split_once('/').is_some_and(|(proto, addr)| {
+                matches!(proto, "tcp" | "udp") && addr.parse::<std::net::SocketAddr>().is_ok()
+            });
+            if !ok {
+                return Err(NodeError::BadInput(format!(
+                    "Zenoh endpoint {e:?}: expected tcp/ADDRESS:PORT or udp/ADDRESS:PORT"
+                )));
+            }
+        }
+        zenoh_options(a)
+            .config()
+            .map_err(|e| NodeError::BadInput(e.to_string()))?;
+    }
+    Ok(())
 }
 
 fn opened<T>(r: Result<T, crate::ipc::IpcError>) -> Result<T, NodeError> {
     r.map_err(|e| NodeError::Failed(e.to_string()))
 }
 
-/// The master's link as the arguments choose it.
+/// The master's link as the arguments choose it; `direct`: no emulator, the slave
+/// is the master's peer (Zenoh only).
 pub fn master_link(
     a: &NodeArgs,
     spin: Duration,
+    direct: bool,
 ) -> Result<Box<dyn crate::link::MasterLink>, NodeError> {
     let wait = crate::ipc::WaitPolicy { spin };
+    if direct && a.link != LinkKind::Zenoh {
+        return Err(NodeError::BadInput(
+            "--direct (no emulator) needs --link zenoh".into(),
+        ));
+    }
     Ok(match a.link {
         LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxMaster::open(&a.prefix, wait))?),
         LinkKind::Udp => Box::new(opened(crate::udp::UdpMaster::open(udp_ports(a)?))?),
+        LinkKind::Zenoh => Box::new(opened(crate::zlink::ZenohMaster::open(
+            &zenoh_options(a),
+            &a.prefix,
+            direct,
+            wait,
+        ))?),
     })
 }
 
-/// The emulator's link as the arguments choose it.
+/// The emulator's link: `towards_master` and `towards_slave` chosen on their own, so
+/// the emulator can sit on either host (Zenoh on one side, iceoryx2 on the other).
 pub fn emulator_link(
     a: &NodeArgs,
     spin: Duration,
+    towards_master: LinkKind,
+    towards_slave: LinkKind,
 ) -> Result<Box<dyn crate::link::EmulatorLink>, NodeError> {
+    use LinkKind::{Iceoryx2, Udp, Zenoh};
     let wait = crate::ipc::WaitPolicy { spin };
-    Ok(match a.link {
-        LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxEmulator::open(&a.prefix, wait))?),
-        LinkKind::Udp => Box::new(opened(crate::udp::UdpEmulator::open(udp_ports(a)?))?),
+    Ok(match (towards_master, towards_slave) {
+        (Iceoryx2, Iceoryx2) => Box::new(opened(crate::ipc::IoxEmulator::open(&a.prefix, wait))?),
+        (Udp, Udp) => Box::new(opened(crate::udp::UdpEmulator::open(udp_ports(a)?))?),
+        (Zenoh, Zenoh) | (Zenoh, Iceoryx2) | (Iceoryx2, Zenoh) => {
+            Box::new(opened(crate::zlink::ZenohEmulator::open(
+                &zenoh_options(a),
+                &a.prefix,
+                towards_master == Iceoryx2,
+                towards_slave == Iceoryx2,
+                wait,
+            ))?)
+        }
+        (m, s) => {
+            return Err(NodeError::BadInput(format!(
+                "--master-link {} with --slave-link {}: UDP cannot be mixed with another link (Zenoh and iceoryx2 can)",
+                m.name(),
+                s.name()
+            )))
+        }
     })
 }
 
@@ -409,5 +518,10 @@ pub fn slave_link(
     Ok(match a.link {
         LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxSlave::open(&a.prefix, wait))?),
         LinkKind::Udp => Box::new(opened(crate::udp::UdpSlave::open(udp_ports(a)?))?),
+        LinkKind::Zenoh => Box::new(opened(crate::zlink::ZenohSlave::open(
+            &zenoh_options(a),
+            &a.prefix,
+            wait,
+        ))?),
     })
 }

@@ -1,25 +1,23 @@
-//! The same loop over UDP on loopback: the transport most teleoperation stacks use,
-//! measured beside iceoryx2 by `tactile bench`.
+//! The same loop over UDP: the transport most teleoperation stacks use, measured beside
+//! iceoryx2 and Zenoh by `tactile bench`.
 //!
-//! Each process binds one socket; a datagram is a tag byte (forward or backward) and
-//! the sample encoded with bincode. Receives block with a timeout (what a typical
-//! stack does), waking every 50 ms at most to notice a stop request. A send refused by
-//! the operating system (no socket bound at the peer's port) counts as published with
-//! no receiver; UDP cannot tell a dead peer otherwise.
+//! Each process binds one socket at its own address; a datagram is one frame of the
+//! wire format ([`crate::wire`]). Receives block with a timeout (what a typical stack
+//! does), waking every 50 ms at most to notice a stop request. A send refused by the
+//! operating system (no socket bound at the peer's port) counts as published with no
+//! receiver; UDP cannot tell a dead peer otherwise. A datagram that is not a whole
+//! frame of this build's format is counted and dropped.
 
 use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats};
 use crate::link::{Arrival, EmulatorLink, EmulatorStats, MasterLink, SlaveLink, Wait};
-use serde::{de::DeserializeOwned, Serialize};
+use crate::wire::{self, backward, count as take, forward, Frame};
 use std::cell::{Cell, RefCell};
 use std::io::ErrorKind;
-use std::net::{SocketAddr, UdpSocket};
+use std::net::{IpAddr, SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_common::samples::{Backward, Forward, Sequenced};
-
-const TAG_FORWARD: u8 = 0;
-const TAG_BACKWARD: u8 = 1;
 
 fn err(context: &str, e: impl std::fmt::Display) -> IpcError {
     IpcError {
@@ -28,7 +26,7 @@ fn err(context: &str, e: impl std::fmt::Display) -> IpcError {
     }
 }
 
-/// Loopback ports of the three processes.
+/// Ports of the three processes, and their hosts' addresses (loopback by default).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct UdpPorts {
     /// The master's port.
@@ -37,7 +35,11 @@ pub struct UdpPorts {
     pub emulator: u16,
     /// The slave's port.
     pub slave: u16,
+    /// Addresses of the master's, the emulator's and the slave's hosts.
+    pub hosts: [IpAddr; 3],
 }
+
+const LOOPBACK: IpAddr = IpAddr::V4(std::net::Ipv4Addr::LOCALHOST);
 
 impl UdpPorts {
     /// Three ports free right now (bound to port 0 and released).
@@ -52,6 +54,7 @@ impl UdpPorts {
             master: pick()?,
             emulator: pick()?,
             slave: pick()?,
+            hosts: [LOOPBACK; 3],
         })
     }
 
@@ -66,9 +69,21 @@ impl UdpPorts {
                 master,
                 emulator,
                 slave,
+                hosts: [LOOPBACK; 3],
             }),
             _ => None,
         }
+    }
+
+    /// The same ports on the hosts `a,b,c` (master, emulator, slave) as on the
+    /// command line.
+    pub fn on_hosts(mut self, text: &str) -> Option<UdpPorts> {
+        let v: Vec<IpAddr> = text
+            .split(',')
+            .map(|p| p.trim().parse().ok())
+            .collect::<Option<_>>()?;
+        self.hosts = v.try_into().ok()?;
+        Some(self)
     }
 
     /// `m,e,s` for the command line.
@@ -76,8 +91,16 @@ impl UdpPorts {
         format!("{},{},{}", self.master, self.emulator, self.slave)
     }
 
-    fn addr(port: u16) -> SocketAddr {
-        SocketAddr::from(([127, 0, 0, 1], port))
+    fn master_addr(&self) -> SocketAddr {
+        SocketAddr::new(self.hosts[0], self.master)
+    }
+
+    fn emulator_addr(&self) -> SocketAddr {
+        SocketAddr::new(self.hosts[1], self.emulator)
+    }
+
+    fn slave_addr(&self) -> SocketAddr {
+        SocketAddr::new(self.hosts[2], self.slave)
     }
 }
 
@@ -90,9 +113,8 @@ struct Endpoint {
 }
 
 impl Endpoint {
-    fn bind(port: u16) -> Result<Endpoint, IpcError> {
-        let socket = UdpSocket::bind(UdpPorts::addr(port))
-            .map_err(|e| err(&format!("binding UDP port {port}"), e))?;
+    fn bind(at: SocketAddr) -> Result<Endpoint, IpcError> {
+        let socket = UdpSocket::bind(at).map_err(|e| err(&format!("binding UDP {at}"), e))?;
         let stop = Arc::new(AtomicBool::new(false));
         for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
             signal_hook::flag::register(sig, Arc::clone(&stop))
@@ -101,25 +123,23 @@ impl Endpoint {
         Ok(Endpoint {
             socket,
             stop,
-            buf: RefCell::new(vec![0; 4096]),
+            buf: RefCell::new(Vec::with_capacity(wire::MAX_FRAME)),
         })
     }
 
-    fn send<T: Serialize + Sequenced>(
+    fn send<T: Sequenced + Copy>(
         &self,
-        to: u16,
-        tag: u8,
+        to: SocketAddr,
         mut value: T,
         control: bool,
         stats: &Cell<OutboxStats>,
+        encode: fn(&T, &mut Vec<u8>) -> Result<(), String>,
     ) -> Result<(), IpcError> {
         let mut st = stats.get();
         st.stamp(&mut value, control);
         let mut buf = self.buf.borrow_mut();
-        buf[0] = tag;
-        let n = bincode::serde::encode_into_slice(&value, &mut buf[1..], bincode::config::legacy())
-            .map_err(|e| err("encoding a sample", e))?;
-        let receivers = match self.socket.send_to(&buf[..n + 1], UdpPorts::addr(to)) {
+        encode(&value, &mut buf).map_err(|e| err("encoding a sample", e))?;
+        let receivers = match self.socket.send_to(&buf, to) {
             Ok(_) => 1,
             Err(e) if e.kind() == ErrorKind::ConnectionRefused => 0,
             Err(e) => return Err(err("sending a datagram", e)),
@@ -129,14 +149,15 @@ impl Endpoint {
         Ok(())
     }
 
-    /// Waits for one datagram until `deadline` and hands its tag and body to `take`
-    /// (decoded in place: no copy, no allocation).
+    /// Waits for one datagram until `deadline` and hands its decoded frame to `take`
+    /// (`Err` for a rejected one, which `take` counts).
     fn recv<R>(
         &self,
         deadline: Instant,
-        mut take: impl FnMut(u8, &[u8]) -> Result<Option<R>, IpcError>,
+        mut take: impl FnMut(Result<Frame, wire::Reject>) -> Option<R>,
     ) -> Result<Result<R, Idle>, IpcError> {
         let mut buf = self.buf.borrow_mut();
+        buf.resize(wire::MAX_FRAME + 1, 0);
         loop {
             if self.stop.load(Ordering::Relaxed) {
                 return Ok(Err(Idle::Terminate));
@@ -152,12 +173,11 @@ impl Endpoint {
                 .set_read_timeout(Some(wait))
                 .map_err(|e| err("setting a UDP timeout", e))?;
             match self.socket.recv(&mut buf) {
-                Ok(n) if n > 0 => {
-                    if let Some(r) = take(buf[0], &buf[1..n])? {
+                Ok(n) => {
+                    if let Some(r) = take(wire::decode(&buf[..n])) {
                         return Ok(Ok(r));
                     }
                 }
-                Ok(_) => {}
                 Err(e)
                     if matches!(
                         e.kind(),
@@ -170,32 +190,6 @@ impl Endpoint {
             }
         }
     }
-}
-
-/// Decodes one datagram body and counts it; a body that is not a whole sample (garbage,
-/// truncated, another format) is counted as malformed and dropped, never an error:
-/// nothing the network delivers may stop a node.
-fn decode<T: DeserializeOwned + Sequenced>(
-    body: &[u8],
-    stats: &Cell<InboxStats>,
-    next: &Cell<Option<u64>>,
-) -> Option<T> {
-    let mut st = stats.get();
-    let decoded = bincode::serde::decode_from_slice::<T, _>(body, bincode::config::legacy());
-    let v = match decoded {
-        Ok((v, used)) if used == body.len() => Some(v),
-        _ => {
-            st.malformed += 1;
-            None
-        }
-    };
-    if let Some(v) = &v {
-        let mut n = next.get();
-        st.count(v, &mut n);
-        next.set(n);
-    }
-    stats.set(st);
-    v
 }
 
 /// The master's end over UDP.
@@ -212,7 +206,7 @@ impl UdpMaster {
     /// Binds the master's port.
     pub fn open(ports: UdpPorts) -> Result<Self, IpcError> {
         Ok(UdpMaster {
-            ep: Endpoint::bind(ports.master)?,
+            ep: Endpoint::bind(ports.master_addr())?,
             ports,
             out: Cell::default(),
             inn: Cell::default(),
@@ -223,19 +217,26 @@ impl UdpMaster {
 
 impl MasterLink for UdpMaster {
     fn send(&self, c: Forward) -> Result<(), IpcError> {
-        self.ep
-            .send(self.ports.emulator, TAG_FORWARD, c, false, &self.out)
+        self.ep.send(
+            self.ports.emulator_addr(),
+            c,
+            false,
+            &self.out,
+            wire::encode_forward,
+        )
     }
     fn send_control(&self, c: Forward) -> Result<(), IpcError> {
-        self.ep
-            .send(self.ports.emulator, TAG_FORWARD, c, true, &self.out)
+        self.ep.send(
+            self.ports.emulator_addr(),
+            c,
+            true,
+            &self.out,
+            wire::encode_forward,
+        )
     }
     fn recv(&self, deadline: Instant) -> Wait<Backward> {
-        self.ep.recv(deadline, |tag, body| {
-            Ok((tag == TAG_BACKWARD)
-                .then(|| decode(body, &self.inn, &self.next))
-                .flatten())
-        })
+        self.ep
+            .recv(deadline, |got| take(got, backward, &self.inn, &self.next))
     }
     fn dead_peers(&self) -> Vec<String> {
         Vec::new()
@@ -259,7 +260,7 @@ impl UdpEmulator {
     /// Binds the emulator's port.
     pub fn open(ports: UdpPorts) -> Result<Self, IpcError> {
         Ok(UdpEmulator {
-            ep: Endpoint::bind(ports.emulator)?,
+            ep: Endpoint::bind(ports.emulator_addr())?,
             ports,
             stats: Default::default(),
             inn: Default::default(),
@@ -270,26 +271,33 @@ impl UdpEmulator {
 
 impl EmulatorLink for UdpEmulator {
     fn recv(&self, deadline: Instant) -> Wait<Arrival> {
-        self.ep.recv(deadline, |tag, body| {
-            Ok(match tag {
-                TAG_FORWARD => decode(body, &self.inn[0], &self.next[0]).map(Arrival::Forward),
-                TAG_BACKWARD => decode(body, &self.inn[1], &self.next[1]).map(Arrival::Backward),
-                _ => {
-                    let mut st = self.inn[0].get();
-                    st.malformed += 1;
-                    self.inn[0].set(st);
-                    None
-                }
-            })
+        self.ep.recv(deadline, |got| match got {
+            Ok(Frame::Forward(_)) => {
+                take(got, forward, &self.inn[0], &self.next[0]).map(Arrival::Forward)
+            }
+            Ok(Frame::Backward(_)) => {
+                take(got, backward, &self.inn[1], &self.next[1]).map(Arrival::Backward)
+            }
+            Err(_) => take(got, forward, &self.inn[0], &self.next[0]).map(Arrival::Forward),
         })
     }
     fn send_v(&self, v: Forward, control: bool) -> Result<(), IpcError> {
-        self.ep
-            .send(self.ports.slave, TAG_FORWARD, v, control, &self.stats[0])
+        self.ep.send(
+            self.ports.slave_addr(),
+            v,
+            control,
+            &self.stats[0],
+            wire::encode_forward,
+        )
     }
     fn send_q(&self, q: Backward, control: bool) -> Result<(), IpcError> {
-        self.ep
-            .send(self.ports.master, TAG_BACKWARD, q, control, &self.stats[1])
+        self.ep.send(
+            self.ports.master_addr(),
+            q,
+            control,
+            &self.stats[1],
+            wire::encode_backward,
+        )
     }
     fn stats(&self) -> EmulatorStats {
         EmulatorStats {
@@ -315,7 +323,7 @@ impl UdpSlave {
     /// Binds the slave's port.
     pub fn open(ports: UdpPorts) -> Result<Self, IpcError> {
         Ok(UdpSlave {
-            ep: Endpoint::bind(ports.slave)?,
+            ep: Endpoint::bind(ports.slave_addr())?,
             ports,
             out: Cell::default(),
             inn: Cell::default(),
@@ -326,15 +334,17 @@ impl UdpSlave {
 
 impl SlaveLink for UdpSlave {
     fn recv(&self, deadline: Instant) -> Wait<Forward> {
-        self.ep.recv(deadline, |tag, body| {
-            Ok((tag == TAG_FORWARD)
-                .then(|| decode(body, &self.inn, &self.next))
-                .flatten())
-        })
+        self.ep
+            .recv(deadline, |got| take(got, forward, &self.inn, &self.next))
     }
     fn send_h(&self, h: Backward, control: bool) -> Result<(), IpcError> {
-        self.ep
-            .send(self.ports.emulator, TAG_BACKWARD, h, control, &self.out)
+        self.ep.send(
+            self.ports.emulator_addr(),
+            h,
+            control,
+            &self.out,
+            wire::encode_backward,
+        )
     }
     fn stats(&self) -> (InboxStats, OutboxStats) {
         (self.inn.get(), self.out.get())
