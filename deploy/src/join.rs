@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use tactile_common::samples::{stage, LATE_WINDOW};
 use tactile_common::trace::TraceRow;
-use tactile_master::record::{Answer, MasterRecord, MasterSample, MasterTotals, Miss, Sent};
+use tactile_master::record::{Answer, MasterSample, MasterTotals, Miss, Sent};
 use tactile_network_emulator::emulator::{Direction, Passage};
 use tactile_network_emulator::process::EmulatorTotals;
 use tactile_node::record::{Record, RecordReader, Start, Totals};
@@ -256,17 +256,45 @@ pub fn locate(dirs: &[PathBuf]) -> Result<[Option<PathBuf>; 3], Error> {
     Ok(found)
 }
 
-/// The master's `Start` (first segment) in `path`, read without joining.
-pub fn master_start(path: &Path) -> Result<Start, Error> {
+/// The `Start` (first segment) of a record, read without joining.
+fn first_start<S, C>(path: &Path) -> Result<Start, Error>
+where
+    S: serde::de::DeserializeOwned,
+    C: serde::de::DeserializeOwned,
+{
     let mut r =
-        RecordReader::<MasterRecord>::open(path).map_err(|e| Error::BadInput(e.to_string()))?;
+        RecordReader::<Record<S, C>>::open(path).map_err(|e| Error::BadInput(e.to_string()))?;
     match r.next_record() {
         Ok(Some(Record::Start(s))) => Ok(s),
         _ => Err(Error::BadInput(format!(
-            "{}: the record does not begin with the master's start",
+            "{}: the record does not begin with its node's start",
             path.display()
         ))),
     }
+}
+
+/// The master's `Start` in `path`.
+pub fn master_start(path: &Path) -> Result<Start, Error> {
+    first_start::<MasterSample, MasterTotals>(path)
+}
+
+/// The clock domain of each node (empty where a node left no record).
+pub fn clock_domains(found: &[Option<PathBuf>; 3]) -> Result<[String; 3], Error> {
+    let domain = |p: &Option<PathBuf>, k: usize| -> Result<String, Error> {
+        let Some(p) = p else {
+            return Ok(String::new());
+        };
+        Ok(match k {
+            0 => first_start::<MasterSample, MasterTotals>(p)?.clock,
+            1 => first_start::<Passage, EmulatorTotals>(p)?.clock,
+            _ => first_start::<SlaveSample, SlaveTotals>(p)?.clock,
+        })
+    };
+    Ok([
+        domain(&found[0], 0)?,
+        domain(&found[1], 1)?,
+        domain(&found[2], 2)?,
+    ])
 }
 
 fn master_key(s: &MasterSample) -> Option<u64> {

@@ -154,6 +154,91 @@ pub const STAGES: [(&str, usize, usize); 9] = [
     ("master_compute_bwd", stage::MASTER_RECV, stage::MASTER_DONE),
 ];
 
+/// The node that stamps `stage`: 0 master, 1 emulator, 2 slave.
+pub fn stamper(stage: usize) -> usize {
+    match stage {
+        stage::EMU_FWD_RECV | stage::EMU_FWD_SEND | stage::EMU_BWD_RECV | stage::EMU_BWD_SEND => 1,
+        stage::SLAVE_RECV | stage::SLAVE_SEND => 2,
+        _ => 0,
+    }
+}
+
+/// Node pairs whose clocks may be compared, with the four stamps of an exchange
+/// between them: A sends, B receives, B sends back, A receives.
+pub const PAIRS: [(usize, usize, [usize; 4]); 3] = [
+    (
+        0,
+        1,
+        [
+            stage::MASTER_SEND,
+            stage::EMU_FWD_RECV,
+            stage::EMU_BWD_SEND,
+            stage::MASTER_RECV,
+        ],
+    ),
+    (
+        1,
+        2,
+        [
+            stage::EMU_FWD_SEND,
+            stage::SLAVE_RECV,
+            stage::SLAVE_SEND,
+            stage::EMU_BWD_RECV,
+        ],
+    ),
+    (
+        0,
+        2,
+        [
+            stage::MASTER_SEND,
+            stage::SLAVE_RECV,
+            stage::SLAVE_SEND,
+            stage::MASTER_RECV,
+        ],
+    ),
+];
+
+/// Role names by index.
+pub const NODES: [&str; 3] = ["master", "emulator", "slave"];
+
+/// The offset of one node's clock from another's, estimated from the exchanges between
+/// them (an estimate: it assumes the two directions of the network take equal time).
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct ClockOffset {
+    /// `A-B`: the offset is B's clock minus A's.
+    pub between: String,
+    /// B's clock minus A's, ns: an estimate from the exchange with the shortest network
+    /// round trip ((t2 - t1) + (t3 - t4)) / 2, as NTP does.
+    pub offset_ns_estimate: i64,
+    /// The estimate is within this of the truth, ns: half that shortest round trip.
+    pub uncertainty_ns: i64,
+    /// The shortest network round trip seen (both hops, without B's own time), ns.
+    pub min_network_round_trip_ns: i64,
+    /// Exchanges used.
+    pub exchanges: u64,
+}
+
+/// Gathers the best exchange between two nodes.
+#[derive(Debug, Clone, Default)]
+struct OffsetFinder {
+    best: Option<(i64, i64)>,
+    exchanges: u64,
+}
+
+impl OffsetFinder {
+    fn add(&mut self, t: [u64; 4]) {
+        let [t1, t2, t3, t4] = t.map(|x| x as i64);
+        let network = (t4 - t1) - (t3 - t2);
+        if network < 0 {
+            return;
+        }
+        self.exchanges += 1;
+        if self.best.is_none_or(|(rtt, _)| network < rtt) {
+            self.best = Some((network, ((t2 - t1) + (t3 - t4)) / 2));
+        }
+    }
+}
+
 /// Tracking and force statistics.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Motion {
@@ -190,6 +275,9 @@ pub struct Analysis {
     /// Rows in all.
     pub rows: u64,
     with_stages: bool,
+    /// Each node's clock domain (empty: the node left no record).
+    domains: [String; 3],
+    offsets: [OffsetFinder; 3],
     track_sq: f64,
     tracked: u64,
     felt_sq: f64,
@@ -200,8 +288,9 @@ fn norm(v: [f64; 3]) -> f64 {
 }
 
 impl Analysis {
-    /// An empty analysis; `with_stages`: the stamps are real (a process run).
-    pub fn new(with_stages: bool) -> Self {
+    /// An empty analysis; `with_stages`: the stamps are real (a process run);
+    /// `domains`: the clock domain of master, emulator and slave.
+    pub fn new(with_stages: bool, domains: [String; 3]) -> Self {
         Analysis {
             round_trip: Latency::default(),
             overhead: Latency::default(),
@@ -210,6 +299,8 @@ impl Analysis {
             received: 0,
             rows: 0,
             with_stages,
+            domains,
+            offsets: Default::default(),
             track_sq: 0.0,
             tracked: 0,
             felt_sq: 0.0,
@@ -246,14 +337,49 @@ impl Analysis {
             self.round_trip.record(row.round_trip_ns as i64);
             self.overhead.record(row.overhead_ns);
         }
-        if self.with_stages {
-            for (k, (_, from, to)) in STAGES.iter().enumerate() {
-                let (a, z) = (row.stamps[*from], row.stamps[*to]);
-                if a != 0 && z != 0 {
-                    self.stages[k].record(z as i64 - a as i64);
-                }
+        if !self.with_stages {
+            return;
+        }
+        for (k, (_, from, to)) in STAGES.iter().enumerate() {
+            let (a, z) = (row.stamps[*from], row.stamps[*to]);
+            if a != 0 && z != 0 && self.same_clock(stamper(*from), stamper(*to)) {
+                self.stages[k].record(z as i64 - a as i64);
             }
         }
+        for (k, (a, b, st)) in PAIRS.iter().enumerate() {
+            let t = st.map(|i| row.stamps[i]);
+            if !self.same_clock(*a, *b) && t.iter().all(|x| *x != 0) {
+                self.offsets[k].add(t);
+            }
+        }
+    }
+
+    /// Each node's clock domain (empty where it left no record).
+    pub fn domains(&self) -> &[String; 3] {
+        &self.domains
+    }
+
+    /// True if nodes `a` and `b` stamp with one clock.
+    pub fn same_clock(&self, a: usize, b: usize) -> bool {
+        self.domains[a] == self.domains[b]
+    }
+
+    /// The offset estimates between nodes on different clocks that exchanged samples.
+    pub fn clock_offsets(&self) -> Vec<ClockOffset> {
+        PAIRS
+            .iter()
+            .zip(&self.offsets)
+            .filter_map(|((a, b, _), f)| {
+                let (rtt, offset) = f.best?;
+                Some(ClockOffset {
+                    between: format!("{}-{}", NODES[*a], NODES[*b]),
+                    offset_ns_estimate: offset,
+                    uncertainty_ns: rtt / 2,
+                    min_network_round_trip_ns: rtt,
+                    exchanges: f.exchanges,
+                })
+            })
+            .collect()
     }
 
     /// Closes the running sums into the motion statistics.

@@ -5,7 +5,7 @@ use crate::error::Error;
 use crate::join::{self, Logs, NodeLog};
 use crate::plots::{self, Series};
 use crate::report::{Analysis, STAGES};
-use crate::summary::{render, ChannelCount, MasterPart, NodeSummary, Summary};
+use crate::summary::{render, ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -121,6 +121,15 @@ fn events<C: Clone>(role: &str, log: &NodeLog<C>, out: &mut Vec<String>) -> u64 
     log.events_omitted
 }
 
+/// True if node `k` (0 master, 1 emulator, 2 slave) left no record.
+fn logs_missing(logs: &Logs, k: usize) -> bool {
+    match k {
+        0 => logs.master.starts.is_empty(),
+        1 => logs.emulator.starts.is_empty(),
+        _ => logs.slave.starts.is_empty(),
+    }
+}
+
 /// The summary from the joined statistics and the nodes' logs.
 fn summarise(
     scenario: &Scenario,
@@ -174,6 +183,16 @@ fn summarise(
         round_trip_ns: a.round_trip.percentiles(),
         overhead_ns: a.overhead.percentiles(),
         overhead_negative: a.overhead.negative,
+        clocks: Clocks {
+            shared: (0..3).all(|k| a.same_clock(0, k) || logs_missing(logs, k)),
+            domains: crate::report::NODES
+                .iter()
+                .zip(a.domains())
+                .filter(|(_, d)| !d.is_empty())
+                .map(|(n, d)| (*n, d.clone()))
+                .collect(),
+            offsets: a.clock_offsets(),
+        },
         stages_ns: STAGES
             .iter()
             .zip(&a.stages)
@@ -207,9 +226,12 @@ fn summarise(
 /// Joins the records in `dirs` and writes the report into `out`: summary, trace,
 /// histograms, plots and the scenario as run. Returns the summary.
 pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Summary, Error> {
-    let [master, _, _] = join::locate(dirs)?;
-    let master = master.ok_or_else(|| Error::BadInput("no master record".into()))?;
+    let found = join::locate(dirs)?;
+    let master = found[0]
+        .clone()
+        .ok_or_else(|| Error::BadInput("no master record".into()))?;
     let start = join::master_start(&master)?;
+    let domains = join::clock_domains(&found)?;
     let scenario = Scenario::from_toml_str(&start.scenario_toml).map_err(|e| {
         Error::BadInput(format!(
             "{}: the scenario recorded is not valid: {e}",
@@ -224,7 +246,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     } else {
         "processes"
     };
-    let mut analysis = Analysis::new(runner != IN_PROCESS);
+    let mut analysis = Analysis::new(runner != IN_PROCESS, domains);
     let mut series = Series::default();
     let trace_path = out.join("trace.csv");
     let mut trace = if launch.no_trace {

@@ -578,11 +578,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
                 .map_or_else(|| default_spin(&loaded.scenario), Duration::from_micros),
             progress: !args.quiet,
             max_restarts: args.max_restarts,
-            link: Links::on_this_host(if args.udp {
-                LinkKind::Udp
-            } else {
-                args.link
-            })?,
+            link: Links::on_this_host(if args.udp { LinkKind::Udp } else { args.link })?,
             pin: !args.no_pin,
             rt: args.rt,
             no_trace: args.no_trace,

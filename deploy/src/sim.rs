@@ -33,6 +33,7 @@ fn start(role: &str, scenario: &Scenario, base_dir: &Path) -> Start {
         version: env!("CARGO_PKG_VERSION").into(),
         pid: std::process::id(),
         host: "in-process".into(),
+        clock: "in-process".into(),
         prefix: String::new(),
         link: IN_PROCESS.into(),
         scenario: scenario.name.clone(),

@@ -1,7 +1,7 @@
 //! `summary.json` and the terminal summary: a view of the nodes' records, with each
 //! stream's accounting.
 
-use crate::report::{us_header, us_line, Motion, Percentiles};
+use crate::report::{us_header, us_line, ClockOffset, Motion, Percentiles};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -88,6 +88,19 @@ pub struct NodeSummary {
     pub unjoined: u64,
 }
 
+/// The nodes' clocks.
+#[derive(Debug, Clone, Serialize)]
+pub struct Clocks {
+    /// True if every node stamps with one clock (one host, or one kernel): every stage
+    /// and hop time is then a true time.
+    pub shared: bool,
+    /// Each node's clock domain (its kernel's boot id).
+    pub domains: BTreeMap<&'static str, String>,
+    /// Between nodes on different clocks: the offset, an estimate; the round trip, on
+    /// the master's clock alone, is exact either way.
+    pub offsets: Vec<ClockOffset>,
+}
+
 /// `summary.json`: a view of the nodes' records.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
@@ -109,8 +122,11 @@ pub struct Summary {
     pub overhead_ns: Option<Percentiles>,
     /// Overheads below zero (tick jitter), clamped to zero in the histogram.
     pub overhead_negative: u64,
-    /// Per-stage times, ns (stages with no data are left out).
+    /// Per-stage times, ns (stages with no data, and stages between two nodes on
+    /// different clocks, are left out).
     pub stages_ns: BTreeMap<String, Percentiles>,
+    /// Which nodes share a clock, and the offset estimates between those that do not.
+    pub clocks: Clocks,
     /// Forward samples the master sent.
     pub samples_sent: u64,
     /// Backward samples the master received.
@@ -156,6 +172,23 @@ pub fn render(s: &Summary, out: &Path) -> String {
     let _ = writeln!(t, "{}", us_line("system overhead", s.overhead_ns.as_ref()));
     for (name, p) in &s.stages_ns {
         let _ = writeln!(t, "{}", us_line(&format!("  {name}"), Some(p)));
+    }
+    if !s.clocks.shared {
+        let _ = writeln!(
+            t,
+            "clocks: the nodes do not share one clock; stages between them are left out"
+        );
+        for o in &s.clocks.offsets {
+            let _ = writeln!(
+                t,
+                "  {} clock offset (estimate): {:.3} ms +- {:.1} us ({} exchanges, shortest network round trip {:.1} us)",
+                o.between,
+                o.offset_ns_estimate as f64 / 1e6,
+                o.uncertainty_ns as f64 / 1e3,
+                o.exchanges,
+                o.min_network_round_trip_ns as f64 / 1e3
+            );
+        }
     }
     let _ = writeln!(
         t,

@@ -42,7 +42,16 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let p = prepare("emulator", a)?;
     check_link_args(a, &[towards_master, towards_slave])?;
     let mut rec = Recorder::open(&a.out, "emulator", a.append)?;
-    rec.start(start_record("emulator", a, &p))?;
+    let mut start = start_record("emulator", a, &p);
+    if towards_master != towards_slave {
+        start.link = format!(
+            "towards the master {}, towards the slave {}; {}",
+            towards_master.name(),
+            towards_slave.name(),
+            start.link
+        );
+    }
+    rec.start(start)?;
     tracing::info!("waiting for the master");
     let ended = emulator_link(a, p.spin, towards_master, towards_slave).and_then(|link| {
         run_with(&p.scenario, link.as_ref(), &mut rec).map_err(|e| NodeError::Failed(e.to_string()))

@@ -26,6 +26,8 @@ fn config() -> impl bincode::config::Config {
 }
 
 /// One entry of a node's record. `S` is the node's per-sample record, `C` its counters.
+// A record lives for one write or one read; boxing `Start` would allocate for nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Record<S, C> {
     /// A node started (a file holds one segment per start).
@@ -53,6 +55,10 @@ pub struct Start {
     pub pid: u32,
     /// Host name.
     pub host: String,
+    /// The clock domain: nodes with the same one share CLOCK_MONOTONIC (the kernel's
+    /// boot id; `TACTILE_CLOCK_DOMAIN` overrides it), so a stage between their stamps is
+    /// a true time; between two domains only an estimate is possible.
+    pub clock: String,
     /// iceoryx2 prefix (or the link's name of the run).
     pub prefix: String,
     /// The link in use.

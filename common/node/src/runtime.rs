@@ -328,9 +328,30 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
     }
 }
 
+/// This node's clock domain: `TACTILE_CLOCK_DOMAIN` if set, else the kernel's boot id
+/// (processes under one kernel, network namespaces included, share CLOCK_MONOTONIC).
+pub fn clock_domain() -> String {
+    if let Ok(d) = std::env::var("TACTILE_CLOCK_DOMAIN") {
+        return d;
+    }
+    std::fs::read_to_string("/proc/sys/kernel/random/boot_id")
+        .map(|s| s.trim().to_string())
+        .unwrap_or_else(|_| {
+            rustix::system::uname()
+                .nodename()
+                .to_string_lossy()
+                .into_owned()
+        })
+}
+
 /// The link in words, for the record and the log.
 pub fn describe_link(a: &NodeArgs) -> String {
+    let zenoh_used = !a.listen.is_empty() || !a.connect.is_empty();
     match a.link {
+        LinkKind::Iceoryx2 if zenoh_used => format!(
+            "iceoryx2 and zenoh (listen {:?}, connect {:?})",
+            a.listen, a.connect
+        ),
         LinkKind::Iceoryx2 => "iceoryx2".into(),
         LinkKind::Udp => format!("udp ports {} on {}", a.udp_ports, a.udp_hosts),
         LinkKind::Zenoh => format!(
@@ -355,6 +376,7 @@ pub fn start_record(role: &str, args: &NodeArgs, p: &Prepared) -> Start {
             .nodename()
             .to_string_lossy()
             .into_owned(),
+        clock: clock_domain(),
         prefix: args.prefix.clone(),
         link: describe_link(args),
         scenario: p.scenario.name.clone(),

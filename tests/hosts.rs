@@ -1,0 +1,487 @@
+//! Master and slave on different hosts, over Zenoh. Two Linux network namespaces
+//! joined by a veth pair are the two hosts, with addresses from 198.18.0.0/15 (the
+//! block reserved for benchmarking); each test creates its own and removes them, also
+//! when it fails. Where namespaces cannot be made (not root), a test says why and
+//! skips. The tests without namespaces (lockstep over Zenoh, bad payloads) run on
+//! loopback.
+
+mod util;
+
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+use tactile_common::samples::{Forward, FLAG_PEER_LOST};
+use tactile_common::trace::signal_columns;
+use util::{column, node_dir, Sandbox};
+
+/// Two network namespaces joined by a veth pair; removed on drop.
+struct Hosts {
+    names: [String; 2],
+    addrs: [String; 2],
+}
+
+impl Hosts {
+    /// Creates the pair, or says why it cannot and returns None.
+    fn new(tag: &str) -> Option<Hosts> {
+        let id = format!("{}{tag}", std::process::id() % 100_000);
+        let names = [format!("tta{id}"), format!("ttb{id}")];
+        let veth = [format!("va{id}"), format!("vb{id}")];
+        let addrs = ["198.18.7.1".to_string(), "198.18.7.2".to_string()];
+        let hosts = Hosts {
+            names: names.clone(),
+            addrs: addrs.clone(),
+        };
+        let steps: Vec<Vec<&str>> = vec![
+            vec!["netns", "add", &names[0]],
+            vec!["netns", "add", &names[1]],
+            vec![
+                "link", "add", &veth[0], "type", "veth", "peer", "name", &veth[1],
+            ],
+            vec!["link", "set", &veth[0], "netns", &names[0]],
+            vec!["link", "set", &veth[1], "netns", &names[1]],
+        ];
+        let a = format!("{}/24", addrs[0]);
+        let b = format!("{}/24", addrs[1]);
+        let inside: Vec<Vec<&str>> = vec![
+            vec!["-n", &names[0], "addr", "add", &a, "dev", &veth[0]],
+            vec!["-n", &names[1], "addr", "add", &b, "dev", &veth[1]],
+            vec!["-n", &names[0], "link", "set", &veth[0], "up"],
+            vec!["-n", &names[1], "link", "set", &veth[1], "up"],
+            vec!["-n", &names[0], "link", "set", "lo", "up"],
+            vec!["-n", &names[1], "link", "set", "lo", "up"],
+        ];
+        for step in steps.iter().chain(&inside) {
+            let out = Command::new("ip").args(step).output();
+            match out {
+                Ok(o) if o.status.success() => {}
+                Ok(o) => {
+                    eprintln!(
+                        "SKIPPED: cannot make network namespaces (ip {}: {}); run as root to test across hosts",
+                        step.join(" "),
+                        String::from_utf8_lossy(&o.stderr).trim()
+                    );
+                    return None; // drop removes what was made
+                }
+                Err(e) => {
+                    eprintln!("SKIPPED: no `ip` command ({e}); install iproute2 and run as root");
+                    return None;
+                }
+            }
+        }
+        Some(hosts)
+    }
+
+    /// `program args...` on host `k`, with its own clock domain so the report treats
+    /// the two hosts as two clocks.
+    fn on(&self, k: usize, program: &str, args: &[&str]) -> Command {
+        let mut c = Command::new("ip");
+        c.args(["netns", "exec", &self.names[k]])
+            .arg(node_dir().join(program))
+            .args(args)
+            .env("TACTILE_CLOCK_DOMAIN", format!("host-{k}"));
+        c
+    }
+}
+
+impl Drop for Hosts {
+    fn drop(&mut self) {
+        for n in &self.names {
+            let _ = Command::new("ip").args(["netns", "del", n]).output();
+        }
+    }
+}
+
+fn spawn(mut c: Command, sb: &Sandbox) -> Child {
+    c.current_dir(sb.dir.path())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start node")
+}
+
+fn finish(child: Child, name: &str) {
+    let o = child.wait_with_output().expect("wait");
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{name}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn realtime(samples: u64) -> String {
+    tactile::run_cmd::PAPER_SCENARIO
+        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
+        .replace("samples = 1200", &format!("samples = {samples}"))
+}
+
+/// A free TCP port on loopback.
+fn free_port() -> u16 {
+    let l = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
+    l.local_addr().expect("addr").port()
+}
+
+/// Master on host A; emulator and slave on host B, the emulator joined to the master
+/// over Zenoh and to the slave over iceoryx2 (`all_zenoh`: over Zenoh too).
+fn master_here_slave_there(all_zenoh: bool) {
+    let tag = if all_zenoh { "z" } else { "m" };
+    let Some(hosts) = Hosts::new(tag) else {
+        return;
+    };
+    let sb = Sandbox::new(&format!("hosts{tag}"));
+    let scenario = sb.write("s.toml", &realtime(3000));
+    let s = scenario.to_str().expect("utf-8");
+    let a = format!("tcp/{}:7447", hosts.addrs[0]);
+    let b = format!("tcp/{}:7448", hosts.addrs[1]);
+    let p = sb.prefix.clone();
+    let common = |dir: &'static str| vec!["--scenario", s, "--out", dir, "--prefix", &p];
+    let mut m = common("a-master");
+    m.extend(["--link", "zenoh", "--listen", &a]);
+    let mut e = common("b-emulator");
+    e.extend(["--master-link", "zenoh", "--connect", &a]);
+    let mut sl = common("b-slave");
+    if all_zenoh {
+        e.extend(["--slave-link", "zenoh", "--listen", &b]);
+        sl.extend(["--link", "zenoh", "--connect", &b]);
+    } else {
+        e.extend(["--slave-link", "iceoryx2"]);
+    }
+    let slave = spawn(hosts.on(1, "tactile-slave", &sl), &sb);
+    let emulator = spawn(hosts.on(1, "tactile-emulator", &e), &sb);
+    let master = spawn(hosts.on(0, "tactile-master", &m), &sb);
+    finish(master, "master");
+    finish(emulator, "emulator");
+    finish(slave, "slave");
+    let o = sb.tactile(&[
+        "report",
+        "a-master",
+        "b-emulator",
+        "b-slave",
+        "--out",
+        "report",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = sb.json("report", "summary.json");
+    let received = column(&sb.trace("report"), "received");
+    let lost: Vec<usize> = (0..received.len())
+        .filter(|&n| received[n] == 0.0)
+        .collect();
+    assert_eq!(s["samples_lost"], 0, "lost {lost:?}; {}", s["channels"]);
+    for stream in ["c", "v", "h", "q"] {
+        assert_eq!(s["channels"][stream]["received"], 3000, "{stream}");
+    }
+    assert!(s["round_trip_ns"]["p50"].as_u64() > Some(0));
+    assert!(s["overhead_ns"]["p99"].as_u64() > Some(0));
+    // Two clocks: the hops across hosts are not reported as times; the stages on one
+    // host are; the offset between the hosts is an estimate, and since the two
+    // namespaces in fact share one kernel clock, the truth is 0: the estimate must be
+    // within its own uncertainty of it.
+    let clocks = &s["clocks"];
+    assert_eq!(clocks["shared"], false, "{clocks}");
+    let stages = &s["stages_ns"];
+    assert!(stages["hop_master_to_emulator"].is_null(), "{stages}");
+    assert!(
+        stages["emulator_forward"]["count"].as_u64() > Some(2000),
+        "{stages}"
+    );
+    assert!(
+        stages["slave_compute"]["count"].as_u64() > Some(2000),
+        "{stages}"
+    );
+    let offsets = clocks["offsets"].as_array().expect("offsets");
+    let me = offsets
+        .iter()
+        .find(|o| o["between"] == "master-emulator")
+        .expect("a master-emulator estimate");
+    let off = me["offset_ns_estimate"].as_i64().expect("offset");
+    let unc = me["uncertainty_ns"].as_i64().expect("uncertainty");
+    assert!(
+        off.abs() <= unc,
+        "offset {off} ns beyond its uncertainty {unc} ns"
+    );
+    assert_eq!(
+        s["nodes"]["emulator"]["link"]
+            .as_str()
+            .map(|l| l.contains("zenoh")),
+        Some(true)
+    );
+}
+
+#[test]
+fn master_on_one_host_emulator_and_slave_on_the_other() {
+    master_here_slave_there(false);
+}
+
+#[test]
+fn all_three_nodes_over_zenoh_across_hosts() {
+    master_here_slave_there(true);
+}
+
+#[test]
+fn the_slave_host_node_killed_breaks_the_loop_and_it_resumes_after_restart() {
+    let Some(hosts) = Hosts::new("k") else {
+        return;
+    };
+    let sb = Sandbox::new("hostkill");
+    let scenario = sb.write("s.toml", &realtime(4000));
+    let s = scenario.to_str().expect("utf-8");
+    let a = format!("tcp/{}:7447", hosts.addrs[0]);
+    let p = sb.prefix.clone();
+    // No emulator: the master talks to the slave across the network directly.
+    let master = spawn(
+        hosts.on(
+            0,
+            "tactile-master",
+            &[
+                "--scenario",
+                s,
+                "--out",
+                "m",
+                "--prefix",
+                &p,
+                "--link",
+                "zenoh",
+                "--listen",
+                &a,
+                "--direct",
+            ],
+        ),
+        &sb,
+    );
+    let slave_args = [
+        "--scenario",
+        s,
+        "--out",
+        "s",
+        "--prefix",
+        &p,
+        "--link",
+        "zenoh",
+        "--connect",
+        &a,
+    ];
+    let mut slave = spawn(hosts.on(1, "tactile-slave", &slave_args), &sb);
+    let rec = sb.path("s").join("slave.rec");
+    let start = Instant::now();
+    while std::fs::metadata(&rec).map_or(0, |m| m.len()) < 150_000 {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the slave never got going"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    slave.kill().expect("SIGKILL the slave");
+    let _ = slave.wait();
+    std::thread::sleep(Duration::from_millis(300));
+    let mut again = slave_args.to_vec();
+    again.push("--append");
+    let slave = spawn(hosts.on(1, "tactile-slave", &again), &sb);
+    finish(master, "master");
+    finish(slave, "slave");
+    let o = sb.tactile(&["report", "m", "s", "--out", "report"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sum = sb.json("report", "summary.json");
+    let m = &sum["master"]["counters"];
+    assert!(m["loop_breaks"].as_u64() >= Some(1), "{m}");
+    assert!(m["resumes"].as_u64() >= Some(1), "{m}");
+    assert_eq!(
+        sum["nodes"]["slave"]["pids"].as_array().map(Vec::len),
+        Some(2)
+    );
+    // The break came exactly at the peer timeout (10 samples after the last answer),
+    // and answers came back after the restart.
+    let trace = sb.trace("report");
+    let flags = column(&trace, "flags_m");
+    let received = column(&trace, "received");
+    let first = (0..flags.len())
+        .find(|&n| flags[n] as u32 & FLAG_PEER_LOST != 0)
+        .expect("a break");
+    assert_eq!(received[first - 10], 1.0);
+    assert!(received[first - 9..=first].iter().all(|r| *r == 0.0));
+    assert!(received[first..].iter().filter(|r| **r == 1.0).count() > 500);
+}
+
+#[test]
+fn lockstep_over_zenoh_equals_the_in_process_simulation() {
+    let sb = Sandbox::new("zlock");
+    let text = tactile::run_cmd::PAPER_SCENARIO
+        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        .replace(
+            "[network.forward]\ndelay = [0, 0, 0]\nnoise_std = [0.0, 0.0, 0.0]",
+            "[network.forward]\ndelay = [2, 3, 1]\nnoise_std = [0.0005, 0.001, 0.0]",
+        );
+    let scenario = sb.write("s.toml", &text);
+    let out = sb.path("z");
+    let o = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--link",
+        "zenoh",
+        "-q",
+        "--prefix",
+        &sb.prefix,
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    sb.simulate(&scenario, "sim");
+    assert_eq!(
+        signal_columns(&sb.trace("z")),
+        signal_columns(&sb.trace("sim"))
+    );
+    assert_eq!(sb.json("z", "summary.json")["samples_lost"], 0);
+    sb.assert_no_leftover_processes();
+}
+
+/// Frames a stranger, a truncating network and another build would send.
+fn bad_payloads() -> Vec<Vec<u8>> {
+    let mut good = Vec::new();
+    let f = Forward {
+        run: 1,
+        ..Forward::default()
+    };
+    tactile_node::wire::encode_forward(&f, &mut good).expect("encode");
+    let mut other_version = good.clone();
+    other_version[4] = other_version[4].wrapping_add(1);
+    vec![
+        b"GET / HTTP/1.1\r\n\r\n".to_vec(),
+        vec![0xff; 300],
+        good[..good.len() / 2].to_vec(),
+        good[..5].to_vec(),
+        other_version,
+    ]
+}
+
+#[test]
+fn garbage_truncated_and_other_version_payloads_are_counted_and_dropped() {
+    let sb = Sandbox::new("garbage");
+    let scenario = sb.write("s.toml", &realtime(2500));
+    let s = scenario.to_str().expect("utf-8");
+    let at: Vec<String> = (0..3)
+        .map(|_| format!("tcp/127.0.0.1:{}", free_port()))
+        .collect();
+    let p = sb.prefix.clone();
+    // Each node listens on its own port; master and slave connect to the emulator.
+    let args = |dir: &'static str, listen: &str| {
+        let mut a: Vec<String> = [
+            "--scenario",
+            s,
+            "--out",
+            dir,
+            "--prefix",
+            &p,
+            "--link",
+            "zenoh",
+        ]
+        .map(String::from)
+        .to_vec();
+        a.extend(["--listen".to_string(), listen.to_string()]);
+        if dir != "e" {
+            a.extend(["--connect".to_string(), at[1].clone()]);
+        }
+        a
+    };
+    let node = |program: &str, a: Vec<String>| {
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        spawn(sb.node(program, &a), &sb)
+    };
+    let emulator = node("tactile-emulator", args("e", &at[1]));
+    let slave = node("tactile-slave", args("s", &at[2]));
+    let master = node("tactile-master", args("m", &at[0]));
+    // Once the run is going, a stranger on the same Zenoh network sends junk at every
+    // stream of the run, one session per node (peers do not route for each other).
+    let rec = sb.path("m").join("master.rec");
+    let start = Instant::now();
+    while std::fs::metadata(&rec).map_or(0, |m| m.len()) < 20_000 {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the run never started"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let sessions: Vec<zenoh::Session> = at
+        .iter()
+        .map(|e| {
+            tactile_node::zlink::open_session(&tactile_node::zlink::ZenohOptions {
+                connect: vec![e.clone()],
+                ..Default::default()
+            })
+            .expect("session")
+        })
+        .collect();
+    std::thread::sleep(Duration::from_millis(300));
+    let bad = bad_payloads();
+    for round in 0..40 {
+        for stream in ["c", "v", "h", "q"] {
+            let key = format!("tactile/{p}/{stream}");
+            for session in &sessions {
+                for b in &bad {
+                    zenoh::Wait::wait(session.put(key.as_str(), b.clone())).expect("put");
+                }
+            }
+        }
+        std::thread::sleep(Duration::from_millis(5 + round % 3));
+    }
+    finish(master, "master");
+    finish(emulator, "emulator");
+    finish(slave, "slave");
+    let o = sb.tactile(&["report", "m", "e", "s", "--out", "report"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sum = sb.json("report", "summary.json");
+    assert_eq!(sum["samples_lost"], 0, "the run went on untouched");
+    for (who, inbox) in [
+        (&sum["slave"]["v_in"], "slave v"),
+        (&sum["emulator"]["links"]["c_in"], "emulator c"),
+        (&sum["master"]["q_in"], "master q"),
+    ] {
+        assert!(who["malformed"].as_u64() >= Some(4 * 40), "{inbox}: {who}");
+        assert!(who["wrong_version"].as_u64() >= Some(40), "{inbox}: {who}");
+    }
+    let log = std::fs::read_to_string(sb.path("s").join("slave.log")).expect("log");
+    assert!(log.contains("wire format version"), "{log}");
+}
+
+#[test]
+fn garbage_datagrams_at_a_udp_node_are_counted_and_dropped() {
+    let sb = Sandbox::new("udpjunk");
+    let scenario = sb.write("s.toml", &realtime(2000));
+    let s = scenario.to_str().expect("utf-8");
+    let ports = tactile_node::udp::UdpPorts::free().expect("ports");
+    let arg = ports.arg();
+    let p = sb.prefix.clone();
+    let args = |dir: &'static str| {
+        vec![
+            "--scenario",
+            s,
+            "--out",
+            dir,
+            "--prefix",
+            &p,
+            "--link",
+            "udp",
+            "--udp-ports",
+            &arg,
+        ]
+    };
+    let emulator = spawn(sb.node("tactile-emulator", &args("e")), &sb);
+    let slave = spawn(sb.node("tactile-slave", &args("s")), &sb);
+    let master = spawn(sb.node("tactile-master", &args("m")), &sb);
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").expect("bind");
+    std::thread::sleep(Duration::from_millis(500));
+    for _ in 0..50 {
+        for b in bad_payloads() {
+            let _ = socket.send_to(&b, ("127.0.0.1", ports.slave));
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    finish(master, "master");
+    finish(emulator, "emulator");
+    finish(slave, "slave");
+    let o = sb.tactile(&["report", "m", "e", "s", "--out", "report"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sum = sb.json("report", "summary.json");
+    assert_eq!(sum["samples_lost"], 0);
+    let v = &sum["slave"]["v_in"];
+    assert_eq!(v["malformed"], 4 * 50, "{v}");
+    assert_eq!(v["wrong_version"], 50, "{v}");
+}
