@@ -27,9 +27,11 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
     let text = String::from_utf8_lossy(&o.stdout);
     for needle in [
         "iceoryx2 loop",
-        "UDP loop",
+        "udp loop",
+        "zenoh loop",
         "bare iceoryx2",
-        "iceoryx2 / UDP",
+        "iceoryx2/udp",
+        "zenoh/udp",
         "lockstep throughput",
     ] {
         assert!(text.contains(needle), "{needle}: {text}");
@@ -40,9 +42,13 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
     let r = &v["rates"][0];
     // Every round trip is accounted for, whatever the load on the machine: the trios
     // record late answers too; the bare hop counts a late one as a miss.
-    for key in ["iceoryx2_overhead_ns", "udp_overhead_ns"] {
-        assert_eq!(r[key]["count"].as_u64(), Some(400), "{key}: {r}");
-        assert!(r[key]["p50"].as_u64() > Some(0), "{key}");
+    let loops = r["loops"].as_array().expect("loops");
+    let names: Vec<&str> = loops.iter().filter_map(|l| l["name"].as_str()).collect();
+    assert_eq!(names, ["iceoryx2", "udp", "zenoh"]);
+    for l in loops {
+        assert_eq!(l["overhead_ns"]["count"].as_u64(), Some(400), "{l}");
+        assert!(l["overhead_ns"]["p50"].as_u64() > Some(0), "{l}");
+        assert_eq!(l["samples_lost"], 0, "{l}");
     }
     let hop = r["bare_hop_round_trip_ns"]["count"]
         .as_u64()
@@ -50,14 +56,16 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
     let hop_misses = r["bare_hop_deadline_misses"].as_u64().expect("misses");
     assert_eq!(hop + hop_misses, 400, "{r}");
     assert!(hop > 0 && r["bare_hop_round_trip_ns"]["p50"].as_u64() > Some(0));
-    assert!(r["ratio_p50"].as_f64().is_some_and(f64::is_finite));
-    assert_eq!(
-        r["iceoryx2_stages_ns"].as_object().map(|m| m.len()),
-        Some(9)
-    );
+    for k in ["iceoryx2/udp", "zenoh/udp"] {
+        assert!(
+            r["ratios"][k].as_array().is_some_and(|a| a.len() == 3),
+            "{k}: {r}"
+        );
+    }
+    assert_eq!(loops[0]["stages_ns"].as_object().map(|m| m.len()), Some(9));
     assert!(v["lockstep_samples_per_s"].as_f64() > Some(100.0));
     // Each trio left its own full report.
-    for run in ["iox-1000", "udp-1000", "lockstep"] {
+    for run in ["iceoryx2-1000", "udp-1000", "zenoh-1000", "lockstep"] {
         assert!(out.join(run).join("summary.json").exists(), "{run}");
     }
     sb.assert_no_leftover_processes();

@@ -13,80 +13,37 @@ use tactile_common::samples::{Forward, FLAG_PEER_LOST};
 use tactile_common::trace::signal_columns;
 use util::{column, node_dir, Sandbox};
 
-/// Two network namespaces joined by a veth pair; removed on drop.
+/// Two hosts: network namespaces made for the test, removed on drop.
 struct Hosts {
-    names: [String; 2],
+    pair: tactile::netns::Pair,
     addrs: [String; 2],
 }
 
 impl Hosts {
-    /// Creates the pair, or says why it cannot and returns None.
+    /// Creates the pair, or says why it cannot and returns None (the test skips).
     fn new(tag: &str) -> Option<Hosts> {
-        let id = format!("{}{tag}", std::process::id() % 100_000);
-        let names = [format!("tta{id}"), format!("ttb{id}")];
-        let veth = [format!("va{id}"), format!("vb{id}")];
-        let addrs = ["198.18.7.1".to_string(), "198.18.7.2".to_string()];
-        let hosts = Hosts {
-            names: names.clone(),
-            addrs: addrs.clone(),
-        };
-        let steps: Vec<Vec<&str>> = vec![
-            vec!["netns", "add", &names[0]],
-            vec!["netns", "add", &names[1]],
-            vec![
-                "link", "add", &veth[0], "type", "veth", "peer", "name", &veth[1],
-            ],
-            vec!["link", "set", &veth[0], "netns", &names[0]],
-            vec!["link", "set", &veth[1], "netns", &names[1]],
-        ];
-        let a = format!("{}/24", addrs[0]);
-        let b = format!("{}/24", addrs[1]);
-        let inside: Vec<Vec<&str>> = vec![
-            vec!["-n", &names[0], "addr", "add", &a, "dev", &veth[0]],
-            vec!["-n", &names[1], "addr", "add", &b, "dev", &veth[1]],
-            vec!["-n", &names[0], "link", "set", &veth[0], "up"],
-            vec!["-n", &names[1], "link", "set", &veth[1], "up"],
-            vec!["-n", &names[0], "link", "set", "lo", "up"],
-            vec!["-n", &names[1], "link", "set", "lo", "up"],
-        ];
-        for step in steps.iter().chain(&inside) {
-            let out = Command::new("ip").args(step).output();
-            match out {
-                Ok(o) if o.status.success() => {}
-                Ok(o) => {
-                    eprintln!(
-                        "SKIPPED: cannot make network namespaces (ip {}: {}); run as root to test across hosts",
-                        step.join(" "),
-                        String::from_utf8_lossy(&o.stderr).trim()
-                    );
-                    return None; // drop removes what was made
-                }
-                Err(e) => {
-                    eprintln!("SKIPPED: no `ip` command ({e}); install iproute2 and run as root");
-                    return None;
-                }
+        match tactile::netns::Pair::new(&format!("{}{tag}", std::process::id() % 100_000)) {
+            Ok(pair) => Some(Hosts {
+                addrs: pair.addrs.clone(),
+                pair,
+            }),
+            Err(e) => {
+                eprintln!("SKIPPED: cannot make network namespaces ({e}); run as root to test across hosts");
+                None
             }
         }
-        Some(hosts)
     }
 
     /// `program args...` on host `k`, with its own clock domain so the report treats
     /// the two hosts as two clocks.
     fn on(&self, k: usize, program: &str, args: &[&str]) -> Command {
-        let mut c = Command::new("ip");
-        c.args(["netns", "exec", &self.names[k]])
+        let exec = self.pair.exec(k);
+        let mut c = Command::new(&exec[0]);
+        c.args(&exec[1..])
             .arg(node_dir().join(program))
             .args(args)
             .env("TACTILE_CLOCK_DOMAIN", format!("host-{k}"));
         c
-    }
-}
-
-impl Drop for Hosts {
-    fn drop(&mut self) {
-        for n in &self.names {
-            let _ = Command::new("ip").args(["netns", "del", n]).output();
-        }
     }
 }
 

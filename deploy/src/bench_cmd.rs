@@ -24,6 +24,22 @@ use tactile_common::scenario::{Mode, Scenario};
 use tactile_node::ipc::{self, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
 use tactile_node::runtime::LinkKind;
 
+/// One loop of a rate: a transport, on one host or across two.
+#[derive(Debug, Clone, Serialize)]
+pub struct LoopResult {
+    /// `iceoryx2`, `udp`, `zenoh` (one host) or `zenoh-hosts`, `udp-hosts` (master in
+    /// one network namespace, emulator and slave in the other).
+    pub name: String,
+    /// System overhead per round trip, ns.
+    pub overhead_ns: Option<Percentiles>,
+    /// Answers not back by the next tick.
+    pub deadline_misses: u64,
+    /// Samples lost.
+    pub samples_lost: u64,
+    /// Per-stage times (compute per process, transport per hop), ns.
+    pub stages_ns: BTreeMap<String, Percentiles>,
+}
+
 /// One rate's results.
 #[derive(Debug, Clone, Serialize)]
 pub struct RateResult {
@@ -31,26 +47,34 @@ pub struct RateResult {
     pub rate_hz: f64,
     /// Samples per run.
     pub samples: u64,
-    /// System overhead of the iceoryx2 trio, ns.
-    pub iceoryx2_overhead_ns: Option<Percentiles>,
-    /// Its deadline misses.
-    pub iceoryx2_deadline_misses: u64,
-    /// Its per-stage times (compute per process, transport per hop), ns.
-    pub iceoryx2_stages_ns: BTreeMap<String, Percentiles>,
-    /// System overhead of the UDP trio, ns.
-    pub udp_overhead_ns: Option<Percentiles>,
-    /// Its deadline misses.
-    pub udp_deadline_misses: u64,
-    /// Its per-stage times, ns.
-    pub udp_stages_ns: BTreeMap<String, Percentiles>,
+    /// Each loop, in the order run.
+    pub loops: Vec<LoopResult>,
     /// Round trip of the bare iceoryx2 hop pair (two hops), ns.
     pub bare_hop_round_trip_ns: Option<Percentiles>,
     /// Bare-hop round trips not back within their sampling period.
     pub bare_hop_deadline_misses: u64,
-    /// iceoryx2 overhead / UDP overhead at p50.
-    pub ratio_p50: f64,
-    /// iceoryx2 overhead / UDP overhead at p99.
-    pub ratio_p99: f64,
+    /// Overhead ratios at p50, p99 and p99.9 taken in this run: `iceoryx2/udp`, and
+    /// `zenoh-hosts/udp-hosts` across hosts.
+    pub ratios: BTreeMap<String, [f64; 3]>,
+}
+
+impl RateResult {
+    fn get(&self, name: &str) -> Option<&Percentiles> {
+        self.loops
+            .iter()
+            .find(|l| l.name == name)
+            .and_then(|l| l.overhead_ns.as_ref())
+    }
+
+    fn ratio(&mut self, a: &str, b: &str) {
+        if let (Some(x), Some(y)) = (self.get(a).copied(), self.get(b).copied()) {
+            let r = |p: u64, q: u64| if q > 0 { p as f64 / q as f64 } else { f64::NAN };
+            self.ratios.insert(
+                format!("{a}/{b}"),
+                [r(x.p50, y.p50), r(x.p99, y.p99), r(x.p999, y.p999)],
+            );
+        }
+    }
 }
 
 /// `bench.json`.
@@ -66,6 +90,21 @@ pub struct BenchReport {
     pub strategy: String,
 }
 
+/// A loop's result; a stop request (SIGINT, SIGTERM) ends the bench, so the
+/// namespaces it made are removed on the way out.
+fn loop_result(name: &str, s: Summary) -> Result<LoopResult, Error> {
+    if s.interrupted {
+        return Err(Error::Interrupted);
+    }
+    Ok(LoopResult {
+        name: name.to_string(),
+        overhead_ns: s.overhead_ns,
+        deadline_misses: s.deadline_misses,
+        samples_lost: s.samples_lost,
+        stages_ns: s.stages_ns,
+    })
+}
+
 fn scenario(rate: f64, samples: u64, mode: Mode) -> Result<Scenario, Error> {
     let mut s = Scenario::from_toml_str(PAPER_SCENARIO)
         .map_err(|e| Error::Failed(format!("built-in scenario: {e}")))?;
@@ -79,8 +118,26 @@ fn scenario(rate: f64, samples: u64, mode: Mode) -> Result<Scenario, Error> {
 }
 
 fn trio(sc: &Scenario, out: &Path, sup: &Supervision, link: LinkKind) -> Result<Summary, Error> {
+    trio_with(
+        sc,
+        out,
+        sup,
+        crate::run_cmd::Links::on_this_host(link)?,
+        Default::default(),
+    )
+}
+
+/// A trio with these links and command prefixes (to put nodes on other hosts).
+fn trio_with(
+    sc: &Scenario,
+    out: &Path,
+    sup: &Supervision,
+    links: crate::run_cmd::Links,
+    wrap: [Vec<String>; 3],
+) -> Result<Summary, Error> {
     let sup = Supervision {
-        link: crate::run_cmd::Links::on_this_host(link)?,
+        link: links,
+        wrap,
         prefix: format!(
             "{}{}",
             sup.prefix,
@@ -244,6 +301,7 @@ fn supervision(args: &BenchArgs, prefix: &str, spin: Duration) -> Supervision {
         pin: !args.no_pin,
         rt: false,
         no_trace: false,
+        wrap: Default::default(),
     }
 }
 
@@ -257,60 +315,88 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
         .prefix
         .clone()
         .unwrap_or_else(|| format!("tactile{}b", std::process::id()));
+    // From here a stop request is a flag the runs look at, not the end of this
+    // process: the bench stops between runs and removes what it made.
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register(sig, std::sync::Arc::clone(&stop))
+            .map_err(Error::io("installing signal handlers"))?;
+    }
+    let hosts = if args.hosts {
+        Some(
+            crate::netns::Pair::new(&format!("b{}", std::process::id() % 100_000)).map_err(
+                |e| Error::Failed(format!("--hosts: cannot make two network namespaces: {e}")),
+            )?,
+        )
+    } else {
+        None
+    };
     for &rate in &args.rates {
         let sc = scenario(rate, args.samples, Mode::Realtime)?;
         let spin = args
             .spin_us
             .map_or_else(|| default_spin(&sc), Duration::from_micros);
         let sup = supervision(args, &prefix, spin);
-        eprintln!(
-            "tactile bench: {rate} Hz, {} samples: iceoryx2 trio",
-            args.samples
-        );
-        let iox = trio(
-            &sc,
-            &args.out.join(format!("iox-{rate}")),
-            &sup,
-            LinkKind::Iceoryx2,
-        )?;
-        eprintln!("tactile bench: {rate} Hz: UDP trio");
-        let udp_sup = Supervision {
-            spin: Duration::ZERO,
-            pin: false,
-            ..sup.clone()
-        };
-        let udp = trio(
-            &sc,
-            &args.out.join(format!("udp-{rate}")),
-            &udp_sup,
-            LinkKind::Udp,
-        )?;
+        // The loops on one host get the same scheduling (pinned unless --no-pin,
+        // polling for the same budget); across hosts the namespaces share the CPUs.
+        let mut loops = Vec::new();
+        for (name, link) in [
+            ("iceoryx2", LinkKind::Iceoryx2),
+            ("udp", LinkKind::Udp),
+            ("zenoh", LinkKind::Zenoh),
+        ] {
+            eprintln!(
+                "tactile bench: {rate} Hz, {} samples: {name} loop",
+                args.samples
+            );
+            let s = trio(&sc, &args.out.join(format!("{name}-{rate}")), &sup, link)?;
+            loops.push(loop_result(name, s)?);
+            if stop.load(std::sync::atomic::Ordering::SeqCst) {
+                return Err(Error::Interrupted);
+            }
+        }
+        if let Some(pair) = &hosts {
+            for (name, link) in [
+                ("zenoh-hosts", LinkKind::Zenoh),
+                ("udp-hosts", LinkKind::Udp),
+            ] {
+                eprintln!(
+                    "tactile bench: {rate} Hz: {name} loop, master in {}, emulator and slave in {}",
+                    pair.names[0], pair.names[1]
+                );
+                let wrap = [pair.exec(0), pair.exec(1), pair.exec(1)];
+                let links = crate::run_cmd::Links::across(link, pair);
+                let out = args.out.join(format!("{name}-{rate}"));
+                let s = trio_with(
+                    &sc,
+                    &out,
+                    &Supervision {
+                        pin: false,
+                        ..sup.clone()
+                    },
+                    links,
+                    wrap,
+                )?;
+                loops.push(loop_result(name, s)?);
+                if stop.load(std::sync::atomic::Ordering::SeqCst) {
+                    return Err(Error::Interrupted);
+                }
+            }
+        }
         eprintln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
         let (hop, hop_misses) = bare_hop(rate, args.samples, &sup)?;
-        let ratio = |a: Option<u64>, b: Option<u64>| match (a, b) {
-            (Some(a), Some(b)) if b > 0 => a as f64 / b as f64,
-            _ => f64::NAN,
-        };
-        rates.push(RateResult {
+        let mut r = RateResult {
             rate_hz: rate,
             samples: args.samples,
-            ratio_p50: ratio(
-                iox.overhead_ns.map(|p| p.p50),
-                udp.overhead_ns.map(|p| p.p50),
-            ),
-            ratio_p99: ratio(
-                iox.overhead_ns.map(|p| p.p99),
-                udp.overhead_ns.map(|p| p.p99),
-            ),
-            iceoryx2_overhead_ns: iox.overhead_ns,
-            iceoryx2_deadline_misses: iox.deadline_misses,
-            iceoryx2_stages_ns: iox.stages_ns,
-            udp_overhead_ns: udp.overhead_ns,
-            udp_deadline_misses: udp.deadline_misses,
-            udp_stages_ns: udp.stages_ns,
+            loops,
             bare_hop_round_trip_ns: hop.percentiles(),
             bare_hop_deadline_misses: hop_misses,
-        });
+            ratios: BTreeMap::new(),
+        };
+        r.ratio("iceoryx2", "udp");
+        r.ratio("zenoh", "udp");
+        r.ratio("zenoh-hosts", "udp-hosts");
+        rates.push(r);
     }
     eprintln!("tactile bench: lockstep throughput");
     let n = args.lockstep_samples;
@@ -350,30 +436,30 @@ fn render(r: &BenchReport) -> String {
             "\n{} Hz, {} samples, zero injected delay: system overhead per round trip",
             x.rate_hz, x.samples
         );
-        let _ = writeln!(t, "{}  misses", us_header());
-        for (name, p, misses) in [
-            (
-                "iceoryx2 loop",
-                &x.iceoryx2_overhead_ns,
-                x.iceoryx2_deadline_misses,
-            ),
-            ("UDP loop", &x.udp_overhead_ns, x.udp_deadline_misses),
-            (
-                "bare iceoryx2 (2 hops)",
-                &x.bare_hop_round_trip_ns,
-                x.bare_hop_deadline_misses,
-            ),
-        ] {
-            let _ = writeln!(t, "{}  {misses}", us_line(name, p.as_ref()));
+        let _ = writeln!(t, "{}  misses  lost", us_header());
+        for l in &x.loops {
+            let _ = writeln!(
+                t,
+                "{}  {}  {}",
+                us_line(&format!("{} loop", l.name), l.overhead_ns.as_ref()),
+                l.deadline_misses,
+                l.samples_lost
+            );
         }
         let _ = writeln!(
             t,
-            "iceoryx2 / UDP: p50 {:.2}, p99 {:.2}",
-            x.ratio_p50, x.ratio_p99
+            "{}  {}",
+            us_line("bare iceoryx2 (2 hops)", x.bare_hop_round_trip_ns.as_ref()),
+            x.bare_hop_deadline_misses
         );
-        let _ = writeln!(t, "iceoryx2 loop stages:");
-        for (name, p) in &x.iceoryx2_stages_ns {
-            let _ = writeln!(t, "{}", us_line(&format!("  {name}"), Some(p)));
+        for (k, [p50, p99, p999]) in &x.ratios {
+            let _ = writeln!(t, "{k}: p50 {p50:.2}, p99 {p99:.2}, p99.9 {p999:.2}");
+        }
+        if let Some(l) = x.loops.first() {
+            let _ = writeln!(t, "{} loop stages:", l.name);
+            for (name, p) in &l.stages_ns {
+                let _ = writeln!(t, "{}", us_line(&format!("  {name}"), Some(p)));
+            }
         }
     }
     let _ = writeln!(

@@ -87,6 +87,10 @@ pub struct BenchArgs {
     /// iceoryx2 prefix of the bench's runs (default: one per invocation).
     #[arg(long)]
     pub prefix: Option<String>,
+    /// Also run the Zenoh and UDP loops across two hosts: two network namespaces
+    /// joined by a veth pair (made and removed by the bench; needs root).
+    #[arg(long)]
+    pub hosts: bool,
 }
 
 /// Arguments of `tactile run`.

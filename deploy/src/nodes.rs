@@ -59,7 +59,11 @@ fn cargo_build(dir: &Path) -> Result<(), String> {
         .arg("--target-dir")
         .arg(target)
         .args(profile)
+        // With `tactile` in the set, Cargo resolves the same features as the `cargo
+        // run` that built this launcher, so nothing it built is compiled again.
         .args([
+            "-p",
+            "tactile",
             "-p",
             "tactile-master",
             "-p",

@@ -170,6 +170,9 @@ pub struct Supervision {
     pub max_restarts: u32,
     /// What carries the samples, and the link options of each node.
     pub link: Links,
+    /// Command prefix of the master, the emulator and the slave (e.g. `ip netns exec
+    /// A` to put a node on another host); empty: run the program directly.
+    pub wrap: [Vec<String>; 3],
     /// Pin master to CPU 0, emulator and slave to CPU 1.
     pub pin: bool,
     /// SCHED_FIFO priority for the three processes, if permitted.
@@ -214,12 +217,43 @@ impl Links {
 
     /// The link options of `role`.
     pub fn args(&self, role: &str) -> &[String] {
-        let k = match role {
-            "master" => 0,
-            "emulator" => 1,
-            _ => 2,
+        &self.args[role_index(role)]
+    }
+
+    /// Master on host 0 of `hosts`, emulator and slave on host 1, every hop on
+    /// `kind` (Zenoh or UDP) across the veth pair.
+    pub fn across(kind: LinkKind, hosts: &crate::netns::Pair) -> Links {
+        let [a, b] = &hosts.addrs;
+        let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+        let args = match kind {
+            LinkKind::Zenoh => {
+                let (la, lb) = (format!("tcp/{a}:7447"), format!("tcp/{b}:7448"));
+                [
+                    s(&["--listen", &la]),
+                    s(&["--connect", &la, "--listen", &lb]),
+                    s(&["--connect", &lb]),
+                ]
+            }
+            _ => {
+                let u = s(&[
+                    "--udp-ports",
+                    "47501,47502,47503",
+                    "--udp-hosts",
+                    &format!("{a},{b},{b}"),
+                ]);
+                [u.clone(), u.clone(), u]
+            }
         };
-        &self.args[k]
+        Links { kind, args }
+    }
+}
+
+/// 0 for the master, 1 the emulator, 2 the slave.
+fn role_index(role: &str) -> usize {
+    match role {
+        "master" => 0,
+        "emulator" => 1,
+        _ => 2,
     }
 }
 
@@ -232,13 +266,13 @@ fn node_command(
     out: &Path,
     append: bool,
 ) -> Command {
-    let mut cmd = if sup.rt {
-        let mut c = Command::new("chrt");
-        c.args(["-f", "10"]).arg(exe);
-        c
-    } else {
-        Command::new(exe)
-    };
+    let mut argv: Vec<String> = sup.wrap[role_index(role)].clone();
+    if sup.rt {
+        argv.extend(["chrt", "-f", "10"].map(String::from));
+    }
+    argv.push(exe.display().to_string());
+    let mut cmd = Command::new(&argv[0]);
+    cmd.args(&argv[1..]);
     cmd.arg("--scenario")
         .arg(scenario_file)
         .arg("--out")
@@ -582,6 +616,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
             pin: !args.no_pin,
             rt: args.rt,
             no_trace: args.no_trace,
+            wrap: Default::default(),
         };
         run_processes(&loaded, &args.out, &sup)?
     };

@@ -5,13 +5,13 @@
 //! endpoints it is given (multicast and gossip scouting off unless asked for, so a
 //! node talks to exactly the peers named: peers do not route for each other, so each
 //! node connects to the nodes it exchanges samples with). Every stream is a key, `tactile/<prefix>/<c|v|h|q>`;
-//! every payload is one frame of the wire format ([`crate::wire`]). Publishers are set
-//! for latency: `express` (no batching: a 1 kHz sample must not wait for company),
-//! priority `RealTime` (ahead of anything else on the session) and congestion control
-//! `Drop` (a stale haptic sample is worth less than a fresh one; a blocked publisher
-//! would stall the loop). Received payloads go from Zenoh's threads into one bounded
-//! queue per node, which the node's loop polls and then blocks on, like the other
-//! links.
+//! every payload is one frame of the wire format ([`crate::wire`]). Set for latency by
+//! measurement (README, "Across hosts"): the low-latency unicast transport, and
+//! publishers with `express` (no batching: a 1 kHz sample must not wait for company;
+//! batching put 15 ms in the p99.9), priority `RealTime` (it matters only where QoS is
+//! on) and congestion control `Block` (`Drop` measured no faster, and a sample must
+//! not vanish unseen). Received payloads go from Zenoh's threads into one bounded queue
+//! per node, which the node's loop polls and then blocks on, like the other links.
 
 use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats, WaitPolicy};
 use crate::link::{Arrival, EmulatorLink, EmulatorStats, MasterLink, SlaveLink, Wait};
@@ -69,11 +69,34 @@ impl ZenohOptions {
         let scout = if self.scout { "true" } else { "false" };
         set(&mut c, "scouting/multicast/enabled", scout)?;
         set(&mut c, "scouting/gossip/enabled", scout)?;
+        // The low-latency transport (no QoS priorities, no batching pipeline) halved
+        // the round trip across two hosts here; every peer of a run must use it.
+        if !tuning().contains(&"qos") {
+            set(&mut c, "transport/unicast/qos/enabled", "false")?;
+            set(&mut c, "transport/unicast/lowlatency", "true")?;
+        }
         // Keep trying to reach a peer that is not up yet (nodes start in any order).
         set(&mut c, "connect/timeout_ms", "-1")?;
         set(&mut c, "connect/exit_on_failure", "false")?;
         Ok(c)
     }
+}
+
+/// Settings to measure the alternatives with, from `TACTILE_ZENOH_TUNING` (a comma
+/// list of `qos` (Zenoh's default transport with QoS priorities instead of the
+/// low-latency one), `batched` (express off), `data` (priority Data instead of
+/// RealTime, with `qos`), `drop` (congestion control Drop instead of Block)). Unset in
+/// normal use: the defaults are the measured choice (README, "Across hosts"); every
+/// node of a run must have the same.
+fn tuning() -> Vec<&'static str> {
+    static TUNING: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+    TUNING
+        .get_or_init(|| {
+            let text = std::env::var("TACTILE_ZENOH_TUNING").unwrap_or_default();
+            let leaked: &'static str = Box::leak(text.into_boxed_str());
+            leaked.split(',').filter(|s| !s.is_empty()).collect()
+        })
+        .clone()
 }
 
 /// The streams, by key suffix.
@@ -146,11 +169,20 @@ impl ZenohEnd {
         let session = open_session(opts)?;
         let mut publishers = Vec::new();
         for &s in publish {
+            let t = tuning();
             let p = session
                 .declare_publisher(key(prefix, s))
-                .express(true)
-                .priority(Priority::RealTime)
-                .congestion_control(CongestionControl::Block)
+                .express(!t.contains(&"batched"))
+                .priority(if t.contains(&"data") {
+                    Priority::Data
+                } else {
+                    Priority::RealTime
+                })
+                .congestion_control(if t.contains(&"drop") {
+                    CongestionControl::Drop
+                } else {
+                    CongestionControl::Block
+                })
                 .wait()
                 .map_err(|e| err(&format!("declaring the publisher of {}", s.name()), e))?;
             publishers.push((s, p));
@@ -248,7 +280,10 @@ impl ZenohEnd {
     }
 
     /// Waits for a frame that `take` accepts: polls (yielding) for the spin budget,
-    /// then blocks on the queue, until `deadline` or a stop request.
+    /// then blocks on the queue, until `deadline` or a stop request. Polling measured
+    /// faster here than blocking at once (all-Zenoh loop across two namespaces, 1 kHz:
+    /// p50 137 us against 336 us): it spares the futex wake-up of the hand-over from
+    /// Zenoh's thread.
     fn wait<R>(
         &self,
         deadline: Instant,
