@@ -359,7 +359,7 @@ fn a_prefix_in_use_is_refused_and_names_its_holder() {
 fn bad_prefixes_are_refused_before_anything_starts() {
     let sb = Sandbox::new("badprefix");
     let scenario = sb.write("s.toml", &realtime(100));
-    let long = "p".repeat(33);
+    let long = "p".repeat(25);
     for bad in ["a/b", "../x", "-x", "a b", long.as_str()] {
         let prefix = format!("--prefix={bad}");
         let o = sb.tactile(&[
@@ -376,6 +376,27 @@ fn bad_prefixes_are_refused_before_anything_starts() {
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(!sb.path("out").join("scenario.toml").exists(), "{bad}");
     }
+}
+
+#[test]
+fn the_longest_prefix_allowed_runs_over_iceoryx2() {
+    // Iceoryx2's event sockets hold the prefix twice in a path of at most 108 bytes:
+    // the longest prefix accepted must still open them.
+    let sb = Sandbox::new("longpfx");
+    let scenario = sb.write("s.toml", &lockstep(50));
+    let prefix = format!("{}{}", sb.prefix, "x".repeat(24 - sb.prefix.len()));
+    let o = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        "run",
+        "--prefix",
+        &prefix,
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(sb.json("run", "summary.json")["samples_received"], 50);
+    tactile_node::ipc::remove_run_files(&prefix);
 }
 
 #[test]

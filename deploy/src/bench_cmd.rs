@@ -24,6 +24,9 @@ use tactile_common::scenario::{Mode, Scenario};
 use tactile_node::ipc::{self, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
 use tactile_node::runtime::LinkKind;
 
+/// Runs of this bench so far (their prefixes' suffix).
+static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+
 /// One loop of a rate: a transport, on one host or across two.
 #[derive(Debug, Clone, Serialize)]
 pub struct LoopResult {
@@ -138,10 +141,12 @@ fn trio_with(
     let sup = Supervision {
         link: links,
         wrap,
+        // A short suffix per run: iceoryx2's socket paths leave room for prefixes of
+        // 26 characters at most (see tactile_node::lock::MAX_PREFIX_LEN).
         prefix: format!(
-            "{}{}",
+            "{}{:x}",
             sup.prefix,
-            out.file_name().map_or("", |n| n.to_str().unwrap_or(""))
+            RUNS.fetch_add(1, std::sync::atomic::Ordering::SeqCst)
         ),
         ..sup.clone()
     };
@@ -192,7 +197,7 @@ fn pin_self(cpu: usize) {
 
 /// Ping-pong with an echo process at `rate` for `n` round trips.
 fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
-    let prefix = format!("{}hop", sup.prefix);
+    let prefix = format!("{}h", sup.prefix);
     let exe = std::env::current_exe().map_err(Error::io("locating the tactile executable"))?;
     let mut cmd = if sup.pin {
         let mut c = Command::new("taskset");

@@ -37,7 +37,7 @@ fn a_bad_prefix_or_timeout_is_refused_before_anything_starts() {
     std::fs::write(dir.path().join("s.toml"), "name = \"x\"\n").expect("write");
     for (args, want) in [
         (vec!["--prefix", "a/b"], "character '/'"),
-        (vec!["--prefix", ""], "1 to 32"),
+        (vec!["--prefix", ""], "1 to 24"),
         (vec!["--startup-timeout-s", "0"], "--startup-timeout-s"),
         (vec!["--startup-timeout-s", "NaN"], "--startup-timeout-s"),
     ] {

@@ -57,7 +57,7 @@ pub struct NodeArgs {
     /// Folder for this node's record (`ROLE.rec`) and log (`ROLE.log`).
     #[arg(long)]
     pub out: PathBuf,
-    /// Name of the run: nodes with the same prefix find each other. 1 to 32 characters
+    /// Name of the run: nodes with the same prefix find each other. 1 to 24 characters
     /// from A-Z a-z 0-9 _ -.
     #[arg(long, default_value = "tactile")]
     pub prefix: String,
