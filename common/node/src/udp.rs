@@ -130,23 +130,20 @@ impl Endpoint {
     fn send<T: Sequenced + Copy>(
         &self,
         to: SocketAddr,
-        mut value: T,
+        value: T,
         control: bool,
         stats: &Cell<OutboxStats>,
         encode: fn(&T, &mut Vec<u8>) -> Result<(), String>,
     ) -> Result<(), IpcError> {
-        let mut st = stats.get();
-        st.stamp(&mut value, control);
         let mut buf = self.buf.borrow_mut();
-        encode(&value, &mut buf).map_err(|e| err("encoding a sample", e))?;
-        let receivers = match self.socket.send_to(&buf, to) {
-            Ok(_) => 1,
-            Err(e) if e.kind() == ErrorKind::ConnectionRefused => 0,
-            Err(e) => return Err(err("sending a datagram", e)),
-        };
-        st.count(receivers, control);
-        stats.set(st);
-        Ok(())
+        wire::send_counted(value, control, stats, &mut buf, encode, |frame| match self
+            .socket
+            .send_to(frame, to)
+        {
+            Ok(_) => Ok(1),
+            Err(e) if e.kind() == ErrorKind::ConnectionRefused => Ok(0),
+            Err(e) => Err(err("sending a datagram", e)),
+        })
     }
 
     /// Waits for one datagram until `deadline` and hands its decoded frame to `take`

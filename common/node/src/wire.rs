@@ -170,6 +170,30 @@ pub struct In {
     pub next: std::cell::Cell<Option<u64>>,
 }
 
+/// Sends one sample over a link that leaves the host: stamps it with its hop's next
+/// publish counter (or the control marker), encodes it into `buf`, hands the frame to
+/// `send` (which says how many receivers it reached) and counts it. UDP and Zenoh
+/// share this, so they stamp and count exactly as iceoryx2 does.
+pub fn send_counted<T: tactile_common::samples::Sequenced + Copy>(
+    mut value: T,
+    control: bool,
+    stats: &std::cell::Cell<crate::ipc::OutboxStats>,
+    buf: &mut Vec<u8>,
+    encode: fn(&T, &mut Vec<u8>) -> Result<(), String>,
+    send: impl FnOnce(&[u8]) -> Result<usize, crate::ipc::IpcError>,
+) -> Result<(), crate::ipc::IpcError> {
+    let mut st = stats.get();
+    st.stamp(&mut value, control);
+    encode(&value, buf).map_err(|detail| crate::ipc::IpcError {
+        context: "encoding a sample".into(),
+        detail,
+    })?;
+    let receivers = send(buf)?;
+    st.count(receivers, control);
+    stats.set(st);
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

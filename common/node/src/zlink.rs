@@ -226,28 +226,25 @@ impl ZenohEnd {
     pub fn put<T: Sequenced + Copy>(
         &self,
         stream: Stream,
-        mut value: T,
+        value: T,
         control: bool,
         stats: &Cell<OutboxStats>,
         encode: fn(&T, &mut Vec<u8>) -> Result<(), String>,
     ) -> Result<(), IpcError> {
-        let mut st = stats.get();
-        st.stamp(&mut value, control);
-        let mut buf = self.buf.borrow_mut();
-        encode(&value, &mut buf).map_err(|e| err("encoding a sample", e))?;
         let publisher = self
             .publishers
             .iter()
             .find(|(s, _)| *s == stream)
             .map(|(_, p)| p)
             .ok_or_else(|| err("publishing", format!("no publisher for {}", stream.name())))?;
-        publisher
-            .put(buf.as_slice())
-            .wait()
-            .map_err(|e| err(&format!("publishing on {}", stream.name()), e))?;
-        st.count(1, control);
-        stats.set(st);
-        Ok(())
+        let mut buf = self.buf.borrow_mut();
+        wire::send_counted(value, control, stats, &mut buf, encode, |frame| {
+            publisher
+                .put(frame)
+                .wait()
+                .map(|()| 1)
+                .map_err(|e| err(&format!("publishing on {}", stream.name()), e))
+        })
     }
 
     /// A received frame if one waits (decoded: a rejected one is `Err`).
