@@ -273,27 +273,23 @@ where
     }
 }
 
-/// The master's `Start` in `path`.
-pub fn master_start(path: &Path) -> Result<Start, Error> {
-    first_start::<MasterSample, MasterTotals>(path)
-}
-
-/// The clock domain of each node (empty where a node left no record).
-pub fn clock_domains(found: &[Option<PathBuf>; 3]) -> Result<[String; 3], Error> {
-    let domain = |p: &Option<PathBuf>, k: usize| -> Result<String, Error> {
+/// The first `Start` of each node's record (None where a node left no record), read
+/// without joining: the master's holds the scenario, each one its clock domain.
+pub fn starts(found: &[Option<PathBuf>; 3]) -> Result<[Option<Start>; 3], Error> {
+    let read = |p: &Option<PathBuf>, k: usize| -> Result<Option<Start>, Error> {
         let Some(p) = p else {
-            return Ok(String::new());
+            return Ok(None);
         };
-        Ok(match k {
-            0 => first_start::<MasterSample, MasterTotals>(p)?.clock,
-            1 => first_start::<Passage, EmulatorTotals>(p)?.clock,
-            _ => first_start::<SlaveSample, SlaveTotals>(p)?.clock,
-        })
+        Ok(Some(match k {
+            0 => first_start::<MasterSample, MasterTotals>(p)?,
+            1 => first_start::<Passage, EmulatorTotals>(p)?,
+            _ => first_start::<SlaveSample, SlaveTotals>(p)?,
+        }))
     };
     Ok([
-        domain(&found[0], 0)?,
-        domain(&found[1], 1)?,
-        domain(&found[2], 2)?,
+        read(&found[0], 0)?,
+        read(&found[1], 1)?,
+        read(&found[2], 2)?,
     ])
 }
 

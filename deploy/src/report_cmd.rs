@@ -230,8 +230,13 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     let master = found[0]
         .clone()
         .ok_or_else(|| Error::BadInput("no master record".into()))?;
-    let start = join::master_start(&master)?;
-    let domains = join::clock_domains(&found)?;
+    let starts = join::starts(&found)?;
+    let domains = starts
+        .clone()
+        .map(|s| s.map_or_else(String::new, |s| s.clock));
+    let start = starts[0]
+        .clone()
+        .ok_or_else(|| Error::BadInput("no master record".into()))?;
     let scenario = Scenario::from_toml_str(&start.scenario_toml).map_err(|e| {
         Error::BadInput(format!(
             "{}: the scenario recorded is not valid: {e}",
