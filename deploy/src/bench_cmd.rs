@@ -310,6 +310,12 @@ fn supervision(args: &BenchArgs, prefix: &str, spin: Duration) -> Supervision {
     }
 }
 
+/// Whether this build can run a loop on `link`: the Zenoh loops need the `zenoh`
+/// feature, and a bench without it says once that it leaves them out.
+fn zenoh_built(link: LinkKind) -> bool {
+    link != LinkKind::Zenoh || cfg!(feature = "zenoh")
+}
+
 /// `tactile bench`.
 pub fn main(args: &BenchArgs) -> Result<(), Error> {
     std::fs::create_dir_all(&args.out)
@@ -326,6 +332,11 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
         signal_hook::flag::register(sig, std::sync::Arc::clone(&stop))
             .map_err(Error::io("installing signal handlers"))?;
+    }
+    if !cfg!(feature = "zenoh") {
+        eprintln!(
+            "tactile bench: no Zenoh loop: this build has no Zenoh link (build with --features zenoh)"
+        );
     }
     let hosts = if args.hosts {
         Some(
@@ -349,7 +360,10 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             ("iceoryx2", LinkKind::Iceoryx2),
             ("udp", LinkKind::Udp),
             ("zenoh", LinkKind::Zenoh),
-        ] {
+        ]
+        .into_iter()
+        .filter(|&(_, l)| zenoh_built(l))
+        {
             eprintln!(
                 "tactile bench: {rate} Hz, {} samples: {name} loop",
                 args.samples
@@ -364,7 +378,10 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             for (name, link) in [
                 ("zenoh-hosts", LinkKind::Zenoh),
                 ("udp-hosts", LinkKind::Udp),
-            ] {
+            ]
+            .into_iter()
+            .filter(|&(_, l)| zenoh_built(l))
+            {
                 eprintln!(
                     "tactile bench: {rate} Hz: {name} loop, master in {}, emulator and slave in {}",
                     pair.names[0], pair.names[1]

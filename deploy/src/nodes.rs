@@ -72,6 +72,13 @@ fn cargo_build(dir: &Path) -> Result<(), String> {
             "tactile-slave",
             "--bins",
         ])
+        // The node programs link Zenoh when the launcher does.
+        .args(
+            cfg!(feature = "zenoh")
+                .then_some(["--features", "tactile/zenoh"])
+                .into_iter()
+                .flatten(),
+        )
         .output()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if out.status.success() {

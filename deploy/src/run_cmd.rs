@@ -194,6 +194,9 @@ impl Links {
     /// Every node on `kind`, on this host: UDP on three free ports; Zenoh with the
     /// emulator listening on a free loopback TCP port and the others connecting to it.
     pub fn on_this_host(kind: LinkKind) -> Result<Links, Error> {
+        if kind == LinkKind::Zenoh && !cfg!(feature = "zenoh") {
+            return Err(Error::BadInput(tactile_node::runtime::NO_ZENOH.into()));
+        }
         let failed = |e: std::io::Error| Error::Failed(format!("picking a free port: {e}"));
         let args = match kind {
             LinkKind::Iceoryx2 => Default::default(),

@@ -12,4 +12,5 @@ pub mod record;
 pub mod runtime;
 pub mod udp;
 pub mod wire;
+#[cfg(feature = "zenoh")]
 pub mod zlink;

@@ -433,7 +433,12 @@ fn udp_ports(a: &NodeArgs) -> Result<crate::udp::UdpPorts, NodeError> {
     })
 }
 
+/// What a build without the `zenoh` feature answers to `--link zenoh`.
+pub const NO_ZENOH: &str = "--link zenoh: this build has no Zenoh link; build with \
+`cargo build --release --features zenoh` (README, Across hosts)";
+
 /// The Zenoh endpoints of the arguments.
+#[cfg(feature = "zenoh")]
 pub fn zenoh_options(a: &NodeArgs) -> crate::zlink::ZenohOptions {
     crate::zlink::ZenohOptions {
         listen: a.listen.clone(),
@@ -448,6 +453,9 @@ pub fn check_link_args(a: &NodeArgs, links: &[LinkKind]) -> Result<(), NodeError
         udp_ports(a)?;
     }
     if links.contains(&LinkKind::Zenoh) {
+        if !cfg!(feature = "zenoh") {
+            return Err(NodeError::BadInput(NO_ZENOH.into()));
+        }
         if a.listen.is_empty() && a.connect.is_empty() && !a.scout {
             return Err(NodeError::BadInput(
                 "--link zenoh: give --listen ENDPOINT and/or --connect ENDPOINT (or --scout) so the nodes can meet".into(),
@@ -463,6 +471,7 @@ pub fn check_link_args(a: &NodeArgs, links: &[LinkKind]) -> Result<(), NodeError
                 )));
             }
         }
+        #[cfg(feature = "zenoh")]
         zenoh_options(a)
             .config()
             .map_err(|e| NodeError::BadInput(e.to_string()))?;
@@ -490,12 +499,7 @@ pub fn master_link(
     Ok(match a.link {
         LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxMaster::open(&a.prefix, wait))?),
         LinkKind::Udp => Box::new(opened(crate::udp::UdpMaster::open(udp_ports(a)?))?),
-        LinkKind::Zenoh => Box::new(opened(crate::zlink::ZenohMaster::open(
-            &zenoh_options(a),
-            &a.prefix,
-            direct,
-            wait,
-        ))?),
+        LinkKind::Zenoh => zenoh_open::master(a, direct, wait)?,
     })
 }
 
@@ -512,15 +516,12 @@ pub fn emulator_link(
     Ok(match (towards_master, towards_slave) {
         (Iceoryx2, Iceoryx2) => Box::new(opened(crate::ipc::IoxEmulator::open(&a.prefix, wait))?),
         (Udp, Udp) => Box::new(opened(crate::udp::UdpEmulator::open(udp_ports(a)?))?),
-        (Zenoh, Zenoh) | (Zenoh, Iceoryx2) | (Iceoryx2, Zenoh) => {
-            Box::new(opened(crate::zlink::ZenohEmulator::open(
-                &zenoh_options(a),
-                &a.prefix,
-                towards_master == Iceoryx2,
-                towards_slave == Iceoryx2,
-                wait,
-            ))?)
-        }
+        (Zenoh, Zenoh) | (Zenoh, Iceoryx2) | (Iceoryx2, Zenoh) => zenoh_open::emulator(
+            a,
+            towards_master == Iceoryx2,
+            towards_slave == Iceoryx2,
+            wait,
+        )?,
         (m, s) => {
             return Err(NodeError::BadInput(format!(
                 "--master-link {} with --slave-link {}: UDP cannot be mixed with another link (Zenoh and iceoryx2 can)",
@@ -540,10 +541,73 @@ pub fn slave_link(
     Ok(match a.link {
         LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxSlave::open(&a.prefix, wait))?),
         LinkKind::Udp => Box::new(opened(crate::udp::UdpSlave::open(udp_ports(a)?))?),
-        LinkKind::Zenoh => Box::new(opened(crate::zlink::ZenohSlave::open(
-            &zenoh_options(a),
-            &a.prefix,
-            wait,
-        ))?),
+        LinkKind::Zenoh => zenoh_open::slave(a, wait)?,
     })
+}
+
+/// Opening the Zenoh links, in a build with the `zenoh` feature.
+#[cfg(feature = "zenoh")]
+mod zenoh_open {
+    use super::{opened, zenoh_options, NodeArgs, NodeError};
+    use crate::ipc::WaitPolicy;
+    use crate::link::{EmulatorLink, MasterLink, SlaveLink};
+    use crate::zlink::{ZenohEmulator, ZenohMaster, ZenohSlave};
+
+    pub fn master(
+        a: &NodeArgs,
+        direct: bool,
+        wait: WaitPolicy,
+    ) -> Result<Box<dyn MasterLink>, NodeError> {
+        let o = zenoh_options(a);
+        Ok(Box::new(opened(ZenohMaster::open(
+            &o, &a.prefix, direct, wait,
+        ))?))
+    }
+
+    pub fn emulator(
+        a: &NodeArgs,
+        master_on_iceoryx2: bool,
+        slave_on_iceoryx2: bool,
+        wait: WaitPolicy,
+    ) -> Result<Box<dyn EmulatorLink>, NodeError> {
+        let o = zenoh_options(a);
+        Ok(Box::new(opened(ZenohEmulator::open(
+            &o,
+            &a.prefix,
+            master_on_iceoryx2,
+            slave_on_iceoryx2,
+            wait,
+        ))?))
+    }
+
+    pub fn slave(a: &NodeArgs, wait: WaitPolicy) -> Result<Box<dyn SlaveLink>, NodeError> {
+        let o = zenoh_options(a);
+        Ok(Box::new(opened(ZenohSlave::open(&o, &a.prefix, wait))?))
+    }
+}
+
+/// In a build without the `zenoh` feature every Zenoh link is a configuration error
+/// that says how to build with it.
+#[cfg(not(feature = "zenoh"))]
+mod zenoh_open {
+    use super::{NodeArgs, NodeError, NO_ZENOH};
+    use crate::ipc::WaitPolicy;
+    use crate::link::{EmulatorLink, MasterLink, SlaveLink};
+
+    pub fn master(_: &NodeArgs, _: bool, _: WaitPolicy) -> Result<Box<dyn MasterLink>, NodeError> {
+        Err(NodeError::BadInput(NO_ZENOH.into()))
+    }
+
+    pub fn emulator(
+        _: &NodeArgs,
+        _: bool,
+        _: bool,
+        _: WaitPolicy,
+    ) -> Result<Box<dyn EmulatorLink>, NodeError> {
+        Err(NodeError::BadInput(NO_ZENOH.into()))
+    }
+
+    pub fn slave(_: &NodeArgs, _: WaitPolicy) -> Result<Box<dyn SlaveLink>, NodeError> {
+        Err(NodeError::BadInput(NO_ZENOH.into()))
+    }
 }
