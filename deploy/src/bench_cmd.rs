@@ -11,7 +11,7 @@ use crate::cli::BenchArgs;
 use crate::error::Error;
 use crate::report::{us_header, us_line, Latency, Percentiles};
 use crate::report_cmd::write_json;
-use crate::run_cmd::{default_spin, run_processes, Loaded, Supervision, PAPER_SCENARIO};
+use crate::run_cmd::{run_processes, Loaded, Supervision, PAPER_SCENARIO};
 use crate::summary::Summary;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -195,6 +195,12 @@ fn pin_self(cpu: usize) {
     let _ = rustix::thread::sched_setaffinity(None, &set);
 }
 
+/// The bare hop's poll budget: as given, else two periods (it has no pacer).
+fn hop_spin(sup: &Supervision, rate: f64) -> Duration {
+    sup.spin
+        .unwrap_or_else(|| Duration::from_nanos((2e9 / rate) as u64))
+}
+
 /// Ping-pong with an echo process at `rate` for `n` round trips.
 fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
     let prefix = format!("{}h", sup.prefix);
@@ -209,7 +215,7 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
     let mut child = cmd
         .arg("bench-echo")
         .args(["--prefix", &prefix, "--spin-us"])
-        .arg(sup.spin.as_micros().to_string())
+        .arg(hop_spin(sup, rate).as_micros().to_string())
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .spawn()
@@ -253,7 +259,7 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
         let mut misses = 0;
         for i in 0..n {
             let tick = t0 + i * t_s;
-            sleep_until_ns(tick.saturating_sub(tactile_master::node::WAKE_EARLY_NS));
+            sleep_until_ns(tick.saturating_sub(tactile_node::pace::default_wake_early_ns(t_s)));
             while now_ns() < tick {
                 std::hint::spin_loop();
             }
@@ -266,7 +272,7 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
             let deadline = Instant::now() + Duration::from_nanos(t_s);
             loop {
                 match waker
-                    .wait(&node, sup.spin, deadline, || inbox.try_recv())
+                    .wait(&node, hop_spin(sup, rate), deadline, || inbox.try_recv())
                     .map_err(fail)?
                 {
                     Ok(f) if f.seq == i => {
@@ -293,10 +299,11 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
 
 /// How the bench supervises its iceoryx2 runs: no restarts (a death fails the bench),
 /// no progress line, pinned unless `--no-pin`.
-fn supervision(args: &BenchArgs, prefix: &str, spin: Duration) -> Supervision {
+fn supervision(args: &BenchArgs, prefix: &str) -> Supervision {
     Supervision {
         prefix: prefix.to_string(),
-        spin,
+        spin: args.spin_us.map(Duration::from_micros),
+        wake_early: args.wake_early_us.map(Duration::from_micros),
         progress: false,
         max_restarts: 0,
         link: crate::run_cmd::Links {
@@ -304,7 +311,7 @@ fn supervision(args: &BenchArgs, prefix: &str, spin: Duration) -> Supervision {
             args: Default::default(),
         },
         pin: !args.no_pin,
-        rt: false,
+        sched: args.sched,
         no_trace: false,
         wrap: Default::default(),
     }
@@ -349,10 +356,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     };
     for &rate in &args.rates {
         let sc = scenario(rate, args.samples, Mode::Realtime)?;
-        let spin = args
-            .spin_us
-            .map_or_else(|| default_spin(&sc), Duration::from_micros);
-        let sup = supervision(args, &prefix, spin);
+        let sup = supervision(args, &prefix);
         // The loops on one host get the same scheduling (pinned unless --no-pin,
         // polling for the same budget); across hosts the namespaces share the CPUs.
         let mut loops = Vec::new();
@@ -423,10 +427,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     eprintln!("tactile bench: lockstep throughput");
     let n = args.lockstep_samples;
     let sc = scenario(1000.0, n, Mode::Lockstep)?;
-    let spin = args
-        .spin_us
-        .map_or_else(|| Duration::from_millis(2), Duration::from_micros);
-    let sup = supervision(args, &prefix, spin);
+    let sup = supervision(args, &prefix);
     let lock = trio(&sc, &args.out.join("lockstep"), &sup, LinkKind::Iceoryx2)?;
     let report = BenchReport {
         lockstep_samples_per_s: lock.master.samples_per_s,

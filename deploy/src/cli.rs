@@ -78,9 +78,16 @@ pub struct BenchArgs {
     /// Output folder (bench.json and each run's report).
     #[arg(long, default_value = "bench-out")]
     pub out: PathBuf,
-    /// Poll budget of the iceoryx2 processes, microseconds (default: two periods).
+    /// Poll budget of every node, microseconds (default: the nodes' own).
     #[arg(long)]
     pub spin_us: Option<u64>,
+    /// Realtime: microseconds before a sample is due that each node stops sleeping
+    /// and polls (default 200, at most 40 % of a period).
+    #[arg(long)]
+    pub wake_early_us: Option<u64>,
+    /// Scheduling of every loop's nodes (the same for every transport).
+    #[arg(long, value_enum, default_value_t = tactile_node::sched::Policy::Fifo)]
+    pub sched: tactile_node::sched::Policy,
     /// Do not pin the iceoryx2 processes to CPUs.
     #[arg(long)]
     pub no_pin: bool,
@@ -106,10 +113,15 @@ pub struct RunArgs {
     #[arg(long)]
     pub prefix: Option<String>,
     /// Microseconds each process polls (yielding the core between polls) before it
-    /// blocks on its wake-up event. Default: two sampling periods, so a running loop
-    /// never sleeps (chosen by measurement, see README "Waiting"); 0 blocks at once.
+    /// blocks on its wake-up event. Default: twice the wake-up margin (each node
+    /// sleeps until 200 us before a sample is due, at most 40 % of a period), two
+    /// periods in lockstep (chosen by measurement, see README "Waiting").
     #[arg(long)]
     pub spin_us: Option<u64>,
+    /// Realtime: microseconds before a sample is due that each node stops sleeping
+    /// and polls (default 200, at most 40 % of a period).
+    #[arg(long)]
+    pub wake_early_us: Option<u64>,
     /// Run master, emulator and slave in this process, without shared memory.
     #[arg(long)]
     pub in_process: bool,
@@ -131,9 +143,11 @@ pub struct RunArgs {
     /// and slave on CPU 1, where the machine has two CPUs).
     #[arg(long)]
     pub no_pin: bool,
-    /// Run the three processes SCHED_FIFO (chrt), where permitted.
-    #[arg(long)]
-    pub rt: bool,
+    /// Scheduling the nodes set on themselves: fifo (SCHED_FIFO at priority 70 with
+    /// memory locked, where permitted; otherwise SCHED_OTHER, said in the report) or
+    /// other.
+    #[arg(long, value_enum, default_value_t = tactile_node::sched::Policy::Fifo)]
+    pub sched: tactile_node::sched::Policy,
     /// Write no trace.csv (a long run's trace is about 1 kB per sample); everything
     /// else is reported.
     #[arg(long)]

@@ -109,6 +109,11 @@ where
         last_sample: log.last_sample,
         ended: log.ending(),
         unjoined: log.unjoined,
+        sched: log
+            .starts
+            .last()
+            .map(|s| s.sched.clone())
+            .unwrap_or_default(),
     })
 }
 

@@ -162,8 +162,10 @@ fn log_tail(out: &Path, role: &str) -> String {
 pub struct Supervision {
     /// iceoryx2 prefix of the run.
     pub prefix: String,
-    /// Busy-poll budget of every process.
-    pub spin: Duration,
+    /// Poll budget of every process (None: each node's default, README "Waiting").
+    pub spin: Option<Duration>,
+    /// How long before a sample is due each node wakes (None: each node's default).
+    pub wake_early: Option<Duration>,
     /// Progress line on a terminal.
     pub progress: bool,
     /// Restarts allowed per process (emulator, slave) when one dies mid-run.
@@ -175,8 +177,8 @@ pub struct Supervision {
     pub wrap: [Vec<String>; 3],
     /// Pin master to CPU 0, emulator and slave to CPU 1.
     pub pin: bool,
-    /// SCHED_FIFO priority for the three processes, if permitted.
-    pub rt: bool,
+    /// Scheduling of the three processes, which each node sets on itself.
+    pub sched: tactile_node::sched::Policy,
     /// Write no trace.csv.
     pub no_trace: bool,
 }
@@ -270,9 +272,6 @@ fn node_command(
     append: bool,
 ) -> Command {
     let mut argv: Vec<String> = sup.wrap[role_index(role)].clone();
-    if sup.rt {
-        argv.extend(["chrt", "-f", "10"].map(String::from));
-    }
     argv.push(exe.display().to_string());
     let mut cmd = Command::new(&argv[0]);
     cmd.args(&argv[1..]);
@@ -281,8 +280,14 @@ fn node_command(
         .arg("--out")
         .arg(out)
         .args(["--prefix", &sup.prefix])
-        .args(["--spin-us", &sup.spin.as_micros().to_string()])
+        .args(["--sched", sched_name(sup.sched)])
         .args(["--supervised", &std::process::id().to_string()]);
+    if let Some(spin) = sup.spin {
+        cmd.args(["--spin-us", &spin.as_micros().to_string()]);
+    }
+    if let Some(early) = sup.wake_early {
+        cmd.args(["--wake-early-us", &early.as_micros().to_string()]);
+    }
     cmd.args(["--link", sup.link.kind.name()]);
     cmd.args(sup.link.args(role));
     if sup.pin {
@@ -297,13 +302,12 @@ fn node_command(
     cmd
 }
 
-fn tool_works(argv: &[&str]) -> bool {
-    Command::new(argv[0])
-        .args(&argv[1..])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
+/// The name of a policy on the nodes' command line.
+pub fn sched_name(p: tactile_node::sched::Policy) -> &'static str {
+    match p {
+        tactile_node::sched::Policy::Fifo => "fifo",
+        tactile_node::sched::Policy::Other => "other",
+    }
 }
 
 /// True if this machine lets the process use CPUs 0 and 1.
@@ -517,15 +521,7 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     if sup.pin && !pin {
         notes.push("fewer than two CPUs: processes not pinned".to_string());
     }
-    let rt = sup.rt && tool_works(&["chrt", "-f", "10", "true"]);
-    if sup.rt && !rt {
-        notes.push("SCHED_FIFO not permitted: processes run SCHED_OTHER".to_string());
-    }
-    let sup = Supervision {
-        pin,
-        rt,
-        ..sup.clone()
-    };
+    let sup = Supervision { pin, ..sup.clone() };
     let spawn = |role: &'static str, append: bool| -> Result<Child, Error> {
         let log = std::fs::OpenOptions::new()
             .create(true)
@@ -577,12 +573,6 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     write_report(&[out.to_path_buf()], out, &launch)
 }
 
-/// The measured default wait: poll (yielding) for two sampling periods before
-/// blocking, so the processes of a running loop never pay a wake-up.
-pub fn default_spin(scenario: &Scenario) -> Duration {
-    Duration::from_nanos(2 * scenario.t_s_ns())
-}
-
 /// How long the launcher lets the emulator and slave run on after the master died:
 /// long enough for the slave to notice and hold (its peer timeout) and to be seen.
 pub fn survivor_grace(scenario: &Scenario) -> Duration {
@@ -610,14 +600,13 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
                 .prefix
                 .clone()
                 .unwrap_or_else(|| format!("tactile{}", std::process::id())),
-            spin: args
-                .spin_us
-                .map_or_else(|| default_spin(&loaded.scenario), Duration::from_micros),
+            spin: args.spin_us.map(Duration::from_micros),
+            wake_early: args.wake_early_us.map(Duration::from_micros),
             progress: !args.quiet,
             max_restarts: args.max_restarts,
             link: Links::on_this_host(if args.udp { LinkKind::Udp } else { args.link })?,
             pin: !args.no_pin,
-            rt: args.rt,
+            sched: args.sched,
             no_trace: args.no_trace,
             wrap: Default::default(),
         };

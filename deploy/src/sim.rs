@@ -40,8 +40,10 @@ fn start(role: &str, scenario: &Scenario, base_dir: &Path) -> Start {
         scenario_toml: scenario.resolved(base_dir).to_toml(),
         samples: scenario.samples,
         rate_hz: scenario.rate_hz,
-        spin_us: 0,
-        cpu: None,
+        sched: tactile_node::sched::Sched {
+            policy: "in-process".into(),
+            ..Default::default()
+        },
         unix_ms: 0,
         mono_ns: 0,
     }

@@ -86,6 +86,9 @@ pub struct NodeSummary {
     pub ended: String,
     /// Sample records that matched no sample of the master.
     pub unjoined: u64,
+    /// Its scheduling (policy, priority, CPU, wake-up margin, poll budget) as its
+    /// last start recorded it; `note` says what the kernel refused.
+    pub sched: tactile_node::sched::Sched,
 }
 
 /// The nodes' clocks.
@@ -236,9 +239,10 @@ pub fn render(s: &Summary, out: &Path) -> String {
     for (role, n) in &s.nodes {
         let _ = writeln!(
             t,
-            "node {role}: peak RSS {:.1} MB, {}",
+            "node {role}: peak RSS {:.1} MB, {}; {}",
             n.peak_rss_kb as f64 / 1024.0,
-            n.ended
+            n.ended,
+            sched_line(&n.sched)
         );
     }
     for e in &s.events {
@@ -253,5 +257,27 @@ pub fn render(s: &Summary, out: &Path) -> String {
         .filter(|f| out.join(f).exists())
         .collect();
     let _ = writeln!(t, "wrote {}: {}", out.display(), files.join(" "));
+    t
+}
+
+/// A node's scheduling in one line, with what the kernel refused.
+fn sched_line(s: &tactile_node::sched::Sched) -> String {
+    let mut t = s.policy.clone();
+    if s.priority > 0 {
+        t += &format!(" {}", s.priority);
+    }
+    if let Some(c) = s.cpu {
+        t += &format!(", CPU {c}");
+    }
+    if s.wake_early_us > 0 {
+        t += &format!(", wakes {} us early", s.wake_early_us);
+    }
+    t += &format!(", polls {} us", s.poll_us);
+    if s.memory_locked {
+        t += ", memory locked";
+    }
+    if let Some(n) = &s.note {
+        t += &format!(" ({n})");
+    }
     t
 }

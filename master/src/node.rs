@@ -11,10 +11,6 @@ use tactile_node::runtime::{
     EXIT_CODES_HELP,
 };
 
-/// How long before each realtime tick the master wakes and spins: covers the ~100 us
-/// lateness of timer wake-ups measured on these machines (see README, "Waiting").
-pub const WAKE_EARLY_NS: u64 = 200_000;
-
 /// tactile-master: the operator's side (OP, MD, HMD). Sends c(n), takes q(n) back,
 /// commands the master device's torques, and records every sample.
 #[derive(Debug, Parser)]
@@ -65,7 +61,7 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
         base_dir: p.base_dir.clone(),
         startup_timeout: Duration::from_secs_f64(cli.startup_timeout_s.min(1e6)),
         answer_timeout: Duration::from_millis(100),
-        wake_early_ns: WAKE_EARLY_NS,
+        wake_early_ns: p.wake_early.as_nanos() as u64,
         run: new_run_token(),
     };
     let ended = master_link(a, p.spin, cli.direct).and_then(|link| {

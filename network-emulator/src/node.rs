@@ -54,7 +54,8 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     rec.start(start)?;
     tracing::info!("waiting for the master");
     let ended = emulator_link(a, p.spin, towards_master, towards_slave).and_then(|link| {
-        run_with(&p.scenario, link.as_ref(), &mut rec).map_err(|e| NodeError::Failed(e.to_string()))
+        run_with(&p.scenario, link.as_ref(), &mut rec, p.wake_early)
+            .map_err(|e| NodeError::Failed(e.to_string()))
     });
     ended.inspect_err(|e| {
         let _ = rec.event(0, format!("failed: {e}"));

@@ -7,9 +7,10 @@ use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 use tactile_common::clock::now_ns;
 use tactile_common::samples::{stage, FLAG_END, FLAG_PROBE};
-use tactile_common::scenario::Scenario;
+use tactile_common::scenario::{Mode, Scenario};
 use tactile_node::ipc::{Idle, IpcError};
 use tactile_node::link::{Arrival, EmulatorLink, EmulatorStats, RunFilter};
+use tactile_node::pace::{recv_paced, Pacer};
 use tactile_node::runtime::{NodeError, Recorder};
 
 /// The emulator's counters.
@@ -49,11 +50,17 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
     scenario: &Scenario,
     link: &L,
     rec: &mut EmulatorRecorder,
+    wake_early: Duration,
 ) -> Result<bool, EmulatorError> {
     let mut emu = Emulator::new(scenario);
     let mut filter = RunFilter::default();
     let mut seen_first = false;
     let mut last_seq = 0;
+    // Realtime: sleep until just before c(n) is due (learned from its arrivals), but
+    // not while h(n) is expected back from the slave, which comes within microseconds.
+    let mut pacer = (scenario.mode == Mode::Realtime)
+        .then(|| Pacer::new(scenario.t_s_ns(), wake_early.as_nanos() as u64));
+    let mut expect_h = false;
     let totals = |emu: &Emulator, filter: &RunFilter| {
         let mut links = link.stats();
         links.c_in.foreign += filter.foreign;
@@ -64,7 +71,9 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
     };
     let completed = loop {
         let deadline = Instant::now() + Duration::from_secs(3600);
-        let arrival = match link.recv(deadline)? {
+        let paced = pacer.as_ref().filter(|_| !expect_h);
+        let (got, waiting) = recv_paced(paced, deadline, |d| link.recv(d))?;
+        let arrival = match got {
             Ok(a) => a,
             Err(Idle::Timeout) => continue,
             Err(Idle::Terminate) => break false,
@@ -97,7 +106,12 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
                 }
                 last_seq = seq;
                 c.stamps[stage::EMU_FWD_RECV] = now_ns();
+                if let Some(p) = &mut pacer {
+                    let t = c.stamps[stage::EMU_FWD_RECV];
+                    p.arrived(c.seq, t, waiting);
+                }
                 let (out, passage) = emu.forward(&c);
+                expect_h = out.is_some();
                 if let Some(mut v) = out {
                     v.stamps[stage::EMU_FWD_SEND] = now_ns();
                     link.send_v(v, false)?;
@@ -110,6 +124,7 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
                     continue;
                 }
                 h.stamps[stage::EMU_BWD_RECV] = now_ns();
+                expect_h = false;
                 let (out, passage) = emu.backward(&h);
                 if let Some(mut q) = out {
                     q.stamps[stage::EMU_BWD_SEND] = now_ns();

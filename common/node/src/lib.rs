@@ -8,8 +8,11 @@ pub mod ipc;
 pub mod link;
 pub mod lock;
 pub mod logging;
+pub mod pace;
 pub mod record;
 pub mod runtime;
+pub mod sched;
+mod sys;
 pub mod udp;
 pub mod wire;
 #[cfg(feature = "zenoh")]

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// First bytes of every record file; the last byte is the format version.
-pub const MAGIC: [u8; 8] = *b"TACTREC\x01";
+pub const MAGIC: [u8; 8] = *b"TACTREC\x02";
 /// Largest frame a reader accepts; anything longer is corruption.
 pub const MAX_FRAME: u32 = 1 << 20;
 
@@ -72,10 +72,8 @@ pub struct Start {
     pub samples: u64,
     /// Sampling rate, Hz.
     pub rate_hz: f64,
-    /// Poll budget before blocking, us.
-    pub spin_us: u64,
-    /// CPU the node is pinned to, if any.
-    pub cpu: Option<usize>,
+    /// Scheduling: policy, priority, CPU, wake-up margin and poll budget.
+    pub sched: crate::sched::Sched,
     /// Wall-clock time of the start, ms since the Unix epoch.
     pub unix_ms: u64,
     /// CLOCK_MONOTONIC at the start, ns.
@@ -98,7 +96,7 @@ pub struct Event {
 pub struct Totals<C> {
     /// The node's own counters.
     pub counters: C,
-    /// Peak resident set size so far, kB (`VmHWM`).
+    /// Peak resident set size so far, kB (getrusage's `ru_maxrss`).
     pub peak_rss_kb: u64,
 }
 
@@ -296,16 +294,9 @@ impl<T: DeserializeOwned> RecordReader<T> {
     }
 }
 
-/// Peak resident set size of this process so far, kB (0 where /proc is missing).
+/// Peak resident set size of this process so far, kB (0 if the kernel will not say).
 pub fn peak_rss_kb() -> u64 {
-    let Ok(status) = std::fs::read_to_string("/proc/self/status") else {
-        return 0;
-    };
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
-        .unwrap_or(0)
+    crate::sys::max_rss_kb()
 }
 
 #[cfg(test)]

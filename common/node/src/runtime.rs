@@ -81,10 +81,22 @@ pub struct NodeArgs {
     #[arg(long)]
     pub scout: bool,
     /// Microseconds to poll (yielding the CPU) before blocking on the wake-up event.
-    /// Default: two sampling periods, so a running loop never sleeps (measured, see
-    /// the README's "Waiting"); 0 blocks at once.
+    /// Default: twice --wake-early-us in realtime (the node wakes that long before a
+    /// sample is due), two sampling periods in lockstep; 0 blocks at once.
     #[arg(long)]
     pub spin_us: Option<u64>,
+    /// Realtime: stop sleeping this long before a sample is due, then poll. Default
+    /// 200 us, at most 40 % of a sampling period (measured, README "Waiting").
+    #[arg(long)]
+    pub wake_early_us: Option<u64>,
+    /// Scheduling: fifo (SCHED_FIFO with memory locked, where permitted; otherwise
+    /// SCHED_OTHER, said in the log and the report) or other. Lockstep runs always
+    /// SCHED_OTHER: its loop never sleeps.
+    #[arg(long, value_enum, default_value_t = crate::sched::Policy::Fifo)]
+    pub sched: crate::sched::Policy,
+    /// SCHED_FIFO priority, 1 to 98.
+    #[arg(long, default_value_t = crate::sched::DEFAULT_PRIORITY, value_parser = clap::value_parser!(u8).range(1..=98))]
+    pub priority: u8,
     /// Pin this node to one CPU.
     #[arg(long)]
     pub cpu: Option<usize>,
@@ -147,6 +159,10 @@ pub struct Prepared {
     pub base_dir: PathBuf,
     /// Poll budget before blocking.
     pub spin: Duration,
+    /// Realtime: how long before a sample is due the node wakes (zero in lockstep).
+    pub wake_early: Duration,
+    /// The scheduling in force.
+    pub sched: crate::sched::Sched,
     /// The run's lock for this role, held while the node lives.
     pub lock: Lock,
 }
@@ -186,16 +202,66 @@ pub fn prepare(role: &str, args: &NodeArgs) -> Result<Prepared, NodeError> {
     if let Some(cpu) = args.cpu {
         pin(cpu).map_err(bad)?;
     }
-    let spin = args.spin_us.map_or_else(
-        || Duration::from_nanos(2 * scenario.t_s_ns()),
-        Duration::from_micros,
-    );
+    let (wake_early, spin) = waiting(&scenario, args.wake_early_us, args.spin_us);
+    let sched = schedule(args, &scenario, wake_early, spin);
     Ok(Prepared {
         scenario,
         base_dir,
         spin,
+        wake_early,
+        sched,
         lock,
     })
+}
+
+/// The wake-up margin and the poll budget: as given, or the measured defaults
+/// (README "Waiting"). Lockstep never sleeps: it polls two sampling periods, then
+/// blocks.
+pub fn waiting(
+    scenario: &Scenario,
+    wake_early_us: Option<u64>,
+    spin_us: Option<u64>,
+) -> (Duration, Duration) {
+    let t_s = scenario.t_s_ns();
+    if scenario.mode != tactile_common::scenario::Mode::Realtime {
+        let spin = spin_us.map_or(Duration::from_nanos(2 * t_s), Duration::from_micros);
+        return (Duration::ZERO, spin);
+    }
+    let early = wake_early_us.map_or_else(
+        || Duration::from_nanos(crate::pace::default_wake_early_ns(t_s)),
+        Duration::from_micros,
+    );
+    let spin = spin_us.map_or(2 * early, Duration::from_micros);
+    (early, spin)
+}
+
+/// Applies the scheduling the arguments ask for (SCHED_FIFO only for a realtime
+/// run) and says in the log what the kernel refused.
+fn schedule(
+    args: &NodeArgs,
+    scenario: &Scenario,
+    wake_early: Duration,
+    spin: Duration,
+) -> crate::sched::Sched {
+    use crate::sched::{apply, Policy, Sched};
+    let realtime = scenario.mode == tactile_common::scenario::Mode::Realtime;
+    let policy = if realtime { args.sched } else { Policy::Other };
+    let (fifo, memory_locked, mut notes) = apply(policy, args.priority);
+    if !realtime && args.sched == Policy::Fifo {
+        notes.push("lockstep: SCHED_OTHER (its loop never sleeps)".into());
+    }
+    for n in &notes {
+        tracing::warn!("{n}");
+    }
+    Sched {
+        policy: if fifo { "SCHED_FIFO" } else { "SCHED_OTHER" }.into(),
+        priority: if fifo { args.priority } else { 0 },
+        cpu: args.cpu,
+        wake_early_us: wake_early.as_micros() as u64,
+        poll_us: spin.as_micros() as u64,
+        memory_locked,
+        note: (!notes.is_empty()).then(|| notes.join("; ")),
+    }
 }
 
 /// Asks the kernel to send SIGTERM when the launcher dies (even by SIGKILL), and stops
@@ -263,15 +329,18 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
     /// The start of a segment.
     pub fn start(&mut self, start: Start) -> Result<(), NodeError> {
         tracing::info!(
-            "start: {} of run {:?} ({} link, scenario {:?}, {} samples at {} Hz, poll {} us{})",
+            "start: {} of run {:?} ({} link, scenario {:?}, {} samples at {} Hz, {} {}, wake {} us early, poll {} us{})",
             start.role,
             start.prefix,
             start.link,
             start.scenario,
             start.samples,
             start.rate_hz,
-            start.spin_us,
-            start.cpu.map_or(String::new(), |c| format!(", CPU {c}"))
+            start.sched.policy,
+            start.sched.priority,
+            start.sched.wake_early_us,
+            start.sched.poll_us,
+            start.sched.cpu.map_or(String::new(), |c| format!(", CPU {c}"))
         );
         self.put(&Record::Start(start))
     }
@@ -383,8 +452,7 @@ pub fn start_record(role: &str, args: &NodeArgs, p: &Prepared) -> Start {
         scenario_toml: p.scenario.resolved(&p.base_dir).to_toml(),
         samples: p.scenario.samples,
         rate_hz: p.scenario.rate_hz,
-        spin_us: p.spin.as_micros() as u64,
-        cpu: args.cpu,
+        sched: p.sched.clone(),
         unix_ms,
         mono_ns: now_ns(),
     }
