@@ -41,6 +41,9 @@ pub struct LoopResult {
     pub samples_lost: u64,
     /// Per-stage times (compute per process, transport per hop), ns.
     pub stages_ns: BTreeMap<String, Percentiles>,
+    /// Each node's scheduling as its record says (the same for every loop of a rate,
+    /// so the comparison is fair).
+    pub sched: BTreeMap<String, tactile_node::sched::Sched>,
 }
 
 /// One rate's results.
@@ -105,6 +108,11 @@ fn loop_result(name: &str, s: Summary) -> Result<LoopResult, Error> {
         deadline_misses: s.deadline_misses,
         samples_lost: s.samples_lost,
         stages_ns: s.stages_ns,
+        sched: s
+            .nodes
+            .iter()
+            .map(|(role, n)| (role.to_string(), n.sched.clone()))
+            .collect(),
     })
 }
 
@@ -409,6 +417,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
                 }
             }
         }
+        percentile_plot(&args.out, rate, &loops)?;
         eprintln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
         let (hop, hop_misses) = bare_hop(rate, args.samples, &sup)?;
         let mut r = RateResult {
@@ -432,21 +441,50 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     let report = BenchReport {
         lockstep_samples_per_s: lock.master.samples_per_s,
         lockstep_samples: n,
-        strategy: format!(
-            "iceoryx2: poll with yield for {} then block{}; UDP: blocking receive",
-            args.spin_us
-                .map_or_else(|| "two sampling periods".to_string(), |u| format!("{u} us")),
-            if args.no_pin {
-                ""
-            } else {
-                ", master on CPU 0, emulator and slave on CPU 1"
-            }
-        ),
+        strategy: strategy(args),
         rates,
     };
     write_json(&args.out.join("bench.json"), &report)?;
     print!("{}", render(&report));
     Ok(())
+}
+
+/// The waiting and scheduling every loop of the bench gets, in words.
+fn strategy(args: &BenchArgs) -> String {
+    format!(
+        "every loop: {}, each node sleeping until {} before its sample is due, then polling (yielding) for {} before it blocks{}",
+        match args.sched {
+            tactile_node::sched::Policy::Fifo => "SCHED_FIFO where permitted (memory locked)",
+            tactile_node::sched::Policy::Other => "SCHED_OTHER",
+        },
+        args.wake_early_us
+            .map_or_else(|| "200 us (at most 40 % of a period)".to_string(), |u| format!("{u} us")),
+        args.spin_us
+            .map_or_else(|| "twice that".to_string(), |u| format!("{u} us")),
+        if args.no_pin {
+            ""
+        } else {
+            "; master on CPU 0, emulator and slave on CPU 1 (one host)"
+        }
+    )
+}
+
+/// `percentiles-RATE.svg`: every loop's overhead by percentile, from its report's
+/// `overhead.hgrm`, side by side.
+fn percentile_plot(out: &Path, rate: f64, loops: &[LoopResult]) -> Result<(), Error> {
+    let mut series = Vec::new();
+    for l in loops {
+        let file = out.join(format!("{}-{rate}", l.name)).join("overhead.hgrm");
+        let text = std::fs::read_to_string(&file)
+            .map_err(Error::io(format!("reading {}", file.display())))?;
+        series.push((l.name.clone(), crate::plots::read_hgrm(&text)));
+    }
+    crate::plots::percentile_plot(
+        &out.join(format!("percentiles-{rate}.svg")),
+        &format!("System overhead by percentile, {rate} Hz"),
+        &series,
+    )
+    .map_err(|e| Error::Failed(format!("plotting percentiles: {e}")))
 }
 
 fn render(r: &BenchReport) -> String {

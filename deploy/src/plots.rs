@@ -198,6 +198,98 @@ pub fn overhead_histogram(lat: &Latency, path: &Path) -> PlotResult {
     root.present().map_err(err)
 }
 
+/// A percentile distribution as an `.hgrm` file gives it: (percentile as a fraction,
+/// value in us) per line, the lines of the header and footer skipped.
+pub fn read_hgrm(text: &str) -> Vec<(f64, f64)> {
+    text.lines()
+        .filter_map(|l| {
+            let mut f = l.split_whitespace();
+            let v: f64 = f.next()?.parse().ok()?;
+            let q: f64 = f.next()?.parse().ok()?;
+            (v.is_finite() && (0.0..=1.0).contains(&q)).then_some((q, v))
+        })
+        .collect()
+}
+
+/// Colours of the loops in a percentile plot.
+const LOOP_COLOURS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// Latency against percentile as the field draws it (HdrHistogram's plotter): the
+/// percentile on a log axis of 1/(1 - p), so 90 %, 99 %, 99.9 % and 99.99 % are evenly
+/// spaced and the tail is as visible as the body; one line per distribution, each
+/// from its `.hgrm` text; latency on a log axis too, since body and tail lie decades
+/// apart.
+pub fn percentile_plot(
+    path: &Path,
+    title: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> PlotResult {
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    // The last point (p = 1) has no finite 1/(1-p): it is drawn at the largest x.
+    let mut x_max = 10.0f64;
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for (_, pts) in series {
+        for &(q, v) in pts {
+            if q < 1.0 {
+                x_max = x_max.max(1.0 / (1.0 - q));
+            }
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if !lo.is_finite() {
+        return root.present().map_err(err);
+    }
+    let x_max = 10f64.powf(x_max.log10().ceil());
+    let (lo, hi) = ((lo * 0.8).max(0.01), (hi * 1.25).max(lo * 10.0).max(0.1));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d((1.0..x_max).log_scale(), (lo..hi).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("percentile")
+        .y_desc("latency (us)")
+        .x_label_formatter(&|x| {
+            let p = 100.0 * (1.0 - 1.0 / x);
+            format!("{}%", (p * 1000.0).round() / 1000.0)
+        })
+        .draw()
+        .map_err(err)?;
+    for (k, (label, pts)) in series.iter().enumerate() {
+        let colour = LOOP_COLOURS[k % LOOP_COLOURS.len()];
+        let line: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|&(q, v)| (if q < 1.0 { 1.0 / (1.0 - q) } else { x_max }.min(x_max), v))
+            .collect();
+        let style = ShapeStyle::from(colour).stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(line, style))
+            .map_err(err)?
+            .label(label.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)
+}
+
 type Line = (String, RGBColor, bool, Vec<(f64, f64)>);
 
 fn time_series(path: &Path, title: &str, y_desc: &str, series: &[Line]) -> PlotResult {
@@ -258,6 +350,33 @@ fn time_series(path: &Path, title: &str, y_desc: &str, series: &[Line]) -> PlotR
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_hgrm_file_reads_back_as_its_distribution() {
+        let mut lat = Latency::default();
+        for ns in 1..=10_000i64 {
+            lat.record(ns * 1000);
+        }
+        let pts = read_hgrm(&lat.hgrm());
+        assert!(pts.len() > 20);
+        assert!(pts.windows(2).all(|w| w[0].0 <= w[1].0 && w[0].1 <= w[1].1));
+        let (q, v) = pts[pts.len() - 1];
+        assert_eq!(q, 1.0);
+        assert!((v - 10_000.0).abs() < 10.0, "{v}");
+        // The median sits near 5000 us.
+        let mid = pts.iter().find(|p| p.0 >= 0.5).expect("median");
+        assert!((mid.1 - 5000.0).abs() < 10.0, "{mid:?}");
+        let dir = tempfile::tempdir().expect("tmp");
+        let svg = dir.path().join("p.svg");
+        percentile_plot(&svg, "t", &[("a".into(), pts)]).expect("plot");
+        let text: String = std::fs::read_to_string(&svg)
+            .expect("svg")
+            .split_whitespace()
+            .collect();
+        for label in [">90%<", ">99.9%<", ">99.99%<", ">a<"] {
+            assert!(text.contains(label), "{label}");
+        }
+    }
 
     #[test]
     fn thinning_keeps_the_extremes_and_bounds_the_points() {

@@ -89,8 +89,10 @@ impl Latency {
         if h.is_empty() {
             return s;
         }
+        let mut total = 0u64;
         for v in h.iter_quantiles(5) {
             let q = v.quantile_iterated_to();
+            total += v.count_since_last_iteration();
             let inv = if q < 1.0 {
                 format!("{:.2}", 1.0 / (1.0 - q))
             } else {
@@ -101,7 +103,7 @@ impl Latency {
                 "{:12.3} {:14.12} {:10} {:>14}",
                 v.value_iterated_to() as f64 / 1000.0,
                 q,
-                v.count_since_last_iteration(),
+                total,
                 inv
             );
         }

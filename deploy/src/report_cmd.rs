@@ -15,12 +15,13 @@ use tactile_common::scenario::Scenario;
 use tactile_common::trace;
 
 /// Files a report writes into its folder.
-pub const REPORT_FILES: [&str; 8] = [
+pub const REPORT_FILES: [&str; 9] = [
     "summary.json",
     "trace.csv",
     "round_trip.hgrm",
     "overhead.hgrm",
     "latency.svg",
+    "percentiles.svg",
     "positions.svg",
     "forces.svg",
     "scenario.toml",
@@ -287,14 +288,27 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         w.flush().map_err(Error::io("writing trace.csv"))?;
     }
     analysis.finish();
-    write_file(&out.join("round_trip.hgrm"), &analysis.round_trip.hgrm())?;
-    write_file(&out.join("overhead.hgrm"), &analysis.overhead.hgrm())?;
+    let round_trip = analysis.round_trip.hgrm();
+    let overhead = analysis.overhead.hgrm();
+    write_file(&out.join("round_trip.hgrm"), &round_trip)?;
+    write_file(&out.join("overhead.hgrm"), &overhead)?;
     let plot = |name: &str, res: Result<(), String>| {
         res.map_err(|e| Error::Failed(format!("plotting {name}: {e}")))
     };
     plot(
         "latency",
         plots::overhead_histogram(&analysis.overhead, &out.join("latency.svg")),
+    )?;
+    plot(
+        "percentiles",
+        plots::percentile_plot(
+            &out.join("percentiles.svg"),
+            "Latency by percentile",
+            &[
+                ("round trip".into(), plots::read_hgrm(&round_trip)),
+                ("system overhead".into(), plots::read_hgrm(&overhead)),
+            ],
+        ),
     )?;
     plot("positions and forces", series.write(out))?;
     write_file(&out.join("scenario.toml"), &start.scenario_toml)?;

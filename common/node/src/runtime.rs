@@ -566,7 +566,7 @@ pub fn master_link(
     }
     Ok(match a.link {
         LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxMaster::open(&a.prefix, wait))?),
-        LinkKind::Udp => Box::new(opened(crate::udp::UdpMaster::open(udp_ports(a)?))?),
+        LinkKind::Udp => Box::new(opened(crate::udp::UdpMaster::open(udp_ports(a)?, wait))?),
         LinkKind::Zenoh => zenoh_open::master(a, direct, wait)?,
     })
 }
@@ -583,7 +583,7 @@ pub fn emulator_link(
     let wait = crate::ipc::WaitPolicy { spin };
     Ok(match (towards_master, towards_slave) {
         (Iceoryx2, Iceoryx2) => Box::new(opened(crate::ipc::IoxEmulator::open(&a.prefix, wait))?),
-        (Udp, Udp) => Box::new(opened(crate::udp::UdpEmulator::open(udp_ports(a)?))?),
+        (Udp, Udp) => Box::new(opened(crate::udp::UdpEmulator::open(udp_ports(a)?, wait))?),
         (Zenoh, Zenoh) | (Zenoh, Iceoryx2) | (Iceoryx2, Zenoh) => zenoh_open::emulator(
             a,
             towards_master == Iceoryx2,
@@ -608,7 +608,7 @@ pub fn slave_link(
     let wait = crate::ipc::WaitPolicy { spin };
     Ok(match a.link {
         LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxSlave::open(&a.prefix, wait))?),
-        LinkKind::Udp => Box::new(opened(crate::udp::UdpSlave::open(udp_ports(a)?))?),
+        LinkKind::Udp => Box::new(opened(crate::udp::UdpSlave::open(udp_ports(a)?, wait))?),
         LinkKind::Zenoh => zenoh_open::slave(a, wait)?,
     })
 }

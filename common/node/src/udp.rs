@@ -8,7 +8,7 @@
 //! receiver; UDP cannot tell a dead peer otherwise. A datagram that is not a whole
 //! frame of this build's format is counted and dropped.
 
-use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats};
+use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats, WaitPolicy};
 use crate::link::{Arrival, EmulatorLink, EmulatorStats, MasterLink, SlaveLink, Wait};
 use crate::wire::{self, backward, count as take, forward, Frame};
 use std::cell::{Cell, RefCell};
@@ -108,12 +108,14 @@ impl UdpPorts {
 #[derive(Debug)]
 struct Endpoint {
     socket: UdpSocket,
+    /// Poll budget before a blocking receive, as the other links have.
+    spin: Duration,
     stop: Arc<AtomicBool>,
     buf: RefCell<Vec<u8>>,
 }
 
 impl Endpoint {
-    fn bind(at: SocketAddr) -> Result<Endpoint, IpcError> {
+    fn bind(at: SocketAddr, wait: WaitPolicy) -> Result<Endpoint, IpcError> {
         let socket = UdpSocket::bind(at).map_err(|e| err(&format!("binding UDP {at}"), e))?;
         let stop = Arc::new(AtomicBool::new(false));
         for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
@@ -122,6 +124,7 @@ impl Endpoint {
         }
         Ok(Endpoint {
             socket,
+            spin: wait.spin,
             stop,
             buf: RefCell::new(Vec::with_capacity(wire::MAX_FRAME)),
         })
@@ -147,7 +150,8 @@ impl Endpoint {
     }
 
     /// Waits for one datagram until `deadline` and hands its decoded frame to `take`
-    /// (`Err` for a rejected one, which `take` counts).
+    /// (`Err` for a rejected one, which `take` counts): looks without waiting (and
+    /// yields) for the poll budget, like the other links, then blocks in the kernel.
     fn recv<R>(
         &self,
         deadline: Instant,
@@ -155,22 +159,27 @@ impl Endpoint {
     ) -> Result<Result<R, Idle>, IpcError> {
         let mut buf = self.buf.borrow_mut();
         buf.resize(wire::MAX_FRAME + 1, 0);
+        let start = Instant::now();
         loop {
             if self.stop.load(Ordering::Relaxed) {
                 return Ok(Err(Idle::Terminate));
             }
+            // One look without waiting: a receive whose deadline is past still takes
+            // what is already there.
+            let flags = rustix::net::RecvFlags::DONTWAIT;
+            if let Ok((n, _)) = rustix::net::recv(&self.socket, &mut buf[..], flags) {
+                match take(wire::decode(&buf[..n])) {
+                    Some(r) => return Ok(Ok(r)),
+                    None => continue,
+                }
+            }
             let now = Instant::now();
             if now >= deadline {
-                // One look without waiting: a receive whose deadline is past still
-                // takes what is already there.
-                let flags = rustix::net::RecvFlags::DONTWAIT;
-                match rustix::net::recv(&self.socket, &mut buf[..], flags) {
-                    Ok((n, _)) => match take(wire::decode(&buf[..n])) {
-                        Some(r) => return Ok(Ok(r)),
-                        None => continue,
-                    },
-                    Err(_) => return Ok(Err(Idle::Timeout)),
-                }
+                return Ok(Err(Idle::Timeout));
+            }
+            if now.duration_since(start) < self.spin {
+                std::thread::yield_now();
+                continue;
             }
             let wait = (deadline - now)
                 .min(Duration::from_millis(50))
@@ -210,9 +219,9 @@ pub struct UdpMaster {
 
 impl UdpMaster {
     /// Binds the master's port.
-    pub fn open(ports: UdpPorts) -> Result<Self, IpcError> {
+    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, IpcError> {
         Ok(UdpMaster {
-            ep: Endpoint::bind(ports.master_addr())?,
+            ep: Endpoint::bind(ports.master_addr(), wait)?,
             ports,
             out: Cell::default(),
             inn: Cell::default(),
@@ -264,9 +273,9 @@ pub struct UdpEmulator {
 
 impl UdpEmulator {
     /// Binds the emulator's port.
-    pub fn open(ports: UdpPorts) -> Result<Self, IpcError> {
+    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, IpcError> {
         Ok(UdpEmulator {
-            ep: Endpoint::bind(ports.emulator_addr())?,
+            ep: Endpoint::bind(ports.emulator_addr(), wait)?,
             ports,
             stats: Default::default(),
             inn: Default::default(),
@@ -327,9 +336,9 @@ pub struct UdpSlave {
 
 impl UdpSlave {
     /// Binds the slave's port.
-    pub fn open(ports: UdpPorts) -> Result<Self, IpcError> {
+    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, IpcError> {
         Ok(UdpSlave {
-            ep: Endpoint::bind(ports.slave_addr())?,
+            ep: Endpoint::bind(ports.slave_addr(), wait)?,
             ports,
             out: Cell::default(),
             inn: Cell::default(),
