@@ -12,6 +12,7 @@ pub mod csv;
 pub mod engine;
 pub mod geometry;
 pub mod kernels;
+pub mod overrides;
 pub mod samples;
 pub mod scenario;
 pub mod trace;

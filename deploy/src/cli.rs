@@ -33,9 +33,34 @@ pub enum Command {
     /// Join the nodes' records (one folder, or one folder per node) into the run's
     /// report: summary, trace, histograms, plots.
     Report(ReportArgs),
+    /// Run a scenario for every combination of values (--set KEY=V1,V2,...), and
+    /// tabulate and plot the runs' metrics.
+    Sweep(SweepArgs),
     /// The echo side of `tactile bench`'s bare iceoryx2 hop (started by the bench).
     #[command(hide = true)]
     BenchEcho(EchoArgs),
+}
+
+/// Arguments of `tactile sweep`.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Scenario file (TOML) every run starts from.
+    pub scenario: PathBuf,
+    /// A swept key and its values, KEY=V1,V2,... (commas inside brackets or quotes
+    /// belong to the value: network.forward.delay=[0,0,0],[5,5,5]). Repeatable: every
+    /// combination runs. The first key is the plots' x axis, the second their lines.
+    #[arg(long, value_name = "KEY=V1,V2,...", required = true)]
+    pub set: Vec<String>,
+    /// Folder for sweep.csv, the plots, and one folder per run (run-0000, ...).
+    #[arg(long, default_value = "sweep-out")]
+    pub out: PathBuf,
+    /// Start the three node programs for every run (in realtime, each run then takes
+    /// its real time) instead of running them in-process.
+    #[arg(long)]
+    pub processes: bool,
+    /// Write each run's trace.csv too (about 1 kB per sample).
+    #[arg(long)]
+    pub trace: bool,
 }
 
 /// Arguments of `tactile report`.
@@ -109,6 +134,11 @@ pub struct RunArgs {
     /// Folder for summary.json, trace.csv, histograms and plots.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
+    /// Change the scenario: KEY is a dotted path (network.forward.delay,
+    /// environment.objects[0].stiffness), VALUE a TOML value ([5, 5, 5], 1000.0; a bare
+    /// word is a string). Repeatable; checked like the file.
+    #[arg(long, value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// iceoryx2 prefix isolating this run's shared memory (default: one per launcher).
     #[arg(long)]
     pub prefix: Option<String>,
@@ -318,6 +348,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Run(args) => crate::run_cmd::main(&args),
         Command::Bench(args) => crate::bench_cmd::main(&args),
         Command::Report(args) => crate::report_cmd::main(&args),
+        Command::Sweep(args) => crate::sweep_cmd::main(&args),
         Command::BenchEcho(args) => crate::bench_cmd::echo(
             &args.prefix,
             tactile_node::ipc::WaitPolicy {

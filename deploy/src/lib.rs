@@ -18,3 +18,4 @@ pub mod report_cmd;
 pub mod run_cmd;
 pub mod sim;
 pub mod summary;
+pub mod sweep_cmd;

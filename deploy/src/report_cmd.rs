@@ -43,7 +43,7 @@ pub struct Launch {
     pub no_trace: bool,
 }
 
-fn write_file(path: &Path, text: &str) -> Result<(), Error> {
+pub fn write_file(path: &Path, text: &str) -> Result<(), Error> {
     std::fs::write(path, text).map_err(Error::io(format!("writing {}", path.display())))
 }
 

@@ -12,6 +12,7 @@ use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+use tactile_common::overrides::Set;
 use tactile_common::scenario::{Mode, Operator, Scenario};
 use tactile_master::operator::OperatorSource;
 use tactile_node::files::{self, same_file};
@@ -34,19 +35,29 @@ pub struct Loaded {
 
 /// Reads and validates a scenario; `None` is the built-in paper scenario. A trajectory
 /// file is read too, so a bad one stops the run before anything starts.
-pub fn load_scenario(path: Option<&Path>) -> Result<Loaded, Error> {
-    let (scenario, base_dir, name) = match path {
+pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error> {
+    let (text, base_dir, name) = match path {
         None => (
-            Scenario::from_toml_str(PAPER_SCENARIO)
-                .map_err(|e| Error::Failed(format!("built-in scenario: {e}")))?,
+            PAPER_SCENARIO.to_string(),
             std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
             "deploy/scenarios/paper.toml (built in)".to_string(),
         ),
-        Some(p) => {
-            let (s, base) = files::load_scenario(p).map_err(Error::BadInput)?;
-            (s, base, p.display().to_string())
-        }
+        Some(p) => (
+            files::read_text(p, "scenario", files::MAX_SCENARIO_BYTES).map_err(Error::BadInput)?,
+            files::base_dir(p),
+            p.display().to_string(),
+        ),
     };
+    let text = tactile_common::overrides::apply(&text, sets)
+        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    let with = if sets.is_empty() {
+        String::new()
+    } else {
+        let s: Vec<&str> = sets.iter().map(|s| s.text.as_str()).collect();
+        format!(" with --set {}", s.join(" --set "))
+    };
+    let scenario = Scenario::from_toml_str(&text)
+        .map_err(|e| Error::BadInput(format!("{name}{with}: {}", e.to_string().trim_end())))?;
     OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
@@ -58,6 +69,33 @@ pub fn load_scenario(path: Option<&Path>) -> Result<Loaded, Error> {
         base_dir,
         inputs,
     })
+}
+
+/// How `tactile sweep --processes` runs each combination: as `tactile run` does by
+/// default, no restarts, no progress line.
+pub fn sweep_supervision(no_trace: bool) -> Supervision {
+    Supervision {
+        prefix: format!("tactile{}s", std::process::id()),
+        spin: None,
+        wake_early: None,
+        progress: false,
+        max_restarts: 0,
+        link: Links {
+            kind: LinkKind::Iceoryx2,
+            args: Default::default(),
+        },
+        wrap: Default::default(),
+        pin: true,
+        sched: tactile_node::sched::Policy::Fifo,
+        no_trace,
+    }
+}
+
+/// The `--set KEY=VALUE` arguments, parsed (bad input when one is malformed).
+pub fn parse_sets(args: &[String]) -> Result<Vec<Set>, Error> {
+    args.iter()
+        .map(|a| Set::parse(a).map_err(Error::BadInput))
+        .collect()
 }
 
 /// Every file a run writes into its output folder.
@@ -581,7 +619,8 @@ pub fn survivor_grace(scenario: &Scenario) -> Duration {
 
 /// `tactile run`.
 pub fn main(args: &RunArgs) -> Result<(), Error> {
-    let loaded = load_scenario(args.scenario.as_deref())?;
+    let sets = parse_sets(&args.set)?;
+    let loaded = load_scenario(args.scenario.as_deref(), &sets)?;
     for w in loaded.scenario.warnings() {
         eprintln!("tactile: warning: {w}");
     }
