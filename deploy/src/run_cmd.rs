@@ -56,8 +56,15 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
         let s: Vec<&str> = sets.iter().map(|s| s.text.as_str()).collect();
         format!(" with --set {}", s.join(" --set "))
     };
-    let scenario = Scenario::from_toml_str(&text)
-        .map_err(|e| Error::BadInput(format!("{name}{with}: {}", e.to_string().trim_end())))?;
+    let scenario = Scenario::from_toml_str(&text).map_err(|e| {
+        let msg = e.to_string();
+        // A line and column would point into the changed text, not the user's file.
+        let msg = match msg.strip_prefix("line ").and_then(|r| r.split_once(": ")) {
+            Some((_, rest)) if !sets.is_empty() => rest.to_string(),
+            _ => msg,
+        };
+        Error::BadInput(format!("{name}{with}: {}", msg.trim_end()))
+    })?;
     OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();

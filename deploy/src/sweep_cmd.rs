@@ -13,7 +13,6 @@ use crate::cli::SweepArgs;
 use crate::error::Error;
 use crate::report_cmd::{write_report, Launch};
 use crate::run_cmd::{load_scenario, prepare_out};
-use std::fmt::Write as _;
 use std::path::Path;
 use tactile_common::overrides::{split_values, Set};
 
@@ -92,13 +91,18 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         .iter()
         .map(|a| axis(a).map_err(Error::BadInput))
         .collect::<Result<Vec<_>, _>>()?;
-    let combos = combinations(&axes);
-    if combos.len() > MAX_RUNS {
+    let count = axes
+        .iter()
+        .try_fold(1usize, |n, a| n.checked_mul(a.values.len()))
+        .filter(|&n| n <= MAX_RUNS);
+    if count.is_none() {
+        let sizes: Vec<String> = axes.iter().map(|a| a.values.len().to_string()).collect();
         return Err(Error::BadInput(format!(
             "{} combinations: more than the {MAX_RUNS} a sweep may run",
-            combos.len()
+            sizes.join(" x ")
         )));
     }
+    let combos = combinations(&axes);
     // Every combination is checked before the first run starts, so a bad value is
     // bad input (exit 2) with nothing run.
     let loaded = combos
@@ -107,7 +111,16 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         .collect::<Result<Vec<_>, _>>()?;
     std::fs::create_dir_all(&args.out)
         .map_err(Error::io(format!("creating {}", args.out.display())))?;
-    let mut csv = header(&axes);
+    // The table grows a row as each run ends, so a sweep cut short keeps what ran.
+    let table = args.out.join("sweep.csv");
+    let mut csv = std::fs::File::create(&table)
+        .map_err(Error::io(format!("creating {}", table.display())))?;
+    let written =
+        |r: std::io::Result<()>| r.map_err(Error::io(format!("writing {}", table.display())));
+    written(std::io::Write::write_all(
+        &mut csv,
+        header(&axes).as_bytes(),
+    ))?;
     let mut rows = Vec::new();
     for (k, (c, l)) in combos.iter().zip(&loaded).enumerate() {
         let dir = args.out.join(format!("run-{k:04}"));
@@ -124,13 +137,15 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
             .iter()
             .map(|(_, p)| json.pointer(p).and_then(serde_json::Value::as_f64))
             .collect();
-        row(&mut csv, &axes, c, &values);
+        written(std::io::Write::write_all(
+            &mut csv,
+            row(k, &axes, c, &values).as_bytes(),
+        ))?;
         rows.push((c.clone(), values));
         if summary.interrupted {
             return Err(Error::Interrupted);
         }
     }
-    crate::report_cmd::write_file(&args.out.join("sweep.csv"), &csv)?;
     crate::plots::sweep_plots(&args.out, &axes, &rows)
         .map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))?;
     println!(
@@ -183,8 +198,8 @@ fn header(axes: &[Axis]) -> String {
     cols.join(",") + "\n"
 }
 
-fn row(csv: &mut String, axes: &[Axis], combo: &[usize], values: &[Option<f64>]) {
-    let mut cols: Vec<String> = vec![format!("{}", csv.lines().count().saturating_sub(1))];
+fn row(k: usize, axes: &[Axis], combo: &[usize], values: &[Option<f64>]) -> String {
+    let mut cols: Vec<String> = vec![k.to_string()];
     cols.extend(
         axes.iter()
             .zip(combo)
@@ -195,7 +210,7 @@ fn row(csv: &mut String, axes: &[Axis], combo: &[usize], values: &[Option<f64>])
             .iter()
             .map(|v| v.map_or_else(String::new, |x| format!("{x}"))),
     );
-    let _ = writeln!(csv, "{}", cols.join(","));
+    cols.join(",") + "\n"
 }
 
 /// A CSV field, quoted when it holds a comma or a quote.

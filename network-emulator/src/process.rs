@@ -60,7 +60,10 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
     // not while h(n) is expected back from the slave, which comes within microseconds.
     let mut pacer = (scenario.mode == Mode::Realtime)
         .then(|| Pacer::new(scenario.t_s_ns(), wake_early.as_nanos() as u64));
-    let mut expect_h = false;
+    // The sequence number of the last v(n) forwarded whose h(n) has not come back:
+    // after a stall several are in flight, and the emulator sleeps only once the
+    // last of them is answered.
+    let mut awaiting: Option<u64> = None;
     let totals = |emu: &Emulator, filter: &RunFilter| {
         let mut links = link.stats();
         links.c_in.foreign += filter.foreign;
@@ -71,7 +74,7 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
     };
     let completed = loop {
         let deadline = Instant::now() + Duration::from_secs(3600);
-        let paced = pacer.as_ref().filter(|_| !expect_h);
+        let paced = pacer.as_ref().filter(|_| awaiting.is_none());
         let (got, waiting) = recv_paced(paced, deadline, |d| link.recv(d))?;
         let arrival = match got {
             Ok(a) => a,
@@ -111,8 +114,8 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
                     p.arrived(c.seq, t, waiting);
                 }
                 let (out, passage) = emu.forward(&c);
-                expect_h = out.is_some();
                 if let Some(mut v) = out {
+                    awaiting = Some(v.seq);
                     v.stamps[stage::EMU_FWD_SEND] = now_ns();
                     link.send_v(v, false)?;
                 }
@@ -124,7 +127,9 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
                     continue;
                 }
                 h.stamps[stage::EMU_BWD_RECV] = now_ns();
-                expect_h = false;
+                if awaiting.is_some_and(|s| h.seq >= s) {
+                    awaiting = None;
+                }
                 let (out, passage) = emu.backward(&h);
                 if let Some(mut q) = out {
                     q.stamps[stage::EMU_BWD_SEND] = now_ns();

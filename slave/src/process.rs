@@ -119,7 +119,7 @@ pub fn run_with<L: SlaveLink + ?Sized>(
                 link.send_h(h, false)?;
                 // The emulator usually shares this CPU, waiting for h(n): let it take
                 // h(n) on to the master now, and write the record after (measured:
-                // the hop's p50 from 10 us to 3 us at 1 kHz under SCHED_FIFO).
+                // the hop's p50 from 10.3 us to 1.4 us at 1 kHz under SCHED_FIFO).
                 std::thread::yield_now();
                 rec.sample(SlaveSample::Step(step))?;
                 deadline = Some(Instant::now() + timeout);

@@ -48,8 +48,8 @@ pub const LATE_WINDOW: u32 = 16;
 /// all late, and then by the least of their lateness (so jitter, which only delays,
 /// and a stall of the sender, which delays a few samples, leave it alone). A sample
 /// that was already waiting when the node woke says only that it came at or before
-/// that moment, so the offset moves a quarter of the margin earlier, until samples
-/// are again seen arriving. Sequence numbers, not the nearest tick, say which sample
+/// that moment, so the offset moves to make it due then (at least a quarter of the
+/// margin earlier), until samples are again seen arriving. Sequence numbers, not the nearest tick, say which sample
 /// an arrival is: after a stall the queued samples come in a burst, and rounding to
 /// the nearest tick would take a late one for the next one.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -81,7 +81,7 @@ impl Pacer {
     /// The predicted arrival of the next sample, once one sample has come.
     pub fn next_ns(&self) -> Option<u64> {
         let o = self.offset_ns?;
-        let t = o + i128::from(self.last_seq + 1) * i128::from(self.period_ns);
+        let t = o + (i128::from(self.last_seq) + 1) * i128::from(self.period_ns);
         Some(u64::try_from(t).unwrap_or(0))
     }
 
@@ -91,13 +91,17 @@ impl Pacer {
     }
 
     /// Sleeps until [`Pacer::wake_ns`], but never past `limit_ns` (a deadline of the
-    /// caller's); returns at once before the first sample or when that time is past.
-    /// True when it slept, so that a sample found at the first poll was waiting.
+    /// caller's) nor longer than two periods (a wrong prediction then costs a poll,
+    /// and a stop request is seen soon); returns at once before the first sample or
+    /// when that time is past. True when it slept to the wake-up, so that a sample
+    /// found at the first poll was waiting.
     pub fn sleep(&self, limit_ns: u64) -> bool {
+        let now = now_ns();
+        let cap = now.saturating_add(2 * self.period_ns);
         match self.wake_ns() {
-            Some(w) if w.min(limit_ns) > now_ns() => {
-                sleep_until_ns(w.min(limit_ns));
-                true
+            Some(w) if w.min(limit_ns).min(cap) > now => {
+                sleep_until_ns(w.min(limit_ns).min(cap));
+                w <= cap
             }
             _ => false,
         }
@@ -116,8 +120,10 @@ impl Pacer {
         };
         let late = t - due_of(o);
         let o = if was_waiting {
+            // It came at or before t: due no later than t, and a step of at least a
+            // quarter of the margin so that the wake-up soon precedes it again.
             self.reset_window();
-            o - i128::from((self.early_ns / 4).max(1_000))
+            o + late.min(-i128::from((self.early_ns / 4).max(1_000)))
         } else if late < 0 {
             self.reset_window();
             o + late
@@ -238,6 +244,50 @@ mod tests {
         // 600 us behind less the 200 us margin, 50 us a step: 8 steps.
         assert!(n <= 10, "took {n} samples");
         assert_eq!(p.next_ns(), Some(truth(200)));
+    }
+
+    #[test]
+    fn recv_paced_takes_what_is_waiting_before_it_sleeps() {
+        use std::cell::RefCell;
+        use std::time::{Duration, Instant};
+        // A pacer whose next wake-up is a second away: a queued sample must still be
+        // taken at once, without sleeping.
+        let mut p = Pacer::new(T, EARLY);
+        p.arrived(0, now_ns() + 1_000_000_000, false);
+        let calls = RefCell::new(Vec::new());
+        let start = Instant::now();
+        let queued = |until: Instant| -> Wait<u32> {
+            calls.borrow_mut().push(until <= Instant::now());
+            Ok(Ok(7))
+        };
+        let (got, waiting) =
+            recv_paced(Some(&p), start + Duration::from_secs(5), queued).expect("recv");
+        assert_eq!(got, Ok(7));
+        assert!(
+            !waiting,
+            "nothing slept, so nothing is known to have waited"
+        );
+        assert_eq!(*calls.borrow(), [true], "one look with a past deadline");
+        assert!(start.elapsed() < Duration::from_millis(100));
+        // Nothing there: it sleeps (never more than two periods), then waits until the
+        // caller's deadline.
+        let mut p = Pacer::new(T, EARLY);
+        p.arrived(0, now_ns() + 1_000_000_000, false);
+        let calls = RefCell::new(0);
+        let start = Instant::now();
+        let empty = |_: Instant| -> Wait<u32> {
+            *calls.borrow_mut() += 1;
+            Ok(Err(Idle::Timeout))
+        };
+        let (got, _) = recv_paced(Some(&p), start + Duration::from_secs(5), empty).expect("recv");
+        assert_eq!(got, Err(Idle::Timeout));
+        assert_eq!(*calls.borrow(), 2);
+        let slept = start.elapsed();
+        assert!(slept >= Duration::from_nanos(2 * T - 100_000), "{slept:?}");
+        assert!(slept < Duration::from_millis(500), "{slept:?}");
+        // Without a pacer (lockstep): one receive, to the caller's deadline.
+        let (got, _) = recv_paced(None, start, |_| Ok(Ok(1u32))).expect("recv");
+        assert_eq!(got, Ok(1));
     }
 
     #[test]

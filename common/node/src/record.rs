@@ -126,6 +126,18 @@ pub enum RecordError {
         /// The file.
         path: String,
     },
+    /// The file is a record of another format version (another build).
+    #[error(
+        "{path}: a Tactile record of format version {found}; this build reads version {reads}"
+    )]
+    OtherVersion {
+        /// The file.
+        path: String,
+        /// Its version.
+        found: u8,
+        /// The version this build reads.
+        reads: u8,
+    },
     /// A frame could not be decoded.
     #[error("{path}: bad frame at byte {offset}: {detail}")]
     Corrupt {
@@ -219,8 +231,15 @@ impl<T: DeserializeOwned> RecordReader<T> {
         }
         let mut input = BufReader::new(std::fs::File::open(path).map_err(io)?);
         let mut head = [0u8; 8];
-        if input.read_exact(&mut head).is_err() || head != MAGIC {
+        if input.read_exact(&mut head).is_err() || head[..7] != MAGIC[..7] {
             return Err(RecordError::NotARecord { path: shown });
+        }
+        if head != MAGIC {
+            return Err(RecordError::OtherVersion {
+                path: shown,
+                found: head[7],
+                reads: MAGIC[7],
+            });
         }
         Ok(RecordReader {
             input,
@@ -349,6 +368,18 @@ mod tests {
             Err(RecordError::NotARecord { .. })
         ));
         assert!(RecordWriter::<R>::create(&path, true).is_err());
+        // A record of another build says which version it is.
+        let mut old = MAGIC.to_vec();
+        old[7] = 1;
+        std::fs::write(&path, &old).expect("write");
+        let e = match RecordReader::<R>::open(&path) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("a record of version 1 was opened"),
+        };
+        assert!(
+            e.contains("format version 1; this build reads version 2"),
+            "{e}"
+        );
         let mut bytes = MAGIC.to_vec();
         bytes.extend_from_slice(&u32::MAX.to_le_bytes());
         std::fs::write(&path, &bytes).expect("write");

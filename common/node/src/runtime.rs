@@ -203,6 +203,7 @@ pub fn prepare(role: &str, args: &NodeArgs) -> Result<Prepared, NodeError> {
         pin(cpu).map_err(bad)?;
     }
     let (wake_early, spin) = waiting(&scenario, args.wake_early_us, args.spin_us);
+    check_waiting(args, &scenario, wake_early, spin)?;
     let sched = schedule(args, &scenario, wake_early, spin);
     Ok(Prepared {
         scenario,
@@ -235,6 +236,35 @@ pub fn waiting(
     (early, spin)
 }
 
+/// A realtime node must sleep in every period: a wake-up margin of a whole period
+/// never sleeps, and under SCHED_FIFO neither does a poll budget of one (the kernel's
+/// real-time throttle then stops the node for tens of milliseconds).
+fn check_waiting(
+    args: &NodeArgs,
+    scenario: &Scenario,
+    wake_early: Duration,
+    spin: Duration,
+) -> Result<(), NodeError> {
+    if scenario.mode != tactile_common::scenario::Mode::Realtime {
+        return Ok(());
+    }
+    let t_s = Duration::from_nanos(scenario.t_s_ns());
+    let period = format!("the sampling period ({} us)", t_s.as_micros());
+    if wake_early >= t_s {
+        return Err(NodeError::BadInput(format!(
+            "--wake-early-us {}: must be under {period}",
+            wake_early.as_micros()
+        )));
+    }
+    if spin >= t_s && args.sched == crate::sched::Policy::Fifo {
+        return Err(NodeError::BadInput(format!(
+            "--spin-us {}: under SCHED_FIFO the poll budget must be under {period} (or use --sched other)",
+            spin.as_micros()
+        )));
+    }
+    Ok(())
+}
+
 /// Applies the scheduling the arguments ask for (SCHED_FIFO only for a realtime
 /// run) and says in the log what the kernel refused.
 fn schedule(
@@ -246,9 +276,9 @@ fn schedule(
     use crate::sched::{apply, Policy, Sched};
     let realtime = scenario.mode == tactile_common::scenario::Mode::Realtime;
     let policy = if realtime { args.sched } else { Policy::Other };
-    let (fifo, memory_locked, mut notes) = apply(policy, args.priority);
+    let (fifo, memory_locked, notes) = apply(policy, args.priority);
     if !realtime && args.sched == Policy::Fifo {
-        notes.push("lockstep: SCHED_OTHER (its loop never sleeps)".into());
+        tracing::info!("lockstep: SCHED_OTHER (its loop never sleeps)");
     }
     for n in &notes {
         tracing::warn!("{n}");
@@ -503,7 +533,7 @@ fn udp_ports(a: &NodeArgs) -> Result<crate::udp::UdpPorts, NodeError> {
 
 /// What a build without the `zenoh` feature answers to `--link zenoh`.
 pub const NO_ZENOH: &str = "--link zenoh: this build has no Zenoh link; build with \
-`cargo build --release --features zenoh` (README, Across hosts)";
+`cargo build --release --workspace --features zenoh` (README, Across hosts)";
 
 /// The Zenoh endpoints of the arguments.
 #[cfg(feature = "zenoh")]
@@ -677,5 +707,61 @@ mod zenoh_open {
 
     pub fn slave(_: &NodeArgs, _: WaitPolicy) -> Result<Box<dyn SlaveLink>, NodeError> {
         Err(NodeError::BadInput(NO_ZENOH.into()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Cli {
+        #[command(flatten)]
+        node: NodeArgs,
+    }
+
+    fn args(extra: &[&str]) -> NodeArgs {
+        let mut v = vec!["node", "--scenario", "s.toml", "--out", "o"];
+        v.extend_from_slice(extra);
+        Cli::parse_from(v).node
+    }
+
+    #[test]
+    fn the_zenoh_link_is_checked_or_refused_by_the_build() {
+        let a = args(&["--link", "zenoh", "--connect", "tcp/127.0.0.1:7447"]);
+        let r = check_link_args(&a, &[LinkKind::Zenoh]);
+        if cfg!(feature = "zenoh") {
+            assert!(r.is_ok(), "{:?}", r.err());
+        } else {
+            let e = r.expect_err("no Zenoh in this build").to_string();
+            assert!(e.contains("--workspace --features zenoh"), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_realtime_node_must_sleep_in_every_period() {
+        let mut sc = Scenario::from_toml_str(
+            "name = \"t\"\nmode = \"realtime\"\nrate_hz = 1000.0\nsamples = 10\n\n[operator]\nkind = \"paper\"\n",
+        )
+        .expect("scenario");
+        let check = |a: &NodeArgs, sc: &Scenario| {
+            let (early, spin) = waiting(sc, a.wake_early_us, a.spin_us);
+            check_waiting(a, sc, early, spin).map(|()| (early, spin))
+        };
+        let ok = check(&args(&[]), &sc).expect("defaults");
+        assert_eq!(ok, (Duration::from_micros(200), Duration::from_micros(400)));
+        let e = check(&args(&["--wake-early-us", "1000"]), &sc).expect_err("a period");
+        assert!(
+            e.to_string()
+                .contains("under the sampling period (1000 us)"),
+            "{e}"
+        );
+        assert!(check(&args(&["--spin-us", "1500"]), &sc).is_err());
+        assert!(check(&args(&["--spin-us", "1500", "--sched", "other"]), &sc).is_ok());
+        // Lockstep never sleeps: nothing to check, and no margin.
+        sc.mode = tactile_common::scenario::Mode::Lockstep;
+        let l = check(&args(&["--wake-early-us", "5000"]), &sc).expect("lockstep");
+        assert_eq!(l.0, Duration::ZERO);
     }
 }

@@ -67,6 +67,14 @@ pub fn apply(policy: Policy, priority: u8) -> (bool, bool, Vec<String>) {
     };
     let locked = match policy {
         Policy::Other => false,
+        Policy::Fifo if !may_lock_everything() => {
+            notes.push(
+                "memory not locked (no CAP_IPC_LOCK and a finite RLIMIT_MEMLOCK: locking \
+                 future pages could make the links' later mappings fail)"
+                    .into(),
+            );
+            false
+        }
         Policy::Fifo => match crate::sys::lock_memory() {
             Ok(()) => true,
             Err(e) => {
@@ -79,6 +87,18 @@ pub fn apply(policy: Policy, priority: u8) -> (bool, bool, Vec<String>) {
         prefault_stack();
     }
     (fifo, locked, notes)
+}
+
+/// True if locking every future page cannot run into a limit: the process holds
+/// CAP_IPC_LOCK, or its RLIMIT_MEMLOCK is unlimited. (With a finite limit, mlockall
+/// may succeed now and make a later mmap, such as a shared-memory segment, fail.)
+fn may_lock_everything() -> bool {
+    use rustix::process::{getrlimit, Resource};
+    let cap = rustix::thread::capabilities(None).is_ok_and(|c| {
+        c.effective
+            .contains(rustix::thread::CapabilitySet::IPC_LOCK)
+    });
+    cap || getrlimit(Resource::Memlock).current.is_none()
 }
 
 /// Timer slack of 1 ns: an ordinary thread's sleeps end up to 50 us late by default

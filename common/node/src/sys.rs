@@ -33,8 +33,9 @@ pub fn lock_memory() -> Result<()> {
 
 /// PR_SET_TIMERSLACK for the calling thread.
 pub fn set_timer_slack(ns: libc::c_ulong) -> Result<()> {
-    // SAFETY: PR_SET_TIMERSLACK takes an integer argument; no pointers.
-    check(unsafe { libc::prctl(libc::PR_SET_TIMERSLACK, ns, 0, 0, 0) })
+    let zero: libc::c_ulong = 0;
+    // SAFETY: PR_SET_TIMERSLACK takes integer arguments (unsigned long); no pointers.
+    check(unsafe { libc::prctl(libc::PR_SET_TIMERSLACK, ns, zero, zero, zero) })
 }
 
 /// Peak resident set size of this process, kB (getrusage: a system call, where
