@@ -150,3 +150,107 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
     rec.stop(totals(&emu, &filter), reason)?;
     Ok(completed)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::RefCell;
+    use std::collections::VecDeque;
+    use tactile_common::samples::{Backward, Forward};
+    use tactile_node::ipc::{InboxStats, OutboxStats};
+
+    /// A scripted link: hands out its arrivals in order and notes, for every receive,
+    /// whether it was a look without waiting (the pacer's try before it sleeps) and
+    /// how many h had been handed out by then.
+    #[derive(Default)]
+    struct Script {
+        arrivals: RefCell<VecDeque<Arrival>>,
+        calls: RefCell<Vec<(bool, usize)>>,
+        h_given: RefCell<usize>,
+    }
+
+    impl EmulatorLink for Script {
+        fn recv(&self, deadline: Instant) -> tactile_node::link::Wait<Arrival> {
+            let is_try = deadline <= Instant::now();
+            self.calls
+                .borrow_mut()
+                .push((is_try, *self.h_given.borrow()));
+            match self.arrivals.borrow_mut().pop_front() {
+                Some(a) => {
+                    if matches!(a, Arrival::Backward(_)) {
+                        *self.h_given.borrow_mut() += 1;
+                    }
+                    Ok(Ok(a))
+                }
+                None if is_try => Ok(Err(Idle::Timeout)),
+                None => Ok(Err(Idle::Terminate)),
+            }
+        }
+        fn send_v(&self, _: Forward, _: bool) -> Result<(), IpcError> {
+            Ok(())
+        }
+        fn send_q(&self, _: Backward, _: bool) -> Result<(), IpcError> {
+            Ok(())
+        }
+        fn stats(&self) -> EmulatorStats {
+            EmulatorStats {
+                c_in: InboxStats::default(),
+                v_out: OutboxStats::default(),
+                h_in: InboxStats::default(),
+                q_out: OutboxStats::default(),
+            }
+        }
+    }
+
+    #[test]
+    fn after_a_burst_it_sleeps_only_once_every_answer_is_back() {
+        let scenario = Scenario::from_toml_str(
+            "name = \"t\"\nmode = \"realtime\"\nrate_hz = 1000.0\nsamples = 10\n\n[operator]\nkind = \"paper\"\n",
+        )
+        .expect("scenario");
+        let c = |seq| {
+            Arrival::Forward(Forward {
+                run: 5,
+                seq,
+                ..Forward::default()
+            })
+        };
+        let h = |seq| {
+            Arrival::Backward(Backward {
+                run: 5,
+                seq,
+                ..Backward::default()
+            })
+        };
+        let mut end = Forward {
+            run: 5,
+            seq: 3,
+            ..Forward::default()
+        };
+        end.signal.flags = FLAG_END;
+        // c(0) answered; then c(1) and c(2) queued after a stall, so v(1) and v(2) go
+        // out back to back and two answers are due.
+        let link = Script {
+            arrivals: RefCell::new(VecDeque::from([
+                c(0),
+                h(0),
+                c(1),
+                c(2),
+                h(1),
+                h(2),
+                Arrival::Forward(end),
+            ])),
+            ..Script::default()
+        };
+        let dir = tempfile::tempdir().expect("tmp");
+        let mut rec = EmulatorRecorder::open(dir.path(), "emulator", false).expect("rec");
+        let done = run_with(&scenario, &link, &mut rec, Duration::from_micros(200)).expect("run");
+        assert!(done);
+        let calls = link.calls.borrow();
+        // The receive right after h(1) (one answer still due) waits for it, with no
+        // look-and-sleep; the one after h(2) is paced again (a look first).
+        let after = |n: usize| calls.iter().find(|c| c.1 == n).map(|c| c.0);
+        assert_eq!(after(2), Some(false), "{calls:?}");
+        assert_eq!(after(3), Some(true), "{calls:?}");
+    }
+}
