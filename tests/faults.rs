@@ -10,13 +10,6 @@ use tactile_common::samples::{Forward, FLAG_PEER_LOST};
 use tactile_node::ipc::{self, Inbox, Outbox};
 use util::{column, Sandbox};
 
-/// A 1 kHz realtime scenario of `samples` samples.
-fn realtime(samples: u64) -> String {
-    tactile::run_cmd::PAPER_SCENARIO
-        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
-        .replace("samples = 1200", &format!("samples = {samples}"))
-}
-
 fn spawn_run(sb: &Sandbox, scenario: &std::path::Path, out: &str) -> Child {
     sb.command(&["run", scenario.to_str().expect("utf-8"), "--out"])
         .arg(sb.path(out))
@@ -67,7 +60,7 @@ fn finish(child: Child) -> (Option<i32>, String, String) {
 /// zero torque, and resume.
 fn peer_dies_and_the_loop_resumes(role: &str) {
     let sb = Sandbox::new(role);
-    let scenario = sb.write("s.toml", &realtime(4000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(4000));
     let child = spawn_run(&sb, &scenario, "run");
     kill_mid_run(&sb, role, Duration::from_millis(1500));
     let (code, stdout, stderr) = finish(child);
@@ -152,7 +145,7 @@ fn emulator_killed_the_master_zeroes_torque_and_resumes_after_restart() {
 #[test]
 fn master_killed_the_slave_holds_and_the_launcher_fails_cleanly() {
     let sb = Sandbox::new("master");
-    let scenario = sb.write("s.toml", &realtime(5000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(5000));
     let child = spawn_run(&sb, &scenario, "run");
     kill_mid_run(&sb, "master", Duration::from_millis(1500));
     let (code, _stdout, stderr) = finish(child);
@@ -174,7 +167,7 @@ fn master_killed_the_slave_holds_and_the_launcher_fails_cleanly() {
 #[test]
 fn sigterm_to_the_launcher_stops_everything_and_writes_the_report() {
     let sb = Sandbox::new("sigterm");
-    let scenario = sb.write("s.toml", &realtime(20_000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let child = spawn_run(&sb, &scenario, "run");
     wait_for_master(&sb);
     std::thread::sleep(Duration::from_millis(1000));
@@ -193,7 +186,7 @@ fn sigterm_to_the_launcher_stops_everything_and_writes_the_report() {
 #[test]
 fn a_new_run_after_a_crash_starts_cleanly() {
     let sb = Sandbox::new("crash");
-    let scenario = sb.write("s.toml", &realtime(20_000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let child = spawn_run(&sb, &scenario, "first");
     kill_mid_run(&sb, "master", Duration::from_millis(500));
     // Kill the launcher first, so nobody cleans up, then every process of the run.
@@ -211,7 +204,7 @@ fn a_new_run_after_a_crash_starts_cleanly() {
     std::thread::sleep(Duration::from_millis(100));
     sb.assert_no_leftover_processes();
     // Stale shared memory of the crashed run is still there; the same prefix must work.
-    let again = sb.write("again.toml", &realtime(500));
+    let again = sb.write("again.toml", &util::paper_1khz(500));
     sb.run(&again, "second");
     let s = sb.json("second", "summary.json");
     assert_eq!(s["samples_received"], 500);
@@ -299,7 +292,7 @@ fn corrupted_samples_never_reach_a_torque() {
 #[test]
 fn dropped_samples_are_counted_and_every_stream_reconciles() {
     let sb = Sandbox::new("loss");
-    let text = realtime(3000)
+    let text = util::paper_1khz(3000)
         .replace("[network.forward]\n", "[network.forward]\nloss = 0.03\n")
         .replace("[network.backward]\n", "[network.backward]\nloss = 0.02\n");
     let scenario = sb.write("s.toml", &text);

@@ -68,12 +68,6 @@ fn finish(child: Child, name: &str) {
     );
 }
 
-fn realtime(samples: u64) -> String {
-    tactile::run_cmd::PAPER_SCENARIO
-        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
-        .replace("samples = 1200", &format!("samples = {samples}"))
-}
-
 /// A free TCP port on loopback.
 fn free_port() -> u16 {
     let l = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
@@ -88,7 +82,7 @@ fn master_here_slave_there(all_zenoh: bool) {
         return;
     };
     let sb = Sandbox::new(&format!("hosts{tag}"));
-    let scenario = sb.write("s.toml", &realtime(3000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(3000));
     let s = scenario.to_str().expect("utf-8");
     let a = format!("tcp/{}:7447", hosts.addrs[0]);
     let b = format!("tcp/{}:7448", hosts.addrs[1]);
@@ -182,7 +176,7 @@ fn the_slave_host_node_killed_breaks_the_loop_and_it_resumes_after_restart() {
         return;
     };
     let sb = Sandbox::new("hostkill");
-    let scenario = sb.write("s.toml", &realtime(4000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(4000));
     let s = scenario.to_str().expect("utf-8");
     let a = format!("tcp/{}:7447", hosts.addrs[0]);
     let p = sb.prefix.clone();
@@ -314,7 +308,7 @@ fn bad_payloads() -> Vec<Vec<u8>> {
 #[test]
 fn garbage_truncated_and_other_version_payloads_are_counted_and_dropped() {
     let sb = Sandbox::new("garbage");
-    let scenario = sb.write("s.toml", &realtime(2500));
+    let scenario = sb.write("s.toml", &util::paper_1khz(2500));
     let s = scenario.to_str().expect("utf-8");
     let at: Vec<String> = (0..3)
         .map(|_| format!("tcp/127.0.0.1:{}", free_port()))
@@ -404,7 +398,7 @@ fn garbage_truncated_and_other_version_payloads_are_counted_and_dropped() {
 #[test]
 fn garbage_datagrams_at_a_udp_node_are_counted_and_dropped() {
     let sb = Sandbox::new("udpjunk");
-    let scenario = sb.write("s.toml", &realtime(2000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(2000));
     let s = scenario.to_str().expect("utf-8");
     let ports = tactile_node::udp::UdpPorts::free().expect("ports");
     let arg = ports.arg();

@@ -21,13 +21,6 @@ fn lockstep(samples: u64) -> String {
         )
 }
 
-/// The paper scenario at 1 kHz in real time.
-fn realtime(samples: u64) -> String {
-    tactile::run_cmd::PAPER_SCENARIO
-        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
-        .replace("samples = 1200", &format!("samples = {samples}"))
-}
-
 /// Starts node `role` by hand with its own output folder `dir`.
 fn start_node(sb: &Sandbox, role: &str, scenario: &Path, dir: &str, extra: &[&str]) -> Child {
     let mut args = vec![
@@ -132,7 +125,7 @@ fn hand_started_nodes_in_any_order_match_tactile_run_and_the_simulation() {
 #[test]
 fn a_killed_slave_leaves_every_sample_it_took_in_its_record() {
     let sb = Sandbox::new("slavekill");
-    let scenario = sb.write("s.toml", &realtime(3000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(3000));
     let master = start_node(&sb, "master", &scenario, "m", &[]);
     let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
     let slave = start_node(&sb, "slave", &scenario, "s", &[]);
@@ -226,7 +219,7 @@ fn a_long_run_keeps_every_node_in_bounded_memory() {
 #[test]
 fn nodes_stop_within_a_second_when_the_launcher_is_killed() {
     let sb = Sandbox::new("orphans");
-    let scenario = sb.write("s.toml", &realtime(60_000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(60_000));
     let mut launcher = sb
         .command(&[
             "run",
@@ -283,7 +276,7 @@ fn nodes_stop_within_a_second_when_the_launcher_is_killed() {
 #[test]
 fn a_prefix_in_use_is_refused_and_names_its_holder() {
     let sb = Sandbox::new("prefix");
-    let scenario = sb.write("s.toml", &realtime(1000));
+    let scenario = sb.write("s.toml", &util::paper_1khz(1000));
     // A slave started by hand holds the prefix.
     let slave = start_node(&sb, "slave", &scenario, "hand", &[]);
     std::thread::sleep(Duration::from_millis(300));
@@ -358,7 +351,7 @@ fn a_prefix_in_use_is_refused_and_names_its_holder() {
 #[test]
 fn bad_prefixes_are_refused_before_anything_starts() {
     let sb = Sandbox::new("badprefix");
-    let scenario = sb.write("s.toml", &realtime(100));
+    let scenario = sb.write("s.toml", &util::paper_1khz(100));
     let long = "p".repeat(25);
     for bad in ["a/b", "../x", "-x", "a b", long.as_str()] {
         let prefix = format!("--prefix={bad}");
@@ -486,7 +479,8 @@ fn a_run_never_overwrites_its_input_nor_mixes_two_runs_in_a_folder() {
 #[test]
 fn statistics_say_na_when_nothing_came_back() {
     let sb = Sandbox::new("nothing");
-    let text = realtime(300).replace("[network.backward]\n", "[network.backward]\nloss = 1.0\n");
+    let text =
+        util::paper_1khz(300).replace("[network.backward]\n", "[network.backward]\nloss = 1.0\n");
     let scenario = sb.write("s.toml", &text);
     let o = sb.tactile(&[
         "run",

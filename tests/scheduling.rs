@@ -6,13 +6,6 @@ mod util;
 
 use util::Sandbox;
 
-/// The paper scenario at 1 kHz in real time.
-fn realtime(samples: u64) -> String {
-    tactile::run_cmd::PAPER_SCENARIO
-        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
-        .replace("samples = 1200", &format!("samples = {samples}"))
-}
-
 fn is_root() -> bool {
     rustix::process::geteuid().is_root()
 }
@@ -28,7 +21,7 @@ fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
         return;
     }
     let sb = Sandbox::new("fifo");
-    let s = sb.write("s.toml", &realtime(1500));
+    let s = sb.write("s.toml", &util::paper_1khz(1500));
     let out = sb.path("out");
     let args = run_args(
         &sb,
@@ -47,7 +40,7 @@ fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
         assert_eq!(s["poll_us"], 400, "{role}: {s}");
         assert_eq!(s["memory_locked"], true, "{role}: {s}");
         assert!(s["note"].is_null(), "{role}: {s}");
-        if two_cpus() {
+        if tactile::run_cmd::two_cpus() {
             assert_eq!(s["cpu"], cpu, "{role}: {s}");
         }
     }
@@ -69,7 +62,7 @@ fn where_sched_fifo_is_refused_the_nodes_run_sched_other_and_say_so() {
         return;
     }
     let sb = Sandbox::new("nofifo");
-    let s = sb.write("s.toml", &realtime(1000));
+    let s = sb.write("s.toml", &util::paper_1khz(1000));
     let out = sb.path("out");
     let mut c = std::process::Command::new(setpriv);
     c.args([
@@ -117,8 +110,4 @@ fn lockstep_runs_sched_other_whatever_is_asked() {
         assert_eq!(s["wake_early_us"], 0, "{role}: {s}");
         assert_eq!(s["priority"], 0, "{role}: {s}");
     }
-}
-
-fn two_cpus() -> bool {
-    rustix::thread::sched_getaffinity(None).is_ok_and(|s| s.is_set(0) && s.is_set(1))
 }

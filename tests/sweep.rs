@@ -6,10 +6,7 @@ use util::Sandbox;
 
 /// The paper scenario at 1 kHz, lockstep, `samples` samples.
 fn scenario(samples: u64) -> String {
-    tactile::run_cmd::PAPER_SCENARIO
-        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
-        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
-        .replace("samples = 1200", &format!("samples = {samples}"))
+    util::paper_1khz(samples).replace("mode = \"realtime\"", "mode = \"lockstep\"")
 }
 
 #[test]

@@ -325,7 +325,7 @@ fn node_command(
         .arg("--out")
         .arg(out)
         .args(["--prefix", &sup.prefix])
-        .args(["--sched", sched_name(sup.sched)])
+        .args(["--sched", sup.sched.name()])
         .args(["--supervised", &std::process::id().to_string()]);
     if let Some(spin) = sup.spin {
         cmd.args(["--spin-us", &spin.as_micros().to_string()]);
@@ -347,16 +347,8 @@ fn node_command(
     cmd
 }
 
-/// The name of a policy on the nodes' command line.
-pub fn sched_name(p: tactile_node::sched::Policy) -> &'static str {
-    match p {
-        tactile_node::sched::Policy::Fifo => "fifo",
-        tactile_node::sched::Policy::Other => "other",
-    }
-}
-
 /// True if this machine lets the process use CPUs 0 and 1.
-fn two_cpus() -> bool {
+pub fn two_cpus() -> bool {
     rustix::thread::sched_getaffinity(None).is_ok_and(|s| s.is_set(0) && s.is_set(1))
 }
 

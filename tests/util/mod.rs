@@ -178,3 +178,10 @@ pub fn std_dev(v: &[f64]) -> f64 {
     let mean = v.iter().sum::<f64>() / n;
     (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
 }
+
+/// The paper scenario at 1 kHz in real time, `samples` samples.
+pub fn paper_1khz(samples: u64) -> String {
+    tactile::run_cmd::PAPER_SCENARIO
+        .replace("rate_hz = 100.0", "rate_hz = 1000.0")
+        .replace("samples = 1200", &format!("samples = {samples}"))
+}

@@ -20,6 +20,16 @@ pub enum Policy {
     Other,
 }
 
+impl Policy {
+    /// The policy's name on the nodes' command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Policy::Fifo => "fifo",
+            Policy::Other => "other",
+        }
+    }
+}
+
 /// Default SCHED_FIFO priority of the nodes: above everything an ordinary system
 /// runs real-time (none on these machines), below the kernel's own (99).
 pub const DEFAULT_PRIORITY: u8 = 70;
