@@ -3,7 +3,7 @@
 //! on stderr naming the file and the field (dotted path) or the line, exit status 2, no
 //! panic, and start nothing: no output folder, nothing on stdout, no role process.
 
-mod util;
+use crate::util;
 
 use std::path::Path;
 use std::process::Output;

@@ -1,7 +1,7 @@
 //! `tactile bench` end to end, small: every part runs and reports, and the same loop
 //! over UDP is the same loop.
 
-mod util;
+use crate::util;
 
 use tactile_common::trace::signal_columns;
 use util::Sandbox;

@@ -1,6 +1,6 @@
 //! The `tactile kernels` and `tactile paper` interfaces, as users script them.
 
-mod util;
+use crate::util;
 
 use std::io::Write;
 use std::process::{Command, Output, Stdio};

@@ -2,7 +2,7 @@
 //! launcher, a crashed run followed by a new one, a full subscriber buffer, corrupted
 //! and dropped samples, forces past the device's limit.
 
-mod util;
+use crate::util;
 
 use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};

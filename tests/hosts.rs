@@ -7,7 +7,7 @@
 //! `--all-features`.
 #![cfg(feature = "zenoh")]
 
-mod util;
+use crate::util;
 
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};

@@ -1,6 +1,6 @@
 //! The loop as three real processes over real iceoryx2 shared memory.
 
-mod util;
+use crate::util;
 
 use tactile_common::trace::signal_columns;
 use util::{column, std_dev, Sandbox};

@@ -2,7 +2,7 @@
 //! its own record, joined by `tactile report`; killed mid-run; long runs in bounded
 //! memory; and what a launcher does when it dies.
 
-mod util;
+use crate::util;
 
 use std::path::Path;
 use std::process::{Child, Stdio};

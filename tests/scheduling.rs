@@ -2,7 +2,7 @@
 //! margins and CPUs recorded in the summary, a clean fallback where the kernel
 //! refuses, and SCHED_OTHER for lockstep (whose loop never sleeps).
 
-mod util;
+use crate::util;
 
 use util::Sandbox;
 

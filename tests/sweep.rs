@@ -1,6 +1,6 @@
 //! `--set KEY=VALUE` on `tactile run`, and `tactile sweep`.
 
-mod util;
+use crate::util;
 
 use util::Sandbox;
 

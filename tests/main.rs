@@ -1,0 +1,17 @@
+//! The workspace's integration tests, as one test binary. Each module is one subject;
+//! one binary means one link of the whole stack (Zenoh included) instead of one per
+//! subject, which kept CI's disk and time in bounds. Every test makes its own temp
+//! folder, iceoryx2 prefix, ports and namespaces (util), so they run in parallel.
+//! Run one subject with `cargo test --all-features --test main faults::`.
+
+mod util;
+
+mod bad_input;
+mod bench;
+mod cli;
+mod faults;
+mod hosts;
+mod loop_processes;
+mod nodes;
+mod scheduling;
+mod sweep;
