@@ -5,8 +5,10 @@
 //! logging) are in `tactile-node`.
 
 pub mod arith;
+pub mod bilateral;
 pub mod channel;
 pub mod clock;
+pub mod control;
 pub mod cordic;
 pub mod csv;
 pub mod engine;

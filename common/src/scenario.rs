@@ -7,6 +7,7 @@
 //! anything starts. The defaults reproduce the paper's setup.
 
 use crate::arith::ArithKind;
+pub use crate::bilateral::{ControlConfig, ControlKind, HandConfig, HandMode, MasterDeviceConfig};
 use crate::cordic::{CordicConfig, Rounding};
 use crate::geometry::Geometry;
 use serde::{Deserialize, Serialize};
@@ -92,6 +93,9 @@ pub struct Scenario {
     /// Objects in the slave's environment.
     #[serde(default)]
     pub environment: Environment,
+    /// Stability control on the channel.
+    #[serde(default)]
+    pub control: ControlConfig,
 }
 
 fn default_name() -> String {
@@ -217,6 +221,16 @@ pub enum Operator {
         #[serde(default = "default_plane")]
         plane: String,
     },
+    /// A press: from one point to another along a minimum-jerk path in `move_s`
+    /// seconds, then held there (into a wall, the hand keeps pushing).
+    Press {
+        /// Start, metres.
+        from: [f64; 3],
+        /// End, held, metres.
+        to: [f64; 3],
+        /// Seconds to get there.
+        move_s: f64,
+    },
     /// Positions from a CSV file with header `x,y,z`, one row per sample (looped).
     Csv {
         /// Path, relative to the scenario file's folder.
@@ -329,6 +343,12 @@ pub struct MasterConfig {
     /// Largest torque commanded on a master joint, N m.
     #[serde(default = "default_master_torque_limit")]
     pub torque_limit: [f64; 3],
+    /// How the operator's hand holds the handle.
+    #[serde(default)]
+    pub hand: HandConfig,
+    /// The master device's joints (used with an impedance hand).
+    #[serde(default)]
+    pub device: MasterDeviceConfig,
 }
 
 fn default_force_limit() -> f64 {
@@ -343,6 +363,8 @@ impl Default for MasterConfig {
         MasterConfig {
             force_limit: default_force_limit(),
             torque_limit: default_master_torque_limit(),
+            hand: HandConfig::default(),
+            device: MasterDeviceConfig::default(),
         }
     }
 }
@@ -577,6 +599,7 @@ impl Scenario {
             master: MasterConfig::default(),
             slave: SlaveConfig::default(),
             faults: FaultConfig::default(),
+            control: ControlConfig::default(),
             environment: Environment {
                 objects: vec![Object::Plane {
                     point: [0.0, 0.0, -0.16],
@@ -689,12 +712,25 @@ impl Scenario {
                     ));
                 }
             }
+            Operator::Press { from, to, move_s } => {
+                finite3(from, "operator.from")?;
+                finite3(to, "operator.to")?;
+                if !move_s.is_finite() || *move_s <= 0.0 {
+                    return Err(invalid(
+                        "operator.move_s",
+                        format!("{move_s} must be positive"),
+                    ));
+                }
+            }
             Operator::Csv { path } => {
                 if path.is_empty() {
                     return Err(invalid("operator.path", "is empty"));
                 }
             }
         }
+        self.master.hand.validate()?;
+        self.master.device.validate()?;
+        self.control.validate()?;
         self.network.forward.validate("network.forward")?;
         self.network.backward.validate("network.backward")?;
         let c = &self.slave.controller;
