@@ -8,6 +8,7 @@ mod util;
 
 mod bad_input;
 mod bench;
+mod bilateral;
 mod cli;
 mod faults;
 mod hosts;

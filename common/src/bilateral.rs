@@ -3,27 +3,13 @@
 //! control on the channel (`[control]`). Validated like the rest of the scenario: an
 //! error names the dotted field.
 
-use crate::scenario::ScenarioError;
+use crate::scenario::{invalid, positive3, ScenarioError};
 use serde::{Deserialize, Serialize};
-
-fn invalid(field: &str, problem: String) -> ScenarioError {
-    ScenarioError::Invalid {
-        field: field.into(),
-        problem,
-    }
-}
 
 fn positive(v: f64, field: &str, zero_ok: bool) -> Result<(), ScenarioError> {
     if !v.is_finite() || v < 0.0 || (!zero_ok && v == 0.0) {
         let want = if zero_ok { "non-negative" } else { "positive" };
         return Err(invalid(field, format!("{v} must be finite and {want}")));
-    }
-    Ok(())
-}
-
-fn positive3(v: &[f64; 3], field: &str, zero_ok: bool) -> Result<(), ScenarioError> {
-    for (i, x) in v.iter().enumerate() {
-        positive(*x, &format!("{field}[{i}]"), zero_ok)?;
     }
     Ok(())
 }

@@ -18,6 +18,10 @@ use rand_distr::{Distribution, Normal};
 pub struct Value {
     /// The signal value.
     pub v: f64,
+    /// The sender's input energy, delayed with the value and never noised, J.
+    pub energy: f64,
+    /// The sender's sample number for this value.
+    pub sent_seq: u64,
     /// Master sample number this value originates from.
     pub origin_seq: u64,
     /// Master's CLOCK_MONOTONIC timestamp of that sample, ns.
@@ -159,6 +163,8 @@ mod tests {
     fn vals(n: u64) -> [Value; 3] {
         [0, 1, 2].map(|i| Value {
             v: n as f64 * 10.0 + i as f64,
+            energy: n as f64 * 0.5,
+            sent_seq: n,
             origin_seq: n,
             origin_ns: n * 1000,
             delay_samples: 0,
@@ -178,6 +184,9 @@ mod tests {
             assert_eq!(e.values[1].origin_seq, n.saturating_sub(2));
             assert_eq!(e.values[2].origin_seq, n.saturating_sub(5));
             assert_eq!(e.values[2].delay_samples, 5);
+            // The energy and the sender's sample number travel with their value.
+            assert_eq!(e.values[1].sent_seq, n.saturating_sub(2));
+            assert_eq!(e.values[1].energy, n.saturating_sub(2) as f64 * 0.5);
             assert_eq!(e.substituted, n < 5);
             assert_eq!(e.noise, [0.0; 3]);
         }
@@ -205,7 +214,12 @@ mod tests {
         let run = |seed| {
             let mut ch = Channel::new(&cfg, seed, BACKWARD_STREAM);
             (0..20_000u64)
-                .map(|n| ch.push(n, vals(n)).noise)
+                .map(|n| {
+                    let e = ch.push(n, vals(n));
+                    // Noise goes on the value only, never on the energy exchanged.
+                    assert!(e.values.iter().all(|v| v.energy == n as f64 * 0.5));
+                    e.noise
+                })
                 .collect::<Vec<_>>()
         };
         let a = run(3);

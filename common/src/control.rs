@@ -43,6 +43,12 @@ pub struct Ledger {
 }
 
 impl Ledger {
+    /// Energy put in minus energy put out, all axes, J: this port's share of the
+    /// energy inside the channel.
+    pub fn net(&self) -> f64 {
+        (0..3).map(|i| self.input[i] - self.output[i]).sum()
+    }
+
     /// Books one sample's energy on axis `i`: positive leaves the channel.
     fn book(&mut self, i: usize, out_j: f64) {
         if out_j > 0.0 {
@@ -83,7 +89,6 @@ pub struct MasterSide {
     t_s: f64,
     ledger: Ledger,
     remote: [f64; 3],
-    last_position: Option<[f64; 3]>,
     velocity: [f64; 3],
     wave_in: [f64; 3],
     base: [f64; 3],
@@ -98,7 +103,6 @@ impl MasterSide {
             t_s,
             ledger: Ledger::default(),
             remote: [0.0; 3],
-            last_position: None,
             velocity: [0.0; 3],
             wave_in: [0.0; 3],
             base: [0.0; 3],
@@ -106,19 +110,17 @@ impl MasterSide {
         }
     }
 
-    /// The handle's measured position c(n); its velocity is the difference from the
-    /// last one (what the encoders give). The energy of the interval just ended is
-    /// booked here, exactly for a force held over the sample: the force applied times
-    /// the displacement.
-    pub fn measure(&mut self, c: [f64; 3]) {
-        if let Some(last) = self.last_position {
-            for i in 0..3 {
-                let dx = c[i] - last[i];
-                self.velocity[i] = dx / self.t_s;
-                self.ledger.book(i, self.applied[i] * dx);
-            }
+    /// The handle's displacement over the sample just ended, m (the master takes it
+    /// from its encoders through the Jacobian, J (b(n) - b(n-1)): differencing the
+    /// FK-HMD positions instead would turn the hybrid datapath's position error,
+    /// tens of micrometres, into velocity noise of centimetres per second). Sets the
+    /// velocity, and books the interval's energy, exactly for a force held over the
+    /// sample: the force applied times the displacement.
+    pub fn measure(&mut self, dx: [f64; 3]) {
+        for (i, d) in dx.into_iter().enumerate() {
+            self.velocity[i] = d / self.t_s;
+            self.ledger.book(i, self.applied[i] * d);
         }
-        self.last_position = Some(c);
     }
 
     /// The handle's velocity estimate, m/s.
@@ -140,6 +142,11 @@ impl MasterSide {
     /// The energy this side has put into the channel, sent with every sample.
     pub fn energy(&self) -> [f64; 3] {
         self.ledger.input
+    }
+
+    /// This port's books.
+    pub fn ledger(&self) -> &Ledger {
+        &self.ledger
     }
 
     /// What came back (a force, or the backward wave) with the slave's input energy:
@@ -249,6 +256,11 @@ impl SlaveSide {
     /// The energy this side has put into the channel, sent with every sample.
     pub fn energy(&self) -> [f64; 3] {
         self.ledger.input
+    }
+
+    /// This port's books.
+    pub fn ledger(&self) -> &Ledger {
+        &self.ledger
     }
 
     /// The current reference, m.
@@ -368,8 +380,10 @@ mod tests {
         // (|f| + b |v|) |dv| T (b: the wave impedance, whose damping has the same lag).
         let (mut slack, mut f_last, mut v_last) = (1e-9, 0.0f64, 0.0f64);
         let b = cfg(kind).wave_impedance;
+        let mut x_last = path[0];
         for &x in path {
-            m.measure([x; 3]);
+            m.measure([x - x_last; 3]);
+            x_last = x;
             let v = m.velocity()[0];
             slack += (f_last.abs() + b * v.abs()) * (v - v_last).abs() * t;
             v_last = v;
@@ -452,7 +466,7 @@ mod tests {
         let (mut m, mut s) = (MasterSide::new(&c, t), SlaveSide::new(&c, t, [0.0; 3]));
         for n in 0..100 {
             let x = 1e-4 * n as f64;
-            m.measure([x; 3]);
+            m.measure([if n == 0 { 0.0 } else { 1e-4 }; 3]);
             let r = s.receive(m.transmit([x; 3]), m.energy(), [0.0; 3]);
             assert!((r.position[0] - x).abs() < 1e-12, "{n}: {r:?}");
             // The observer is off by at most one sample of the damper's energy: the

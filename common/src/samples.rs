@@ -100,10 +100,18 @@ impl Sequenced for Backward {
 /// Three signal values with their provenance.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Signal/2")]
+#[type_name("tactile::Signal/3")]
 pub struct Signal {
-    /// Values: position in metres (forward) or force in newtons (backward).
+    /// Values: what crosses the network. Position in metres (forward) and force in
+    /// newtons (backward); with `control.kind = "wave"`, the wave variables.
     pub value: [f64; 3],
+    /// The sender's input energy into the channel so far, per axis, J (the passivity
+    /// observers' exchange); delayed with the value, never noised.
+    pub energy: [f64; 3],
+    /// The sender's sample number when it produced each value (the master's n
+    /// forward, the slave's step backward), so a receiver's value can be compared
+    /// with what the sender had then.
+    pub sent_seq: [u64; 3],
     /// Master sample each value originates from.
     pub origin_seq: [u64; 3],
     /// Master timestamp of that sample (CLOCK_MONOTONIC, ns).
@@ -118,7 +126,7 @@ pub struct Signal {
 /// loop needs; what each node did with it is in that node's own record.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Forward/2")]
+#[type_name("tactile::Forward/3")]
 pub struct Forward {
     /// Sample number n on this stream.
     pub seq: u64,
@@ -137,7 +145,7 @@ pub struct Forward {
 /// Backward stream: h(n) from the slave, q(n) from the emulator.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Backward/2")]
+#[type_name("tactile::Backward/3")]
 pub struct Backward {
     /// Sample number n on this stream (the forward sample that triggered it).
     pub seq: u64,

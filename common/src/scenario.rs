@@ -29,7 +29,7 @@ pub enum ScenarioError {
     },
 }
 
-fn invalid(field: impl Into<String>, problem: impl Into<String>) -> ScenarioError {
+pub(crate) fn invalid(field: impl Into<String>, problem: impl Into<String>) -> ScenarioError {
     ScenarioError::Invalid {
         field: field.into(),
         problem: problem.into(),
@@ -550,7 +550,7 @@ fn finite3(v: &[f64; 3], field: &str) -> Result<(), ScenarioError> {
     Ok(())
 }
 
-fn positive3(v: &[f64; 3], field: &str, allow_zero: bool) -> Result<(), ScenarioError> {
+pub(crate) fn positive3(v: &[f64; 3], field: &str, allow_zero: bool) -> Result<(), ScenarioError> {
     finite3(v, field)?;
     for (i, x) in v.iter().enumerate() {
         if *x < 0.0 || (!allow_zero && *x == 0.0) {

@@ -9,7 +9,7 @@ use crate::samples::stage;
 use std::fmt::Write;
 
 /// Three-valued signal columns, in order, with their prefix.
-pub const SIGNALS: [&str; 17] = [
+pub const SIGNALS: [&str; 23] = [
     "target",
     "theta_md",
     "c",
@@ -27,6 +27,12 @@ pub const SIGNALS: [&str; 17] = [
     "delay_b",
     "tau",
     "felt",
+    "handle",
+    "hand_force",
+    "reference",
+    "observer_m",
+    "observer_s",
+    "q_from",
 ];
 
 /// Name of the first timing column; everything from here on is wall-clock dependent.
@@ -40,7 +46,9 @@ pub fn header() -> String {
             let _ = write!(h, ",{s}_{axis}");
         }
     }
-    h.push_str(",flags_f,flags_b,flags_m,contact_object,round_trip_ns,overhead_ns");
+    h.push_str(",flags_f,flags_b,flags_m,contact_object,dissipated_m,dissipated_s");
+    h.push_str(",port_net_m,port_net_s");
+    h.push_str(",round_trip_ns,overhead_ns");
     for name in stage::NAMES {
         let _ = write!(h, ",t_{name}");
     }
@@ -91,6 +99,26 @@ pub struct TraceRow {
     pub tau: [f64; 3],
     /// The force the operator feels, N.
     pub felt: [f64; 3],
+    /// The handle's true position, m.
+    pub handle: [f64; 3],
+    /// The impedance hand's force on the handle, N.
+    pub hand_force: [f64; 3],
+    /// The slave's Cartesian reference from the channel's control, m.
+    pub reference: [f64; 3],
+    /// The master's passivity observer per axis, J.
+    pub observer_m: [f64; 3],
+    /// The slave's passivity observer per axis, J.
+    pub observer_s: [f64; 3],
+    /// The slave step each value of q(n) was produced at.
+    pub q_from: [u64; 3],
+    /// Energy the master's control dissipated this sample, J.
+    pub dissipated_m: f64,
+    /// The master port's net energy into the channel so far, J.
+    pub port_net_m: f64,
+    /// The slave port's net energy into the channel so far, J.
+    pub port_net_s: f64,
+    /// Energy the slave's control dissipated this step, J.
+    pub dissipated_s: f64,
     /// Flags of v(n) as received.
     pub flags_f: u32,
     /// Flags of q(n) as received.
@@ -143,15 +171,31 @@ impl TraceRow {
             push3(line, v);
         }
         push3u(line, self.delay_b);
-        push3(line, self.tau);
-        push3(line, self.felt);
+        for v in [
+            self.tau,
+            self.felt,
+            self.handle,
+            self.hand_force,
+            self.reference,
+            self.observer_m,
+            self.observer_s,
+        ] {
+            push3(line, v);
+        }
+        for x in self.q_from {
+            let _ = write!(line, ",{x}");
+        }
         let _ = write!(
             line,
-            ",{},{},{},{},{},{}",
+            ",{},{},{},{},{:?},{:?},{:?},{:?},{},{}",
             self.flags_f,
             self.flags_b,
             self.flags_m,
             self.contact_object,
+            self.dissipated_m,
+            self.dissipated_s,
+            self.port_net_m,
+            self.port_net_s,
             self.round_trip_ns,
             self.overhead_ns
         );

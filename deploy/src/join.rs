@@ -325,6 +325,8 @@ fn row(
         target: sent.target,
         theta_md: sent.theta_md,
         c: sent.c,
+        handle: sent.handle,
+        hand_force: sent.hand_force,
         contact_object: -1,
         ..TraceRow::default()
     };
@@ -338,6 +340,10 @@ fn row(
         r.tau = a.tau;
         r.felt = a.felt;
         r.flags_m = a.flags;
+        r.observer_m = a.observer;
+        r.dissipated_m = a.dissipated_j;
+        r.port_net_m = a.port_net_j;
+        r.q_from = a.q.sent_seq;
         r.round_trip_ns = a.round_trip_ns;
         r.overhead_ns = a.overhead_ns;
         r.stamps = a.stamps;
@@ -345,6 +351,9 @@ fn row(
         r.tau = m.tau;
         r.felt = m.felt;
         r.flags_m = m.flags;
+        r.observer_m = m.observer;
+        r.dissipated_m = m.dissipated_j;
+        r.port_net_m = m.port_net_j;
     }
     for p in passages {
         match p.dir {
@@ -361,6 +370,10 @@ fn row(
         r.delay_f = s.received.delay_samples;
         r.flags_f = s.received.flags;
         r.theta_ref = s.theta_ref;
+        r.reference = s.reference;
+        r.observer_s = s.observer;
+        r.port_net_s = s.port_net_j;
+        r.dissipated_s = s.dissipated_j;
         r.theta_sd = s.theta;
         r.u = s.torque;
         r.tool = s.tool;

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod error;
 pub mod join;
 pub mod kernels_cmd;
+pub mod metrics;
 pub mod netns;
 pub mod nodes;
 pub mod paper_cmd;

@@ -95,25 +95,46 @@ impl Thinned {
 /// The time series of a run, gathered row by row.
 #[derive(Debug, Clone, Default)]
 pub struct Series {
-    target: [Thinned; 3],
+    handle: [Thinned; 3],
     tool: [Thinned; 3],
     force: [Thinned; 3],
     felt: [Thinned; 3],
+    channel: Thinned,
+    observer_m: Thinned,
+    observer_s: Thinned,
+    dissipated: Thinned,
+    slave_net: f64,
+    dissipated_sum: f64,
 }
 
 impl Series {
     /// Adds one row at its time.
     pub fn add(&mut self, row: &TraceRow, t_s: f64) {
         let t = row.n as f64 * t_s;
+        let low = |w: [f64; 3]| w.iter().copied().fold(f64::INFINITY, f64::min);
+        if row.stepped {
+            self.slave_net = row.port_net_s;
+        }
+        self.dissipated_sum += row.dissipated_m + row.dissipated_s;
+        self.channel
+            .push(t, 1e3 * (row.port_net_m + self.slave_net));
+        self.observer_m.push(t, 1e3 * low(row.observer_m));
+        let s = if row.stepped {
+            1e3 * low(row.observer_s)
+        } else {
+            f64::NAN
+        };
+        self.observer_s.push(t, s);
+        self.dissipated.push(t, 1e3 * self.dissipated_sum);
         for i in 0..3 {
-            self.target[i].push(t, row.target[i]);
+            self.handle[i].push(t, row.handle[i]);
             self.tool[i].push(t, if row.stepped { row.tool[i] } else { f64::NAN });
             self.force[i].push(t, if row.stepped { row.h[i] } else { f64::NAN });
             self.felt[i].push(t, row.felt[i]);
         }
     }
 
-    /// Writes `positions.svg` and `forces.svg` into `out`.
+    /// Writes `positions.svg`, `forces.svg` and `passivity.svg` into `out`.
     pub fn write(&self, out: &Path) -> PlotResult {
         let series = |a: &[Thinned; 3], b: &[Thinned; 3], la: &str, lb: &str, pre: &str| {
             let mut v = Vec::new();
@@ -135,21 +156,47 @@ impl Series {
         };
         time_series(
             &out.join("positions.svg"),
-            "Master target and slave tool position",
+            "Master handle and slave tool position",
             "position (m)",
-            &series(
-                &self.target,
-                &self.tool,
-                "operator target",
-                "slave tool",
-                "",
-            ),
+            &series(&self.handle, &self.tool, "master handle", "slave tool", ""),
         )?;
         time_series(
             &out.join("forces.svg"),
             "Contact force (slave) and feedback force (master)",
             "force (N)",
-            &series(&self.felt, &self.force, "felt q(n)", "slave h(n)", "F"),
+            &series(&self.felt, &self.force, "felt", "slave h(n)", "F"),
+        )?;
+        let grey = RGBColor(90, 90, 90);
+        time_series(
+            &out.join("passivity.svg"),
+            "Channel energy (below zero: the channel made energy), observers, dissipation",
+            "energy (mJ)",
+            &[
+                (
+                    "channel energy".into(),
+                    COLOURS[0],
+                    false,
+                    self.channel.points(),
+                ),
+                (
+                    "master observer (lowest axis)".into(),
+                    COLOURS[1],
+                    false,
+                    self.observer_m.points(),
+                ),
+                (
+                    "slave observer (lowest axis)".into(),
+                    COLOURS[2],
+                    false,
+                    self.observer_s.points(),
+                ),
+                (
+                    "dissipated by the control".into(),
+                    grey,
+                    true,
+                    self.dissipated.points(),
+                ),
+            ],
         )
     }
 }

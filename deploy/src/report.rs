@@ -272,6 +272,8 @@ pub struct Analysis {
     pub stages: Vec<Latency>,
     /// Tracking and forces.
     pub motion: Motion,
+    /// The bilateral loop's metrics.
+    pub bilateral: crate::metrics::Bilateral,
     /// Rows with an answer.
     pub received: u64,
     /// Rows in all.
@@ -298,6 +300,7 @@ impl Analysis {
             overhead: Latency::default(),
             stages: vec![Latency::default(); STAGES.len()],
             motion: Motion::default(),
+            bilateral: crate::metrics::Bilateral::default(),
             received: 0,
             rows: 0,
             with_stages,
@@ -312,6 +315,7 @@ impl Analysis {
     /// Adds one row.
     pub fn add(&mut self, row: &TraceRow) {
         self.rows += 1;
+        self.bilateral.add(row);
         let m = &mut self.motion;
         m.force_max_n = m.force_max_n.max(norm(row.h));
         if row.contact_object >= 0 {
@@ -386,6 +390,7 @@ impl Analysis {
 
     /// Closes the running sums into the motion statistics.
     pub fn finish(&mut self) {
+        self.bilateral.finish();
         if self.tracked > 0 {
             self.motion.tracking_rms_m = Some((self.track_sq / self.tracked as f64).sqrt());
         }

@@ -3,6 +3,7 @@
 
 use crate::error::Error;
 use crate::join::{self, Logs, NodeLog};
+use crate::metrics::Packets;
 use crate::plots::{self, Series};
 use crate::report::{Analysis, STAGES};
 use crate::summary::{render, ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
@@ -15,7 +16,7 @@ use tactile_common::scenario::Scenario;
 use tactile_common::trace;
 
 /// Files a report writes into its folder.
-pub const REPORT_FILES: [&str; 9] = [
+pub const REPORT_FILES: [&str; 10] = [
     "summary.json",
     "trace.csv",
     "round_trip.hgrm",
@@ -24,6 +25,7 @@ pub const REPORT_FILES: [&str; 9] = [
     "percentiles.svg",
     "positions.svg",
     "forces.svg",
+    "passivity.svg",
     "scenario.toml",
 ];
 
@@ -209,6 +211,15 @@ fn summarise(
         samples_lost: a.rows - a.received,
         deadline_misses: master_totals.deadline_misses,
         tracking_rms_m: a.motion.tracking_rms_m,
+        hand: scenario.master.hand.mode,
+        control: scenario.control.kind.name(),
+        tracking: a.bilateral.tracking,
+        contact: a.bilateral.contact,
+        passivity: a.bilateral.passivity,
+        packets: Packets {
+            forward: master_totals.counters.sent,
+            backward: slave.as_ref().map_or(0, |s| s.counters.steps),
+        },
         master: MasterPart {
             totals: master_totals,
             motion: a.motion,

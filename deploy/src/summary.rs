@@ -1,6 +1,7 @@
 //! `summary.json` and the terminal summary: a view of the nodes' records, with each
 //! stream's accounting.
 
+use crate::metrics::{Contact, Packets, Passivity, Tracking};
 use crate::report::{us_header, us_line, ClockOffset, Motion, Percentiles};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -140,6 +141,20 @@ pub struct Summary {
     pub deadline_misses: u64,
     /// RMS distance of the slave's tool from the position it was asked to reach, m.
     pub tracking_rms_m: Option<f64>,
+    /// The operator's hand: `position` (ideal) or `impedance`.
+    pub hand: tactile_common::scenario::HandMode,
+    /// The channel's control: `none`, `tdpa` or `wave`.
+    pub control: &'static str,
+    /// The slave against the master's delay-shifted handle, the felt force against the
+    /// environment's.
+    pub tracking: Tracking,
+    /// How deep the tool went.
+    pub contact: Contact,
+    /// The channel's passivity observers, the energy the control dissipated, and the
+    /// drift of the slave's reference.
+    pub passivity: Passivity,
+    /// Samples put on the network per direction.
+    pub packets: Packets,
     /// Everything the master reported.
     pub master: MasterPart,
     /// Per stream: c (master to emulator), v (emulator to slave), h, q.
@@ -221,6 +236,27 @@ pub fn render(s: &Summary, out: &Path) -> String {
         mo.felt_rms_n.map_or("n/a".to_string(), |f| format!("{f:.3} N")),
         mo.felt_max_n,
         mo.tau_max_nm
+    );
+    let _ = writeln!(
+        t,
+        "bilateral ({} hand, control {}): position rms {} against the delay-shifted handle, force rms {}, penetration max {:.2} mm",
+        match s.hand {
+            tactile_common::scenario::HandMode::Position => "position",
+            tactile_common::scenario::HandMode::Impedance => "impedance",
+        },
+        s.control,
+        mm(s.tracking.position_rms_m),
+        s.tracking.force_rms_n.map_or("n/a".to_string(), |f| format!("{f:.3} N")),
+        s.contact.max_penetration_m * 1e3
+    );
+    let _ = writeln!(
+        t,
+        "passivity: observer min {}, dissipated {:.3} mJ, drift max {}; packets forward {}, backward {}",
+        s.passivity.observer_min_j.map_or("n/a".to_string(), |w| format!("{:.3} mJ", w * 1e3)),
+        s.passivity.dissipated_j * 1e3,
+        mm(Some(s.passivity.drift_max_m)),
+        s.packets.forward,
+        s.packets.backward
     );
     let mc = &m.totals.counters;
     let _ = writeln!(

@@ -18,7 +18,7 @@ use tactile_common::overrides::{split_values, Set};
 
 /// The columns of `sweep.csv` after the swept keys: a name, and where the value is in
 /// a run's `summary.json` (a JSON pointer).
-pub const METRICS: [(&str, &str); 12] = [
+pub const METRICS: [(&str, &str); 22] = [
     ("samples_sent", "/samples_sent"),
     ("samples_lost", "/samples_lost"),
     ("deadline_misses", "/deadline_misses"),
@@ -31,6 +31,16 @@ pub const METRICS: [(&str, &str); 12] = [
     ("round_trip_p99_ns", "/round_trip_ns/p99"),
     ("overhead_p50_ns", "/overhead_ns/p50"),
     ("overhead_p99_ns", "/overhead_ns/p99"),
+    ("position_rms_m", "/tracking/position_rms_m"),
+    ("force_rms_n", "/tracking/force_rms_n"),
+    ("max_penetration_m", "/contact/max_penetration_m"),
+    ("force_swing_n", "/contact/force_swing_n"),
+    ("observer_min_j", "/passivity/observer_min_j"),
+    ("side_observer_min_j", "/passivity/side_observer_min_j"),
+    ("dissipated_j", "/passivity/dissipated_j"),
+    ("drift_max_m", "/passivity/drift_max_m"),
+    ("packets_forward", "/packets/forward"),
+    ("packets_backward", "/packets/backward"),
 ];
 
 /// Most runs one sweep may ask for: beyond this a typo in a list is likelier than a

@@ -5,16 +5,23 @@
 //! a received q(n) into joint torques p(n) = J(b)^T q (KFF-HMD). Each returns the
 //! sample for the wire and the master's record of it. The process edge and the
 //! in-process simulation call the same functions.
+//!
+//! The MD model is the hand's mode: `position`, an ideal hand that puts the handle on
+//! the trajectory (the torques drive nothing), or `impedance`, a hand holding the
+//! simulated device ([`HeldDevice`]) that the torques push back. The channel's control
+//! ([`MasterSide`]) decides what is sent for c(n) and which force comes of q(n).
 
-use crate::operator::{OperatorSource, Target};
+use crate::device::HeldDevice;
+use crate::operator::{min_jerk, OperatorSource, Target};
 use crate::record::{Answer, Miss, Sent};
 use serde::{Deserialize, Serialize};
+use tactile_common::control::{MasterForce, MasterSide};
 use tactile_common::engine::Engine;
 use tactile_common::kernels::IkStatus;
 use tactile_common::samples::{
     stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_REJECTED,
 };
-use tactile_common::scenario::{MasterConfig, Scenario, ScenarioError};
+use tactile_common::scenario::{HandMode, MasterConfig, Scenario, ScenarioError};
 
 /// What the master counted over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -57,6 +64,13 @@ pub struct Master {
     silent: u64,
     last_tau: [f64; 3],
     last_felt: [f64; 3],
+    /// The impedance hand's device and where its intended position was last sample.
+    held: Option<(HeldDevice, [f64; 3])>,
+    /// Where the handle starts (the devices' home), m.
+    home: [f64; 3],
+    approach_s: f64,
+    control: MasterSide,
+    last_theta: [f64; 3],
 }
 
 impl Master {
@@ -68,6 +82,17 @@ impl Master {
             field: "cordic".into(),
             problem: e.to_string(),
         };
+        let lengths = geometry.lengths();
+        let home = tactile_common::kernels::fk(&lengths, &tactile_common::arith::StdTrig, [0.0; 3]);
+        let held = (scenario.master.hand.mode == HandMode::Impedance).then(|| {
+            let device = HeldDevice::new(
+                scenario.master.device.clone(),
+                scenario.master.hand.clone(),
+                lengths,
+                [0.0; 3],
+            );
+            (device, home)
+        });
         Ok(Master {
             engine: Engine::new(scenario.arithmetic, geometry, cordic).map_err(bad)?,
             truth: Engine::new(tactile_common::arith::ArithKind::F64, geometry, cordic)
@@ -82,6 +107,11 @@ impl Master {
             silent: 0,
             last_tau: [0.0; 3],
             last_felt: [0.0; 3],
+            held,
+            home,
+            approach_s: scenario.master.hand.approach_s,
+            last_theta: [0.0; 3],
+            control: MasterSide::new(&scenario.control, scenario.t_s()),
         })
     }
 
@@ -93,7 +123,84 @@ impl Master {
     /// Sample n forward: operator a(n) -> MD encoders b(n) -> FK-HMD c(n).
     /// `now_ns` is the tick time; it becomes the origin timestamp of all three values.
     pub fn forward(&mut self, n: u64, now_ns: u64) -> (Forward, Sent) {
-        let target = match self.source.target(n, self.t_s) {
+        let (target, hand_force) = match self.held.is_some() {
+            false => (self.ideal_hand(n), [0.0; 3]),
+            true => self.impedance_hand(n),
+        };
+        let c = self.engine.fk(self.theta_md);
+        let moved = self.moved(n);
+        self.control.measure(moved);
+        let mut f = Forward {
+            seq: n,
+            ..Forward::default()
+        };
+        f.signal.value = self.control.transmit(c);
+        f.signal.energy = self.control.energy();
+        f.signal.sent_seq = [n; 3];
+        f.signal.origin_seq = [n; 3];
+        f.signal.origin_ns = [now_ns; 3];
+        f.stamps[stage::MASTER_TICK] = now_ns;
+        self.counters.sent += 1;
+        let sent = Sent {
+            n,
+            target,
+            theta_md: self.theta_md,
+            c,
+            handle: self.truth.fk(self.theta_md),
+            hand_force,
+            tick_ns: now_ns,
+            send_ns: 0,
+        };
+        (f, sent)
+    }
+
+    /// The handle's displacement since the last sample, J(b(n)) (b(n) - b(n-1)), in
+    /// the HMD's arithmetic.
+    fn moved(&mut self, n: u64) -> [f64; 3] {
+        let last = std::mem::replace(&mut self.last_theta, self.theta_md);
+        if n == 0 {
+            return [0.0; 3];
+        }
+        let j = self.engine.jacobian(self.theta_md);
+        let d = [0, 1, 2].map(|k| self.theta_md[k] - last[k]);
+        [0, 1, 2].map(|i| j[i][0] * d[0] + j[i][1] * d[1] + j[i][2] * d[2])
+    }
+
+    /// The hand's intended position at sample n: the trajectory, blended in from the
+    /// handle's home over the approach time.
+    fn intended(&self, n: u64) -> [f64; 3] {
+        let approach_s = self.approach_s;
+        let a = match self.source.target(n, self.t_s) {
+            Target::Joints(theta) => self.truth.fk(theta),
+            Target::Position(p) => p,
+        };
+        let s = if approach_s > 0.0 {
+            min_jerk(n as f64 * self.t_s / approach_s)
+        } else {
+            1.0
+        };
+        [0, 1, 2].map(|i| self.home[i] + s * (a[i] - self.home[i]))
+    }
+
+    /// The impedance hand: the device moves over the sample just ended under the hand
+    /// and the torques then applied; the encoders read where it got to.
+    fn impedance_hand(&mut self, n: u64) -> ([f64; 3], [f64; 3]) {
+        let x_d = self.intended(n);
+        let (tau, t_s) = (self.last_tau, self.t_s);
+        let Some((device, last)) = &mut self.held else {
+            return (self.ideal_hand(n), [0.0; 3]);
+        };
+        if n > 0 {
+            device.advance(tau, *last, x_d, t_s);
+        }
+        *last = x_d;
+        self.theta_md = device.theta;
+        (x_d, device.hand_force)
+    }
+
+    /// The ideal hand: the handle is where the trajectory says.
+    fn ideal_hand(&mut self, n: u64) -> [f64; 3] {
+        match self.source.target(n, self.t_s) {
             Target::Joints(theta) => {
                 self.theta_md = theta;
                 self.truth.fk(theta)
@@ -112,26 +219,7 @@ impl Master {
                 }
                 p
             }
-        };
-        let c = self.engine.fk(self.theta_md);
-        let mut f = Forward {
-            seq: n,
-            ..Forward::default()
-        };
-        f.signal.value = c;
-        f.signal.origin_seq = [n; 3];
-        f.signal.origin_ns = [now_ns; 3];
-        f.stamps[stage::MASTER_TICK] = now_ns;
-        self.counters.sent += 1;
-        let sent = Sent {
-            n,
-            target,
-            theta_md: self.theta_md,
-            c,
-            tick_ns: now_ns,
-            send_ns: 0,
-        };
-        (f, sent)
+        }
     }
 
     /// True while the loop is broken (no answer for the peer timeout).
@@ -150,28 +238,39 @@ impl Master {
         }
         self.silent = 0;
         let mut flags = 0;
-        let force = q.signal.value;
-        if force.iter().all(|f| f.is_finite()) {
-            let lim = self.limits.force_limit;
-            let felt = force.map(|f| f.clamp(-lim, lim));
-            let clamped = felt.iter().zip(&force).filter(|(a, b)| a != b).count() as u64;
-            let raw = self.engine.kff(self.theta_md, felt);
-            let tau: [f64; 3] = [0, 1, 2].map(|j| {
-                let l = self.limits.torque_limit[j];
-                raw[j].clamp(-l, l)
-            });
-            let tau_clamped = tau.iter().zip(&raw).filter(|(a, b)| a != b).count() as u64;
-            self.counters.force_clamps += clamped;
-            self.counters.torque_clamps += tau_clamped;
-            if clamped + tau_clamped > 0 {
+        let lim = self.limits.force_limit;
+        if q.signal.value.iter().all(|f| f.is_finite()) {
+            let out = self.control.receive(q.signal.value, q.signal.energy, lim);
+            if self.command(&out) {
                 flags |= FLAG_CLAMPED;
             }
-            self.last_felt = felt;
-            self.last_tau = tau;
-        } else {
-            self.counters.rejected += 1;
-            flags |= FLAG_REJECTED;
+            return self.answer(q, flags, &out);
         }
+        // A value that is not finite never reaches a torque: the last one is held (the
+        // control's books still run on the force in effect).
+        self.counters.rejected += 1;
+        let out = self.control.hold(lim);
+        self.answer(q, flags | FLAG_REJECTED, &out)
+    }
+
+    /// Takes the control's force as the felt force and its KFF-HMD torques, clamped;
+    /// counts the clamps and says whether there were any.
+    fn command(&mut self, out: &MasterForce) -> bool {
+        let felt = out.force;
+        let raw = self.engine.kff(self.theta_md, felt);
+        let tau: [f64; 3] = [0, 1, 2].map(|j| {
+            let l = self.limits.torque_limit[j];
+            raw[j].clamp(-l, l)
+        });
+        let tau_clamped = tau.iter().zip(&raw).filter(|(a, b)| a != b).count() as u64;
+        self.counters.force_clamps += u64::from(out.clamped);
+        self.counters.torque_clamps += tau_clamped;
+        self.last_felt = felt;
+        self.last_tau = tau;
+        u64::from(out.clamped) + tau_clamped > 0
+    }
+
+    fn answer(&self, q: &Backward, flags: u32, out: &MasterForce) -> Answer {
         Answer {
             n: q.seq,
             q: q.signal,
@@ -179,34 +278,44 @@ impl Master {
             tau: self.last_tau,
             felt: self.last_felt,
             flags,
+            observer: out.observer,
+            port_net_j: self.control.ledger().net(),
+            dissipated_j: out.dissipated,
             round_trip_ns: 0,
             overhead_ns: 0,
             late: false,
         }
     }
 
-    /// Sample n got no answer in time. Within the peer timeout the last torque is held
-    /// (one lost sample must not jerk the operator's hand); past it the loop is broken
-    /// and the master commands zero torque.
+    /// Sample n got no answer in time. Within the peer timeout the last force is held
+    /// (one lost sample must not jerk the operator's hand; with waves, the last wave
+    /// against the present velocity); past it the loop is broken and the master
+    /// commands zero torque.
     pub fn missing(&mut self, n: u64) -> Miss {
         self.silent += 1;
-        let flags = if self.peer_lost() {
+        let (flags, out) = if self.peer_lost() {
             if self.silent == self.peer_timeout {
                 self.counters.loop_breaks += 1;
             }
             self.counters.peer_lost_samples += 1;
+            let out = self.control.release();
             self.last_tau = [0.0; 3];
             self.last_felt = [0.0; 3];
-            FLAG_PEER_LOST
+            (FLAG_PEER_LOST, out)
         } else {
             self.counters.held_samples += 1;
-            FLAG_HELD
+            let out = self.control.hold(self.limits.force_limit);
+            self.command(&out);
+            (FLAG_HELD, out)
         };
         Miss {
             n,
             tau: self.last_tau,
             felt: self.last_felt,
             flags,
+            observer: out.observer,
+            port_net_j: self.control.ledger().net(),
+            dissipated_j: out.dissipated,
         }
     }
 

@@ -60,8 +60,24 @@ pub enum OperatorSource {
         /// Indices of the plane's two axes.
         axes: (usize, usize),
     },
+    /// A minimum-jerk move from one point to another in `move_s`, then held.
+    Press {
+        /// Start, m.
+        from: [f64; 3],
+        /// End, m.
+        to: [f64; 3],
+        /// Seconds to get there.
+        move_s: f64,
+    },
     /// Positions from a file, looped.
     Positions(Vec<[f64; 3]>),
+}
+
+/// Minimum-jerk progress at fraction `tau` of a move (Flash and Hogan, 1985): zero
+/// velocity and acceleration at both ends.
+pub fn min_jerk(tau: f64) -> f64 {
+    let t = tau.clamp(0.0, 1.0);
+    t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
 }
 
 fn plane_axes(plane: &str) -> (usize, usize) {
@@ -100,6 +116,11 @@ impl OperatorSource {
                 size: *size,
                 period_s: *period_s,
                 axes: plane_axes(plane),
+            },
+            Operator::Press { from, to, move_s } => OperatorSource::Press {
+                from: *from,
+                to: *to,
+                move_s: *move_s,
             },
             Operator::Csv { path } => {
                 let full = base_dir.join(path);
@@ -155,6 +176,10 @@ impl OperatorSource {
                 p[axes.0] += u;
                 p[axes.1] += v;
                 Target::Position(p)
+            }
+            OperatorSource::Press { from, to, move_s } => {
+                let s = min_jerk(t / move_s);
+                Target::Position([0, 1, 2].map(|i| from[i] + s * (to[i] - from[i])))
             }
             OperatorSource::Positions(rows) => {
                 Target::Position(rows[(n % rows.len() as u64) as usize])

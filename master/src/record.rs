@@ -17,6 +17,10 @@ pub struct Sent {
     pub theta_md: [f64; 3],
     /// c(n), m.
     pub c: [f64; 3],
+    /// The handle's true position (the device's joints, f64), m.
+    pub handle: [f64; 3],
+    /// The impedance hand's force on the handle, N (zero for the ideal hand).
+    pub hand_force: [f64; 3],
     /// The sample's instant (its scheduled tick in realtime), ns.
     pub tick_ns: u64,
     /// When c(n) was published, ns.
@@ -38,6 +42,13 @@ pub struct Answer {
     pub felt: [f64; 3],
     /// `FLAG_*` bits of the master (clamped, rejected).
     pub flags: u32,
+    /// The master's passivity observer per axis after this sample, J.
+    pub observer: [f64; 3],
+    /// Energy the master's port has put into the channel minus what it took out, all
+    /// axes, J (its share of the channel's energy).
+    pub port_net_j: f64,
+    /// Energy the control dissipated this sample, J.
+    pub dissipated_j: f64,
     /// Round trip on the master's clock, ns.
     pub round_trip_ns: u64,
     /// Round trip minus injected delay, ns.
@@ -57,6 +68,12 @@ pub struct Miss {
     pub felt: [f64; 3],
     /// `FLAG_HELD` or `FLAG_PEER_LOST`.
     pub flags: u32,
+    /// The master's passivity observer per axis after this sample, J.
+    pub observer: [f64; 3],
+    /// As [`Answer::port_net_j`].
+    pub port_net_j: f64,
+    /// Energy the control dissipated this sample, J.
+    pub dissipated_j: f64,
 }
 
 /// One entry per thing the master did with a sample.

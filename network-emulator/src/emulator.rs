@@ -117,6 +117,8 @@ pub struct Emulator {
 fn values(s: &Signal) -> [Value; 3] {
     [0, 1, 2].map(|i| Value {
         v: s.value[i],
+        energy: s.energy[i],
+        sent_seq: s.sent_seq[i],
         origin_seq: s.origin_seq[i],
         origin_ns: s.origin_ns[i],
         delay_samples: s.delay_samples[i],
@@ -126,6 +128,8 @@ fn values(s: &Signal) -> [Value; 3] {
 fn apply(s: &mut Signal, e: &tactile_common::channel::Emitted) {
     for i in 0..3 {
         s.value[i] = e.values[i].v;
+        s.energy[i] = e.values[i].energy;
+        s.sent_seq[i] = e.values[i].sent_seq;
         s.origin_seq[i] = e.values[i].origin_seq;
         s.origin_ns[i] = e.values[i].origin_ns;
         s.delay_samples[i] = e.values[i].delay_samples;

@@ -4,9 +4,11 @@
 //! The process edge (`process.rs`) only moves samples and stamps times, and the
 //! in-process simulation calls the same function, so both compute identical values.
 //!
-//! One step: CPD (pass-through) -> IK-HSD -> JPD (pass-through) -> FCS (PID) -> SD joint
-//! dynamics over t_s, with the contact force of the environment acting on the joints
-//! -> FK-HSD -> ENV nearest surface point -> FBF-HSD.
+//! One step: the channel's control (the received position itself, or TDPA's or the
+//! wave's reference) -> CPD (pass-through) -> IK-HSD -> JPD (pass-through) -> FCS (PID)
+//! -> SD joint dynamics over t_s, with the contact force of the environment acting on
+//! the joints -> FK-HSD -> ENV nearest surface point -> FBF-HSD -> the control's value
+//! to send back (the force, or the backward wave).
 //! The HSD kernels (IK, FK, FBF) run in the scenario's arithmetic; the physical world
 //! (the device's true tool position and the contact force on it) is f64.
 
@@ -15,6 +17,7 @@ use crate::environment::deepest_contact;
 use crate::record::{HoldStep, Step};
 use serde::{Deserialize, Serialize};
 use tactile_common::arith::StdTrig;
+use tactile_common::control::SlaveSide;
 use tactile_common::engine::Engine;
 use tactile_common::geometry::Lengths;
 use tactile_common::kernels::{self, IkStatus};
@@ -54,6 +57,8 @@ pub struct Slave {
     reference: [f64; 3],
     counters: SlaveCounters,
     hold_from: Option<[f64; 3]>,
+    control: SlaveSide,
+    last_force: [f64; 3],
 }
 
 impl Slave {
@@ -65,9 +70,13 @@ impl Slave {
                 field: "cordic".into(),
                 problem: e.to_string(),
             })?;
+        let truth = geometry.lengths();
+        let start = kernels::fk(&truth, &StdTrig, [0.0; 3]);
         Ok(Slave {
             engine,
-            truth: geometry.lengths(),
+            truth,
+            control: SlaveSide::new(&scenario.control, scenario.t_s(), start),
+            last_force: [0.0; 3],
             controller: Controller::new(scenario.slave.controller.clone()),
             dynamics: Dynamics::new(scenario.slave.dynamics.clone(), [0.0; 3]),
             objects: scenario.environment.objects.clone(),
@@ -143,9 +152,16 @@ impl Slave {
         self.counters.steps += 1;
         self.hold_from = None;
         let mut flags = 0;
-        // CPD-HSD: pass-through. A non-finite value never reaches IK or a torque.
-        let target = v.signal.value;
-        if target.iter().all(|x| x.is_finite()) {
+        // The channel's control, then CPD-HSD: pass-through. A non-finite value never
+        // reaches the control, IK or a torque.
+        let mut observer = [0.0; 3];
+        let mut dissipated_j = 0.0;
+        if v.signal.value.iter().all(|x| x.is_finite()) {
+            let r = self
+                .control
+                .receive(v.signal.value, v.signal.energy, self.last_force);
+            (observer, dissipated_j) = (r.observer, r.dissipated);
+            let target = r.position;
             // IK-HSD, then JPD-HSD: pass-through.
             let ik = self.engine.ik(target);
             match ik.status {
@@ -196,13 +212,16 @@ impl Slave {
         };
 
         // h(n): the force takes the provenance of the oldest position value it used.
+        self.last_force = force;
         let oldest = (0..3).min_by_key(|&i| v.signal.origin_seq[i]).unwrap_or(0);
         let mut out = Backward {
             seq: v.seq,
             stamps: v.stamps,
             ..Backward::default()
         };
-        out.signal.value = force;
+        out.signal.value = self.control.transmit(force);
+        out.signal.energy = self.control.energy();
+        out.signal.sent_seq = [v.seq; 3];
         out.signal.origin_seq = [v.signal.origin_seq[oldest]; 3];
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
         out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
@@ -210,12 +229,16 @@ impl Slave {
         let step = Step {
             n: v.seq,
             received: v.signal,
+            reference: self.control.position(),
             theta_ref: self.reference,
             theta,
             torque: cmd.torque,
             tool,
             surface,
             force,
+            observer,
+            port_net_j: self.control.ledger().net(),
+            dissipated_j,
             clamps: cmd.clamped,
             contact_object,
             flags,

@@ -13,6 +13,9 @@ pub struct Step {
     pub n: u64,
     /// v(n) as received (values, provenance, injected delay, flags).
     pub received: Signal,
+    /// The control's Cartesian reference (the received position itself without
+    /// control), m.
+    pub reference: [f64; 3],
     /// IK-HSD reference angles, rad.
     pub theta_ref: [f64; 3],
     /// Joint angles after the step, rad.
@@ -25,6 +28,13 @@ pub struct Step {
     pub surface: [f64; 3],
     /// h(n) before the backward channel, N.
     pub force: [f64; 3],
+    /// The slave's passivity observer per axis after this step, J.
+    pub observer: [f64; 3],
+    /// Energy the slave's port has put into the channel minus what it took out, all
+    /// axes, J (its share of the channel's energy).
+    pub port_net_j: f64,
+    /// Energy the control dissipated this step, J.
+    pub dissipated_j: f64,
     /// Torque clamps this step.
     pub clamps: u32,
     /// Object index in contact, or u32::MAX.
@@ -48,7 +58,9 @@ pub struct HoldStep {
     pub tool: [f64; 3],
 }
 
-/// One entry per step the slave took.
+/// One entry per step the slave took. A sample lives for one write or one read, and
+/// steps outnumber holds: boxing the step would allocate on every sample for nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum SlaveSample {
     /// A step on v(n).

@@ -14,7 +14,7 @@ use tactile_common::samples::{Backward, Forward};
 /// First bytes of every frame.
 pub const MAGIC: [u8; 4] = *b"TCTL";
 /// The format version; bump it whenever a sample's layout changes.
-pub const VERSION: u16 = 2;
+pub const VERSION: u16 = 3;
 /// Header length, bytes.
 pub const HEADER: usize = 7;
 /// Largest frame a receiver accepts (a sample is about 250 bytes).
