@@ -207,6 +207,31 @@ mod tests {
     }
 
     #[test]
+    fn a_press_moves_with_minimum_jerk_then_holds() {
+        let s = OperatorSource::load(
+            &Operator::Press {
+                from: [0.0, -0.11, -0.035],
+                to: [0.0, -0.11, -0.075],
+                move_s: 1.0,
+            },
+            Path::new("."),
+        )
+        .expect("press");
+        let z = |n: u64| match s.target(n, 1e-3) {
+            Target::Position(p) => p[2],
+            Target::Joints(_) => f64::NAN,
+        };
+        assert_eq!(z(0), -0.035);
+        assert!((z(500) + 0.055).abs() < 1e-12, "halfway at half time");
+        assert_eq!(z(1000), -0.075);
+        assert_eq!(z(5000), -0.075);
+        // Zero velocity at both ends, fastest in the middle (15/8 of the mean).
+        let v = |n: u64| (z(n + 1) - z(n)) / 1e-3;
+        assert!(v(0).abs() < 1e-6 && v(999).abs() < 1e-6);
+        assert!((v(500).abs() - 1.875 * 0.04).abs() < 1e-4, "{}", v(500));
+    }
+
+    #[test]
     fn circle_and_csv() {
         let op = Operator::Circle {
             center: [0.0, -0.05, -0.1],
