@@ -9,6 +9,7 @@ mod util;
 mod bad_input;
 mod bench;
 mod bilateral;
+mod channels;
 mod cli;
 mod faults;
 mod hosts;

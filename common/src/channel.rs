@@ -3,15 +3,21 @@
 //! The emulator process feeds each arriving sample into a [`Channel`] and sends what
 //! comes out; the in-process simulation does the same, so both produce identical
 //! values. Each of the three signals has its own delay (whole samples, constant or
-//! scheduled) and its own zero-mean Gaussian noise. Every output value carries the
+//! scheduled, plus the packet's jitter when configured) and its own zero-mean Gaussian
+//! noise. Each packet sent at n arrives at n + d(n); at each sample the receiver gets
+//! the newest packet that has arrived (a packet overtaken by a newer one is of no use
+//! to it), or, when none has arrived since the last, the same value again, flagged.
+//! With a constant delay this is exactly c(n - d). Every output value carries the
 //! origin (sequence and timestamp) of the input value it came from and the delay that
 //! was injected, so the master can tell injected delay from system overhead; the noise
 //! actually added is returned too.
 
+use crate::netem::Jitter;
 use crate::scenario::ChannelConfig;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
+use std::collections::BTreeMap;
 
 /// One signal value with its provenance.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -37,6 +43,8 @@ pub struct Emitted {
     pub values: [Value; 3],
     /// The noise added to each value.
     pub noise: [f64; 3],
+    /// The jitter drawn for the input packet, samples (before rounding).
+    pub jitter: f64,
     /// True if a value had to stand in for one not yet (or no longer) in the history:
     /// the first `d` samples of a delayed channel, or after a gap.
     pub substituted: bool,
@@ -48,6 +56,36 @@ struct Slot {
     values: [Value; 3],
 }
 
+/// One signal's packets in flight: arrival sample -> newest sequence arriving then.
+#[derive(Debug, Clone, Default)]
+struct InFlight {
+    arriving: BTreeMap<u64, u64>,
+    newest: Option<u64>,
+    last_arrival: u64,
+    last_emitted: Option<u64>,
+}
+
+impl InFlight {
+    /// Packet `seq` arrives at `at`.
+    fn send(&mut self, seq: u64, at: u64) {
+        let e = self.arriving.entry(at).or_insert(seq);
+        *e = (*e).max(seq);
+        self.last_arrival = self.last_arrival.max(at);
+    }
+
+    /// The newest packet arrived by sample `now`.
+    fn receive(&mut self, now: u64) -> Option<u64> {
+        while let Some((&at, &seq)) = self.arriving.first_key_value() {
+            if at > now {
+                break;
+            }
+            self.arriving.remove(&at);
+            self.newest = Some(self.newest.map_or(seq, |n| n.max(seq)));
+        }
+        self.newest
+    }
+}
+
 /// One direction of the emulated network.
 #[derive(Debug)]
 pub struct Channel {
@@ -56,6 +94,9 @@ pub struct Channel {
     noise: [Option<Normal<f64>>; 3],
     rng: ChaCha8Rng,
     ring: Vec<Option<Slot>>,
+    jitter: Option<(Jitter, ChaCha8Rng)>,
+    reorder: bool,
+    flight: [InFlight; 3],
 }
 
 /// Seeds of the two channels differ so their noise is independent.
@@ -79,23 +120,34 @@ impl Channel {
                 )
             })
             .collect();
+        let jitter_bound = cfg.jitter.as_ref().map_or(0, |j| j.bound().ceil() as usize);
         let max_delay = schedule
             .iter()
             .flat_map(|(_, d)| d.iter().copied())
             .chain(delay.iter().copied())
             .max()
-            .unwrap_or(0) as usize;
+            .unwrap_or(0) as usize
+            + jitter_bound;
         let noise = cfg
             .noise_std
             .map(|s| (s > 0.0).then(|| Normal::new(0.0, s).ok()).flatten());
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(stream);
+        // The jitter's own random stream, so enabling it leaves the noise unchanged.
+        let jitter = cfg.jitter.as_ref().map(|j| {
+            let mut r = ChaCha8Rng::seed_from_u64(seed);
+            r.set_stream(stream + 200);
+            (Jitter::new(j), r)
+        });
         Channel {
             delay,
             schedule,
             noise,
             rng,
             ring: vec![None; max_delay + 1],
+            jitter,
+            reorder: cfg.reorder,
+            flight: Default::default(),
         }
     }
 
@@ -114,19 +166,41 @@ impl Channel {
         let len = self.ring.len() as u64;
         self.ring[(seq % len) as usize] = Some(Slot { seq, values });
         let delay = self.delay_at(seq);
+        let jitter = self.jitter.as_mut().map_or(0.0, |(j, rng)| j.next(rng));
         let mut out = [Value::default(); 3];
         let mut noise = [0.0; 3];
         let mut substituted = false;
         for i in 0..3 {
-            let want = seq.checked_sub(u64::from(delay[i]));
-            let found = want.and_then(|w| self.ring[(w % len) as usize].filter(|s| s.seq == w));
-            let src = match found {
-                Some(s) => s.values[i],
+            let d = (f64::from(delay[i]) + jitter).round().max(0.0) as u64;
+            let f = &mut self.flight[i];
+            let at = if self.reorder {
+                seq + d
+            } else {
+                (seq + d).max(f.last_arrival)
+            };
+            f.send(seq, at);
+            let newest = f.receive(seq);
+            let fresh = newest.is_some() && newest != f.last_emitted;
+            f.last_emitted = newest;
+            let found = newest.and_then(|w| self.ring[(w % len) as usize].filter(|s| s.seq == w));
+            let slot = match found {
+                Some(s) => {
+                    // Held when no newer packet came: flagged so the receiver knows.
+                    substituted |= !fresh;
+                    s
+                }
                 None => {
                     substituted = true;
-                    // Nothing sent that long ago yet: hold the oldest value we have.
-                    self.oldest_value(i)
+                    // Nothing has arrived yet: hold the oldest value we have.
+                    self.oldest()
                 }
+            };
+            // The delay injected is the value's age here: the packet's delay, and any
+            // time it was held.
+            let age = u32::try_from(seq - slot.seq.min(seq)).unwrap_or(u32::MAX);
+            let src = Value {
+                delay_samples: slot.values[i].delay_samples.saturating_add(age),
+                ..slot.values[i]
             };
             let r = match &self.noise[i] {
                 Some(dist) => dist.sample(&mut self.rng),
@@ -135,24 +209,27 @@ impl Channel {
             noise[i] = r;
             out[i] = Value {
                 v: src.v + r,
-                delay_samples: src.delay_samples.saturating_add(delay[i]),
                 ..src
             };
         }
         Emitted {
             values: out,
             noise,
+            jitter,
             substituted,
         }
     }
 
-    fn oldest_value(&self, i: usize) -> Value {
+    fn oldest(&self) -> Slot {
         self.ring
             .iter()
             .flatten()
             .min_by_key(|s| s.seq)
-            .map(|s| s.values[i])
-            .unwrap_or_default()
+            .copied()
+            .unwrap_or(Slot {
+                seq: 0,
+                values: [Value::default(); 3],
+            })
     }
 }
 
@@ -183,13 +260,58 @@ mod tests {
             assert_eq!(e.values[0].origin_seq, n);
             assert_eq!(e.values[1].origin_seq, n.saturating_sub(2));
             assert_eq!(e.values[2].origin_seq, n.saturating_sub(5));
-            assert_eq!(e.values[2].delay_samples, 5);
+            // The injected delay is the value's age: n while the line fills.
+            assert_eq!(e.values[2].delay_samples, 5.min(n as u32));
             // The energy and the sender's sample number travel with their value.
             assert_eq!(e.values[1].sent_seq, n.saturating_sub(2));
             assert_eq!(e.values[1].energy, n.saturating_sub(2) as f64 * 0.5);
             assert_eq!(e.substituted, n < 5);
             assert_eq!(e.noise, [0.0; 3]);
         }
+    }
+
+    /// Jitter: each packet's delay varies, the receiver never goes back in time, and
+    /// a packet that arrives after a newer one is not used.
+    #[test]
+    fn jitter_delays_packets_and_the_receiver_keeps_the_newest() {
+        let run = |reorder: bool| {
+            let cfg = ChannelConfig {
+                delay: [20, 20, 20],
+                jitter: Some(crate::netem::JitterConfig {
+                    jitter: 3.0,
+                    correlation: 0.0,
+                    distribution: crate::netem::JitterDistribution::Normal,
+                }),
+                reorder,
+                ..Default::default()
+            };
+            let mut ch = Channel::new(&cfg, 9, FORWARD_STREAM);
+            let (mut last, mut held, mut delays) = (0u64, 0u32, Vec::new());
+            for n in 0..20_000u64 {
+                let e = ch.push(n, vals(n));
+                let src = e.values[0].origin_seq;
+                assert!(src >= last, "{n}: went back from {last} to {src}");
+                assert_eq!(e.values[0].delay_samples as u64, n - src.min(n));
+                if n > 100 {
+                    if e.substituted {
+                        held += 1;
+                    } else {
+                        delays.push(f64::from(e.values[0].delay_samples));
+                    }
+                }
+                last = src;
+            }
+            let mean = delays.iter().sum::<f64>() / delays.len() as f64;
+            (mean, held)
+        };
+        let (free, held_free) = run(true);
+        let (fifo, _) = run(false);
+        // The values used are the newest arrived, so fresher than the average packet
+        // (20 samples: late ones are overtaken and never used); in sending order every
+        // packet waits for the one before it, so older than the average.
+        assert!(free < 19.5 && free > 15.0, "{free}");
+        assert!(fifo > 20.5, "{fifo}");
+        assert!(held_free > 100, "jitter leaves gaps: {held_free}");
     }
 
     #[test]

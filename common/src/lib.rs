@@ -14,6 +14,7 @@ pub mod csv;
 pub mod engine;
 pub mod geometry;
 pub mod kernels;
+pub mod netem;
 pub mod overrides;
 pub mod samples;
 pub mod scenario;

@@ -255,7 +255,7 @@ pub struct Network {
 }
 
 /// One channel: v_i(n) = c_i(n - d_i(n)) + r_i(n).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ChannelConfig {
     /// Constant delay per signal (x, y, z), in whole samples.
@@ -275,6 +275,36 @@ pub struct ChannelConfig {
     /// NaN, 0 to 1 (seeded), to prove the receivers reject them.
     #[serde(default)]
     pub corrupt: f64,
+    /// Jitter on each packet's delay, netem's `delay D JITTER CORRELATION
+    /// distribution NAME` with D the `delay` above (all in samples).
+    #[serde(default)]
+    pub jitter: Option<crate::netem::JitterConfig>,
+    /// Whether a packet may overtake an earlier one when jitter shortens its delay
+    /// (netem's behaviour) [true]; false keeps arrivals in sending order.
+    #[serde(default = "default_reorder")]
+    pub reorder: bool,
+    /// A loss model instead of `loss` (netem's random loss): `gemodel` or `state`.
+    #[serde(default)]
+    pub loss_model: Option<crate::netem::LossModel>,
+}
+
+fn default_reorder() -> bool {
+    true
+}
+
+impl Default for ChannelConfig {
+    fn default() -> Self {
+        ChannelConfig {
+            delay: [0; 3],
+            schedule: Vec::new(),
+            noise_std: [0.0; 3],
+            loss: 0.0,
+            corrupt: 0.0,
+            jitter: None,
+            reorder: default_reorder(),
+            loss_model: None,
+        }
+    }
 }
 
 /// Largest delay accepted, in samples: ten seconds at the highest rate.
@@ -326,6 +356,18 @@ impl ChannelConfig {
                 return Err(invalid(
                     format!("{field}.noise_std[{i}]"),
                     format!("{s} must be a finite, non-negative standard deviation"),
+                ));
+            }
+        }
+        if let Some(j) = &self.jitter {
+            j.validate(field)?;
+        }
+        if let Some(m) = &self.loss_model {
+            m.validate(field)?;
+            if self.loss > 0.0 {
+                return Err(invalid(
+                    format!("{field}.loss_model"),
+                    "and `loss` both set: choose one loss model",
                 ));
             }
         }

@@ -10,6 +10,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use tactile_common::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
+use tactile_common::netem::Loss;
 use tactile_common::samples::{Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED};
 use tactile_common::scenario::{ChannelConfig, Scenario};
 
@@ -39,6 +40,7 @@ pub struct EmulatorCounters {
 #[derive(Debug)]
 struct Faults {
     loss: f64,
+    model: Option<Loss>,
     corrupt: f64,
     rng: ChaCha8Rng,
 }
@@ -77,6 +79,8 @@ pub struct Passage {
     pub out: Signal,
     /// Noise added to each value.
     pub noise: [f64; 3],
+    /// Jitter drawn for this packet, samples (zero without a jitter model).
+    pub jitter: f64,
     /// Delivered, corrupted or dropped.
     pub fate: Fate,
 }
@@ -87,6 +91,7 @@ impl Faults {
         rng.set_stream(stream + 100);
         Faults {
             loss: cfg.loss,
+            model: cfg.loss_model.as_ref().map(Loss::new),
             corrupt: cfg.corrupt,
             rng,
         }
@@ -96,6 +101,11 @@ impl Faults {
         // Draw only for enabled faults, so a run without them draws nothing.
         if self.loss > 0.0 && self.rng.random::<f64>() < self.loss {
             return Fate::Drop;
+        }
+        if let Some(m) = &mut self.model {
+            if m.lose(&mut self.rng) {
+                return Fate::Drop;
+            }
         }
         if self.corrupt > 0.0 && self.rng.random::<f64>() < self.corrupt {
             return Fate::Corrupt;
@@ -160,7 +170,7 @@ impl Emulator {
     /// c(n) in, v(n) out (`None` when the loss model drops it), and the record of it.
     pub fn forward(&mut self, c: &Forward) -> (Option<Forward>, Passage) {
         let mut v = *c;
-        let (fate, noise) = pass(
+        let (fate, noise, jitter) = pass(
             &mut self.forward,
             &mut self.forward_faults,
             c.seq,
@@ -177,6 +187,7 @@ impl Emulator {
             input: c.signal.value,
             out: v.signal,
             noise,
+            jitter,
             fate,
         };
         ((fate != Fate::Drop).then_some(v), record)
@@ -185,7 +196,7 @@ impl Emulator {
     /// h(n) in, q(n) out (`None` when the loss model drops it), and the record of it.
     pub fn backward(&mut self, h: &Backward) -> (Option<Backward>, Passage) {
         let mut q = *h;
-        let (fate, noise) = pass(
+        let (fate, noise, jitter) = pass(
             &mut self.backward,
             &mut self.backward_faults,
             h.seq,
@@ -202,6 +213,7 @@ impl Emulator {
             input: h.signal.value,
             out: q.signal,
             noise,
+            jitter,
             fate,
         };
         ((fate != Fate::Drop).then_some(q), record)
@@ -210,13 +222,13 @@ impl Emulator {
 
 /// One sample through one channel: delay and noise into `signal`, then the fault
 /// model's decision (a corrupted signal is already NaN when this returns). Returns the
-/// decision and the noise added.
+/// decision, the noise added and the jitter drawn.
 fn pass(
     channel: &mut Channel,
     faults: &mut Faults,
     seq: u64,
     signal: &mut Signal,
-) -> (Fate, [f64; 3]) {
+) -> (Fate, [f64; 3], f64) {
     let e = channel.push(seq, values(signal));
     apply(signal, &e);
     let fate = faults.fate();
@@ -224,5 +236,5 @@ fn pass(
         signal.value = [f64::NAN; 3];
         signal.flags |= FLAG_CORRUPTED;
     }
-    (fate, e.noise)
+    (fate, e.noise, e.jitter)
 }

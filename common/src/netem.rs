@@ -1,0 +1,638 @@
+//! netem-class channel models with netem's meanings and names (Linux `tc-netem(8)`):
+//! delay jitter drawn from a distribution, with correlation; packet loss as a
+//! Gilbert-Elliott model (netem's `gemodel p r 1-h 1-k`) or netem's 4-state Markov
+//! model (`state p13 p31 p32 p23 p14`, Salsano et al., "Definition of a general and
+//! intuitive loss model for packet networks", 2012). Everything is seeded and pure.
+//!
+//! Where netem's own implementation is known to be wrong we keep its meaning and not
+//! its flaw: netem correlates successive uniform draws by mixing (next = c last +
+//! (1-c) fresh), which shrinks the spread and does not give correlation c. Here the
+//! jitter is driven by a Gaussian AR(1) process z_n = c z_{n-1} + sqrt(1-c^2) e_n,
+//! whose marginal stays standard normal and whose lag-1 correlation is exactly c, and
+//! is mapped to each distribution through its inverse CDF (a Gaussian copula), so the
+//! spread is the configured one whatever the correlation.
+
+use crate::scenario::{invalid, ScenarioError};
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+/// netem's jitter distributions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum JitterDistribution {
+    /// Uniform on delay +- jitter (netem's default when no distribution is named).
+    #[default]
+    Uniform,
+    /// Normal, standard deviation `jitter`.
+    Normal,
+    /// Pareto (shape 3, the heavy right tail of queueing), shifted to mean zero and
+    /// scaled to standard deviation `jitter`.
+    Pareto,
+    /// netem's paretonormal: a quarter normal and three quarters Pareto, mean zero,
+    /// standard deviation `jitter` (here the two parts move together, so the
+    /// correlation carries through).
+    Paretonormal,
+}
+
+/// `jitter = { jitter = J, correlation = C, distribution = "normal" }`: the delay of
+/// each packet is `delay + X`, X drawn as netem draws it, in samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JitterConfig {
+    /// Spread, samples: half-width for uniform, standard deviation otherwise.
+    pub jitter: f64,
+    /// Correlation of successive packets' jitter, 0 to 1 (lag-1, of the driving
+    /// Gaussian process) [0].
+    #[serde(default)]
+    pub correlation: f64,
+    /// `uniform`, `normal`, `pareto` or `paretonormal` [uniform].
+    #[serde(default)]
+    pub distribution: JitterDistribution,
+}
+
+/// Loss models beyond netem's `random` (which is the channel's `loss`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum LossModel {
+    /// Gilbert-Elliott, netem's `gemodel p r 1-h 1-k`: a good and a bad state; p the
+    /// probability of going bad, r of recovering; a packet is lost with probability
+    /// `1 - k` in the good state [0] and `1 - h` in the bad state [1]. With the
+    /// defaults it is the simple Gilbert model: loss rate p/(p+r), mean burst 1/r.
+    Gemodel {
+        /// Good to bad.
+        p: f64,
+        /// Bad to good.
+        r: f64,
+        /// Loss probability in the bad state, netem's `1-h` [1].
+        #[serde(default = "one")]
+        bad_loss: f64,
+        /// Loss probability in the good state, netem's `1-k` [0].
+        #[serde(default)]
+        good_loss: f64,
+    },
+    /// netem's 4-state model: 1 good reception, 2 good reception within a burst, 3
+    /// burst loss, 4 isolated loss. Lost in states 3 and 4.
+    State {
+        /// 1 to 3.
+        p13: f64,
+        /// 3 to 1.
+        p31: f64,
+        /// 3 to 2 [0].
+        #[serde(default)]
+        p32: f64,
+        /// 2 to 3 [0].
+        #[serde(default)]
+        p23: f64,
+        /// 1 to 4 [0].
+        #[serde(default)]
+        p14: f64,
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn probability(v: f64, field: &str) -> Result<(), ScenarioError> {
+    if !v.is_finite() || !(0.0..=1.0).contains(&v) {
+        return Err(invalid(
+            field,
+            format!("{v} is not a probability in [0, 1]"),
+        ));
+    }
+    Ok(())
+}
+
+/// Jitter beyond this many spreads is cut off (a Pareto tail is unbounded; the delay
+/// line must not be). For Pareto and paretonormal the cut is part of the shape, whose
+/// scale then gives the configured spread exactly.
+pub const JITTER_CAP: f64 = 10.0;
+
+impl JitterConfig {
+    /// Checks the ranges; errors name `FIELD.jitter.*`.
+    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        if !self.jitter.is_finite() || self.jitter < 0.0 || self.jitter > 10_000.0 {
+            return Err(invalid(
+                format!("{field}.jitter.jitter"),
+                format!("{} samples is outside 0..=10000", self.jitter),
+            ));
+        }
+        let c = self.correlation;
+        if !c.is_finite() || !(0.0..1.0).contains(&c) {
+            return Err(invalid(
+                format!("{field}.jitter.correlation"),
+                format!("{c} is outside [0, 1)"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The largest jitter it can add, samples (the cut shapes, rescaled, stay within
+    /// twice the cap).
+    pub fn bound(&self) -> f64 {
+        2.0 * JITTER_CAP * self.jitter
+    }
+}
+
+impl LossModel {
+    /// Checks the probabilities; errors name `FIELD.loss_model.*`.
+    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        let f = |k: &str| format!("{field}.loss_model.{k}");
+        match self {
+            LossModel::Gemodel {
+                p,
+                r,
+                bad_loss,
+                good_loss,
+            } => {
+                for (k, v) in [
+                    ("p", p),
+                    ("r", r),
+                    ("bad_loss", bad_loss),
+                    ("good_loss", good_loss),
+                ] {
+                    probability(*v, &f(k))?;
+                }
+            }
+            LossModel::State {
+                p13,
+                p31,
+                p32,
+                p23,
+                p14,
+            } => {
+                for (k, v) in [
+                    ("p13", p13),
+                    ("p31", p31),
+                    ("p32", p32),
+                    ("p23", p23),
+                    ("p14", p14),
+                ] {
+                    probability(*v, &f(k))?;
+                }
+                if p13 + p14 > 1.0 {
+                    return Err(invalid(
+                        f("p14"),
+                        format!("p13 + p14 = {} exceeds 1", p13 + p14),
+                    ));
+                }
+                if p31 + p32 > 1.0 {
+                    return Err(invalid(
+                        f("p32"),
+                        format!("p31 + p32 = {} exceeds 1", p31 + p32),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The long-run loss rate (the stationary probability of the losing states).
+    pub fn loss_rate(&self) -> f64 {
+        match *self {
+            LossModel::Gemodel {
+                p,
+                r,
+                bad_loss,
+                good_loss,
+            } => {
+                if p + r == 0.0 {
+                    return good_loss;
+                }
+                let bad = p / (p + r);
+                (1.0 - bad) * good_loss + bad * bad_loss
+            }
+            LossModel::State {
+                p13,
+                p31,
+                p32,
+                p23,
+                p14,
+            } => {
+                // Balance: pi4 = p14 pi1; pi3 (p31 + p32) = p13 pi1 + p23 pi2;
+                // pi2 p23 = p32 pi3. With p23 > 0: pi3 p31 = p13 pi1.
+                let s = StateChain::stationary(p13, p31, p32, p23, p14);
+                s[2] + s[3]
+            }
+        }
+    }
+}
+
+/// The stationary distribution of the 4-state chain.
+struct StateChain;
+
+impl StateChain {
+    fn stationary(p13: f64, p31: f64, p32: f64, p23: f64, p14: f64) -> [f64; 4] {
+        // Relative to pi1 = 1: pi4 = p14; pi3 = p13 / p31 (flows between {1,4} and
+        // {2,3} balance, since only 1 -> 3 and 3 -> 1 cross); pi2 = p32 pi3 / p23.
+        if p31 == 0.0 {
+            return if p13 > 0.0 {
+                [0.0, 0.0, 1.0, 0.0]
+            } else {
+                [1.0 / (1.0 + p14), 0.0, 0.0, p14 / (1.0 + p14)]
+            };
+        }
+        let pi3 = p13 / p31;
+        let pi2 = if p23 > 0.0 {
+            p32 * pi3 / p23
+        } else if p32 > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        };
+        if !pi2.is_finite() {
+            return [0.0, 1.0, 0.0, 0.0];
+        }
+        let total = 1.0 + p14 + pi3 + pi2;
+        [1.0 / total, pi2 / total, pi3 / total, p14 / total]
+    }
+}
+
+/// The correlated jitter process of one channel.
+#[derive(Debug, Clone)]
+pub struct Jitter {
+    cfg: JitterConfig,
+    z: Option<f64>,
+    offset: f64,
+    scale: f64,
+}
+
+/// Standard normal CDF (Abramowitz and Stegun 7.1.26 via erfc, error below 1.5e-7).
+fn phi(z: f64) -> f64 {
+    let x = z.abs() / std::f64::consts::SQRT_2;
+    let t = 1.0 / (1.0 + 0.327_591_1 * x);
+    let poly = t
+        * (0.254_829_592
+            + t * (-0.284_496_736
+                + t * (1.421_413_741 + t * (-1.453_152_027 + t * 1.061_405_429))));
+    let erfc = poly * (-x * x).exp();
+    if z >= 0.0 {
+        1.0 - 0.5 * erfc
+    } else {
+        0.5 * erfc
+    }
+}
+
+/// Pareto shape: 3, the smallest integer shape with a finite variance.
+const PARETO_SHAPE: f64 = 3.0;
+
+/// A shape-3 Pareto value at quantile u, standardized (mean 0, variance 1).
+fn pareto(u: f64) -> f64 {
+    let a = PARETO_SHAPE;
+    let mean = a / (a - 1.0);
+    let sd = (a / ((a - 1.0) * (a - 1.0) * (a - 2.0))).sqrt();
+    let x = (1.0 - u.clamp(0.0, 1.0 - 1e-16)).powf(-1.0 / a);
+    (x - mean) / sd
+}
+
+/// The shape of a distribution at the driving Gaussian's value z, before scaling:
+/// Pareto and paretonormal cut at [`JITTER_CAP`] standard units, so the delay line is
+/// bounded (the cut is inside the shape, and the scale below restores the spread).
+fn shape(d: JitterDistribution, z: f64) -> f64 {
+    match d {
+        JitterDistribution::Uniform => 2.0 * phi(z) - 1.0,
+        JitterDistribution::Normal => z,
+        JitterDistribution::Pareto => pareto(phi(z)).min(JITTER_CAP),
+        JitterDistribution::Paretonormal => {
+            (0.25 * z + 0.75 * pareto(phi(z))).clamp(-JITTER_CAP, JITTER_CAP)
+        }
+    }
+}
+
+/// Mean, standard deviation and kurtosis of [`shape`] over a standard normal z, by
+/// quadrature (midpoint rule over +-9 sigma).
+fn shape_moments(d: JitterDistribution) -> (f64, f64, f64) {
+    let (n, lo, hi) = (20_000, -9.0, 9.0);
+    let h = (hi - lo) / f64::from(n);
+    let mut m = [0.0; 5];
+    for k in 0..n {
+        let z = lo + (f64::from(k) + 0.5) * h;
+        let w = (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt() * h;
+        let v = shape(d, z);
+        for (p, acc) in m.iter_mut().enumerate() {
+            *acc += w * v.powi(p as i32);
+        }
+    }
+    let mean = m[1] / m[0];
+    let var = m[2] / m[0] - mean * mean;
+    let c4 = m[4] / m[0] - 4.0 * mean * m[3] / m[0] + 6.0 * mean * mean * m[2] / m[0]
+        - 3.0 * mean.powi(4);
+    (mean, var.sqrt(), c4 / (var * var))
+}
+
+impl Jitter {
+    /// The process for `cfg` (validated).
+    pub fn new(cfg: &JitterConfig) -> Self {
+        // Uniform spans +-jitter as netem's does; the others have mean zero and
+        // standard deviation `jitter`, their cut tails included.
+        let (offset, scale) = match cfg.distribution {
+            JitterDistribution::Uniform | JitterDistribution::Normal => (0.0, 1.0),
+            d => {
+                let (mean, sd, _) = shape_moments(d);
+                (mean, 1.0 / sd)
+            }
+        };
+        Jitter {
+            cfg: cfg.clone(),
+            z: None,
+            offset,
+            scale,
+        }
+    }
+
+    /// The next packet's jitter, samples (continuous; the channel rounds the delay).
+    pub fn next(&mut self, rng: &mut impl Rng) -> f64 {
+        let e: f64 = StandardNormal.sample(rng);
+        let c = self.cfg.correlation;
+        let z = match self.z {
+            None => e,
+            Some(last) => c * last + (1.0 - c * c).sqrt() * e,
+        };
+        self.z = Some(z);
+        let x = self.cfg.jitter * self.scale * (shape(self.cfg.distribution, z) - self.offset);
+        x.clamp(-self.cfg.bound(), self.cfg.bound())
+    }
+}
+
+/// The state of a loss model.
+#[derive(Debug, Clone)]
+pub struct Loss {
+    model: LossModel,
+    state: u8,
+}
+
+impl Loss {
+    /// A model in its good state.
+    pub fn new(model: &LossModel) -> Self {
+        Loss {
+            model: model.clone(),
+            state: 1,
+        }
+    }
+
+    /// Whether the next packet is lost; moves the chain one packet on.
+    pub fn lose(&mut self, rng: &mut impl Rng) -> bool {
+        match self.model {
+            LossModel::Gemodel {
+                p,
+                r,
+                bad_loss,
+                good_loss,
+            } => {
+                // netem: the state moves first, then the packet's fate in that state.
+                let u: f64 = rng.random();
+                self.state = match self.state {
+                    1 if u < p => 3,
+                    3 if u < r => 1,
+                    s => s,
+                };
+                let loss = if self.state == 3 { bad_loss } else { good_loss };
+                loss > 0.0 && rng.random::<f64>() < loss
+            }
+            LossModel::State {
+                p13,
+                p31,
+                p32,
+                p23,
+                p14,
+            } => {
+                let u: f64 = rng.random();
+                self.state = match self.state {
+                    1 if u < p13 => 3,
+                    1 if u < p13 + p14 => 4,
+                    2 if u < p23 => 3,
+                    3 if u < p31 => 1,
+                    3 if u < p31 + p32 => 2,
+                    4 => 1,
+                    s => s,
+                };
+                self.state == 3 || self.state == 4
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    const N: usize = 100_000;
+
+    fn stats(x: &[f64]) -> (f64, f64, f64) {
+        let n = x.len() as f64;
+        let mean = x.iter().sum::<f64>() / n;
+        let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+        let lag = x
+            .windows(2)
+            .map(|w| (w[0] - mean) * (w[1] - mean))
+            .sum::<f64>()
+            / (n - 1.0);
+        (mean, var.sqrt(), lag / var)
+    }
+
+    /// Each value's rank in the series, 0 to N - 1.
+    fn ranks(x: &[f64]) -> Vec<f64> {
+        let mut order: Vec<usize> = (0..x.len()).collect();
+        order.sort_by(|&a, &b| x[a].total_cmp(&x[b]));
+        let mut r = vec![0.0; x.len()];
+        for (rank, &k) in order.iter().enumerate() {
+            r[k] = rank as f64;
+        }
+        r
+    }
+
+    fn draw(cfg: JitterConfig, seed: u64) -> Vec<f64> {
+        let mut j = Jitter::new(&cfg);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..N).map(|_| j.next(&mut rng)).collect()
+    }
+
+    /// Tolerances from the sample count: for an AR(1) series of lag-1 correlation c the
+    /// effective count is N (1 - c) / (1 + c), so the mean's standard error is
+    /// sd sqrt((1 + c) / (N (1 - c))); the sample standard deviation's relative error
+    /// about sqrt((1 + c^2) / (2 N (1 - c^2))) for Gaussian data (heavier tails need
+    /// more: Pareto shape 3 has no fourth moment, so its spread is checked to 5 %);
+    /// the lag-1 correlation's about sqrt((1 - c^2) / N). Five standard errors each.
+    /// The spread's error depends on the tail (kurtosis): see `spread_tolerance`.
+    #[test]
+    fn jitter_matches_its_distribution_spread_and_correlation() {
+        // The sample variance's relative standard error is sqrt((kurtosis - 1) / N_eff)
+        // (half that for the standard deviation), N_eff = N (1 - c^2) / (1 + c^2).
+        let spread_tolerance = |d: JitterDistribution, c: f64| {
+            let kurtosis = match d {
+                JitterDistribution::Uniform => 1.8,
+                JitterDistribution::Normal => 3.0,
+                d => shape_moments(d).2,
+            };
+            let n_eff = N as f64 * (1.0 - c * c) / (1.0 + c * c);
+            5.0 * 0.5 * ((kurtosis - 1.0) / n_eff).sqrt()
+        };
+        for distribution in [
+            JitterDistribution::Uniform,
+            JitterDistribution::Normal,
+            JitterDistribution::Pareto,
+            JitterDistribution::Paretonormal,
+        ] {
+            for c in [0.0, 0.5, 0.9] {
+                let x = draw(
+                    JitterConfig {
+                        jitter: 4.0,
+                        correlation: c,
+                        distribution,
+                    },
+                    7,
+                );
+                let (mean, sd, rho) = stats(&x);
+                // netem's uniform takes `jitter` as the half-width: sd = J / sqrt(3).
+                let want_sd = if distribution == JitterDistribution::Uniform {
+                    4.0 / 3f64.sqrt()
+                } else {
+                    4.0
+                };
+                let se_mean = want_sd * ((1.0 + c) / (N as f64 * (1.0 - c))).sqrt();
+                assert!(
+                    mean.abs() < 5.0 * se_mean,
+                    "{distribution:?} c {c}: mean {mean}"
+                );
+                let rel = (sd - want_sd).abs() / want_sd;
+                assert!(
+                    rel < spread_tolerance(distribution, c),
+                    "{distribution:?} c {c}: sd {sd}"
+                );
+                // Through the copula the rank (Spearman) correlation of successive
+                // values is (6/pi) asin(c/2) whatever the distribution; the Pearson
+                // correlation is c itself for normal. Bartlett: the lag-1 estimate's
+                // standard error is about sqrt((1 - c^2) / N); at least 1/sqrt(N) here.
+                let se_rho = ((1.0 - c * c) / N as f64)
+                    .sqrt()
+                    .max(1.0 / (N as f64).sqrt());
+                let want_rank = 6.0 / std::f64::consts::PI * (c / 2.0).asin();
+                let rank = stats(&ranks(&x)).2;
+                assert!(
+                    (rank - want_rank).abs() < 5.0 * se_rho,
+                    "{distribution:?} c {c}: rank correlation {rank} vs {want_rank}"
+                );
+                if distribution == JitterDistribution::Normal {
+                    assert!((rho - c).abs() < 5.0 * se_rho, "c {c}: rho {rho}");
+                }
+            }
+        }
+        // Pareto's tail: skewed right, so the median sits below the mean.
+        let mut x = draw(
+            JitterConfig {
+                jitter: 1.0,
+                correlation: 0.0,
+                distribution: JitterDistribution::Pareto,
+            },
+            3,
+        );
+        x.sort_by(f64::total_cmp);
+        assert!(x[N / 2] < -0.2, "median {}", x[N / 2]);
+    }
+
+    /// Loss runs: the loss rate against the stationary probability, and the mean burst
+    /// length against 1/r (simple Gilbert: every packet in the bad state is lost).
+    /// A Markov chain's loss indicator has lag correlation lambda = 1 - p - r, so the
+    /// rate's standard error is sqrt(pi (1 - pi) (1 + lambda) / (N (1 - lambda))); a
+    /// burst length is geometric with mean 1/r and variance (1 - r)/r^2, averaged over
+    /// about N pi r bursts. Five standard errors each.
+    #[test]
+    fn gilbert_elliott_loss_rate_and_burst_length_match_the_closed_form() {
+        for (p, r) in [(0.01, 0.3), (0.002, 0.05), (0.05, 0.5)] {
+            let model = LossModel::Gemodel {
+                p,
+                r,
+                bad_loss: 1.0,
+                good_loss: 0.0,
+            };
+            let mut loss = Loss::new(&model);
+            let mut rng = ChaCha8Rng::seed_from_u64(11);
+            let lost: Vec<bool> = (0..N).map(|_| loss.lose(&mut rng)).collect();
+            let rate = lost.iter().filter(|l| **l).count() as f64 / N as f64;
+            let pi = model.loss_rate();
+            assert!((pi - p / (p + r)).abs() < 1e-15);
+            let lambda = 1.0 - p - r;
+            let se = (pi * (1.0 - pi) * (1.0 + lambda) / (N as f64 * (1.0 - lambda))).sqrt();
+            assert!(
+                (rate - pi).abs() < 5.0 * se,
+                "p {p} r {r}: rate {rate} vs {pi}"
+            );
+            let mut bursts = Vec::new();
+            let mut run = 0u32;
+            for l in &lost {
+                if *l {
+                    run += 1;
+                } else if run > 0 {
+                    bursts.push(f64::from(run));
+                    run = 0;
+                }
+            }
+            let mean = bursts.iter().sum::<f64>() / bursts.len() as f64;
+            let se_b = ((1.0 - r) / (r * r) / bursts.len() as f64).sqrt();
+            assert!(
+                (mean - 1.0 / r).abs() < 5.0 * se_b,
+                "p {p} r {r}: burst {mean} vs {}",
+                1.0 / r
+            );
+        }
+    }
+
+    #[test]
+    fn gilbert_elliott_with_partial_loss_and_the_four_state_model_match_their_rates() {
+        let cases = [
+            LossModel::Gemodel {
+                p: 0.02,
+                r: 0.2,
+                bad_loss: 0.6,
+                good_loss: 0.01,
+            },
+            LossModel::State {
+                p13: 0.01,
+                p31: 0.4,
+                p32: 0.1,
+                p23: 0.3,
+                p14: 0.005,
+            },
+        ];
+        for model in cases {
+            let mut loss = Loss::new(&model);
+            let mut rng = ChaCha8Rng::seed_from_u64(5);
+            let rate = (0..N).filter(|_| loss.lose(&mut rng)).count() as f64 / N as f64;
+            let pi = model.loss_rate();
+            // Bursty: allow for correlation with a generous effective count of N / 20.
+            let se = (pi * (1.0 - pi) / (N as f64 / 20.0)).sqrt();
+            assert!((rate - pi).abs() < 5.0 * se, "{model:?}: {rate} vs {pi}");
+        }
+        // The 4-state chain's stationary distribution solves its balance equations.
+        let s = StateChain::stationary(0.01, 0.4, 0.1, 0.3, 0.005);
+        assert!((s.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        assert!((s[0] * 0.01 - s[2] * 0.4).abs() < 1e-12);
+        assert!((s[1] * 0.3 - s[2] * 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn seeded_and_repeatable() {
+        let cfg = JitterConfig {
+            jitter: 3.0,
+            correlation: 0.3,
+            distribution: JitterDistribution::Paretonormal,
+        };
+        assert_eq!(draw(cfg.clone(), 1), draw(cfg.clone(), 1));
+        assert_ne!(draw(cfg.clone(), 1), draw(cfg, 2));
+    }
+
+    #[test]
+    fn phi_is_the_normal_cdf() {
+        for (z, want) in [
+            (0.0, 0.5),
+            (1.0, 0.841_344_746),
+            (-1.96, 0.024_997_895),
+            (3.0, 0.998_650_102),
+        ] {
+            assert!((phi(z) - want).abs() < 2e-7, "{z}: {}", phi(z));
+        }
+    }
+}

@@ -1,0 +1,114 @@
+//! netem-class channels in a closed loop: jitter with correlation, Gilbert-Elliott
+//! loss, reordering off; seeded, so a run repeats; checked like any scenario field.
+//! (Each model's statistics against its closed form are unit tests in
+//! common/src/netem.rs, over 100,000 draws.)
+
+use crate::util;
+
+use util::Sandbox;
+
+fn wall_delay() -> String {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/wall-delay.toml");
+    std::fs::read_to_string(path).expect("deploy/scenarios/wall-delay.toml")
+}
+
+/// 20 ms of normal jitter (correlated 0.5) on both channels around 25 ms each, 5 %
+/// Gilbert-Elliott loss (p = 0.01, r = 0.19: mean burst 5.3 samples) on the backward
+/// one, TDPA on: the run repeats byte for byte, loses what the model says, and stays
+/// passive.
+#[test]
+fn a_jittery_lossy_network_repeats_and_tdpa_stays_passive() {
+    let sb = Sandbox::new("netem");
+    let text = wall_delay().replace("kind = \"none\"", "kind = \"tdpa\"")
+        + "\n[network.forward.jitter]\njitter = 20.0\ncorrelation = 0.5\ndistribution = \"normal\"\n"
+        + "\n[network.backward.jitter]\njitter = 20.0\ncorrelation = 0.5\ndistribution = \"normal\"\n"
+        + "\n[network.backward.loss_model]\nkind = \"gemodel\"\np = 0.01\nr = 0.19\n";
+    let s = sb.write("s.toml", &text);
+    let s = s.to_str().expect("utf-8");
+    for out in ["a", "b"] {
+        let o = sb.tactile(&["run", s, "--in-process", "--out", out, "-q"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    assert_eq!(sb.trace("a"), sb.trace("b"), "same seed, same run");
+    let sum = sb.json("a", "summary.json");
+    // 8000 samples at a loss rate of 5 %: 400 expected; bursts of mean 5.3 make the
+    // count's standard deviation about sqrt(400 (1 - 0.05) (1 + 0.8) / 0.2) = 58.
+    let dropped = sum["emulator"]["counters"]["backward_dropped"]
+        .as_u64()
+        .expect("dropped");
+    assert!((110..=690).contains(&dropped), "{dropped} dropped");
+    assert_eq!(sum["emulator"]["counters"]["forward_dropped"], 0);
+    let w = sum["passivity"]["observer_min_j"]
+        .as_f64()
+        .expect("observer");
+    assert!(w >= -1e-3, "observer {w} J");
+    // The delays vary: the trace's injected forward delay takes many values.
+    let delays = util::column(&sb.trace("a"), "delay_f_3");
+    let mut seen: Vec<u64> = delays.iter().map(|d| *d as u64).collect();
+    seen.sort_unstable();
+    seen.dedup();
+    assert!(seen.len() > 20, "{seen:?}");
+    // Another seed, another network.
+    let o = sb.tactile(&[
+        "run",
+        s,
+        "--in-process",
+        "--out",
+        "c",
+        "-q",
+        "--set",
+        "seed=9",
+    ]);
+    assert!(o.status.success());
+    assert_ne!(sb.trace("a"), sb.trace("c"));
+}
+
+#[test]
+fn bad_channel_models_name_the_field() {
+    let sb = Sandbox::new("netembad");
+    let s = sb.write("s.toml", &wall_delay());
+    let s = s.to_str().expect("utf-8");
+    for (set, needle) in [
+        (
+            "network.forward.jitter={ jitter = 5.0, correlation = 1.0 }",
+            "network.forward.jitter.correlation",
+        ),
+        (
+            "network.forward.jitter={ jitter = 5.0, distribution = \"cauchy\" }",
+            "unknown variant `cauchy`",
+        ),
+        (
+            "network.backward.loss_model={ kind = \"gemodel\", p = 1.5, r = 0.1 }",
+            "network.backward.loss_model.p",
+        ),
+        (
+            "network.backward.loss_model={ kind = \"state\", p13 = 0.7, p31 = 0.1, p14 = 0.5 }",
+            "p13 + p14",
+        ),
+    ] {
+        let o = sb.tactile(&["run", s, "--in-process", "--out", "bad", "--set", set]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
+        assert!(
+            err.contains(needle) && err.lines().count() == 1,
+            "{set}: {err}"
+        );
+        assert!(!sb.path("bad").exists(), "{set}");
+    }
+    // Both loss models at once is a choice to make, not to guess.
+    let both = wall_delay().replace(
+        "[network.backward]\ndelay = [25, 25, 25]\n",
+        "[network.backward]\ndelay = [25, 25, 25]\nloss = 0.1\n",
+    ) + "\n[network.backward.loss_model]\nkind = \"gemodel\"\np = 0.01\nr = 0.2\n";
+    let b = sb.write("both.toml", &both);
+    let o = sb.tactile(&[
+        "run",
+        b.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        "bad",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("choose one loss model"), "{err}");
+}
