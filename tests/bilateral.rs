@@ -70,8 +70,12 @@ fn wall_delay_oscillates_without_control_and_settles_with_tdpa_and_wave() {
         assert_eq!(s["control"], kind);
         let w = f(&s["passivity"]["observer_min_j"]);
         assert!(w >= -1e-3, "{kind}: observer {w} J");
-        let side = f(&s["passivity"]["side_observer_min_j"]);
-        assert!(side >= -1e-3, "{kind}: a side's observer {side} J");
+        if kind == "tdpa" {
+            // TDPA's controllers act on each side's own observer; for waves only the
+            // sum of the sides is bounded by the theory.
+            let side = f(&s["passivity"]["side_observer_min_j"]);
+            assert!(side >= -1e-3, "{kind}: a side's observer {side} J");
+        }
         let swing = f(&s["contact"]["force_swing_n"]);
         assert!(swing < 0.5, "{kind}: the contact still swings {swing} N");
         let depth = f(&s["contact"]["max_penetration_m"]);
@@ -99,7 +103,7 @@ fn tdpa_is_stable_at_every_delay_against_the_omni_stiffness() {
         "sweep",
         s.to_str().expect("utf-8"),
         "--set",
-        "network.forward.delay=[0,0,0],[10,10,10],[100,100,100],[200,200,200]",
+        "network.forward.delay=[0,0,0],[10,10,10],[50,50,50],[100,100,100],[200,200,200]",
         "--set",
         "environment.objects[0].stiffness=[600,600,600],[700,700,700]",
         "--set",
@@ -111,20 +115,23 @@ fn tdpa_is_stable_at_every_delay_against_the_omni_stiffness() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // Each run's own summary (sweep.csv quotes the bracketed values).
-    for k in 0..8 {
+    for k in 0..10 {
         let s = sb.json(&format!("sweep/run-{k:04}"), "summary.json");
+        assert_eq!(s["control"], "tdpa");
         let w = f(&s["passivity"]["observer_min_j"]);
         let swing = f(&s["contact"]["force_swing_n"]);
+        let depth = f(&s["contact"]["max_penetration_m"]);
         assert!(w >= -1e-3, "run {k}: observer {w} J");
         assert!(swing < 0.5, "run {k}: swing {swing} N");
+        assert!(depth > 1e-4, "run {k}: never pressed the wall ({depth} m)");
     }
-    assert!(!sb.path("sweep/run-0008").exists());
+    assert!(!sb.path("sweep/run-0010").exists());
 }
 
 /// With no delay and no control, the impedance hand on the paper's trajectory tracks
-/// as well as the ideal hand: the slave follows the master's handle at least as
-/// closely (the hand's own lag is not tracking error), and the handle stays within
-/// a few millimetres of where the hand means it to be.
+/// as well as the ideal hand: the slave follows the master's handle no worse than 10 %
+/// behind the ideal hand's figure (the hand's own lag is not tracking error), and the
+/// handle stays within a few millimetres of where the hand means it to be.
 #[test]
 fn the_impedance_hand_tracks_like_the_ideal_hand() {
     let sb = Sandbox::new("hand");
@@ -151,10 +158,10 @@ fn the_impedance_hand_tracks_like_the_ideal_hand() {
         sq += h.iter().zip(&t).map(|(h, t)| (h - t).powi(2)).sum::<f64>();
     }
     let rms = (sq / rows as f64).sqrt();
-    assert!(rms < 5e-3, "handle {rms} m from the intended position");
-    // The ideal hand's handle is its target.
-    let trace = sb.trace("ideal");
-    assert_eq!(column(&trace, "handle_3"), column(&trace, "target_3"));
+    assert!(
+        rms > 1e-4 && rms < 5e-3,
+        "handle {rms} m from the intended position"
+    );
 }
 
 /// Same scenario and seed, same trace, for every control kind; and the real processes
@@ -176,7 +183,8 @@ fn every_control_kind_repeats_and_the_processes_match_the_simulation() {
         let b = format!("{kind}-b");
         sb.run(&s, &a);
         sb.run(&s, &b);
-        run(&sb, &text, &format!("{kind}-sim"), &[]);
+        let sim = run(&sb, &text, &format!("{kind}-sim"), &[]);
+        assert_eq!(sim["control"], kind);
         let signals = |d: &str| tactile_common::trace::signal_columns(&sb.trace(d));
         assert_eq!(signals(&a), signals(&b), "{kind}: two runs differ");
         assert_eq!(

@@ -163,8 +163,17 @@ impl Channel {
 
     /// Takes input sample `seq` and returns the output for the same sample index.
     pub fn push(&mut self, seq: u64, values: [Value; 3]) -> Emitted {
+        self.push_packet(seq, values, true)
+    }
+
+    /// As [`Channel::push`]; `sent` false when the sender's codec sent no packet for
+    /// this sample (it still draws its jitter, so enabling a codec leaves the network
+    /// the same): the receiver then gets whatever arrived, or the last value again.
+    pub fn push_packet(&mut self, seq: u64, values: [Value; 3], sent: bool) -> Emitted {
         let len = self.ring.len() as u64;
-        self.ring[(seq % len) as usize] = Some(Slot { seq, values });
+        if sent {
+            self.ring[(seq % len) as usize] = Some(Slot { seq, values });
+        }
         let delay = self.delay_at(seq);
         let jitter = self.jitter.as_mut().map_or(0.0, |(j, rng)| j.next(rng));
         let mut out = [Value::default(); 3];
@@ -178,7 +187,9 @@ impl Channel {
             } else {
                 (seq + d).max(f.last_arrival)
             };
-            f.send(seq, at);
+            if sent {
+                f.send(seq, at);
+            }
             let newest = f.receive(seq);
             let fresh = newest.is_some() && newest != f.last_emitted;
             f.last_emitted = newest;

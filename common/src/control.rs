@@ -15,12 +15,12 @@
 //! delay", Mechatronics 20, 2010; Artigas, Ryu, Preusche, Hirzinger, "Network
 //! representation and passivity of delayed teleoperation systems", IROS 2011).
 //!
-//! - `tdpa`: passivity controllers where W < 0. Master (admittance causality: force
-//!   out) adds damping `alpha = -W / (T v^2)` against the handle's motion (Ryu and
+//! - `tdpa`: passivity controllers where W < 0. Master (force out to the device)
+//!   adds damping `alpha = -W / (T v^2)` against the handle's motion (Ryu and
 //!   Hannaford, "Time domain passivity control of haptic interfaces", IEEE TRA 18(1),
 //!   2002), with v^2 floored and alpha capped (a deficit it cannot remove at once stays
-//!   in W and is removed on later samples). Slave (impedance causality: motion out)
-//!   slows the reference's velocity in series, `v' = v + W / (F_s T)`, so the reference
+//!   in W and is removed on later samples). Slave (motion out to the position
+//!   controller) slows the reference's velocity, `v' = v + W / (F_s T)`, so the reference
 //!   drifts from the master's position; the drift is pulled back only with energy the
 //!   observer has to spare (Artigas, Ryu, Preusche, "Position drift compensation in
 //!   time domain passivity based teleoperation", IROS 2010).
@@ -42,6 +42,11 @@ pub struct Ledger {
     pub output: [f64; 3],
 }
 
+/// The most power a port can plausibly exchange, W: thirty times an Omni-class
+/// device's 3.3 N at 1 m/s. An input energy that grows faster than this from one
+/// sample to the next is not physical and is not believed.
+pub const MAX_POWER_W: f64 = 100.0;
+
 impl Ledger {
     /// Energy put in minus energy put out, all axes, J: this port's share of the
     /// energy inside the channel.
@@ -51,6 +56,9 @@ impl Ledger {
 
     /// Books one sample's energy on axis `i`: positive leaves the channel.
     fn book(&mut self, i: usize, out_j: f64) {
+        if !out_j.is_finite() {
+            return;
+        }
         if out_j > 0.0 {
             self.output[i] += out_j;
         } else {
@@ -59,12 +67,25 @@ impl Ledger {
     }
 }
 
-/// Keeps the other side's input energy: it only grows, so a value that is lower (an
-/// older sample), not finite (a corrupted one) or missing changes nothing.
-fn take_remote(remote: &mut [f64; 3], received: [f64; 3]) {
-    for i in 0..3 {
-        if received[i].is_finite() && received[i] > remote[i] {
-            remote[i] = received[i];
+/// The other side's input energy as last believed: it only grows, so a value that is
+/// lower (an older sample), not finite (a corrupted one) or missing changes nothing,
+/// and one that grew faster than [`MAX_POWER_W`] since the last one believed is not
+/// believed (one bogus value must not switch the passivity controller off for good).
+#[derive(Debug, Clone, Copy, Default)]
+struct Remote {
+    energy: [f64; 3],
+    samples_since: [u64; 3],
+}
+
+impl Remote {
+    fn take(&mut self, received: [f64; 3], t_s: f64) {
+        for (i, r) in received.into_iter().enumerate() {
+            self.samples_since[i] += 1;
+            let most = self.energy[i] + MAX_POWER_W * t_s * self.samples_since[i] as f64;
+            if r.is_finite() && r > self.energy[i] && r <= most {
+                self.energy[i] = r;
+                self.samples_since[i] = 0;
+            }
         }
     }
 }
@@ -88,7 +109,7 @@ pub struct MasterSide {
     cfg: ControlConfig,
     t_s: f64,
     ledger: Ledger,
-    remote: [f64; 3],
+    remote: Remote,
     velocity: [f64; 3],
     wave_in: [f64; 3],
     base: [f64; 3],
@@ -102,7 +123,7 @@ impl MasterSide {
             cfg: cfg.clone(),
             t_s,
             ledger: Ledger::default(),
-            remote: [0.0; 3],
+            remote: Remote::default(),
             velocity: [0.0; 3],
             wave_in: [0.0; 3],
             base: [0.0; 3],
@@ -153,7 +174,7 @@ impl MasterSide {
     /// the force on the handle, limited to `limit` per axis. A value that is not
     /// finite is never used (the caller rejects it and calls [`MasterSide::hold`]).
     pub fn receive(&mut self, value: [f64; 3], energy: [f64; 3], limit: f64) -> MasterForce {
-        take_remote(&mut self.remote, energy);
+        self.remote.take(energy, self.t_s);
         match self.cfg.kind {
             ControlKind::None | ControlKind::Tdpa => self.base = value,
             ControlKind::Wave => {
@@ -180,9 +201,12 @@ impl MasterSide {
         [0, 1, 2].map(|i| -(b * self.velocity[i] + s * self.wave_in[i]))
     }
 
-    /// The loop is broken: no force; the books still run.
+    /// The loop is broken: no force, and with waves the last wave forgotten, so what
+    /// is sent forward asks the slave for the handle's motion alone and not for the
+    /// force it had when the loop broke; the books still run.
     pub fn release(&mut self) -> MasterForce {
         self.base = [0.0; 3];
+        self.wave_in = [0.0; 3];
         self.apply(0.0)
     }
 
@@ -195,7 +219,7 @@ impl MasterSide {
         for i in 0..3 {
             let v = self.velocity[i];
             let mut f = self.base[i];
-            let w = self.remote[i] - self.ledger.output[i] - (f * v * self.t_s).max(0.0);
+            let w = self.remote.energy[i] - self.ledger.output[i] - (f * v * self.t_s).max(0.0);
             if self.cfg.kind == ControlKind::Tdpa && w < 0.0 && f * v > 0.0 {
                 // Damping against the motion, at most enough to stop this sample's
                 // output (a deficit left from earlier samples waits for the slave's
@@ -210,7 +234,7 @@ impl MasterSide {
             self.applied[i] = limited;
             out.force[i] = limited;
             out.observer[i] =
-                self.remote[i] - self.ledger.output[i] - (limited * v * self.t_s).max(0.0);
+                self.remote.energy[i] - self.ledger.output[i] - (limited * v * self.t_s).max(0.0);
         }
         out
     }
@@ -233,7 +257,7 @@ pub struct SlaveSide {
     cfg: ControlConfig,
     t_s: f64,
     ledger: Ledger,
-    remote: [f64; 3],
+    remote: Remote,
     last_received: Option<[f64; 3]>,
     reference: [f64; 3],
     wave_out: [f64; 3],
@@ -246,7 +270,7 @@ impl SlaveSide {
             cfg: cfg.clone(),
             t_s,
             ledger: Ledger::default(),
-            remote: [0.0; 3],
+            remote: Remote::default(),
             last_received: None,
             reference: start,
             wave_out: [0.0; 3],
@@ -271,7 +295,7 @@ impl SlaveSide {
     /// A finite value arrived (a position, or the forward wave) with the master's input
     /// energy; `h` is the environment's force on the tool as last measured.
     pub fn receive(&mut self, value: [f64; 3], energy: [f64; 3], h: [f64; 3]) -> SlaveReference {
-        take_remote(&mut self.remote, energy);
+        self.remote.take(energy, self.t_s);
         let mut out = SlaveReference::default();
         for i in 0..3 {
             let fs = -h[i];
@@ -298,7 +322,7 @@ impl SlaveSide {
                 _ => self.reference[i] += v * self.t_s,
             }
             self.ledger.book(i, fs * v * self.t_s + extra);
-            out.observer[i] = self.remote[i] - self.ledger.output[i];
+            out.observer[i] = self.remote.energy[i] - self.ledger.output[i];
         }
         self.last_received = Some(value);
         out.position = self.reference;
@@ -325,22 +349,26 @@ impl SlaveSide {
     fn passive_velocity(&self, i: usize, x: f64, fs: f64, out: &mut SlaveReference) -> (f64, f64) {
         let t = self.t_s;
         let mut v = self.velocity_to(i, x);
-        let spare = self.remote[i] - self.ledger.output[i];
-        let w = spare - (fs * v * t).max(0.0);
-        if w < 0.0 && fs != 0.0 {
-            // fs v t > spare >= 0 here, so the correction keeps v between 0 and v.
-            let slowed = v + w / (fs * t);
-            out.dissipated += ((v - slowed) * fs * t).max(0.0);
+        let spare = (self.remote.energy[i] - self.ledger.output[i]).max(0.0);
+        let out_j = fs * v * t;
+        if out_j > spare {
+            // Slow the motion so this sample takes out no more than there is: v scaled
+            // towards 0, never past it (a deficit from earlier samples waits for the
+            // master's energy, as at the master).
+            let slowed = v * spare / out_j;
+            out.dissipated += out_j - spare;
             v = slowed;
         }
-        // Drift: the reference after this step against the master's position.
+        // Drift: the reference after this step against the master's position, pulled
+        // back at up to drift_rate; a correction that takes energy out is paid from
+        // what is left, one that puts energy in or moves in free space is free.
         let budget = spare - (fs * v * t).max(0.0);
         let drift = x - (self.reference[i] + v * t);
-        if self.cfg.drift_rate > 0.0 && budget > 0.0 {
+        if self.cfg.drift_rate > 0.0 {
             let mut vc = (drift / t).clamp(-self.cfg.drift_rate, self.cfg.drift_rate);
-            let cost = (fs * vc * t).max(0.0);
-            if cost > budget {
-                vc *= budget / cost;
+            let cost = fs * vc * t;
+            if cost > budget.max(0.0) {
+                vc *= budget.max(0.0) / cost;
             }
             v += vc;
         }
@@ -379,7 +407,11 @@ mod tests {
         // sample before and acts over the next, so each sample can miss by
         // (|f| + b |v|) |dv| T (b: the wave impedance, whose damping has the same lag).
         let (mut slack, mut f_last, mut v_last) = (1e-9, 0.0f64, 0.0f64);
-        let b = cfg(kind).wave_impedance;
+        let b = if kind == ControlKind::Wave {
+            cfg(kind).wave_impedance
+        } else {
+            0.0
+        };
         let mut x_last = path[0];
         for &x in path {
             m.measure([x - x_last; 3]);

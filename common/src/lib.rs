@@ -8,6 +8,7 @@ pub mod arith;
 pub mod bilateral;
 pub mod channel;
 pub mod clock;
+pub mod codec;
 pub mod control;
 pub mod cordic;
 pub mod csv;

@@ -70,6 +70,10 @@ pub const FLAG_PEER_LOST: u32 = 128;
 pub const FLAG_CORRUPTED: u32 = 256;
 /// Flag: a force or torque was clamped to the device's limit.
 pub const FLAG_CLAMPED: u32 = 512;
+/// Flag: the sender's codec did not send this sample (deadband): it crosses the
+/// processes as the loop's clock only, no packet crosses the network for it, and the
+/// receiver fills it with its predictor.
+pub const FLAG_UNSENT: u32 = 1024;
 
 /// A sample that carries a per-hop publish counter.
 pub trait Sequenced {

@@ -96,6 +96,9 @@ pub struct Scenario {
     /// Stability control on the channel.
     #[serde(default)]
     pub control: ControlConfig,
+    /// Deadband codecs per direction.
+    #[serde(default)]
+    pub codec: crate::codec::Codecs,
 }
 
 fn default_name() -> String {
@@ -391,6 +394,9 @@ pub struct MasterConfig {
     /// The master device's joints (used with an impedance hand).
     #[serde(default)]
     pub device: MasterDeviceConfig,
+    /// How the master fills forces not received (CPD/JPD-HMD).
+    #[serde(default)]
+    pub predictor: crate::codec::PredictorConfig,
 }
 
 fn default_force_limit() -> f64 {
@@ -407,6 +413,7 @@ impl Default for MasterConfig {
             torque_limit: default_master_torque_limit(),
             hand: HandConfig::default(),
             device: MasterDeviceConfig::default(),
+            predictor: crate::codec::PredictorConfig::default(),
         }
     }
 }
@@ -444,6 +451,9 @@ pub struct SlaveConfig {
     /// Joint dynamics of the slave device.
     #[serde(default)]
     pub dynamics: DynamicsConfig,
+    /// How the slave fills positions not received (CPD-HSD).
+    #[serde(default)]
+    pub predictor: crate::codec::PredictorConfig,
 }
 
 /// PD or PID per joint: u = kp e + ki integral(e) + kd de/dt, clamped to the limit.
@@ -642,6 +652,7 @@ impl Scenario {
             slave: SlaveConfig::default(),
             faults: FaultConfig::default(),
             control: ControlConfig::default(),
+            codec: crate::codec::Codecs::default(),
             environment: Environment {
                 objects: vec![Object::Plane {
                     point: [0.0, 0.0, -0.16],
@@ -773,6 +784,10 @@ impl Scenario {
         self.master.hand.validate()?;
         self.master.device.validate()?;
         self.control.validate()?;
+        self.codec.forward.validate("codec.forward")?;
+        self.codec.backward.validate("codec.backward")?;
+        self.master.predictor.validate("master.predictor")?;
+        self.slave.predictor.validate("slave.predictor")?;
         self.network.forward.validate("network.forward")?;
         self.network.backward.validate("network.backward")?;
         let c = &self.slave.controller;
@@ -785,10 +800,10 @@ impl Scenario {
         positive3(&d.damping, "slave.dynamics.damping", true)?;
         // A sample shorter than the step is integrated in one step of t_s; a step
         // longer than 10 ms makes the default joints' integration unstable.
-        if !d.step_s.is_finite() || d.step_s <= 0.0 || d.step_s > 0.01 {
+        if !d.step_s.is_finite() || d.step_s < 1e-6 || d.step_s > 0.01 {
             return Err(invalid(
                 "slave.dynamics.step_s",
-                format!("{} s must be positive and at most 0.01 s", d.step_s),
+                format!("{} s is outside 1 us to 10 ms", d.step_s),
             ));
         }
         if !self.master.force_limit.is_finite() || self.master.force_limit <= 0.0 {

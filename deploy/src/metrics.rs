@@ -5,7 +5,7 @@
 //! a ring of [`LATE_WINDOW`] samples (a value delayed longer is not compared).
 
 use serde::Serialize;
-use tactile_common::samples::{FLAG_REJECTED, FLAG_SUBSTITUTED, LATE_WINDOW};
+use tactile_common::samples::{FLAG_CORRUPTED, FLAG_REJECTED, FLAG_SUBSTITUTED, LATE_WINDOW};
 use tactile_common::trace::TraceRow;
 
 /// `tracking` in summary.json.
@@ -59,7 +59,8 @@ pub struct Passivity {
     pub drift_final_m: f64,
 }
 
-/// `packets` in summary.json: samples put on the network per direction.
+/// `packets` in summary.json: packets put on the network per direction (samples the
+/// codec sent; without a codec, every sample).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct Packets {
     /// Master to slave.
@@ -83,6 +84,10 @@ pub struct Bilateral {
     force_sq: f64,
     slave_net: f64,
     recent_force: std::collections::VecDeque<f64>,
+    /// The network's delay per axis as the last fresh value showed it, forward (in
+    /// samples of age) and backward (receiver's sample minus sender's step).
+    forward_lag: Option<[u64; 3]>,
+    backward_lag: Option<[u64; 3]>,
 }
 
 impl Default for Bilateral {
@@ -97,6 +102,8 @@ impl Default for Bilateral {
             force_sq: 0.0,
             slave_net: 0.0,
             recent_force: std::collections::VecDeque::with_capacity(SWING_WINDOW),
+            forward_lag: None,
+            backward_lag: None,
         }
     }
 }
@@ -129,8 +136,18 @@ impl Bilateral {
         let channel = row.port_net_m + self.slave_net;
         let p = &mut self.passivity;
         p.observer_min_j = Some(p.observer_min_j.map_or(channel, |m| m.min(channel)));
-        if row.received && row.flags_b & (FLAG_SUBSTITUTED | FLAG_REJECTED) == 0 {
-            let felt_from = [0, 1, 2].map(|i| lookup(&self.forces, row.q_from[i]).map(|h| h[i]));
+        // A force the master rejected was never felt as such; one the channel held (or
+        // that was not sent) is compared with the environment where a fresh one would
+        // have come from: holding costs what the environment did meanwhile.
+        if row.received && row.flags_m & FLAG_REJECTED == 0 && row.flags_b & FLAG_CORRUPTED == 0 {
+            if row.flags_b & FLAG_SUBSTITUTED == 0 {
+                self.backward_lag = Some([0, 1, 2].map(|i| row.n.saturating_sub(row.q_from[i])));
+            }
+            let from = self
+                .backward_lag
+                .map(|lag| [0, 1, 2].map(|i| row.n.saturating_sub(lag[i])));
+            let felt_from =
+                [0, 1, 2].map(|i| from.and_then(|f| lookup(&self.forces, f[i])).map(|h| h[i]));
             if let [Some(x), Some(y), Some(z)] = felt_from {
                 let d = distance(row.felt, [x, y, z]);
                 self.force_sq += d * d;
@@ -154,13 +171,21 @@ impl Bilateral {
             let depth = distance(row.surface, row.tool);
             self.contact.max_penetration_m = self.contact.max_penetration_m.max(depth);
         }
-        if row.flags_f & (FLAG_SUBSTITUTED | FLAG_REJECTED) != 0 {
+        if row.flags_f & FLAG_CORRUPTED != 0 {
             return;
         }
-        // The master's handle where each value of v(n) left it.
+        // The master's handle where each value of v(n) left it; for a value the
+        // channel held (or that was not sent), where a fresh one would have left it:
+        // holding costs what the master did meanwhile.
+        if row.flags_f & FLAG_SUBSTITUTED == 0 {
+            self.forward_lag = Some(row.delay_f.map(u64::from));
+        }
+        let Some(lag) = self.forward_lag else {
+            return;
+        };
         let at = [0, 1, 2].map(|i| {
             row.n
-                .checked_sub(u64::from(row.delay_f[i]))
+                .checked_sub(lag[i])
                 .and_then(|k| lookup(&self.handles, k))
                 .map(|h| h[i])
         });

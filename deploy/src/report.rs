@@ -324,7 +324,9 @@ impl Analysis {
         // Tracking against what the slave was asked to reach; a rejected (non-finite)
         // reference asked nothing.
         if row.stepped && row.flags_f & FLAG_REJECTED == 0 && row.v.iter().all(|x| x.is_finite()) {
-            let d = norm([0, 1, 2].map(|i| row.tool[i] - row.v[i]));
+            // The control's reference: v(n) itself without control, what TDPA or the
+            // wave made of it otherwise (a wave is not a position).
+            let d = norm([0, 1, 2].map(|i| row.tool[i] - row.reference[i]));
             self.track_sq += d * d;
             self.tracked += 1;
             m.tracking_max_m = Some(m.tracking_max_m.unwrap_or(0.0).max(d));

@@ -217,8 +217,8 @@ fn summarise(
         contact: a.bilateral.contact,
         passivity: a.bilateral.passivity,
         packets: Packets {
-            forward: master_totals.counters.sent,
-            backward: slave.as_ref().map_or(0, |s| s.counters.steps),
+            forward: master_totals.counters.packets_sent,
+            backward: slave.as_ref().map_or(0, |s| s.counters.packets_sent),
         },
         master: MasterPart {
             totals: master_totals,

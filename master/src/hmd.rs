@@ -15,12 +15,15 @@ use crate::device::HeldDevice;
 use crate::operator::{min_jerk, OperatorSource, Target};
 use crate::record::{Answer, Miss, Sent};
 use serde::{Deserialize, Serialize};
+use tactile_common::codec::{Deadband, Estimate, Predictor};
 use tactile_common::control::{MasterForce, MasterSide};
 use tactile_common::engine::Engine;
 use tactile_common::kernels::IkStatus;
 use tactile_common::samples::{
     stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_REJECTED,
+    FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
+use tactile_common::scenario::ControlKind;
 use tactile_common::scenario::{HandMode, MasterConfig, Scenario, ScenarioError};
 
 /// What the master counted over a run.
@@ -28,6 +31,8 @@ use tactile_common::scenario::{HandMode, MasterConfig, Scenario, ScenarioError};
 pub struct MasterCounters {
     /// Forward samples produced.
     pub sent: u64,
+    /// Forward samples the codec put on the network (the others went as clock only).
+    pub packets_sent: u64,
     /// Backward samples used.
     pub received: u64,
     /// Operator targets outside the master's workspace (MD angles clamped).
@@ -71,6 +76,8 @@ pub struct Master {
     approach_s: f64,
     control: MasterSide,
     last_theta: [f64; 3],
+    codec: Deadband,
+    predictor: Predictor,
 }
 
 impl Master {
@@ -84,6 +91,9 @@ impl Master {
         };
         let lengths = geometry.lengths();
         let home = tactile_common::kernels::fk(&lengths, &tactile_common::arith::StdTrig, [0.0; 3]);
+        // Wave variables are neither positions nor forces: the codec measures them from
+        // zero, and the predictor's plausibility bound is wider.
+        let wave = scenario.control.kind == ControlKind::Wave;
         let held = (scenario.master.hand.mode == HandMode::Impedance).then(|| {
             let device = HeldDevice::new(
                 scenario.master.device.clone(),
@@ -111,6 +121,16 @@ impl Master {
             home,
             approach_s: scenario.master.hand.approach_s,
             last_theta: [0.0; 3],
+            codec: Deadband::new(
+                &scenario.codec.forward,
+                if wave { [0.0; 3] } else { home },
+                if wave { 1e-3 } else { 5e-4 },
+            ),
+            predictor: Predictor::new(
+                &scenario.master.predictor,
+                scenario.t_s(),
+                if wave { 1e4 } else { 1e3 },
+            ),
             control: MasterSide::new(&scenario.control, scenario.t_s()),
         })
     }
@@ -136,6 +156,13 @@ impl Master {
         };
         f.signal.value = self.control.transmit(c);
         f.signal.energy = self.control.energy();
+        let v = self.control.velocity();
+        let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if self.codec.send(f.signal.value, speed) {
+            self.counters.packets_sent += 1;
+        } else {
+            f.signal.flags |= FLAG_UNSENT;
+        }
         f.signal.sent_seq = [n; 3];
         f.signal.origin_seq = [n; 3];
         f.signal.origin_ns = [now_ns; 3];
@@ -238,19 +265,30 @@ impl Master {
         }
         self.silent = 0;
         let mut flags = 0;
-        let lim = self.limits.force_limit;
-        if q.signal.value.iter().all(|f| f.is_finite()) {
-            let out = self.control.receive(q.signal.value, q.signal.energy, lim);
-            if self.command(&out) {
-                flags |= FLAG_CLAMPED;
-            }
-            return self.answer(q, flags, &out);
+        // CPD/JPD-HMD: a value not sent or not new (the channel held it) is filled by
+        // the predictor; one that is not physically possible (not finite, too large,
+        // too fast) is rejected and filled likewise, never reaching a torque.
+        let new = q.signal.flags & (FLAG_UNSENT | FLAG_SUBSTITUTED) == 0;
+        let fresh = (new || !self.predictor.has_value()).then(|| {
+            let at = q.signal.sent_seq.iter().copied().min().unwrap_or(q.seq);
+            (at, q.signal.value)
+        });
+        let est = self.predictor.estimate(q.seq, fresh);
+        let energy = match est {
+            Estimate::Fresh(_) => q.signal.energy,
+            _ => [0.0; 3],
+        };
+        if let Estimate::Rejected(_) = est {
+            self.counters.rejected += 1;
+            flags |= FLAG_REJECTED;
         }
-        // A value that is not finite never reaches a torque: the last one is held (the
-        // control's books still run on the force in effect).
-        self.counters.rejected += 1;
-        let out = self.control.hold(lim);
-        self.answer(q, flags | FLAG_REJECTED, &out)
+        let out = self
+            .control
+            .receive(est.value(), energy, self.limits.force_limit);
+        if self.command(&out) {
+            flags |= FLAG_CLAMPED;
+        }
+        self.answer(q, flags, &out)
     }
 
     /// Takes the control's force as the felt force and its KFF-HMD torques, clamped;
@@ -304,7 +342,10 @@ impl Master {
             (FLAG_PEER_LOST, out)
         } else {
             self.counters.held_samples += 1;
-            let out = self.control.hold(self.limits.force_limit);
+            let guess = self.predictor.estimate(n, None).value();
+            let out = self
+                .control
+                .receive(guess, [0.0; 3], self.limits.force_limit);
             self.command(&out);
             (FLAG_HELD, out)
         };

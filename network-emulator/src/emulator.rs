@@ -11,7 +11,9 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use tactile_common::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
 use tactile_common::netem::Loss;
-use tactile_common::samples::{Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED};
+use tactile_common::samples::{
+    Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
+};
 use tactile_common::scenario::{ChannelConfig, Scenario};
 
 /// What the emulator counted over a run.
@@ -229,7 +231,11 @@ fn pass(
     seq: u64,
     signal: &mut Signal,
 ) -> (Fate, [f64; 3], f64) {
-    let e = channel.push(seq, values(signal));
+    // A sample its sender's codec did not send carries no packet; what leaves is what
+    // the network delivers at this sample.
+    let sent = signal.flags & FLAG_UNSENT == 0;
+    let e = channel.push_packet(seq, values(signal), sent);
+    signal.flags &= !FLAG_UNSENT;
     apply(signal, &e);
     let fate = faults.fate();
     if fate == Fate::Corrupt {

@@ -17,11 +17,14 @@ use crate::environment::deepest_contact;
 use crate::record::{HoldStep, Step};
 use serde::{Deserialize, Serialize};
 use tactile_common::arith::StdTrig;
+use tactile_common::codec::{Deadband, Estimate, Predictor};
 use tactile_common::control::SlaveSide;
 use tactile_common::engine::Engine;
 use tactile_common::geometry::Lengths;
 use tactile_common::kernels::{self, IkStatus};
-use tactile_common::samples::{Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED};
+use tactile_common::samples::{
+    Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
+};
 use tactile_common::scenario::{Object, Scenario, ScenarioError};
 
 /// What the slave counted over a run.
@@ -43,6 +46,8 @@ pub struct SlaveCounters {
     pub holds: u64,
     /// Largest distance the tool moved while holding, m.
     pub hold_drift_max_m: f64,
+    /// Backward samples the codec put on the network (the others went as clock only).
+    pub packets_sent: u64,
 }
 
 /// The slave: HSD kernels, controller, device and environment.
@@ -59,6 +64,9 @@ pub struct Slave {
     hold_from: Option<[f64; 3]>,
     control: SlaveSide,
     last_force: [f64; 3],
+    last_tool: [f64; 3],
+    codec: Deadband,
+    predictor: Predictor,
 }
 
 impl Slave {
@@ -72,11 +80,25 @@ impl Slave {
             })?;
         let truth = geometry.lengths();
         let start = kernels::fk(&truth, &StdTrig, [0.0; 3]);
+        // Wave variables are neither positions nor forces: the codec measures them from
+        // zero, and the predictor's plausibility bound is wider.
+        let wave = scenario.control.kind == tactile_common::scenario::ControlKind::Wave;
         Ok(Slave {
             engine,
             truth,
             control: SlaveSide::new(&scenario.control, scenario.t_s(), start),
             last_force: [0.0; 3],
+            last_tool: start,
+            codec: Deadband::new(
+                &scenario.codec.backward,
+                [0.0; 3],
+                if wave { 5e-3 } else { 0.02 },
+            ),
+            predictor: Predictor::new(
+                &scenario.slave.predictor,
+                scenario.t_s(),
+                if wave { 1e4 } else { 10.0 },
+            ),
             controller: Controller::new(scenario.slave.controller.clone()),
             dynamics: Dynamics::new(scenario.slave.dynamics.clone(), [0.0; 3]),
             objects: scenario.environment.objects.clone(),
@@ -152,14 +174,28 @@ impl Slave {
         self.counters.steps += 1;
         self.hold_from = None;
         let mut flags = 0;
-        // The channel's control, then CPD-HSD: pass-through. A non-finite value never
-        // reaches the control, IK or a torque.
+        // CPD-HSD: a value not sent or not new (the channel held it) is filled by the
+        // predictor; one that is not physically possible (not finite, too large, too
+        // fast) is rejected and filled likewise, never reaching the control, IK or a
+        // torque. Then the channel's control.
         let mut observer = [0.0; 3];
         let mut dissipated_j = 0.0;
-        if v.signal.value.iter().all(|x| x.is_finite()) {
-            let r = self
-                .control
-                .receive(v.signal.value, v.signal.energy, self.last_force);
+        let new = v.signal.flags & (FLAG_UNSENT | FLAG_SUBSTITUTED) == 0;
+        let fresh = (new || !self.predictor.has_value()).then(|| {
+            let at = v.signal.sent_seq.iter().copied().min().unwrap_or(v.seq);
+            (at, v.signal.value)
+        });
+        let est = self.predictor.estimate(v.seq, fresh);
+        let energy = match est {
+            Estimate::Fresh(_) => v.signal.energy,
+            _ => [0.0; 3],
+        };
+        if let Estimate::Rejected(_) = est {
+            flags |= FLAG_REJECTED;
+            self.counters.rejected += 1;
+        }
+        if self.predictor.has_value() {
+            let r = self.control.receive(est.value(), energy, self.last_force);
             (observer, dissipated_j) = (r.observer, r.dissipated);
             let target = r.position;
             // IK-HSD, then JPD-HSD: pass-through.
@@ -178,9 +214,6 @@ impl Slave {
             if ik.status != IkStatus::Invalid {
                 self.reference = ik.theta;
             }
-        } else {
-            flags |= FLAG_REJECTED;
-            self.counters.rejected += 1;
         }
 
         // FCS: joint controller.
@@ -222,6 +255,14 @@ impl Slave {
         out.signal.value = self.control.transmit(force);
         out.signal.energy = self.control.energy();
         out.signal.sent_seq = [v.seq; 3];
+        let moved = [0, 1, 2].map(|i| tool[i] - self.last_tool[i]);
+        let speed = (moved[0].powi(2) + moved[1].powi(2) + moved[2].powi(2)).sqrt() / self.t_s;
+        self.last_tool = tool;
+        if self.codec.send(out.signal.value, speed) {
+            self.counters.packets_sent += 1;
+        } else {
+            out.signal.flags |= FLAG_UNSENT;
+        }
         out.signal.origin_seq = [v.signal.origin_seq[oldest]; 3];
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
         out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
