@@ -199,3 +199,67 @@ fn predictors_fill_the_gaps_better_than_holding_on_a_moving_target() {
         "hold, linear, kalman: {rms:?}"
     );
 }
+
+/// A recorded network replayed: the same file twice gives the same run, and the run
+/// reproduces the file's delays and losses packet for packet: every value the slave
+/// got fresh carries the delay its packet was given, no lost packet ever arrives, and
+/// the emulator counts the losses.
+#[test]
+fn a_replayed_trace_reproduces_its_delays_and_losses() {
+    let sb = Sandbox::new("replay");
+    let n = 3000usize;
+    let delay = |k: usize| 10 + (k / 100) % 5;
+    let lost = |k: usize| k % 37 == 5;
+    let mut csv = String::from("delay,lost\n");
+    for k in 0..n {
+        csv.push_str(&format!("{},{}\n", delay(k), u8::from(lost(k))));
+    }
+    sb.write("net.csv", &csv);
+    let text = util::paper_1khz(n as u64).replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        + "\n[network.forward.replay]\npath = \"net.csv\"\n";
+    let s = sb.write("s.toml", &text);
+    let s = s.to_str().expect("utf-8");
+    for out in ["a", "b"] {
+        let o = sb.tactile(&["run", s, "--in-process", "--out", out, "-q"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let trace = sb.trace("a");
+    assert_eq!(trace, sb.trace("b"), "replayed twice, run once");
+    let flags = util::column(&trace, "flags_f");
+    let delays = util::column(&trace, "delay_f_1");
+    let mut fresh = 0;
+    for (row, (f, d)) in flags.iter().zip(&delays).enumerate() {
+        if (*f as u32) & 1 != 0 {
+            continue;
+        }
+        fresh += 1;
+        let origin = row - *d as usize;
+        assert_eq!(*d as usize, delay(origin), "row {row}: packet {origin}");
+        assert!(!lost(origin), "row {row}: lost packet {origin} arrived");
+    }
+    assert!(fresh > 2500, "{fresh} fresh rows");
+    let sum = sb.json("a", "summary.json");
+    let want = (0..n).filter(|k| lost(*k)).count() as u64;
+    assert_eq!(
+        sum["emulator"]["counters"]["forward_replay_lost"].as_u64(),
+        Some(want)
+    );
+    // A broken file is bad input naming the field, the file and the line.
+    sb.write("bad.csv", "delay,lost\n3,0\n-1,0\n");
+    let bad = text.replace("net.csv", "bad.csv");
+    let b = sb.write("bad.toml", &bad);
+    let o = sb.tactile(&[
+        "run",
+        b.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        "x",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("network.forward.replay") && err.contains("bad.csv") && err.contains("line 3"),
+        "{err}"
+    );
+    assert!(!sb.path("x").exists());
+}

@@ -12,7 +12,7 @@
 //! was injected, so the master can tell injected delay from system overhead; the noise
 //! actually added is returned too.
 
-use crate::netem::Jitter;
+use crate::netem::{Jitter, Replay};
 use crate::scenario::ChannelConfig;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -45,6 +45,8 @@ pub struct Emitted {
     pub noise: [f64; 3],
     /// The jitter drawn for the input packet, samples (before rounding).
     pub jitter: f64,
+    /// True if a replayed network lost the input packet.
+    pub lost: bool,
     /// True if a value had to stand in for one not yet (or no longer) in the history:
     /// the first `d` samples of a delayed channel, or after a gap.
     pub substituted: bool,
@@ -97,6 +99,7 @@ pub struct Channel {
     jitter: Option<(Jitter, ChaCha8Rng)>,
     reorder: bool,
     flight: [InFlight; 3],
+    replay: Option<(Replay, f64)>,
 }
 
 /// Seeds of the two channels differ so their noise is independent.
@@ -148,7 +151,19 @@ impl Channel {
             jitter,
             reorder: cfg.reorder,
             flight: Default::default(),
+            replay: None,
         }
+    }
+
+    /// The same channel driven by a recorded network (`t_s`: the sampling period):
+    /// each packet's delay and loss come from it.
+    pub fn with_replay(mut self, replay: Replay, t_s: f64) -> Channel {
+        let need = replay.bound() as usize + 1;
+        if self.ring.len() < need {
+            self.ring = vec![None; need];
+        }
+        self.replay = Some((replay, t_s));
+        self
     }
 
     /// The delays in force at sample `n`.
@@ -171,6 +186,9 @@ impl Channel {
     /// the same): the receiver then gets whatever arrived, or the last value again.
     pub fn push_packet(&mut self, seq: u64, values: [Value; 3], sent: bool) -> Emitted {
         let len = self.ring.len() as u64;
+        let replayed = self.replay.as_mut().map(|(r, t_s)| r.packet(seq, *t_s));
+        let lost = replayed.is_some_and(|(_, lost)| lost);
+        let sent = sent && !lost;
         if sent {
             self.ring[(seq % len) as usize] = Some(Slot { seq, values });
         }
@@ -180,7 +198,10 @@ impl Channel {
         let mut noise = [0.0; 3];
         let mut substituted = false;
         for i in 0..3 {
-            let d = (f64::from(delay[i]) + jitter).round().max(0.0) as u64;
+            let d = match replayed {
+                Some((d, _)) => u64::from(d),
+                None => (f64::from(delay[i]) + jitter).round().max(0.0) as u64,
+            };
             let f = &mut self.flight[i];
             let at = if self.reorder {
                 seq + d
@@ -227,6 +248,7 @@ impl Channel {
             values: out,
             noise,
             jitter,
+            lost,
             substituted,
         }
     }

@@ -413,6 +413,197 @@ impl Loss {
     }
 }
 
+/// `replay = { path = "...", format = "csv" }`: a recorded network, packet by packet.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReplayConfig {
+    /// The file, relative to the scenario's folder.
+    pub path: String,
+    /// `csv`: header `delay,lost`, one row per packet (delay in samples, lost 0 or 1),
+    /// looped; `mahimahi`: Mahimahi's delivery trace, one line per millisecond at
+    /// which the link can deliver an MTU (1500 bytes), looped [csv].
+    #[serde(default)]
+    pub format: ReplayFormat,
+    /// Mahimahi: bytes per packet on the wire (a sample's frame is about 250) [250].
+    #[serde(default = "default_packet_bytes")]
+    pub packet_bytes: u32,
+    /// Mahimahi: a packet that would queue longer than this many samples is dropped,
+    /// as a drop-tail queue would [1000].
+    #[serde(default = "default_max_queue")]
+    pub max_queue_samples: u32,
+}
+
+/// Replay formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ReplayFormat {
+    /// Per-packet delays and losses.
+    #[default]
+    Csv,
+    /// Mahimahi's delivery opportunities.
+    Mahimahi,
+}
+
+fn default_packet_bytes() -> u32 {
+    250
+}
+fn default_max_queue() -> u32 {
+    1000
+}
+
+impl ReplayConfig {
+    /// Checks the fields; errors name `FIELD.replay.*`.
+    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        if self.path.is_empty() {
+            return Err(invalid(format!("{field}.replay.path"), "is empty"));
+        }
+        if self.packet_bytes == 0 || self.packet_bytes > 1500 {
+            return Err(invalid(
+                format!("{field}.replay.packet_bytes"),
+                format!("{} is outside 1..=1500 (one MTU)", self.packet_bytes),
+            ));
+        }
+        if self.max_queue_samples == 0
+            || i64::from(self.max_queue_samples) > crate::scenario::MAX_DELAY_SAMPLES
+        {
+            return Err(invalid(
+                format!("{field}.replay.max_queue_samples"),
+                format!(
+                    "{} is outside 1..={}",
+                    self.max_queue_samples,
+                    crate::scenario::MAX_DELAY_SAMPLES
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A loaded replay: each packet's delay (samples) and whether it is lost.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Replay {
+    /// Rows of a CSV file, looped.
+    Packets(Vec<(u32, bool)>),
+    /// Mahimahi delivery opportunities (ms), looped, served first come first served.
+    Mahimahi(Mahimahi),
+}
+
+/// The FIFO queue of a Mahimahi link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mahimahi {
+    times_ms: Vec<u64>,
+    period_ms: u64,
+    per_opportunity: u32,
+    max_queue: u32,
+    next: u64,
+    used: u32,
+}
+
+impl Replay {
+    /// Parses a CSV replay: header `delay,lost`; the error names the line.
+    pub fn parse_csv(text: &str) -> Result<Replay, String> {
+        let rows = crate::csv::parse(text, &["delay", "lost"]).map_err(|e| e.to_string())?;
+        let mut out = Vec::with_capacity(rows.len());
+        for (k, r) in rows.iter().enumerate() {
+            let line = k + 2;
+            let (d, l) = (r[0], r[1]);
+            if !(d >= 0.0 && d <= crate::scenario::MAX_DELAY_SAMPLES as f64 && d.fract() == 0.0) {
+                return Err(format!(
+                    "line {line}: delay {d} is not a whole number of samples in 0..=100000"
+                ));
+            }
+            if l != 0.0 && l != 1.0 {
+                return Err(format!("line {line}: lost {l} is not 0 or 1"));
+            }
+            out.push((d as u32, l == 1.0));
+        }
+        if out.is_empty() {
+            return Err("no packets after the header".into());
+        }
+        Ok(Replay::Packets(out))
+    }
+
+    /// Parses a Mahimahi trace (one non-decreasing millisecond timestamp per line).
+    pub fn parse_mahimahi(text: &str, cfg: &ReplayConfig) -> Result<Replay, String> {
+        let mut times = Vec::new();
+        for (k, line) in text.lines().enumerate() {
+            let t = line.trim();
+            if t.is_empty() {
+                continue;
+            }
+            let v: u64 = t.parse().map_err(|_| {
+                format!(
+                    "line {}: {t:?} is not a whole number of milliseconds",
+                    k + 1
+                )
+            })?;
+            if times.last().is_some_and(|&last| v < last) {
+                return Err(format!("line {}: {v} ms goes back in time", k + 1));
+            }
+            times.push(v);
+        }
+        let Some(&last) = times.last() else {
+            return Err("no delivery opportunities".into());
+        };
+        if last == 0 {
+            return Err("the trace lasts 0 ms".into());
+        }
+        Ok(Replay::Mahimahi(Mahimahi {
+            times_ms: times,
+            period_ms: last,
+            per_opportunity: (1500 / cfg.packet_bytes).max(1),
+            max_queue: cfg.max_queue_samples,
+            next: 0,
+            used: 0,
+        }))
+    }
+
+    /// The largest delay a packet can be given, samples.
+    pub fn bound(&self) -> u32 {
+        match self {
+            Replay::Packets(rows) => rows.iter().map(|r| r.0).max().unwrap_or(0),
+            Replay::Mahimahi(m) => m.max_queue,
+        }
+    }
+
+    /// Packet `n`, sent at n t_s: its delay in samples and whether it is lost. Packets
+    /// come in order.
+    pub fn packet(&mut self, n: u64, t_s: f64) -> (u32, bool) {
+        match self {
+            Replay::Packets(rows) => rows[(n % rows.len() as u64) as usize],
+            Replay::Mahimahi(m) => m.deliver(n, t_s),
+        }
+    }
+}
+
+impl Mahimahi {
+    fn time(&self, k: u64) -> u64 {
+        let len = self.times_ms.len() as u64;
+        self.times_ms[(k % len) as usize] + (k / len) * self.period_ms
+    }
+
+    /// The first opportunity at or after the packet's sending time with room left.
+    fn deliver(&mut self, n: u64, t_s: f64) -> (u32, bool) {
+        let sent_ms = n as f64 * t_s * 1e3;
+        while (self.time(self.next) as f64) < sent_ms {
+            self.next += 1;
+            self.used = 0;
+        }
+        if self.used >= self.per_opportunity {
+            self.next += 1;
+            self.used = 0;
+        }
+        let at_ms = self.time(self.next) as f64;
+        let delay = ((at_ms - sent_ms) / (t_s * 1e3)).ceil().max(0.0);
+        if delay > f64::from(self.max_queue) {
+            // The queue is full: dropped, and it takes no room.
+            return (self.max_queue, true);
+        }
+        self.used += 1;
+        (delay as u32, false)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -611,6 +802,66 @@ mod tests {
         assert!((s.iter().sum::<f64>() - 1.0).abs() < 1e-12);
         assert!((s[0] * 0.01 - s[2] * 0.4).abs() < 1e-12);
         assert!((s[1] * 0.3 - s[2] * 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_csv_replay_reads_back_row_by_row_and_loops() {
+        let mut r = Replay::parse_csv("delay,lost\n3,0\n5,1\n0,0\n").expect("csv");
+        let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3)).collect();
+        assert_eq!(
+            got,
+            vec![
+                (3, false),
+                (5, true),
+                (0, false),
+                (3, false),
+                (5, true),
+                (0, false)
+            ]
+        );
+        assert_eq!(r.bound(), 5);
+        for (text, needle) in [
+            ("delay,lost\n1.5,0\n", "line 2: delay 1.5"),
+            ("delay,lost\n1,2\n", "line 2: lost 2"),
+            ("delay,lost\n", "no packets"),
+            ("d,l\n1,0\n", "header"),
+        ] {
+            let e = Replay::parse_csv(text).expect_err(text);
+            assert!(e.contains(needle), "{text}: {e}");
+        }
+    }
+
+    /// A Mahimahi link that can deliver one MTU every 2 ms carries 6 packets of 250
+    /// bytes per opportunity: at 1 kHz (a packet per ms) it keeps up, each packet
+    /// waiting for the next opportunity; at 10 kHz it cannot, the queue grows to its
+    /// limit and the excess is dropped.
+    #[test]
+    fn a_mahimahi_link_queues_and_drops_what_it_cannot_carry() {
+        let cfg = ReplayConfig {
+            path: "x".into(),
+            format: ReplayFormat::Mahimahi,
+            packet_bytes: 250,
+            max_queue_samples: 50,
+        };
+        let mut r = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+        let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3)).collect();
+        assert_eq!(
+            got,
+            vec![
+                (2, false),
+                (1, false),
+                (0, false),
+                (1, false),
+                (0, false),
+                (1, false)
+            ]
+        );
+        let mut fast = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+        let lost = (0..10_000).filter(|&n| fast.packet(n, 1e-4).1).count();
+        // 3 packets per ms fit of the 10 sent: 70 % dropped once the queue is full.
+        assert!((6_500..=7_100).contains(&lost), "{lost}");
+        assert!(Replay::parse_mahimahi("3\n2\n", &cfg).is_err());
+        assert!(Replay::parse_mahimahi("x\n", &cfg).is_err());
     }
 
     #[test]

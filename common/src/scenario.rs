@@ -289,6 +289,10 @@ pub struct ChannelConfig {
     /// A loss model instead of `loss` (netem's random loss): `gemodel` or `state`.
     #[serde(default)]
     pub loss_model: Option<crate::netem::LossModel>,
+    /// A recorded network replayed packet by packet, instead of `delay`, `schedule`
+    /// and `jitter`.
+    #[serde(default)]
+    pub replay: Option<crate::netem::ReplayConfig>,
 }
 
 fn default_reorder() -> bool {
@@ -306,6 +310,7 @@ impl Default for ChannelConfig {
             jitter: None,
             reorder: default_reorder(),
             loss_model: None,
+            replay: None,
         }
     }
 }
@@ -364,6 +369,15 @@ impl ChannelConfig {
         }
         if let Some(j) = &self.jitter {
             j.validate(field)?;
+        }
+        if let Some(r) = &self.replay {
+            r.validate(field)?;
+            if self.jitter.is_some() || !self.schedule.is_empty() || self.delay != [0; 3] {
+                return Err(invalid(
+                    format!("{field}.replay"),
+                    "gives each packet's delay: leave delay at [0, 0, 0], and schedule and jitter out",
+                ));
+            }
         }
         if let Some(m) = &self.loss_model {
             m.validate(field)?;
@@ -675,10 +689,18 @@ impl Scenario {
     /// (the scenario file's folder), so a copy of it runs from any folder.
     pub fn resolved(&self, base_dir: &std::path::Path) -> Scenario {
         let mut s = self.clone();
-        if let Operator::Csv { path } = &mut s.operator {
+        let absolute = |path: &mut String| {
             let p = std::path::Path::new(path.as_str());
             if p.is_relative() {
                 *path = base_dir.join(p).display().to_string();
+            }
+        };
+        if let Operator::Csv { path } = &mut s.operator {
+            absolute(path);
+        }
+        for c in [&mut s.network.forward, &mut s.network.backward] {
+            if let Some(r) = &mut c.replay {
+                absolute(&mut r.path);
             }
         }
         s

@@ -67,7 +67,14 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
     })?;
     OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
+    tactile_network_emulator::replay::load(&scenario, &base_dir)
+        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
+    for c in [&scenario.network.forward, &scenario.network.backward] {
+        if let Some(r) = &c.replay {
+            inputs.push(base_dir.join(&r.path));
+        }
+    }
     if let Operator::Csv { path } = &scenario.operator {
         inputs.push(base_dir.join(path));
     }

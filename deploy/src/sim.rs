@@ -60,7 +60,9 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<(), 
         .map_err(|e| Error::BadInput(e.to_string()))?;
     let bad = |e: tactile_common::scenario::ScenarioError| Error::BadInput(e.to_string());
     let mut master = Master::new(scenario, source).map_err(bad)?;
-    let mut emulator = Emulator::new(scenario);
+    let replays =
+        tactile_network_emulator::replay::load(scenario, base_dir).map_err(Error::BadInput)?;
+    let mut emulator = Emulator::with_replays(scenario, replays);
     let mut slave = Slave::new(scenario).map_err(bad)?;
     let mut mrec: MasterRecorder = Recorder::open(out, "master", false).map_err(failed)?;
     let mut erec: EmulatorRecorder = Recorder::open(out, "emulator", false).map_err(failed)?;

@@ -10,7 +10,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use tactile_common::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
-use tactile_common::netem::Loss;
+use tactile_common::netem::{Loss, Replay};
 use tactile_common::samples::{
     Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
@@ -35,6 +35,10 @@ pub struct EmulatorCounters {
     pub forward_corrupted: u64,
     /// Backward samples corrupted to NaN on purpose.
     pub backward_corrupted: u64,
+    /// Forward packets a replayed network lost (the receiver held its last value).
+    pub forward_replay_lost: u64,
+    /// Backward packets a replayed network lost.
+    pub backward_replay_lost: u64,
 }
 
 /// The seeded drop and corruption decisions of one channel. A random stream of its
@@ -83,6 +87,8 @@ pub struct Passage {
     pub noise: [f64; 3],
     /// Jitter drawn for this packet, samples (zero without a jitter model).
     pub jitter: f64,
+    /// True if a replayed network lost this packet.
+    pub lost: bool,
     /// Delivered, corrupted or dropped.
     pub fate: Fate,
 }
@@ -154,10 +160,24 @@ fn apply(s: &mut Signal, e: &tactile_common::channel::Emitted) {
 impl Emulator {
     /// Channels as the scenario configures them, seeded from its seed.
     pub fn new(scenario: &Scenario) -> Emulator {
+        Emulator::with_replays(scenario, [None, None])
+    }
+
+    /// As [`Emulator::new`], the forward and backward channels driven by recorded
+    /// networks where given (loaded by [`crate::replay::load`]).
+    pub fn with_replays(scenario: &Scenario, replays: [Option<Replay>; 2]) -> Emulator {
         let (f, b) = (&scenario.network.forward, &scenario.network.backward);
+        let [rf, rb] = replays;
+        let channel = |c, stream, r: Option<Replay>| {
+            let ch = Channel::new(c, scenario.seed, stream);
+            match r {
+                Some(r) => ch.with_replay(r, scenario.t_s()),
+                None => ch,
+            }
+        };
         Emulator {
-            forward: Channel::new(f, scenario.seed, FORWARD_STREAM),
-            backward: Channel::new(b, scenario.seed, BACKWARD_STREAM),
+            forward: channel(f, FORWARD_STREAM, rf),
+            backward: channel(b, BACKWARD_STREAM, rb),
             forward_faults: Faults::new(f, scenario.seed, FORWARD_STREAM),
             backward_faults: Faults::new(b, scenario.seed, BACKWARD_STREAM),
             counters: EmulatorCounters::default(),
@@ -172,7 +192,7 @@ impl Emulator {
     /// c(n) in, v(n) out (`None` when the loss model drops it), and the record of it.
     pub fn forward(&mut self, c: &Forward) -> (Option<Forward>, Passage) {
         let mut v = *c;
-        let (fate, noise, jitter) = pass(
+        let (fate, noise, jitter, lost) = pass(
             &mut self.forward,
             &mut self.forward_faults,
             c.seq,
@@ -183,6 +203,7 @@ impl Emulator {
         k.forward_substituted += u64::from(v.signal.flags & FLAG_SUBSTITUTED != 0);
         k.forward_corrupted += u64::from(fate == Fate::Corrupt);
         k.forward_dropped += u64::from(fate == Fate::Drop);
+        k.forward_replay_lost += u64::from(lost);
         let record = Passage {
             dir: Direction::Forward,
             n: c.seq,
@@ -190,6 +211,7 @@ impl Emulator {
             out: v.signal,
             noise,
             jitter,
+            lost,
             fate,
         };
         ((fate != Fate::Drop).then_some(v), record)
@@ -198,7 +220,7 @@ impl Emulator {
     /// h(n) in, q(n) out (`None` when the loss model drops it), and the record of it.
     pub fn backward(&mut self, h: &Backward) -> (Option<Backward>, Passage) {
         let mut q = *h;
-        let (fate, noise, jitter) = pass(
+        let (fate, noise, jitter, lost) = pass(
             &mut self.backward,
             &mut self.backward_faults,
             h.seq,
@@ -209,6 +231,7 @@ impl Emulator {
         k.backward_substituted += u64::from(q.signal.flags & FLAG_SUBSTITUTED != 0);
         k.backward_corrupted += u64::from(fate == Fate::Corrupt);
         k.backward_dropped += u64::from(fate == Fate::Drop);
+        k.backward_replay_lost += u64::from(lost);
         let record = Passage {
             dir: Direction::Backward,
             n: h.seq,
@@ -216,6 +239,7 @@ impl Emulator {
             out: q.signal,
             noise,
             jitter,
+            lost,
             fate,
         };
         ((fate != Fate::Drop).then_some(q), record)
@@ -224,13 +248,14 @@ impl Emulator {
 
 /// One sample through one channel: delay and noise into `signal`, then the fault
 /// model's decision (a corrupted signal is already NaN when this returns). Returns the
-/// decision, the noise added and the jitter drawn.
+/// decision, the noise added, the jitter drawn and whether a replayed network lost the
+/// packet.
 fn pass(
     channel: &mut Channel,
     faults: &mut Faults,
     seq: u64,
     signal: &mut Signal,
-) -> (Fate, [f64; 3], f64) {
+) -> (Fate, [f64; 3], f64, bool) {
     // A sample its sender's codec did not send carries no packet; what leaves is what
     // the network delivers at this sample.
     let sent = signal.flags & FLAG_UNSENT == 0;
@@ -242,5 +267,5 @@ fn pass(
         signal.value = [f64::NAN; 3];
         signal.flags |= FLAG_CORRUPTED;
     }
-    (fate, e.noise, e.jitter)
+    (fate, e.noise, e.jitter, e.lost)
 }

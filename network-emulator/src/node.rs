@@ -41,6 +41,8 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let towards_slave = cli.slave_link.unwrap_or(a.link);
     let p = prepare("emulator", a)?;
     check_link_args(a, &[towards_master, towards_slave])?;
+    let replays = crate::replay::load(&p.scenario, &p.base_dir)
+        .map_err(|e| NodeError::BadInput(format!("{}: {e}", a.scenario.display())))?;
     let mut rec = Recorder::open(&a.out, "emulator", a.append)?;
     let mut start = start_record("emulator", a, &p);
     if towards_master != towards_slave {
@@ -54,7 +56,7 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     rec.start(start)?;
     tracing::info!("waiting for the master");
     let ended = emulator_link(a, p.spin, towards_master, towards_slave).and_then(|link| {
-        run_with(&p.scenario, link.as_ref(), &mut rec, p.wake_early)
+        run_with(&p.scenario, replays, link.as_ref(), &mut rec, p.wake_early)
             .map_err(|e| NodeError::Failed(e.to_string()))
     });
     ended.inspect_err(|e| {

@@ -48,11 +48,12 @@ impl From<NodeError> for EmulatorError {
 /// a stop request (false).
 pub fn run_with<L: EmulatorLink + ?Sized>(
     scenario: &Scenario,
+    replays: [Option<tactile_common::netem::Replay>; 2],
     link: &L,
     rec: &mut EmulatorRecorder,
     wake_early: Duration,
 ) -> Result<bool, EmulatorError> {
-    let mut emu = Emulator::new(scenario);
+    let mut emu = Emulator::with_replays(scenario, replays);
     let mut filter = RunFilter::default();
     let mut seen_first = false;
     let mut last_seq = 0;
@@ -244,7 +245,14 @@ mod tests {
         };
         let dir = tempfile::tempdir().expect("tmp");
         let mut rec = EmulatorRecorder::open(dir.path(), "emulator", false).expect("rec");
-        let done = run_with(&scenario, &link, &mut rec, Duration::from_micros(200)).expect("run");
+        let done = run_with(
+            &scenario,
+            [None, None],
+            &link,
+            &mut rec,
+            Duration::from_micros(200),
+        )
+        .expect("run");
         assert!(done);
         let calls = link.calls.borrow();
         // The receive right after h(1) (one answer still due) waits for it, with no
