@@ -14,7 +14,7 @@
 
 use crate::netem::{Jitter, Replay};
 use crate::scenario::ChannelConfig;
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use std::collections::BTreeMap;
@@ -47,6 +47,8 @@ pub struct Emitted {
     pub jitter: f64,
     /// True if a replayed network lost the input packet.
     pub lost: bool,
+    /// True if the input packet was sent twice (netem's `duplicate`).
+    pub duplicated: bool,
     /// True if a value had to stand in for one not yet (or no longer) in the history:
     /// the first `d` samples of a delayed channel, or after a gap.
     pub substituted: bool,
@@ -100,6 +102,7 @@ pub struct Channel {
     reorder: bool,
     flight: [InFlight; 3],
     replay: Option<(Replay, f64)>,
+    duplicate: Option<(f64, ChaCha8Rng)>,
 }
 
 /// Seeds of the two channels differ so their noise is independent.
@@ -152,6 +155,13 @@ impl Channel {
             reorder: cfg.reorder,
             flight: Default::default(),
             replay: None,
+            // Duplication draws from its own stream, so turning it on leaves the
+            // others' draws unchanged.
+            duplicate: (cfg.duplicate > 0.0).then(|| {
+                let mut r = ChaCha8Rng::seed_from_u64(seed);
+                r.set_stream(stream + 300);
+                (cfg.duplicate, r)
+            }),
         }
     }
 
@@ -194,6 +204,19 @@ impl Channel {
         }
         let delay = self.delay_at(seq);
         let jitter = self.jitter.as_mut().map_or(0.0, |(j, rng)| j.next(rng));
+        // A duplicate is a second copy of the packet with its own jitter: it may arrive
+        // before the original (which is then of no use) or after (no use itself).
+        let duplicated = sent
+            && self
+                .duplicate
+                .as_mut()
+                .is_some_and(|(p, rng)| rng.random::<f64>() < *p);
+        // The copy's jitter comes from the same correlated process, drawn with the
+        // duplication's stream, so the original packets' jitter stays as it was.
+        let copy_jitter = match (&self.jitter, &mut self.duplicate) {
+            (Some((j, _)), Some((_, rng))) if duplicated => j.clone().next(rng),
+            _ => 0.0,
+        };
         let mut out = [Value::default(); 3];
         let mut noise = [0.0; 3];
         let mut substituted = false;
@@ -210,6 +233,18 @@ impl Channel {
             };
             if sent {
                 f.send(seq, at);
+            }
+            if duplicated {
+                let d2 = match replayed {
+                    Some((d, _)) => u64::from(d),
+                    None => (f64::from(delay[i]) + copy_jitter).round().max(0.0) as u64,
+                };
+                let at2 = if self.reorder {
+                    seq + d2
+                } else {
+                    (seq + d2).max(f.last_arrival)
+                };
+                f.send(seq, at2);
             }
             let newest = f.receive(seq);
             let fresh = newest.is_some() && newest != f.last_emitted;
@@ -249,6 +284,7 @@ impl Channel {
             noise,
             jitter,
             lost,
+            duplicated,
             substituted,
         }
     }
@@ -345,6 +381,48 @@ mod tests {
         assert!(free < 19.5 && free > 15.0, "{free}");
         assert!(fifo > 20.5, "{fifo}");
         assert!(held_free > 100, "jitter leaves gaps: {held_free}");
+    }
+
+    /// netem's duplicate: about the configured share of packets go twice (binomial:
+    /// five standard deviations), the originals' jitter is what it was without
+    /// duplication, and no packet reaches the receiver fresh twice.
+    #[test]
+    fn duplicates_are_counted_and_never_used_twice() {
+        let run = |duplicate: f64| {
+            let cfg = ChannelConfig {
+                delay: [10, 10, 10],
+                jitter: Some(crate::netem::JitterConfig {
+                    jitter: 4.0,
+                    correlation: 0.3,
+                    distribution: crate::netem::JitterDistribution::Normal,
+                }),
+                duplicate,
+                ..Default::default()
+            };
+            let mut ch = Channel::new(&cfg, 4, FORWARD_STREAM);
+            let (mut dups, mut jitters, mut last) = (0u32, Vec::new(), None);
+            for n in 0..100_000u64 {
+                let e = ch.push(n, vals(n));
+                dups += u32::from(e.duplicated);
+                jitters.push(e.jitter);
+                if !e.substituted {
+                    let src = e.values[0].origin_seq;
+                    assert!(last.is_none_or(|l| src > l), "{n}: packet {src} used twice");
+                    last = Some(src);
+                }
+            }
+            (dups, jitters)
+        };
+        let (none, base) = run(0.0);
+        let (dups, jitters) = run(0.3);
+        assert_eq!(none, 0);
+        assert_eq!(
+            base, jitters,
+            "duplication leaves the originals' jitter alone"
+        );
+        let (n, p) = (100_000.0, 0.3);
+        let sd = (n * p * (1.0 - p)) as f64;
+        assert!((f64::from(dups) - n * p).abs() < 5.0 * sd.sqrt(), "{dups}");
     }
 
     #[test]

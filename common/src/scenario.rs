@@ -293,6 +293,10 @@ pub struct ChannelConfig {
     /// and `jitter`.
     #[serde(default)]
     pub replay: Option<crate::netem::ReplayConfig>,
+    /// Probability that a packet is sent twice, netem's `duplicate` (the copy takes
+    /// its own jitter), 0 to 1 [0].
+    #[serde(default)]
+    pub duplicate: f64,
 }
 
 fn default_reorder() -> bool {
@@ -311,6 +315,7 @@ impl Default for ChannelConfig {
             reorder: default_reorder(),
             loss_model: None,
             replay: None,
+            duplicate: 0.0,
         }
     }
 }
@@ -351,7 +356,11 @@ impl ChannelConfig {
                 check_delay(e[i + 1], format!("{field}.schedule[{k}][{}]", i + 1))?;
             }
         }
-        for (name, p) in [("loss", self.loss), ("corrupt", self.corrupt)] {
+        for (name, p) in [
+            ("loss", self.loss),
+            ("corrupt", self.corrupt),
+            ("duplicate", self.duplicate),
+        ] {
             if !p.is_finite() || !(0.0..=1.0).contains(&p) {
                 return Err(invalid(
                     format!("{field}.{name}"),

@@ -39,6 +39,10 @@ pub struct EmulatorCounters {
     pub forward_replay_lost: u64,
     /// Backward packets a replayed network lost.
     pub backward_replay_lost: u64,
+    /// Forward packets sent twice (netem's duplicate).
+    pub forward_duplicated: u64,
+    /// Backward packets sent twice.
+    pub backward_duplicated: u64,
 }
 
 /// The seeded drop and corruption decisions of one channel. A random stream of its
@@ -192,7 +196,7 @@ impl Emulator {
     /// c(n) in, v(n) out (`None` when the loss model drops it), and the record of it.
     pub fn forward(&mut self, c: &Forward) -> (Option<Forward>, Passage) {
         let mut v = *c;
-        let (fate, noise, jitter, lost) = pass(
+        let (fate, noise, jitter, lost, duplicated) = pass(
             &mut self.forward,
             &mut self.forward_faults,
             c.seq,
@@ -204,6 +208,7 @@ impl Emulator {
         k.forward_corrupted += u64::from(fate == Fate::Corrupt);
         k.forward_dropped += u64::from(fate == Fate::Drop);
         k.forward_replay_lost += u64::from(lost);
+        k.forward_duplicated += u64::from(duplicated);
         let record = Passage {
             dir: Direction::Forward,
             n: c.seq,
@@ -220,7 +225,7 @@ impl Emulator {
     /// h(n) in, q(n) out (`None` when the loss model drops it), and the record of it.
     pub fn backward(&mut self, h: &Backward) -> (Option<Backward>, Passage) {
         let mut q = *h;
-        let (fate, noise, jitter, lost) = pass(
+        let (fate, noise, jitter, lost, duplicated) = pass(
             &mut self.backward,
             &mut self.backward_faults,
             h.seq,
@@ -232,6 +237,7 @@ impl Emulator {
         k.backward_corrupted += u64::from(fate == Fate::Corrupt);
         k.backward_dropped += u64::from(fate == Fate::Drop);
         k.backward_replay_lost += u64::from(lost);
+        k.backward_duplicated += u64::from(duplicated);
         let record = Passage {
             dir: Direction::Backward,
             n: h.seq,
@@ -248,14 +254,14 @@ impl Emulator {
 
 /// One sample through one channel: delay and noise into `signal`, then the fault
 /// model's decision (a corrupted signal is already NaN when this returns). Returns the
-/// decision, the noise added, the jitter drawn and whether a replayed network lost the
-/// packet.
+/// decision, the noise added, the jitter drawn, whether a replayed network lost the
+/// packet and whether it was duplicated.
 fn pass(
     channel: &mut Channel,
     faults: &mut Faults,
     seq: u64,
     signal: &mut Signal,
-) -> (Fate, [f64; 3], f64, bool) {
+) -> (Fate, [f64; 3], f64, bool, bool) {
     // A sample its sender's codec did not send carries no packet; what leaves is what
     // the network delivers at this sample.
     let sent = signal.flags & FLAG_UNSENT == 0;
@@ -267,5 +273,5 @@ fn pass(
         signal.value = [f64::NAN; 3];
         signal.flags |= FLAG_CORRUPTED;
     }
-    (fate, e.noise, e.jitter, e.lost)
+    (fate, e.noise, e.jitter, e.lost, e.duplicated)
 }
