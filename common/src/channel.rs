@@ -420,7 +420,7 @@ mod tests {
             base, jitters,
             "duplication leaves the originals' jitter alone"
         );
-        let (n, p) = (100_000.0, 0.3);
+        let (n, p): (f64, f64) = (100_000.0, 0.3);
         let sd = (n * p * (1.0 - p)).sqrt();
         assert!((f64::from(dups) - n * p).abs() < 5.0 * sd, "{dups}");
     }
