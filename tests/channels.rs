@@ -1,5 +1,7 @@
 //! netem-class channels in a closed loop: jitter with correlation, Gilbert-Elliott
-//! loss, reordering off; seeded, so a run repeats; checked like any scenario field.
+//! loss, a replayed network, deadband codecs and predictors; seeded, so a run
+//! repeats; checked like any scenario field. (Reordering on and off is a unit test of
+//! the channel.)
 //! (Each model's statistics against its closed form are unit tests in
 //! common/src/netem.rs, over 100,000 draws.)
 
@@ -150,10 +152,19 @@ fn deadband_with_tdpa_sends_far_fewer_packets_and_stays_passive() {
     assert!(w >= -1e-3, "observer {w} J");
     let depth = sum["contact"]["max_penetration_m"].as_f64().expect("depth");
     assert!(depth > 1e-4, "pressed the wall: {depth} m");
-    // The samples not sent are flagged in the trace, and the slave filled them.
-    let flags = util::column(&sb.trace("a"), "flags_f");
-    let held = flags.iter().filter(|f| (**f as u32) & 1 != 0).count();
-    assert!(held > 6000, "{held} samples filled by the predictor");
+    // The samples not sent are no packets on the network: each receiver got the
+    // last value again (flagged) and filled it, in both directions.
+    let trace = sb.trace("a");
+    for column in ["flags_f", "flags_b"] {
+        let flags = util::column(&trace, column);
+        let held = flags.iter().filter(|f| (**f as u32) & 1 != 0).count();
+        assert!(
+            held > 6000,
+            "{column}: {held} samples filled by the predictor"
+        );
+    }
+    let c = &sum["emulator"]["counters"];
+    assert!(c["backward_substituted"].as_u64() > Some(6000), "{c}");
 }
 
 /// The predictors fill what the deadband does not send: on the paper's trajectory at

@@ -32,7 +32,9 @@ pub struct Value {
     pub origin_seq: u64,
     /// Master's CLOCK_MONOTONIC timestamp of that sample, ns.
     pub origin_ns: u64,
-    /// Delay injected on purpose so far along its path, in samples.
+    /// Delay the network added so far along its path, samples: the value's age at
+    /// each channel's output (its packet's delay, plus any time it was held because
+    /// no newer packet had arrived).
     pub delay_samples: u32,
 }
 
@@ -49,8 +51,8 @@ pub struct Emitted {
     pub lost: bool,
     /// True if the input packet was sent twice (netem's `duplicate`).
     pub duplicated: bool,
-    /// True if a value had to stand in for one not yet (or no longer) in the history:
-    /// the first `d` samples of a delayed channel, or after a gap.
+    /// True if no new packet arrived for this sample: the last value again (or, before
+    /// the first arrival, the first value sent).
     pub substituted: bool,
 }
 
@@ -60,11 +62,13 @@ struct Slot {
     values: [Value; 3],
 }
 
-/// One signal's packets in flight: arrival sample -> newest sequence arriving then.
+/// One signal's packets in flight: arrival sample -> newest sequence arriving then;
+/// and the newest arrived, with its value copied when it arrives (its slot in the ring
+/// may be reused by a later packet while the receiver still holds it).
 #[derive(Debug, Clone, Default)]
 struct InFlight {
     arriving: BTreeMap<u64, u64>,
-    newest: Option<u64>,
+    newest: Option<(u64, Value)>,
     last_arrival: u64,
     last_emitted: Option<u64>,
 }
@@ -77,18 +81,30 @@ impl InFlight {
         self.last_arrival = self.last_arrival.max(at);
     }
 
-    /// The newest packet arrived by sample `now`.
-    fn receive(&mut self, now: u64) -> Option<u64> {
+    /// The newest packet arrived by sample `now`, its value read from `ring` as it
+    /// arrives (every packet arrives within the ring's length of being sent, so its
+    /// slot still holds it then).
+    fn receive(&mut self, now: u64, ring: &[Option<Slot>], i: usize) -> Option<(u64, Value)> {
+        let len = ring.len() as u64;
         while let Some((&at, &seq)) = self.arriving.first_key_value() {
             if at > now {
                 break;
             }
             self.arriving.remove(&at);
-            self.newest = Some(self.newest.map_or(seq, |n| n.max(seq)));
+            if self.newest.is_none_or(|(n, _)| seq > n) {
+                if let Some(s) = ring[(seq % len) as usize].filter(|s| s.seq == seq) {
+                    self.newest = Some((seq, s.values[i]));
+                }
+            }
         }
         self.newest
     }
 }
+
+/// Largest step between successive sample numbers a channel takes: a sender's numbers
+/// that jump further are not a network's packets (a peer's bug or a forgery), and are
+/// carried as no packet at all.
+pub const MAX_SEQ_JUMP: u64 = 1 << 20;
 
 /// One direction of the emulated network.
 #[derive(Debug)]
@@ -103,6 +119,8 @@ pub struct Channel {
     flight: [InFlight; 3],
     replay: Option<(Replay, f64)>,
     duplicate: Option<(f64, ChaCha8Rng)>,
+    first: Option<Slot>,
+    last_seq: Option<u64>,
 }
 
 /// Seeds of the two channels differ so their noise is independent.
@@ -162,6 +180,8 @@ impl Channel {
                 r.set_stream(stream + 300);
                 (cfg.duplicate, r)
             }),
+            first: None,
+            last_seq: None,
         }
     }
 
@@ -196,25 +216,43 @@ impl Channel {
     /// the same): the receiver then gets whatever arrived, or the last value again.
     pub fn push_packet(&mut self, seq: u64, values: [Value; 3], sent: bool) -> Emitted {
         let len = self.ring.len() as u64;
-        let replayed = self.replay.as_mut().map(|(r, t_s)| r.packet(seq, *t_s));
+        // Sample numbers must increase, and not by absurd steps.
+        let in_order = self
+            .last_seq
+            .is_none_or(|l| seq > l && seq - l <= MAX_SEQ_JUMP);
+        if in_order {
+            self.last_seq = Some(seq);
+        }
+        let sent = sent && in_order;
+        let replayed = self
+            .replay
+            .as_mut()
+            .map(|(r, t_s)| r.packet(seq, *t_s, sent));
         let lost = replayed.is_some_and(|(_, lost)| lost);
         let sent = sent && !lost;
         if sent {
-            self.ring[(seq % len) as usize] = Some(Slot { seq, values });
+            let slot = Slot { seq, values };
+            self.ring[(seq % len) as usize] = Some(slot);
+            self.first.get_or_insert(slot);
         }
         let delay = self.delay_at(seq);
         let jitter = self.jitter.as_mut().map_or(0.0, |(j, rng)| j.next(rng));
         // A duplicate is a second copy of the packet with its own jitter: it may arrive
-        // before the original (which is then of no use) or after (no use itself).
-        let duplicated = sent
-            && self
-                .duplicate
-                .as_mut()
-                .is_some_and(|(p, rng)| rng.random::<f64>() < *p);
-        // The copy's jitter comes from the same correlated process, drawn with the
-        // duplication's stream, so the original packets' jitter stays as it was.
-        let copy_jitter = match (&self.jitter, &mut self.duplicate) {
-            (Some((j, _)), Some((_, rng))) if duplicated => j.clone().next(rng),
+        // before the original (which is then of no use) or after (no use itself). Its
+        // stream draws the same numbers every sample whatever else is on (a codec, a
+        // replay, jitter), so turning those on leaves the duplicates where they were;
+        // the copy's jitter continues the correlated process with the duplication's own
+        // draw, so the originals' jitter stays as it was.
+        let (dup_draw, dup_e) = match &mut self.duplicate {
+            Some((p, rng)) => (
+                rng.random::<f64>() < *p,
+                rand_distr::StandardNormal.sample(rng),
+            ),
+            None => (false, 0.0),
+        };
+        let duplicated = sent && dup_draw;
+        let copy_jitter = match &self.jitter {
+            Some((j, _)) if duplicated => j.clone().next_with(dup_e),
             _ => 0.0,
         };
         let mut out = [Value::default(); 3];
@@ -227,9 +265,9 @@ impl Channel {
             };
             let f = &mut self.flight[i];
             let at = if self.reorder {
-                seq + d
+                seq.saturating_add(d)
             } else {
-                (seq + d).max(f.last_arrival)
+                seq.saturating_add(d).max(f.last_arrival)
             };
             if sent {
                 f.send(seq, at);
@@ -240,34 +278,37 @@ impl Channel {
                     None => (f64::from(delay[i]) + copy_jitter).round().max(0.0) as u64,
                 };
                 let at2 = if self.reorder {
-                    seq + d2
+                    seq.saturating_add(d2)
                 } else {
-                    (seq + d2).max(f.last_arrival)
+                    seq.saturating_add(d2).max(f.last_arrival)
                 };
                 f.send(seq, at2);
             }
-            let newest = f.receive(seq);
-            let fresh = newest.is_some() && newest != f.last_emitted;
-            f.last_emitted = newest;
-            let found = newest.and_then(|w| self.ring[(w % len) as usize].filter(|s| s.seq == w));
-            let slot = match found {
-                Some(s) => {
+            let newest = f.receive(seq, &self.ring, i);
+            let fresh = newest.is_some() && newest.map(|n| n.0) != f.last_emitted;
+            f.last_emitted = newest.map(|n| n.0);
+            let (from, value) = match newest {
+                Some(n) => {
                     // Held when no newer packet came: flagged so the receiver knows.
                     substituted |= !fresh;
-                    s
+                    n
                 }
                 None => {
                     substituted = true;
-                    // Nothing has arrived yet: hold the oldest value we have.
-                    self.oldest()
+                    // Nothing has arrived yet: hold the first value sent.
+                    let s = self.first.unwrap_or(Slot {
+                        seq,
+                        values: [Value::default(); 3],
+                    });
+                    (s.seq, s.values[i])
                 }
             };
             // The delay injected is the value's age here: the packet's delay, and any
             // time it was held.
-            let age = u32::try_from(seq - slot.seq.min(seq)).unwrap_or(u32::MAX);
+            let age = u32::try_from(seq.saturating_sub(from)).unwrap_or(u32::MAX);
             let src = Value {
-                delay_samples: slot.values[i].delay_samples.saturating_add(age),
-                ..slot.values[i]
+                delay_samples: value.delay_samples.saturating_add(age),
+                ..value
             };
             let r = match &self.noise[i] {
                 Some(dist) => dist.sample(&mut self.rng),
@@ -287,18 +328,6 @@ impl Channel {
             duplicated,
             substituted,
         }
-    }
-
-    fn oldest(&self) -> Slot {
-        self.ring
-            .iter()
-            .flatten()
-            .min_by_key(|s| s.seq)
-            .copied()
-            .unwrap_or(Slot {
-                seq: 0,
-                values: [Value::default(); 3],
-            })
     }
 }
 

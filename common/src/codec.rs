@@ -17,6 +17,7 @@
 //! `FLAG_UNSENT`: the network (the emulator's channel) carries no packet for it, and
 //! the receiver fills it with its predictor, exactly as for a packet that is late.
 
+use crate::samples::LATE_WINDOW;
 use crate::scenario::{invalid, ScenarioError};
 use serde::{Deserialize, Serialize};
 
@@ -175,10 +176,19 @@ pub struct PredictorConfig {
     #[serde(default = "default_r")]
     pub measurement_noise: f64,
     /// Values farther than this from the last accepted one per second are not
-    /// physically possible and are rejected (m/s forward, N/s backward) [10 m/s,
-    /// 1000 N/s when left at 0].
+    /// physically possible and are rejected (m/s forward, N/s backward) [100 m/s,
+    /// 1e5 N/s when left at 0: generous, so noise and stiff contacts pass, garbage
+    /// does not].
     #[serde(default)]
     pub max_rate: f64,
+    /// Linear and Kalman: the longest they extrapolate, s; past it they hold [0.05]
+    /// (a codec's silence means "within the deadband", not "going on for ever").
+    #[serde(default = "default_horizon")]
+    pub horizon_s: f64,
+}
+
+fn default_horizon() -> f64 {
+    0.05
 }
 
 /// The predictors.
@@ -208,6 +218,7 @@ impl Default for PredictorConfig {
             process_noise: default_q(),
             measurement_noise: default_r(),
             max_rate: 0.0,
+            horizon_s: default_horizon(),
         }
     }
 }
@@ -219,12 +230,18 @@ impl PredictorConfig {
             ("process_noise", self.process_noise),
             ("measurement_noise", self.measurement_noise),
         ] {
-            if !v.is_finite() || v <= 0.0 {
+            if !v.is_finite() || v <= 0.0 || v > 1e12 {
                 return Err(invalid(
                     format!("{field}.{name}"),
-                    format!("{v} must be positive"),
+                    format!("{v} is outside (0, 1e12]"),
                 ));
             }
+        }
+        if !self.horizon_s.is_finite() || !(0.0..=10.0).contains(&self.horizon_s) {
+            return Err(invalid(
+                format!("{field}.horizon_s"),
+                format!("{} s is outside 0..=10 s", self.horizon_s),
+            ));
         }
         if !self.max_rate.is_finite() || self.max_rate < 0.0 {
             return Err(invalid(
@@ -357,7 +374,15 @@ impl Predictor {
     /// (filling, not compensating the network's delay).
     pub fn estimate(&mut self, n: u64, fresh: Option<(u64, [f64; 3])>) -> Estimate {
         if let Some((at, v)) = fresh {
-            if self.possible(at, v) {
+            // A sender that started again (its numbers far behind the last) starts a
+            // new signal.
+            if self
+                .last
+                .is_some_and(|(t, _)| at.saturating_add(LATE_WINDOW) < t)
+            {
+                self.reset();
+            }
+            if at <= n && self.possible(at, v) {
                 self.accept(at, v);
                 self.arrived_at = n;
                 return Estimate::Fresh(v);
@@ -367,34 +392,60 @@ impl Predictor {
         Estimate::Predicted(self.predict(n))
     }
 
+    fn reset(&mut self) {
+        self.last = None;
+        self.before = None;
+        self.kalman = [Kalman::default(); 3];
+    }
+
     /// Finite, no larger than `max_rate` allows over a second, and no faster from the
-    /// last accepted value than `max_rate`. A value older than the last accepted one
-    /// (a reordered packet) is not possible either.
+    /// last accepted value than `max_rate` (a value of the same sample as the last, the
+    /// real one of a sample the channel first stood in for, is measured from the one
+    /// before). A value older than the last accepted one (a reordered packet) is not
+    /// possible, nor one from after the receiver's present sample (checked by the
+    /// caller).
     fn possible(&self, at: u64, v: [f64; 3]) -> bool {
         if !v.iter().all(|x| x.is_finite()) || norm(v) > self.max_rate {
             return false;
         }
-        match self.last {
+        let reference = match self.last {
+            Some((t, _)) if at == t => self.before,
+            other => other,
+        };
+        match reference {
             None => true,
             Some((t, last)) if at > t => {
                 let dt = (at - t) as f64 * self.t_s;
                 norm([0, 1, 2].map(|i| v[i] - last[i])) <= self.max_rate * dt
             }
-            Some((t, last)) => at == t && v == last,
+            Some(_) => false,
         }
     }
 
     fn accept(&mut self, at: u64, v: [f64; 3]) {
         if self.last.is_some_and(|(t, _)| t == at) {
+            // The real value of a sample the channel first stood in for replaces it.
+            self.last = Some((at, v));
+            if self.cfg.kind == PredictorKind::Kalman {
+                self.kalman = [Kalman::default(); 3];
+                if let Some((t0, x0)) = self.before {
+                    self.feed(t0, x0);
+                }
+                self.feed(at, v);
+            }
             return;
         }
         self.before = self.last;
         self.last = Some((at, v));
         if self.cfg.kind == PredictorKind::Kalman {
-            let (q, r) = (self.cfg.process_noise, self.cfg.measurement_noise);
-            for (i, k) in self.kalman.iter_mut().enumerate() {
-                k.update(at, v[i], self.t_s, q, r);
-            }
+            self.feed(at, v);
+        }
+    }
+
+    fn feed(&mut self, at: u64, v: [f64; 3]) {
+        let (q, r) = (self.cfg.process_noise, self.cfg.measurement_noise);
+        for (i, k) in self.kalman.iter_mut().enumerate() {
+            k.update(at, v[i], self.t_s, q, r);
         }
     }
 
@@ -404,8 +455,9 @@ impl Predictor {
         let Some((t1, x1)) = self.last else {
             return [0.0; 3];
         };
-        let n = t1 + n.saturating_sub(self.arrived_at);
-        match self.cfg.kind {
+        let horizon = (self.cfg.horizon_s / self.t_s).round() as u64;
+        let n = t1 + n.saturating_sub(self.arrived_at).min(horizon);
+        let guess = match self.cfg.kind {
             PredictorKind::Hold => x1,
             PredictorKind::Linear => match self.before {
                 Some((t0, x0)) if n > t1 && t1 > t0 => {
@@ -415,6 +467,11 @@ impl Predictor {
                 _ => x1,
             },
             PredictorKind::Kalman => [0, 1, 2].map(|i| self.kalman[i].peek(n, self.t_s)),
+        };
+        if guess.iter().all(|x| x.is_finite()) {
+            guess
+        } else {
+            x1
         }
     }
 }

@@ -223,27 +223,29 @@ impl LossModel {
 struct StateChain;
 
 impl StateChain {
+    /// The long-run share of each state, starting from state 1 (for a chain that is
+    /// not irreducible, the class the chain ends up in from there).
     fn stationary(p13: f64, p31: f64, p32: f64, p23: f64, p14: f64) -> [f64; 4] {
-        // Relative to pi1 = 1: pi4 = p14; pi3 = p13 / p31 (flows between {1,4} and
-        // {2,3} balance, since only 1 -> 3 and 3 -> 1 cross); pi2 = p32 pi3 / p23.
+        // Never leaving {1, 4}: pi4 = p14 pi1.
+        if p13 == 0.0 {
+            return [1.0 / (1.0 + p14), 0.0, 0.0, p14 / (1.0 + p14)];
+        }
+        // Once in {2, 3} for good (no way back to 1): the 2-3 chain alone.
         if p31 == 0.0 {
-            return if p13 > 0.0 {
-                [0.0, 0.0, 1.0, 0.0]
-            } else {
-                [1.0 / (1.0 + p14), 0.0, 0.0, p14 / (1.0 + p14)]
+            return match (p32 > 0.0, p23 > 0.0) {
+                (true, true) => [0.0, p23 / (p23 + p32), p32 / (p23 + p32), 0.0],
+                (true, false) => [0.0, 1.0, 0.0, 0.0],
+                _ => [0.0, 0.0, 1.0, 0.0],
             };
         }
-        let pi3 = p13 / p31;
-        let pi2 = if p23 > 0.0 {
-            p32 * pi3 / p23
-        } else if p32 > 0.0 {
-            f64::INFINITY
-        } else {
-            0.0
-        };
-        if !pi2.is_finite() {
+        // State 2 absorbing once reached.
+        if p32 > 0.0 && p23 == 0.0 {
             return [0.0, 1.0, 0.0, 0.0];
         }
+        // Relative to pi1 = 1: pi4 = p14; pi3 = p13 / p31 (the flows between {1, 4}
+        // and {2, 3} balance, and only 1 -> 3 and 3 -> 1 cross); pi2 = p32 pi3 / p23.
+        let pi3 = p13 / p31;
+        let pi2 = if p23 > 0.0 { p32 * pi3 / p23 } else { 0.0 };
         let total = 1.0 + p14 + pi3 + pi2;
         [1.0 / total, pi2 / total, pi3 / total, p14 / total]
     }
@@ -344,6 +346,11 @@ impl Jitter {
     /// The next packet's jitter, samples (continuous; the channel rounds the delay).
     pub fn next(&mut self, rng: &mut impl Rng) -> f64 {
         let e: f64 = StandardNormal.sample(rng);
+        self.next_with(e)
+    }
+
+    /// The next jitter with the given standard normal innovation.
+    pub fn next_with(&mut self, e: f64) -> f64 {
         let c = self.cfg.correlation;
         let z = match self.z {
             None => e,
@@ -380,7 +387,9 @@ impl Loss {
                 bad_loss,
                 good_loss,
             } => {
-                // netem: the state moves first, then the packet's fate in that state.
+                // The state moves, then the packet's fate is drawn in the state it moved
+                // to (netem's loss_gilb_ell draws the fate in the state it leaves; the
+                // long-run rates are the same).
                 let u: f64 = rng.random();
                 self.state = match self.state {
                     1 if u < p => 3,
@@ -482,8 +491,8 @@ impl ReplayConfig {
 /// A loaded replay: each packet's delay (samples) and whether it is lost.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Replay {
-    /// Rows of a CSV file, looped.
-    Packets(Vec<(u32, bool)>),
+    /// Rows of a CSV file, one per packet sent, looped; the number of packets so far.
+    Packets(Vec<(u32, bool)>, u64),
     /// Mahimahi delivery opportunities (ms), looped, served first come first served.
     Mahimahi(Mahimahi),
 }
@@ -500,27 +509,44 @@ pub struct Mahimahi {
 }
 
 impl Replay {
-    /// Parses a CSV replay: header `delay,lost`; the error names the line.
+    /// Parses a CSV replay: header `delay,lost`; the error names the line. Rows are
+    /// read straight into 5 bytes each (a replay file may hold hours of packets).
     pub fn parse_csv(text: &str) -> Result<Replay, String> {
-        let rows = crate::csv::parse(text, &["delay", "lost"]).map_err(|e| e.to_string())?;
-        let mut out = Vec::with_capacity(rows.len());
-        for (k, r) in rows.iter().enumerate() {
-            let line = k + 2;
-            let (d, l) = (r[0], r[1]);
-            if !(d >= 0.0 && d <= crate::scenario::MAX_DELAY_SAMPLES as f64 && d.fract() == 0.0) {
-                return Err(format!(
-                    "line {line}: delay {d} is not a whole number of samples in 0..=100000"
-                ));
+        let mut lines = text.lines().enumerate();
+        match lines.next() {
+            Some((_, h)) if h.trim().replace(' ', "") == "delay,lost" => {}
+            Some((_, h)) => return Err(format!("line 1: header is {h:?}, expected delay,lost")),
+            None => return Err("empty: expected the header delay,lost".into()),
+        }
+        let mut out = Vec::new();
+        for (k, raw) in lines {
+            let line = k + 1;
+            let row = raw.trim();
+            if row.is_empty() {
+                continue;
             }
-            if l != 0.0 && l != 1.0 {
-                return Err(format!("line {line}: lost {l} is not 0 or 1"));
-            }
-            out.push((d as u32, l == 1.0));
+            let mut cells = row.split(',').map(str::trim);
+            let (Some(d), Some(l), None) = (cells.next(), cells.next(), cells.next()) else {
+                return Err(format!("line {line}: expected 2 columns (delay,lost)"));
+            };
+            let d: u32 = d
+                .parse()
+                .ok()
+                .filter(|d| i64::from(*d) <= crate::scenario::MAX_DELAY_SAMPLES)
+                .ok_or_else(|| {
+                    format!("line {line}: delay {d} is not a whole number of samples in 0..=100000")
+                })?;
+            let l = match l {
+                "0" => false,
+                "1" => true,
+                other => return Err(format!("line {line}: lost {other} is not 0 or 1")),
+            };
+            out.push((d, l));
         }
         if out.is_empty() {
             return Err("no packets after the header".into());
         }
-        Ok(Replay::Packets(out))
+        Ok(Replay::Packets(out, 0))
     }
 
     /// Parses a Mahimahi trace (one non-decreasing millisecond timestamp per line).
@@ -561,16 +587,24 @@ impl Replay {
     /// The largest delay a packet can be given, samples.
     pub fn bound(&self) -> u32 {
         match self {
-            Replay::Packets(rows) => rows.iter().map(|r| r.0).max().unwrap_or(0),
+            Replay::Packets(rows, _) => rows.iter().map(|r| r.0).max().unwrap_or(0),
             Replay::Mahimahi(m) => m.max_queue,
         }
     }
 
-    /// Packet `n`, sent at n t_s: its delay in samples and whether it is lost. Packets
-    /// come in order.
-    pub fn packet(&mut self, n: u64, t_s: f64) -> (u32, bool) {
+    /// The sample `n`, sent at n t_s if `sent` (a sample its codec did not send is no
+    /// packet: it takes no row and no room on the link): the packet's delay in samples
+    /// and whether it is lost. Samples come in order.
+    pub fn packet(&mut self, n: u64, t_s: f64, sent: bool) -> (u32, bool) {
+        if !sent {
+            return (0, false);
+        }
         match self {
-            Replay::Packets(rows) => rows[(n % rows.len() as u64) as usize],
+            Replay::Packets(rows, k) => {
+                let r = rows[(*k % rows.len() as u64) as usize];
+                *k += 1;
+                r
+            }
             Replay::Mahimahi(m) => m.deliver(n, t_s),
         }
     }
@@ -582,11 +616,28 @@ impl Mahimahi {
         self.times_ms[(k % len) as usize] + (k / len) * self.period_ms
     }
 
+    /// The first opportunity at or after `ms`, found directly (a late or sparse
+    /// packet must not walk the trace one opportunity at a time).
+    fn first_at(&self, ms: f64) -> u64 {
+        let len = self.times_ms.len() as u64;
+        let ms = ms.clamp(0.0, 1e15);
+        let loops = (ms / self.period_ms as f64).floor() as u64;
+        let within = ms - (loops * self.period_ms) as f64;
+        let mut k = loops * len + self.times_ms.partition_point(|&t| (t as f64) < within) as u64;
+        // The last opportunity of a loop falls at the period itself, where the next
+        // loop starts: step back onto opportunities that are still at or after `ms`.
+        while k > 0 && self.time(k - 1) as f64 >= ms {
+            k -= 1;
+        }
+        k
+    }
+
     /// The first opportunity at or after the packet's sending time with room left.
     fn deliver(&mut self, n: u64, t_s: f64) -> (u32, bool) {
         let sent_ms = n as f64 * t_s * 1e3;
-        while (self.time(self.next) as f64) < sent_ms {
-            self.next += 1;
+        let k = self.first_at(sent_ms);
+        if k > self.next {
+            self.next = k;
             self.used = 0;
         }
         if self.used >= self.per_opportunity {
@@ -797,31 +848,57 @@ mod tests {
             let se = (pi * (1.0 - pi) / (N as f64 / 20.0)).sqrt();
             assert!((rate - pi).abs() < 5.0 * se, "{model:?}: {rate} vs {pi}");
         }
-        // The 4-state chain's stationary distribution solves its balance equations.
-        let s = StateChain::stationary(0.01, 0.4, 0.1, 0.3, 0.005);
+        // The 4-state chain's stationary distribution solves every balance equation
+        // (pi = pi P, state by state), and the chains that are not irreducible end
+        // where they must.
+        let (p13, p31, p32, p23, p14) = (0.01, 0.4, 0.1, 0.3, 0.005);
+        let s = StateChain::stationary(p13, p31, p32, p23, p14);
         assert!((s.iter().sum::<f64>() - 1.0).abs() < 1e-12);
-        assert!((s[0] * 0.01 - s[2] * 0.4).abs() < 1e-12);
-        assert!((s[1] * 0.3 - s[2] * 0.1).abs() < 1e-12);
+        let next = [
+            s[0] * (1.0 - p13 - p14) + s[2] * p31 + s[3],
+            s[1] * (1.0 - p23) + s[2] * p32,
+            s[0] * p13 + s[1] * p23 + s[2] * (1.0 - p31 - p32),
+            s[0] * p14,
+        ];
+        for k in 0..4 {
+            assert!(
+                (next[k] - s[k]).abs() < 1e-12,
+                "state {}: {next:?} vs {s:?}",
+                k + 1
+            );
+        }
+        assert_eq!(
+            StateChain::stationary(0.0, 0.4, 0.1, 0.3, 0.25),
+            [0.8, 0.0, 0.0, 0.2]
+        );
+        let t = StateChain::stationary(0.1, 0.0, 0.1, 0.3, 0.0);
+        assert!(
+            (t[1] - 0.75).abs() < 1e-12 && (t[2] - 0.25).abs() < 1e-12,
+            "{t:?}"
+        );
     }
 
     #[test]
     fn a_csv_replay_reads_back_row_by_row_and_loops() {
         let mut r = Replay::parse_csv("delay,lost\n3,0\n5,1\n0,0\n").expect("csv");
-        let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3)).collect();
-        assert_eq!(
-            got,
-            vec![
-                (3, false),
-                (5, true),
-                (0, false),
-                (3, false),
-                (5, true),
-                (0, false)
-            ]
-        );
+        let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3, true)).collect();
+        let want = [
+            (3, false),
+            (5, true),
+            (0, false),
+            (3, false),
+            (5, true),
+            (0, false),
+        ];
+        assert_eq!(got, want);
+        // A sample not sent takes no row: the next packet gets the next one.
+        assert_eq!(r.packet(6, 1e-3, false), (0, false));
+        assert_eq!(r.packet(7, 1e-3, true), (3, false));
         assert_eq!(r.bound(), 5);
         for (text, needle) in [
             ("delay,lost\n1.5,0\n", "line 2: delay 1.5"),
+            ("delay,lost\n-1,0\n", "line 2: delay -1"),
+            ("delay,lost\n1\n", "line 2: expected 2 columns"),
             ("delay,lost\n1,2\n", "line 2: lost 2"),
             ("delay,lost\n", "no packets"),
             ("d,l\n1,0\n", "header"),
@@ -844,22 +921,28 @@ mod tests {
             max_queue_samples: 50,
         };
         let mut r = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
-        let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3)).collect();
-        assert_eq!(
-            got,
-            vec![
-                (2, false),
-                (1, false),
-                (0, false),
-                (1, false),
-                (0, false),
-                (1, false)
-            ]
-        );
+        let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3, true)).collect();
+        let want = [
+            (2, false),
+            (1, false),
+            (0, false),
+            (1, false),
+            (0, false),
+            (1, false),
+        ];
+        assert_eq!(got, want);
         let mut fast = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
-        let lost = (0..10_000).filter(|&n| fast.packet(n, 1e-4).1).count();
+        let lost = (0..10_000)
+            .filter(|&n| fast.packet(n, 1e-4, true).1)
+            .count();
         // 3 packets per ms fit of the 10 sent: 70 % dropped once the queue is full.
         assert!((6_500..=7_100).contains(&lost), "{lost}");
+        // A packet sent an hour in goes at once: the trace is not walked.
+        let mut late = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+        assert_eq!(late.packet(3_600_000, 1e-3, true), (0, false));
+        // Samples not sent take no room.
+        let mut quiet = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+        assert!((0..10_000).all(|n| !quiet.packet(n, 1e-4, n % 10 == 0).1));
         assert!(Replay::parse_mahimahi("3\n2\n", &cfg).is_err());
         assert!(Replay::parse_mahimahi("x\n", &cfg).is_err());
     }

@@ -37,7 +37,8 @@ pub struct MasterCounters {
     pub received: u64,
     /// Operator targets outside the master's workspace (MD angles clamped).
     pub operator_clamped: u64,
-    /// Backward samples with a NaN or infinite force, rejected (torque held).
+    /// Backward samples not physically possible (not finite, too large, too fast,
+    /// out of order), rejected and filled by the predictor.
     pub rejected: u64,
     /// Force components clamped to the device's force limit.
     pub force_clamps: u64,
@@ -129,7 +130,7 @@ impl Master {
             predictor: Predictor::new(
                 &scenario.master.predictor,
                 scenario.t_s(),
-                if wave { 1e4 } else { 1e3 },
+                if wave { 1e6 } else { 1e5 },
             ),
             control: MasterSide::new(&scenario.control, scenario.t_s()),
         })

@@ -1,7 +1,10 @@
 //! The network emulator's per-sample logic: both channels of the paper's NW subsystem.
 //!
 //! Forward, v_i(n) = c_i(n - d^f_i(n)) + r^f_i(n); backward, q_i(n) = h_i(n - d^b_i(n)) +
-//! r^b_i(n). Each arriving sample is pushed through its [`Channel`]; what comes out
+//! r^b_i(n), with a constant delay; with jitter, a replay or a codec, each packet
+//! arrives when its own delay says and the newest arrived is passed on
+//! (`tactile_common::channel`). Each arriving sample is pushed through its
+//! [`Channel`]; what comes out
 //! keeps the sample number and stamps of the sample that triggered it, with values (and
 //! their provenance) taken from the delayed one. What was done to each sample (noise
 //! added, delay, drop or corruption) is returned as the emulator's record of it.
@@ -23,7 +26,8 @@ pub struct EmulatorCounters {
     pub forward: u64,
     /// Backward samples passed.
     pub backward: u64,
-    /// Forward samples with a value substituted (delay line not yet filled).
+    /// Forward samples with no new packet: the last value (or, before the first
+    /// arrival, the first value sent) passed again, flagged.
     pub forward_substituted: u64,
     /// Backward samples with a value substituted.
     pub backward_substituted: u64,
@@ -50,7 +54,9 @@ pub struct EmulatorCounters {
 #[derive(Debug)]
 struct Faults {
     loss: f64,
-    model: Option<Loss>,
+    /// A loss model and its own random stream, so choosing one leaves the corruption
+    /// draws where they were.
+    model: Option<(Loss, ChaCha8Rng)>,
     corrupt: f64,
     rng: ChaCha8Rng,
 }
@@ -103,7 +109,11 @@ impl Faults {
         rng.set_stream(stream + 100);
         Faults {
             loss: cfg.loss,
-            model: cfg.loss_model.as_ref().map(Loss::new),
+            model: cfg.loss_model.as_ref().map(|m| {
+                let mut r = ChaCha8Rng::seed_from_u64(seed);
+                r.set_stream(stream + 500);
+                (Loss::new(m), r)
+            }),
             corrupt: cfg.corrupt,
             rng,
         }
@@ -114,8 +124,8 @@ impl Faults {
         if self.loss > 0.0 && self.rng.random::<f64>() < self.loss {
             return Fate::Drop;
         }
-        if let Some(m) = &mut self.model {
-            if m.lose(&mut self.rng) {
+        if let Some((m, rng)) = &mut self.model {
+            if m.lose(rng) {
                 return Fate::Drop;
             }
         }

@@ -34,7 +34,8 @@ pub struct SlaveCounters {
     pub steps: u64,
     /// Targets outside the workspace: IK clamped.
     pub ik_clamped: u64,
-    /// Samples with a NaN or infinite value, rejected (previous reference held).
+    /// Samples not physically possible (not finite, too large, too fast, out of
+    /// order), rejected and filled by the predictor; or outside the workspace (IK).
     pub rejected: u64,
     /// Joint torque clamps (one per joint per step).
     pub torque_clamps: u64,
@@ -97,7 +98,7 @@ impl Slave {
             predictor: Predictor::new(
                 &scenario.slave.predictor,
                 scenario.t_s(),
-                if wave { 1e4 } else { 10.0 },
+                if wave { 1e6 } else { 100.0 },
             ),
             controller: Controller::new(scenario.slave.controller.clone()),
             dynamics: Dynamics::new(scenario.slave.dynamics.clone(), [0.0; 3]),
@@ -266,7 +267,7 @@ impl Slave {
         out.signal.origin_seq = [v.signal.origin_seq[oldest]; 3];
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
         out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
-        out.signal.flags = flags;
+        out.signal.flags |= flags;
         let step = Step {
             n: v.seq,
             received: v.signal,
