@@ -39,10 +39,11 @@ pub struct EmulatorCounters {
     pub forward_corrupted: u64,
     /// Backward samples corrupted to NaN on purpose.
     pub backward_corrupted: u64,
-    /// Forward packets a replayed network lost (the receiver held its last value).
-    pub forward_replay_lost: u64,
-    /// Backward packets a replayed network lost.
-    pub backward_replay_lost: u64,
+    /// Forward packets the network lost (a loss model or a replay): no packet
+    /// arrived for them, and the receiver filled the sample from what it had.
+    pub forward_packets_lost: u64,
+    /// Backward packets the network lost.
+    pub backward_packets_lost: u64,
     /// Forward packets sent twice (netem's duplicate).
     pub forward_duplicated: u64,
     /// Backward packets sent twice.
@@ -97,7 +98,7 @@ pub struct Passage {
     pub noise: [f64; 3],
     /// Jitter drawn for this packet, samples (zero without a jitter model).
     pub jitter: f64,
-    /// True if a replayed network lost this packet.
+    /// True if the network lost this packet (a loss model or a replay).
     pub lost: bool,
     /// Delivered, corrupted or dropped.
     pub fate: Fate,
@@ -119,15 +120,16 @@ impl Faults {
         }
     }
 
+    /// Whether the loss model loses this sample's packet (one draw per sample, sent or
+    /// not, so a codec leaves the losses where they were).
+    fn packet_lost(&mut self) -> bool {
+        self.model.as_mut().is_some_and(|(m, rng)| m.lose(rng))
+    }
+
     fn fate(&mut self) -> Fate {
         // Draw only for enabled faults, so a run without them draws nothing.
         if self.loss > 0.0 && self.rng.random::<f64>() < self.loss {
             return Fate::Drop;
-        }
-        if let Some((m, rng)) = &mut self.model {
-            if m.lose(rng) {
-                return Fate::Drop;
-            }
         }
         if self.corrupt > 0.0 && self.rng.random::<f64>() < self.corrupt {
             return Fate::Corrupt;
@@ -217,7 +219,7 @@ impl Emulator {
         k.forward_substituted += u64::from(v.signal.flags & FLAG_SUBSTITUTED != 0);
         k.forward_corrupted += u64::from(fate == Fate::Corrupt);
         k.forward_dropped += u64::from(fate == Fate::Drop);
-        k.forward_replay_lost += u64::from(lost);
+        k.forward_packets_lost += u64::from(lost);
         k.forward_duplicated += u64::from(duplicated);
         let record = Passage {
             dir: Direction::Forward,
@@ -246,7 +248,7 @@ impl Emulator {
         k.backward_substituted += u64::from(q.signal.flags & FLAG_SUBSTITUTED != 0);
         k.backward_corrupted += u64::from(fate == Fate::Corrupt);
         k.backward_dropped += u64::from(fate == Fate::Drop);
-        k.backward_replay_lost += u64::from(lost);
+        k.backward_packets_lost += u64::from(lost);
         k.backward_duplicated += u64::from(duplicated);
         let record = Passage {
             dir: Direction::Backward,
@@ -272,10 +274,13 @@ fn pass(
     seq: u64,
     signal: &mut Signal,
 ) -> (Fate, [f64; 3], f64, bool, bool) {
-    // A sample its sender's codec did not send carries no packet; what leaves is what
-    // the network delivers at this sample.
-    let sent = signal.flags & FLAG_UNSENT == 0;
-    let e = channel.push_packet(seq, values(signal), sent);
+    // A sample its sender's codec did not send carries no packet, nor one the loss
+    // model loses (netem's loss is of packets: the receiver still ticks and fills the
+    // sample from what it has); `loss` instead drops the whole sample (the receiver
+    // gets nothing). What leaves is what the network delivers at this sample.
+    let unsent = signal.flags & FLAG_UNSENT != 0;
+    let model_lost = faults.packet_lost() && !unsent;
+    let e = channel.push_packet(seq, values(signal), !unsent && !model_lost);
     signal.flags &= !FLAG_UNSENT;
     apply(signal, &e);
     let fate = faults.fate();
@@ -283,5 +288,5 @@ fn pass(
         signal.value = [f64::NAN; 3];
         signal.flags |= FLAG_CORRUPTED;
     }
-    (fate, e.noise, e.jitter, e.lost, e.duplicated)
+    (fate, e.noise, e.jitter, e.lost || model_lost, e.duplicated)
 }
