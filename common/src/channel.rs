@@ -259,30 +259,29 @@ impl Channel {
         let mut noise = [0.0; 3];
         let mut substituted = false;
         for i in 0..3 {
-            let d = match replayed {
-                Some((d, _)) => u64::from(d),
-                None => (f64::from(delay[i]) + jitter).round().max(0.0) as u64,
-            };
+            // When a copy sent now with this jitter arrives: the replay's delay, or the
+            // configured one plus jitter; in sending order unless reordering is on.
+            let reorder = self.reorder;
             let f = &mut self.flight[i];
-            let at = if self.reorder {
-                seq.saturating_add(d)
-            } else {
-                seq.saturating_add(d).max(f.last_arrival)
+            let arrival = |f: &InFlight, jitter: f64| {
+                let d = match replayed {
+                    Some((d, _)) => u64::from(d),
+                    None => (f64::from(delay[i]) + jitter).round().max(0.0) as u64,
+                };
+                let at = seq.saturating_add(d);
+                if reorder {
+                    at
+                } else {
+                    at.max(f.last_arrival)
+                }
             };
             if sent {
+                let at = arrival(f, jitter);
                 f.send(seq, at);
             }
             if duplicated {
-                let d2 = match replayed {
-                    Some((d, _)) => u64::from(d),
-                    None => (f64::from(delay[i]) + copy_jitter).round().max(0.0) as u64,
-                };
-                let at2 = if self.reorder {
-                    seq.saturating_add(d2)
-                } else {
-                    seq.saturating_add(d2).max(f.last_arrival)
-                };
-                f.send(seq, at2);
+                let at = arrival(f, copy_jitter);
+                f.send(seq, at);
             }
             let newest = f.receive(seq, &self.ring, i);
             let fresh = newest.is_some() && newest.map(|n| n.0) != f.last_emitted;

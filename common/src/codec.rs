@@ -19,6 +19,7 @@
 
 use crate::samples::LATE_WINDOW;
 use crate::scenario::{invalid, ScenarioError};
+use crate::vec3::{distance, norm};
 use serde::{Deserialize, Serialize};
 
 /// `[codec.forward]`, `[codec.backward]`.
@@ -113,10 +114,6 @@ pub struct Deadband {
     last: Option<[f64; 3]>,
 }
 
-fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
-
 impl Deadband {
     /// A codec measuring values from `origin` (the device's home for positions, zero
     /// for forces); `default_floor` stands in for a floor left at 0.
@@ -149,7 +146,7 @@ impl Deadband {
             None => true,
             Some(last) => {
                 let rel = |v: [f64; 3]| [0, 1, 2].map(|i| v[i] - self.origin[i]);
-                let d = norm([0, 1, 2].map(|i| value[i] - last[i]));
+                let d = distance(value, last);
                 // A NaN distance (a non-finite value) is sent: the receiver rejects it.
                 d.is_nan() || d > k * norm(rel(last)) + self.floor
             }
@@ -416,7 +413,7 @@ impl Predictor {
             None => true,
             Some((t, last)) if at > t => {
                 let dt = (at - t) as f64 * self.t_s;
-                norm([0, 1, 2].map(|i| v[i] - last[i])) <= self.max_rate * dt
+                distance(v, last) <= self.max_rate * dt
             }
             Some(_) => false,
         }

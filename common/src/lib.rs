@@ -21,3 +21,4 @@ pub mod samples;
 pub mod scenario;
 pub mod trace;
 pub mod validation;
+pub mod vec3;

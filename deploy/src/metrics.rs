@@ -7,6 +7,7 @@
 use serde::Serialize;
 use tactile_common::samples::{FLAG_CORRUPTED, FLAG_REJECTED, FLAG_SUBSTITUTED, LATE_WINDOW};
 use tactile_common::trace::TraceRow;
+use tactile_common::vec3::{distance, norm};
 
 /// `tracking` in summary.json.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -112,10 +113,6 @@ fn slot(n: u64) -> usize {
     (n % LATE_WINDOW) as usize
 }
 
-fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
-}
-
 /// The entry for sample `n` of a ring, if still there.
 fn lookup(ring: &[Option<(u64, [f64; 3])>], n: u64) -> Option<[f64; 3]> {
     ring[slot(n)].filter(|(k, _)| *k == n).map(|(_, v)| v)
@@ -166,7 +163,7 @@ impl Bilateral {
         if self.recent_force.len() == SWING_WINDOW {
             self.recent_force.pop_front();
         }
-        self.recent_force.push_back(distance(row.h, [0.0; 3]));
+        self.recent_force.push_back(norm(row.h));
         if row.contact_object >= 0 {
             let depth = distance(row.surface, row.tool);
             self.contact.max_penetration_m = self.contact.max_penetration_m.max(depth);

@@ -12,6 +12,7 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use tactile_common::samples::{stage, FLAG_REJECTED, FLAG_SUBSTITUTED};
 use tactile_common::trace::TraceRow;
+use tactile_common::vec3::{distance, norm};
 
 /// Percentiles of one latency distribution, nanoseconds.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
@@ -287,10 +288,6 @@ pub struct Analysis {
     felt_sq: f64,
 }
 
-fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
-
 impl Analysis {
     /// An empty analysis; `with_stages`: the stamps are real (a process run);
     /// `domains`: the clock domain of master, emulator and slave.
@@ -326,7 +323,7 @@ impl Analysis {
         if row.stepped && row.flags_f & FLAG_REJECTED == 0 && row.v.iter().all(|x| x.is_finite()) {
             // The control's reference: v(n) itself without control, what TDPA or the
             // wave made of it otherwise (a wave is not a position).
-            let d = norm([0, 1, 2].map(|i| row.tool[i] - row.reference[i]));
+            let d = distance(row.tool, row.reference);
             self.track_sq += d * d;
             self.tracked += 1;
             m.tracking_max_m = Some(m.tracking_max_m.unwrap_or(0.0).max(d));

@@ -157,8 +157,7 @@ impl Master {
         };
         f.signal.value = self.control.transmit(c);
         f.signal.energy = self.control.energy();
-        let v = self.control.velocity();
-        let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let speed = tactile_common::vec3::norm(self.control.velocity());
         if self.codec.send(f.signal.value, speed) {
             self.counters.packets_sent += 1;
         } else {

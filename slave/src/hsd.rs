@@ -26,6 +26,7 @@ use tactile_common::samples::{
     Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
 use tactile_common::scenario::{Object, Scenario, ScenarioError};
+use tactile_common::vec3::distance;
 
 /// What the slave counted over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -140,8 +141,7 @@ impl Slave {
         self.advance(cmd.torque);
         let p0 = kernels::fk(&self.truth, &StdTrig, from);
         let p = kernels::fk(&self.truth, &StdTrig, self.dynamics.state.theta);
-        let drift =
-            ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2) + (p[2] - p0[2]).powi(2)).sqrt();
+        let drift = distance(p, p0);
         self.counters.hold_drift_max_m = self.counters.hold_drift_max_m.max(drift);
         HoldStep {
             step: self.counters.held_steps,
@@ -256,8 +256,7 @@ impl Slave {
         out.signal.value = self.control.transmit(force);
         out.signal.energy = self.control.energy();
         out.signal.sent_seq = [v.seq; 3];
-        let moved = [0, 1, 2].map(|i| tool[i] - self.last_tool[i]);
-        let speed = (moved[0].powi(2) + moved[1].powi(2) + moved[2].powi(2)).sqrt() / self.t_s;
+        let speed = distance(tool, self.last_tool) / self.t_s;
         self.last_tool = tool;
         if self.codec.send(out.signal.value, speed) {
             self.counters.packets_sent += 1;
