@@ -5,13 +5,7 @@
 
 use crate::util;
 
-use util::{column, Sandbox};
-
-/// The shipped wall-delay scenario (a 600 N/m wall, round trip 50 ms at 1 kHz).
-fn wall_delay() -> String {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/wall-delay.toml");
-    std::fs::read_to_string(path).expect("deploy/scenarios/wall-delay.toml")
-}
+use util::{column, wall_delay, Sandbox};
 
 /// Runs `scenario` in-process with `sets`, returns the summary.
 fn run(sb: &Sandbox, scenario: &str, out: &str, sets: &[&str]) -> serde_json::Value {
@@ -213,13 +207,6 @@ fn bad_control_settings_name_the_field() {
         ("master.device.step_s=1", "master.device.step_s"),
         ("operator.move_s=0", "operator.move_s"),
     ] {
-        let o = sb.tactile(&["run", s, "--in-process", "--out", "bad", "--set", set]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
-        assert!(
-            err.contains(needle) && err.lines().count() == 1,
-            "{set}: {err}"
-        );
-        assert!(!sb.path("bad").exists(), "{set}");
+        sb.assert_bad_set(s, set, needle);
     }
 }

@@ -7,12 +7,7 @@
 
 use crate::util;
 
-use util::Sandbox;
-
-fn wall_delay() -> String {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/wall-delay.toml");
-    std::fs::read_to_string(path).expect("deploy/scenarios/wall-delay.toml")
-}
+use util::{wall_delay, Sandbox};
 
 /// 20 ms of normal jitter (correlated 0.5) on both channels around 25 ms each, 5 %
 /// Gilbert-Elliott loss (p = 0.01, r = 0.19: mean burst 5.3 samples) on the backward
@@ -91,14 +86,7 @@ fn bad_channel_models_name_the_field() {
             "p13 + p14",
         ),
     ] {
-        let o = sb.tactile(&["run", s, "--in-process", "--out", "bad", "--set", set]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
-        assert!(
-            err.contains(needle) && err.lines().count() == 1,
-            "{set}: {err}"
-        );
-        assert!(!sb.path("bad").exists(), "{set}");
+        sb.assert_bad_set(s, set, needle);
     }
     // Both loss models at once is a choice to make, not to guess.
     let both = wall_delay().replace(

@@ -45,15 +45,7 @@ fn set_changes_the_scenario_as_run_and_is_checked_like_the_file() {
         ("samples", "expected KEY=VALUE"),
         ("network.forward.delay[7]=1", "delay has 3 entries"),
     ] {
-        let out = format!("bad-{}", set.len());
-        let o = sb.tactile(&["run", s, "--in-process", "--out", &out, "--set", set]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
-        assert!(
-            err.contains(needle) && err.lines().count() == 1,
-            "{set}: {err}"
-        );
-        assert!(!sb.path(&out).exists(), "{set}: nothing is written");
+        sb.assert_bad_set(s, set, needle);
     }
 }
 

@@ -126,6 +126,20 @@ impl Sandbox {
         serde_json::from_str(&text).expect("parse json")
     }
 
+    /// `tactile run SCENARIO --in-process --set SET` must be refused as bad input:
+    /// exit status 2, one line on stderr containing `needle`, nothing written.
+    pub fn assert_bad_set(&self, scenario: &str, set: &str, needle: &str) {
+        let out = format!("bad-{}", set.len());
+        let o = self.tactile(&["run", scenario, "--in-process", "--out", &out, "--set", set]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
+        assert!(
+            err.contains(needle) && err.lines().count() == 1,
+            "{set}: {err}"
+        );
+        assert!(!self.path(&out).exists(), "{set}: nothing is written");
+    }
+
     /// Reads a run's trace.
     pub fn trace(&self, out: &str) -> String {
         std::fs::read_to_string(self.path(out).join("trace.csv")).expect("read trace")
@@ -177,6 +191,12 @@ pub fn std_dev(v: &[f64]) -> f64 {
     let n = v.len() as f64;
     let mean = v.iter().sum::<f64>() / n;
     (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+/// The shipped wall-delay scenario (a 600 N/m wall, round trip 50 ms at 1 kHz).
+pub fn wall_delay() -> String {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/wall-delay.toml");
+    std::fs::read_to_string(path).expect("deploy/scenarios/wall-delay.toml")
 }
 
 /// The paper scenario at 1 kHz in real time, `samples` samples.
