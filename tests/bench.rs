@@ -18,6 +18,10 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
         "1000",
         "--lockstep-samples",
         "400",
+        // A SCHED_FIFO 99 probe would stall the tests running beside this one; the
+        // probe has its own unit test.
+        "--probe-s",
+        "0",
         "--out",
         out.to_str().expect("utf-8"),
         "--prefix",
@@ -76,6 +80,7 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
     }
     assert_eq!(loops[0]["stages_ns"].as_object().map(|m| m.len()), Some(9));
     assert!(v["lockstep_samples_per_s"].as_f64() > Some(100.0));
+    assert_eq!(v["machine"]["note"], "not probed (--probe-s 0)", "{v}");
     // Each trio left its own full report.
     for run in ["iceoryx2-1000", "udp-1000", "lockstep"]
         .into_iter()

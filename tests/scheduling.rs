@@ -39,6 +39,7 @@ fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
         assert_eq!(s["wake_early_us"], 200, "{role}: {s}");
         assert_eq!(s["poll_us"], 400, "{role}: {s}");
         assert_eq!(s["memory_locked"], true, "{role}: {s}");
+        assert_eq!(s["idle_poll"], false, "{role}: {s}");
         assert!(s["note"].is_null(), "{role}: {s}");
         if tactile::run_cmd::two_cpus() {
             assert_eq!(s["cpu"], cpu, "{role}: {s}");
@@ -46,6 +47,7 @@ fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
     }
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("SCHED_FIFO 70"), "{text}");
+    assert!(!text.contains("kept awake"), "{text}");
     // The percentile plot is written beside the histograms.
     let svg = std::fs::read_to_string(out.join("percentiles.svg")).expect("svg");
     assert!(svg.contains("99.9%"), "percentile axis");
@@ -87,6 +89,8 @@ fn where_sched_fifo_is_refused_the_nodes_run_sched_other_and_say_so() {
         let s = &sum["nodes"][role]["sched"];
         assert_eq!(s["policy"], "SCHED_OTHER", "{role}: {s}");
         assert_eq!(s["priority"], 0, "{role}: {s}");
+        // A SCHED_OTHER node that yields would hand its CPU to the idle-poll thread.
+        assert_eq!(s["idle_poll"], false, "{role}: {s}");
         let note = s["note"].as_str().unwrap_or_default();
         assert!(note.contains("SCHED_FIFO not permitted"), "{role}: {s}");
     }
@@ -109,5 +113,35 @@ fn lockstep_runs_sched_other_whatever_is_asked() {
         assert_eq!(s["policy"], "SCHED_OTHER", "{role}: {s}");
         assert_eq!(s["wake_early_us"], 0, "{role}: {s}");
         assert_eq!(s["priority"], 0, "{role}: {s}");
+        assert_eq!(s["idle_poll"], false, "{role}: {s}");
     }
+}
+
+#[test]
+fn idle_poll_keeps_the_cpus_awake_and_the_summary_says_so() {
+    if !is_root() {
+        eprintln!("SKIPPED: not root, so SCHED_FIFO is not permitted here");
+        return;
+    }
+    let sb = Sandbox::new("awake");
+    let s = sb.write("s.toml", &util::paper_1khz(1000));
+    let out = sb.path("out");
+    let mut args = run_args(
+        &sb,
+        s.to_str().expect("utf-8"),
+        out.to_str().expect("utf-8"),
+    );
+    args.extend(["--idle", "poll"]);
+    let o = sb.tactile(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sum = sb.json("out", "summary.json");
+    for role in ["master", "emulator", "slave"] {
+        let s = &sum["nodes"][role]["sched"];
+        assert_eq!(s["policy"], "SCHED_FIFO", "{role}: {s}");
+        assert_eq!(s["idle_poll"], true, "{role}: {s}");
+        assert!(s["note"].is_null(), "{role}: {s}");
+    }
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("CPU kept awake"), "{text}");
+    sb.assert_no_leftover_processes();
 }

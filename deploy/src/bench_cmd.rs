@@ -94,6 +94,8 @@ pub struct BenchReport {
     pub lockstep_samples: u64,
     /// Wait strategy used.
     pub strategy: String,
+    /// The machine's own stalls, probed after the loops (`--probe-s`).
+    pub machine: crate::stalls::StallReport,
 }
 
 /// A loop's result; a stop request (SIGINT, SIGTERM) ends the bench, so the
@@ -320,6 +322,7 @@ fn supervision(args: &BenchArgs, prefix: &str) -> Supervision {
         },
         pin: !args.no_pin,
         sched: args.sched,
+        idle: args.idle,
         no_trace: false,
         wrap: Default::default(),
     }
@@ -333,6 +336,12 @@ fn zenoh_built(link: LinkKind) -> bool {
 
 /// `tactile bench`.
 pub fn main(args: &BenchArgs) -> Result<(), Error> {
+    if !(0.0..=3600.0).contains(&args.probe_s) {
+        return Err(Error::BadInput(format!(
+            "--probe-s {}: must be 0 to 3600 seconds",
+            args.probe_s
+        )));
+    }
     std::fs::create_dir_all(&args.out)
         .map_err(Error::io(format!("creating {}", args.out.display())))?;
     crate::run_cmd::clean_stale_runs();
@@ -438,7 +447,20 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     let sc = scenario(1000.0, n, Mode::Lockstep)?;
     let sup = supervision(args, &prefix);
     let lock = trio(&sc, &args.out.join("lockstep"), &sup, LinkKind::Iceoryx2)?;
+    let machine = if args.probe_s > 0.0 {
+        eprintln!(
+            "tactile bench: the machine's own stalls, {} s per CPU",
+            args.probe_s
+        );
+        crate::stalls::probe(args.probe_s, true)
+    } else {
+        crate::stalls::StallReport {
+            note: Some("not probed (--probe-s 0)".into()),
+            ..Default::default()
+        }
+    };
     let report = BenchReport {
+        machine,
         lockstep_samples_per_s: lock.master.samples_per_s,
         lockstep_samples: n,
         strategy: strategy(args),
@@ -453,9 +475,14 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
 fn strategy(args: &BenchArgs) -> String {
     format!(
         "every loop: {}, each node sleeping until {} before its sample is due, then polling (yielding) for {} before it blocks{}",
-        match args.sched {
-            tactile_node::sched::Policy::Fifo => "SCHED_FIFO where permitted (memory locked)",
-            tactile_node::sched::Policy::Other => "SCHED_OTHER",
+        match (args.sched, args.idle) {
+            (tactile_node::sched::Policy::Fifo, tactile_node::sched::Idle::Poll) => {
+                "SCHED_FIFO where permitted (memory locked, each CPU kept awake while its node sleeps)"
+            }
+            (tactile_node::sched::Policy::Fifo, tactile_node::sched::Idle::Halt) => {
+                "SCHED_FIFO where permitted (memory locked)"
+            }
+            (tactile_node::sched::Policy::Other, _) => "SCHED_OTHER",
         },
         args.wake_early_us
             .map_or_else(|| "200 us (at most 40 % of a period)".to_string(), |u| format!("{u} us")),
@@ -527,6 +554,11 @@ fn render(r: &BenchReport) -> String {
         t,
         "\nlockstep throughput: {:.0} samples/s over {} samples",
         r.lockstep_samples_per_s, r.lockstep_samples
+    );
+    let _ = write!(
+        t,
+        "\nthe machine's own stalls:\n{}",
+        crate::stalls::render(&r.machine)
     );
     t
 }

@@ -18,5 +18,6 @@ pub mod report;
 pub mod report_cmd;
 pub mod run_cmd;
 pub mod sim;
+pub mod stalls;
 pub mod summary;
 pub mod sweep_cmd;

@@ -101,6 +101,7 @@ pub fn sweep_supervision(no_trace: bool) -> Supervision {
         wrap: Default::default(),
         pin: true,
         sched: tactile_node::sched::Policy::Fifo,
+        idle: tactile_node::sched::Idle::Halt,
         no_trace,
     }
 }
@@ -231,6 +232,8 @@ pub struct Supervision {
     pub pin: bool,
     /// Scheduling of the three processes, which each node sets on itself.
     pub sched: tactile_node::sched::Policy,
+    /// What each node's CPU does while the node sleeps (realtime, SCHED_FIFO).
+    pub idle: tactile_node::sched::Idle,
     /// Write no trace.csv.
     pub no_trace: bool,
 }
@@ -333,6 +336,7 @@ fn node_command(
         .arg(out)
         .args(["--prefix", &sup.prefix])
         .args(["--sched", sup.sched.name()])
+        .args(["--idle", sup.idle.name()])
         .args(["--supervised", &std::process::id().to_string()]);
     if let Some(spin) = sup.spin {
         cmd.args(["--spin-us", &spin.as_micros().to_string()]);
@@ -652,6 +656,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
             link: Links::on_this_host(if args.udp { LinkKind::Udp } else { args.link })?,
             pin: !args.no_pin,
             sched: args.sched,
+            idle: args.idle,
             no_trace: args.no_trace,
             wrap: Default::default(),
         };

@@ -312,6 +312,9 @@ fn sched_line(s: &tactile_node::sched::Sched) -> String {
     if s.memory_locked {
         t += ", memory locked";
     }
+    if s.idle_poll {
+        t += ", CPU kept awake";
+    }
     if let Some(n) = &s.note {
         t += &format!(" ({n})");
     }

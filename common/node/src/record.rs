@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// First bytes of every record file; the last byte is the format version.
-pub const MAGIC: [u8; 8] = *b"TACTREC\x03";
+pub const MAGIC: [u8; 8] = *b"TACTREC\x04";
 /// Largest frame a reader accepts; anything longer is corruption.
 pub const MAX_FRAME: u32 = 1 << 20;
 
@@ -377,7 +377,10 @@ mod tests {
             Ok(_) => panic!("a record of version 1 was opened"),
         };
         assert!(
-            e.contains("format version 1; this build reads version 3"),
+            e.contains(&format!(
+                "format version 1; this build reads version {}",
+                MAGIC[7]
+            )),
             "{e}"
         );
         let mut bytes = MAGIC.to_vec();

@@ -94,6 +94,12 @@ pub struct NodeArgs {
     /// SCHED_OTHER: its loop never sleeps.
     #[arg(long, value_enum, default_value_t = crate::sched::Policy::Fifo)]
     pub sched: crate::sched::Policy,
+    /// What the node's CPU does while a realtime node under SCHED_FIFO sleeps: halt
+    /// (the kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so
+    /// a halted CPU is not woken late; on these virtual machines a CPU kept busy is
+    /// taken away for 7 ms every 10 s instead: README "Waiting").
+    #[arg(long, value_enum, default_value_t = crate::sched::Idle::Halt)]
+    pub idle: crate::sched::Idle,
     /// SCHED_FIFO priority, 1 to 98.
     #[arg(long, default_value_t = crate::sched::DEFAULT_PRIORITY, value_parser = clap::value_parser!(u8).range(1..=98))]
     pub priority: u8,
@@ -163,6 +169,8 @@ pub struct Prepared {
     pub wake_early: Duration,
     /// The scheduling in force.
     pub sched: crate::sched::Sched,
+    /// The threads keeping the node's CPUs awake, while the node lives.
+    pub awake: Option<crate::sched::KeepAwake>,
     /// The run's lock for this role, held while the node lives.
     pub lock: Lock,
 }
@@ -204,13 +212,14 @@ pub fn prepare(role: &str, args: &NodeArgs) -> Result<Prepared, NodeError> {
     }
     let (wake_early, spin) = waiting(&scenario, args.wake_early_us, args.spin_us);
     check_waiting(args, &scenario, wake_early, spin)?;
-    let sched = schedule(args, &scenario, wake_early, spin);
+    let (sched, awake) = schedule(args, &scenario, wake_early, spin);
     Ok(Prepared {
         scenario,
         base_dir,
         spin,
         wake_early,
         sched,
+        awake,
         lock,
     })
 }
@@ -266,32 +275,41 @@ fn check_waiting(
 }
 
 /// Applies the scheduling the arguments ask for (SCHED_FIFO only for a realtime
-/// run) and says in the log what the kernel refused.
+/// run, the CPUs kept awake only under SCHED_FIFO) and says in the log what the kernel
+/// refused.
 fn schedule(
     args: &NodeArgs,
     scenario: &Scenario,
     wake_early: Duration,
     spin: Duration,
-) -> crate::sched::Sched {
-    use crate::sched::{apply, Policy, Sched};
+) -> (crate::sched::Sched, Option<crate::sched::KeepAwake>) {
+    use crate::sched::{apply, Idle, KeepAwake, Policy, Sched};
     let realtime = scenario.mode == tactile_common::scenario::Mode::Realtime;
     let policy = if realtime { args.sched } else { Policy::Other };
-    let (fifo, memory_locked, notes) = apply(policy, args.priority);
+    let (fifo, memory_locked, mut notes) = apply(policy, args.priority);
     if !realtime && args.sched == Policy::Fifo {
         tracing::info!("lockstep: SCHED_OTHER (its loop never sleeps)");
     }
+    let awake = match fifo && args.idle == Idle::Poll {
+        false => None,
+        true => KeepAwake::start()
+            .map_err(|e| notes.push(format!("CPUs not kept awake ({e})")))
+            .ok(),
+    };
     for n in &notes {
         tracing::warn!("{n}");
     }
-    Sched {
+    let sched = Sched {
         policy: if fifo { "SCHED_FIFO" } else { "SCHED_OTHER" }.into(),
         priority: if fifo { args.priority } else { 0 },
         cpu: args.cpu,
         wake_early_us: wake_early.as_micros() as u64,
         poll_us: spin.as_micros() as u64,
         memory_locked,
+        idle_poll: awake.is_some(),
         note: (!notes.is_empty()).then(|| notes.join("; ")),
-    }
+    };
+    (sched, awake)
 }
 
 /// Asks the kernel to send SIGTERM when the launcher dies (even by SIGKILL), and stops

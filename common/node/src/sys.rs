@@ -23,6 +23,14 @@ pub fn set_fifo(priority: i32) -> Result<()> {
     check(unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &p) })
 }
 
+/// SCHED_IDLE for the calling thread: it runs only when nothing else on its CPU wants
+/// to, and any other thread's wake-up preempts it.
+pub fn set_idle() -> Result<()> {
+    let p = libc::sched_param { sched_priority: 0 };
+    // SAFETY: as in `set_fifo`.
+    check(unsafe { libc::sched_setscheduler(0, libc::SCHED_IDLE, &p) })
+}
+
 /// Locks what is mapped now and every page as it is first touched (MCL_ONFAULT:
 /// thread stacks and arenas are not faulted in whole, so memory stays as small
 /// as it was).
