@@ -44,7 +44,9 @@ impl Hosts {
         c.args(&exec[1..])
             .arg(node_dir().join(program))
             .args(args)
-            .env("TACTILE_CLOCK_DOMAIN", format!("host-{k}"));
+            .env("TACTILE_CLOCK_DOMAIN", format!("host-{k}"))
+            // The nodes' own choice of Zenoh runtimes, whatever the caller's shell has.
+            .env_remove("ZENOH_RUNTIME");
         c
     }
 }
@@ -158,6 +160,13 @@ fn master_here_slave_there(all_zenoh: bool) {
             .map(|l| l.contains("zenoh")),
         Some(true)
     );
+    // Each node hands Zenoh's work to one runtime thread unless the user says
+    // otherwise (ZENOH_RUNTIME), and its log says which runtimes it ran.
+    for (dir, role) in [("a-master", "master"), ("b-emulator", "emulator")] {
+        let log = std::fs::read_to_string(sb.path(dir).join(format!("{role}.log"))).expect("log");
+        let want = format!("Zenoh runtimes: {}", tactile_node::zlink::RUNTIME);
+        assert!(log.contains(&want), "{role}: {log}");
+    }
 }
 
 #[test]
