@@ -79,6 +79,7 @@ fn where_sched_fifo_is_refused_the_nodes_run_sched_other_and_say_so() {
         s.to_str().expect("utf-8"),
         out.to_str().expect("utf-8"),
     ))
+    .args(["--idle", "poll"])
     .current_dir(sb.dir.path())
     .env("TACTILE_NODE_DIR", util::node_dir());
     let o = c.output().expect("setpriv");
@@ -89,7 +90,8 @@ fn where_sched_fifo_is_refused_the_nodes_run_sched_other_and_say_so() {
         let s = &sum["nodes"][role]["sched"];
         assert_eq!(s["policy"], "SCHED_OTHER", "{role}: {s}");
         assert_eq!(s["priority"], 0, "{role}: {s}");
-        // A SCHED_OTHER node that yields would hand its CPU to the idle-poll thread.
+        // Asked for, but a SCHED_OTHER node that yields would hand its CPU to the
+        // idle-poll thread: not started.
         assert_eq!(s["idle_poll"], false, "{role}: {s}");
         let note = s["note"].as_str().unwrap_or_default();
         assert!(note.contains("SCHED_FIFO not permitted"), "{role}: {s}");
@@ -106,7 +108,15 @@ fn lockstep_runs_sched_other_whatever_is_asked() {
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace("samples = 1200", "samples = 300");
     let s = sb.write("s.toml", &text);
-    sb.run(&s, "out");
+    let out = sb.path("out");
+    let mut args = run_args(
+        &sb,
+        s.to_str().expect("utf-8"),
+        out.to_str().expect("utf-8"),
+    );
+    args.extend(["--sched", "fifo", "--idle", "poll"]);
+    let o = sb.tactile(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let sum = sb.json("out", "summary.json");
     for role in ["master", "emulator", "slave"] {
         let s = &sum["nodes"][role]["sched"];

@@ -336,9 +336,9 @@ fn zenoh_built(link: LinkKind) -> bool {
 
 /// `tactile bench`.
 pub fn main(args: &BenchArgs) -> Result<(), Error> {
-    if !(0.0..=3600.0).contains(&args.probe_s) {
+    if !(0.0..=600.0).contains(&args.probe_s) {
         return Err(Error::BadInput(format!(
-            "--probe-s {}: must be 0 to 3600 seconds",
+            "--probe-s {}: must be 0 to 600 seconds",
             args.probe_s
         )));
     }
@@ -452,13 +452,16 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             "tactile bench: the machine's own stalls, {} s per CPU",
             args.probe_s
         );
-        crate::stalls::probe(args.probe_s, true)
+        crate::stalls::probe(args.probe_s, true, &stop)
     } else {
         crate::stalls::StallReport {
             note: Some("not probed (--probe-s 0)".into()),
             ..Default::default()
         }
     };
+    if stop.load(std::sync::atomic::Ordering::SeqCst) {
+        return Err(Error::Interrupted);
+    }
     let report = BenchReport {
         machine,
         lockstep_samples_per_s: lock.master.samples_per_s,
@@ -476,10 +479,10 @@ fn strategy(args: &BenchArgs) -> String {
     format!(
         "every loop: {}, each node sleeping until {} before its sample is due, then polling (yielding) for {} before it blocks{}",
         match (args.sched, args.idle) {
-            (tactile_node::sched::Policy::Fifo, tactile_node::sched::Idle::Poll) => {
+            (tactile_node::sched::Policy::Fifo, tactile_node::sched::IdleMode::Poll) => {
                 "SCHED_FIFO where permitted (memory locked, each CPU kept awake while its node sleeps)"
             }
-            (tactile_node::sched::Policy::Fifo, tactile_node::sched::Idle::Halt) => {
+            (tactile_node::sched::Policy::Fifo, tactile_node::sched::IdleMode::Halt) => {
                 "SCHED_FIFO where permitted (memory locked)"
             }
             (tactile_node::sched::Policy::Other, _) => "SCHED_OTHER",

@@ -98,7 +98,8 @@ pub struct BenchArgs {
     #[arg(long, value_delimiter = ',', default_values_t = [1000.0, 10000.0])]
     pub rates: Vec<f64>,
     /// Seconds to probe the machine's own stalls after the loops: a SCHED_FIFO 99
-    /// thread per CPU that reads the clock, 900 ms of every second (0: no probe).
+    /// thread per CPU that reads the clock, 900 ms of every second (0: no probe; at
+    /// most 600).
     #[arg(long, default_value_t = 20.0)]
     pub probe_s: f64,
     /// Samples of the lockstep throughput run.
@@ -120,9 +121,10 @@ pub struct BenchArgs {
     /// What each node's CPU does while the node sleeps, under SCHED_FIFO: halt (the
     /// kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so a
     /// halted CPU is not woken late; on these virtual machines a CPU kept busy is
-    /// taken away for 7 ms every 10 s instead: README "Waiting").
-    #[arg(long, value_enum, default_value_t = tactile_node::sched::Idle::Halt)]
-    pub idle: tactile_node::sched::Idle,
+    /// taken away for about 7.5 ms every 10 s instead: README "What the CPUs do while the nodes
+    /// sleep").
+    #[arg(long, value_enum, default_value_t = tactile_node::sched::IdleMode::Halt)]
+    pub idle: tactile_node::sched::IdleMode,
     /// Do not pin the iceoryx2 processes to CPUs.
     #[arg(long)]
     pub no_pin: bool,
@@ -191,9 +193,10 @@ pub struct RunArgs {
     /// What each node's CPU does while the node sleeps, under SCHED_FIFO: halt (the
     /// kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so a
     /// halted CPU is not woken late; on these virtual machines a CPU kept busy is
-    /// taken away for 7 ms every 10 s instead: README "Waiting").
-    #[arg(long, value_enum, default_value_t = tactile_node::sched::Idle::Halt)]
-    pub idle: tactile_node::sched::Idle,
+    /// taken away for about 7.5 ms every 10 s instead: README "What the CPUs do while the nodes
+    /// sleep").
+    #[arg(long, value_enum, default_value_t = tactile_node::sched::IdleMode::Halt)]
+    pub idle: tactile_node::sched::IdleMode,
     /// Write no trace.csv (a long run's trace is about 1 kB per sample); everything
     /// else is reported.
     #[arg(long)]

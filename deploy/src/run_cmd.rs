@@ -101,7 +101,7 @@ pub fn sweep_supervision(no_trace: bool) -> Supervision {
         wrap: Default::default(),
         pin: true,
         sched: tactile_node::sched::Policy::Fifo,
-        idle: tactile_node::sched::Idle::Halt,
+        idle: tactile_node::sched::IdleMode::Halt,
         no_trace,
     }
 }
@@ -233,7 +233,7 @@ pub struct Supervision {
     /// Scheduling of the three processes, which each node sets on itself.
     pub sched: tactile_node::sched::Policy,
     /// What each node's CPU does while the node sleeps (realtime, SCHED_FIFO).
-    pub idle: tactile_node::sched::Idle,
+    pub idle: tactile_node::sched::IdleMode,
     /// Write no trace.csv.
     pub no_trace: bool,
 }

@@ -2,15 +2,18 @@
 //!
 //! A thread per CPU at SCHED_FIFO 99, pinned, reads the monotonic clock in a tight
 //! loop; a gap between two reads is time its CPU did not run it. Nothing in the guest
-//! preempts a SCHED_FIFO 99 thread but interrupts and the kernel's stop-machine
-//! work, so a gap of milliseconds is the CPU taken away (by the hypervisor, which
+//! preempts a SCHED_FIFO 99 thread but interrupts, the kernel's stop-machine work and
+//! (if set below 900 ms a second) the real-time throttle, and the loop touches no new
+//! memory, so a gap of milliseconds is the CPU taken away (by the hypervisor, which
 //! the steal counter of `/proc/stat` does not always show): a loop's deadline miss
 //! that lines up with such gaps is the machine's, not the loop's. Each thread spins
-//! 900 ms of every second and sleeps the rest: the kernel's real-time throttle
-//! (950 ms of every second) is never reached and the other tasks keep a tenth of
-//! the CPUs.
+//! 900 ms of every second and sleeps the rest: the kernel's default real-time
+//! throttle (950 ms of every second) is never reached and the other tasks keep a
+//! tenth of the CPUs (so the CPUs probed are busy 90 % of the time, not always).
 
 use serde::Serialize;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Shortest gap counted, ns: a timer interrupt on these machines takes 5 to 50 us.
@@ -64,13 +67,16 @@ impl CpuStalls {
 pub struct StallReport {
     /// Each CPU probed.
     pub cpus: Vec<CpuStalls>,
+    /// Probed at SCHED_FIFO 99 (else at the caller's policy).
+    pub fifo: bool,
     /// Why nothing (or not everything) was measured.
     pub note: Option<String>,
 }
 
-/// Probes every CPU this process may use for `seconds`, all at once. `fifo`: at
-/// SCHED_FIFO 99 (else at the caller's policy, which measures the scheduler too).
-pub fn probe(seconds: f64, fifo: bool) -> StallReport {
+/// Probes every CPU this process may use for `seconds`, all at once, until `stop` is
+/// set. `fifo`: at SCHED_FIFO 99 (else at the caller's policy, which measures the
+/// scheduler too).
+pub fn probe(seconds: f64, fifo: bool, stop: &Arc<AtomicBool>) -> StallReport {
     let cpus = match allowed_cpus() {
         Ok(c) => c,
         Err(e) => {
@@ -83,16 +89,28 @@ pub fn probe(seconds: f64, fifo: bool) -> StallReport {
     let length = Duration::from_secs_f64(seconds.max(0.0));
     let threads: Vec<_> = cpus
         .into_iter()
-        .map(|cpu| std::thread::spawn(move || probe_cpu(cpu, length, fifo)))
+        .map(|cpu| {
+            let stop = Arc::clone(stop);
+            std::thread::spawn(move || probe_cpu(cpu, length, fifo, &stop))
+        })
         .collect();
-    let mut report = StallReport::default();
+    let mut report = StallReport {
+        fifo,
+        ..Default::default()
+    };
+    let mut notes = Vec::new();
     for t in threads {
         match t.join() {
             Ok(Ok(c)) => report.cpus.push(c),
-            Ok(Err(e)) => report.note = Some(e),
-            Err(_) => report.note = Some("a probe thread panicked".into()),
+            Ok(Err(e)) => notes.push(e),
+            Err(_) => notes.push("a probe thread panicked".into()),
         }
     }
+    if stop.load(Ordering::Relaxed) {
+        notes.push("stopped before the end".into());
+    }
+    notes.dedup();
+    report.note = (!notes.is_empty()).then(|| notes.join("; "));
     report
 }
 
@@ -103,7 +121,12 @@ fn allowed_cpus() -> Result<Vec<usize>, String> {
 }
 
 /// One CPU's probe, in its own thread (the affinity and policy it sets die with it).
-fn probe_cpu(cpu: usize, length: Duration, fifo: bool) -> Result<CpuStalls, String> {
+fn probe_cpu(
+    cpu: usize,
+    length: Duration,
+    fifo: bool,
+    stop: &AtomicBool,
+) -> Result<CpuStalls, String> {
     let mut set = rustix::thread::CpuSet::new();
     set.set(cpu);
     rustix::thread::sched_setaffinity(None, &set)
@@ -114,15 +137,17 @@ fn probe_cpu(cpu: usize, length: Duration, fifo: bool) -> Result<CpuStalls, Stri
     }
     let mut s = CpuStalls {
         cpu,
+        // Allocated before the spin, which then touches no new memory.
+        long_at_s: Vec::with_capacity(KEPT),
         ..Default::default()
     };
     let start = Instant::now();
     let mut spun = Duration::ZERO;
-    while spun < length {
+    while spun < length && !stop.load(Ordering::Relaxed) {
         let burst = SPIN_OF_SECOND.min(length - spun);
         let from = Instant::now();
         let mut last = from;
-        while last - from < burst {
+        while last - from < burst && !stop.load(Ordering::Relaxed) {
             let now = Instant::now();
             let gap = (now - last).as_nanos() as u64;
             s.add((last - start).as_nanos() as u64, gap);
@@ -141,6 +166,11 @@ fn probe_cpu(cpu: usize, length: Duration, fifo: bool) -> Result<CpuStalls, Stri
 pub fn render(r: &StallReport) -> String {
     use std::fmt::Write as _;
     let mut t = String::new();
+    let how = if r.fifo {
+        "at SCHED_FIFO 99"
+    } else {
+        "at the bench's own policy"
+    };
     for c in &r.cpus {
         let every = if c.over_1ms > 0 {
             format!(", one every {:.1} s", c.spun_s / c.over_1ms as f64)
@@ -149,7 +179,7 @@ pub fn render(r: &StallReport) -> String {
         };
         let _ = writeln!(
             t,
-            "CPU {}: {:.1} s spun at SCHED_FIFO 99: {} gaps >= 100 us, {} >= 1 ms ({:.1} ms lost{every}), longest {:.0} us",
+            "CPU {}: {:.1} s spun {how}: {} gaps >= 100 us, {} >= 1 ms ({:.1} ms lost{every}), longest {:.0} us",
             c.cpu, c.spun_s, c.over_100us, c.over_1ms, c.lost_ms, c.max_us
         );
     }
@@ -171,10 +201,16 @@ mod tests {
         fn gaps_are_counted_by_class(gaps in proptest::collection::vec(0u64..20_000_000, 0..200)) {
             let mut s = CpuStalls::default();
             let mut at = 0;
+            let mut long_at = Vec::new();
             for &g in &gaps {
                 s.add(at, g);
+                if g >= LONG_NS {
+                    long_at.push(at as f64 / 1e9);
+                }
                 at += g + 1_000;
             }
+            long_at.truncate(KEPT);
+            prop_assert_eq!(&s.long_at_s, &long_at);
             let long: Vec<u64> = gaps.iter().copied().filter(|&g| g >= LONG_NS).collect();
             prop_assert_eq!(s.over_100us, gaps.iter().filter(|&&g| g >= COUNTED_NS).count() as u64);
             prop_assert_eq!(s.over_1ms, long.len() as u64);
@@ -190,12 +226,24 @@ mod tests {
     fn a_probe_spins_as_long_as_asked_on_every_cpu() {
         // At the caller's policy: a SCHED_FIFO 99 spinner would stall the tests
         // running beside this one.
-        let r = probe(0.2, false);
+        let r = probe(0.2, false, &Arc::new(AtomicBool::new(false)));
         assert!(r.note.is_none(), "{r:?}");
         assert_eq!(r.cpus.len(), allowed_cpus().expect("cpus").len());
         for c in &r.cpus {
             assert!((0.2..0.5).contains(&c.spun_s), "{c:?}");
         }
         assert!(render(&r).contains("gaps >= 100 us"));
+    }
+
+    #[test]
+    fn a_stop_request_ends_the_probe_at_once() {
+        let started = Instant::now();
+        let r = probe(30.0, false, &Arc::new(AtomicBool::new(true)));
+        assert!(started.elapsed() < Duration::from_secs(2), "{r:?}");
+        assert!(
+            r.note.as_deref().is_some_and(|n| n.contains("stopped")),
+            "{r:?}"
+        );
+        assert!(r.cpus.iter().all(|c| c.spun_s < 1.0), "{r:?}");
     }
 }

@@ -97,9 +97,10 @@ pub struct NodeArgs {
     /// What the node's CPU does while a realtime node under SCHED_FIFO sleeps: halt
     /// (the kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so
     /// a halted CPU is not woken late; on these virtual machines a CPU kept busy is
-    /// taken away for 7 ms every 10 s instead: README "Waiting").
-    #[arg(long, value_enum, default_value_t = crate::sched::Idle::Halt)]
-    pub idle: crate::sched::Idle,
+    /// taken away for about 7.5 ms every 10 s instead: README "What the CPUs do while the nodes
+    /// sleep").
+    #[arg(long, value_enum, default_value_t = crate::sched::IdleMode::Halt)]
+    pub idle: crate::sched::IdleMode,
     /// SCHED_FIFO priority, 1 to 98.
     #[arg(long, default_value_t = crate::sched::DEFAULT_PRIORITY, value_parser = clap::value_parser!(u8).range(1..=98))]
     pub priority: u8,
@@ -283,14 +284,17 @@ fn schedule(
     wake_early: Duration,
     spin: Duration,
 ) -> (crate::sched::Sched, Option<crate::sched::KeepAwake>) {
-    use crate::sched::{apply, Idle, KeepAwake, Policy, Sched};
+    use crate::sched::{apply, IdleMode, KeepAwake, Policy, Sched};
     let realtime = scenario.mode == tactile_common::scenario::Mode::Realtime;
     let policy = if realtime { args.sched } else { Policy::Other };
     let (fifo, memory_locked, mut notes) = apply(policy, args.priority);
     if !realtime && args.sched == Policy::Fifo {
         tracing::info!("lockstep: SCHED_OTHER (its loop never sleeps)");
     }
-    let awake = match fifo && args.idle == Idle::Poll {
+    if args.idle == IdleMode::Poll && !fifo {
+        tracing::info!("--idle poll applies under SCHED_FIFO only: CPUs not kept awake");
+    }
+    let awake = match fifo && args.idle == IdleMode::Poll {
         false => None,
         true => KeepAwake::start()
             .map_err(|e| notes.push(format!("CPUs not kept awake ({e})")))
@@ -515,6 +519,9 @@ SIGTERM (the record is complete).\n\nThe record (ROLE.rec) and log (ROLE.log) go
 /// Parses a node's command line; on an error prints clap's message and returns the
 /// exit status (2 for bad arguments, 0 for --help and --version).
 pub fn parse<T: clap::Parser>() -> Result<T, ExitCode> {
+    // First thing, while the node has one thread.
+    #[cfg(feature = "zenoh")]
+    crate::zlink::default_runtime();
     T::try_parse().map_err(|e| {
         let _ = e.print();
         ExitCode::from(if e.use_stderr() {

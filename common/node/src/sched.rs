@@ -34,7 +34,7 @@ impl Policy {
 
 /// What a CPU does while the realtime node on it sleeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Idle {
+pub enum IdleMode {
     /// A SCHED_IDLE thread keeps the CPU busy, so the virtual machine never halts it
     /// ([`KeepAwake`]).
     Poll,
@@ -42,12 +42,12 @@ pub enum Idle {
     Halt,
 }
 
-impl Idle {
+impl IdleMode {
     /// The choice's name on the nodes' command line.
     pub fn name(self) -> &'static str {
         match self {
-            Idle::Poll => "poll",
-            Idle::Halt => "halt",
+            IdleMode::Poll => "poll",
+            IdleMode::Halt => "halt",
         }
     }
 }
@@ -157,13 +157,14 @@ fn prefault_stack() {
 ///
 /// Why: on a virtual machine a CPU with nothing to run halts, and the hypervisor wakes
 /// it late for the node's timer. A SCHED_FIFO thread sleeping to each 1 ms tick on
-/// these machines woke 39 us late at p50, 304 to 428 us at p99.9 and up to 1.7 ms; with
-/// a SCHED_IDLE thread spinning on its CPU, 16 us, 23 to 64 us and 31 to 227 us. Any
-/// thread's wake-up preempts a SCHED_IDLE thread at once, so it takes nothing from the
-/// loop. But it is not the default: here the hypervisor takes a CPU that never idles
-/// away for about 7.5 ms every 10 s, and the loop misses 11 to 12 deadlines in 20 s
-/// where with halting CPUs it missed none (README "Waiting"). On a machine whose cores
-/// are the loop's own it is what the kernel's `idle=poll` does, for these CPUs only. The spin has no `pause` hint: on these machines a
+/// these machines woke 39 us late at p50, 304 to 428 us at p99.9 and up to 1.7 ms;
+/// with a SCHED_IDLE thread spinning on its CPU, 16 us, 23 to 64 us and 31 to 227 us.
+/// Any thread's wake-up preempts a SCHED_IDLE thread at once, so it takes nothing from
+/// the loop. But it is not the default: here the hypervisor takes a CPU that never
+/// idles away for about 7.5 ms every 10 s, and the loop misses 11 to 12 deadlines in
+/// 20 s where with halting CPUs it missed none (README "What the CPUs do while the
+/// nodes sleep"). On a machine whose cores are the loop's own it is what the kernel's
+/// `idle=poll` does, for these CPUs only. The spin has no `pause` hint: on these machines a
 /// pause loop makes the hypervisor take the CPU away (pause-loop exiting), which
 /// measured worse. Only under SCHED_FIFO: a SCHED_OTHER node that yields while it polls
 /// would hand its CPU to the spinning thread until the next scheduler tick.
@@ -184,9 +185,10 @@ impl KeepAwake {
             stop: stop.clone(),
             threads: Vec::new(),
         };
-        let (tx, rx) = std::sync::mpsc::channel();
         for cpu in (0..CpuSet::MAX_CPU).filter(|&c| allowed.is_set(c)) {
-            let (stop, tx) = (stop.clone(), tx.clone());
+            let stop = stop.clone();
+            // The thread's only sender: if it dies before it says, the receive fails.
+            let (tx, rx) = std::sync::mpsc::sync_channel(1);
             let t = std::thread::Builder::new()
                 .name(format!("idle-poll-{cpu}"))
                 .stack_size(64 * 1024)
@@ -237,6 +239,10 @@ mod tests {
 
     #[test]
     fn keep_awake_spins_at_sched_idle_and_stops() {
+        // Where permitted (root), from a SCHED_FIFO thread as in a node: the spinners
+        // inherit SCHED_FIFO and must lower themselves. (This test's thread ends with
+        // the test.)
+        let _ = set_thread_fifo(10);
         let awake = KeepAwake::start().expect("start");
         assert!(!awake.threads.is_empty());
         let me = std::process::id();
