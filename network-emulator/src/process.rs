@@ -119,6 +119,11 @@ pub fn run_with<L: EmulatorLink + ?Sized>(
                     awaiting = Some(v.seq);
                     v.stamps[stage::EMU_FWD_SEND] = now_ns();
                     link.send_v(v, false)?;
+                    // The slave usually shares this CPU, polling for v(n): let it take
+                    // v(n) now and write the record after, as the slave does with h(n)
+                    // (measured: the hop's p50 from 3.0 to 1.6 us at 1 kHz under
+                    // SCHED_FIFO, the loop's from 10.1-10.4 to 9.5-9.6 us).
+                    std::thread::yield_now();
                 }
                 rec.sample(passage)?;
             }
