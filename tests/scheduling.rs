@@ -14,6 +14,21 @@ fn run_args<'a>(sb: &'a Sandbox, scenario: &'a str, out: &'a str) -> Vec<&'a str
     vec!["run", scenario, "--out", out, "--prefix", &sb.prefix, "-q"]
 }
 
+/// `tactile run` of the scenario `text` into the folder `out` with `extra` arguments;
+/// it must succeed. Returns its stdout and the summary.
+fn run(sb: &Sandbox, text: &str, extra: &[&str]) -> (String, serde_json::Value) {
+    let s = sb.write("s.toml", text);
+    let out = sb.path("out");
+    let mut args = run_args(sb, s.to_str().expect("utf-8"), out.to_str().expect("utf-8"));
+    args.extend(extra);
+    let o = sb.tactile(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        sb.json("out", "summary.json"),
+    )
+}
+
 #[test]
 fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
     if !is_root() {
@@ -21,16 +36,7 @@ fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
         return;
     }
     let sb = Sandbox::new("fifo");
-    let s = sb.write("s.toml", &util::paper_1khz(1500));
-    let out = sb.path("out");
-    let args = run_args(
-        &sb,
-        s.to_str().expect("utf-8"),
-        out.to_str().expect("utf-8"),
-    );
-    let o = sb.tactile(&args);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let sum = sb.json("out", "summary.json");
+    let (text, sum) = run(&sb, &util::paper_1khz(1500), &[]);
     assert_eq!(sum["samples_lost"], 0);
     for (role, cpu) in [("master", 0), ("emulator", 1), ("slave", 1)] {
         let s = &sum["nodes"][role]["sched"];
@@ -45,11 +51,10 @@ fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
             assert_eq!(s["cpu"], cpu, "{role}: {s}");
         }
     }
-    let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("SCHED_FIFO 70"), "{text}");
     assert!(!text.contains("kept awake"), "{text}");
     // The percentile plot is written beside the histograms.
-    let svg = std::fs::read_to_string(out.join("percentiles.svg")).expect("svg");
+    let svg = std::fs::read_to_string(sb.path("out").join("percentiles.svg")).expect("svg");
     assert!(svg.contains("99.9%"), "percentile axis");
     sb.assert_no_leftover_processes();
 }
@@ -107,17 +112,7 @@ fn lockstep_runs_sched_other_whatever_is_asked() {
     let text = tactile::run_cmd::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace("samples = 1200", "samples = 300");
-    let s = sb.write("s.toml", &text);
-    let out = sb.path("out");
-    let mut args = run_args(
-        &sb,
-        s.to_str().expect("utf-8"),
-        out.to_str().expect("utf-8"),
-    );
-    args.extend(["--sched", "fifo", "--idle", "poll"]);
-    let o = sb.tactile(&args);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let sum = sb.json("out", "summary.json");
+    let (_, sum) = run(&sb, &text, &["--sched", "fifo", "--idle", "poll"]);
     for role in ["master", "emulator", "slave"] {
         let s = &sum["nodes"][role]["sched"];
         assert_eq!(s["policy"], "SCHED_OTHER", "{role}: {s}");
@@ -134,24 +129,13 @@ fn idle_poll_keeps_the_cpus_awake_and_the_summary_says_so() {
         return;
     }
     let sb = Sandbox::new("awake");
-    let s = sb.write("s.toml", &util::paper_1khz(1000));
-    let out = sb.path("out");
-    let mut args = run_args(
-        &sb,
-        s.to_str().expect("utf-8"),
-        out.to_str().expect("utf-8"),
-    );
-    args.extend(["--idle", "poll"]);
-    let o = sb.tactile(&args);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let sum = sb.json("out", "summary.json");
+    let (text, sum) = run(&sb, &util::paper_1khz(1000), &["--idle", "poll"]);
     for role in ["master", "emulator", "slave"] {
         let s = &sum["nodes"][role]["sched"];
         assert_eq!(s["policy"], "SCHED_FIFO", "{role}: {s}");
         assert_eq!(s["idle_poll"], true, "{role}: {s}");
         assert!(s["note"].is_null(), "{role}: {s}");
     }
-    let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("CPU kept awake"), "{text}");
     sb.assert_no_leftover_processes();
 }

@@ -199,12 +199,6 @@ impl Drop for Restore {
     }
 }
 
-fn pin_self(cpu: usize) {
-    let mut set = rustix::thread::CpuSet::new();
-    set.set(cpu);
-    let _ = rustix::thread::sched_setaffinity(None, &set);
-}
-
 /// The bare hop's poll budget: as given, else two periods (it has no pacer).
 fn hop_spin(sup: &Supervision, rate: f64) -> Duration {
     sup.spin
@@ -234,7 +228,7 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
     let result = (|| -> Result<(Latency, u64), Error> {
         let fail = |e: IpcError| Error::Failed(e.to_string());
         if sup.pin {
-            pin_self(0);
+            let _ = tactile_node::sched::pin_thread(0);
         }
         let _restore = Restore(saved_affinity);
         let node = ipc::node(&prefix, "bench").map_err(fail)?;

@@ -77,7 +77,7 @@ pub struct StallReport {
 /// set. `fifo`: at SCHED_FIFO 99 (else at the caller's policy, which measures the
 /// scheduler too).
 pub fn probe(seconds: f64, fifo: bool, stop: &Arc<AtomicBool>) -> StallReport {
-    let cpus = match allowed_cpus() {
+    let cpus = match tactile_node::sched::allowed_cpus() {
         Ok(c) => c,
         Err(e) => {
             return StallReport {
@@ -114,12 +114,6 @@ pub fn probe(seconds: f64, fifo: bool, stop: &Arc<AtomicBool>) -> StallReport {
     report
 }
 
-fn allowed_cpus() -> Result<Vec<usize>, String> {
-    use rustix::thread::{sched_getaffinity, CpuSet};
-    let set = sched_getaffinity(None).map_err(|e| format!("reading CPU affinity: {e}"))?;
-    Ok((0..CpuSet::MAX_CPU).filter(|&c| set.is_set(c)).collect())
-}
-
 /// One CPU's probe, in its own thread (the affinity and policy it sets die with it).
 fn probe_cpu(
     cpu: usize,
@@ -127,9 +121,7 @@ fn probe_cpu(
     fifo: bool,
     stop: &AtomicBool,
 ) -> Result<CpuStalls, String> {
-    let mut set = rustix::thread::CpuSet::new();
-    set.set(cpu);
-    rustix::thread::sched_setaffinity(None, &set)
+    tactile_node::sched::pin_thread(cpu)
         .map_err(|e| format!("pinning the probe to CPU {cpu}: {e}"))?;
     if fifo {
         tactile_node::sched::set_thread_fifo(99)
@@ -228,7 +220,10 @@ mod tests {
         // running beside this one.
         let r = probe(0.2, false, &Arc::new(AtomicBool::new(false)));
         assert!(r.note.is_none(), "{r:?}");
-        assert_eq!(r.cpus.len(), allowed_cpus().expect("cpus").len());
+        assert_eq!(
+            r.cpus.len(),
+            tactile_node::sched::allowed_cpus().expect("cpus").len()
+        );
         for c in &r.cpus {
             assert!((0.2..0.5).contains(&c.spun_s), "{c:?}");
         }

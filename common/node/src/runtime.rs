@@ -333,14 +333,10 @@ fn supervise(parent: u32) -> Result<(), NodeError> {
 
 /// Pins the calling thread (the node's only thread) to `cpu`.
 pub fn pin(cpu: usize) -> Result<(), String> {
-    use rustix::thread::{sched_getaffinity, sched_setaffinity, CpuSet};
-    let allowed = sched_getaffinity(None).map_err(|e| format!("reading CPU affinity: {e}"))?;
-    if cpu >= CpuSet::MAX_CPU || !allowed.is_set(cpu) {
+    if !crate::sched::allowed_cpus()?.contains(&cpu) {
         return Err(format!("--cpu {cpu}: not a CPU this process may use"));
     }
-    let mut set = CpuSet::new();
-    set.set(cpu);
-    sched_setaffinity(None, &set).map_err(|e| format!("pinning to CPU {cpu}: {e}"))
+    crate::sched::pin_thread(cpu).map_err(|e| format!("pinning to CPU {cpu}: {e}"))
 }
 
 /// The record file of `role` in `dir`.

@@ -178,14 +178,13 @@ impl KeepAwake {
     /// Starts one spinning thread on each CPU the calling thread may run on; each
     /// lowers itself to SCHED_IDLE before it spins.
     pub fn start() -> Result<KeepAwake, String> {
-        use rustix::thread::{sched_getaffinity, CpuSet};
-        let allowed = sched_getaffinity(None).map_err(|e| format!("reading CPU affinity: {e}"))?;
+        let cpus = allowed_cpus()?;
         let stop = Arc::new(AtomicBool::new(false));
         let mut awake = KeepAwake {
             stop: stop.clone(),
             threads: Vec::new(),
         };
-        for cpu in (0..CpuSet::MAX_CPU).filter(|&c| allowed.is_set(c)) {
+        for cpu in cpus {
             let stop = stop.clone();
             // The thread's only sender: if it dies before it says, the receive fails.
             let (tx, rx) = std::sync::mpsc::sync_channel(1);
@@ -209,12 +208,23 @@ impl KeepAwake {
     }
 }
 
-/// Pins the calling thread to `cpu` and lowers it to SCHED_IDLE.
-fn spinner_setup(cpu: usize) -> Result<(), String> {
+/// The CPUs the calling thread may run on.
+pub fn allowed_cpus() -> Result<Vec<usize>, String> {
+    use rustix::thread::{sched_getaffinity, CpuSet};
+    let set = sched_getaffinity(None).map_err(|e| format!("reading CPU affinity: {e}"))?;
+    Ok((0..CpuSet::MAX_CPU).filter(|&c| set.is_set(c)).collect())
+}
+
+/// Pins the calling thread to `cpu` alone (threads it starts later inherit it).
+pub fn pin_thread(cpu: usize) -> rustix::io::Result<()> {
     let mut set = rustix::thread::CpuSet::new();
     set.set(cpu);
     rustix::thread::sched_setaffinity(None, &set)
-        .map_err(|e| format!("pinning the idle-poll thread to CPU {cpu}: {e}"))?;
+}
+
+/// Pins the calling thread to `cpu` and lowers it to SCHED_IDLE.
+fn spinner_setup(cpu: usize) -> Result<(), String> {
+    pin_thread(cpu).map_err(|e| format!("pinning the idle-poll thread to CPU {cpu}: {e}"))?;
     crate::sys::set_idle().map_err(|e| format!("SCHED_IDLE for the idle-poll thread: {e}"))
 }
 
