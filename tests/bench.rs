@@ -3,7 +3,7 @@
 
 use crate::util;
 
-use tactile_common::trace::signal_columns;
+use tactile_report::trace::signal_columns;
 use util::Sandbox;
 
 #[test]

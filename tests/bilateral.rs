@@ -179,7 +179,7 @@ fn every_control_kind_repeats_and_the_processes_match_the_simulation() {
         sb.run(&s, &b);
         let sim = run(&sb, &text, &format!("{kind}-sim"), &[]);
         assert_eq!(sim["control"], kind);
-        let signals = |d: &str| tactile_common::trace::signal_columns(&sb.trace(d));
+        let signals = |d: &str| tactile_report::trace::signal_columns(&sb.trace(d));
         assert_eq!(signals(&a), signals(&b), "{kind}: two runs differ");
         assert_eq!(
             signals(&a),

@@ -6,7 +6,7 @@ use crate::util;
 
 use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};
-use tactile_common::samples::{Forward, FLAG_PEER_LOST};
+use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
 use tactile_node::ipc::{self, Inbox, Outbox};
 use util::{column, Sandbox};
 

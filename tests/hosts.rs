@@ -11,8 +11,8 @@ use crate::util;
 
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
-use tactile_common::samples::{Forward, FLAG_PEER_LOST};
-use tactile_common::trace::signal_columns;
+use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
+use tactile_report::trace::signal_columns;
 use util::{column, node_dir, Sandbox};
 
 /// Two hosts: network namespaces made for the test, removed on drop.

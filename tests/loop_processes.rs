@@ -2,7 +2,7 @@
 
 use crate::util;
 
-use tactile_common::trace::signal_columns;
+use tactile_report::trace::signal_columns;
 use util::{column, std_dev, Sandbox};
 
 /// The paper scenario with a delayed, noisy network, in the given mode.

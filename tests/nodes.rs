@@ -7,7 +7,7 @@ use crate::util;
 use std::path::Path;
 use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};
-use tactile_common::trace::signal_columns;
+use tactile_report::trace::signal_columns;
 use util::{column, pid_of, Sandbox};
 
 /// The paper scenario in lockstep with a noisy, delayed network.

@@ -18,11 +18,11 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-use tactile_common::clock::{now_ns, sleep_until_ns};
-use tactile_common::samples::{Forward, FLAG_END, FLAG_PROBE};
-use tactile_common::scenario::{Mode, Scenario};
+use tactile_messages::clock::{now_ns, sleep_until_ns};
+use tactile_messages::samples::{Forward, FLAG_END, FLAG_PROBE};
 use tactile_node::ipc::{self, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
 use tactile_node::runtime::LinkKind;
+use tactile_scenario::{Mode, Scenario};
 
 /// Runs of this bench so far (their prefixes' suffix).
 static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);

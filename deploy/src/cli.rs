@@ -5,9 +5,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use tactile_common::arith::ArithKind;
-use tactile_common::cordic::{CordicConfig, Rounding};
-use tactile_common::geometry::Geometry;
+use tactile_math::arith::ArithKind;
+use tactile_math::cordic::{CordicConfig, Rounding};
+use tactile_math::geometry::Geometry;
 
 /// Tactile: runtime and testbed for bilateral tactile-internet teleoperation.
 #[derive(Debug, Parser)]
@@ -303,7 +303,7 @@ impl DatapathArgs {
                 self.device
             ))
         })?;
-        Geometry::from_toml_str(&text)
+        tactile_scenario::geometry_from_toml(&text)
             .map_err(|e| Error::BadInput(format!("{}: {e}", path.display())))
     }
 }

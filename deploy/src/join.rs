@@ -10,13 +10,13 @@
 use crate::error::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use tactile_common::samples::{stage, LATE_WINDOW};
-use tactile_common::trace::TraceRow;
 use tactile_master::record::{Answer, MasterSample, MasterTotals, Miss, Sent};
+use tactile_messages::samples::{stage, LATE_WINDOW};
 use tactile_network_emulator::emulator::{Direction, Passage};
 use tactile_network_emulator::process::EmulatorTotals;
 use tactile_node::record::{Record, RecordReader, Start, Totals};
 use tactile_node::runtime::record_path;
+use tactile_report::trace::TraceRow;
 use tactile_slave::record::{SlaveSample, SlaveTotals, Step};
 
 /// The roles whose records are joined.

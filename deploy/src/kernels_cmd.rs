@@ -8,10 +8,10 @@
 use crate::cli::{KernelsArgs, Module};
 use crate::error::Error;
 use std::io::{BufRead, Write};
-use tactile_common::arith::ArithKind;
-use tactile_common::csv;
-use tactile_common::engine::Engine;
-use tactile_common::kernels::IkStatus;
+use tactile_math::arith::ArithKind;
+use tactile_math::engine::Engine;
+use tactile_math::kernels::IkStatus;
+use tactile_scenario::csv;
 
 impl Module {
     /// Input column names, in order.

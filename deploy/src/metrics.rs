@@ -5,9 +5,9 @@
 //! a ring of [`LATE_WINDOW`] samples (a value delayed longer is not compared).
 
 use serde::Serialize;
-use tactile_common::samples::{FLAG_CORRUPTED, FLAG_REJECTED, FLAG_SUBSTITUTED, LATE_WINDOW};
-use tactile_common::trace::TraceRow;
-use tactile_common::vec3::{distance, norm};
+use tactile_math::vec3::{distance, norm};
+use tactile_messages::samples::{FLAG_CORRUPTED, FLAG_REJECTED, FLAG_SUBSTITUTED, LATE_WINDOW};
+use tactile_report::trace::TraceRow;
 
 /// `tracking` in summary.json.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]

@@ -4,8 +4,8 @@ use crate::cli::PaperArgs;
 use crate::error::Error;
 use serde::Serialize;
 use std::io::Write;
-use tactile_common::cordic::{CordicConfig, Rounding};
-use tactile_common::validation::{self, MseRow};
+use tactile_math::cordic::{CordicConfig, Rounding};
+use tactile_math::validation::{self, MseRow};
 
 #[derive(Debug, Serialize)]
 struct Report<'a> {

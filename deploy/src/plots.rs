@@ -10,7 +10,7 @@
 use crate::report::Latency;
 use plotters::prelude::*;
 use std::path::Path;
-use tactile_common::trace::TraceRow;
+use tactile_report::trace::TraceRow;
 
 type PlotResult = Result<(), String>;
 

@@ -10,9 +10,9 @@
 use hdrhistogram::Histogram;
 use serde::Serialize;
 use std::fmt::Write as _;
-use tactile_common::samples::{stage, FLAG_REJECTED, FLAG_SUBSTITUTED};
-use tactile_common::trace::TraceRow;
-use tactile_common::vec3::{distance, norm};
+use tactile_math::vec3::{distance, norm};
+use tactile_messages::samples::{stage, FLAG_REJECTED, FLAG_SUBSTITUTED};
+use tactile_report::trace::TraceRow;
 
 /// Percentiles of one latency distribution, nanoseconds.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]

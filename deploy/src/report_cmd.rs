@@ -12,8 +12,8 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use tactile_common::scenario::Scenario;
-use tactile_common::trace;
+use tactile_report::trace;
+use tactile_scenario::Scenario;
 
 /// Files a report writes into its folder.
 pub const REPORT_FILES: [&str; 10] = [

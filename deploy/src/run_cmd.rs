@@ -12,11 +12,11 @@ use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tactile_common::overrides::Set;
-use tactile_common::scenario::{Mode, Operator, Scenario};
 use tactile_master::operator::OperatorSource;
 use tactile_node::files::{self, same_file};
 use tactile_node::runtime::{LinkKind, EXIT_BAD_INPUT, EXIT_INTERRUPTED};
+use tactile_scenario::overrides::Set;
+use tactile_scenario::{Mode, Operator, Scenario};
 
 /// The paper scenario, built into the executable so `tactile run` works from any folder.
 pub const PAPER_SCENARIO: &str = include_str!("../scenarios/paper.toml");
@@ -48,7 +48,7 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
             p.display().to_string(),
         ),
     };
-    let text = tactile_common::overrides::apply(&text, sets)
+    let text = tactile_scenario::overrides::apply(&text, sets)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     let with = if sets.is_empty() {
         String::new()

@@ -9,17 +9,17 @@
 use crate::error::Error;
 use crate::report_cmd::IN_PROCESS;
 use std::path::Path;
-use tactile_common::clock::now_ns;
-use tactile_common::samples::stage;
-use tactile_common::scenario::Scenario;
 use tactile_master::hmd::Master;
 use tactile_master::operator::OperatorSource;
 use tactile_master::process::MasterRecorder;
 use tactile_master::record::{MasterSample, MasterTotals};
+use tactile_messages::clock::now_ns;
+use tactile_messages::samples::stage;
 use tactile_network_emulator::emulator::Emulator;
 use tactile_network_emulator::process::{EmulatorRecorder, EmulatorTotals};
 use tactile_node::record::Start;
 use tactile_node::runtime::{NodeError, Recorder};
+use tactile_scenario::Scenario;
 use tactile_slave::hsd::Slave;
 use tactile_slave::process::SlaveRecorder;
 use tactile_slave::record::{SlaveSample, SlaveTotals};
@@ -58,7 +58,7 @@ fn failed(e: NodeError) -> Error {
 pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<(), Error> {
     let source = OperatorSource::load(&scenario.operator, base_dir)
         .map_err(|e| Error::BadInput(e.to_string()))?;
-    let bad = |e: tactile_common::scenario::ScenarioError| Error::BadInput(e.to_string());
+    let bad = |e: tactile_scenario::ScenarioError| Error::BadInput(e.to_string());
     let mut master = Master::new(scenario, source).map_err(bad)?;
     let replays =
         tactile_network_emulator::replay::load(scenario, base_dir).map_err(Error::BadInput)?;

@@ -6,9 +6,9 @@ use crate::report::{us_header, us_line, ClockOffset, Motion, Percentiles};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
-use tactile_common::scenario::Mode;
 use tactile_master::record::MasterTotals;
 use tactile_network_emulator::process::EmulatorTotals;
+use tactile_scenario::Mode;
 use tactile_slave::record::SlaveTotals;
 
 /// Accounting of one stream: every sample offered is received or lost, and every
@@ -142,7 +142,7 @@ pub struct Summary {
     /// RMS distance of the slave's tool from the position it was asked to reach, m.
     pub tracking_rms_m: Option<f64>,
     /// The operator's hand: `position` (ideal) or `impedance`.
-    pub hand: tactile_common::scenario::HandMode,
+    pub hand: tactile_scenario::HandMode,
     /// The channel's control: `none`, `tdpa` or `wave`.
     pub control: &'static str,
     /// The slave against the master's delay-shifted handle, the felt force against the
@@ -241,8 +241,8 @@ pub fn render(s: &Summary, out: &Path) -> String {
         t,
         "bilateral ({} hand, control {}): position rms {} against the delay-shifted handle, force rms {}, penetration max {:.2} mm",
         match s.hand {
-            tactile_common::scenario::HandMode::Position => "position",
-            tactile_common::scenario::HandMode::Impedance => "impedance",
+            tactile_scenario::HandMode::Position => "position",
+            tactile_scenario::HandMode::Impedance => "impedance",
         },
         s.control,
         mm(s.tracking.position_rms_m),

@@ -14,7 +14,7 @@ use crate::error::Error;
 use crate::report_cmd::{write_report, Launch};
 use crate::run_cmd::{load_scenario, prepare_out};
 use std::path::Path;
-use tactile_common::overrides::{split_values, Set};
+use tactile_scenario::overrides::{split_values, Set};
 
 /// The columns of `sweep.csv` after the swept keys: a name, and where the value is in
 /// a run's `summary.json` (a JSON pointer).

@@ -11,10 +11,10 @@
 //! semi-implicit Euler at a fixed step, so a run depends only on its inputs.
 
 use nalgebra::{Matrix3, Vector3};
-use tactile_common::arith::StdTrig;
-use tactile_common::geometry::Lengths;
-use tactile_common::kernels;
-use tactile_common::scenario::{HandConfig, MasterDeviceConfig};
+use tactile_math::arith::StdTrig;
+use tactile_math::geometry::Lengths;
+use tactile_math::kernels;
+use tactile_scenario::{HandConfig, MasterDeviceConfig};
 
 /// Velocity, rad/s, below which Coulomb friction fades in (tanh smoothing, so the
 /// integration stays smooth through zero velocity).
@@ -106,11 +106,11 @@ impl HeldDevice {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tactile_common::geometry::Geometry;
+    use tactile_math::geometry::Geometry;
 
     fn device() -> HeldDevice {
         let hand = HandConfig {
-            mode: tactile_common::scenario::HandMode::Impedance,
+            mode: tactile_scenario::HandMode::Impedance,
             ..HandConfig::default()
         };
         HeldDevice::new(

@@ -15,16 +15,16 @@ use crate::device::HeldDevice;
 use crate::operator::{min_jerk, OperatorSource, Target};
 use crate::record::{Answer, Miss, Sent};
 use serde::{Deserialize, Serialize};
-use tactile_common::codec::{Deadband, Estimate, Predictor};
-use tactile_common::control::{MasterForce, MasterSide};
-use tactile_common::engine::Engine;
-use tactile_common::kernels::IkStatus;
-use tactile_common::samples::{
+use tactile_control::codec::{Deadband, Estimate, Predictor};
+use tactile_control::passivity::{MasterForce, MasterSide};
+use tactile_math::engine::Engine;
+use tactile_math::kernels::IkStatus;
+use tactile_messages::samples::{
     stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_REJECTED,
     FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
-use tactile_common::scenario::ControlKind;
-use tactile_common::scenario::{HandMode, MasterConfig, Scenario, ScenarioError};
+use tactile_scenario::ControlKind;
+use tactile_scenario::{HandMode, MasterConfig, Scenario, ScenarioError};
 
 /// What the master counted over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -86,12 +86,12 @@ impl Master {
     pub fn new(scenario: &Scenario, source: OperatorSource) -> Result<Master, ScenarioError> {
         let geometry = scenario.device.geometry()?;
         let cordic = scenario.cordic.config()?;
-        let bad = |e: tactile_common::cordic::CordicError| ScenarioError::Invalid {
+        let bad = |e: tactile_math::cordic::CordicError| ScenarioError::Invalid {
             field: "cordic".into(),
             problem: e.to_string(),
         };
         let lengths = geometry.lengths();
-        let home = tactile_common::kernels::fk(&lengths, &tactile_common::arith::StdTrig, [0.0; 3]);
+        let home = tactile_math::kernels::fk(&lengths, &tactile_math::arith::StdTrig, [0.0; 3]);
         // Wave variables are neither positions nor forces: the codec measures them from
         // zero, and the predictor's plausibility bound is wider.
         let wave = scenario.control.kind == ControlKind::Wave;
@@ -106,7 +106,7 @@ impl Master {
         });
         Ok(Master {
             engine: Engine::new(scenario.arithmetic, geometry, cordic).map_err(bad)?,
-            truth: Engine::new(tactile_common::arith::ArithKind::F64, geometry, cordic)
+            truth: Engine::new(tactile_math::arith::ArithKind::F64, geometry, cordic)
                 .map_err(bad)?,
             source,
             t_s: scenario.t_s(),
@@ -157,7 +157,7 @@ impl Master {
         };
         f.signal.value = self.control.transmit(c);
         f.signal.energy = self.control.energy();
-        let speed = tactile_common::vec3::norm(self.control.velocity());
+        let speed = tactile_math::vec3::norm(self.control.velocity());
         if self.codec.send(f.signal.value, speed) {
             self.counters.packets_sent += 1;
         } else {

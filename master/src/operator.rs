@@ -6,9 +6,9 @@
 //! a run repeats exactly.
 
 use std::path::Path;
-use tactile_common::csv;
-use tactile_common::scenario::Operator;
-use tactile_common::validation::{paper_joint_path, MOVE_S};
+use tactile_math::validation::{paper_joint_path, MOVE_S};
+use tactile_scenario::csv;
+use tactile_scenario::Operator;
 use thiserror::Error;
 
 /// What the operator commands at one sample.

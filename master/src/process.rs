@@ -13,12 +13,12 @@ use crate::operator::{OperatorError, OperatorSource};
 use crate::record::{MasterSample, MasterTotals};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-use tactile_common::clock::{now_ns, sleep_until_ns};
-use tactile_common::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, LATE_WINDOW};
-use tactile_common::scenario::{Mode, Scenario, ScenarioError};
+use tactile_messages::clock::{now_ns, sleep_until_ns};
+use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, LATE_WINDOW};
 use tactile_node::ipc::{Idle, IpcError};
 use tactile_node::link::MasterLink;
 use tactile_node::runtime::{NodeError, Recorder};
+use tactile_scenario::{Mode, Scenario, ScenarioError};
 use thiserror::Error;
 
 /// What the master process needs to run.

@@ -3,7 +3,7 @@
 
 use crate::hmd::MasterCounters;
 use serde::{Deserialize, Serialize};
-use tactile_common::samples::{stage, Signal};
+use tactile_messages::samples::{stage, Signal};
 use tactile_node::ipc::{InboxStats, OutboxStats};
 
 /// Sample n as it left the master.

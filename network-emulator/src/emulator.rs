@@ -3,7 +3,7 @@
 //! Forward, v_i(n) = c_i(n - d^f_i(n)) + r^f_i(n); backward, q_i(n) = h_i(n - d^b_i(n)) +
 //! r^b_i(n), with a constant delay; with jitter, a replay or a codec, each packet
 //! arrives when its own delay says and the newest arrived is passed on
-//! (`tactile_common::channel`). Each arriving sample is pushed through its
+//! (`tactile_netem::channel`). Each arriving sample is pushed through its
 //! [`Channel`]; what comes out
 //! keeps the sample number and stamps of the sample that triggered it, with values (and
 //! their provenance) taken from the delayed one. What was done to each sample (noise
@@ -12,12 +12,12 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
-use tactile_common::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
-use tactile_common::netem::{Loss, Replay};
-use tactile_common::samples::{
+use tactile_messages::samples::{
     Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
-use tactile_common::scenario::{ChannelConfig, Scenario};
+use tactile_netem::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
+use tactile_netem::models::{Loss, Replay};
+use tactile_scenario::{ChannelConfig, Scenario};
 
 /// What the emulator counted over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -159,7 +159,7 @@ fn values(s: &Signal) -> [Value; 3] {
     })
 }
 
-fn apply(s: &mut Signal, e: &tactile_common::channel::Emitted) {
+fn apply(s: &mut Signal, e: &tactile_netem::channel::Emitted) {
     for i in 0..3 {
         s.value[i] = e.values[i].v;
         s.energy[i] = e.values[i].energy;

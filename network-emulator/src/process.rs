@@ -5,13 +5,13 @@
 use crate::emulator::{Emulator, EmulatorCounters, Passage};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
-use tactile_common::clock::now_ns;
-use tactile_common::samples::{stage, FLAG_END, FLAG_PROBE};
-use tactile_common::scenario::{Mode, Scenario};
+use tactile_messages::clock::now_ns;
+use tactile_messages::samples::{stage, FLAG_END, FLAG_PROBE};
 use tactile_node::ipc::{Idle, IpcError};
 use tactile_node::link::{Arrival, EmulatorLink, EmulatorStats, RunFilter};
 use tactile_node::pace::{recv_paced, Pacer};
 use tactile_node::runtime::{NodeError, Recorder};
+use tactile_scenario::{Mode, Scenario};
 
 /// The emulator's counters.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -48,7 +48,7 @@ impl From<NodeError> for EmulatorError {
 /// a stop request (false).
 pub fn run_with<L: EmulatorLink + ?Sized>(
     scenario: &Scenario,
-    replays: [Option<tactile_common::netem::Replay>; 2],
+    replays: [Option<tactile_netem::models::Replay>; 2],
     link: &L,
     rec: &mut EmulatorRecorder,
     wake_early: Duration,
@@ -162,7 +162,7 @@ mod tests {
     use super::*;
     use std::cell::RefCell;
     use std::collections::VecDeque;
-    use tactile_common::samples::{Backward, Forward};
+    use tactile_messages::samples::{Backward, Forward};
     use tactile_node::ipc::{InboxStats, OutboxStats};
 
     /// A scripted link: hands out its arrivals in order and notes, for every receive,

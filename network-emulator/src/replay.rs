@@ -2,8 +2,9 @@
 //! checked, and handed to the pure channel).
 
 use std::path::Path;
-use tactile_common::netem::{Replay, ReplayConfig, ReplayFormat};
-use tactile_common::scenario::{ChannelConfig, Scenario};
+use tactile_netem::models::Replay;
+use tactile_scenario::{ChannelConfig, Scenario};
+use tactile_scenario::{ReplayConfig, ReplayFormat};
 
 /// Largest replay file accepted, bytes (a line per packet: hours at 1 kHz).
 pub const MAX_REPLAY_BYTES: u64 = 256 << 20;

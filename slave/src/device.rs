@@ -6,7 +6,7 @@
 //! is three decoupled joints, I theta'' = u + tau_env - b theta', integrated with
 //! semi-implicit Euler at a fixed step so the result depends only on the inputs.
 
-use tactile_common::scenario::{ControllerConfig, DynamicsConfig};
+use tactile_scenario::{ControllerConfig, DynamicsConfig};
 
 /// PID joint controller state.
 #[derive(Debug, Clone)]

@@ -5,7 +5,7 @@
 //! the tool penetrates, with that object's stiffness (h_x, h_y, h_z). Pure geometry in
 //! f64: this is the physical world, not the HSD's datapath.
 
-use tactile_common::scenario::Object;
+use tactile_scenario::Object;
 
 /// The tool inside an object.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -16,17 +16,17 @@ use crate::device::{Controller, Dynamics, JointState};
 use crate::environment::deepest_contact;
 use crate::record::{HoldStep, Step};
 use serde::{Deserialize, Serialize};
-use tactile_common::arith::StdTrig;
-use tactile_common::codec::{Deadband, Estimate, Predictor};
-use tactile_common::control::SlaveSide;
-use tactile_common::engine::Engine;
-use tactile_common::geometry::Lengths;
-use tactile_common::kernels::{self, IkStatus};
-use tactile_common::samples::{
+use tactile_control::codec::{Deadband, Estimate, Predictor};
+use tactile_control::passivity::SlaveSide;
+use tactile_math::arith::StdTrig;
+use tactile_math::engine::Engine;
+use tactile_math::geometry::Lengths;
+use tactile_math::kernels::{self, IkStatus};
+use tactile_math::vec3::distance;
+use tactile_messages::samples::{
     Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
-use tactile_common::scenario::{Object, Scenario, ScenarioError};
-use tactile_common::vec3::distance;
+use tactile_scenario::{Object, Scenario, ScenarioError};
 
 /// What the slave counted over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -84,7 +84,7 @@ impl Slave {
         let start = kernels::fk(&truth, &StdTrig, [0.0; 3]);
         // Wave variables are neither positions nor forces: the codec measures them from
         // zero, and the predictor's plausibility bound is wider.
-        let wave = scenario.control.kind == tactile_common::scenario::ControlKind::Wave;
+        let wave = scenario.control.kind == tactile_scenario::ControlKind::Wave;
         Ok(Slave {
             engine,
             truth,

@@ -5,13 +5,13 @@
 use crate::hsd::Slave;
 use crate::record::{SlaveSample, SlaveTotals};
 use std::time::{Duration, Instant};
-use tactile_common::clock::now_ns;
-use tactile_common::samples::{stage, Backward, FLAG_END, FLAG_PROBE};
-use tactile_common::scenario::{Mode, Scenario, ScenarioError};
+use tactile_messages::clock::now_ns;
+use tactile_messages::samples::{stage, Backward, FLAG_END, FLAG_PROBE};
 use tactile_node::ipc::{Idle, IpcError};
 use tactile_node::link::{RunFilter, SlaveLink};
 use tactile_node::pace::{recv_paced, Pacer};
 use tactile_node::runtime::{NodeError, Recorder};
+use tactile_scenario::{Mode, Scenario, ScenarioError};
 use thiserror::Error;
 
 /// What went wrong in the slave process.

@@ -3,7 +3,7 @@
 
 use crate::hsd::SlaveCounters;
 use serde::{Deserialize, Serialize};
-use tactile_common::samples::Signal;
+use tactile_messages::samples::Signal;
 use tactile_node::ipc::{InboxStats, OutboxStats};
 
 /// One step on a received v(n).

@@ -7,7 +7,7 @@
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
-use tactile_common::scenario::Scenario;
+use tactile_scenario::Scenario;
 
 /// Largest scenario file accepted (a scenario is a few hundred lines of TOML).
 pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;

@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use std::cell::Cell;
 use std::fmt::Debug;
 use std::time::{Duration, Instant};
-use tactile_common::samples::Sequenced;
+use tactile_messages::samples::Sequenced;
 use thiserror::Error;
 
 pub use crate::link::CONTROL_HOP_SEQ;
@@ -418,8 +418,8 @@ pub fn remove_run_files(prefix: &str) {
 #[derive(Debug)]
 pub struct IoxMaster {
     node: IpcNode,
-    out: Outbox<tactile_common::samples::Forward>,
-    inbox: Inbox<tactile_common::samples::Backward>,
+    out: Outbox<tactile_messages::samples::Forward>,
+    inbox: Inbox<tactile_messages::samples::Backward>,
     waker: Waker,
     spin: Duration,
     prefix: String,
@@ -441,13 +441,13 @@ impl IoxMaster {
 }
 
 impl crate::link::MasterLink for IoxMaster {
-    fn send(&self, c: tactile_common::samples::Forward) -> Result<(), IpcError> {
+    fn send(&self, c: tactile_messages::samples::Forward) -> Result<(), IpcError> {
         self.out.publish(c, false).map(|_| ())
     }
-    fn send_control(&self, c: tactile_common::samples::Forward) -> Result<(), IpcError> {
+    fn send_control(&self, c: tactile_messages::samples::Forward) -> Result<(), IpcError> {
         self.out.publish(c, true).map(|_| ())
     }
-    fn recv(&self, deadline: Instant) -> crate::link::Wait<tactile_common::samples::Backward> {
+    fn recv(&self, deadline: Instant) -> crate::link::Wait<tactile_messages::samples::Backward> {
         self.waker
             .wait(&self.node, self.spin, deadline, || self.inbox.try_recv())
     }
@@ -463,10 +463,10 @@ impl crate::link::MasterLink for IoxMaster {
 #[derive(Debug)]
 pub struct IoxEmulator {
     node: IpcNode,
-    in_c: Inbox<tactile_common::samples::Forward>,
-    out_v: Outbox<tactile_common::samples::Forward>,
-    in_h: Inbox<tactile_common::samples::Backward>,
-    out_q: Outbox<tactile_common::samples::Backward>,
+    in_c: Inbox<tactile_messages::samples::Forward>,
+    out_v: Outbox<tactile_messages::samples::Forward>,
+    in_h: Inbox<tactile_messages::samples::Backward>,
+    out_q: Outbox<tactile_messages::samples::Backward>,
     waker: Waker,
     spin: Duration,
 }
@@ -498,10 +498,14 @@ impl crate::link::EmulatorLink for IoxEmulator {
             Ok(self.in_c.try_recv()?.map(Arrival::Forward))
         })
     }
-    fn send_v(&self, v: tactile_common::samples::Forward, control: bool) -> Result<(), IpcError> {
+    fn send_v(&self, v: tactile_messages::samples::Forward, control: bool) -> Result<(), IpcError> {
         self.out_v.publish(v, control).map(|_| ())
     }
-    fn send_q(&self, q: tactile_common::samples::Backward, control: bool) -> Result<(), IpcError> {
+    fn send_q(
+        &self,
+        q: tactile_messages::samples::Backward,
+        control: bool,
+    ) -> Result<(), IpcError> {
         self.out_q.publish(q, control).map(|_| ())
     }
     fn stats(&self) -> crate::link::EmulatorStats {
@@ -518,8 +522,8 @@ impl crate::link::EmulatorLink for IoxEmulator {
 #[derive(Debug)]
 pub struct IoxSlave {
     node: IpcNode,
-    inbox: Inbox<tactile_common::samples::Forward>,
-    out: Outbox<tactile_common::samples::Backward>,
+    inbox: Inbox<tactile_messages::samples::Forward>,
+    out: Outbox<tactile_messages::samples::Backward>,
     waker: Waker,
     spin: Duration,
 }
@@ -539,11 +543,15 @@ impl IoxSlave {
 }
 
 impl crate::link::SlaveLink for IoxSlave {
-    fn recv(&self, deadline: Instant) -> crate::link::Wait<tactile_common::samples::Forward> {
+    fn recv(&self, deadline: Instant) -> crate::link::Wait<tactile_messages::samples::Forward> {
         self.waker
             .wait(&self.node, self.spin, deadline, || self.inbox.try_recv())
     }
-    fn send_h(&self, h: tactile_common::samples::Backward, control: bool) -> Result<(), IpcError> {
+    fn send_h(
+        &self,
+        h: tactile_messages::samples::Backward,
+        control: bool,
+    ) -> Result<(), IpcError> {
         self.out.publish(h, control).map(|_| ())
     }
     fn stats(&self) -> (InboxStats, OutboxStats) {
@@ -563,12 +571,12 @@ pub struct IoxHalf {
 #[derive(Debug)]
 enum Half {
     Master {
-        c: Inbox<tactile_common::samples::Forward>,
-        q: Outbox<tactile_common::samples::Backward>,
+        c: Inbox<tactile_messages::samples::Forward>,
+        q: Outbox<tactile_messages::samples::Backward>,
     },
     Slave {
-        v: Outbox<tactile_common::samples::Forward>,
-        h: Inbox<tactile_common::samples::Backward>,
+        v: Outbox<tactile_messages::samples::Forward>,
+        h: Inbox<tactile_messages::samples::Backward>,
     },
 }
 
@@ -602,7 +610,7 @@ impl IoxHalf {
     /// Publishes v(n) (slave side only).
     pub fn send_forward(
         &self,
-        v: tactile_common::samples::Forward,
+        v: tactile_messages::samples::Forward,
         control: bool,
     ) -> Result<(), IpcError> {
         match &self.half {
@@ -617,7 +625,7 @@ impl IoxHalf {
     /// Publishes q(n) (master side only).
     pub fn send_backward(
         &self,
-        q: tactile_common::samples::Backward,
+        q: tactile_messages::samples::Backward,
         control: bool,
     ) -> Result<(), IpcError> {
         match &self.half {

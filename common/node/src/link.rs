@@ -9,7 +9,7 @@
 use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
-use tactile_common::samples::{Backward, Forward, Sequenced};
+use tactile_messages::samples::{Backward, Forward, Sequenced};
 
 /// The outcome of a wait: a value, or why none came.
 pub type Wait<T> = Result<Result<T, Idle>, IpcError>;

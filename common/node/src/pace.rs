@@ -11,7 +11,7 @@
 
 use crate::ipc::{Idle, IpcError};
 use crate::link::Wait;
-use tactile_common::clock::{now_ns, sleep_until_ns};
+use tactile_messages::clock::{now_ns, sleep_until_ns};
 
 /// How long before a sample is due a node wakes, at most: timer wake-ups of an
 /// ordinary thread come up to ~100 us late here (slack plus the VM's wake-up cost).

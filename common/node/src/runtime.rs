@@ -13,8 +13,8 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
-use tactile_common::clock::now_ns;
-use tactile_common::scenario::Scenario;
+use tactile_messages::clock::now_ns;
+use tactile_scenario::Scenario;
 
 /// Exit status: the run completed.
 pub const EXIT_OK: u8 = 0;
@@ -234,7 +234,7 @@ pub fn waiting(
     spin_us: Option<u64>,
 ) -> (Duration, Duration) {
     let t_s = scenario.t_s_ns();
-    if scenario.mode != tactile_common::scenario::Mode::Realtime {
+    if scenario.mode != tactile_scenario::Mode::Realtime {
         let spin = spin_us.map_or(Duration::from_nanos(2 * t_s), Duration::from_micros);
         return (Duration::ZERO, spin);
     }
@@ -255,7 +255,7 @@ fn check_waiting(
     wake_early: Duration,
     spin: Duration,
 ) -> Result<(), NodeError> {
-    if scenario.mode != tactile_common::scenario::Mode::Realtime {
+    if scenario.mode != tactile_scenario::Mode::Realtime {
         return Ok(());
     }
     let t_s = Duration::from_nanos(scenario.t_s_ns());
@@ -285,7 +285,7 @@ fn schedule(
     spin: Duration,
 ) -> (crate::sched::Sched, Option<crate::sched::KeepAwake>) {
     use crate::sched::{apply, IdleMode, KeepAwake, Policy, Sched};
-    let realtime = scenario.mode == tactile_common::scenario::Mode::Realtime;
+    let realtime = scenario.mode == tactile_scenario::Mode::Realtime;
     let policy = if realtime { args.sched } else { Policy::Other };
     let (fifo, memory_locked, mut notes) = apply(policy, args.priority);
     if !realtime && args.sched == Policy::Fifo {
@@ -781,7 +781,7 @@ mod tests {
         assert!(check(&args(&["--spin-us", "1500"]), &sc).is_err());
         assert!(check(&args(&["--spin-us", "1500", "--sched", "other"]), &sc).is_ok());
         // Lockstep never sleeps: nothing to check, and no margin.
-        sc.mode = tactile_common::scenario::Mode::Lockstep;
+        sc.mode = tactile_scenario::Mode::Lockstep;
         let l = check(&args(&["--wake-early-us", "5000"]), &sc).expect("lockstep");
         assert_eq!(l.0, Duration::ZERO);
     }

@@ -17,7 +17,7 @@ use std::net::{IpAddr, SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tactile_common::samples::{Backward, Forward, Sequenced};
+use tactile_messages::samples::{Backward, Forward, Sequenced};
 
 fn err(context: &str, e: impl std::fmt::Display) -> IpcError {
     IpcError {

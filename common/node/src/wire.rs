@@ -9,7 +9,7 @@
 //! panic: every field is checked by the decoder.
 
 use serde::{de::DeserializeOwned, Serialize};
-use tactile_common::samples::{Backward, Forward};
+use tactile_messages::samples::{Backward, Forward};
 
 /// First bytes of every frame.
 pub const MAGIC: [u8; 4] = *b"TCTL";
@@ -116,7 +116,7 @@ pub fn count_reject(r: Reject, stats: &mut crate::ipc::InboxStats) {
 
 /// Counts a received frame (rejected, of the wrong kind, or good) and returns the
 /// sample if `want` extracts it.
-pub fn count<T: tactile_common::samples::Sequenced>(
+pub fn count<T: tactile_messages::samples::Sequenced>(
     got: Result<Frame, Reject>,
     want: fn(Frame) -> Option<T>,
     stats: &std::cell::Cell<crate::ipc::InboxStats>,
@@ -174,7 +174,7 @@ pub struct In {
 /// publish counter (or the control marker), encodes it into `buf`, hands the frame to
 /// `send` (which says how many receivers it reached) and counts it. UDP and Zenoh
 /// share this, so they stamp and count exactly as iceoryx2 does.
-pub fn send_counted<T: tactile_common::samples::Sequenced + Copy>(
+pub fn send_counted<T: tactile_messages::samples::Sequenced + Copy>(
     mut value: T,
     control: bool,
     stats: &std::cell::Cell<crate::ipc::OutboxStats>,

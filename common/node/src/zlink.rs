@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, TrySendError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-use tactile_common::samples::{Backward, Forward, Sequenced};
+use tactile_messages::samples::{Backward, Forward, Sequenced};
 /// The Zenoh crate this link is built on, for tools and tests that talk to the nodes.
 pub use zenoh;
 use zenoh::qos::{CongestionControl, Priority};

@@ -12,12 +12,12 @@
 //! was injected, so the master can tell injected delay from system overhead; the noise
 //! actually added is returned too.
 
-use crate::netem::{Jitter, Replay};
-use crate::scenario::ChannelConfig;
+use crate::models::{Jitter, Replay};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use std::collections::BTreeMap;
+use tactile_scenario::ChannelConfig;
 
 /// One signal value with its provenance.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -374,10 +374,10 @@ mod tests {
         let run = |reorder: bool| {
             let cfg = ChannelConfig {
                 delay: [20, 20, 20],
-                jitter: Some(crate::netem::JitterConfig {
+                jitter: Some(tactile_scenario::JitterConfig {
                     jitter: 3.0,
                     correlation: 0.0,
-                    distribution: crate::netem::JitterDistribution::Normal,
+                    distribution: tactile_scenario::JitterDistribution::Normal,
                 }),
                 reorder,
                 ..Default::default()
@@ -419,10 +419,10 @@ mod tests {
         let run = |duplicate: f64| {
             let cfg = ChannelConfig {
                 delay: [10, 10, 10],
-                jitter: Some(crate::netem::JitterConfig {
+                jitter: Some(tactile_scenario::JitterConfig {
                     jitter: 4.0,
                     correlation: 0.3,
-                    distribution: crate::netem::JitterDistribution::Normal,
+                    distribution: tactile_scenario::JitterDistribution::Normal,
                 }),
                 duplicate,
                 ..Default::default()

@@ -7,7 +7,7 @@
 use std::sync::OnceLock;
 
 use proptest::prelude::*;
-use tactile_common::cordic::{Cordic, CordicConfig, CordicError, Rounding};
+use tactile_math::cordic::{Cordic, CordicConfig, CordicError, Rounding};
 
 const PI: f64 = std::f64::consts::PI;
 const PI_F32: f32 = std::f32::consts::PI;

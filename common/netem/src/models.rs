@@ -12,209 +12,36 @@
 //! is mapped to each distribution through its inverse CDF (a Gaussian copula), so the
 //! spread is the configured one whatever the correlation.
 
-use crate::scenario::{invalid, ScenarioError};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
-use serde::{Deserialize, Serialize};
+use tactile_scenario::{JitterConfig, JitterDistribution, LossModel, ReplayConfig, JITTER_CAP};
 
-/// netem's jitter distributions.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum JitterDistribution {
-    /// Uniform on delay +- jitter (netem's default when no distribution is named).
-    #[default]
-    Uniform,
-    /// Normal, standard deviation `jitter`.
-    Normal,
-    /// Pareto (shape 3, the heavy right tail of queueing), shifted to mean zero and
-    /// scaled to standard deviation `jitter`.
-    Pareto,
-    /// netem's paretonormal: a quarter normal and three quarters Pareto, mean zero,
-    /// standard deviation `jitter` (here the two parts move together, so the
-    /// correlation carries through).
-    Paretonormal,
-}
-
-/// `jitter = { jitter = J, correlation = C, distribution = "normal" }`: the delay of
-/// each packet is `delay + X`, X drawn as netem draws it, in samples.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct JitterConfig {
-    /// Spread, samples: half-width for uniform, standard deviation otherwise.
-    pub jitter: f64,
-    /// Correlation of successive packets' jitter, 0 to 1 (lag-1, of the driving
-    /// Gaussian process) [0].
-    #[serde(default)]
-    pub correlation: f64,
-    /// `uniform`, `normal`, `pareto` or `paretonormal` [uniform].
-    #[serde(default)]
-    pub distribution: JitterDistribution,
-}
-
-/// Loss models beyond netem's `random` (which is the channel's `loss`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
-pub enum LossModel {
-    /// Gilbert-Elliott, netem's `gemodel p r 1-h 1-k`: a good and a bad state; p the
-    /// probability of going bad, r of recovering; a packet is lost with probability
-    /// `1 - k` in the good state [0] and `1 - h` in the bad state [1]. With the
-    /// defaults it is the simple Gilbert model: loss rate p/(p+r), mean burst 1/r.
-    Gemodel {
-        /// Good to bad.
-        p: f64,
-        /// Bad to good.
-        r: f64,
-        /// Loss probability in the bad state, netem's `1-h` [1].
-        #[serde(default = "one")]
-        bad_loss: f64,
-        /// Loss probability in the good state, netem's `1-k` [0].
-        #[serde(default)]
-        good_loss: f64,
-    },
-    /// netem's 4-state model: 1 good reception, 2 good reception within a burst, 3
-    /// burst loss, 4 isolated loss. Lost in states 3 and 4.
-    State {
-        /// 1 to 3.
-        p13: f64,
-        /// 3 to 1.
-        p31: f64,
-        /// 3 to 2 [0].
-        #[serde(default)]
-        p32: f64,
-        /// 2 to 3 [0].
-        #[serde(default)]
-        p23: f64,
-        /// 1 to 4 [0].
-        #[serde(default)]
-        p14: f64,
-    },
-}
-
-fn one() -> f64 {
-    1.0
-}
-
-fn probability(v: f64, field: &str) -> Result<(), ScenarioError> {
-    if !v.is_finite() || !(0.0..=1.0).contains(&v) {
-        return Err(invalid(
-            field,
-            format!("{v} is not a probability in [0, 1]"),
-        ));
-    }
-    Ok(())
-}
-
-/// Jitter beyond this many spreads is cut off (a Pareto tail is unbounded; the delay
-/// line must not be). For Pareto and paretonormal the cut is part of the shape, whose
-/// scale then gives the configured spread exactly.
-pub const JITTER_CAP: f64 = 10.0;
-
-impl JitterConfig {
-    /// Checks the ranges; errors name `FIELD.jitter.*`.
-    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
-        if !self.jitter.is_finite() || self.jitter < 0.0 || self.jitter > 10_000.0 {
-            return Err(invalid(
-                format!("{field}.jitter.jitter"),
-                format!("{} samples is outside 0..=10000", self.jitter),
-            ));
+/// The long-run loss rate (the stationary probability of the losing states).
+pub fn loss_rate(model: &LossModel) -> f64 {
+    match *model {
+        LossModel::Gemodel {
+            p,
+            r,
+            bad_loss,
+            good_loss,
+        } => {
+            if p + r == 0.0 {
+                return good_loss;
+            }
+            let bad = p / (p + r);
+            (1.0 - bad) * good_loss + bad * bad_loss
         }
-        let c = self.correlation;
-        if !c.is_finite() || !(0.0..1.0).contains(&c) {
-            return Err(invalid(
-                format!("{field}.jitter.correlation"),
-                format!("{c} is outside [0, 1)"),
-            ));
-        }
-        Ok(())
-    }
-
-    /// The largest jitter it can add, samples (the cut shapes, rescaled, stay within
-    /// twice the cap).
-    pub fn bound(&self) -> f64 {
-        2.0 * JITTER_CAP * self.jitter
-    }
-}
-
-impl LossModel {
-    /// Checks the probabilities; errors name `FIELD.loss_model.*`.
-    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
-        let f = |k: &str| format!("{field}.loss_model.{k}");
-        match self {
-            LossModel::Gemodel {
-                p,
-                r,
-                bad_loss,
-                good_loss,
-            } => {
-                for (k, v) in [
-                    ("p", p),
-                    ("r", r),
-                    ("bad_loss", bad_loss),
-                    ("good_loss", good_loss),
-                ] {
-                    probability(*v, &f(k))?;
-                }
-            }
-            LossModel::State {
-                p13,
-                p31,
-                p32,
-                p23,
-                p14,
-            } => {
-                for (k, v) in [
-                    ("p13", p13),
-                    ("p31", p31),
-                    ("p32", p32),
-                    ("p23", p23),
-                    ("p14", p14),
-                ] {
-                    probability(*v, &f(k))?;
-                }
-                if p13 + p14 > 1.0 {
-                    return Err(invalid(
-                        f("p14"),
-                        format!("p13 + p14 = {} exceeds 1", p13 + p14),
-                    ));
-                }
-                if p31 + p32 > 1.0 {
-                    return Err(invalid(
-                        f("p32"),
-                        format!("p31 + p32 = {} exceeds 1", p31 + p32),
-                    ));
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// The long-run loss rate (the stationary probability of the losing states).
-    pub fn loss_rate(&self) -> f64 {
-        match *self {
-            LossModel::Gemodel {
-                p,
-                r,
-                bad_loss,
-                good_loss,
-            } => {
-                if p + r == 0.0 {
-                    return good_loss;
-                }
-                let bad = p / (p + r);
-                (1.0 - bad) * good_loss + bad * bad_loss
-            }
-            LossModel::State {
-                p13,
-                p31,
-                p32,
-                p23,
-                p14,
-            } => {
-                // Balance: pi4 = p14 pi1; pi3 (p31 + p32) = p13 pi1 + p23 pi2;
-                // pi2 p23 = p32 pi3. With p23 > 0: pi3 p31 = p13 pi1.
-                let s = StateChain::stationary(p13, p31, p32, p23, p14);
-                s[2] + s[3]
-            }
+        LossModel::State {
+            p13,
+            p31,
+            p32,
+            p23,
+            p14,
+        } => {
+            // Balance: pi4 = p14 pi1; pi3 (p31 + p32) = p13 pi1 + p23 pi2;
+            // pi2 p23 = p32 pi3. With p23 > 0: pi3 p31 = p13 pi1.
+            let s = StateChain::stationary(p13, p31, p32, p23, p14);
+            s[2] + s[3]
         }
     }
 }
@@ -422,72 +249,6 @@ impl Loss {
     }
 }
 
-/// `replay = { path = "...", format = "csv" }`: a recorded network, packet by packet.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ReplayConfig {
-    /// The file, relative to the scenario's folder.
-    pub path: String,
-    /// `csv`: header `delay,lost`, one row per packet (delay in samples, lost 0 or 1),
-    /// looped; `mahimahi`: Mahimahi's delivery trace, one line per millisecond at
-    /// which the link can deliver an MTU (1500 bytes), looped [csv].
-    #[serde(default)]
-    pub format: ReplayFormat,
-    /// Mahimahi: bytes per packet on the wire (a sample's frame is about 250) [250].
-    #[serde(default = "default_packet_bytes")]
-    pub packet_bytes: u32,
-    /// Mahimahi: a packet that would queue longer than this many samples is dropped,
-    /// as a drop-tail queue would [1000].
-    #[serde(default = "default_max_queue")]
-    pub max_queue_samples: u32,
-}
-
-/// Replay formats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum ReplayFormat {
-    /// Per-packet delays and losses.
-    #[default]
-    Csv,
-    /// Mahimahi's delivery opportunities.
-    Mahimahi,
-}
-
-fn default_packet_bytes() -> u32 {
-    250
-}
-fn default_max_queue() -> u32 {
-    1000
-}
-
-impl ReplayConfig {
-    /// Checks the fields; errors name `FIELD.replay.*`.
-    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
-        if self.path.is_empty() {
-            return Err(invalid(format!("{field}.replay.path"), "is empty"));
-        }
-        if self.packet_bytes == 0 || self.packet_bytes > 1500 {
-            return Err(invalid(
-                format!("{field}.replay.packet_bytes"),
-                format!("{} is outside 1..=1500 (one MTU)", self.packet_bytes),
-            ));
-        }
-        if self.max_queue_samples == 0
-            || i64::from(self.max_queue_samples) > crate::scenario::MAX_DELAY_SAMPLES
-        {
-            return Err(invalid(
-                format!("{field}.replay.max_queue_samples"),
-                format!(
-                    "{} is outside 1..={}",
-                    self.max_queue_samples,
-                    crate::scenario::MAX_DELAY_SAMPLES
-                ),
-            ));
-        }
-        Ok(())
-    }
-}
-
 /// A loaded replay: each packet's delay (samples) and whether it is lost.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Replay {
@@ -532,7 +293,7 @@ impl Replay {
             let d: u32 = d
                 .parse()
                 .ok()
-                .filter(|d| i64::from(*d) <= crate::scenario::MAX_DELAY_SAMPLES)
+                .filter(|d| i64::from(*d) <= tactile_scenario::MAX_DELAY_SAMPLES)
                 .ok_or_else(|| {
                     format!("line {line}: delay {d} is not a whole number of samples in 0..=100000")
                 })?;
@@ -658,6 +419,7 @@ impl Mahimahi {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tactile_scenario::ReplayFormat;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
@@ -794,7 +556,7 @@ mod tests {
             let mut rng = ChaCha8Rng::seed_from_u64(11);
             let lost: Vec<bool> = (0..N).map(|_| loss.lose(&mut rng)).collect();
             let rate = lost.iter().filter(|l| **l).count() as f64 / N as f64;
-            let pi = model.loss_rate();
+            let pi = loss_rate(&model);
             assert!((pi - p / (p + r)).abs() < 1e-15);
             let lambda = 1.0 - p - r;
             let se = (pi * (1.0 - pi) * (1.0 + lambda) / (N as f64 * (1.0 - lambda))).sqrt();
@@ -843,7 +605,7 @@ mod tests {
             let mut loss = Loss::new(&model);
             let mut rng = ChaCha8Rng::seed_from_u64(5);
             let rate = (0..N).filter(|_| loss.lose(&mut rng)).count() as f64 / N as f64;
-            let pi = model.loss_rate();
+            let pi = loss_rate(&model);
             // Bursty: allow for correlation with a generous effective count of N / 20.
             let se = (pi * (1.0 - pi) / (N as f64 / 20.0)).sqrt();
             assert!((rate - pi).abs() < 5.0 * se, "{model:?}: {rate} vs {pi}");

@@ -1,16 +1,16 @@
 //! Time per call and batch throughput of each module in each arithmetic.
 //!
-//! Run with `cargo bench -p tactile-common --bench kernels`. Per-call benchmarks cycle
+//! Run with `cargo bench -p tactile-math --bench kernels`. Per-call benchmarks cycle
 //! through 1024 distinct inputs from the paper's validation run so neither the branch
 //! predictor nor the optimiser sees one constant input; batch benchmarks run the
 //! structure-of-arrays kernels over 4096 samples and report samples per second.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use tactile_common::arith::{Real, StdTrig, Trig};
-use tactile_common::cordic::{Cordic, CordicConfig};
-use tactile_common::geometry::{Geometry, Lengths};
-use tactile_common::kernels::{self, Columns, ColumnsMut, IkStatus};
-use tactile_common::validation::{validation_inputs, ValidationInput};
+use tactile_math::arith::{Real, StdTrig, Trig};
+use tactile_math::cordic::{Cordic, CordicConfig};
+use tactile_math::geometry::{Geometry, Lengths};
+use tactile_math::kernels::{self, Columns, ColumnsMut, IkStatus};
+use tactile_math::validation::{validation_inputs, ValidationInput};
 
 const BATCH: usize = 4096;
 

@@ -31,7 +31,7 @@
 //!   reflected in free motion), integrates the velocity into its position reference and
 //!   returns `w = F_env / sqrt(2b)`; the master feels `-(b v_m + sqrt(2b) w)`.
 
-use crate::bilateral::{ControlConfig, ControlKind};
+use tactile_scenario::{ControlConfig, ControlKind};
 
 /// Energy that entered and left the channel at one port, per axis, J.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

@@ -5,8 +5,8 @@
 //! the timing columns off by name. Floats are written in shortest round-trip form, so
 //! equal values give equal text and the file reads back exactly.
 
-use crate::samples::stage;
 use std::fmt::Write;
+use tactile_messages::samples::stage;
 
 /// Three-valued signal columns, in order, with their prefix.
 pub const SIGNALS: [&str; 23] = [

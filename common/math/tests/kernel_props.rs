@@ -4,12 +4,12 @@
 use nalgebra::{Matrix3, Vector3};
 use proptest::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
-use tactile_common::arith::{ArithKind, StdTrig};
-use tactile_common::cordic::{Cordic, CordicConfig};
-use tactile_common::engine::Engine;
-use tactile_common::geometry::{Geometry, Lengths};
-use tactile_common::kernels::{self, Columns, ColumnsMut, IkStatus};
-use tactile_common::validation::WAYPOINTS;
+use tactile_math::arith::{ArithKind, StdTrig};
+use tactile_math::cordic::{Cordic, CordicConfig};
+use tactile_math::engine::Engine;
+use tactile_math::geometry::{Geometry, Lengths};
+use tactile_math::kernels::{self, Columns, ColumnsMut, IkStatus};
+use tactile_math::validation::WAYPOINTS;
 
 const G: Geometry = Geometry::PAPER;
 

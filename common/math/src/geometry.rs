@@ -76,14 +76,6 @@ impl Geometry {
         }
     }
 
-    /// Parses and validates a TOML document with keys `l1`, `l2`, `l3`, `a`.
-    pub fn from_toml_str(text: &str) -> Result<Geometry, GeometryError> {
-        let g: Geometry = toml::from_str(text)
-            .map_err(|e| GeometryError::Parse(crate::scenario::one_line(text, &e)))?;
-        g.validate()?;
-        Ok(g)
-    }
-
     /// Checks every length is finite, within range, and the segments are non-zero.
     pub fn validate(&self) -> Result<(), GeometryError> {
         let fields = [
@@ -148,31 +140,5 @@ mod tests {
         assert_eq!(Geometry::PAPER.validate(), Ok(()));
         assert_eq!(Geometry::OMNI.validate(), Ok(()));
         assert!((Geometry::PAPER.l4() - 0.167).abs() < 1e-15);
-    }
-
-    #[test]
-    fn toml_round_trip_and_errors() {
-        let g = Geometry::from_toml_str("l1 = 0.1\nl2 = 0.12\nl3 = 0.02\na = 0.03\n");
-        assert_eq!(
-            g,
-            Ok(Geometry {
-                l1: 0.1,
-                l2: 0.12,
-                l3: 0.02,
-                a: 0.03
-            })
-        );
-        let unknown = Geometry::from_toml_str("l1 = 0.1\nl2 = 0.1\nl3 = 0\na = 0\nl5 = 1\n");
-        assert!(matches!(unknown, Err(GeometryError::Parse(m)) if m.contains("l5")));
-        let mm = Geometry::from_toml_str("l1 = 132.0\nl2 = 0.1\nl3 = 0.0\na = 0.0\n");
-        assert!(matches!(
-            mm,
-            Err(GeometryError::BadLength { field: "l1", .. })
-        ));
-        let neg = Geometry::from_toml_str("l1 = 0.1\nl2 = 0.1\nl3 = -0.1\na = 0.0\n");
-        assert!(matches!(
-            neg,
-            Err(GeometryError::BadLength { field: "l3", .. })
-        ));
     }
 }

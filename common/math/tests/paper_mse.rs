@@ -1,8 +1,8 @@
 //! The paper's MSE table reproduced: hybrid against f32 on the validation run.
 
-use tactile_common::cordic::{CordicConfig, Rounding};
-use tactile_common::geometry::Geometry;
-use tactile_common::validation::mse_table;
+use tactile_math::cordic::{CordicConfig, Rounding};
+use tactile_math::geometry::Geometry;
+use tactile_math::validation::mse_table;
 
 #[test]
 fn s16_13_is_no_worse_than_the_paper_for_every_row() {

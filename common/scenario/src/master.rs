@@ -1,17 +1,70 @@
-//! Scenario types of the bilateral loop: how the operator's hand holds the master
-//! (`[master.hand]`), the master device's joints (`[master.device]`) and the stability
-//! control on the channel (`[control]`). Validated like the rest of the scenario: an
-//! error names the dotted field.
+//! `[master]` and `[faults]`: the master device's limits, the operator's hand, the
+//! master device's joints, and how a dead peer is noticed.
 
-use crate::scenario::{invalid, positive3, ScenarioError};
+use crate::{invalid, positive, positive3, PredictorConfig, ScenarioError};
 use serde::{Deserialize, Serialize};
 
-fn positive(v: f64, field: &str, zero_ok: bool) -> Result<(), ScenarioError> {
-    if !v.is_finite() || v < 0.0 || (!zero_ok && v == 0.0) {
-        let want = if zero_ok { "non-negative" } else { "positive" };
-        return Err(invalid(field, format!("{v} must be finite and {want}")));
+/// The master device's limits (PHANToM Omni class by default).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MasterConfig {
+    /// Largest force the operator is made to feel, N, per axis (the Omni: ~3.3 N).
+    #[serde(default = "default_force_limit")]
+    pub force_limit: f64,
+    /// Largest torque commanded on a master joint, N m.
+    #[serde(default = "default_master_torque_limit")]
+    pub torque_limit: [f64; 3],
+    /// How the operator's hand holds the handle.
+    #[serde(default)]
+    pub hand: HandConfig,
+    /// The master device's joints (used with an impedance hand).
+    #[serde(default)]
+    pub device: MasterDeviceConfig,
+    /// How the master fills forces not received (CPD/JPD-HMD).
+    #[serde(default)]
+    pub predictor: PredictorConfig,
+}
+
+fn default_force_limit() -> f64 {
+    3.3
+}
+fn default_master_torque_limit() -> [f64; 3] {
+    [0.45; 3]
+}
+
+impl Default for MasterConfig {
+    fn default() -> Self {
+        MasterConfig {
+            force_limit: default_force_limit(),
+            torque_limit: default_master_torque_limit(),
+            hand: HandConfig::default(),
+            device: MasterDeviceConfig::default(),
+            predictor: PredictorConfig::default(),
+        }
     }
-    Ok(())
+}
+
+/// How the processes notice a dead peer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaultConfig {
+    /// Consecutive samples without an answer after which the master declares the loop
+    /// broken, commands zero torque and marks the samples; and without input after
+    /// which the slave holds its position.
+    #[serde(default = "default_peer_timeout")]
+    pub peer_timeout_samples: u64,
+}
+
+fn default_peer_timeout() -> u64 {
+    10
+}
+
+impl Default for FaultConfig {
+    fn default() -> Self {
+        FaultConfig {
+            peer_timeout_samples: default_peer_timeout(),
+        }
+    }
 }
 
 /// How the hand moves the master handle.
@@ -127,83 +180,6 @@ impl Default for MasterDeviceConfig {
     }
 }
 
-/// Stability control on the channel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum ControlKind {
-    /// Positions forward, forces back, nothing else (observers still watch).
-    #[default]
-    None,
-    /// Time-domain passivity approach, two-port, position-force architecture.
-    Tdpa,
-    /// Wave variables with an impedance-matched slave.
-    Wave,
-}
-
-impl ControlKind {
-    /// The name used in scenarios and reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            ControlKind::None => "none",
-            ControlKind::Tdpa => "tdpa",
-            ControlKind::Wave => "wave",
-        }
-    }
-}
-
-/// `[control]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ControlConfig {
-    /// `none`, `tdpa` or `wave`.
-    #[serde(default)]
-    pub kind: ControlKind,
-    /// Wave impedance b, N s/m: larger feels stiffer contact and more damping in free
-    /// motion.
-    #[serde(default = "default_wave_impedance")]
-    pub wave_impedance: f64,
-    /// TDPA: speeds below this count as this when the master's passivity controller
-    /// computes its damping (v^2 in a denominator), m/s.
-    #[serde(default = "default_velocity_floor")]
-    pub velocity_floor: f64,
-    /// TDPA: the largest damping the master's passivity controller adds, N s/m; a
-    /// deficit it cannot remove at once is carried to the next samples.
-    #[serde(default = "default_max_damping")]
-    pub max_damping: f64,
-    /// TDPA: the fastest the slave's reference is pulled back towards the master's
-    /// position when energy allows (position drift compensation), m/s; 0 disables it.
-    #[serde(default = "default_drift_rate")]
-    pub drift_rate: f64,
-}
-
-fn default_wave_impedance() -> f64 {
-    10.0
-}
-// Measured on wall-delay over floors 1e-5..1e-3 m/s and caps 200..1e4 N s/m: these
-// kept the channel's energy closest to zero without a codec (README). Larger caps make
-// the force chatter between full and zero, and the sampling's prediction error grows.
-fn default_velocity_floor() -> f64 {
-    1.0e-3
-}
-fn default_max_damping() -> f64 {
-    200.0
-}
-fn default_drift_rate() -> f64 {
-    0.05
-}
-
-impl Default for ControlConfig {
-    fn default() -> Self {
-        ControlConfig {
-            kind: ControlKind::None,
-            wave_impedance: default_wave_impedance(),
-            velocity_floor: default_velocity_floor(),
-            max_damping: default_max_damping(),
-            drift_rate: default_drift_rate(),
-        }
-    }
-}
-
 impl HandConfig {
     /// Checks the ranges; errors name `master.hand.*`.
     pub fn validate(&self) -> Result<(), ScenarioError> {
@@ -230,15 +206,5 @@ impl MasterDeviceConfig {
             ));
         }
         Ok(())
-    }
-}
-
-impl ControlConfig {
-    /// Checks the ranges; errors name `control.*`.
-    pub fn validate(&self) -> Result<(), ScenarioError> {
-        positive(self.wave_impedance, "control.wave_impedance", false)?;
-        positive(self.velocity_floor, "control.velocity_floor", false)?;
-        positive(self.max_damping, "control.max_damping", false)?;
-        positive(self.drift_rate, "control.drift_rate", true)
     }
 }

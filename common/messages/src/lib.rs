@@ -1,0 +1,7 @@
+//! What crosses a link between Tactile's nodes: the forward and backward samples with
+//! their provenance, stages and flags, laid out for iceoryx2's zero-copy shared memory
+//! (this is the one crate that derives iceoryx2's types), and the monotonic clock
+//! every stamp is read from.
+
+pub mod clock;
+pub mod samples;

@@ -1,0 +1,202 @@
+//! Scenario files: what one run of the loop does.
+//!
+//! A scenario is TOML; every table rejects unknown keys so a typo is an error naming
+//! the key rather than a silently ignored setting. [`Scenario::from_toml_str`] parses
+//! and then checks ranges ([`Scenario::validate`]) so that an absurd value (a negative
+//! delay, a zero rate, negative noise) is refused with the field's dotted path before
+//! anything starts. The defaults reproduce the paper's setup.
+
+mod control;
+pub mod csv;
+mod device;
+mod error;
+mod master;
+mod network;
+mod operator;
+pub mod overrides;
+mod slave;
+mod validate;
+
+pub use control::{
+    CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, PredictorConfig, PredictorKind,
+};
+pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
+pub(crate) use error::{finite3, invalid, positive, positive3};
+pub use error::{one_line, ScenarioError};
+pub use master::{FaultConfig, HandConfig, HandMode, MasterConfig, MasterDeviceConfig};
+pub use network::{
+    ChannelConfig, JitterConfig, JitterDistribution, LossModel, Network, ReplayConfig,
+    ReplayFormat, JITTER_CAP, MAX_DELAY_SAMPLES,
+};
+pub use operator::Operator;
+use serde::{Deserialize, Serialize};
+pub use slave::{
+    ControllerConfig, DynamicsConfig, Environment, Object, SlaveConfig, MAX_STIFFNESS,
+    NOMINAL_MAX_STIFFNESS,
+};
+pub use tactile_math::arith::ArithKind;
+
+/// How the master paces the loop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// The master ticks every `t_s` of wall-clock time.
+    #[default]
+    Realtime,
+    /// Each sample goes round as fast as the processes allow; no sleeping.
+    Lockstep,
+}
+
+/// One whole run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Name used in reports.
+    #[serde(default = "default_name")]
+    pub name: String,
+    /// `realtime` or `lockstep`.
+    #[serde(default)]
+    pub mode: Mode,
+    /// Sampling rate 1/t_s in Hz, 100 to 10000 (the paper: 100 Hz).
+    #[serde(default = "default_rate")]
+    pub rate_hz: f64,
+    /// Number of samples the master sends.
+    #[serde(default = "default_samples")]
+    pub samples: u64,
+    /// Arithmetic of the HMD and HSD kernels: `f64`, `f32` or `hybrid`.
+    #[serde(default)]
+    pub arithmetic: ArithKind,
+    /// Fixed-point format of the hybrid CORDIC block.
+    #[serde(default)]
+    pub cordic: CordicSettings,
+    /// Device geometry of master and slave: a preset name or explicit lengths.
+    #[serde(default)]
+    pub device: DeviceChoice,
+    /// Seed of every random source (channel noise), so runs repeat.
+    #[serde(default)]
+    pub seed: u64,
+    /// What the operator does.
+    #[serde(default)]
+    pub operator: Operator,
+    /// The emulated network.
+    #[serde(default)]
+    pub network: Network,
+    /// The master side: device limits.
+    #[serde(default)]
+    pub master: MasterConfig,
+    /// The slave side: controller and device dynamics.
+    #[serde(default)]
+    pub slave: SlaveConfig,
+    /// Fault handling shared by the processes.
+    #[serde(default)]
+    pub faults: FaultConfig,
+    /// Objects in the slave's environment.
+    #[serde(default)]
+    pub environment: Environment,
+    /// Stability control on the channel.
+    #[serde(default)]
+    pub control: ControlConfig,
+    /// Deadband codecs per direction.
+    #[serde(default)]
+    pub codec: Codecs,
+}
+
+fn default_name() -> String {
+    "unnamed".into()
+}
+fn default_rate() -> f64 {
+    100.0
+}
+fn default_samples() -> u64 {
+    1200
+}
+
+impl Scenario {
+    /// The paper scenario (`deploy/scenarios/paper.toml` holds the same values).
+    pub fn paper() -> Scenario {
+        Scenario {
+            name: "paper".into(),
+            mode: Mode::Realtime,
+            rate_hz: default_rate(),
+            samples: default_samples(),
+            arithmetic: ArithKind::Hybrid,
+            cordic: CordicSettings::default(),
+            device: DeviceChoice::default(),
+            seed: 1,
+            operator: Operator::Paper,
+            network: Network::default(),
+            master: MasterConfig::default(),
+            slave: SlaveConfig::default(),
+            faults: FaultConfig::default(),
+            control: ControlConfig::default(),
+            codec: Codecs::default(),
+            environment: Environment {
+                objects: vec![Object::Plane {
+                    point: [0.0, 0.0, -0.16],
+                    normal: [0.0, 0.0, 1.0],
+                    stiffness: [300.0; 3],
+                }],
+            },
+        }
+    }
+
+    /// Parses TOML and validates every range.
+    pub fn from_toml_str(text: &str) -> Result<Scenario, ScenarioError> {
+        let s: Scenario =
+            toml::from_str(text).map_err(|e| ScenarioError::Parse(one_line(text, &e)))?;
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// The same scenario with every relative path made absolute against `base_dir`
+    /// (the scenario file's folder), so a copy of it runs from any folder.
+    pub fn resolved(&self, base_dir: &std::path::Path) -> Scenario {
+        let mut s = self.clone();
+        let absolute = |path: &mut String| {
+            let p = std::path::Path::new(path.as_str());
+            if p.is_relative() {
+                *path = base_dir.join(p).display().to_string();
+            }
+        };
+        if let Operator::Csv { path } = &mut s.operator {
+            absolute(path);
+        }
+        for c in [&mut s.network.forward, &mut s.network.backward] {
+            if let Some(r) = &mut c.replay {
+                absolute(&mut r.path);
+            }
+        }
+        s
+    }
+
+    /// The scenario as TOML text (what a run's `scenario.toml` holds).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_else(|e| format!("# cannot encode the scenario: {e}\n"))
+    }
+
+    /// Things that load but deserve a word: stiffness above the device's nominal
+    /// maximum.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        for (k, o) in self.environment.objects.iter().enumerate() {
+            for (i, h) in o.stiffness().iter().enumerate() {
+                if *h > NOMINAL_MAX_STIFFNESS {
+                    w.push(format!(
+                        "environment.objects[{k}].stiffness[{i}] = {h} N/m is above the device's nominal {NOMINAL_MAX_STIFFNESS} N/m: contact may buzz"
+                    ));
+                }
+            }
+        }
+        w
+    }
+
+    /// Sampling period t_s in seconds.
+    pub fn t_s(&self) -> f64 {
+        1.0 / self.rate_hz
+    }
+
+    /// Sampling period in nanoseconds.
+    pub fn t_s_ns(&self) -> u64 {
+        (1e9 / self.rate_hz).round() as u64
+    }
+}

@@ -1,0 +1,397 @@
+//! `[network.forward]`, `[network.backward]`: each channel's delay, noise, loss and
+//! the netem-class models and replays (their behaviour is in `tactile-netem`; their
+//! settings and ranges are here).
+
+use crate::{invalid, ScenarioError};
+use serde::{Deserialize, Serialize};
+
+/// Both channels of the emulated network.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct Network {
+    /// Master to slave: positions c(n) -> v(n).
+    #[serde(default)]
+    pub forward: ChannelConfig,
+    /// Slave to master: forces h(n) -> q(n).
+    #[serde(default)]
+    pub backward: ChannelConfig,
+}
+
+/// One channel: v_i(n) = c_i(n - d_i(n)) + r_i(n).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelConfig {
+    /// Constant delay per signal (x, y, z), in whole samples.
+    #[serde(default)]
+    pub delay: [i64; 3],
+    /// Optional schedule overriding `delay`: `[[from_sample, dx, dy, dz], ...]`, sorted by
+    /// `from_sample`; each entry holds from its sample until the next.
+    #[serde(default)]
+    pub schedule: Vec<[i64; 4]>,
+    /// Standard deviation of the zero-mean Gaussian noise per signal (m forward, N back).
+    #[serde(default)]
+    pub noise_std: [f64; 3],
+    /// Probability that the emulator drops a sample on purpose, 0 to 1 (seeded).
+    #[serde(default)]
+    pub loss: f64,
+    /// Fault injection: probability that the emulator replaces a sample's values with
+    /// NaN, 0 to 1 (seeded), to prove the receivers reject them.
+    #[serde(default)]
+    pub corrupt: f64,
+    /// Jitter on each packet's delay, netem's `delay D JITTER CORRELATION
+    /// distribution NAME` with D the `delay` above (all in samples).
+    #[serde(default)]
+    pub jitter: Option<JitterConfig>,
+    /// Whether a packet may overtake an earlier one when jitter shortens its delay
+    /// (netem's behaviour) [true]; false keeps arrivals in sending order.
+    #[serde(default = "default_reorder")]
+    pub reorder: bool,
+    /// A loss model instead of `loss` (netem's random loss): `gemodel` or `state`.
+    #[serde(default)]
+    pub loss_model: Option<LossModel>,
+    /// A recorded network replayed packet by packet, instead of `delay`, `schedule`
+    /// and `jitter`.
+    #[serde(default)]
+    pub replay: Option<ReplayConfig>,
+    /// Probability that a packet is sent twice, netem's `duplicate` (the copy takes
+    /// its own jitter), 0 to 1 [0].
+    #[serde(default)]
+    pub duplicate: f64,
+}
+
+fn default_reorder() -> bool {
+    true
+}
+
+impl Default for ChannelConfig {
+    fn default() -> Self {
+        ChannelConfig {
+            delay: [0; 3],
+            schedule: Vec::new(),
+            noise_std: [0.0; 3],
+            loss: 0.0,
+            corrupt: 0.0,
+            jitter: None,
+            reorder: default_reorder(),
+            loss_model: None,
+            replay: None,
+            duplicate: 0.0,
+        }
+    }
+}
+
+/// Largest delay accepted, in samples: ten seconds at the highest rate.
+pub const MAX_DELAY_SAMPLES: i64 = 100_000;
+
+impl ChannelConfig {
+    pub(crate) fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        let check_delay = |d: i64, f: String| {
+            if d < 0 {
+                Err(invalid(
+                    f,
+                    format!("delay {d} is negative: a channel cannot deliver before sending"),
+                ))
+            } else if d > MAX_DELAY_SAMPLES {
+                Err(invalid(
+                    f,
+                    format!("delay {d} exceeds {MAX_DELAY_SAMPLES} samples"),
+                ))
+            } else {
+                Ok(())
+            }
+        };
+        for (i, d) in self.delay.iter().enumerate() {
+            check_delay(*d, format!("{field}.delay[{i}]"))?;
+        }
+        let mut last = -1;
+        for (k, e) in self.schedule.iter().enumerate() {
+            if e[0] < 0 || e[0] <= last {
+                return Err(invalid(
+                    format!("{field}.schedule[{k}]"),
+                    "from_sample must be non-negative and strictly increasing",
+                ));
+            }
+            last = e[0];
+            for i in 0..3 {
+                check_delay(e[i + 1], format!("{field}.schedule[{k}][{}]", i + 1))?;
+            }
+        }
+        for (name, p) in [
+            ("loss", self.loss),
+            ("corrupt", self.corrupt),
+            ("duplicate", self.duplicate),
+        ] {
+            if !p.is_finite() || !(0.0..=1.0).contains(&p) {
+                return Err(invalid(
+                    format!("{field}.{name}"),
+                    format!("{p} is not a probability in [0, 1]"),
+                ));
+            }
+        }
+        for (i, s) in self.noise_std.iter().enumerate() {
+            if !s.is_finite() || *s < 0.0 {
+                return Err(invalid(
+                    format!("{field}.noise_std[{i}]"),
+                    format!("{s} must be a finite, non-negative standard deviation"),
+                ));
+            }
+        }
+        if let Some(j) = &self.jitter {
+            j.validate(field)?;
+        }
+        if let Some(r) = &self.replay {
+            r.validate(field)?;
+            if self.jitter.is_some() || !self.schedule.is_empty() || self.delay != [0; 3] {
+                return Err(invalid(
+                    format!("{field}.replay"),
+                    "gives each packet's delay: leave delay at [0, 0, 0], and schedule and jitter out",
+                ));
+            }
+        }
+        if let Some(m) = &self.loss_model {
+            m.validate(field)?;
+            if self.loss > 0.0 {
+                return Err(invalid(
+                    format!("{field}.loss_model"),
+                    "and `loss` both set: choose one loss model",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// netem's jitter distributions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum JitterDistribution {
+    /// Uniform on delay +- jitter (netem's default when no distribution is named).
+    #[default]
+    Uniform,
+    /// Normal, standard deviation `jitter`.
+    Normal,
+    /// Pareto (shape 3, the heavy right tail of queueing), shifted to mean zero and
+    /// scaled to standard deviation `jitter`.
+    Pareto,
+    /// netem's paretonormal: a quarter normal and three quarters Pareto, mean zero,
+    /// standard deviation `jitter` (here the two parts move together, so the
+    /// correlation carries through).
+    Paretonormal,
+}
+
+/// `jitter = { jitter = J, correlation = C, distribution = "normal" }`: the delay of
+/// each packet is `delay + X`, X drawn as netem draws it, in samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JitterConfig {
+    /// Spread, samples: half-width for uniform, standard deviation otherwise.
+    pub jitter: f64,
+    /// Correlation of successive packets' jitter, 0 to 1 (lag-1, of the driving
+    /// Gaussian process) [0].
+    #[serde(default)]
+    pub correlation: f64,
+    /// `uniform`, `normal`, `pareto` or `paretonormal` [uniform].
+    #[serde(default)]
+    pub distribution: JitterDistribution,
+}
+
+/// Loss models beyond netem's `random` (which is the channel's `loss`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum LossModel {
+    /// Gilbert-Elliott, netem's `gemodel p r 1-h 1-k`: a good and a bad state; p the
+    /// probability of going bad, r of recovering; a packet is lost with probability
+    /// `1 - k` in the good state [0] and `1 - h` in the bad state [1]. With the
+    /// defaults it is the simple Gilbert model: loss rate p/(p+r), mean burst 1/r.
+    Gemodel {
+        /// Good to bad.
+        p: f64,
+        /// Bad to good.
+        r: f64,
+        /// Loss probability in the bad state, netem's `1-h` [1].
+        #[serde(default = "one")]
+        bad_loss: f64,
+        /// Loss probability in the good state, netem's `1-k` [0].
+        #[serde(default)]
+        good_loss: f64,
+    },
+    /// netem's 4-state model: 1 good reception, 2 good reception within a burst, 3
+    /// burst loss, 4 isolated loss. Lost in states 3 and 4.
+    State {
+        /// 1 to 3.
+        p13: f64,
+        /// 3 to 1.
+        p31: f64,
+        /// 3 to 2 [0].
+        #[serde(default)]
+        p32: f64,
+        /// 2 to 3 [0].
+        #[serde(default)]
+        p23: f64,
+        /// 1 to 4 [0].
+        #[serde(default)]
+        p14: f64,
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn probability(v: f64, field: &str) -> Result<(), ScenarioError> {
+    if !v.is_finite() || !(0.0..=1.0).contains(&v) {
+        return Err(invalid(
+            field,
+            format!("{v} is not a probability in [0, 1]"),
+        ));
+    }
+    Ok(())
+}
+
+/// Jitter beyond this many spreads is cut off (a Pareto tail is unbounded; the delay
+/// line must not be). For Pareto and paretonormal the cut is part of the shape, whose
+/// scale then gives the configured spread exactly.
+pub const JITTER_CAP: f64 = 10.0;
+
+impl JitterConfig {
+    /// Checks the ranges; errors name `FIELD.jitter.*`.
+    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        if !self.jitter.is_finite() || self.jitter < 0.0 || self.jitter > 10_000.0 {
+            return Err(invalid(
+                format!("{field}.jitter.jitter"),
+                format!("{} samples is outside 0..=10000", self.jitter),
+            ));
+        }
+        let c = self.correlation;
+        if !c.is_finite() || !(0.0..1.0).contains(&c) {
+            return Err(invalid(
+                format!("{field}.jitter.correlation"),
+                format!("{c} is outside [0, 1)"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The largest jitter it can add, samples (the cut shapes, rescaled, stay within
+    /// twice the cap).
+    pub fn bound(&self) -> f64 {
+        2.0 * JITTER_CAP * self.jitter
+    }
+}
+
+impl LossModel {
+    /// Checks the probabilities; errors name `FIELD.loss_model.*`.
+    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        let f = |k: &str| format!("{field}.loss_model.{k}");
+        match self {
+            LossModel::Gemodel {
+                p,
+                r,
+                bad_loss,
+                good_loss,
+            } => {
+                for (k, v) in [
+                    ("p", p),
+                    ("r", r),
+                    ("bad_loss", bad_loss),
+                    ("good_loss", good_loss),
+                ] {
+                    probability(*v, &f(k))?;
+                }
+            }
+            LossModel::State {
+                p13,
+                p31,
+                p32,
+                p23,
+                p14,
+            } => {
+                for (k, v) in [
+                    ("p13", p13),
+                    ("p31", p31),
+                    ("p32", p32),
+                    ("p23", p23),
+                    ("p14", p14),
+                ] {
+                    probability(*v, &f(k))?;
+                }
+                if p13 + p14 > 1.0 {
+                    return Err(invalid(
+                        f("p14"),
+                        format!("p13 + p14 = {} exceeds 1", p13 + p14),
+                    ));
+                }
+                if p31 + p32 > 1.0 {
+                    return Err(invalid(
+                        f("p32"),
+                        format!("p31 + p32 = {} exceeds 1", p31 + p32),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `replay = { path = "...", format = "csv" }`: a recorded network, packet by packet.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReplayConfig {
+    /// The file, relative to the scenario's folder.
+    pub path: String,
+    /// `csv`: header `delay,lost`, one row per packet (delay in samples, lost 0 or 1),
+    /// looped; `mahimahi`: Mahimahi's delivery trace, one line per millisecond at
+    /// which the link can deliver an MTU (1500 bytes), looped [csv].
+    #[serde(default)]
+    pub format: ReplayFormat,
+    /// Mahimahi: bytes per packet on the wire (a sample's frame is about 250) [250].
+    #[serde(default = "default_packet_bytes")]
+    pub packet_bytes: u32,
+    /// Mahimahi: a packet that would queue longer than this many samples is dropped,
+    /// as a drop-tail queue would [1000].
+    #[serde(default = "default_max_queue")]
+    pub max_queue_samples: u32,
+}
+
+/// Replay formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ReplayFormat {
+    /// Per-packet delays and losses.
+    #[default]
+    Csv,
+    /// Mahimahi's delivery opportunities.
+    Mahimahi,
+}
+
+fn default_packet_bytes() -> u32 {
+    250
+}
+fn default_max_queue() -> u32 {
+    1000
+}
+
+impl ReplayConfig {
+    /// Checks the fields; errors name `FIELD.replay.*`.
+    pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        if self.path.is_empty() {
+            return Err(invalid(format!("{field}.replay.path"), "is empty"));
+        }
+        if self.packet_bytes == 0 || self.packet_bytes > 1500 {
+            return Err(invalid(
+                format!("{field}.replay.packet_bytes"),
+                format!("{} is outside 1..=1500 (one MTU)", self.packet_bytes),
+            ));
+        }
+        if self.max_queue_samples == 0 || i64::from(self.max_queue_samples) > MAX_DELAY_SAMPLES {
+            return Err(invalid(
+                format!("{field}.replay.max_queue_samples"),
+                format!(
+                    "{} is outside 1..={}",
+                    self.max_queue_samples, MAX_DELAY_SAMPLES
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
