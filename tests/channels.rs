@@ -164,7 +164,7 @@ fn deadband_with_tdpa_sends_far_fewer_packets_and_stays_passive() {
 #[test]
 fn predictors_fill_the_gaps_better_than_holding_on_a_moving_target() {
     let sb = Sandbox::new("predictors");
-    let text = tactile::run_cmd::PAPER_SCENARIO
+    let text = tactile::launch::PAPER_SCENARIO
         .replace("rate_hz = 100.0", "rate_hz = 1000.0")
         .replace("samples = 1200", "samples = 6000")
         .replace("mode = \"realtime\"", "mode = \"lockstep\"");

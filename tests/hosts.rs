@@ -17,14 +17,14 @@ use util::{column, node_dir, Sandbox};
 
 /// Two hosts: network namespaces made for the test, removed on drop.
 struct Hosts {
-    pair: tactile::netns::Pair,
+    pair: tactile::launch::netns::Pair,
     addrs: [String; 2],
 }
 
 impl Hosts {
     /// Creates the pair, or says why it cannot and returns None (the test skips).
     fn new(tag: &str) -> Option<Hosts> {
-        match tactile::netns::Pair::new(&format!("{}{tag}", std::process::id() % 100_000)) {
+        match tactile::launch::netns::Pair::new(&format!("{}{tag}", std::process::id() % 100_000)) {
             Ok(pair) => Some(Hosts {
                 addrs: pair.addrs.clone(),
                 pair,
@@ -266,7 +266,7 @@ fn the_slave_host_node_killed_breaks_the_loop_and_it_resumes_after_restart() {
 #[test]
 fn lockstep_over_zenoh_equals_the_in_process_simulation() {
     let sb = Sandbox::new("zlock");
-    let text = tactile::run_cmd::PAPER_SCENARIO
+    let text = tactile::launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace(
             "[network.forward]\ndelay = [0, 0, 0]\nnoise_std = [0.0, 0.0, 0.0]",

@@ -12,7 +12,7 @@ use util::{column, pid_of, Sandbox};
 
 /// The paper scenario in lockstep with a noisy, delayed network.
 fn lockstep(samples: u64) -> String {
-    tactile::run_cmd::PAPER_SCENARIO
+    tactile::launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace("samples = 1200", &format!("samples = {samples}"))
         .replace(

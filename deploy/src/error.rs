@@ -1,13 +1,7 @@
 //! The launcher's errors and the exit status each one maps to.
 
+use tactile_node::exit::{EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED};
 use thiserror::Error;
-
-/// Exit status for bad input: a malformed file, row or argument. Nothing was run.
-pub const EXIT_BAD_INPUT: u8 = 2;
-/// Exit status for a failure while running.
-pub const EXIT_FAILURE: u8 = 1;
-/// Exit status when SIGINT or SIGTERM stopped a run (128 + SIGINT, by convention).
-pub const EXIT_INTERRUPTED: u8 = 130;
 
 /// Everything the launcher can fail with.
 #[derive(Debug, Error)]
@@ -26,6 +20,9 @@ pub enum Error {
     /// A failure while running.
     #[error("{0}")]
     Failed(String),
+    /// Reading records or writing the report failed.
+    #[error(transparent)]
+    Report(#[from] tactile_report::Error),
     /// SIGINT or SIGTERM stopped the run; its report was written.
     #[error("stopped by a signal; the report of what ran was written")]
     Interrupted,
@@ -35,7 +32,10 @@ impl Error {
     /// The process exit status for this error.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::BadInput(_) => EXIT_BAD_INPUT,
+            Error::BadInput(_) | Error::Report(tactile_report::Error::BadInput(_)) => {
+                EXIT_BAD_INPUT
+            }
+            Error::Report(_) => EXIT_FAILURE,
             Error::Io { .. } | Error::Failed(_) => EXIT_FAILURE,
             Error::Interrupted => EXIT_INTERRUPTED,
         }
@@ -47,3 +47,4 @@ impl Error {
         move |source| Error::Io { context, source }
     }
 }
+

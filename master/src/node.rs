@@ -6,6 +6,7 @@ use crate::process::{run_with, Ending, MasterOptions};
 use clap::Parser;
 use std::process::ExitCode;
 use std::time::Duration;
+use tactile_messages::Role;
 use tactile_node::runtime::{
     exit, master_link, new_run_token, parse, prepare, start_record, NodeArgs, NodeError, Recorder,
     EXIT_CODES_HELP,
@@ -31,7 +32,7 @@ pub struct Cli {
 /// The program: parse, run, exit status.
 pub fn main() -> ExitCode {
     match parse::<Cli>() {
-        Ok(cli) => exit("master", run(&cli)),
+        Ok(cli) => exit(Role::Master, run(&cli)),
         Err(code) => code,
     }
 }
@@ -51,11 +52,11 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
             "--direct (no emulator) needs --link zenoh".into(),
         ));
     }
-    let p = prepare("master", a)?;
+    let p = prepare(Role::Master, a)?;
     OperatorSource::load(&p.scenario.operator, &p.base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: operator: {e}", a.scenario.display())))?;
-    let mut rec = Recorder::open(&a.out, "master", a.append)?;
-    rec.start(start_record("master", a, &p))?;
+    let mut rec = Recorder::open(&a.out, Role::Master, a.append)?;
+    rec.start(start_record(Role::Master, a, &p))?;
     let opts = MasterOptions {
         scenario: p.scenario.clone(),
         base_dir: p.base_dir.clone(),

@@ -3,6 +3,7 @@
 use crate::process::run_with;
 use clap::Parser;
 use std::process::ExitCode;
+use tactile_messages::Role;
 use tactile_node::runtime::{
     check_link_args, emulator_link, exit, parse, prepare, start_record, LinkKind, NodeArgs,
     NodeError, Recorder, EXIT_CODES_HELP,
@@ -28,7 +29,7 @@ pub struct Cli {
 /// The program: parse, run, exit status.
 pub fn main() -> ExitCode {
     match parse::<Cli>() {
-        Ok(cli) => exit("emulator", run(&cli)),
+        Ok(cli) => exit(Role::Emulator, run(&cli)),
         Err(code) => code,
     }
 }
@@ -39,12 +40,12 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let a = &cli.node;
     let towards_master = cli.master_link.unwrap_or(a.link);
     let towards_slave = cli.slave_link.unwrap_or(a.link);
-    let p = prepare("emulator", a)?;
+    let p = prepare(Role::Emulator, a)?;
     check_link_args(a, &[towards_master, towards_slave])?;
     let replays = crate::replay::load(&p.scenario, &p.base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: {e}", a.scenario.display())))?;
-    let mut rec = Recorder::open(&a.out, "emulator", a.append)?;
-    let mut start = start_record("emulator", a, &p);
+    let mut rec = Recorder::open(&a.out, Role::Emulator, a.append)?;
+    let mut start = start_record(Role::Emulator, a, &p);
     if towards_master != towards_slave {
         start.link = format!(
             "towards the master {}, towards the slave {}; {}",

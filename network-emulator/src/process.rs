@@ -249,7 +249,8 @@ mod tests {
             ..Script::default()
         };
         let dir = tempfile::tempdir().expect("tmp");
-        let mut rec = EmulatorRecorder::open(dir.path(), "emulator", false).expect("rec");
+        let mut rec = EmulatorRecorder::open(dir.path(), tactile_messages::Role::Emulator, false)
+            .expect("rec");
         let done = run_with(
             &scenario,
             [None, None],

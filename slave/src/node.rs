@@ -3,6 +3,7 @@
 use crate::process::run_with;
 use clap::Parser;
 use std::process::ExitCode;
+use tactile_messages::Role;
 use tactile_node::runtime::{
     exit, parse, prepare, slave_link, start_record, NodeArgs, NodeError, Recorder, EXIT_CODES_HELP,
 };
@@ -20,7 +21,7 @@ pub struct Cli {
 /// The program: parse, run, exit status.
 pub fn main() -> ExitCode {
     match parse::<Cli>() {
-        Ok(cli) => exit("slave", run(&cli)),
+        Ok(cli) => exit(Role::Slave, run(&cli)),
         Err(code) => code,
     }
 }
@@ -29,9 +30,9 @@ pub fn main() -> ExitCode {
 /// request (`Ok(false)`).
 pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let a = &cli.node;
-    let p = prepare("slave", a)?;
-    let mut rec = Recorder::open(&a.out, "slave", a.append)?;
-    rec.start(start_record("slave", a, &p))?;
+    let p = prepare(Role::Slave, a)?;
+    let mut rec = Recorder::open(&a.out, Role::Slave, a.append)?;
+    rec.start(start_record(Role::Slave, a, &p))?;
     tracing::info!("waiting for the master");
     let ended = slave_link(a, p.spin).and_then(|link| {
         run_with(&p.scenario, link.as_ref(), &mut rec, p.wake_early)

@@ -4,4 +4,7 @@
 //! every stamp is read from.
 
 pub mod clock;
+pub mod role;
 pub mod samples;
+
+pub use role::Role;

@@ -419,9 +419,9 @@ impl Mahimahi {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tactile_scenario::ReplayFormat;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
+    use tactile_scenario::ReplayFormat;
 
     const N: usize = 100_000;
 

@@ -24,6 +24,7 @@ use std::cell::Cell;
 use std::fmt::Debug;
 use std::time::{Duration, Instant};
 use tactile_messages::samples::Sequenced;
+use tactile_messages::Role;
 use thiserror::Error;
 
 pub use crate::link::CONTROL_HOP_SEQ;
@@ -49,11 +50,11 @@ pub mod streams {
     /// q(n): emulator to master.
     pub const Q: &str = "backward/q";
     /// Wake-up event of the master.
-    pub const WAKE_MASTER: &str = "master";
+    pub const WAKE_MASTER: &str = tactile_messages::Role::Master.name();
     /// Wake-up event of the emulator.
-    pub const WAKE_EMULATOR: &str = "emulator";
+    pub const WAKE_EMULATOR: &str = tactile_messages::Role::Emulator.name();
     /// Wake-up event of the slave.
-    pub const WAKE_SLAVE: &str = "slave";
+    pub const WAKE_SLAVE: &str = tactile_messages::Role::Slave.name();
 }
 
 /// How a process waits for its next sample.
@@ -428,7 +429,7 @@ pub struct IoxMaster {
 impl IoxMaster {
     /// Opens the master's streams of run `prefix`.
     pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
-        let node = node(prefix, "master")?;
+        let node = node(prefix, Role::Master.name())?;
         Ok(IoxMaster {
             out: Outbox::open(&node, streams::C, streams::WAKE_EMULATOR)?,
             inbox: Inbox::open(&node, streams::Q)?,
@@ -474,7 +475,7 @@ pub struct IoxEmulator {
 impl IoxEmulator {
     /// Opens the emulator's streams of run `prefix`.
     pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
-        let node = node(prefix, "emulator")?;
+        let node = node(prefix, Role::Emulator.name())?;
         Ok(IoxEmulator {
             in_c: Inbox::open(&node, streams::C)?,
             out_v: Outbox::open(&node, streams::V, streams::WAKE_SLAVE)?,
@@ -531,7 +532,7 @@ pub struct IoxSlave {
 impl IoxSlave {
     /// Opens the slave's streams of run `prefix`.
     pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
-        let node = node(prefix, "slave")?;
+        let node = node(prefix, Role::Slave.name())?;
         Ok(IoxSlave {
             inbox: Inbox::open(&node, streams::V)?,
             out: Outbox::open(&node, streams::H, streams::WAKE_EMULATOR)?,
@@ -583,7 +584,7 @@ enum Half {
 impl IoxHalf {
     /// Opens the master side (`master_side`) or the slave side of run `prefix`.
     pub fn open(prefix: &str, master_side: bool) -> Result<Self, IpcError> {
-        let node = node(prefix, "emulator")?;
+        let node = node(prefix, Role::Emulator.name())?;
         let half = if master_side {
             Half::Master {
                 c: Inbox::open(&node, streams::C)?,

@@ -3,6 +3,7 @@
 //! its log, the locks that keep runs apart, and the command line of the three node
 //! programs. The loops themselves are in the master, emulator and slave crates.
 
+pub mod exit;
 pub mod files;
 pub mod ipc;
 pub mod link;
@@ -12,6 +13,7 @@ pub mod pace;
 pub mod record;
 pub mod runtime;
 pub mod sched;
+pub mod signals;
 mod sys;
 pub mod udp;
 pub mod wire;

@@ -9,7 +9,7 @@ use tracing_subscriber::{fmt, EnvFilter, Layer};
 
 /// Installs the node's logger; `to_stderr` adds a terminal copy. Returns an error line
 /// if the log file cannot be opened.
-pub fn init(dir: &Path, role: &str, to_stderr: bool) -> Result<(), String> {
+pub fn init(dir: &Path, role: tactile_messages::Role, to_stderr: bool) -> Result<(), String> {
     let path = dir.join(format!("{role}.log"));
     let file = std::fs::OpenOptions::new()
         .create(true)

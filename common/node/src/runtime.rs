@@ -14,16 +14,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 use tactile_messages::clock::now_ns;
+use tactile_messages::Role;
 use tactile_scenario::Scenario;
 
-/// Exit status: the run completed.
-pub const EXIT_OK: u8 = 0;
-/// Exit status: a failure while running.
-pub const EXIT_FAILURE: u8 = 1;
-/// Exit status: bad input (arguments, scenario, prefix in use); nothing was started.
-pub const EXIT_BAD_INPUT: u8 = 2;
-/// Exit status: SIGINT or SIGTERM stopped the node; its record is complete.
-pub const EXIT_INTERRUPTED: u8 = 130;
+pub use crate::exit::{EXIT_BAD_INPUT, EXIT_CODES_HELP, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK};
 
 /// What carries the samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
@@ -145,7 +139,7 @@ impl std::fmt::Display for NodeError {
 }
 
 /// Maps a node's outcome to its exit status and one line on stderr.
-pub fn exit(role: &str, outcome: Result<bool, NodeError>) -> ExitCode {
+pub fn exit(role: Role, outcome: Result<bool, NodeError>) -> ExitCode {
     match outcome {
         Ok(true) => ExitCode::from(EXIT_OK),
         Ok(false) => ExitCode::from(EXIT_INTERRUPTED),
@@ -179,7 +173,7 @@ pub struct Prepared {
 /// Checks the arguments, the scenario and the prefix, creates the output folder, takes
 /// the role's lock, installs the logger and pins the CPU. Nothing is started when it
 /// fails: the error is bad input (exit 2).
-pub fn prepare(role: &str, args: &NodeArgs) -> Result<Prepared, NodeError> {
+pub fn prepare(role: Role, args: &NodeArgs) -> Result<Prepared, NodeError> {
     let bad = NodeError::BadInput;
     lock::check_prefix(&args.prefix).map_err(bad)?;
     let (scenario, base_dir) = crate::files::load_scenario(&args.scenario).map_err(bad)?;
@@ -203,7 +197,7 @@ pub fn prepare(role: &str, args: &NodeArgs) -> Result<Prepared, NodeError> {
         std::process::id(),
         args.out.display()
     );
-    let lock = lock::take(&args.prefix, role, &holder).map_err(bad)?;
+    let lock = lock::take(&args.prefix, role.name(), &holder).map_err(bad)?;
     crate::logging::init(&args.out, role, args.supervised.is_none()).map_err(bad)?;
     if let Some(parent) = args.supervised {
         supervise(parent)?;
@@ -340,7 +334,7 @@ pub fn pin(cpu: usize) -> Result<(), String> {
 }
 
 /// The record file of `role` in `dir`.
-pub fn record_path(dir: &Path, role: &str) -> PathBuf {
+pub fn record_path(dir: &Path, role: Role) -> PathBuf {
     dir.join(format!("{role}.rec"))
 }
 
@@ -358,7 +352,7 @@ pub const COUNTERS_EVERY_NS: u64 = 1_000_000_000;
 
 impl<S: Serialize, C: Serialize> Recorder<S, C> {
     /// Opens `ROLE.rec` in `dir` (afresh, or appended to with `append`).
-    pub fn open(dir: &Path, role: &str, append: bool) -> Result<Self, NodeError> {
+    pub fn open(dir: &Path, role: Role, append: bool) -> Result<Self, NodeError> {
         let path = record_path(dir, role);
         let writer = RecordWriter::create(&path, append)
             .map_err(|e| NodeError::Failed(format!("opening {}: {e}", path.display())))?;
@@ -481,12 +475,12 @@ pub fn describe_link(a: &NodeArgs) -> String {
 }
 
 /// The `Start` of a node's record from its arguments.
-pub fn start_record(role: &str, args: &NodeArgs, p: &Prepared) -> Start {
+pub fn start_record(role: Role, args: &NodeArgs, p: &Prepared) -> Start {
     let unix_ms = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_millis() as u64);
     Start {
-        role: role.to_string(),
+        role: role.name().to_string(),
         version: env!("CARGO_PKG_VERSION").to_string(),
         pid: std::process::id(),
         host: rustix::system::uname()
@@ -505,12 +499,6 @@ pub fn start_record(role: &str, args: &NodeArgs, p: &Prepared) -> Start {
         mono_ns: now_ns(),
     }
 }
-
-/// The exit statuses, for each node's `--help`.
-pub const EXIT_CODES_HELP: &str = "Exit status: 0 the run completed; 1 a failure while running; \
-2 bad input (arguments, scenario, a prefix in use), nothing started; 130 stopped by SIGINT or \
-SIGTERM (the record is complete).\n\nThe record (ROLE.rec) and log (ROLE.log) go to --out; \
-`tactile report DIR...` joins the nodes' folders into the run's report.";
 
 /// Parses a node's command line; on an error prints clap's message and returns the
 /// exit status (2 for bad arguments, 0 for --help and --version).

@@ -117,11 +117,7 @@ struct Endpoint {
 impl Endpoint {
     fn bind(at: SocketAddr, wait: WaitPolicy) -> Result<Endpoint, IpcError> {
         let socket = UdpSocket::bind(at).map_err(|e| err(&format!("binding UDP {at}"), e))?;
-        let stop = Arc::new(AtomicBool::new(false));
-        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-            signal_hook::flag::register(sig, Arc::clone(&stop))
-                .map_err(|e| err("installing signal handlers", e))?;
-        }
+        let stop = crate::signals::stop_flag().map_err(|e| err("installing signal handlers", e))?;
         Ok(Endpoint {
             socket,
             spin: wait.spin,

@@ -231,11 +231,7 @@ impl ZenohEnd {
                 .map_err(|e| err(&format!("declaring the subscriber of {}", s.name()), e))?;
             subscribers.push(sub);
         }
-        let stop = Arc::new(AtomicBool::new(false));
-        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-            signal_hook::flag::register(sig, Arc::clone(&stop))
-                .map_err(|e| err("installing signal handlers", e))?;
-        }
+        let stop = crate::signals::stop_flag().map_err(|e| err("installing signal handlers", e))?;
         Ok(ZenohEnd {
             session,
             publishers,

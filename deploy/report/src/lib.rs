@@ -1,3 +1,18 @@
-//! The report of a run as a library: the trace row and its columns.
+//! The report of a run as a library, so a notebook, a script or another tool can do
+//! what `tactile report` does: [`join`] streams the nodes' records (one host's folder
+//! or several) and joins them by sequence number into [`trace::TraceRow`]s;
+//! [`analysis`] and [`metrics`] fold the rows into latency histograms and the loop's
+//! figures; [`summary`] says it in JSON and text; [`plots`] draws it; [`write`] puts
+//! the report's files in a folder; [`sweep`] tabulates many runs' summaries.
 
+pub mod analysis;
+pub mod error;
+pub mod join;
+pub mod metrics;
+pub mod plots;
+pub mod summary;
+pub mod sweep;
 pub mod trace;
+pub mod write;
+
+pub use error::Error;

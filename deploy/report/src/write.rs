@@ -1,18 +1,19 @@
-//! `tactile report DIR...`: the run's report from the nodes' records, and the files it
-//! writes. `tactile run` calls the same [`write_report`] when its nodes have stopped.
+//! The run's report from the nodes' records, and the files it writes: `tactile report`
+//! and `tactile run` (when its nodes have stopped) both call [`write_report`].
 
-use crate::error::Error;
+use crate::analysis::{Analysis, STAGES};
 use crate::join::{self, Logs, NodeLog};
 use crate::metrics::Packets;
 use crate::plots::{self, Series};
-use crate::report::{Analysis, STAGES};
-use crate::summary::{render, ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
+use crate::summary::{ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
+use crate::trace;
+use crate::Error;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use tactile_report::trace;
+use tactile_messages::Role;
 use tactile_scenario::Scenario;
 
 /// Files a report writes into its folder.
@@ -120,7 +121,7 @@ where
     })
 }
 
-fn events<C: Clone>(role: &str, log: &NodeLog<C>, out: &mut Vec<String>) -> u64 {
+fn events<C: Clone>(role: Role, log: &NodeLog<C>, out: &mut Vec<String>) -> u64 {
     out.extend(
         log.events
             .iter()
@@ -168,18 +169,18 @@ fn summarise(
     }
     let mut nodes = BTreeMap::new();
     for (role, n) in [
-        ("master", node_summary(&logs.master)),
-        ("emulator", node_summary(&logs.emulator)),
-        ("slave", node_summary(&logs.slave)),
+        (Role::Master, node_summary(&logs.master)),
+        (Role::Emulator, node_summary(&logs.emulator)),
+        (Role::Slave, node_summary(&logs.slave)),
     ] {
         if let Some(n) = n {
-            nodes.insert(role, n);
+            nodes.insert(role.name(), n);
         }
     }
     let mut ev = launch.events.clone();
-    let omitted = events("master", &logs.master, &mut ev)
-        + events("emulator", &logs.emulator, &mut ev)
-        + events("slave", &logs.slave, &mut ev);
+    let omitted = events(Role::Master, &logs.master, &mut ev)
+        + events(Role::Emulator, &logs.emulator, &mut ev)
+        + events(Role::Slave, &logs.slave, &mut ev);
     let elapsed = master_totals.elapsed_ns;
     Summary {
         scenario: scenario.name.clone(),
@@ -193,11 +194,11 @@ fn summarise(
         overhead_negative: a.overhead.negative,
         clocks: Clocks {
             shared: (0..3).all(|k| a.same_clock(0, k) || logs_missing(logs, k)),
-            domains: crate::report::NODES
+            domains: Role::ALL
                 .iter()
                 .zip(a.domains())
                 .filter(|(_, d)| !d.is_empty())
-                .map(|(n, d)| (*n, d.clone()))
+                .map(|(r, d)| (r.name(), d.clone()))
                 .collect(),
             offsets: a.clock_offsets(),
         },
@@ -326,23 +327,4 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     let summary = summarise(&scenario, runner, &analysis, &logs, launch);
     write_json(&out.join("summary.json"), &summary)?;
     Ok(summary)
-}
-
-/// `tactile report DIR... [--out OUT]`.
-pub fn main(args: &crate::cli::ReportArgs) -> Result<(), Error> {
-    let [master, _, _] = join::locate(&args.dirs)?;
-    let out = match &args.out {
-        Some(o) => o.clone(),
-        None => master
-            .as_deref()
-            .and_then(Path::parent)
-            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
-    };
-    let launch = Launch {
-        no_trace: args.no_trace,
-        ..Launch::default()
-    };
-    let summary = write_report(&args.dirs, &out, &launch)?;
-    print!("{}", render(&summary, &out));
-    Ok(())
 }

@@ -7,12 +7,13 @@
 //! p50, p90, p99, p99.9 and max; the full distribution is written in HdrHistogram's
 //! percentile-file form (`*.hgrm`, microseconds) so standard tools can plot it.
 
+use crate::trace::TraceRow;
 use hdrhistogram::Histogram;
 use serde::Serialize;
 use std::fmt::Write as _;
 use tactile_math::vec3::{distance, norm};
 use tactile_messages::samples::{stage, FLAG_REJECTED, FLAG_SUBSTITUTED};
-use tactile_report::trace::TraceRow;
+use tactile_messages::Role;
 
 /// Percentiles of one latency distribution, nanoseconds.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
@@ -201,9 +202,6 @@ pub const PAIRS: [(usize, usize, [usize; 4]); 3] = [
     ),
 ];
 
-/// Role names by index.
-pub const NODES: [&str; 3] = ["master", "emulator", "slave"];
-
 /// The offset of one node's clock from another's, estimated from the exchanges between
 /// them (an estimate: it assumes the two directions of the network take equal time).
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
@@ -377,7 +375,7 @@ impl Analysis {
             .filter_map(|((a, b, _), f)| {
                 let (rtt, offset) = f.best?;
                 Some(ClockOffset {
-                    between: format!("{}-{}", NODES[*a], NODES[*b]),
+                    between: format!("{}-{}", Role::ALL[*a], Role::ALL[*b]),
                     offset_ns_estimate: offset,
                     uncertainty_ns: rtt / 2,
                     min_network_round_trip_ns: rtt,

@@ -1,8 +1,8 @@
 //! `summary.json` and the terminal summary: a view of the nodes' records, with each
 //! stream's accounting.
 
+use crate::analysis::{us_header, us_line, ClockOffset, Motion, Percentiles};
 use crate::metrics::{Contact, Packets, Passivity, Tracking};
-use crate::report::{us_header, us_line, ClockOffset, Motion, Percentiles};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -287,7 +287,7 @@ pub fn render(s: &Summary, out: &Path) -> String {
     if s.events_omitted > 0 {
         let _ = writeln!(t, "({} more events in the records)", s.events_omitted);
     }
-    let files: Vec<&str> = crate::report_cmd::REPORT_FILES
+    let files: Vec<&str> = crate::write::REPORT_FILES
         .iter()
         .copied()
         .filter(|f| out.join(f).exists())

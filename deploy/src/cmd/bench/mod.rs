@@ -7,21 +7,23 @@
 //! floor any loop over iceoryx2 stands on. Then the lockstep throughput of the trio.
 //! Everything is reported as percentiles and as ratios taken in the same run.
 
-use crate::cli::BenchArgs;
+mod stalls;
+
 use crate::error::Error;
-use crate::report::{us_header, us_line, Latency, Percentiles};
-use crate::report_cmd::write_json;
-use crate::run_cmd::{run_processes, Loaded, Supervision, PAPER_SCENARIO};
-use crate::summary::Summary;
+use crate::launch::{run_processes, Loaded, Supervision, PAPER_SCENARIO};
+use clap::Args;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{Forward, FLAG_END, FLAG_PROBE};
 use tactile_node::ipc::{self, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
 use tactile_node::runtime::LinkKind;
+use tactile_report::analysis::{us_header, us_line, Latency, Percentiles};
+use tactile_report::summary::Summary;
+use tactile_report::write::write_json;
 use tactile_scenario::{Mode, Scenario};
 
 /// Runs of this bench so far (their prefixes' suffix).
@@ -95,7 +97,66 @@ pub struct BenchReport {
     /// Wait strategy used.
     pub strategy: String,
     /// The machine's own stalls, probed after the loops (`--probe-s`).
-    pub machine: crate::stalls::StallReport,
+    pub machine: stalls::StallReport,
+}
+
+/// Arguments of `tactile bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Samples per run (each rate, each transport).
+    #[arg(long, default_value_t = 60_000)]
+    pub samples: u64,
+    /// Rates to measure, Hz.
+    #[arg(long, value_delimiter = ',', default_values_t = [1000.0, 10000.0])]
+    pub rates: Vec<f64>,
+    /// Seconds to probe the machine's own stalls after the loops: a SCHED_FIFO 99
+    /// thread per CPU that reads the clock, 900 ms of every second (0: no probe; at
+    /// most 600).
+    #[arg(long, default_value_t = 20.0)]
+    pub probe_s: f64,
+    /// Samples of the lockstep throughput run.
+    #[arg(long, default_value_t = 20_000)]
+    pub lockstep_samples: u64,
+    /// Output folder (bench.json and each run's report).
+    #[arg(long, default_value = "bench-out")]
+    pub out: PathBuf,
+    /// Poll budget of every node, microseconds (default: the nodes' own).
+    #[arg(long)]
+    pub spin_us: Option<u64>,
+    /// Realtime: microseconds before a sample is due that each node stops sleeping
+    /// and polls (default 200, at most 40 % of a period).
+    #[arg(long)]
+    pub wake_early_us: Option<u64>,
+    /// Scheduling of every loop's nodes (the same for every transport).
+    #[arg(long, value_enum, default_value_t = tactile_node::sched::Policy::Fifo)]
+    pub sched: tactile_node::sched::Policy,
+    /// What each node's CPU does while the node sleeps, under SCHED_FIFO: halt (the
+    /// kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so a
+    /// halted CPU is not woken late; on these virtual machines a CPU kept busy is
+    /// taken away for about 7.5 ms every 10 s instead: docs/07-latency.md).
+    #[arg(long, value_enum, default_value_t = tactile_node::sched::IdleMode::Halt)]
+    pub idle: tactile_node::sched::IdleMode,
+    /// Do not pin the iceoryx2 processes to CPUs.
+    #[arg(long)]
+    pub no_pin: bool,
+    /// iceoryx2 prefix of the bench's runs (default: one per invocation).
+    #[arg(long)]
+    pub prefix: Option<String>,
+    /// Also run the Zenoh and UDP loops across two hosts: two network namespaces
+    /// joined by a veth pair (made and removed by the bench; needs root).
+    #[arg(long)]
+    pub hosts: bool,
+}
+
+/// Arguments of `tactile bench-echo`.
+#[derive(Debug, Args)]
+pub struct EchoArgs {
+    /// iceoryx2 prefix of the hop.
+    #[arg(long)]
+    pub prefix: String,
+    /// Busy-poll budget, microseconds.
+    #[arg(long, default_value_t = 0)]
+    pub spin_us: u64,
 }
 
 /// A loop's result; a stop request (SIGINT, SIGTERM) ends the bench, so the
@@ -135,7 +196,7 @@ fn trio(sc: &Scenario, out: &Path, sup: &Supervision, link: LinkKind) -> Result<
         sc,
         out,
         sup,
-        crate::run_cmd::Links::on_this_host(link)?,
+        crate::launch::Links::on_this_host(link)?,
         Default::default(),
     )
 }
@@ -145,7 +206,7 @@ fn trio_with(
     sc: &Scenario,
     out: &Path,
     sup: &Supervision,
-    links: crate::run_cmd::Links,
+    links: crate::launch::Links,
     wrap: [Vec<String>; 3],
 ) -> Result<Summary, Error> {
     let sup = Supervision {
@@ -310,7 +371,7 @@ fn supervision(args: &BenchArgs, prefix: &str) -> Supervision {
         wake_early: args.wake_early_us.map(Duration::from_micros),
         progress: false,
         max_restarts: 0,
-        link: crate::run_cmd::Links {
+        link: crate::launch::Links {
             kind: LinkKind::Iceoryx2,
             args: Default::default(),
         },
@@ -338,7 +399,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     }
     std::fs::create_dir_all(&args.out)
         .map_err(Error::io(format!("creating {}", args.out.display())))?;
-    crate::run_cmd::clean_stale_runs();
+    crate::launch::clean_stale_runs();
     let mut rates = Vec::new();
     let prefix = args
         .prefix
@@ -346,11 +407,8 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
         .unwrap_or_else(|| format!("tactile{}b", std::process::id()));
     // From here a stop request is a flag the runs look at, not the end of this
     // process: the bench stops between runs and removes what it made.
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        signal_hook::flag::register(sig, std::sync::Arc::clone(&stop))
-            .map_err(Error::io("installing signal handlers"))?;
-    }
+    let stop =
+        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     if !cfg!(feature = "zenoh") {
         eprintln!(
             "tactile bench: no Zenoh loop: this build has no Zenoh link (build with --features zenoh)"
@@ -358,9 +416,10 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     }
     let hosts = if args.hosts {
         Some(
-            crate::netns::Pair::new(&format!("b{}", std::process::id() % 100_000)).map_err(
-                |e| Error::Failed(format!("--hosts: cannot make two network namespaces: {e}")),
-            )?,
+            crate::launch::netns::Pair::new(&format!("b{}", std::process::id() % 100_000))
+                .map_err(|e| {
+                    Error::Failed(format!("--hosts: cannot make two network namespaces: {e}"))
+                })?,
         )
     } else {
         None
@@ -402,7 +461,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
                     pair.names[0], pair.names[1]
                 );
                 let wrap = [pair.exec(0), pair.exec(1), pair.exec(1)];
-                let links = crate::run_cmd::Links::across(link, pair);
+                let links = crate::launch::Links::across(link, pair);
                 let out = args.out.join(format!("{name}-{rate}"));
                 let s = trio_with(
                     &sc,
@@ -446,9 +505,9 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             "tactile bench: the machine's own stalls, {} s per CPU",
             args.probe_s
         );
-        crate::stalls::probe(args.probe_s, true, &stop)
+        stalls::probe(args.probe_s, true, &stop)
     } else {
-        crate::stalls::StallReport {
+        stalls::StallReport {
             note: Some("not probed (--probe-s 0)".into()),
             ..Default::default()
         }
@@ -501,9 +560,9 @@ fn percentile_plot(out: &Path, rate: f64, loops: &[LoopResult]) -> Result<(), Er
         let file = out.join(format!("{}-{rate}", l.name)).join("overhead.hgrm");
         let text = std::fs::read_to_string(&file)
             .map_err(Error::io(format!("reading {}", file.display())))?;
-        series.push((l.name.clone(), crate::plots::read_hgrm(&text)));
+        series.push((l.name.clone(), tactile_report::plots::read_hgrm(&text)));
     }
-    crate::plots::percentile_plot(
+    tactile_report::plots::percentile_plot(
         &out.join(format!("percentiles-{rate}.svg")),
         &format!("System overhead by percentile, {rate} Hz"),
         &series,
@@ -555,7 +614,7 @@ fn render(r: &BenchReport) -> String {
     let _ = write!(
         t,
         "\nthe machine's own stalls:\n{}",
-        crate::stalls::render(&r.machine)
+        stalls::render(&r.machine)
     );
     t
 }

@@ -7,20 +7,18 @@
 //! late answers), so joining a run of any length takes bounded memory. The records may
 //! come from one folder or one folder per node, as they would from different hosts.
 
-use crate::error::Error;
+use crate::trace::TraceRow;
+use crate::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use tactile_master::record::{Answer, MasterSample, MasterTotals, Miss, Sent};
 use tactile_messages::samples::{stage, LATE_WINDOW};
+use tactile_messages::Role;
 use tactile_network_emulator::emulator::{Direction, Passage};
 use tactile_network_emulator::process::EmulatorTotals;
 use tactile_node::record::{Record, RecordReader, Start, Totals};
 use tactile_node::runtime::record_path;
-use tactile_report::trace::TraceRow;
 use tactile_slave::record::{SlaveSample, SlaveTotals, Step};
-
-/// The roles whose records are joined.
-pub const ROLES: [&str; 3] = ["master", "emulator", "slave"];
 
 /// Events kept per node in the report; further ones are counted, not kept, so a node
 /// that broke a million times still gives a readable report.
@@ -232,7 +230,7 @@ pub fn locate(dirs: &[PathBuf]) -> Result<[Option<PathBuf>; 3], Error> {
                 dir.display()
             )));
         }
-        for (k, role) in ROLES.iter().enumerate() {
+        for (k, role) in Role::ALL.into_iter().enumerate() {
             let p = record_path(dir, role);
             if p.exists() {
                 if let Some(other) = &found[k] {
@@ -444,8 +442,8 @@ fn check_one_run(logs: &Logs) -> Result<(), Error> {
         return Ok(());
     };
     for (role, runs, path) in [
-        ("emulator", &logs.emulator.runs, &logs.emulator.path),
-        ("slave", &logs.slave.runs, &logs.slave.path),
+        (Role::Emulator, &logs.emulator.runs, &logs.emulator.path),
+        (Role::Slave, &logs.slave.runs, &logs.slave.path),
     ] {
         if let Some(other) = runs.iter().find(|&&t| t != token) {
             return Err(Error::BadInput(format!(

@@ -7,10 +7,10 @@
 //! there are more buckets than pixel columns. A plot of a million samples is
 //! then as small and as readable as one of a thousand, and no spike is lost.
 
-use crate::report::Latency;
+use crate::analysis::Latency;
+use crate::trace::TraceRow;
 use plotters::prelude::*;
 use std::path::Path;
-use tactile_report::trace::TraceRow;
 
 type PlotResult = Result<(), String>;
 
@@ -342,7 +342,7 @@ pub fn percentile_plot(
 /// the second key. A run without a value for the metric leaves a gap.
 pub fn sweep_plots(
     out: &Path,
-    axes: &[crate::sweep_cmd::Axis],
+    axes: &[crate::sweep::Axis],
     rows: &[(Vec<usize>, Vec<Option<f64>>)],
 ) -> PlotResult {
     let Some(first) = axes.first() else {
@@ -351,7 +351,7 @@ pub fn sweep_plots(
     let numeric: Option<Vec<f64>> = first.values.iter().map(|v| v.parse().ok()).collect();
     let x_of = |i: usize| numeric.as_ref().map_or(i as f64, |n| n[i]);
     let lines = axes.get(1).map_or(1, |a| a.values.len());
-    for (m, (name, _)) in crate::sweep_cmd::METRICS.iter().enumerate() {
+    for (m, (name, _)) in crate::sweep::METRICS.iter().enumerate() {
         let mut series = Vec::new();
         for line in 0..lines {
             let mut pts: Vec<(f64, f64)> = rows

@@ -5,13 +5,28 @@
 //! input row. The whole output is built in memory and written only when every row
 //! parsed, so a bad row leaves stdout empty rather than half written.
 
-use crate::cli::{KernelsArgs, Module};
+use super::datapath::{ArithArg, DatapathArgs, Module};
 use crate::error::Error;
+use clap::Args;
 use std::io::{BufRead, Write};
 use tactile_math::arith::ArithKind;
 use tactile_math::engine::Engine;
 use tactile_math::kernels::IkStatus;
 use tactile_scenario::csv;
+
+/// Arguments of `tactile kernels`.
+#[derive(Debug, Args)]
+pub struct KernelsArgs {
+    /// Which kernel to evaluate.
+    #[arg(value_enum)]
+    pub module: Module,
+    /// Arithmetic to evaluate in.
+    #[arg(long, value_enum, default_value_t = ArithArg::F64)]
+    pub arith: ArithArg,
+    /// Datapath format and device.
+    #[command(flatten)]
+    pub datapath: DatapathArgs,
+}
 
 impl Module {
     /// Input column names, in order.

@@ -10,25 +10,15 @@
 use crate::error::Error;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-/// The program names, by role.
-pub const PROGRAMS: [(&str, &str); 3] = [
-    ("master", "tactile-master"),
-    ("emulator", "tactile-emulator"),
-    ("slave", "tactile-slave"),
-];
+use tactile_messages::Role;
 
 /// The executable of `role` in `dir`.
-pub fn exe(dir: &Path, role: &str) -> PathBuf {
-    let name = PROGRAMS
-        .iter()
-        .find(|(r, _)| *r == role)
-        .map_or("tactile-master", |(_, n)| n);
-    dir.join(name)
+pub fn exe(dir: &Path, role: Role) -> PathBuf {
+    dir.join(role.program())
 }
 
 fn all_in(dir: &Path) -> bool {
-    PROGRAMS.iter().all(|(_, n)| dir.join(n).is_file())
+    Role::ALL.iter().all(|r| exe(dir, *r).is_file())
 }
 
 /// The Cargo profile a target folder holds (`debug` is the dev profile).

@@ -4,10 +4,10 @@
 //! dissipated. Memory is bounded: the rows a delayed value refers back to are kept in
 //! a ring of [`LATE_WINDOW`] samples (a value delayed longer is not compared).
 
+use crate::trace::TraceRow;
 use serde::Serialize;
 use tactile_math::vec3::{distance, norm};
 use tactile_messages::samples::{FLAG_CORRUPTED, FLAG_REJECTED, FLAG_SUBSTITUTED, LATE_WINDOW};
-use tactile_report::trace::TraceRow;
 
 /// `tracking` in summary.json.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]

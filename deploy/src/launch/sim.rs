@@ -7,7 +7,6 @@
 //! (n * t_s), so round trips equal the injected delay and overheads are zero.
 
 use crate::error::Error;
-use crate::report_cmd::IN_PROCESS;
 use std::path::Path;
 use tactile_master::hmd::Master;
 use tactile_master::operator::OperatorSource;
@@ -15,10 +14,12 @@ use tactile_master::process::MasterRecorder;
 use tactile_master::record::{MasterSample, MasterTotals};
 use tactile_messages::clock::now_ns;
 use tactile_messages::samples::stage;
+use tactile_messages::Role;
 use tactile_network_emulator::emulator::Emulator;
 use tactile_network_emulator::process::{EmulatorRecorder, EmulatorTotals};
 use tactile_node::record::Start;
 use tactile_node::runtime::{NodeError, Recorder};
+use tactile_report::write::IN_PROCESS;
 use tactile_scenario::Scenario;
 use tactile_slave::hsd::Slave;
 use tactile_slave::process::SlaveRecorder;
@@ -27,9 +28,9 @@ use tactile_slave::record::{SlaveSample, SlaveTotals};
 /// The run token of a simulation (there is no master process to choose one).
 pub const SIM_RUN: u64 = 1;
 
-fn start(role: &str, scenario: &Scenario, base_dir: &Path) -> Start {
+fn start(role: Role, scenario: &Scenario, base_dir: &Path) -> Start {
     Start {
-        role: role.into(),
+        role: role.name().into(),
         version: env!("CARGO_PKG_VERSION").into(),
         pid: std::process::id(),
         host: "in-process".into(),
@@ -64,14 +65,14 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<(), 
         tactile_network_emulator::replay::load(scenario, base_dir).map_err(Error::BadInput)?;
     let mut emulator = Emulator::with_replays(scenario, replays);
     let mut slave = Slave::new(scenario).map_err(bad)?;
-    let mut mrec: MasterRecorder = Recorder::open(out, "master", false).map_err(failed)?;
-    let mut erec: EmulatorRecorder = Recorder::open(out, "emulator", false).map_err(failed)?;
-    let mut srec: SlaveRecorder = Recorder::open(out, "slave", false).map_err(failed)?;
-    mrec.start(start("master", scenario, base_dir))
+    let mut mrec: MasterRecorder = Recorder::open(out, Role::Master, false).map_err(failed)?;
+    let mut erec: EmulatorRecorder = Recorder::open(out, Role::Emulator, false).map_err(failed)?;
+    let mut srec: SlaveRecorder = Recorder::open(out, Role::Slave, false).map_err(failed)?;
+    mrec.start(start(Role::Master, scenario, base_dir))
         .map_err(failed)?;
-    erec.start(start("emulator", scenario, base_dir))
+    erec.start(start(Role::Emulator, scenario, base_dir))
         .map_err(failed)?;
-    srec.start(start("slave", scenario, base_dir))
+    srec.start(start(Role::Slave, scenario, base_dir))
         .map_err(failed)?;
     mrec.run(SIM_RUN).map_err(failed)?;
     erec.run(SIM_RUN).map_err(failed)?;

@@ -1,11 +1,23 @@
 //! `tactile paper`: the paper's MSE table from our own kernels.
 
-use crate::cli::PaperArgs;
+use super::datapath::DatapathArgs;
 use crate::error::Error;
+use clap::Args;
 use serde::Serialize;
 use std::io::Write;
 use tactile_math::cordic::{CordicConfig, Rounding};
 use tactile_math::validation::{self, MseRow};
+
+/// Arguments of `tactile paper`.
+#[derive(Debug, Args)]
+pub struct PaperArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Datapath format and device.
+    #[command(flatten)]
+    pub datapath: DatapathArgs,
+}
 
 #[derive(Debug, Serialize)]
 struct Report<'a> {

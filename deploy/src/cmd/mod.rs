@@ -1,0 +1,9 @@
+//! One module per `tactile` subcommand, each owning its arguments and its `main`.
+
+pub mod bench;
+pub mod datapath;
+pub mod kernels;
+pub mod paper;
+pub mod report;
+pub mod run;
+pub mod sweep;

@@ -1,0 +1,42 @@
+//! `tactile report DIR...`: the run's report from the nodes' records (one folder, or
+//! one folder per node from several hosts).
+
+use crate::error::Error;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use tactile_report::join;
+use tactile_report::summary::render;
+use tactile_report::write::{write_report, Launch};
+
+/// Arguments of `tactile report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Folders holding the nodes' records (master.rec, emulator.rec, slave.rec).
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Folder for the report (default: the master's folder).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Write no trace.csv (a long run's trace is about 1 kB per sample).
+    #[arg(long)]
+    pub no_trace: bool,
+}
+
+/// `tactile report DIR... [--out OUT]`.
+pub fn main(args: &ReportArgs) -> Result<(), Error> {
+    let [master, _, _] = join::locate(&args.dirs)?;
+    let out = match &args.out {
+        Some(o) => o.clone(),
+        None => master
+            .as_deref()
+            .and_then(Path::parent)
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+    };
+    let launch = Launch {
+        no_trace: args.no_trace,
+        ..Launch::default()
+    };
+    let summary = write_report(&args.dirs, &out, &launch)?;
+    print!("{}", render(&summary, &out));
+    Ok(())
+}

@@ -1,0 +1,99 @@
+//! The launcher: runs a scenario's three node programs on this host (or across
+//! network namespaces) and supervises them, or simulates the loop in this process.
+//! `tactile run`, `sweep` and `bench` all start runs through here.
+
+pub mod links;
+pub mod netns;
+pub mod nodes;
+pub mod scenario;
+pub mod sim;
+pub mod supervise;
+
+pub use links::Links;
+pub use scenario::{load_scenario, parse_sets, prepare_out, Loaded, PAPER_SCENARIO};
+pub use supervise::run_processes;
+
+use std::path::Path;
+use std::time::Duration;
+use tactile_node::runtime::LinkKind;
+use tactile_scenario::Scenario;
+
+/// How `tactile run` supervises its processes.
+#[derive(Debug, Clone)]
+pub struct Supervision {
+    /// iceoryx2 prefix of the run.
+    pub prefix: String,
+    /// Poll budget of every process (None: each node's default, README "Waiting").
+    pub spin: Option<Duration>,
+    /// How long before a sample is due each node wakes (None: each node's default).
+    pub wake_early: Option<Duration>,
+    /// Progress line on a terminal.
+    pub progress: bool,
+    /// Restarts allowed per process (emulator, slave) when one dies mid-run.
+    pub max_restarts: u32,
+    /// What carries the samples, and the link options of each node.
+    pub link: Links,
+    /// Command prefix of the master, the emulator and the slave (e.g. `ip netns exec
+    /// A` to put a node on another host); empty: run the program directly.
+    pub wrap: [Vec<String>; 3],
+    /// Pin master to CPU 0, emulator and slave to CPU 1.
+    pub pin: bool,
+    /// Scheduling of the three processes, which each node sets on itself.
+    pub sched: tactile_node::sched::Policy,
+    /// What each node's CPU does while the node sleeps (realtime, SCHED_FIFO).
+    pub idle: tactile_node::sched::IdleMode,
+    /// Write no trace.csv.
+    pub no_trace: bool,
+}
+
+/// How `tactile sweep --processes` runs each combination: as `tactile run` does by
+/// default, no restarts, no progress line.
+pub fn sweep_supervision(no_trace: bool) -> Supervision {
+    Supervision {
+        prefix: format!("tactile{}s", std::process::id()),
+        spin: None,
+        wake_early: None,
+        progress: false,
+        max_restarts: 0,
+        link: Links {
+            kind: LinkKind::Iceoryx2,
+            args: Default::default(),
+        },
+        wrap: Default::default(),
+        pin: true,
+        sched: tactile_node::sched::Policy::Fifo,
+        idle: tactile_node::sched::IdleMode::Halt,
+        no_trace,
+    }
+}
+
+/// True if this machine lets the process use CPUs 0 and 1.
+pub fn two_cpus() -> bool {
+    rustix::thread::sched_getaffinity(None).is_ok_and(|s| s.is_set(0) && s.is_set(1))
+}
+
+/// Removes the shared memory of earlier runs whose launcher is gone (a crashed or
+/// killed run leaves it behind; iceoryx2 would clean it only for the same prefix).
+pub fn clean_stale_runs() {
+    let Ok(dir) = std::fs::read_dir(tactile_node::ipc::ROOT) else {
+        return;
+    };
+    for entry in dir.flatten() {
+        let name = entry.file_name().to_string_lossy().to_string();
+        let Some(pid) = name
+            .strip_prefix("tactile")
+            .and_then(|p| p.parse::<i32>().ok())
+        else {
+            continue;
+        };
+        if !Path::new(&format!("/proc/{pid}")).exists() {
+            tactile_node::ipc::remove_run_files(&name);
+        }
+    }
+}
+
+/// How long the launcher lets the emulator and slave run on after the master died:
+/// long enough for the slave to notice and hold (its peer timeout) and to be seen.
+pub fn survivor_grace(scenario: &Scenario) -> Duration {
+    tactile_slave::process::hold_timeout(scenario) + Duration::from_millis(500)
+}

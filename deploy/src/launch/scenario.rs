@@ -1,0 +1,122 @@
+//! The scenario a run starts from: read, changed by `--set`, validated with its
+//! inputs (trajectory, recorded networks), and the output folder made ready for it.
+//! Everything here can refuse a run, so it all happens before any process starts.
+
+use crate::error::Error;
+use std::path::{Path, PathBuf};
+use tactile_master::operator::OperatorSource;
+use tactile_messages::Role;
+use tactile_node::files::{self, same_file};
+use tactile_report::write::REPORT_FILES;
+use tactile_scenario::overrides::Set;
+use tactile_scenario::{Operator, Scenario};
+
+/// The paper scenario, built into the executable so `tactile run` works from any folder.
+pub const PAPER_SCENARIO: &str = include_str!("../../scenarios/paper.toml");
+
+/// A scenario ready to run: validated, its trajectory checked, and where it came from.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Folder its relative paths are resolved against.
+    pub base_dir: PathBuf,
+    /// The files it was read from (the scenario, a trajectory), which a run must never
+    /// overwrite.
+    pub inputs: Vec<PathBuf>,
+}
+
+/// Reads and validates a scenario; `None` is the built-in paper scenario. A trajectory
+/// file is read too, so a bad one stops the run before anything starts.
+pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error> {
+    let (text, base_dir, name) = match path {
+        None => (
+            PAPER_SCENARIO.to_string(),
+            std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+            "deploy/scenarios/paper.toml (built in)".to_string(),
+        ),
+        Some(p) => (
+            files::read_text(p, "scenario", files::MAX_SCENARIO_BYTES).map_err(Error::BadInput)?,
+            files::base_dir(p),
+            p.display().to_string(),
+        ),
+    };
+    let text = tactile_scenario::overrides::apply(&text, sets)
+        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    let with = if sets.is_empty() {
+        String::new()
+    } else {
+        let s: Vec<&str> = sets.iter().map(|s| s.text.as_str()).collect();
+        format!(" with --set {}", s.join(" --set "))
+    };
+    let scenario = Scenario::from_toml_str(&text).map_err(|e| {
+        let msg = e.to_string();
+        // A line and column would point into the changed text, not the user's file.
+        let msg = match msg.strip_prefix("line ").and_then(|r| r.split_once(": ")) {
+            Some((_, rest)) if !sets.is_empty() => rest.to_string(),
+            _ => msg,
+        };
+        Error::BadInput(format!("{name}{with}: {}", msg.trim_end()))
+    })?;
+    OperatorSource::load(&scenario.operator, &base_dir)
+        .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
+    tactile_network_emulator::replay::load(&scenario, &base_dir)
+        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
+    for c in [&scenario.network.forward, &scenario.network.backward] {
+        if let Some(r) = &c.replay {
+            inputs.push(base_dir.join(&r.path));
+        }
+    }
+    if let Operator::Csv { path } = &scenario.operator {
+        inputs.push(base_dir.join(path));
+    }
+    Ok(Loaded {
+        scenario,
+        base_dir,
+        inputs,
+    })
+}
+
+/// The `--set KEY=VALUE` arguments, parsed (bad input when one is malformed).
+pub fn parse_sets(args: &[String]) -> Result<Vec<Set>, Error> {
+    args.iter()
+        .map(|a| Set::parse(a).map_err(Error::BadInput))
+        .collect()
+}
+
+/// Every file a run writes into its output folder.
+pub fn output_files(out: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = REPORT_FILES.iter().map(|f| out.join(f)).collect();
+    for role in Role::ALL {
+        v.push(out.join(format!("{role}.rec")));
+        v.push(out.join(format!("{role}.log")));
+    }
+    v
+}
+
+/// Makes `out` ready for a new run: refuses if a file the run would write is one of
+/// its inputs, then removes the files of an earlier run, so the folder never mixes
+/// two runs' files.
+pub fn prepare_out(out: &Path, inputs: &[PathBuf]) -> Result<(), Error> {
+    std::fs::create_dir_all(out).map_err(Error::io(format!("creating {}", out.display())))?;
+    let outputs = output_files(out);
+    for i in inputs {
+        if let Some(o) = outputs.iter().find(|o| same_file(o, i)) {
+            return Err(Error::BadInput(format!(
+                "--out {}: the run would overwrite its input {} (as {}); choose another output folder",
+                out.display(),
+                i.display(),
+                o.display()
+            )));
+        }
+    }
+    for o in outputs {
+        match std::fs::remove_file(&o) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(Error::io(format!("removing {}", o.display()))(e)),
+        }
+    }
+    Ok(())
+}

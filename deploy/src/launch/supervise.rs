@@ -1,0 +1,411 @@
+//! Starts a scenario's three node programs, watches them until the master ends
+//! (restarting the emulator or the slave when one dies, as allowed), stops them, and
+//! writes the report from their records.
+
+use super::links::node_command;
+use super::{nodes, prepare_out, survivor_grace, two_cpus, Loaded, Supervision};
+use crate::error::Error;
+use std::io::Write as _;
+use std::path::Path;
+use std::process::{Child, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use tactile_messages::Role;
+use tactile_node::exit::{EXIT_BAD_INPUT, EXIT_INTERRUPTED};
+use tactile_report::summary::Summary;
+use tactile_report::write::{write_report, Launch};
+use tactile_scenario::{Mode, Scenario};
+
+/// Wait before restarting a dead process: a process that dies at once again must not
+/// spin the launcher, and the peers see a clear break (longer than the peer timeout
+/// of 10 samples at 100 Hz) rather than a flicker.
+pub const RESTART_BACKOFF: Duration = Duration::from_millis(200);
+
+/// How often the launcher looks at its processes.
+const POLL: Duration = Duration::from_millis(20);
+
+/// Starts the node of a role (`true`: appending to its record after a restart).
+type Spawn<'a> = dyn Fn(Role, bool) -> Result<Child, Error> + 'a;
+
+/// How a child process ended, in words.
+pub fn describe(status: ExitStatus) -> String {
+    use std::os::unix::process::ExitStatusExt;
+    match (status.code(), status.signal()) {
+        (Some(c), _) => format!("exited with status {c}"),
+        (None, Some(s)) => format!("was killed by signal {s}"),
+        _ => "ended".to_string(),
+    }
+}
+
+/// One node program under supervision.
+struct Proc {
+    role: Role,
+    child: Child,
+    status: Option<ExitStatus>,
+    restarts: u32,
+    /// Set while a dead process waits out the restart backoff.
+    restart_at: Option<Instant>,
+}
+
+impl Proc {
+    fn signal(&self, sig: rustix::process::Signal) {
+        if let Some(pid) = rustix::process::Pid::from_raw(self.child.id() as i32) {
+            let _ = rustix::process::kill_process(pid, sig);
+        }
+    }
+
+    /// SIGTERM, then SIGKILL after `grace`; records how it ended.
+    fn stop(&mut self, grace: Duration) {
+        if self.status.is_some() {
+            return;
+        }
+        self.signal(rustix::process::Signal::TERM);
+        let until = Instant::now() + grace;
+        while Instant::now() < until {
+            if let Ok(Some(s)) = self.child.try_wait() {
+                self.status = Some(s);
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let _ = self.child.kill();
+        self.status = self.child.wait().ok();
+    }
+
+    /// True while the program runs.
+    fn running(&mut self) -> bool {
+        self.status.is_none() && !matches!(self.child.try_wait(), Ok(Some(_)))
+    }
+
+    /// The exit status if it has ended since the last look.
+    fn ended(&mut self) -> Option<ExitStatus> {
+        if self.status.is_some() || self.restart_at.is_some() {
+            return None;
+        }
+        self.child.try_wait().ok().flatten()
+    }
+}
+
+/// The last lines of a node's log, bounded: the log of a long run can be large.
+fn log_tail(out: &Path, role: Role) -> String {
+    use std::io::{Read, Seek, SeekFrom};
+    let Ok(mut f) = std::fs::File::open(out.join(format!("{role}.log"))) else {
+        return String::new();
+    };
+    let len = f.metadata().map_or(0, |m| m.len());
+    let _ = f.seek(SeekFrom::Start(len.saturating_sub(4096)));
+    let mut text = String::new();
+    let _ = f.take(4096).read_to_string(&mut text);
+    let lines: Vec<&str> = text.lines().collect();
+    lines[lines.len().saturating_sub(5)..].join("\n")
+}
+
+/// What the supervision saw.
+struct Watch {
+    events: Vec<String>,
+    failed: bool,
+    interrupted: bool,
+    /// A node refused its configuration (exit 2): its message.
+    config_error: Option<String>,
+    /// How the master ended, once it has.
+    master: Option<ExitStatus>,
+}
+
+/// The nodes of a run and what happened to them.
+struct Supervisor<'a> {
+    sup: &'a Supervision,
+    spawn: &'a Spawn<'a>,
+    out: &'a Path,
+    procs: Vec<Proc>,
+    started: Instant,
+    watch: Watch,
+}
+
+impl<'a> Supervisor<'a> {
+    /// Starts the emulator, the slave and the master, in that order (the master
+    /// waits for its peers); stops those started if one cannot start.
+    fn start(
+        sup: &'a Supervision,
+        spawn: &'a Spawn<'a>,
+        out: &'a Path,
+        notes: Vec<String>,
+    ) -> Result<Self, Error> {
+        let mut procs: Vec<Proc> = Vec::new();
+        for role in [Role::Emulator, Role::Slave, Role::Master] {
+            match spawn(role, false) {
+                Ok(child) => procs.push(Proc {
+                    role,
+                    child,
+                    status: None,
+                    restarts: 0,
+                    restart_at: None,
+                }),
+                Err(e) => {
+                    procs
+                        .iter_mut()
+                        .for_each(|p| p.stop(Duration::from_secs(1)));
+                    return Err(e);
+                }
+            }
+        }
+        let watch = Watch {
+            events: notes,
+            failed: false,
+            interrupted: false,
+            config_error: None,
+            master: None,
+        };
+        Ok(Supervisor {
+            sup,
+            spawn,
+            out,
+            procs,
+            started: Instant::now(),
+            watch,
+        })
+    }
+
+    fn elapsed_s(&self) -> f64 {
+        self.started.elapsed().as_secs_f64()
+    }
+
+    fn master(&mut self) -> Option<&mut Proc> {
+        self.procs.iter_mut().find(|p| p.role == Role::Master)
+    }
+
+    /// A stop request asks the master to stop; the others follow its end-of-run
+    /// sample, and the report of what ran is written.
+    fn on_stop_request(&mut self) {
+        if self.watch.interrupted {
+            return;
+        }
+        self.watch.interrupted = true;
+        let at = self.elapsed_s();
+        self.watch.events.push(format!(
+            "stop requested after {at:.2} s: stopping the master"
+        ));
+        if let Some(m) = self.master() {
+            m.signal(rustix::process::Signal::TERM);
+        }
+    }
+
+    /// Restarts the processes whose backoff is over.
+    fn restart_due(&mut self) -> Result<(), Error> {
+        let now = Instant::now();
+        for k in 0..self.procs.len() {
+            if self.procs[k].restart_at.is_some_and(|at| now >= at) {
+                let role = self.procs[k].role;
+                self.procs[k].restart_at = None;
+                self.procs[k].child = (self.spawn)(role, true)?;
+                let at = self.elapsed_s();
+                self.watch
+                    .events
+                    .push(format!("{role} restarted after {at:.2} s"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Takes in how process `k` ended; true if the master must be stopped.
+    fn on_end(&mut self, k: usize, status: ExitStatus) -> bool {
+        let role = self.procs[k].role;
+        if status.code() == Some(i32::from(EXIT_BAD_INPUT)) {
+            // A configuration error: restarting would fail the same way.
+            self.procs[k].status = Some(status);
+            let tail = log_tail(self.out, role);
+            self.watch.config_error = Some(format!("{role}: {tail}"));
+            if role == Role::Master {
+                self.watch.master = Some(status);
+            }
+            return role != Role::Master;
+        }
+        if role == Role::Master {
+            self.watch.master = Some(status);
+            return false;
+        }
+        if status.success() || self.watch.interrupted {
+            // Passed on the master's end-of-run sample, or stopping as asked.
+            self.procs[k].status = Some(status);
+            return false;
+        }
+        self.on_death(k, status)
+    }
+
+    /// The emulator or the slave died while the master runs: restart it if allowed.
+    fn on_death(&mut self, k: usize, status: ExitStatus) -> bool {
+        self.watch.failed = true;
+        let at = self.elapsed_s();
+        let how = describe(status);
+        let p = &mut self.procs[k];
+        if p.restarts < self.sup.max_restarts {
+            p.restarts += 1;
+            p.restart_at = Some(Instant::now() + RESTART_BACKOFF);
+            let role = p.role;
+            self.watch
+                .events
+                .push(format!("{role} {how} after {at:.2} s; restarting"));
+            return false;
+        }
+        p.status = Some(status);
+        let role = p.role;
+        let tail = log_tail(self.out, role);
+        self.watch.events.push(format!(
+            "{role} {how} after {at:.2} s; no restarts left, stopping the run; its last words:\n{tail}"
+        ));
+        true
+    }
+
+    /// One look at every process.
+    fn poll(&mut self) -> Result<(), Error> {
+        self.restart_due()?;
+        let mut stop_master = false;
+        for k in 0..self.procs.len() {
+            if let Some(status) = self.procs[k].ended() {
+                stop_master |= self.on_end(k, status);
+            }
+        }
+        if stop_master {
+            if let Some(m) = self.master() {
+                m.stop(Duration::from_secs(2));
+                let status = m.status;
+                self.watch.master = status;
+            }
+        }
+        Ok(())
+    }
+
+    fn progress(&self, expected_s: Option<f64>) {
+        if !self.sup.progress || !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+            return;
+        }
+        let el = self.elapsed_s();
+        match expected_s {
+            Some(total) => eprint!("\r  running: {el:5.1} s of {total:.1} s"),
+            None => eprint!("\r  running (lockstep): {el:5.1} s"),
+        }
+        let _ = std::io::stderr().flush();
+    }
+
+    /// Watches until the master has ended.
+    fn watch(&mut self, scenario: &Scenario, stop: &AtomicBool) -> Result<(), Error> {
+        let expected_s = match scenario.mode {
+            Mode::Realtime => Some(scenario.samples as f64 * scenario.t_s()),
+            Mode::Lockstep => None,
+        };
+        while self.watch.master.is_none() {
+            if stop.swap(false, Ordering::SeqCst) {
+                self.on_stop_request();
+            }
+            self.poll()?;
+            self.progress(expected_s);
+            std::thread::sleep(POLL);
+        }
+        if self.sup.progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+            eprintln!();
+        }
+        self.after_master(scenario);
+        Ok(())
+    }
+
+    /// A master that failed (not on a stop request): say so, and let the survivors
+    /// notice (the slave holds its position) before they are stopped.
+    fn after_master(&mut self, scenario: &Scenario) {
+        let Some(s) = self.watch.master else { return };
+        let asked = s.code() == Some(i32::from(EXIT_INTERRUPTED)) && self.watch.interrupted;
+        if s.success() || asked || self.watch.config_error.is_some() {
+            return;
+        }
+        self.watch.failed = true;
+        let (how, at) = (describe(s), self.elapsed_s());
+        let tail = log_tail(self.out, Role::Master);
+        self.watch.events.push(format!(
+            "master {how} after {at:.2} s; its last words:\n{tail}"
+        ));
+        std::thread::sleep(survivor_grace(scenario));
+    }
+
+    /// After a clean master the end-of-run sample stops the others: a moment for
+    /// them, then every process still running is stopped.
+    fn finish(mut self) -> Watch {
+        let master_ok = self.watch.master.is_some_and(|s| s.success());
+        let until = Instant::now() + Duration::from_secs(if master_ok { 3 } else { 0 });
+        while Instant::now() < until && self.procs.iter_mut().any(Proc::running) {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        for p in &mut self.procs {
+            if p.status.is_none() {
+                p.status = p.child.try_wait().ok().flatten();
+            }
+            p.stop(Duration::from_secs(2));
+        }
+        self.watch
+    }
+}
+
+/// Runs the scenario's three node programs; returns the summary (which says whether
+/// the run failed: a process died, or a stop request cut it short).
+pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<Summary, Error> {
+    let dir = nodes::node_dir()?;
+    tactile_node::lock::check_prefix(&sup.prefix).map_err(Error::BadInput)?;
+    prepare_out(out, &loaded.inputs)?;
+    let holder = format!(
+        "tactile run (pid {}, writing to {})",
+        std::process::id(),
+        out.display()
+    );
+    let _lock = tactile_node::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
+    // The nodes run the scenario as written here, relative paths made absolute, so
+    // the copy also runs again as it is from any folder.
+    let scenario_file = out.join("scenario.toml");
+    let text = loaded.scenario.resolved(&loaded.base_dir).to_toml();
+    std::fs::write(&scenario_file, text)
+        .map_err(Error::io(format!("writing {}", scenario_file.display())))?;
+    let mut notes = Vec::new();
+    let pin = sup.pin && two_cpus();
+    if sup.pin && !pin {
+        notes.push("fewer than two CPUs: processes not pinned".to_string());
+    }
+    let sup = Supervision { pin, ..sup.clone() };
+    let spawn = |role: Role, append: bool| -> Result<Child, Error> {
+        let log = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(out.join(format!("{role}.log")))
+            .map_err(Error::io(format!("creating {role}.log")))?;
+        let exe = nodes::exe(&dir, role);
+        node_command(&sup, &exe, role, &scenario_file, out, append)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(log)
+            .spawn()
+            .map_err(|e| Error::Failed(format!("cannot start {}: {e}", exe.display())))
+    };
+    let stop: Arc<AtomicBool> =
+        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
+    let mut run = Supervisor::start(&sup, &spawn, out, notes)?;
+    run.watch(&loaded.scenario, &stop)?;
+    let w = run.finish();
+    tactile_node::ipc::remove_run_files(&sup.prefix);
+    report(out, w, sup.no_trace)
+}
+
+/// The report of a supervised run, or the error that ended it.
+fn report(out: &Path, w: Watch, no_trace: bool) -> Result<Summary, Error> {
+    if let Some(msg) = w.config_error {
+        return Err(Error::BadInput(msg));
+    }
+    if !out.join("master.rec").exists() {
+        return Err(Error::Failed(format!(
+            "the run failed, no record from the master:\n{}",
+            w.events.join("\n")
+        )));
+    }
+    let launch = Launch {
+        events: w.events,
+        failed: w.failed,
+        interrupted: w.interrupted,
+        no_trace,
+    };
+    Ok(write_report(&[out.to_path_buf()], out, &launch)?)
+}
