@@ -81,7 +81,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Sweep(args) => crate::cmd::sweep::main(&args),
         Command::BenchEcho(args) => crate::cmd::bench::echo(
             &args.prefix,
-            tactile_node::ipc::WaitPolicy {
+            tactile_node::link::WaitPolicy {
                 spin: std::time::Duration::from_micros(args.spin_us),
             },
         )

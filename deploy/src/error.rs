@@ -47,4 +47,3 @@ impl Error {
         move |source| Error::Io { context, source }
     }
 }
-

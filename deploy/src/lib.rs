@@ -9,3 +9,24 @@ pub mod cli;
 pub mod cmd;
 pub mod error;
 pub mod launch;
+
+/// The user guide (`docs/`), one module per chapter, so its Rust examples run as
+/// doctests and the guide reads in rustdoc beside the code.
+pub mod guide {
+    #[doc = include_str!("../../docs/01-the-loop.md")]
+    pub mod the_loop {}
+    #[doc = include_str!("../../docs/02-running-by-hand.md")]
+    pub mod running_by_hand {}
+    #[doc = include_str!("../../docs/03-across-hosts.md")]
+    pub mod across_hosts {}
+    #[doc = include_str!("../../docs/04-networks-and-codecs.md")]
+    pub mod networks_and_codecs {}
+    #[doc = include_str!("../../docs/05-control.md")]
+    pub mod control {}
+    #[doc = include_str!("../../docs/06-records-and-reports.md")]
+    pub mod records_and_reports {}
+    #[doc = include_str!("../../docs/07-latency.md")]
+    pub mod latency {}
+    #[doc = include_str!("../../docs/08-kernels-and-the-paper.md")]
+    pub mod kernels_and_the_paper {}
+}

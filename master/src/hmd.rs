@@ -13,8 +13,7 @@
 
 use crate::device::HeldDevice;
 use crate::operator::{min_jerk, OperatorSource, Target};
-use crate::record::{Answer, Miss, Sent};
-use serde::{Deserialize, Serialize};
+use crate::record::{Answer, MasterCounters, Miss, Sent};
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::{MasterForce, MasterSide};
 use tactile_math::engine::Engine;
@@ -25,34 +24,6 @@ use tactile_messages::samples::{
 };
 use tactile_scenario::ControlKind;
 use tactile_scenario::{HandMode, MasterConfig, Scenario, ScenarioError};
-
-/// What the master counted over a run.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct MasterCounters {
-    /// Forward samples produced.
-    pub sent: u64,
-    /// Forward samples the codec put on the network (the others went as clock only).
-    pub packets_sent: u64,
-    /// Backward samples used.
-    pub received: u64,
-    /// Operator targets outside the master's workspace (MD angles clamped).
-    pub operator_clamped: u64,
-    /// Backward samples not physically possible (not finite, too large, too fast,
-    /// out of order), rejected and filled by the predictor.
-    pub rejected: u64,
-    /// Force components clamped to the device's force limit.
-    pub force_clamps: u64,
-    /// Joint torques clamped to the device's torque limit.
-    pub torque_clamps: u64,
-    /// Samples without an answer on which the last torque was held.
-    pub held_samples: u64,
-    /// Samples without an answer past the peer timeout: zero torque.
-    pub peer_lost_samples: u64,
-    /// Times the loop broke (a peer silent past the timeout).
-    pub loop_breaks: u64,
-    /// Times answers came back after a break.
-    pub resumes: u64,
-}
 
 /// The master: operator source, device model and HMD kernels.
 #[derive(Debug)]

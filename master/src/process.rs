@@ -15,8 +15,8 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, LATE_WINDOW};
-use tactile_node::ipc::{Idle, IpcError};
 use tactile_node::link::MasterLink;
+use tactile_node::link::{Idle, LinkError};
 use tactile_node::runtime::{NodeError, Recorder};
 use tactile_scenario::{Mode, Scenario, ScenarioError};
 use thiserror::Error;
@@ -49,7 +49,7 @@ pub enum MasterError {
     Operator(#[from] OperatorError),
     /// The link failed.
     #[error(transparent)]
-    Ipc(#[from] IpcError),
+    Ipc(#[from] LinkError),
     /// The other processes did not answer.
     #[error("{0}")]
     NoAnswer(String),
@@ -364,7 +364,7 @@ pub fn run_with<L: MasterLink + ?Sized>(
 
 /// Logs the force and torque clamps of the last second, if any (at most one line a
 /// second, however often the device saturates).
-fn log_clamps(seen: &mut (u64, u64), c: &crate::hmd::MasterCounters) {
+fn log_clamps(seen: &mut (u64, u64), c: &crate::record::MasterCounters) {
     let now = (c.force_clamps, c.torque_clamps);
     if now != *seen {
         tracing::info!(

@@ -1,10 +1,37 @@
 //! The master's record: one schema for what it sent, what came back and what it did.
 //! The report joins these with the emulator's and the slave's records by sample number.
 
-use crate::hmd::MasterCounters;
 use serde::{Deserialize, Serialize};
 use tactile_messages::samples::{stage, Signal};
-use tactile_node::ipc::{InboxStats, OutboxStats};
+use tactile_node::link::{InboxStats, OutboxStats};
+
+/// What the master counted over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MasterCounters {
+    /// Forward samples produced.
+    pub sent: u64,
+    /// Forward samples the codec put on the network (the others went as clock only).
+    pub packets_sent: u64,
+    /// Backward samples used.
+    pub received: u64,
+    /// Operator targets outside the master's workspace (MD angles clamped).
+    pub operator_clamped: u64,
+    /// Backward samples not physically possible (not finite, too large, too fast,
+    /// out of order), rejected and filled by the predictor.
+    pub rejected: u64,
+    /// Force components clamped to the device's force limit.
+    pub force_clamps: u64,
+    /// Joint torques clamped to the device's torque limit.
+    pub torque_clamps: u64,
+    /// Samples without an answer on which the last torque was held.
+    pub held_samples: u64,
+    /// Samples without an answer past the peer timeout: zero torque.
+    pub peer_lost_samples: u64,
+    /// Times the loop broke (a peer silent past the timeout).
+    pub loop_breaks: u64,
+    /// Times answers came back after a break.
+    pub resumes: u64,
+}
 
 /// Sample n as it left the master.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

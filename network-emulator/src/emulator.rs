@@ -16,7 +16,7 @@ use tactile_messages::samples::{
     Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
 use tactile_netem::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
-use tactile_netem::models::{Loss, Replay};
+use tactile_netem::{Loss, Replay};
 use tactile_scenario::{ChannelConfig, Scenario};
 
 /// What the emulator counted over a run.

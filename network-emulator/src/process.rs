@@ -7,8 +7,8 @@ use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::now_ns;
 use tactile_messages::samples::{stage, FLAG_END, FLAG_PROBE};
-use tactile_node::ipc::{Idle, IpcError};
 use tactile_node::link::{Arrival, EmulatorLink, EmulatorStats, RunFilter};
+use tactile_node::link::{Idle, LinkError};
 use tactile_node::pace::{recv_paced, Pacer};
 use tactile_node::runtime::{NodeError, Recorder};
 use tactile_scenario::{Mode, Scenario};
@@ -32,7 +32,7 @@ pub type EmulatorRecord = tactile_node::record::Record<Passage, EmulatorTotals>;
 pub enum EmulatorError {
     /// The link failed.
     #[error(transparent)]
-    Ipc(#[from] IpcError),
+    Ipc(#[from] LinkError),
     /// The record could not be written.
     #[error("{0}")]
     Record(String),
@@ -48,7 +48,7 @@ impl From<NodeError> for EmulatorError {
 /// a stop request (false).
 pub fn run_with<L: EmulatorLink + ?Sized>(
     scenario: &Scenario,
-    replays: [Option<tactile_netem::models::Replay>; 2],
+    replays: [Option<tactile_netem::Replay>; 2],
     link: &L,
     rec: &mut EmulatorRecorder,
     wake_early: Duration,
@@ -163,7 +163,7 @@ mod tests {
     use std::cell::RefCell;
     use std::collections::VecDeque;
     use tactile_messages::samples::{Backward, Forward};
-    use tactile_node::ipc::{InboxStats, OutboxStats};
+    use tactile_node::link::{InboxStats, OutboxStats};
 
     /// A scripted link: hands out its arrivals in order and notes, for every receive,
     /// whether it was a look without waiting (the pacer's try before it sleeps) and
@@ -192,10 +192,10 @@ mod tests {
                 None => Ok(Err(Idle::Terminate)),
             }
         }
-        fn send_v(&self, _: Forward, _: bool) -> Result<(), IpcError> {
+        fn send_v(&self, _: Forward, _: bool) -> Result<(), LinkError> {
             Ok(())
         }
-        fn send_q(&self, _: Backward, _: bool) -> Result<(), IpcError> {
+        fn send_q(&self, _: Backward, _: bool) -> Result<(), LinkError> {
             Ok(())
         }
         fn stats(&self) -> EmulatorStats {

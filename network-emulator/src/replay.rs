@@ -2,7 +2,7 @@
 //! checked, and handed to the pure channel).
 
 use std::path::Path;
-use tactile_netem::models::Replay;
+use tactile_netem::Replay;
 use tactile_scenario::{ChannelConfig, Scenario};
 use tactile_scenario::{ReplayConfig, ReplayFormat};
 

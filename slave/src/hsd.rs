@@ -14,8 +14,7 @@
 
 use crate::device::{Controller, Dynamics, JointState};
 use crate::environment::deepest_contact;
-use crate::record::{HoldStep, Step};
-use serde::{Deserialize, Serialize};
+use crate::record::{HoldStep, SlaveCounters, Step};
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::SlaveSide;
 use tactile_math::arith::StdTrig;
@@ -27,30 +26,6 @@ use tactile_messages::samples::{
     Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
 use tactile_scenario::{Object, Scenario, ScenarioError};
-
-/// What the slave counted over a run.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct SlaveCounters {
-    /// Steps taken.
-    pub steps: u64,
-    /// Targets outside the workspace: IK clamped.
-    pub ik_clamped: u64,
-    /// Samples not physically possible (not finite, too large, too fast, out of
-    /// order), rejected and filled by the predictor; or outside the workspace (IK).
-    pub rejected: u64,
-    /// Joint torque clamps (one per joint per step).
-    pub torque_clamps: u64,
-    /// Steps in contact with an object.
-    pub contact_steps: u64,
-    /// Steps taken holding position because the input went silent.
-    pub held_steps: u64,
-    /// Times the input went silent and the slave started holding.
-    pub holds: u64,
-    /// Largest distance the tool moved while holding, m.
-    pub hold_drift_max_m: f64,
-    /// Backward samples the codec put on the network (the others went as clock only).
-    pub packets_sent: u64,
-}
 
 /// The slave: HSD kernels, controller, device and environment.
 #[derive(Debug)]

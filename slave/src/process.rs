@@ -7,7 +7,7 @@ use crate::record::{SlaveSample, SlaveTotals};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::now_ns;
 use tactile_messages::samples::{stage, Backward, FLAG_END, FLAG_PROBE};
-use tactile_node::ipc::{Idle, IpcError};
+use tactile_node::link::{Idle, LinkError};
 use tactile_node::link::{RunFilter, SlaveLink};
 use tactile_node::pace::{recv_paced, Pacer};
 use tactile_node::runtime::{NodeError, Recorder};
@@ -22,7 +22,7 @@ pub enum SlaveError {
     Scenario(#[from] ScenarioError),
     /// The link failed.
     #[error(transparent)]
-    Ipc(#[from] IpcError),
+    Ipc(#[from] LinkError),
     /// The record could not be written.
     #[error("{0}")]
     Record(String),

@@ -1,10 +1,33 @@
 //! The slave's record: one schema for what it received, computed and commanded. The
 //! report joins it with the master's and the emulator's records by sample number.
 
-use crate::hsd::SlaveCounters;
 use serde::{Deserialize, Serialize};
 use tactile_messages::samples::Signal;
-use tactile_node::ipc::{InboxStats, OutboxStats};
+use tactile_node::link::{InboxStats, OutboxStats};
+
+/// What the slave counted over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SlaveCounters {
+    /// Steps taken.
+    pub steps: u64,
+    /// Targets outside the workspace: IK clamped.
+    pub ik_clamped: u64,
+    /// Samples not physically possible (not finite, too large, too fast, out of
+    /// order), rejected and filled by the predictor; or outside the workspace (IK).
+    pub rejected: u64,
+    /// Joint torque clamps (one per joint per step).
+    pub torque_clamps: u64,
+    /// Steps in contact with an object.
+    pub contact_steps: u64,
+    /// Steps taken holding position because the input went silent.
+    pub held_steps: u64,
+    /// Times the input went silent and the slave started holding.
+    pub holds: u64,
+    /// Largest distance the tool moved while holding, m.
+    pub hold_drift_max_m: f64,
+    /// Backward samples the codec put on the network (the others went as clock only).
+    pub packets_sent: u64,
+}
 
 /// One step on a received v(n).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

@@ -3,6 +3,9 @@
 //! trigonometric block, the engine that picks an arithmetic at run time, and the
 //! paper's validation run. Nothing here performs I/O or links a transport, so the
 //! math builds, tests and benchmarks on its own and can be reused anywhere.
+//!
+//! The README follows; its examples run as doctests.
+#![doc = include_str!("../README.md")]
 
 pub mod arith;
 pub mod cordic;

@@ -12,7 +12,7 @@
 //! was injected, so the master can tell injected delay from system overhead; the noise
 //! actually added is returned too.
 
-use crate::models::{Jitter, Replay};
+use crate::{Jitter, Replay};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};

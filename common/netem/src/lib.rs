@@ -1,10 +1,20 @@
 //! The network between the master and the slave, as the emulator runs it: netem-class
-//! models (delay jitter with correlation, loss models, duplication) with netem's
-//! meanings, recorded networks replayed packet by packet, and the channel that puts a
-//! sample through them. Seeded and pure: the same scenario and seed give the same
-//! packets. Only the emulator links this crate; the settings are `tactile-scenario`'s.
+//! models (delay [`jitter`] with correlation, [`loss`] models, duplication) with
+//! netem's meanings, recorded networks [`replay`]ed packet by packet, and the
+//! [`channel`] that puts a sample through them. Seeded and pure: the same scenario and
+//! seed give the same packets. Only the emulator links this crate; the settings are
+//! `tactile-scenario`'s.
+//!
+//! Where netem's own implementation is known to be wrong we keep its meaning and not
+//! its flaw: see [`jitter`].
 
 pub mod channel;
-pub mod models;
+pub mod jitter;
+pub mod loss;
+pub mod replay;
+#[cfg(test)]
+mod tests;
 
-pub use models::{loss_rate, Jitter, Loss, Mahimahi, Replay};
+pub use jitter::Jitter;
+pub use loss::{loss_rate, Loss};
+pub use replay::{Mahimahi, Replay};

@@ -1,8 +1,7 @@
-//! The one edge in `common`: iceoryx2 wiring shared by the three processes.
+//! The iceoryx2 link: shared-memory wiring shared by the three processes.
 //!
-//! Every other module here is pure; this one opens shared memory. It lives in `common`
-//! because all three processes must agree on service names, buffer sizes and overflow
-//! policy, or they cannot connect. Each stream is a publish-subscribe service plus an
+//! It lives in `tactile-node` because all three processes must agree on service
+//! names, buffer sizes and overflow policy, or they cannot connect. Each stream is a publish-subscribe service plus an
 //! event service of the same name: the sender publishes then notifies, the receiver
 //! spins for a short budget and then blocks on the event.
 //!
@@ -19,15 +18,13 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::{
     ipc, FileName, Node, NodeBuilder, NodeName, SemanticString, ServiceName, ZeroCopySend,
 };
-use serde::{Deserialize, Serialize};
 use std::cell::Cell;
 use std::fmt::Debug;
 use std::time::{Duration, Instant};
 use tactile_messages::samples::Sequenced;
 use tactile_messages::Role;
-use thiserror::Error;
 
-pub use crate::link::CONTROL_HOP_SEQ;
+use crate::link::{Idle, InboxStats, LinkError, OutboxStats, WaitPolicy};
 
 /// A process's iceoryx2 node.
 pub type IpcNode = Node<ipc::Service>;
@@ -57,38 +54,21 @@ pub mod streams {
     pub const WAKE_SLAVE: &str = tactile_messages::Role::Slave.name();
 }
 
-/// How a process waits for its next sample.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct WaitPolicy {
-    /// Busy-poll this long before blocking on the wake-up event.
-    pub spin: Duration,
-}
-
-/// An iceoryx2 failure, with what was being done.
-#[derive(Debug, Error)]
-#[error("{context}: {detail}")]
-pub struct IpcError {
-    /// What was being done.
-    pub context: String,
-    /// iceoryx2's description.
-    pub detail: String,
-}
-
-fn err(context: impl Into<String>) -> impl FnOnce(&dyn Debug) -> IpcError {
+fn err(context: impl Into<String>) -> impl FnOnce(&dyn Debug) -> LinkError {
     let context = context.into();
-    move |e| IpcError {
+    move |e| LinkError {
         context,
         detail: format!("{e:?}"),
     }
 }
 
-/// Maps any iceoryx2 error to [`IpcError`].
-fn map<T, E: Debug>(r: Result<T, E>, context: impl Into<String>) -> Result<T, IpcError> {
+/// Maps any iceoryx2 error to [`LinkError`].
+fn map<T, E: Debug>(r: Result<T, E>, context: impl Into<String>) -> Result<T, LinkError> {
     r.map_err(|e| err(context)(&e))
 }
 
 /// The iceoryx2 configuration of one run: its own prefix and root folder.
-pub fn config(prefix: &str) -> Result<Config, IpcError> {
+pub fn config(prefix: &str) -> Result<Config, LinkError> {
     let mut cfg = Config::default();
     let root = format!("{ROOT}/{prefix}/");
     cfg.global.set_root_path(&map(
@@ -104,7 +84,7 @@ pub fn config(prefix: &str) -> Result<Config, IpcError> {
 
 /// Creates this process's node; dead nodes of an earlier crashed run with the same
 /// prefix are cleaned up on creation.
-pub fn node(prefix: &str, name: &str) -> Result<Node<ipc::Service>, IpcError> {
+pub fn node(prefix: &str, name: &str) -> Result<Node<ipc::Service>, LinkError> {
     let cfg = config(prefix)?;
     let node_name = map(NodeName::new(name), format!("node name {name:?}"))?;
     let node = map(
@@ -128,7 +108,7 @@ pub fn termination_requested(node: &Node<ipc::Service>) -> bool {
     )
 }
 
-fn service_name(stream: &str) -> Result<ServiceName, IpcError> {
+fn service_name(stream: &str) -> Result<ServiceName, LinkError> {
     let name = format!("tactile/{stream}");
     map(ServiceName::new(&name), format!("service name {name}"))
 }
@@ -143,15 +123,6 @@ pub struct Outbox<T: Debug + ZeroCopySend + 'static> {
     stats: Cell<OutboxStats>,
 }
 
-/// What a sending end counted.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct OutboxStats {
-    /// Samples published.
-    pub published: u64,
-    /// Published while no subscriber was connected (the receiver was dead): lost.
-    pub no_receiver: u64,
-}
-
 /// Receiving end of a stream.
 #[derive(Debug)]
 pub struct Inbox<T: Debug + ZeroCopySend + 'static> {
@@ -159,27 +130,6 @@ pub struct Inbox<T: Debug + ZeroCopySend + 'static> {
     stream: String,
     stats: Cell<InboxStats>,
     next_hop_seq: Cell<Option<u64>>,
-}
-
-/// What a receiving end counted.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct InboxStats {
-    /// Samples taken.
-    pub received: u64,
-    /// Samples overwritten in the full buffer before they were taken (gaps in the
-    /// publisher's counter; the buffer's overflow policy is safe overflow).
-    pub overwritten: u64,
-    /// Times the publisher's counter started again (the sender was restarted).
-    pub publisher_restarts: u64,
-    /// Payloads that were not a whole sample (garbage, truncated), dropped.
-    #[serde(default)]
-    pub malformed: u64,
-    /// Samples of another run (a different run token), dropped.
-    #[serde(default)]
-    pub foreign: u64,
-    /// Frames of another wire-format version (another build), dropped.
-    #[serde(default)]
-    pub wrong_version: u64,
 }
 
 /// A process's wake-up event: every stream into the process notifies it.
@@ -194,7 +144,7 @@ fn open_pubsub<T: Debug + ZeroCopySend + 'static>(
     stream: &str,
 ) -> Result<
     iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>,
-    IpcError,
+    LinkError,
 > {
     map(
         node.service_builder(&service_name(stream)?)
@@ -213,7 +163,7 @@ fn open_pubsub<T: Debug + ZeroCopySend + 'static>(
 fn open_event(
     node: &Node<ipc::Service>,
     name: &str,
-) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, IpcError> {
+) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, LinkError> {
     map(
         node.service_builder(&service_name(&format!("wake/{name}"))?)
             .event()
@@ -227,7 +177,7 @@ fn open_event(
 
 impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Outbox<T> {
     /// Opens (or creates) `stream` for sending; each send wakes process `wake`.
-    pub fn open(node: &Node<ipc::Service>, stream: &str, wake: &str) -> Result<Self, IpcError> {
+    pub fn open(node: &Node<ipc::Service>, stream: &str, wake: &str) -> Result<Self, LinkError> {
         let svc = open_pubsub::<T>(node, stream)?;
         let ev = open_event(node, wake)?;
         Ok(Outbox {
@@ -246,18 +196,18 @@ impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Outbox<T> {
 
     /// Publishes a copy of `value` (stamped with this hop's publish counter) and wakes
     /// the receiver; returns how many subscribers it reached.
-    pub fn send(&self, value: T) -> Result<usize, IpcError> {
+    pub fn send(&self, value: T) -> Result<usize, LinkError> {
         self.publish(value, false)
     }
 
     /// Publishes a control sample (start-up probe, end of run): not counted, and
     /// marked so the receiver does not count it either.
-    pub fn send_control(&self, value: T) -> Result<usize, IpcError> {
+    pub fn send_control(&self, value: T) -> Result<usize, LinkError> {
         self.publish(value, true)
     }
 
     /// Publishes, counted unless `control`.
-    pub fn publish(&self, mut value: T, control: bool) -> Result<usize, IpcError> {
+    pub fn publish(&self, mut value: T, control: bool) -> Result<usize, LinkError> {
         let mut st = self.stats.get();
         st.stamp(&mut value, control);
         let n = map(
@@ -278,7 +228,7 @@ impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Outbox<T> {
 
 impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Inbox<T> {
     /// Opens (or creates) `stream` for receiving.
-    pub fn open(node: &Node<ipc::Service>, stream: &str) -> Result<Self, IpcError> {
+    pub fn open(node: &Node<ipc::Service>, stream: &str) -> Result<Self, LinkError> {
         let svc = open_pubsub::<T>(node, stream)?;
         Ok(Inbox {
             subscriber: map(
@@ -294,7 +244,7 @@ impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Inbox<T> {
     }
 
     /// A sample if one is waiting; counts it, and any overwritten before it.
-    pub fn try_recv(&self) -> Result<Option<T>, IpcError> {
+    pub fn try_recv(&self) -> Result<Option<T>, LinkError> {
         let got = map(
             self.subscriber.receive(),
             format!("receiving on {}", self.stream),
@@ -316,18 +266,9 @@ impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Inbox<T> {
     }
 }
 
-/// Why [`Waker::wait`] returned without the awaited condition.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Idle {
-    /// The deadline passed.
-    Timeout,
-    /// SIGINT or SIGTERM arrived.
-    Terminate,
-}
-
 impl Waker {
     /// Opens this process's wake-up event `name`.
-    pub fn open(node: &Node<ipc::Service>, name: &str) -> Result<Self, IpcError> {
+    pub fn open(node: &Node<ipc::Service>, name: &str) -> Result<Self, LinkError> {
         let ev = open_event(node, name)?;
         Ok(Waker {
             listener: map(
@@ -345,8 +286,8 @@ impl Waker {
         node: &Node<ipc::Service>,
         spin: Duration,
         deadline: Instant,
-        mut poll: impl FnMut() -> Result<Option<V>, IpcError>,
-    ) -> Result<Result<V, Idle>, IpcError> {
+        mut poll: impl FnMut() -> Result<Option<V>, LinkError>,
+    ) -> Result<Result<V, Idle>, LinkError> {
         let start = Instant::now();
         loop {
             if let Some(v) = poll()? {
@@ -380,7 +321,7 @@ impl Waker {
 
 /// Names of the nodes of run `prefix` whose process died; their stale resources are
 /// removed on the way, so a restarted process can take their place.
-pub fn dead_nodes(prefix: &str) -> Result<Vec<String>, IpcError> {
+pub fn dead_nodes(prefix: &str) -> Result<Vec<String>, LinkError> {
     use iceoryx2::node::{NodeState, NodeView};
     let cfg = config(prefix)?;
     let mut dead = Vec::new();
@@ -428,7 +369,7 @@ pub struct IoxMaster {
 
 impl IoxMaster {
     /// Opens the master's streams of run `prefix`.
-    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
+    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, LinkError> {
         let node = node(prefix, Role::Master.name())?;
         Ok(IoxMaster {
             out: Outbox::open(&node, streams::C, streams::WAKE_EMULATOR)?,
@@ -442,10 +383,10 @@ impl IoxMaster {
 }
 
 impl crate::link::MasterLink for IoxMaster {
-    fn send(&self, c: tactile_messages::samples::Forward) -> Result<(), IpcError> {
+    fn send(&self, c: tactile_messages::samples::Forward) -> Result<(), LinkError> {
         self.out.publish(c, false).map(|_| ())
     }
-    fn send_control(&self, c: tactile_messages::samples::Forward) -> Result<(), IpcError> {
+    fn send_control(&self, c: tactile_messages::samples::Forward) -> Result<(), LinkError> {
         self.out.publish(c, true).map(|_| ())
     }
     fn recv(&self, deadline: Instant) -> crate::link::Wait<tactile_messages::samples::Backward> {
@@ -474,7 +415,7 @@ pub struct IoxEmulator {
 
 impl IoxEmulator {
     /// Opens the emulator's streams of run `prefix`.
-    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
+    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, LinkError> {
         let node = node(prefix, Role::Emulator.name())?;
         Ok(IoxEmulator {
             in_c: Inbox::open(&node, streams::C)?,
@@ -499,14 +440,18 @@ impl crate::link::EmulatorLink for IoxEmulator {
             Ok(self.in_c.try_recv()?.map(Arrival::Forward))
         })
     }
-    fn send_v(&self, v: tactile_messages::samples::Forward, control: bool) -> Result<(), IpcError> {
+    fn send_v(
+        &self,
+        v: tactile_messages::samples::Forward,
+        control: bool,
+    ) -> Result<(), LinkError> {
         self.out_v.publish(v, control).map(|_| ())
     }
     fn send_q(
         &self,
         q: tactile_messages::samples::Backward,
         control: bool,
-    ) -> Result<(), IpcError> {
+    ) -> Result<(), LinkError> {
         self.out_q.publish(q, control).map(|_| ())
     }
     fn stats(&self) -> crate::link::EmulatorStats {
@@ -531,7 +476,7 @@ pub struct IoxSlave {
 
 impl IoxSlave {
     /// Opens the slave's streams of run `prefix`.
-    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
+    pub fn open(prefix: &str, wait: WaitPolicy) -> Result<Self, LinkError> {
         let node = node(prefix, Role::Slave.name())?;
         Ok(IoxSlave {
             inbox: Inbox::open(&node, streams::V)?,
@@ -552,7 +497,7 @@ impl crate::link::SlaveLink for IoxSlave {
         &self,
         h: tactile_messages::samples::Backward,
         control: bool,
-    ) -> Result<(), IpcError> {
+    ) -> Result<(), LinkError> {
         self.out.publish(h, control).map(|_| ())
     }
     fn stats(&self) -> (InboxStats, OutboxStats) {
@@ -583,7 +528,7 @@ enum Half {
 
 impl IoxHalf {
     /// Opens the master side (`master_side`) or the slave side of run `prefix`.
-    pub fn open(prefix: &str, master_side: bool) -> Result<Self, IpcError> {
+    pub fn open(prefix: &str, master_side: bool) -> Result<Self, LinkError> {
         let node = node(prefix, Role::Emulator.name())?;
         let half = if master_side {
             Half::Master {
@@ -600,7 +545,7 @@ impl IoxHalf {
     }
 
     /// A sample if one waits.
-    pub fn try_recv(&self) -> Result<Option<crate::link::Arrival>, IpcError> {
+    pub fn try_recv(&self) -> Result<Option<crate::link::Arrival>, LinkError> {
         use crate::link::Arrival;
         Ok(match &self.half {
             Half::Master { c, .. } => c.try_recv()?.map(Arrival::Forward),
@@ -613,10 +558,10 @@ impl IoxHalf {
         &self,
         v: tactile_messages::samples::Forward,
         control: bool,
-    ) -> Result<(), IpcError> {
+    ) -> Result<(), LinkError> {
         match &self.half {
             Half::Slave { v: out, .. } => out.publish(v, control).map(|_| ()),
-            Half::Master { .. } => Err(IpcError {
+            Half::Master { .. } => Err(LinkError {
                 context: "sending v".into(),
                 detail: "this side faces the master".into(),
             }),
@@ -628,10 +573,10 @@ impl IoxHalf {
         &self,
         q: tactile_messages::samples::Backward,
         control: bool,
-    ) -> Result<(), IpcError> {
+    ) -> Result<(), LinkError> {
         match &self.half {
             Half::Master { q: out, .. } => out.publish(q, control).map(|_| ()),
-            Half::Slave { .. } => Err(IpcError {
+            Half::Slave { .. } => Err(LinkError {
                 context: "sending q".into(),
                 detail: "this side faces the slave".into(),
             }),

@@ -2,24 +2,81 @@
 //!
 //! The process loops (in the master, emulator and slave crates) are written against
 //! these traits, so the same loop runs over iceoryx2 shared memory (the product,
-//! [`crate::ipc`]) or over UDP (the reference a user would pick instead, measured
-//! beside it by `tactile bench`). Every implementation stamps the per-hop publish
-//! counter and counts what it sends and receives the same way.
+//! `ipc`), UDP (the reference a user would pick instead, measured beside it by
+//! `tactile bench`) or Zenoh (across hosts). This module owns what they share: the
+//! error, why a wait ended, the counters; every implementation stamps the per-hop
+//! publish counter and counts what it sends and receives the same way.
 
-use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats};
 use serde::{Deserialize, Serialize};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use tactile_messages::samples::{Backward, Forward, Sequenced};
+use thiserror::Error;
+
+/// How a process waits for its next sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WaitPolicy {
+    /// Busy-poll this long before blocking on the wake-up event.
+    pub spin: Duration,
+}
+
+/// A link failure (iceoryx2, UDP, Zenoh), with what was being done.
+#[derive(Debug, Error)]
+#[error("{context}: {detail}")]
+pub struct LinkError {
+    /// What was being done.
+    pub context: String,
+    /// The transport's description.
+    pub detail: String,
+}
+
+/// Why a wait returned without a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Idle {
+    /// The deadline passed.
+    Timeout,
+    /// SIGINT or SIGTERM arrived.
+    Terminate,
+}
+
+/// What a sending end counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OutboxStats {
+    /// Samples published.
+    pub published: u64,
+    /// Published while no subscriber was connected (the receiver was dead): lost.
+    pub no_receiver: u64,
+}
+
+/// What a receiving end counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct InboxStats {
+    /// Samples taken.
+    pub received: u64,
+    /// Samples overwritten in the full buffer before they were taken (gaps in the
+    /// publisher's counter; the buffer's overflow policy is safe overflow).
+    pub overwritten: u64,
+    /// Times the publisher's counter started again (the sender was restarted).
+    pub publisher_restarts: u64,
+    /// Payloads that were not a whole sample (garbage, truncated), dropped.
+    #[serde(default)]
+    pub malformed: u64,
+    /// Samples of another run (a different run token), dropped.
+    #[serde(default)]
+    pub foreign: u64,
+    /// Frames of another wire-format version (another build), dropped.
+    #[serde(default)]
+    pub wrong_version: u64,
+}
 
 /// The outcome of a wait: a value, or why none came.
-pub type Wait<T> = Result<Result<T, Idle>, IpcError>;
+pub type Wait<T> = Result<Result<T, Idle>, LinkError>;
 
 /// The master's view: c(n) out, q(n) in.
 pub trait MasterLink {
     /// Publishes c(n).
-    fn send(&self, c: Forward) -> Result<(), IpcError>;
+    fn send(&self, c: Forward) -> Result<(), LinkError>;
     /// Publishes a control sample (probe, end of run), uncounted.
-    fn send_control(&self, c: Forward) -> Result<(), IpcError>;
+    fn send_control(&self, c: Forward) -> Result<(), LinkError>;
     /// Waits for the next q until `deadline`.
     fn recv(&self, deadline: Instant) -> Wait<Backward>;
     /// Names of peers known to have died (and cleans up after them).
@@ -57,9 +114,9 @@ pub trait EmulatorLink {
     /// Waits for the next c or h until `deadline` (h first when both wait).
     fn recv(&self, deadline: Instant) -> Wait<Arrival>;
     /// Publishes v(n); `control` leaves it uncounted.
-    fn send_v(&self, v: Forward, control: bool) -> Result<(), IpcError>;
+    fn send_v(&self, v: Forward, control: bool) -> Result<(), LinkError>;
     /// Publishes q(n); `control` leaves it uncounted.
-    fn send_q(&self, q: Backward, control: bool) -> Result<(), IpcError>;
+    fn send_q(&self, q: Backward, control: bool) -> Result<(), LinkError>;
     /// What the four ends counted.
     fn stats(&self) -> EmulatorStats;
 }
@@ -69,7 +126,7 @@ pub trait SlaveLink {
     /// Waits for the next v until `deadline`.
     fn recv(&self, deadline: Instant) -> Wait<Forward>;
     /// Publishes h(n); `control` leaves it uncounted.
-    fn send_h(&self, h: Backward, control: bool) -> Result<(), IpcError>;
+    fn send_h(&self, h: Backward, control: bool) -> Result<(), LinkError>;
     /// What v-in and h-out counted.
     fn stats(&self) -> (InboxStats, OutboxStats);
 }

@@ -9,8 +9,8 @@
 //! which keeps working when arrivals drift (another host's clock) or jitter (a real
 //! network).
 
-use crate::ipc::{Idle, IpcError};
 use crate::link::Wait;
+use crate::link::{Idle, LinkError};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 
 /// How long before a sample is due a node wakes, at most: timer wake-ups of an
@@ -157,7 +157,7 @@ pub fn recv_paced<T>(
     pacer: Option<&Pacer>,
     until: std::time::Instant,
     mut recv: impl FnMut(std::time::Instant) -> Wait<T>,
-) -> Result<(Result<T, Idle>, bool), IpcError> {
+) -> Result<(Result<T, Idle>, bool), LinkError> {
     let Some(p) = pacer else {
         return Ok((recv(until)?, false));
     };

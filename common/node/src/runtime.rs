@@ -586,7 +586,7 @@ pub fn check_link_args(a: &NodeArgs, links: &[LinkKind]) -> Result<(), NodeError
     Ok(())
 }
 
-fn opened<T>(r: Result<T, crate::ipc::IpcError>) -> Result<T, NodeError> {
+fn opened<T>(r: Result<T, crate::link::LinkError>) -> Result<T, NodeError> {
     r.map_err(|e| NodeError::Failed(e.to_string()))
 }
 
@@ -597,7 +597,7 @@ pub fn master_link(
     spin: Duration,
     direct: bool,
 ) -> Result<Box<dyn crate::link::MasterLink>, NodeError> {
-    let wait = crate::ipc::WaitPolicy { spin };
+    let wait = crate::link::WaitPolicy { spin };
     if direct && a.link != LinkKind::Zenoh {
         return Err(NodeError::BadInput(
             "--direct (no emulator) needs --link zenoh".into(),
@@ -619,7 +619,7 @@ pub fn emulator_link(
     towards_slave: LinkKind,
 ) -> Result<Box<dyn crate::link::EmulatorLink>, NodeError> {
     use LinkKind::{Iceoryx2, Udp, Zenoh};
-    let wait = crate::ipc::WaitPolicy { spin };
+    let wait = crate::link::WaitPolicy { spin };
     Ok(match (towards_master, towards_slave) {
         (Iceoryx2, Iceoryx2) => Box::new(opened(crate::ipc::IoxEmulator::open(&a.prefix, wait))?),
         (Udp, Udp) => Box::new(opened(crate::udp::UdpEmulator::open(udp_ports(a)?, wait))?),
@@ -644,7 +644,7 @@ pub fn slave_link(
     a: &NodeArgs,
     spin: Duration,
 ) -> Result<Box<dyn crate::link::SlaveLink>, NodeError> {
-    let wait = crate::ipc::WaitPolicy { spin };
+    let wait = crate::link::WaitPolicy { spin };
     Ok(match a.link {
         LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxSlave::open(&a.prefix, wait))?),
         LinkKind::Udp => Box::new(opened(crate::udp::UdpSlave::open(udp_ports(a)?, wait))?),
@@ -656,7 +656,7 @@ pub fn slave_link(
 #[cfg(feature = "zenoh")]
 mod zenoh_open {
     use super::{opened, zenoh_options, NodeArgs, NodeError};
-    use crate::ipc::WaitPolicy;
+    use crate::link::WaitPolicy;
     use crate::link::{EmulatorLink, MasterLink, SlaveLink};
     use crate::zlink::{ZenohEmulator, ZenohMaster, ZenohSlave};
 
@@ -698,7 +698,7 @@ mod zenoh_open {
 #[cfg(not(feature = "zenoh"))]
 mod zenoh_open {
     use super::{NodeArgs, NodeError, NO_ZENOH};
-    use crate::ipc::WaitPolicy;
+    use crate::link::WaitPolicy;
     use crate::link::{EmulatorLink, MasterLink, SlaveLink};
 
     pub fn master(_: &NodeArgs, _: bool, _: WaitPolicy) -> Result<Box<dyn MasterLink>, NodeError> {

@@ -8,8 +8,8 @@
 //! receiver; UDP cannot tell a dead peer otherwise. A datagram that is not a whole
 //! frame of this build's format is counted and dropped.
 
-use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats, WaitPolicy};
 use crate::link::{Arrival, EmulatorLink, EmulatorStats, MasterLink, SlaveLink, Wait};
+use crate::link::{Idle, InboxStats, LinkError, OutboxStats, WaitPolicy};
 use crate::wire::{self, backward, count as take, forward, Frame};
 use std::cell::{Cell, RefCell};
 use std::io::ErrorKind;
@@ -19,8 +19,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_messages::samples::{Backward, Forward, Sequenced};
 
-fn err(context: &str, e: impl std::fmt::Display) -> IpcError {
-    IpcError {
+fn err(context: &str, e: impl std::fmt::Display) -> LinkError {
+    LinkError {
         context: context.to_string(),
         detail: e.to_string(),
     }
@@ -43,8 +43,8 @@ const LOOPBACK: IpAddr = IpAddr::V4(std::net::Ipv4Addr::LOCALHOST);
 
 impl UdpPorts {
     /// Three ports free right now (bound to port 0 and released).
-    pub fn free() -> Result<UdpPorts, IpcError> {
-        let pick = || -> Result<u16, IpcError> {
+    pub fn free() -> Result<UdpPorts, LinkError> {
+        let pick = || -> Result<u16, LinkError> {
             let s = UdpSocket::bind("127.0.0.1:0").map_err(|e| err("picking a UDP port", e))?;
             Ok(s.local_addr()
                 .map_err(|e| err("picking a UDP port", e))?
@@ -115,7 +115,7 @@ struct Endpoint {
 }
 
 impl Endpoint {
-    fn bind(at: SocketAddr, wait: WaitPolicy) -> Result<Endpoint, IpcError> {
+    fn bind(at: SocketAddr, wait: WaitPolicy) -> Result<Endpoint, LinkError> {
         let socket = UdpSocket::bind(at).map_err(|e| err(&format!("binding UDP {at}"), e))?;
         let stop = crate::signals::stop_flag().map_err(|e| err("installing signal handlers", e))?;
         Ok(Endpoint {
@@ -133,7 +133,7 @@ impl Endpoint {
         control: bool,
         stats: &Cell<OutboxStats>,
         encode: fn(&T, &mut Vec<u8>) -> Result<(), String>,
-    ) -> Result<(), IpcError> {
+    ) -> Result<(), LinkError> {
         let mut buf = self.buf.borrow_mut();
         wire::send_counted(value, control, stats, &mut buf, encode, |frame| match self
             .socket
@@ -152,7 +152,7 @@ impl Endpoint {
         &self,
         deadline: Instant,
         mut take: impl FnMut(Result<Frame, wire::Reject>) -> Option<R>,
-    ) -> Result<Result<R, Idle>, IpcError> {
+    ) -> Result<Result<R, Idle>, LinkError> {
         let mut buf = self.buf.borrow_mut();
         buf.resize(wire::MAX_FRAME + 1, 0);
         let start = Instant::now();
@@ -216,7 +216,7 @@ pub struct UdpMaster {
 
 impl UdpMaster {
     /// Binds the master's port.
-    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, IpcError> {
+    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, LinkError> {
         Ok(UdpMaster {
             ep: Endpoint::bind(ports.master_addr(), wait)?,
             ports,
@@ -228,7 +228,7 @@ impl UdpMaster {
 }
 
 impl MasterLink for UdpMaster {
-    fn send(&self, c: Forward) -> Result<(), IpcError> {
+    fn send(&self, c: Forward) -> Result<(), LinkError> {
         self.ep.send(
             self.ports.emulator_addr(),
             c,
@@ -237,7 +237,7 @@ impl MasterLink for UdpMaster {
             wire::encode_forward,
         )
     }
-    fn send_control(&self, c: Forward) -> Result<(), IpcError> {
+    fn send_control(&self, c: Forward) -> Result<(), LinkError> {
         self.ep.send(
             self.ports.emulator_addr(),
             c,
@@ -270,7 +270,7 @@ pub struct UdpEmulator {
 
 impl UdpEmulator {
     /// Binds the emulator's port.
-    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, IpcError> {
+    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, LinkError> {
         Ok(UdpEmulator {
             ep: Endpoint::bind(ports.emulator_addr(), wait)?,
             ports,
@@ -293,7 +293,7 @@ impl EmulatorLink for UdpEmulator {
             Err(_) => take(got, forward, &self.inn[0], &self.next[0]).map(Arrival::Forward),
         })
     }
-    fn send_v(&self, v: Forward, control: bool) -> Result<(), IpcError> {
+    fn send_v(&self, v: Forward, control: bool) -> Result<(), LinkError> {
         self.ep.send(
             self.ports.slave_addr(),
             v,
@@ -302,7 +302,7 @@ impl EmulatorLink for UdpEmulator {
             wire::encode_forward,
         )
     }
-    fn send_q(&self, q: Backward, control: bool) -> Result<(), IpcError> {
+    fn send_q(&self, q: Backward, control: bool) -> Result<(), LinkError> {
         self.ep.send(
             self.ports.master_addr(),
             q,
@@ -333,7 +333,7 @@ pub struct UdpSlave {
 
 impl UdpSlave {
     /// Binds the slave's port.
-    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, IpcError> {
+    pub fn open(ports: UdpPorts, wait: WaitPolicy) -> Result<Self, LinkError> {
         Ok(UdpSlave {
             ep: Endpoint::bind(ports.slave_addr(), wait)?,
             ports,
@@ -349,7 +349,7 @@ impl SlaveLink for UdpSlave {
         self.ep
             .recv(deadline, |got| take(got, forward, &self.inn, &self.next))
     }
-    fn send_h(&self, h: Backward, control: bool) -> Result<(), IpcError> {
+    fn send_h(&self, h: Backward, control: bool) -> Result<(), LinkError> {
         self.ep.send(
             self.ports.emulator_addr(),
             h,

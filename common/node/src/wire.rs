@@ -99,7 +99,7 @@ pub fn decode(bytes: &[u8]) -> Result<Frame, Reject> {
 
 /// Counts a rejected frame in a receiver's counters, and logs the first frame of
 /// another version loudly: it means two builds that do not agree.
-pub fn count_reject(r: Reject, stats: &mut crate::ipc::InboxStats) {
+pub fn count_reject(r: Reject, stats: &mut crate::link::InboxStats) {
     match r {
         Reject::Malformed => stats.malformed += 1,
         Reject::Version(v) => {
@@ -119,7 +119,7 @@ pub fn count_reject(r: Reject, stats: &mut crate::ipc::InboxStats) {
 pub fn count<T: tactile_messages::samples::Sequenced>(
     got: Result<Frame, Reject>,
     want: fn(Frame) -> Option<T>,
-    stats: &std::cell::Cell<crate::ipc::InboxStats>,
+    stats: &std::cell::Cell<crate::link::InboxStats>,
     next: &std::cell::Cell<Option<u64>>,
 ) -> Option<T> {
     let mut st = stats.get();
@@ -165,7 +165,7 @@ pub fn backward(f: Frame) -> Option<Backward> {
 #[derive(Debug, Default)]
 pub struct In {
     /// What it counted.
-    pub stats: std::cell::Cell<crate::ipc::InboxStats>,
+    pub stats: std::cell::Cell<crate::link::InboxStats>,
     /// The sender's next publish counter.
     pub next: std::cell::Cell<Option<u64>>,
 }
@@ -177,14 +177,14 @@ pub struct In {
 pub fn send_counted<T: tactile_messages::samples::Sequenced + Copy>(
     mut value: T,
     control: bool,
-    stats: &std::cell::Cell<crate::ipc::OutboxStats>,
+    stats: &std::cell::Cell<crate::link::OutboxStats>,
     buf: &mut Vec<u8>,
     encode: fn(&T, &mut Vec<u8>) -> Result<(), String>,
-    send: impl FnOnce(&[u8]) -> Result<usize, crate::ipc::IpcError>,
-) -> Result<(), crate::ipc::IpcError> {
+    send: impl FnOnce(&[u8]) -> Result<usize, crate::link::LinkError>,
+) -> Result<(), crate::link::LinkError> {
     let mut st = stats.get();
     st.stamp(&mut value, control);
-    encode(&value, buf).map_err(|detail| crate::ipc::IpcError {
+    encode(&value, buf).map_err(|detail| crate::link::LinkError {
         context: "encoding a sample".into(),
         detail,
     })?;

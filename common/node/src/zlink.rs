@@ -13,8 +13,8 @@
 //! not vanish unseen). Received payloads go from Zenoh's threads into one bounded queue
 //! per node, which the node's loop polls and then blocks on, like the other links.
 
-use crate::ipc::{Idle, InboxStats, IpcError, OutboxStats, WaitPolicy};
 use crate::link::{Arrival, EmulatorLink, EmulatorStats, MasterLink, SlaveLink, Wait};
+use crate::link::{Idle, InboxStats, LinkError, OutboxStats, WaitPolicy};
 use crate::wire::{self, backward, count, forward, Frame, In};
 use std::cell::{Cell, RefCell};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -30,8 +30,8 @@ use zenoh::Wait as _;
 /// Frames a node's receive queue holds before it drops (and counts) new ones.
 pub const QUEUE: usize = 1024;
 
-fn err(context: &str, e: impl std::fmt::Display) -> IpcError {
-    IpcError {
+fn err(context: &str, e: impl std::fmt::Display) -> LinkError {
+    LinkError {
         context: context.to_string(),
         detail: e.to_string(),
     }
@@ -50,7 +50,7 @@ pub struct ZenohOptions {
 
 impl ZenohOptions {
     /// The Zenoh configuration: peer mode, these endpoints, scouting as asked.
-    pub fn config(&self) -> Result<zenoh::Config, IpcError> {
+    pub fn config(&self) -> Result<zenoh::Config, LinkError> {
         let mut c = zenoh::Config::default();
         let json = |v: &[String]| {
             let quoted: Vec<String> = v.iter().map(|e| format!("{e:?}")).collect();
@@ -151,7 +151,7 @@ pub fn key(prefix: &str, stream: Stream) -> String {
 }
 
 /// Opens a Zenoh session with the options.
-pub fn open_session(opts: &ZenohOptions) -> Result<zenoh::Session, IpcError> {
+pub fn open_session(opts: &ZenohOptions) -> Result<zenoh::Session, LinkError> {
     tracing::info!(
         "Zenoh runtimes: {}",
         std::env::var("ZENOH_RUNTIME").unwrap_or_else(|_| "Zenoh's defaults".into())
@@ -191,7 +191,7 @@ impl ZenohEnd {
         publish: &[Stream],
         subscribe: &[Stream],
         wait: WaitPolicy,
-    ) -> Result<ZenohEnd, IpcError> {
+    ) -> Result<ZenohEnd, LinkError> {
         let session = open_session(opts)?;
         let mut publishers = Vec::new();
         for &s in publish {
@@ -252,7 +252,7 @@ impl ZenohEnd {
         control: bool,
         stats: &Cell<OutboxStats>,
         encode: fn(&T, &mut Vec<u8>) -> Result<(), String>,
-    ) -> Result<(), IpcError> {
+    ) -> Result<(), LinkError> {
         let publisher = self
             .publishers
             .iter()
@@ -353,7 +353,7 @@ impl ZenohMaster {
         prefix: &str,
         direct: bool,
         wait: WaitPolicy,
-    ) -> Result<Self, IpcError> {
+    ) -> Result<Self, LinkError> {
         let (out, inn) = if direct {
             (Stream::V, Stream::H)
         } else {
@@ -369,11 +369,11 @@ impl ZenohMaster {
 }
 
 impl MasterLink for ZenohMaster {
-    fn send(&self, c: Forward) -> Result<(), IpcError> {
+    fn send(&self, c: Forward) -> Result<(), LinkError> {
         self.end
             .put(self.out, c, false, &self.out_stats, wire::encode_forward)
     }
-    fn send_control(&self, c: Forward) -> Result<(), IpcError> {
+    fn send_control(&self, c: Forward) -> Result<(), LinkError> {
         self.end
             .put(self.out, c, true, &self.out_stats, wire::encode_forward)
     }
@@ -402,7 +402,7 @@ pub struct ZenohSlave {
 
 impl ZenohSlave {
     /// Opens the slave's streams of run `prefix`.
-    pub fn open(opts: &ZenohOptions, prefix: &str, wait: WaitPolicy) -> Result<Self, IpcError> {
+    pub fn open(opts: &ZenohOptions, prefix: &str, wait: WaitPolicy) -> Result<Self, LinkError> {
         Ok(ZenohSlave {
             end: ZenohEnd::open(opts, prefix, &[Stream::H], &[Stream::V], wait)?,
             out_stats: Cell::default(),
@@ -417,7 +417,7 @@ impl SlaveLink for ZenohSlave {
             count(f, forward, &self.inn.stats, &self.inn.next)
         })
     }
-    fn send_h(&self, h: Backward, control: bool) -> Result<(), IpcError> {
+    fn send_h(&self, h: Backward, control: bool) -> Result<(), LinkError> {
         self.end.put(
             Stream::H,
             h,
@@ -464,7 +464,7 @@ impl ZenohEmulator {
         iox_master: bool,
         iox_slave: bool,
         wait: WaitPolicy,
-    ) -> Result<Self, IpcError> {
+    ) -> Result<Self, LinkError> {
         let mut publish = Vec::new();
         let mut subscribe = Vec::new();
         if !iox_master {
@@ -476,7 +476,7 @@ impl ZenohEmulator {
             subscribe.push(Stream::H);
         }
         let end = ZenohEnd::open(opts, prefix, &publish, &subscribe, wait)?;
-        let side = |iox: bool, master_side: bool| -> Result<Side, IpcError> {
+        let side = |iox: bool, master_side: bool| -> Result<Side, LinkError> {
             Ok(if iox {
                 Side::Iox(Box::new(crate::ipc::IoxHalf::open(prefix, master_side)?))
             } else {
@@ -503,7 +503,7 @@ impl ZenohEmulator {
         }
     }
 
-    fn poll_iox(&self) -> Result<Option<Arrival>, IpcError> {
+    fn poll_iox(&self) -> Result<Option<Arrival>, LinkError> {
         // Backward first: it completes a round trip the master is waiting for.
         if let Side::Iox(s) = &self.slave {
             if let Some(a) = s.try_recv()? {
@@ -565,7 +565,7 @@ impl EmulatorLink for ZenohEmulator {
             }
         }
     }
-    fn send_v(&self, v: Forward, control: bool) -> Result<(), IpcError> {
+    fn send_v(&self, v: Forward, control: bool) -> Result<(), LinkError> {
         match &self.slave {
             Side::Iox(s) => s.send_forward(v, control),
             Side::Zenoh => self
@@ -573,7 +573,7 @@ impl EmulatorLink for ZenohEmulator {
                 .put(Stream::V, v, control, &self.v_out, wire::encode_forward),
         }
     }
-    fn send_q(&self, q: Backward, control: bool) -> Result<(), IpcError> {
+    fn send_q(&self, q: Backward, control: bool) -> Result<(), LinkError> {
         match &self.master {
             Side::Iox(s) => s.send_backward(q, control),
             Side::Zenoh => self

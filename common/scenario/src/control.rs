@@ -31,53 +31,35 @@ impl ControlKind {
 
 /// `[control]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct ControlConfig {
     /// `none`, `tdpa` or `wave`.
-    #[serde(default)]
     pub kind: ControlKind,
     /// Wave impedance b, N s/m: larger feels stiffer contact and more damping in free
     /// motion.
-    #[serde(default = "default_wave_impedance")]
     pub wave_impedance: f64,
     /// TDPA: speeds below this count as this when the master's passivity controller
     /// computes its damping (v^2 in a denominator), m/s.
-    #[serde(default = "default_velocity_floor")]
     pub velocity_floor: f64,
     /// TDPA: the largest damping the master's passivity controller adds, N s/m; a
     /// deficit it cannot remove at once is carried to the next samples.
-    #[serde(default = "default_max_damping")]
     pub max_damping: f64,
     /// TDPA: the fastest the slave's reference is pulled back towards the master's
     /// position when energy allows (position drift compensation), m/s; 0 disables it.
-    #[serde(default = "default_drift_rate")]
     pub drift_rate: f64,
-}
-
-fn default_wave_impedance() -> f64 {
-    10.0
-}
-// Measured on wall-delay over floors 1e-5..1e-3 m/s and caps 200..1e4 N s/m: these
-// kept the channel's energy closest to zero without a codec (README). Larger caps make
-// the force chatter between full and zero, and the sampling's prediction error grows.
-fn default_velocity_floor() -> f64 {
-    1.0e-3
-}
-fn default_max_damping() -> f64 {
-    200.0
-}
-fn default_drift_rate() -> f64 {
-    0.05
 }
 
 impl Default for ControlConfig {
     fn default() -> Self {
         ControlConfig {
             kind: ControlKind::None,
-            wave_impedance: default_wave_impedance(),
-            velocity_floor: default_velocity_floor(),
-            max_damping: default_max_damping(),
-            drift_rate: default_drift_rate(),
+            wave_impedance: 10.0,
+            // Measured on wall-delay over floors 1e-5..1e-3 m/s and caps 200..1e4 N s/m: these
+            // kept the channel's energy closest to zero without a codec (README). Larger caps make
+            // the force chatter between full and zero, and the sampling's prediction error grows.
+            velocity_floor: 1.0e-3,
+            max_damping: 200.0,
+            drift_rate: 0.05,
         }
     }
 }
@@ -93,20 +75,16 @@ impl ControlConfig {
 }
 /// `[codec.forward]`, `[codec.backward]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct CodecConfig {
     /// `none`, `deadband` or `adaptive` [none].
-    #[serde(default)]
     pub kind: CodecKind,
     /// Weber fraction k [0.1].
-    #[serde(default = "default_k")]
     pub k: f64,
     /// Absolute threshold near zero, in the signal's unit (m forward, N backward)
     /// [0.0005 forward, 0.02 backward when left at 0].
-    #[serde(default)]
     pub floor: f64,
     /// Adaptive: the speed at which the fraction doubles, m/s [0.05].
-    #[serde(default = "default_v_ref")]
     pub v_ref: f64,
 }
 
@@ -123,33 +101,24 @@ pub enum CodecKind {
     Adaptive,
 }
 
-fn default_k() -> f64 {
-    0.1
-}
-fn default_v_ref() -> f64 {
-    0.05
-}
-
 impl Default for CodecConfig {
     fn default() -> Self {
         CodecConfig {
             kind: CodecKind::None,
-            k: default_k(),
+            k: 0.1,
             floor: 0.0,
-            v_ref: default_v_ref(),
+            v_ref: 0.05,
         }
     }
 }
 
 /// Both directions.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct Codecs {
     /// Master to slave (positions).
-    #[serde(default)]
     pub forward: CodecConfig,
     /// Slave to master (forces).
-    #[serde(default)]
     pub backward: CodecConfig,
 }
 
@@ -176,32 +145,23 @@ impl CodecConfig {
 
 /// `[slave.predictor]`, `[master.predictor]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct PredictorConfig {
     /// `hold`, `linear` or `kalman` [hold].
-    #[serde(default)]
     pub kind: PredictorKind,
     /// Kalman: the white acceleration's spectral density (per second, squared units
     /// per s^3) [1.0].
-    #[serde(default = "default_q")]
     pub process_noise: f64,
     /// Kalman: the measurement's variance, squared units [1e-8].
-    #[serde(default = "default_r")]
     pub measurement_noise: f64,
     /// Values farther than this from the last accepted one per second are not
     /// physically possible and are rejected (m/s forward, N/s backward) [100 m/s,
     /// 1e5 N/s when left at 0: generous, so noise and stiff contacts pass, garbage
     /// does not].
-    #[serde(default)]
     pub max_rate: f64,
     /// Linear and Kalman: the longest they extrapolate, s; past it they hold [0.05]
     /// (a codec's silence means "within the deadband", not "going on for ever").
-    #[serde(default = "default_horizon")]
     pub horizon_s: f64,
-}
-
-fn default_horizon() -> f64 {
-    0.05
 }
 
 /// The predictors.
@@ -217,21 +177,14 @@ pub enum PredictorKind {
     Kalman,
 }
 
-fn default_q() -> f64 {
-    1.0
-}
-fn default_r() -> f64 {
-    1e-8
-}
-
 impl Default for PredictorConfig {
     fn default() -> Self {
         PredictorConfig {
             kind: PredictorKind::Hold,
-            process_noise: default_q(),
-            measurement_noise: default_r(),
+            process_noise: 1.0,
+            measurement_noise: 1e-8,
             max_rate: 0.0,
-            horizon_s: default_horizon(),
+            horizon_s: 0.05,
         }
     }
 }

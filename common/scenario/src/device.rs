@@ -8,39 +8,25 @@ use tactile_math::geometry::{Geometry, GeometryError};
 
 /// CORDIC settings in a scenario; missing keys take the [s16.13] defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct CordicSettings {
     /// Word length V of [sV.N].
-    #[serde(default = "default_word")]
     pub word: u32,
     /// Fractional bits N.
-    #[serde(default = "default_frac")]
     pub frac: u32,
     /// Iterations; default derived from `frac`.
-    #[serde(default)]
     pub iterations: Option<u32>,
     /// `truncate` or `nearest`.
-    #[serde(default = "default_rounding")]
     pub rounding: Rounding,
-}
-
-fn default_word() -> u32 {
-    CordicConfig::S16_13.word
-}
-fn default_frac() -> u32 {
-    CordicConfig::S16_13.frac
-}
-fn default_rounding() -> Rounding {
-    CordicConfig::S16_13.rounding
 }
 
 impl Default for CordicSettings {
     fn default() -> Self {
         CordicSettings {
-            word: default_word(),
-            frac: default_frac(),
+            word: CordicConfig::S16_13.word,
+            frac: CordicConfig::S16_13.frac,
             iterations: None,
-            rounding: default_rounding(),
+            rounding: CordicConfig::S16_13.rounding,
         }
     }
 }

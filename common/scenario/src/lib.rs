@@ -49,66 +49,65 @@ pub enum Mode {
 
 /// One whole run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct Scenario {
     /// Name used in reports.
-    #[serde(default = "default_name")]
     pub name: String,
     /// `realtime` or `lockstep`.
-    #[serde(default)]
     pub mode: Mode,
     /// Sampling rate 1/t_s in Hz, 100 to 10000 (the paper: 100 Hz).
-    #[serde(default = "default_rate")]
     pub rate_hz: f64,
     /// Number of samples the master sends.
-    #[serde(default = "default_samples")]
     pub samples: u64,
     /// Arithmetic of the HMD and HSD kernels: `f64`, `f32` or `hybrid`.
-    #[serde(default)]
     pub arithmetic: ArithKind,
     /// Fixed-point format of the hybrid CORDIC block.
-    #[serde(default)]
     pub cordic: CordicSettings,
     /// Device geometry of master and slave: a preset name or explicit lengths.
-    #[serde(default)]
     pub device: DeviceChoice,
     /// Seed of every random source (channel noise), so runs repeat.
-    #[serde(default)]
     pub seed: u64,
     /// What the operator does.
-    #[serde(default)]
     pub operator: Operator,
     /// The emulated network.
-    #[serde(default)]
     pub network: Network,
     /// The master side: device limits.
-    #[serde(default)]
     pub master: MasterConfig,
     /// The slave side: controller and device dynamics.
-    #[serde(default)]
     pub slave: SlaveConfig,
     /// Fault handling shared by the processes.
-    #[serde(default)]
     pub faults: FaultConfig,
     /// Objects in the slave's environment.
-    #[serde(default)]
     pub environment: Environment,
     /// Stability control on the channel.
-    #[serde(default)]
     pub control: ControlConfig,
     /// Deadband codecs per direction.
-    #[serde(default)]
     pub codec: Codecs,
 }
 
-fn default_name() -> String {
-    "unnamed".into()
-}
-fn default_rate() -> f64 {
-    100.0
-}
-fn default_samples() -> u64 {
-    1200
+impl Default for Scenario {
+    /// What a scenario file that sets nothing runs: 1200 samples at 100 Hz of the
+    /// paper's trajectory, seed 0, no objects; each table its own defaults.
+    fn default() -> Self {
+        Scenario {
+            name: "unnamed".into(),
+            mode: Mode::default(),
+            rate_hz: 100.0,
+            samples: 1200,
+            arithmetic: ArithKind::default(),
+            cordic: CordicSettings::default(),
+            device: DeviceChoice::default(),
+            seed: 0,
+            operator: Operator::default(),
+            network: Network::default(),
+            master: MasterConfig::default(),
+            slave: SlaveConfig::default(),
+            faults: FaultConfig::default(),
+            environment: Environment::default(),
+            control: ControlConfig::default(),
+            codec: Codecs::default(),
+        }
+    }
 }
 
 impl Scenario {
@@ -116,20 +115,8 @@ impl Scenario {
     pub fn paper() -> Scenario {
         Scenario {
             name: "paper".into(),
-            mode: Mode::Realtime,
-            rate_hz: default_rate(),
-            samples: default_samples(),
             arithmetic: ArithKind::Hybrid,
-            cordic: CordicSettings::default(),
-            device: DeviceChoice::default(),
             seed: 1,
-            operator: Operator::Paper,
-            network: Network::default(),
-            master: MasterConfig::default(),
-            slave: SlaveConfig::default(),
-            faults: FaultConfig::default(),
-            control: ControlConfig::default(),
-            codec: Codecs::default(),
             environment: Environment {
                 objects: vec![Object::Plane {
                     point: [0.0, 0.0, -0.16],
@@ -137,6 +124,7 @@ impl Scenario {
                     stiffness: [300.0; 3],
                 }],
             },
+            ..Scenario::default()
         }
     }
 

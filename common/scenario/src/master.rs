@@ -6,37 +6,25 @@ use serde::{Deserialize, Serialize};
 
 /// The master device's limits (PHANToM Omni class by default).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct MasterConfig {
     /// Largest force the operator is made to feel, N, per axis (the Omni: ~3.3 N).
-    #[serde(default = "default_force_limit")]
     pub force_limit: f64,
     /// Largest torque commanded on a master joint, N m.
-    #[serde(default = "default_master_torque_limit")]
     pub torque_limit: [f64; 3],
     /// How the operator's hand holds the handle.
-    #[serde(default)]
     pub hand: HandConfig,
     /// The master device's joints (used with an impedance hand).
-    #[serde(default)]
     pub device: MasterDeviceConfig,
     /// How the master fills forces not received (CPD/JPD-HMD).
-    #[serde(default)]
     pub predictor: PredictorConfig,
-}
-
-fn default_force_limit() -> f64 {
-    3.3
-}
-fn default_master_torque_limit() -> [f64; 3] {
-    [0.45; 3]
 }
 
 impl Default for MasterConfig {
     fn default() -> Self {
         MasterConfig {
-            force_limit: default_force_limit(),
-            torque_limit: default_master_torque_limit(),
+            force_limit: 3.3,
+            torque_limit: [0.45; 3],
             hand: HandConfig::default(),
             device: MasterDeviceConfig::default(),
             predictor: PredictorConfig::default(),
@@ -46,23 +34,18 @@ impl Default for MasterConfig {
 
 /// How the processes notice a dead peer.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct FaultConfig {
     /// Consecutive samples without an answer after which the master declares the loop
     /// broken, commands zero torque and marks the samples; and without input after
     /// which the slave holds its position.
-    #[serde(default = "default_peer_timeout")]
     pub peer_timeout_samples: u64,
-}
-
-fn default_peer_timeout() -> u64 {
-    10
 }
 
 impl Default for FaultConfig {
     fn default() -> Self {
         FaultConfig {
-            peer_timeout_samples: default_peer_timeout(),
+            peer_timeout_samples: 10,
         }
     }
 }
@@ -90,48 +73,30 @@ pub enum HandMode {
 /// the defaults sit in the middle of those ranges (a relaxed grasp, the case where a
 /// delayed stiff contact is hardest to keep stable).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct HandConfig {
     /// `position` (ideal, the default) or `impedance`.
-    #[serde(default)]
     pub mode: HandMode,
     /// Mass of the hand moving with the handle, kg.
-    #[serde(default = "default_hand_mass")]
     pub mass: f64,
     /// Damping between the hand and its intended motion, N s/m.
-    #[serde(default = "default_hand_damping")]
     pub damping: f64,
     /// Stiffness pulling the handle towards the intended position, N/m.
-    #[serde(default = "default_hand_stiffness")]
     pub stiffness: f64,
     /// Seconds over which the intended position blends from where the handle starts
     /// (the devices' home) into the trajectory, so a trajectory that starts elsewhere
     /// does not yank the handle. No effect when the trajectory starts at home.
-    #[serde(default = "default_approach")]
     pub approach_s: f64,
-}
-
-fn default_hand_mass() -> f64 {
-    0.2
-}
-fn default_hand_damping() -> f64 {
-    4.0
-}
-fn default_hand_stiffness() -> f64 {
-    250.0
-}
-fn default_approach() -> f64 {
-    1.0
 }
 
 impl Default for HandConfig {
     fn default() -> Self {
         HandConfig {
             mode: HandMode::Position,
-            mass: default_hand_mass(),
-            damping: default_hand_damping(),
-            stiffness: default_hand_stiffness(),
-            approach_s: default_approach(),
+            mass: 0.2,
+            damping: 4.0,
+            stiffness: 250.0,
+            approach_s: 1.0,
         }
     }
 }
@@ -140,42 +105,25 @@ impl Default for HandConfig {
 /// tip of a 0.13 m arm gives joint inertias near 8e-4 kg m^2; small viscous damping and
 /// Coulomb friction of a few mN m (about 0.03 N at the tip).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct MasterDeviceConfig {
     /// Inertia per joint, kg m^2.
-    #[serde(default = "default_md_inertia")]
     pub inertia: [f64; 3],
     /// Viscous damping per joint, N m s / rad.
-    #[serde(default = "default_md_damping")]
     pub damping: [f64; 3],
     /// Coulomb friction per joint, N m (smoothed near zero velocity).
-    #[serde(default = "default_md_friction")]
     pub friction: [f64; 3],
     /// Integration step, seconds, at most 0.01.
-    #[serde(default = "default_md_step")]
     pub step_s: f64,
-}
-
-fn default_md_inertia() -> [f64; 3] {
-    [8.0e-4; 3]
-}
-fn default_md_damping() -> [f64; 3] {
-    [2.0e-4; 3]
-}
-fn default_md_friction() -> [f64; 3] {
-    [4.0e-3; 3]
-}
-fn default_md_step() -> f64 {
-    2.5e-4
 }
 
 impl Default for MasterDeviceConfig {
     fn default() -> Self {
         MasterDeviceConfig {
-            inertia: default_md_inertia(),
-            damping: default_md_damping(),
-            friction: default_md_friction(),
-            step_s: default_md_step(),
+            inertia: [8.0e-4; 3],
+            damping: [2.0e-4; 3],
+            friction: [4.0e-3; 3],
+            step_s: 2.5e-4,
         }
     }
 }

@@ -7,60 +7,44 @@ use serde::{Deserialize, Serialize};
 
 /// Both channels of the emulated network.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct Network {
     /// Master to slave: positions c(n) -> v(n).
-    #[serde(default)]
     pub forward: ChannelConfig,
     /// Slave to master: forces h(n) -> q(n).
-    #[serde(default)]
     pub backward: ChannelConfig,
 }
 
 /// One channel: v_i(n) = c_i(n - d_i(n)) + r_i(n).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct ChannelConfig {
     /// Constant delay per signal (x, y, z), in whole samples.
-    #[serde(default)]
     pub delay: [i64; 3],
     /// Optional schedule overriding `delay`: `[[from_sample, dx, dy, dz], ...]`, sorted by
     /// `from_sample`; each entry holds from its sample until the next.
-    #[serde(default)]
     pub schedule: Vec<[i64; 4]>,
     /// Standard deviation of the zero-mean Gaussian noise per signal (m forward, N back).
-    #[serde(default)]
     pub noise_std: [f64; 3],
     /// Probability that the emulator drops a sample on purpose, 0 to 1 (seeded).
-    #[serde(default)]
     pub loss: f64,
     /// Fault injection: probability that the emulator replaces a sample's values with
     /// NaN, 0 to 1 (seeded), to prove the receivers reject them.
-    #[serde(default)]
     pub corrupt: f64,
     /// Jitter on each packet's delay, netem's `delay D JITTER CORRELATION
     /// distribution NAME` with D the `delay` above (all in samples).
-    #[serde(default)]
     pub jitter: Option<JitterConfig>,
     /// Whether a packet may overtake an earlier one when jitter shortens its delay
     /// (netem's behaviour) [true]; false keeps arrivals in sending order.
-    #[serde(default = "default_reorder")]
     pub reorder: bool,
     /// A loss model instead of `loss` (netem's random loss): `gemodel` or `state`.
-    #[serde(default)]
     pub loss_model: Option<LossModel>,
     /// A recorded network replayed packet by packet, instead of `delay`, `schedule`
     /// and `jitter`.
-    #[serde(default)]
     pub replay: Option<ReplayConfig>,
     /// Probability that a packet is sent twice, netem's `duplicate` (the copy takes
     /// its own jitter), 0 to 1 [0].
-    #[serde(default)]
     pub duplicate: f64,
-}
-
-fn default_reorder() -> bool {
-    true
 }
 
 impl Default for ChannelConfig {
@@ -72,7 +56,7 @@ impl Default for ChannelConfig {
             loss: 0.0,
             corrupt: 0.0,
             jitter: None,
-            reorder: default_reorder(),
+            reorder: true,
             loss_model: None,
             replay: None,
             duplicate: 0.0,

@@ -6,100 +6,69 @@ use serde::{Deserialize, Serialize};
 
 /// The slave side.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct SlaveConfig {
     /// Joint controller.
-    #[serde(default)]
     pub controller: ControllerConfig,
     /// Joint dynamics of the slave device.
-    #[serde(default)]
     pub dynamics: DynamicsConfig,
     /// How the slave fills positions not received (CPD-HSD).
-    #[serde(default)]
     pub predictor: PredictorConfig,
 }
 
 /// PD or PID per joint: u = kp e + ki integral(e) + kd de/dt, clamped to the limit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct ControllerConfig {
     /// Proportional gains, N m / rad.
-    #[serde(default = "default_kp")]
     pub kp: [f64; 3],
     /// Integral gains, N m / (rad s); zero gives PD.
-    #[serde(default)]
     pub ki: [f64; 3],
     /// Derivative gains, N m s / rad.
-    #[serde(default = "default_kd")]
     pub kd: [f64; 3],
     /// Torque limit per joint, N m (the Omni's 3.3 N at its 0.132 m arm: ~0.44 N m).
-    #[serde(default = "default_torque_limit")]
     pub torque_limit: [f64; 3],
-}
-
-fn default_kp() -> [f64; 3] {
-    [6.0; 3]
-}
-fn default_kd() -> [f64; 3] {
-    [0.12; 3]
-}
-fn default_torque_limit() -> [f64; 3] {
-    [0.45; 3]
 }
 
 impl Default for ControllerConfig {
     fn default() -> Self {
         ControllerConfig {
-            kp: default_kp(),
+            kp: [6.0; 3],
             ki: [0.0; 3],
-            kd: default_kd(),
-            torque_limit: default_torque_limit(),
+            kd: [0.12; 3],
+            torque_limit: [0.45; 3],
         }
     }
 }
 
 /// Per-joint inertia and viscous damping, integrated at a fixed step.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct DynamicsConfig {
     /// Inertia per joint, kg m^2.
-    #[serde(default = "default_inertia")]
     pub inertia: [f64; 3],
     /// Viscous damping per joint, N m s / rad.
-    #[serde(default = "default_damping")]
     pub damping: [f64; 3],
     /// Integration step, seconds, at most 0.01; each sample integrates t_s in steps of
     /// at most this (one step of t_s when t_s is shorter).
-    #[serde(default = "default_step")]
     pub step_s: f64,
-}
-
-fn default_inertia() -> [f64; 3] {
-    [2.0e-3; 3]
-}
-fn default_damping() -> [f64; 3] {
-    [5.0e-3; 3]
-}
-fn default_step() -> f64 {
-    2.5e-4
 }
 
 impl Default for DynamicsConfig {
     fn default() -> Self {
         DynamicsConfig {
-            inertia: default_inertia(),
-            damping: default_damping(),
-            step_s: default_step(),
+            inertia: [2.0e-3; 3],
+            damping: [5.0e-3; 3],
+            step_s: 2.5e-4,
         }
     }
 }
 
 /// The slave's environment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct Environment {
     /// Objects; the one the tool penetrates most deeply produces the contact force.
-    #[serde(default)]
     pub objects: Vec<Object>,
 }
 

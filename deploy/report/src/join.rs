@@ -7,7 +7,7 @@
 //! late answers), so joining a run of any length takes bounded memory. The records may
 //! come from one folder or one folder per node, as they would from different hosts.
 
-use crate::trace::TraceRow;
+use crate::trace::{Stamps, TraceRow};
 use crate::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -344,7 +344,7 @@ fn row(
         r.q_from = a.q.sent_seq;
         r.round_trip_ns = a.round_trip_ns;
         r.overhead_ns = a.overhead_ns;
-        r.stamps = a.stamps;
+        r.stamps = Stamps(a.stamps);
     } else if let Some(m) = miss {
         r.tau = m.tau;
         r.felt = m.felt;

@@ -11,6 +11,20 @@ use tactile_network_emulator::process::EmulatorTotals;
 use tactile_scenario::Mode;
 use tactile_slave::record::SlaveTotals;
 
+/// Files a report writes into its folder.
+pub const REPORT_FILES: [&str; 10] = [
+    "summary.json",
+    "trace.csv",
+    "round_trip.hgrm",
+    "overhead.hgrm",
+    "latency.svg",
+    "percentiles.svg",
+    "positions.svg",
+    "forces.svg",
+    "passivity.svg",
+    "scenario.toml",
+];
+
 /// Accounting of one stream: every sample offered is received or lost, and every
 /// loss has a cause.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
@@ -35,9 +49,9 @@ pub struct ChannelCount {
 impl ChannelCount {
     /// The accounting of a stream from its sender's and receiver's counts.
     pub fn new(
-        out: tactile_node::ipc::OutboxStats,
+        out: tactile_node::link::OutboxStats,
         dropped: u64,
-        inn: tactile_node::ipc::InboxStats,
+        inn: tactile_node::link::InboxStats,
     ) -> Self {
         let offered = out.published + dropped;
         let received = inn.received;
@@ -287,7 +301,7 @@ pub fn render(s: &Summary, out: &Path) -> String {
     if s.events_omitted > 0 {
         let _ = writeln!(t, "({} more events in the records)", s.events_omitted);
     }
-    let files: Vec<&str> = crate::write::REPORT_FILES
+    let files: Vec<&str> = REPORT_FILES
         .iter()
         .copied()
         .filter(|f| out.join(f).exists())

@@ -1,209 +1,227 @@
 //! One row of `trace.csv` per master sample: every signal of the loop and every stamp.
 //!
-//! Signal columns come first and timing columns last, so a comparison of two runs'
-//! signals (the determinism test, lockstep against the in-process simulation) can cut
-//! the timing columns off by name. Floats are written in shortest round-trip form, so
-//! equal values give equal text and the file reads back exactly.
+//! The columns are described once, in [`trace_row!`]'s invocation below: the struct's
+//! fields in CSV order, from which the header and the writer follow, so a column
+//! cannot be added to one and missed in the other. A three-valued field `x` gives
+//! columns `x_1,x_2,x_3`; the stamps give `t_<stage>` (relative to the first sample's
+//! tick). Signal columns come first and timing columns last, so a comparison of two
+//! runs' signals (the determinism test, lockstep against the in-process simulation)
+//! can cut the timing columns off by name. Floats are written in shortest round-trip
+//! form, so equal values give equal text and the file reads back exactly.
 
 use std::fmt::Write;
 use tactile_messages::samples::stage;
 
-/// Three-valued signal columns, in order, with their prefix.
-pub const SIGNALS: [&str; 23] = [
-    "target",
-    "theta_md",
-    "c",
-    "v",
-    "noise_f",
-    "delay_f",
-    "theta_ref",
-    "theta_sd",
-    "u",
-    "tool",
-    "surface",
-    "h",
-    "q",
-    "noise_b",
-    "delay_b",
-    "tau",
-    "felt",
-    "handle",
-    "hand_force",
-    "reference",
-    "observer_m",
-    "observer_s",
-    "q_from",
-];
-
 /// Name of the first timing column; everything from here on is wall-clock dependent.
 pub const FIRST_TIMING_COLUMN: &str = "round_trip_ns";
 
-/// The header line (without newline).
-pub fn header() -> String {
-    let mut h = String::from("n,received");
-    for s in SIGNALS {
+/// How a field's type becomes columns: their names and the cells of one row.
+trait Cells {
+    /// Appends `,name` for each column of field `field`.
+    fn names(field: &str, h: &mut String);
+    /// Appends `,value` for each column; `t0` is subtracted from stamps.
+    fn cells(&self, line: &mut String, t0: u64);
+}
+
+impl Cells for u64 {
+    fn names(field: &str, h: &mut String) {
+        let _ = write!(h, ",{field}");
+    }
+    fn cells(&self, line: &mut String, _: u64) {
+        let _ = write!(line, ",{self}");
+    }
+}
+
+impl Cells for u32 {
+    fn names(field: &str, h: &mut String) {
+        let _ = write!(h, ",{field}");
+    }
+    fn cells(&self, line: &mut String, _: u64) {
+        let _ = write!(line, ",{self}");
+    }
+}
+
+impl Cells for i64 {
+    fn names(field: &str, h: &mut String) {
+        let _ = write!(h, ",{field}");
+    }
+    fn cells(&self, line: &mut String, _: u64) {
+        let _ = write!(line, ",{self}");
+    }
+}
+
+impl Cells for bool {
+    fn names(field: &str, h: &mut String) {
+        let _ = write!(h, ",{field}");
+    }
+    fn cells(&self, line: &mut String, _: u64) {
+        let _ = write!(line, ",{}", u8::from(*self));
+    }
+}
+
+impl Cells for f64 {
+    fn names(field: &str, h: &mut String) {
+        let _ = write!(h, ",{field}");
+    }
+    fn cells(&self, line: &mut String, _: u64) {
+        let _ = write!(line, ",{self:?}");
+    }
+}
+
+/// Three values per axis: `field_1`, `field_2`, `field_3`.
+impl<T: Cells> Cells for [T; 3] {
+    fn names(field: &str, h: &mut String) {
         for axis in ["1", "2", "3"] {
-            let _ = write!(h, ",{s}_{axis}");
+            T::names(&format!("{field}_{axis}"), h);
         }
     }
-    h.push_str(",flags_f,flags_b,flags_m,contact_object,dissipated_m,dissipated_s");
-    h.push_str(",port_net_m,port_net_s");
-    h.push_str(",round_trip_ns,overhead_ns");
-    for name in stage::NAMES {
-        let _ = write!(h, ",t_{name}");
+    fn cells(&self, line: &mut String, t0: u64) {
+        for x in self {
+            x.cells(line, t0);
+        }
     }
-    h
 }
 
-/// Sample n as the report joins it from the nodes' records: the master's part (target,
-/// encoders, c, q, torques, round trip), the emulator's (noise injected) and the
-/// slave's (what it received and did). A part whose node recorded nothing for n stays
-/// zero, and `received` says whether the answer came back.
+/// A timestamp per stage, ns from the first sample's tick (zero where not passed).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct TraceRow {
-    /// Sample number.
-    pub n: u64,
-    /// True if q(n) came back to the master.
-    pub received: bool,
-    /// The operator's target a(n), m.
-    pub target: [f64; 3],
-    /// Master joint angles b(n), rad.
-    pub theta_md: [f64; 3],
-    /// c(n) as sent, m.
-    pub c: [f64; 3],
-    /// v(n) as the slave received it, m.
-    pub v: [f64; 3],
-    /// Noise the emulator added to v(n).
-    pub noise_f: [f64; 3],
-    /// Delay injected into v(n), samples.
-    pub delay_f: [u32; 3],
-    /// IK-HSD reference angles, rad.
-    pub theta_ref: [f64; 3],
-    /// Slave joint angles after the step, rad.
-    pub theta_sd: [f64; 3],
-    /// Slave controller torques, N m.
-    pub u: [f64; 3],
-    /// FK-HSD tool position l(n), m.
-    pub tool: [f64; 3],
-    /// Nearest surface point, m (zero without contact).
-    pub surface: [f64; 3],
-    /// h(n), N.
-    pub h: [f64; 3],
-    /// q(n) as the master received it, N.
-    pub q: [f64; 3],
-    /// Noise the emulator added to q(n).
-    pub noise_b: [f64; 3],
-    /// Delay injected into q(n), samples.
-    pub delay_b: [u32; 3],
-    /// KFF-HMD torques p(n), N m.
-    pub tau: [f64; 3],
-    /// The force the operator feels, N.
-    pub felt: [f64; 3],
-    /// The handle's true position, m.
-    pub handle: [f64; 3],
-    /// The impedance hand's force on the handle, N.
-    pub hand_force: [f64; 3],
-    /// The slave's Cartesian reference from the channel's control, m.
-    pub reference: [f64; 3],
-    /// The master's passivity observer per axis, J.
-    pub observer_m: [f64; 3],
-    /// The slave's passivity observer per axis, J.
-    pub observer_s: [f64; 3],
-    /// The slave step each value of q(n) was produced at.
-    pub q_from: [u64; 3],
-    /// Energy the master's control dissipated this sample, J.
-    pub dissipated_m: f64,
-    /// The master port's net energy into the channel so far, J.
-    pub port_net_m: f64,
-    /// The slave port's net energy into the channel so far, J.
-    pub port_net_s: f64,
-    /// Energy the slave's control dissipated this step, J.
-    pub dissipated_s: f64,
-    /// Flags of v(n) as received.
-    pub flags_f: u32,
-    /// Flags of q(n) as received.
-    pub flags_b: u32,
-    /// The master's flags for this sample (held, peer lost, clamped, rejected).
-    pub flags_m: u32,
-    /// Object in contact, or -1.
-    pub contact_object: i64,
-    /// Round trip, ns (0 if no answer).
-    pub round_trip_ns: u64,
-    /// Round trip minus injected delay, ns.
-    pub overhead_ns: i64,
-    /// Stamps per stage, ns (zero where not passed).
-    pub stamps: [u64; stage::COUNT],
-    /// True if the slave recorded a step on v(n) (not a trace column: it says whether
-    /// the slave's columns hold data).
-    pub stepped: bool,
-}
+pub struct Stamps(pub [u64; stage::COUNT]);
 
-fn push3(line: &mut String, v: [f64; 3]) {
-    for x in v {
-        let _ = write!(line, ",{x:?}");
+impl std::ops::Deref for Stamps {
+    type Target = [u64; stage::COUNT];
+    fn deref(&self) -> &Self::Target {
+        &self.0
     }
 }
 
-fn push3u(line: &mut String, v: [u32; 3]) {
-    for x in v {
-        let _ = write!(line, ",{x}");
+impl std::ops::DerefMut for Stamps {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.0
     }
 }
 
-impl TraceRow {
-    /// Appends this row as one CSV line (with newline); `t0` is subtracted from stamps.
-    pub fn write_csv(&self, line: &mut String, t0: u64) {
-        let _ = write!(line, "{},{}", self.n, u8::from(self.received));
-        for v in [self.target, self.theta_md, self.c, self.v, self.noise_f] {
-            push3(line, v);
+impl Cells for Stamps {
+    fn names(_: &str, h: &mut String) {
+        for name in stage::NAMES {
+            let _ = write!(h, ",t_{name}");
         }
-        push3u(line, self.delay_f);
-        for v in [
-            self.theta_ref,
-            self.theta_sd,
-            self.u,
-            self.tool,
-            self.surface,
-            self.h,
-            self.q,
-            self.noise_b,
-        ] {
-            push3(line, v);
-        }
-        push3u(line, self.delay_b);
-        for v in [
-            self.tau,
-            self.felt,
-            self.handle,
-            self.hand_force,
-            self.reference,
-            self.observer_m,
-            self.observer_s,
-        ] {
-            push3(line, v);
-        }
-        for x in self.q_from {
-            let _ = write!(line, ",{x}");
-        }
-        let _ = write!(
-            line,
-            ",{},{},{},{},{:?},{:?},{:?},{:?},{},{}",
-            self.flags_f,
-            self.flags_b,
-            self.flags_m,
-            self.contact_object,
-            self.dissipated_m,
-            self.dissipated_s,
-            self.port_net_m,
-            self.port_net_s,
-            self.round_trip_ns,
-            self.overhead_ns
-        );
-        for t in self.stamps {
+    }
+    fn cells(&self, line: &mut String, t0: u64) {
+        for t in self.0 {
             let _ = write!(line, ",{}", t.saturating_sub(t0));
         }
-        line.push('\n');
     }
+}
+
+/// Declares [`TraceRow`] from its columns in CSV order, with the header and the
+/// writer that follow from them.
+macro_rules! trace_row {
+    ($($(#[doc = $doc:literal])* $field:ident: $ty:ty,)*) => {
+        /// Sample n as the report joins it from the nodes' records: the master's part
+        /// (target, encoders, c, q, torques, round trip), the emulator's (noise
+        /// injected) and the slave's (what it received and did). A part whose node
+        /// recorded nothing for n stays zero, and `received` says whether the answer
+        /// came back.
+        #[derive(Debug, Clone, Copy, PartialEq, Default)]
+        pub struct TraceRow {
+            $($(#[doc = $doc])* pub $field: $ty,)*
+            /// True if the slave recorded a step on v(n) (not a trace column: it says
+            /// whether the slave's columns hold data).
+            pub stepped: bool,
+        }
+
+        /// The header line (without newline).
+        pub fn header() -> String {
+            let mut h = String::new();
+            $(<$ty as Cells>::names(stringify!($field), &mut h);)*
+            h.split_off(1)
+        }
+
+        impl TraceRow {
+            /// Appends this row as one CSV line (with newline); `t0` is subtracted
+            /// from stamps.
+            pub fn write_csv(&self, line: &mut String, t0: u64) {
+                let start = line.len();
+                $(self.$field.cells(line, t0);)*
+                line.remove(start);
+                line.push('\n');
+            }
+        }
+    };
+}
+
+trace_row! {
+    /// Sample number.
+    n: u64,
+    /// True if q(n) came back to the master.
+    received: bool,
+    /// The operator's target a(n), m.
+    target: [f64; 3],
+    /// Master joint angles b(n), rad.
+    theta_md: [f64; 3],
+    /// c(n) as sent, m.
+    c: [f64; 3],
+    /// v(n) as the slave received it, m.
+    v: [f64; 3],
+    /// Noise the emulator added to v(n).
+    noise_f: [f64; 3],
+    /// Delay injected into v(n), samples.
+    delay_f: [u32; 3],
+    /// IK-HSD reference angles, rad.
+    theta_ref: [f64; 3],
+    /// Slave joint angles after the step, rad.
+    theta_sd: [f64; 3],
+    /// Slave controller torques, N m.
+    u: [f64; 3],
+    /// FK-HSD tool position l(n), m.
+    tool: [f64; 3],
+    /// Nearest surface point, m (zero without contact).
+    surface: [f64; 3],
+    /// h(n), N.
+    h: [f64; 3],
+    /// q(n) as the master received it, N.
+    q: [f64; 3],
+    /// Noise the emulator added to q(n).
+    noise_b: [f64; 3],
+    /// Delay injected into q(n), samples.
+    delay_b: [u32; 3],
+    /// KFF-HMD torques p(n), N m.
+    tau: [f64; 3],
+    /// The force the operator feels, N.
+    felt: [f64; 3],
+    /// The handle's true position, m.
+    handle: [f64; 3],
+    /// The impedance hand's force on the handle, N.
+    hand_force: [f64; 3],
+    /// The slave's Cartesian reference from the channel's control, m.
+    reference: [f64; 3],
+    /// The master's passivity observer per axis, J.
+    observer_m: [f64; 3],
+    /// The slave's passivity observer per axis, J.
+    observer_s: [f64; 3],
+    /// The slave step each value of q(n) was produced at.
+    q_from: [u64; 3],
+    /// Flags of v(n) as received.
+    flags_f: u32,
+    /// Flags of q(n) as received.
+    flags_b: u32,
+    /// The master's flags for this sample (held, peer lost, clamped, rejected).
+    flags_m: u32,
+    /// Object in contact, or -1.
+    contact_object: i64,
+    /// Energy the master's control dissipated this sample, J.
+    dissipated_m: f64,
+    /// Energy the slave's control dissipated this step, J.
+    dissipated_s: f64,
+    /// The master port's net energy into the channel so far, J.
+    port_net_m: f64,
+    /// The slave port's net energy into the channel so far, J.
+    port_net_s: f64,
+    /// Round trip, ns (0 if no answer).
+    round_trip_ns: u64,
+    /// Round trip minus injected delay, ns.
+    overhead_ns: i64,
+    /// Stamps per stage, ns (zero where not passed).
+    stamps: Stamps,
 }
 
 /// Keeps only the columns before [`FIRST_TIMING_COLUMN`] of a trace's text.
@@ -220,4 +238,35 @@ pub fn signal_columns(trace: &str) -> String {
         .map(|l| l.split(',').take(keep).collect::<Vec<_>>().join(","))
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_and_row_have_the_same_columns_in_order() {
+        let h = header();
+        let names: Vec<&str> = h.split(',').collect();
+        assert_eq!(names[..3], ["n", "received", "target_1"]);
+        assert_eq!(names.last().copied(), Some("t_master_done"));
+        let first_timing = names.iter().position(|c| *c == FIRST_TIMING_COLUMN);
+        assert_eq!(first_timing, Some(names.len() - stage::COUNT - 2));
+        let mut line = String::new();
+        let row = TraceRow {
+            n: 7,
+            received: true,
+            contact_object: -1,
+            ..TraceRow::default()
+        };
+        row.write_csv(&mut line, 0);
+        let cells: Vec<&str> = line.trim_end().split(',').collect();
+        assert_eq!(cells.len(), names.len());
+        assert_eq!(cells[..2], ["7", "1"]);
+        let k = names
+            .iter()
+            .position(|c| *c == "contact_object")
+            .expect("column");
+        assert_eq!(cells[k], "-1");
+    }
 }

@@ -5,6 +5,7 @@ use crate::analysis::{Analysis, STAGES};
 use crate::join::{self, Logs, NodeLog};
 use crate::metrics::Packets;
 use crate::plots::{self, Series};
+pub use crate::summary::REPORT_FILES;
 use crate::summary::{ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
 use crate::trace;
 use crate::Error;
@@ -15,20 +16,6 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use tactile_messages::Role;
 use tactile_scenario::Scenario;
-
-/// Files a report writes into its folder.
-pub const REPORT_FILES: [&str; 10] = [
-    "summary.json",
-    "trace.csv",
-    "round_trip.hgrm",
-    "overhead.hgrm",
-    "latency.svg",
-    "percentiles.svg",
-    "positions.svg",
-    "forces.svg",
-    "passivity.svg",
-    "scenario.toml",
-];
 
 /// The link name an in-process simulation records.
 pub const IN_PROCESS: &str = "in-process";

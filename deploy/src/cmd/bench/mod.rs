@@ -19,7 +19,8 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{Forward, FLAG_END, FLAG_PROBE};
-use tactile_node::ipc::{self, Idle, Inbox, IpcError, Outbox, WaitPolicy, Waker};
+use tactile_node::ipc::{self, Inbox, Outbox, Waker};
+use tactile_node::link::{Idle, LinkError, WaitPolicy};
 use tactile_node::runtime::LinkKind;
 use tactile_report::analysis::{us_header, us_line, Latency, Percentiles};
 use tactile_report::summary::Summary;
@@ -230,7 +231,7 @@ fn trio_with(
 }
 
 /// The echo side of the bare hop: sends back every sample it gets, until the end mark.
-pub fn echo(prefix: &str, wait: WaitPolicy) -> Result<(), IpcError> {
+pub fn echo(prefix: &str, wait: WaitPolicy) -> Result<(), LinkError> {
     let node = ipc::node(prefix, "echo")?;
     let inbox: Inbox<Forward> = Inbox::open(&node, "hop/ping")?;
     let out: Outbox<Forward> = Outbox::open(&node, "hop/pong", "bench")?;
@@ -287,7 +288,7 @@ fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Erro
         .map_err(|e| Error::Failed(format!("starting the echo process: {e}")))?;
     let saved_affinity = rustix::thread::sched_getaffinity(None).ok();
     let result = (|| -> Result<(Latency, u64), Error> {
-        let fail = |e: IpcError| Error::Failed(e.to_string());
+        let fail = |e: LinkError| Error::Failed(e.to_string());
         if sup.pin {
             let _ = tactile_node::sched::pin_thread(0);
         }

@@ -1,0 +1,319 @@
+//! The models against their closed forms: jitter moments and correlation, loss
+//! rates and burst lengths, replays.
+
+use crate::jitter::*;
+use crate::loss::*;
+use crate::replay::*;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use tactile_scenario::ReplayFormat;
+use tactile_scenario::{JitterConfig, JitterDistribution, LossModel, ReplayConfig};
+
+const N: usize = 100_000;
+
+fn stats(x: &[f64]) -> (f64, f64, f64) {
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+    let lag = x
+        .windows(2)
+        .map(|w| (w[0] - mean) * (w[1] - mean))
+        .sum::<f64>()
+        / (n - 1.0);
+    (mean, var.sqrt(), lag / var)
+}
+
+/// Each value's rank in the series, 0 to N - 1.
+fn ranks(x: &[f64]) -> Vec<f64> {
+    let mut order: Vec<usize> = (0..x.len()).collect();
+    order.sort_by(|&a, &b| x[a].total_cmp(&x[b]));
+    let mut r = vec![0.0; x.len()];
+    for (rank, &k) in order.iter().enumerate() {
+        r[k] = rank as f64;
+    }
+    r
+}
+
+fn draw(cfg: JitterConfig, seed: u64) -> Vec<f64> {
+    let mut j = Jitter::new(&cfg);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..N).map(|_| j.next(&mut rng)).collect()
+}
+
+/// Tolerances from the sample count: for an AR(1) series of lag-1 correlation c the
+/// effective count is N (1 - c) / (1 + c), so the mean's standard error is
+/// sd sqrt((1 + c) / (N (1 - c))); the sample standard deviation's relative error
+/// about sqrt((1 + c^2) / (2 N (1 - c^2))) for Gaussian data (heavier tails need
+/// more: Pareto shape 3 has no fourth moment, so its spread is checked to 5 %);
+/// the lag-1 correlation's about sqrt((1 - c^2) / N). Five standard errors each.
+/// The spread's error depends on the tail (kurtosis): see `spread_tolerance`.
+#[test]
+fn jitter_matches_its_distribution_spread_and_correlation() {
+    // The sample variance's relative standard error is sqrt((kurtosis - 1) / N_eff)
+    // (half that for the standard deviation), N_eff = N (1 - c^2) / (1 + c^2).
+    let spread_tolerance = |d: JitterDistribution, c: f64| {
+        let kurtosis = match d {
+            JitterDistribution::Uniform => 1.8,
+            JitterDistribution::Normal => 3.0,
+            d => shape_moments(d).2,
+        };
+        let n_eff = N as f64 * (1.0 - c * c) / (1.0 + c * c);
+        5.0 * 0.5 * ((kurtosis - 1.0) / n_eff).sqrt()
+    };
+    for distribution in [
+        JitterDistribution::Uniform,
+        JitterDistribution::Normal,
+        JitterDistribution::Pareto,
+        JitterDistribution::Paretonormal,
+    ] {
+        for c in [0.0, 0.5, 0.9] {
+            let x = draw(
+                JitterConfig {
+                    jitter: 4.0,
+                    correlation: c,
+                    distribution,
+                },
+                7,
+            );
+            let (mean, sd, rho) = stats(&x);
+            // netem's uniform takes `jitter` as the half-width: sd = J / sqrt(3).
+            let want_sd = if distribution == JitterDistribution::Uniform {
+                4.0 / 3f64.sqrt()
+            } else {
+                4.0
+            };
+            let se_mean = want_sd * ((1.0 + c) / (N as f64 * (1.0 - c))).sqrt();
+            assert!(
+                mean.abs() < 5.0 * se_mean,
+                "{distribution:?} c {c}: mean {mean}"
+            );
+            let rel = (sd - want_sd).abs() / want_sd;
+            assert!(
+                rel < spread_tolerance(distribution, c),
+                "{distribution:?} c {c}: sd {sd}"
+            );
+            // Through the copula the rank (Spearman) correlation of successive
+            // values is (6/pi) asin(c/2) whatever the distribution; the Pearson
+            // correlation is c itself for normal. Bartlett: the lag-1 estimate's
+            // standard error is about sqrt((1 - c^2) / N); at least 1/sqrt(N) here.
+            let se_rho = ((1.0 - c * c) / N as f64)
+                .sqrt()
+                .max(1.0 / (N as f64).sqrt());
+            let want_rank = 6.0 / std::f64::consts::PI * (c / 2.0).asin();
+            let rank = stats(&ranks(&x)).2;
+            assert!(
+                (rank - want_rank).abs() < 5.0 * se_rho,
+                "{distribution:?} c {c}: rank correlation {rank} vs {want_rank}"
+            );
+            if distribution == JitterDistribution::Normal {
+                assert!((rho - c).abs() < 5.0 * se_rho, "c {c}: rho {rho}");
+            }
+        }
+    }
+    // Pareto's tail: skewed right, so the median sits below the mean.
+    let mut x = draw(
+        JitterConfig {
+            jitter: 1.0,
+            correlation: 0.0,
+            distribution: JitterDistribution::Pareto,
+        },
+        3,
+    );
+    x.sort_by(f64::total_cmp);
+    assert!(x[N / 2] < -0.2, "median {}", x[N / 2]);
+}
+
+/// Loss runs: the loss rate against the stationary probability, and the mean burst
+/// length against 1/r (simple Gilbert: every packet in the bad state is lost).
+/// A Markov chain's loss indicator has lag correlation lambda = 1 - p - r, so the
+/// rate's standard error is sqrt(pi (1 - pi) (1 + lambda) / (N (1 - lambda))); a
+/// burst length is geometric with mean 1/r and variance (1 - r)/r^2, averaged over
+/// about N pi r bursts. Five standard errors each.
+#[test]
+fn gilbert_elliott_loss_rate_and_burst_length_match_the_closed_form() {
+    for (p, r) in [(0.01, 0.3), (0.002, 0.05), (0.05, 0.5)] {
+        let model = LossModel::Gemodel {
+            p,
+            r,
+            bad_loss: 1.0,
+            good_loss: 0.0,
+        };
+        let mut loss = Loss::new(&model);
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let lost: Vec<bool> = (0..N).map(|_| loss.lose(&mut rng)).collect();
+        let rate = lost.iter().filter(|l| **l).count() as f64 / N as f64;
+        let pi = loss_rate(&model);
+        assert!((pi - p / (p + r)).abs() < 1e-15);
+        let lambda = 1.0 - p - r;
+        let se = (pi * (1.0 - pi) * (1.0 + lambda) / (N as f64 * (1.0 - lambda))).sqrt();
+        assert!(
+            (rate - pi).abs() < 5.0 * se,
+            "p {p} r {r}: rate {rate} vs {pi}"
+        );
+        let mut bursts = Vec::new();
+        let mut run = 0u32;
+        for l in &lost {
+            if *l {
+                run += 1;
+            } else if run > 0 {
+                bursts.push(f64::from(run));
+                run = 0;
+            }
+        }
+        let mean = bursts.iter().sum::<f64>() / bursts.len() as f64;
+        let se_b = ((1.0 - r) / (r * r) / bursts.len() as f64).sqrt();
+        assert!(
+            (mean - 1.0 / r).abs() < 5.0 * se_b,
+            "p {p} r {r}: burst {mean} vs {}",
+            1.0 / r
+        );
+    }
+}
+
+#[test]
+fn gilbert_elliott_with_partial_loss_and_the_four_state_model_match_their_rates() {
+    let cases = [
+        LossModel::Gemodel {
+            p: 0.02,
+            r: 0.2,
+            bad_loss: 0.6,
+            good_loss: 0.01,
+        },
+        LossModel::State {
+            p13: 0.01,
+            p31: 0.4,
+            p32: 0.1,
+            p23: 0.3,
+            p14: 0.005,
+        },
+    ];
+    for model in cases {
+        let mut loss = Loss::new(&model);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let rate = (0..N).filter(|_| loss.lose(&mut rng)).count() as f64 / N as f64;
+        let pi = loss_rate(&model);
+        // Bursty: allow for correlation with a generous effective count of N / 20.
+        let se = (pi * (1.0 - pi) / (N as f64 / 20.0)).sqrt();
+        assert!((rate - pi).abs() < 5.0 * se, "{model:?}: {rate} vs {pi}");
+    }
+    // The 4-state chain's stationary distribution solves every balance equation
+    // (pi = pi P, state by state), and the chains that are not irreducible end
+    // where they must.
+    let (p13, p31, p32, p23, p14) = (0.01, 0.4, 0.1, 0.3, 0.005);
+    let s = StateChain::stationary(p13, p31, p32, p23, p14);
+    assert!((s.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    let next = [
+        s[0] * (1.0 - p13 - p14) + s[2] * p31 + s[3],
+        s[1] * (1.0 - p23) + s[2] * p32,
+        s[0] * p13 + s[1] * p23 + s[2] * (1.0 - p31 - p32),
+        s[0] * p14,
+    ];
+    for k in 0..4 {
+        assert!(
+            (next[k] - s[k]).abs() < 1e-12,
+            "state {}: {next:?} vs {s:?}",
+            k + 1
+        );
+    }
+    assert_eq!(
+        StateChain::stationary(0.0, 0.4, 0.1, 0.3, 0.25),
+        [0.8, 0.0, 0.0, 0.2]
+    );
+    let t = StateChain::stationary(0.1, 0.0, 0.1, 0.3, 0.0);
+    assert!(
+        (t[1] - 0.75).abs() < 1e-12 && (t[2] - 0.25).abs() < 1e-12,
+        "{t:?}"
+    );
+}
+
+#[test]
+fn a_csv_replay_reads_back_row_by_row_and_loops() {
+    let mut r = Replay::parse_csv("delay,lost\n3,0\n5,1\n0,0\n").expect("csv");
+    let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3, true)).collect();
+    let want = [
+        (3, false),
+        (5, true),
+        (0, false),
+        (3, false),
+        (5, true),
+        (0, false),
+    ];
+    assert_eq!(got, want);
+    // A sample not sent takes no row: the next packet gets the next one.
+    assert_eq!(r.packet(6, 1e-3, false), (0, false));
+    assert_eq!(r.packet(7, 1e-3, true), (3, false));
+    assert_eq!(r.bound(), 5);
+    for (text, needle) in [
+        ("delay,lost\n1.5,0\n", "line 2: delay 1.5"),
+        ("delay,lost\n-1,0\n", "line 2: delay -1"),
+        ("delay,lost\n1\n", "line 2: expected 2 columns"),
+        ("delay,lost\n1,2\n", "line 2: lost 2"),
+        ("delay,lost\n", "no packets"),
+        ("d,l\n1,0\n", "header"),
+    ] {
+        let e = Replay::parse_csv(text).expect_err(text);
+        assert!(e.contains(needle), "{text}: {e}");
+    }
+}
+
+/// A Mahimahi link that can deliver one MTU every 2 ms carries 6 packets of 250
+/// bytes per opportunity: at 1 kHz (a packet per ms) it keeps up, each packet
+/// waiting for the next opportunity; at 10 kHz it cannot, the queue grows to its
+/// limit and the excess is dropped.
+#[test]
+fn a_mahimahi_link_queues_and_drops_what_it_cannot_carry() {
+    let cfg = ReplayConfig {
+        path: "x".into(),
+        format: ReplayFormat::Mahimahi,
+        packet_bytes: 250,
+        max_queue_samples: 50,
+    };
+    let mut r = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+    let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3, true)).collect();
+    let want = [
+        (2, false),
+        (1, false),
+        (0, false),
+        (1, false),
+        (0, false),
+        (1, false),
+    ];
+    assert_eq!(got, want);
+    let mut fast = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+    let lost = (0..10_000)
+        .filter(|&n| fast.packet(n, 1e-4, true).1)
+        .count();
+    // 3 packets per ms fit of the 10 sent: 70 % dropped once the queue is full.
+    assert!((6_500..=7_100).contains(&lost), "{lost}");
+    // A packet sent an hour in goes at once: the trace is not walked.
+    let mut late = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+    assert_eq!(late.packet(3_600_000, 1e-3, true), (0, false));
+    // Samples not sent take no room.
+    let mut quiet = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+    assert!((0..10_000).all(|n| !quiet.packet(n, 1e-4, n % 10 == 0).1));
+    assert!(Replay::parse_mahimahi("3\n2\n", &cfg).is_err());
+    assert!(Replay::parse_mahimahi("x\n", &cfg).is_err());
+}
+
+#[test]
+fn seeded_and_repeatable() {
+    let cfg = JitterConfig {
+        jitter: 3.0,
+        correlation: 0.3,
+        distribution: JitterDistribution::Paretonormal,
+    };
+    assert_eq!(draw(cfg.clone(), 1), draw(cfg.clone(), 1));
+    assert_ne!(draw(cfg.clone(), 1), draw(cfg, 2));
+}
+
+#[test]
+fn phi_is_the_normal_cdf() {
+    for (z, want) in [
+        (0.0, 0.5),
+        (1.0, 0.841_344_746),
+        (-1.96, 0.024_997_895),
+        (3.0, 0.998_650_102),
+    ] {
+        assert!((phi(z) - want).abs() < 2e-7, "{z}: {}", phi(z));
+    }
+}
