@@ -13,6 +13,7 @@ mod channels;
 mod cli;
 mod faults;
 mod hosts;
+mod layout;
 mod loop_processes;
 mod nodes;
 mod scheduling;

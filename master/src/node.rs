@@ -7,10 +7,11 @@ use clap::Parser;
 use std::process::ExitCode;
 use std::time::Duration;
 use tactile_messages::Role;
-use tactile_node::runtime::{
-    exit, master_link, new_run_token, parse, prepare, start_record, NodeArgs, NodeError, Recorder,
-    EXIT_CODES_HELP,
-};
+use tactile_node::args::{exit, parse, NodeArgs, NodeError};
+use tactile_node::exit::EXIT_CODES_HELP;
+use tactile_node::open::master_link;
+use tactile_node::recorder::Recorder;
+use tactile_node::runtime::{new_run_token, prepare, start_record};
 
 /// tactile-master: the operator's side (OP, MD, HMD). Sends c(n), takes q(n) back,
 /// commands the master device's torques, and records every sample.
@@ -47,7 +48,7 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
             cli.startup_timeout_s
         )));
     }
-    if cli.direct && a.link != tactile_node::runtime::LinkKind::Zenoh {
+    if cli.direct && a.link != tactile_node::args::LinkKind::Zenoh {
         return Err(NodeError::BadInput(
             "--direct (no emulator) needs --link zenoh".into(),
         ));

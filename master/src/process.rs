@@ -15,9 +15,10 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, LATE_WINDOW};
+use tactile_node::args::NodeError;
 use tactile_node::link::MasterLink;
 use tactile_node::link::{Idle, LinkError};
-use tactile_node::runtime::{NodeError, Recorder};
+use tactile_node::recorder::Recorder;
 use tactile_scenario::{Mode, Scenario, ScenarioError};
 use thiserror::Error;
 

@@ -4,10 +4,11 @@ use crate::process::run_with;
 use clap::Parser;
 use std::process::ExitCode;
 use tactile_messages::Role;
-use tactile_node::runtime::{
-    check_link_args, emulator_link, exit, parse, prepare, start_record, LinkKind, NodeArgs,
-    NodeError, Recorder, EXIT_CODES_HELP,
-};
+use tactile_node::args::{exit, parse, LinkKind, NodeArgs, NodeError};
+use tactile_node::exit::EXIT_CODES_HELP;
+use tactile_node::open::{check_link_args, emulator_link};
+use tactile_node::recorder::Recorder;
+use tactile_node::runtime::{prepare, start_record};
 
 /// tactile-emulator: the network between master and slave. Delays, perturbs, drops
 /// and corrupts c(n) and h(n) as the scenario says (seeded), and records every sample.

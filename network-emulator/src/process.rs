@@ -7,10 +7,11 @@ use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::now_ns;
 use tactile_messages::samples::{stage, FLAG_END, FLAG_PROBE};
+use tactile_node::args::NodeError;
 use tactile_node::link::{Arrival, EmulatorLink, EmulatorStats, RunFilter};
 use tactile_node::link::{Idle, LinkError};
 use tactile_node::pace::{recv_paced, Pacer};
-use tactile_node::runtime::{NodeError, Recorder};
+use tactile_node::recorder::Recorder;
 use tactile_scenario::{Mode, Scenario};
 
 /// The emulator's counters.

@@ -4,9 +4,11 @@ use crate::process::run_with;
 use clap::Parser;
 use std::process::ExitCode;
 use tactile_messages::Role;
-use tactile_node::runtime::{
-    exit, parse, prepare, slave_link, start_record, NodeArgs, NodeError, Recorder, EXIT_CODES_HELP,
-};
+use tactile_node::args::{exit, parse, NodeArgs, NodeError};
+use tactile_node::exit::EXIT_CODES_HELP;
+use tactile_node::open::slave_link;
+use tactile_node::recorder::Recorder;
+use tactile_node::runtime::{prepare, start_record};
 
 /// tactile-slave: the remote side (HSD, SD, ENV). Follows v(n) with the slave arm,
 /// senses contact, sends the force h(n) back, and records every step.

@@ -7,10 +7,11 @@ use crate::record::{SlaveSample, SlaveTotals};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::now_ns;
 use tactile_messages::samples::{stage, Backward, FLAG_END, FLAG_PROBE};
+use tactile_node::args::NodeError;
 use tactile_node::link::{Idle, LinkError};
 use tactile_node::link::{RunFilter, SlaveLink};
 use tactile_node::pace::{recv_paced, Pacer};
-use tactile_node::runtime::{NodeError, Recorder};
+use tactile_node::recorder::Recorder;
 use tactile_scenario::{Mode, Scenario, ScenarioError};
 use thiserror::Error;
 

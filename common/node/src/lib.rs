@@ -3,14 +3,17 @@
 //! its log, the locks that keep runs apart, and the command line of the three node
 //! programs. The loops themselves are in the master, emulator and slave crates.
 
+pub mod args;
 pub mod exit;
 pub mod files;
 pub mod ipc;
 pub mod link;
 pub mod lock;
 pub mod logging;
+pub mod open;
 pub mod pace;
 pub mod record;
+pub mod recorder;
 pub mod runtime;
 pub mod sched;
 pub mod signals;

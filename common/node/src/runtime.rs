@@ -1,155 +1,23 @@
-//! What the three node programs share: their command line, their start-up checks, their
-//! record and the mapping of their outcome to an exit status.
+//! What the three node programs share between parsing and their loop: the start-up
+//! checks, the scheduling, and the start of their record.
 //!
-//! A node's `main.rs` is one call into its crate; the crate parses [`NodeArgs`], calls
-//! [`prepare`] (which checks everything a user controls before anything starts), runs
-//! its loop against a link and a [`Recorder`], and returns a [`NodeError`] or the
-//! reason it stopped. [`exit`] turns that into one line on stderr and the status.
+//! A node's program is one call into its crate; the crate parses
+//! [`NodeArgs`](crate::args::NodeArgs), calls [`prepare`] (which checks everything a
+//! user controls before anything starts), opens its link (`crate::open`), runs its
+//! loop against it and a [`Recorder`](crate::recorder::Recorder), and returns a
+//! [`NodeError`] or the reason it stopped; [`exit`](crate::args::exit) turns that into
+//! one line on stderr and the status.
 
+use crate::args::{LinkKind, NodeArgs, NodeError};
 use crate::lock::{self, Lock};
-use crate::record::{peak_rss_kb, Event, Record, RecordWriter, Start, Stop, Totals};
-use clap::{Args, ValueEnum};
-use serde::Serialize;
-use std::path::{Path, PathBuf};
-use std::process::ExitCode;
+use crate::open::check_link_args;
+use crate::record::Start;
+use crate::recorder::record_path;
+use std::path::PathBuf;
 use std::time::Duration;
 use tactile_messages::clock::now_ns;
 use tactile_messages::Role;
 use tactile_scenario::Scenario;
-
-pub use crate::exit::{EXIT_BAD_INPUT, EXIT_CODES_HELP, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK};
-
-/// What carries the samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum LinkKind {
-    /// iceoryx2 zero-copy shared memory (one host).
-    Iceoryx2,
-    /// UDP datagrams (the reference most stacks use); loopback unless --udp-hosts.
-    Udp,
-    /// Zenoh (across hosts): --listen and --connect name the endpoints.
-    Zenoh,
-}
-
-impl LinkKind {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            LinkKind::Iceoryx2 => "iceoryx2",
-            LinkKind::Udp => "udp",
-            LinkKind::Zenoh => "zenoh",
-        }
-    }
-}
-
-/// The command line every node takes.
-#[derive(Debug, Clone, Args)]
-pub struct NodeArgs {
-    /// Scenario file (TOML); its relative paths are resolved against its own folder.
-    #[arg(long)]
-    pub scenario: PathBuf,
-    /// Folder for this node's record (`ROLE.rec`) and log (`ROLE.log`).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Name of the run: nodes with the same prefix find each other. 1 to 24 characters
-    /// from A-Z a-z 0-9 _ -.
-    #[arg(long, default_value = "tactile")]
-    pub prefix: String,
-    /// Transport between the nodes.
-    #[arg(long, value_enum, default_value_t = LinkKind::Iceoryx2)]
-    pub link: LinkKind,
-    /// UDP ports of master, emulator and slave, as `m,e,s` (with --link udp).
-    #[arg(long, default_value = "47501,47502,47503")]
-    pub udp_ports: String,
-    /// Addresses of the master's, emulator's and slave's hosts, as `a,b,c` (with --link
-    /// udp).
-    #[arg(long, default_value = "127.0.0.1,127.0.0.1,127.0.0.1")]
-    pub udp_hosts: String,
-    /// Zenoh endpoint to listen on, e.g. `tcp/198.18.0.1:7447` (repeatable).
-    #[arg(long)]
-    pub listen: Vec<String>,
-    /// Zenoh endpoint of a peer to connect to, e.g. `tcp/198.18.0.1:7447` (repeatable).
-    #[arg(long)]
-    pub connect: Vec<String>,
-    /// Let Zenoh find peers by multicast scouting too (off: only the endpoints given).
-    #[arg(long)]
-    pub scout: bool,
-    /// Microseconds to poll (yielding the CPU) before blocking on the wake-up event.
-    /// Default: twice --wake-early-us in realtime (the node wakes that long before a
-    /// sample is due), two sampling periods in lockstep; 0 blocks at once.
-    #[arg(long)]
-    pub spin_us: Option<u64>,
-    /// Realtime: stop sleeping this long before a sample is due, then poll. Default
-    /// 200 us, at most 40 % of a sampling period (measured, README "Waiting").
-    #[arg(long)]
-    pub wake_early_us: Option<u64>,
-    /// Scheduling: fifo (SCHED_FIFO with memory locked, where permitted; otherwise
-    /// SCHED_OTHER, said in the log and the report) or other. Lockstep runs always
-    /// SCHED_OTHER: its loop never sleeps.
-    #[arg(long, value_enum, default_value_t = crate::sched::Policy::Fifo)]
-    pub sched: crate::sched::Policy,
-    /// What the node's CPU does while a realtime node under SCHED_FIFO sleeps: halt
-    /// (the kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so
-    /// a halted CPU is not woken late; on these virtual machines a CPU kept busy is
-    /// taken away for about 7.5 ms every 10 s instead: README "What the CPUs do while the nodes
-    /// sleep").
-    #[arg(long, value_enum, default_value_t = crate::sched::IdleMode::Halt)]
-    pub idle: crate::sched::IdleMode,
-    /// SCHED_FIFO priority, 1 to 98.
-    #[arg(long, default_value_t = crate::sched::DEFAULT_PRIORITY, value_parser = clap::value_parser!(u8).range(1..=98))]
-    pub priority: u8,
-    /// Pin this node to one CPU.
-    #[arg(long)]
-    pub cpu: Option<usize>,
-    /// Continue this node's record in --out instead of starting it afresh (a node
-    /// restarted into a run that is still going).
-    #[arg(long)]
-    pub append: bool,
-    /// Started by `tactile run` (process id of the launcher): stop when it dies, log
-    /// to the file only.
-    #[arg(long, hide = true)]
-    pub supervised: Option<u32>,
-}
-
-/// Why a node stopped without completing.
-#[derive(Debug)]
-pub enum NodeError {
-    /// Bad input; nothing was started (exit 2).
-    BadInput(String),
-    /// A failure while running (exit 1).
-    Failed(String),
-}
-
-impl NodeError {
-    /// The exit status.
-    pub fn code(&self) -> u8 {
-        match self {
-            NodeError::BadInput(_) => EXIT_BAD_INPUT,
-            NodeError::Failed(_) => EXIT_FAILURE,
-        }
-    }
-}
-
-impl std::fmt::Display for NodeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            NodeError::BadInput(m) | NodeError::Failed(m) => f.write_str(m),
-        }
-    }
-}
-
-/// Maps a node's outcome to its exit status and one line on stderr.
-pub fn exit(role: Role, outcome: Result<bool, NodeError>) -> ExitCode {
-    match outcome {
-        Ok(true) => ExitCode::from(EXIT_OK),
-        Ok(false) => ExitCode::from(EXIT_INTERRUPTED),
-        Err(e) => {
-            tracing::error!("{e}");
-            eprintln!("tactile-{role}: {e}");
-            ExitCode::from(e.code())
-        }
-    }
-}
 
 /// Everything a node has after its start-up checks.
 #[derive(Debug)]
@@ -333,112 +201,6 @@ pub fn pin(cpu: usize) -> Result<(), String> {
     crate::sched::pin_thread(cpu).map_err(|e| format!("pinning to CPU {cpu}: {e}"))
 }
 
-/// The record file of `role` in `dir`.
-pub fn record_path(dir: &Path, role: Role) -> PathBuf {
-    dir.join(format!("{role}.rec"))
-}
-
-/// A node's record writer with its bookkeeping: events go to the log as well, and the
-/// counters are written every second, so a node killed at any moment leaves counters
-/// at most a second old.
-#[derive(Debug)]
-pub struct Recorder<S, C> {
-    writer: RecordWriter<Record<S, C>>,
-    next_counters_ns: u64,
-}
-
-/// Counters are written this often, ns.
-pub const COUNTERS_EVERY_NS: u64 = 1_000_000_000;
-
-impl<S: Serialize, C: Serialize> Recorder<S, C> {
-    /// Opens `ROLE.rec` in `dir` (afresh, or appended to with `append`).
-    pub fn open(dir: &Path, role: Role, append: bool) -> Result<Self, NodeError> {
-        let path = record_path(dir, role);
-        let writer = RecordWriter::create(&path, append)
-            .map_err(|e| NodeError::Failed(format!("opening {}: {e}", path.display())))?;
-        Ok(Recorder {
-            writer,
-            next_counters_ns: now_ns() + COUNTERS_EVERY_NS,
-        })
-    }
-
-    fn put(&mut self, r: &Record<S, C>) -> Result<(), NodeError> {
-        self.writer.write(r).map_err(|e| {
-            NodeError::Failed(format!("writing {}: {e}", self.writer.path().display()))
-        })
-    }
-
-    /// The start of a segment.
-    pub fn start(&mut self, start: Start) -> Result<(), NodeError> {
-        tracing::info!(
-            "start: {} of run {:?} ({} link, scenario {:?}, {} samples at {} Hz, {} {}, wake {} us early, poll {} us{})",
-            start.role,
-            start.prefix,
-            start.link,
-            start.scenario,
-            start.samples,
-            start.rate_hz,
-            start.sched.policy,
-            start.sched.priority,
-            start.sched.wake_early_us,
-            start.sched.poll_us,
-            start.sched.cpu.map_or(String::new(), |c| format!(", CPU {c}"))
-        );
-        self.put(&Record::Start(start))
-    }
-
-    /// The run token this node joined.
-    pub fn run(&mut self, token: u64) -> Result<(), NodeError> {
-        tracing::info!("joined run {token:016x}");
-        self.put(&Record::Run(token))
-    }
-
-    /// One sample's record.
-    pub fn sample(&mut self, s: S) -> Result<(), NodeError> {
-        self.put(&Record::Sample(s))
-    }
-
-    /// An event, logged and recorded.
-    pub fn event(&mut self, sample: u64, what: impl Into<String>) -> Result<(), NodeError> {
-        let what = what.into();
-        tracing::info!("sample {sample}: {what}");
-        self.put(&Record::Event(Event {
-            sample,
-            mono_ns: now_ns(),
-            what,
-        }))
-    }
-
-    /// True once a second has passed since the counters were last written (then the
-    /// node writes them with [`Recorder::counters`]).
-    pub fn counters_due(&mut self) -> bool {
-        let now = now_ns();
-        if now < self.next_counters_ns {
-            return false;
-        }
-        self.next_counters_ns = now + COUNTERS_EVERY_NS;
-        true
-    }
-
-    /// Writes the counters now.
-    pub fn counters(&mut self, counters: C) -> Result<(), NodeError> {
-        self.put(&Record::Counters(Totals {
-            counters,
-            peak_rss_kb: peak_rss_kb(),
-        }))
-    }
-
-    /// The end of the segment: final counters, then `Stop`.
-    pub fn stop(&mut self, counters: C, reason: &str) -> Result<(), NodeError> {
-        self.counters(counters)?;
-        tracing::info!("stop: {reason} (peak RSS {} kB)", peak_rss_kb());
-        self.put(&Record::Stop(Stop {
-            reason: reason.to_string(),
-            mono_ns: now_ns(),
-        }))
-    }
-}
-
 /// This node's clock domain: `TACTILE_CLOCK_DOMAIN` if set, else the kernel's boot id
 /// (processes under one kernel, network namespaces included, share CLOCK_MONOTONIC).
 pub fn clock_domain() -> String {
@@ -500,22 +262,6 @@ pub fn start_record(role: Role, args: &NodeArgs, p: &Prepared) -> Start {
     }
 }
 
-/// Parses a node's command line; on an error prints clap's message and returns the
-/// exit status (2 for bad arguments, 0 for --help and --version).
-pub fn parse<T: clap::Parser>() -> Result<T, ExitCode> {
-    // First thing, while the node has one thread.
-    #[cfg(feature = "zenoh")]
-    crate::zlink::default_runtime();
-    T::try_parse().map_err(|e| {
-        let _ = e.print();
-        ExitCode::from(if e.use_stderr() {
-            EXIT_BAD_INPUT
-        } else {
-            EXIT_OK
-        })
-    })
-}
-
 /// A fresh run token: random, never zero (zero means "unknown").
 pub fn new_run_token() -> u64 {
     use std::hash::{BuildHasher, Hasher};
@@ -525,203 +271,10 @@ pub fn new_run_token() -> u64 {
     h.finish().max(1)
 }
 
-fn udp_ports(a: &NodeArgs) -> Result<crate::udp::UdpPorts, NodeError> {
-    let ports = crate::udp::UdpPorts::parse(&a.udp_ports).ok_or_else(|| {
-        NodeError::BadInput(format!(
-            "--udp-ports {:?}: expected three ports m,e,s",
-            a.udp_ports
-        ))
-    })?;
-    ports.on_hosts(&a.udp_hosts).ok_or_else(|| {
-        NodeError::BadInput(format!(
-            "--udp-hosts {:?}: expected three IP addresses a,b,c",
-            a.udp_hosts
-        ))
-    })
-}
-
-/// What a build without the `zenoh` feature answers to `--link zenoh`.
-pub const NO_ZENOH: &str = "--link zenoh: this build has no Zenoh link; build with \
-`cargo build --release --workspace --features zenoh` (README, Across hosts)";
-
-/// The Zenoh endpoints of the arguments.
-#[cfg(feature = "zenoh")]
-pub fn zenoh_options(a: &NodeArgs) -> crate::zlink::ZenohOptions {
-    crate::zlink::ZenohOptions {
-        listen: a.listen.clone(),
-        connect: a.connect.clone(),
-        scout: a.scout,
-    }
-}
-
-/// Checks the options of the links in use, before anything starts.
-pub fn check_link_args(a: &NodeArgs, links: &[LinkKind]) -> Result<(), NodeError> {
-    if links.contains(&LinkKind::Udp) {
-        udp_ports(a)?;
-    }
-    if links.contains(&LinkKind::Zenoh) {
-        if !cfg!(feature = "zenoh") {
-            return Err(NodeError::BadInput(NO_ZENOH.into()));
-        }
-        if a.listen.is_empty() && a.connect.is_empty() && !a.scout {
-            return Err(NodeError::BadInput(
-                "--link zenoh: give --listen ENDPOINT and/or --connect ENDPOINT (or --scout) so the nodes can meet".into(),
-            ));
-        }
-        for e in a.listen.iter().chain(&a.connect) {
-            let ok = e.split_once('/').is_some_and(|(proto, addr)| {
-                matches!(proto, "tcp" | "udp") && addr.parse::<std::net::SocketAddr>().is_ok()
-            });
-            if !ok {
-                return Err(NodeError::BadInput(format!(
-                    "Zenoh endpoint {e:?}: expected tcp/ADDRESS:PORT or udp/ADDRESS:PORT"
-                )));
-            }
-        }
-        #[cfg(feature = "zenoh")]
-        zenoh_options(a)
-            .config()
-            .map_err(|e| NodeError::BadInput(e.to_string()))?;
-    }
-    Ok(())
-}
-
-fn opened<T>(r: Result<T, crate::link::LinkError>) -> Result<T, NodeError> {
-    r.map_err(|e| NodeError::Failed(e.to_string()))
-}
-
-/// The master's link as the arguments choose it; `direct`: no emulator, the slave
-/// is the master's peer (Zenoh only).
-pub fn master_link(
-    a: &NodeArgs,
-    spin: Duration,
-    direct: bool,
-) -> Result<Box<dyn crate::link::MasterLink>, NodeError> {
-    let wait = crate::link::WaitPolicy { spin };
-    if direct && a.link != LinkKind::Zenoh {
-        return Err(NodeError::BadInput(
-            "--direct (no emulator) needs --link zenoh".into(),
-        ));
-    }
-    Ok(match a.link {
-        LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxMaster::open(&a.prefix, wait))?),
-        LinkKind::Udp => Box::new(opened(crate::udp::UdpMaster::open(udp_ports(a)?, wait))?),
-        LinkKind::Zenoh => zenoh_open::master(a, direct, wait)?,
-    })
-}
-
-/// The emulator's link: `towards_master` and `towards_slave` chosen on their own, so
-/// the emulator can sit on either host (Zenoh on one side, iceoryx2 on the other).
-pub fn emulator_link(
-    a: &NodeArgs,
-    spin: Duration,
-    towards_master: LinkKind,
-    towards_slave: LinkKind,
-) -> Result<Box<dyn crate::link::EmulatorLink>, NodeError> {
-    use LinkKind::{Iceoryx2, Udp, Zenoh};
-    let wait = crate::link::WaitPolicy { spin };
-    Ok(match (towards_master, towards_slave) {
-        (Iceoryx2, Iceoryx2) => Box::new(opened(crate::ipc::IoxEmulator::open(&a.prefix, wait))?),
-        (Udp, Udp) => Box::new(opened(crate::udp::UdpEmulator::open(udp_ports(a)?, wait))?),
-        (Zenoh, Zenoh) | (Zenoh, Iceoryx2) | (Iceoryx2, Zenoh) => zenoh_open::emulator(
-            a,
-            towards_master == Iceoryx2,
-            towards_slave == Iceoryx2,
-            wait,
-        )?,
-        (m, s) => {
-            return Err(NodeError::BadInput(format!(
-                "--master-link {} with --slave-link {}: UDP cannot be mixed with another link (Zenoh and iceoryx2 can)",
-                m.name(),
-                s.name()
-            )))
-        }
-    })
-}
-
-/// The slave's link as the arguments choose it.
-pub fn slave_link(
-    a: &NodeArgs,
-    spin: Duration,
-) -> Result<Box<dyn crate::link::SlaveLink>, NodeError> {
-    let wait = crate::link::WaitPolicy { spin };
-    Ok(match a.link {
-        LinkKind::Iceoryx2 => Box::new(opened(crate::ipc::IoxSlave::open(&a.prefix, wait))?),
-        LinkKind::Udp => Box::new(opened(crate::udp::UdpSlave::open(udp_ports(a)?, wait))?),
-        LinkKind::Zenoh => zenoh_open::slave(a, wait)?,
-    })
-}
-
-/// Opening the Zenoh links, in a build with the `zenoh` feature.
-#[cfg(feature = "zenoh")]
-mod zenoh_open {
-    use super::{opened, zenoh_options, NodeArgs, NodeError};
-    use crate::link::WaitPolicy;
-    use crate::link::{EmulatorLink, MasterLink, SlaveLink};
-    use crate::zlink::{ZenohEmulator, ZenohMaster, ZenohSlave};
-
-    pub fn master(
-        a: &NodeArgs,
-        direct: bool,
-        wait: WaitPolicy,
-    ) -> Result<Box<dyn MasterLink>, NodeError> {
-        let o = zenoh_options(a);
-        Ok(Box::new(opened(ZenohMaster::open(
-            &o, &a.prefix, direct, wait,
-        ))?))
-    }
-
-    pub fn emulator(
-        a: &NodeArgs,
-        master_on_iceoryx2: bool,
-        slave_on_iceoryx2: bool,
-        wait: WaitPolicy,
-    ) -> Result<Box<dyn EmulatorLink>, NodeError> {
-        let o = zenoh_options(a);
-        Ok(Box::new(opened(ZenohEmulator::open(
-            &o,
-            &a.prefix,
-            master_on_iceoryx2,
-            slave_on_iceoryx2,
-            wait,
-        ))?))
-    }
-
-    pub fn slave(a: &NodeArgs, wait: WaitPolicy) -> Result<Box<dyn SlaveLink>, NodeError> {
-        let o = zenoh_options(a);
-        Ok(Box::new(opened(ZenohSlave::open(&o, &a.prefix, wait))?))
-    }
-}
-
-/// In a build without the `zenoh` feature every Zenoh link is a configuration error
-/// that says how to build with it.
-#[cfg(not(feature = "zenoh"))]
-mod zenoh_open {
-    use super::{NodeArgs, NodeError, NO_ZENOH};
-    use crate::link::WaitPolicy;
-    use crate::link::{EmulatorLink, MasterLink, SlaveLink};
-
-    pub fn master(_: &NodeArgs, _: bool, _: WaitPolicy) -> Result<Box<dyn MasterLink>, NodeError> {
-        Err(NodeError::BadInput(NO_ZENOH.into()))
-    }
-
-    pub fn emulator(
-        _: &NodeArgs,
-        _: bool,
-        _: bool,
-        _: WaitPolicy,
-    ) -> Result<Box<dyn EmulatorLink>, NodeError> {
-        Err(NodeError::BadInput(NO_ZENOH.into()))
-    }
-
-    pub fn slave(_: &NodeArgs, _: WaitPolicy) -> Result<Box<dyn SlaveLink>, NodeError> {
-        Err(NodeError::BadInput(NO_ZENOH.into()))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::args::NodeArgs;
     use clap::Parser;
 
     #[derive(Debug, Parser)]
@@ -734,18 +287,6 @@ mod tests {
         let mut v = vec!["node", "--scenario", "s.toml", "--out", "o"];
         v.extend_from_slice(extra);
         Cli::parse_from(v).node
-    }
-
-    #[test]
-    fn the_zenoh_link_is_checked_or_refused_by_the_build() {
-        let a = args(&["--link", "zenoh", "--connect", "tcp/127.0.0.1:7447"]);
-        let r = check_link_args(&a, &[LinkKind::Zenoh]);
-        if cfg!(feature = "zenoh") {
-            assert!(r.is_ok(), "{:?}", r.err());
-        } else {
-            let e = r.expect_err("no Zenoh in this build").to_string();
-            assert!(e.contains("--workspace --features zenoh"), "{e}");
-        }
     }
 
     #[test]

@@ -156,3 +156,19 @@ impl MasterDeviceConfig {
         Ok(())
     }
 }
+
+impl MasterConfig {
+    /// Checks the ranges; errors name `master.*`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        if !self.force_limit.is_finite() || self.force_limit <= 0.0 {
+            return Err(invalid(
+                "master.force_limit",
+                format!("{} N must be positive", self.force_limit),
+            ));
+        }
+        positive3(&self.torque_limit, "master.torque_limit", false)?;
+        self.hand.validate()?;
+        self.device.validate()?;
+        self.predictor.validate("master.predictor")
+    }
+}

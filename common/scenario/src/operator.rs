@@ -1,5 +1,6 @@
 //! `[operator]`: what the operator's hand does, a(n).
 
+use crate::{finite3, invalid, ScenarioError};
 use serde::{Deserialize, Serialize};
 
 /// The operator's motion, a(n).
@@ -53,4 +54,61 @@ pub enum Operator {
 
 fn default_plane() -> String {
     "xy".into()
+}
+
+impl Operator {
+    /// Checks the ranges; errors name `operator.*`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        match self {
+            Operator::Paper => {}
+            Operator::Circle {
+                center,
+                radius,
+                period_s,
+                plane,
+            }
+            | Operator::FigureEight {
+                center,
+                size: radius,
+                period_s,
+                plane,
+            } => {
+                finite3(center, "operator.center")?;
+                if !radius.is_finite() || *radius <= 0.0 || *radius > 1.0 {
+                    return Err(invalid(
+                        "operator.radius",
+                        format!("{radius} m is outside (0, 1] m"),
+                    ));
+                }
+                if !period_s.is_finite() || *period_s <= 0.0 {
+                    return Err(invalid(
+                        "operator.period_s",
+                        format!("{period_s} must be positive"),
+                    ));
+                }
+                if !["xy", "yz", "xz"].contains(&plane.as_str()) {
+                    return Err(invalid(
+                        "operator.plane",
+                        format!("{plane:?} is not xy, yz or xz"),
+                    ));
+                }
+            }
+            Operator::Press { from, to, move_s } => {
+                finite3(from, "operator.from")?;
+                finite3(to, "operator.to")?;
+                if !move_s.is_finite() || *move_s <= 0.0 {
+                    return Err(invalid(
+                        "operator.move_s",
+                        format!("{move_s} must be positive"),
+                    ));
+                }
+            }
+            Operator::Csv { path } => {
+                if path.is_empty() {
+                    return Err(invalid("operator.path", "is empty"));
+                }
+            }
+        }
+        Ok(())
+    }
 }

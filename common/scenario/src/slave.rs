@@ -2,6 +2,7 @@
 //! objects the tool can touch.
 
 use crate::PredictorConfig;
+use crate::{finite3, invalid, positive3, ScenarioError};
 use serde::{Deserialize, Serialize};
 
 /// The slave side.
@@ -119,5 +120,76 @@ impl Object {
             | Object::Sphere { stiffness, .. }
             | Object::Box { stiffness, .. } => *stiffness,
         }
+    }
+}
+
+impl SlaveConfig {
+    /// Checks the ranges; errors name `slave.*`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        let c = &self.controller;
+        positive3(&c.kp, "slave.controller.kp", true)?;
+        positive3(&c.ki, "slave.controller.ki", true)?;
+        positive3(&c.kd, "slave.controller.kd", true)?;
+        positive3(&c.torque_limit, "slave.controller.torque_limit", false)?;
+        let d = &self.dynamics;
+        positive3(&d.inertia, "slave.dynamics.inertia", false)?;
+        positive3(&d.damping, "slave.dynamics.damping", true)?;
+        // A sample shorter than the step is integrated in one step of t_s; a step
+        // longer than 10 ms makes the default joints' integration unstable.
+        if !d.step_s.is_finite() || d.step_s < 1e-6 || d.step_s > 0.01 {
+            return Err(invalid(
+                "slave.dynamics.step_s",
+                format!("{} s is outside 1 us to 10 ms", d.step_s),
+            ));
+        }
+        self.predictor.validate("slave.predictor")
+    }
+}
+
+impl Environment {
+    /// Checks every object; errors name `environment.objects[k].*`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        for (k, o) in self.objects.iter().enumerate() {
+            let f = format!("environment.objects[{k}]");
+            positive3(&o.stiffness(), &format!("{f}.stiffness"), true)?;
+            for (i, h) in o.stiffness().iter().enumerate() {
+                if *h > MAX_STIFFNESS {
+                    return Err(invalid(
+                    format!("{f}.stiffness[{i}]"),
+                    format!("{h} N/m is above {MAX_STIFFNESS} N/m, ten times the device's nominal maximum"),
+                ));
+                }
+            }
+            match o {
+                Object::Plane { point, normal, .. } => {
+                    finite3(point, &format!("{f}.point"))?;
+                    finite3(normal, &format!("{f}.normal"))?;
+                    if normal.iter().map(|v| v * v).sum::<f64>() < 1e-12 {
+                        return Err(invalid(
+                            format!("{f}.normal"),
+                            "must not be the zero vector",
+                        ));
+                    }
+                }
+                Object::Sphere { center, radius, .. } => {
+                    finite3(center, &format!("{f}.center"))?;
+                    if !radius.is_finite() || *radius <= 0.0 {
+                        return Err(invalid(
+                            format!("{f}.radius"),
+                            format!("{radius} must be positive"),
+                        ));
+                    }
+                }
+                Object::Box {
+                    center,
+                    half_extents,
+                    ..
+                } => {
+                    finite3(center, &format!("{f}.center"))?;
+                    positive3(half_extents, &format!("{f}.half_extents"), false)?;
+                }
+            }
+        }
+        Ok(())
     }
 }

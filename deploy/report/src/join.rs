@@ -17,7 +17,7 @@ use tactile_messages::Role;
 use tactile_network_emulator::emulator::{Direction, Passage};
 use tactile_network_emulator::process::EmulatorTotals;
 use tactile_node::record::{Record, RecordReader, Start, Totals};
-use tactile_node::runtime::record_path;
+use tactile_node::recorder::record_path;
 use tactile_slave::record::{SlaveSample, SlaveTotals, Step};
 
 /// Events kept per node in the report; further ones are counted, not kept, so a node

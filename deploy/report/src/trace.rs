@@ -23,32 +23,21 @@ trait Cells {
     fn cells(&self, line: &mut String, t0: u64);
 }
 
-impl Cells for u64 {
-    fn names(field: &str, h: &mut String) {
-        let _ = write!(h, ",{field}");
-    }
-    fn cells(&self, line: &mut String, _: u64) {
-        let _ = write!(line, ",{self}");
-    }
+/// Integers as they print.
+macro_rules! integer_cells {
+    ($($t:ty),*) => {$(
+        impl Cells for $t {
+            fn names(field: &str, h: &mut String) {
+                let _ = write!(h, ",{field}");
+            }
+            fn cells(&self, line: &mut String, _: u64) {
+                let _ = write!(line, ",{self}");
+            }
+        }
+    )*};
 }
 
-impl Cells for u32 {
-    fn names(field: &str, h: &mut String) {
-        let _ = write!(h, ",{field}");
-    }
-    fn cells(&self, line: &mut String, _: u64) {
-        let _ = write!(line, ",{self}");
-    }
-}
-
-impl Cells for i64 {
-    fn names(field: &str, h: &mut String) {
-        let _ = write!(h, ",{field}");
-    }
-    fn cells(&self, line: &mut String, _: u64) {
-        let _ = write!(line, ",{self}");
-    }
-}
+integer_cells!(u64, u32, i64);
 
 impl Cells for bool {
     fn names(field: &str, h: &mut String) {

@@ -6,7 +6,7 @@ use crate::launch::{self, load_scenario, parse_sets, prepare_out, Links, Supervi
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Duration;
-use tactile_node::runtime::LinkKind;
+use tactile_node::args::LinkKind;
 use tactile_report::summary::render;
 use tactile_report::write::{write_report, Launch};
 
@@ -49,8 +49,8 @@ pub struct RunArgs {
     /// What carries the samples between the nodes on this host: iceoryx2 (shared
     /// memory), udp (loopback datagrams, the reference) or zenoh (loopback TCP; across
     /// hosts, start the nodes by hand, see docs/03-across-hosts.md).
-    #[arg(long, value_enum, default_value_t = tactile_node::runtime::LinkKind::Iceoryx2)]
-    pub link: tactile_node::runtime::LinkKind,
+    #[arg(long, value_enum, default_value_t = tactile_node::args::LinkKind::Iceoryx2)]
+    pub link: tactile_node::args::LinkKind,
     /// Shorthand for --link udp.
     #[arg(long, conflicts_with = "link")]
     pub udp: bool,

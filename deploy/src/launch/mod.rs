@@ -15,7 +15,7 @@ pub use supervise::run_processes;
 
 use std::path::Path;
 use std::time::Duration;
-use tactile_node::runtime::LinkKind;
+use tactile_node::args::LinkKind;
 use tactile_scenario::Scenario;
 
 /// How `tactile run` supervises its processes.

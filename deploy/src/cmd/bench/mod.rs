@@ -7,22 +7,23 @@
 //! floor any loop over iceoryx2 stands on. Then the lockstep throughput of the trio.
 //! Everything is reported as percentiles and as ratios taken in the same run.
 
+mod hop;
 mod stalls;
 
+pub use hop::echo;
+
 use crate::error::Error;
+use crate::launch::netns::Pair;
 use crate::launch::{run_processes, Loaded, Supervision, PAPER_SCENARIO};
 use clap::Args;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
-use tactile_messages::clock::{now_ns, sleep_until_ns};
-use tactile_messages::samples::{Forward, FLAG_END, FLAG_PROBE};
-use tactile_node::ipc::{self, Inbox, Outbox, Waker};
-use tactile_node::link::{Idle, LinkError, WaitPolicy};
-use tactile_node::runtime::LinkKind;
-use tactile_report::analysis::{us_header, us_line, Latency, Percentiles};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+use tactile_node::args::LinkKind;
+use tactile_report::analysis::{us_header, us_line, Percentiles};
 use tactile_report::summary::Summary;
 use tactile_report::write::write_json;
 use tactile_scenario::{Mode, Scenario};
@@ -230,139 +231,6 @@ fn trio_with(
     run_processes(&loaded, out, &sup)
 }
 
-/// The echo side of the bare hop: sends back every sample it gets, until the end mark.
-pub fn echo(prefix: &str, wait: WaitPolicy) -> Result<(), LinkError> {
-    let node = ipc::node(prefix, "echo")?;
-    let inbox: Inbox<Forward> = Inbox::open(&node, "hop/ping")?;
-    let out: Outbox<Forward> = Outbox::open(&node, "hop/pong", "bench")?;
-    let waker = Waker::open(&node, "echo")?;
-    loop {
-        let deadline = Instant::now() + Duration::from_secs(3600);
-        match waker.wait(&node, wait.spin, deadline, || inbox.try_recv())? {
-            Ok(f) if f.signal.flags & FLAG_END != 0 => return Ok(()),
-            Ok(f) => {
-                out.publish(f, f.signal.flags & FLAG_PROBE != 0)?;
-            }
-            Err(Idle::Terminate) => return Ok(()),
-            Err(Idle::Timeout) => {}
-        }
-    }
-}
-
-/// Puts back the CPU affinity the bench had, so the bare hop's pinning does not leak
-/// into the next step of the bench.
-struct Restore(Option<rustix::thread::CpuSet>);
-
-impl Drop for Restore {
-    fn drop(&mut self) {
-        if let Some(set) = &self.0 {
-            let _ = rustix::thread::sched_setaffinity(None, set);
-        }
-    }
-}
-
-/// The bare hop's poll budget: as given, else two periods (it has no pacer).
-fn hop_spin(sup: &Supervision, rate: f64) -> Duration {
-    sup.spin
-        .unwrap_or_else(|| Duration::from_nanos((2e9 / rate) as u64))
-}
-
-/// Ping-pong with an echo process at `rate` for `n` round trips.
-fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
-    let prefix = format!("{}h", sup.prefix);
-    let exe = std::env::current_exe().map_err(Error::io("locating the tactile executable"))?;
-    let mut cmd = if sup.pin {
-        let mut c = Command::new("taskset");
-        c.args(["-c", "1"]).arg(&exe);
-        c
-    } else {
-        Command::new(&exe)
-    };
-    let mut child = cmd
-        .arg("bench-echo")
-        .args(["--prefix", &prefix, "--spin-us"])
-        .arg(hop_spin(sup, rate).as_micros().to_string())
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .spawn()
-        .map_err(|e| Error::Failed(format!("starting the echo process: {e}")))?;
-    let saved_affinity = rustix::thread::sched_getaffinity(None).ok();
-    let result = (|| -> Result<(Latency, u64), Error> {
-        let fail = |e: LinkError| Error::Failed(e.to_string());
-        if sup.pin {
-            let _ = tactile_node::sched::pin_thread(0);
-        }
-        let _restore = Restore(saved_affinity);
-        let node = ipc::node(&prefix, "bench").map_err(fail)?;
-        let out: Outbox<Forward> = Outbox::open(&node, "hop/ping", "echo").map_err(fail)?;
-        let inbox: Inbox<Forward> = Inbox::open(&node, "hop/pong").map_err(fail)?;
-        let waker = Waker::open(&node, "bench").map_err(fail)?;
-        // Probe until the echo answers.
-        let start = Instant::now();
-        loop {
-            let mut p = Forward::default();
-            p.signal.flags = FLAG_PROBE;
-            out.send_control(p).map_err(fail)?;
-            let got = waker
-                .wait(
-                    &node,
-                    Duration::ZERO,
-                    Instant::now() + Duration::from_millis(20),
-                    || inbox.try_recv(),
-                )
-                .map_err(fail)?;
-            if got.is_ok() {
-                break;
-            }
-            if start.elapsed() > Duration::from_secs(10) {
-                return Err(Error::Failed("the echo process did not answer".into()));
-            }
-        }
-        while inbox.try_recv().map_err(fail)?.is_some() {}
-        let t_s = (1e9 / rate) as u64;
-        let t0 = now_ns() + 2_000_000;
-        let mut lat = Latency::default();
-        let mut misses = 0;
-        for i in 0..n {
-            let tick = t0 + i * t_s;
-            sleep_until_ns(tick.saturating_sub(tactile_node::pace::default_wake_early_ns(t_s)));
-            while now_ns() < tick {
-                std::hint::spin_loop();
-            }
-            let sent = now_ns();
-            out.send(Forward {
-                seq: i,
-                ..Forward::default()
-            })
-            .map_err(fail)?;
-            let deadline = Instant::now() + Duration::from_nanos(t_s);
-            loop {
-                match waker
-                    .wait(&node, hop_spin(sup, rate), deadline, || inbox.try_recv())
-                    .map_err(fail)?
-                {
-                    Ok(f) if f.seq == i => {
-                        lat.record((now_ns() - sent) as i64);
-                        break;
-                    }
-                    Ok(_) => {}
-                    Err(_) => {
-                        misses += 1;
-                        break;
-                    }
-                }
-            }
-        }
-        let mut end = Forward::default();
-        end.signal.flags = FLAG_END;
-        out.send_control(end).map_err(fail)?;
-        Ok((lat, misses))
-    })();
-    let _ = child.wait();
-    ipc::remove_run_files(&prefix);
-    result
-}
-
 /// How the bench supervises its iceoryx2 runs: no restarts (a death fails the bench),
 /// no progress line, pinned unless `--no-pin`.
 fn supervision(args: &BenchArgs, prefix: &str) -> Supervision {
@@ -401,7 +269,6 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     std::fs::create_dir_all(&args.out)
         .map_err(Error::io(format!("creating {}", args.out.display())))?;
     crate::launch::clean_stale_runs();
-    let mut rates = Vec::new();
     let prefix = args
         .prefix
         .clone()
@@ -416,20 +283,71 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
         );
     }
     let hosts = if args.hosts {
-        Some(
-            crate::launch::netns::Pair::new(&format!("b{}", std::process::id() % 100_000))
-                .map_err(|e| {
-                    Error::Failed(format!("--hosts: cannot make two network namespaces: {e}"))
-                })?,
-        )
+        let tag = format!("b{}", std::process::id() % 100_000);
+        Some(crate::launch::netns::Pair::new(&tag).map_err(|e| {
+            Error::Failed(format!("--hosts: cannot make two network namespaces: {e}"))
+        })?)
     } else {
         None
     };
+    let bench = Bench {
+        args,
+        sup: supervision(args, &prefix),
+        stop: &stop,
+    };
+    let mut rates = Vec::new();
     for &rate in &args.rates {
-        let sc = scenario(rate, args.samples, Mode::Realtime)?;
-        let sup = supervision(args, &prefix);
-        // The loops on one host get the same scheduling (pinned unless --no-pin,
-        // polling for the same budget); across hosts the namespaces share the CPUs.
+        rates.push(bench.rate(rate, hosts.as_ref())?);
+    }
+    let report = bench.finish(rates)?;
+    write_json(&args.out.join("bench.json"), &report)?;
+    print!("{}", render(&report));
+    Ok(())
+}
+
+/// One bench invocation: its arguments, the supervision every loop gets, and the
+/// stop request it looks at between runs.
+struct Bench<'a> {
+    args: &'a BenchArgs,
+    sup: Supervision,
+    stop: &'a Arc<AtomicBool>,
+}
+
+impl Bench<'_> {
+    fn stopped(&self) -> Result<(), Error> {
+        if self.stop.load(Ordering::SeqCst) {
+            return Err(Error::Interrupted);
+        }
+        Ok(())
+    }
+
+    /// Every loop at `rate`, the percentile plot, the bare hop and the ratios.
+    fn rate(&self, rate: f64, hosts: Option<&Pair>) -> Result<RateResult, Error> {
+        let sc = scenario(rate, self.args.samples, Mode::Realtime)?;
+        let mut loops = self.one_host(&sc)?;
+        if let Some(pair) = hosts {
+            loops.extend(self.across_hosts(&sc, pair)?);
+        }
+        percentile_plot(&self.args.out, rate, &loops)?;
+        eprintln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
+        let (hop, hop_misses) = hop::bare_hop(rate, self.args.samples, &self.sup)?;
+        let mut r = RateResult {
+            rate_hz: rate,
+            samples: self.args.samples,
+            loops,
+            bare_hop_round_trip_ns: hop.percentiles(),
+            bare_hop_deadline_misses: hop_misses,
+            ratios: BTreeMap::new(),
+        };
+        r.ratio("iceoryx2", "udp");
+        r.ratio("zenoh", "udp");
+        r.ratio("zenoh-hosts", "udp-hosts");
+        Ok(r)
+    }
+
+    /// The loops on one host, with the same scheduling (pinned unless --no-pin,
+    /// polling for the same budget).
+    fn one_host(&self, sc: &Scenario) -> Result<Vec<LoopResult>, Error> {
         let mut loops = Vec::new();
         for (name, link) in [
             ("iceoryx2", LinkKind::Iceoryx2),
@@ -439,93 +357,75 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
         .into_iter()
         .filter(|&(_, l)| zenoh_built(l))
         {
-            eprintln!(
-                "tactile bench: {rate} Hz, {} samples: {name} loop",
-                args.samples
-            );
-            let s = trio(&sc, &args.out.join(format!("{name}-{rate}")), &sup, link)?;
+            let (rate, n) = (sc.rate_hz, sc.samples);
+            eprintln!("tactile bench: {rate} Hz, {n} samples: {name} loop");
+            let out = self.args.out.join(format!("{name}-{rate}"));
+            let s = trio(sc, &out, &self.sup, link)?;
             loops.push(loop_result(name, s)?);
-            if stop.load(std::sync::atomic::Ordering::SeqCst) {
-                return Err(Error::Interrupted);
-            }
+            self.stopped()?;
         }
-        if let Some(pair) = &hosts {
-            for (name, link) in [
-                ("zenoh-hosts", LinkKind::Zenoh),
-                ("udp-hosts", LinkKind::Udp),
-            ]
-            .into_iter()
-            .filter(|&(_, l)| zenoh_built(l))
-            {
-                eprintln!(
-                    "tactile bench: {rate} Hz: {name} loop, master in {}, emulator and slave in {}",
-                    pair.names[0], pair.names[1]
-                );
-                let wrap = [pair.exec(0), pair.exec(1), pair.exec(1)];
-                let links = crate::launch::Links::across(link, pair);
-                let out = args.out.join(format!("{name}-{rate}"));
-                let s = trio_with(
-                    &sc,
-                    &out,
-                    &Supervision {
-                        pin: false,
-                        ..sup.clone()
-                    },
-                    links,
-                    wrap,
-                )?;
-                loops.push(loop_result(name, s)?);
-                if stop.load(std::sync::atomic::Ordering::SeqCst) {
-                    return Err(Error::Interrupted);
-                }
-            }
+        Ok(loops)
+    }
+
+    /// The loops across the two namespaces (which share the CPUs: not pinned).
+    fn across_hosts(&self, sc: &Scenario, pair: &Pair) -> Result<Vec<LoopResult>, Error> {
+        let mut loops = Vec::new();
+        for (name, link) in [
+            ("zenoh-hosts", LinkKind::Zenoh),
+            ("udp-hosts", LinkKind::Udp),
+        ]
+        .into_iter()
+        .filter(|&(_, l)| zenoh_built(l))
+        {
+            let rate = sc.rate_hz;
+            eprintln!(
+                "tactile bench: {rate} Hz: {name} loop, master in {}, emulator and slave in {}",
+                pair.names[0], pair.names[1]
+            );
+            let wrap = [pair.exec(0), pair.exec(1), pair.exec(1)];
+            let links = crate::launch::Links::across(link, pair);
+            let out = self.args.out.join(format!("{name}-{rate}"));
+            let sup = Supervision {
+                pin: false,
+                ..self.sup.clone()
+            };
+            let s = trio_with(sc, &out, &sup, links, wrap)?;
+            loops.push(loop_result(name, s)?);
+            self.stopped()?;
         }
-        percentile_plot(&args.out, rate, &loops)?;
-        eprintln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
-        let (hop, hop_misses) = bare_hop(rate, args.samples, &sup)?;
-        let mut r = RateResult {
-            rate_hz: rate,
-            samples: args.samples,
-            loops,
-            bare_hop_round_trip_ns: hop.percentiles(),
-            bare_hop_deadline_misses: hop_misses,
-            ratios: BTreeMap::new(),
+        Ok(loops)
+    }
+
+    /// The lockstep throughput and the machine's own stalls, with the rates' results.
+    fn finish(&self, rates: Vec<RateResult>) -> Result<BenchReport, Error> {
+        eprintln!("tactile bench: lockstep throughput");
+        let n = self.args.lockstep_samples;
+        let sc = scenario(1000.0, n, Mode::Lockstep)?;
+        let lock = trio(
+            &sc,
+            &self.args.out.join("lockstep"),
+            &self.sup,
+            LinkKind::Iceoryx2,
+        )?;
+        let machine = if self.args.probe_s > 0.0 {
+            let s = self.args.probe_s;
+            eprintln!("tactile bench: the machine's own stalls, {s} s per CPU");
+            stalls::probe(s, true, self.stop)
+        } else {
+            stalls::StallReport {
+                note: Some("not probed (--probe-s 0)".into()),
+                ..Default::default()
+            }
         };
-        r.ratio("iceoryx2", "udp");
-        r.ratio("zenoh", "udp");
-        r.ratio("zenoh-hosts", "udp-hosts");
-        rates.push(r);
+        self.stopped()?;
+        Ok(BenchReport {
+            machine,
+            lockstep_samples_per_s: lock.master.samples_per_s,
+            lockstep_samples: n,
+            strategy: strategy(self.args),
+            rates,
+        })
     }
-    eprintln!("tactile bench: lockstep throughput");
-    let n = args.lockstep_samples;
-    let sc = scenario(1000.0, n, Mode::Lockstep)?;
-    let sup = supervision(args, &prefix);
-    let lock = trio(&sc, &args.out.join("lockstep"), &sup, LinkKind::Iceoryx2)?;
-    let machine = if args.probe_s > 0.0 {
-        eprintln!(
-            "tactile bench: the machine's own stalls, {} s per CPU",
-            args.probe_s
-        );
-        stalls::probe(args.probe_s, true, &stop)
-    } else {
-        stalls::StallReport {
-            note: Some("not probed (--probe-s 0)".into()),
-            ..Default::default()
-        }
-    };
-    if stop.load(std::sync::atomic::Ordering::SeqCst) {
-        return Err(Error::Interrupted);
-    }
-    let report = BenchReport {
-        machine,
-        lockstep_samples_per_s: lock.master.samples_per_s,
-        lockstep_samples: n,
-        strategy: strategy(args),
-        rates,
-    };
-    write_json(&args.out.join("bench.json"), &report)?;
-    print!("{}", render(&report));
-    Ok(())
 }
 
 /// The waiting and scheduling every loop of the bench gets, in words.

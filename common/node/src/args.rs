@@ -1,0 +1,159 @@
+//! A node program's command line and outcome: the options every node takes
+//! ([`NodeArgs`]), the link kinds, why a node stops ([`NodeError`]), and the mapping of
+//! its outcome to an exit status and one line on stderr.
+
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use tactile_messages::Role;
+
+use crate::exit::{EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK};
+
+/// What carries the samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LinkKind {
+    /// iceoryx2 zero-copy shared memory (one host).
+    Iceoryx2,
+    /// UDP datagrams (the reference most stacks use); loopback unless --udp-hosts.
+    Udp,
+    /// Zenoh (across hosts): --listen and --connect name the endpoints.
+    Zenoh,
+}
+
+impl LinkKind {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            LinkKind::Iceoryx2 => "iceoryx2",
+            LinkKind::Udp => "udp",
+            LinkKind::Zenoh => "zenoh",
+        }
+    }
+}
+
+/// The command line every node takes.
+#[derive(Debug, Clone, Args)]
+pub struct NodeArgs {
+    /// Scenario file (TOML); its relative paths are resolved against its own folder.
+    #[arg(long)]
+    pub scenario: PathBuf,
+    /// Folder for this node's record (`ROLE.rec`) and log (`ROLE.log`).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Name of the run: nodes with the same prefix find each other. 1 to 24 characters
+    /// from A-Z a-z 0-9 _ -.
+    #[arg(long, default_value = "tactile")]
+    pub prefix: String,
+    /// Transport between the nodes.
+    #[arg(long, value_enum, default_value_t = LinkKind::Iceoryx2)]
+    pub link: LinkKind,
+    /// UDP ports of master, emulator and slave, as `m,e,s` (with --link udp).
+    #[arg(long, default_value = "47501,47502,47503")]
+    pub udp_ports: String,
+    /// Addresses of the master's, emulator's and slave's hosts, as `a,b,c` (with --link
+    /// udp).
+    #[arg(long, default_value = "127.0.0.1,127.0.0.1,127.0.0.1")]
+    pub udp_hosts: String,
+    /// Zenoh endpoint to listen on, e.g. `tcp/198.18.0.1:7447` (repeatable).
+    #[arg(long)]
+    pub listen: Vec<String>,
+    /// Zenoh endpoint of a peer to connect to, e.g. `tcp/198.18.0.1:7447` (repeatable).
+    #[arg(long)]
+    pub connect: Vec<String>,
+    /// Let Zenoh find peers by multicast scouting too (off: only the endpoints given).
+    #[arg(long)]
+    pub scout: bool,
+    /// Microseconds to poll (yielding the CPU) before blocking on the wake-up event.
+    /// Default: twice --wake-early-us in realtime (the node wakes that long before a
+    /// sample is due), two sampling periods in lockstep; 0 blocks at once.
+    #[arg(long)]
+    pub spin_us: Option<u64>,
+    /// Realtime: stop sleeping this long before a sample is due, then poll. Default
+    /// 200 us, at most 40 % of a sampling period (measured, README "Waiting").
+    #[arg(long)]
+    pub wake_early_us: Option<u64>,
+    /// Scheduling: fifo (SCHED_FIFO with memory locked, where permitted; otherwise
+    /// SCHED_OTHER, said in the log and the report) or other. Lockstep runs always
+    /// SCHED_OTHER: its loop never sleeps.
+    #[arg(long, value_enum, default_value_t = crate::sched::Policy::Fifo)]
+    pub sched: crate::sched::Policy,
+    /// What the node's CPU does while a realtime node under SCHED_FIFO sleeps: halt
+    /// (the kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so
+    /// a halted CPU is not woken late; on these virtual machines a CPU kept busy is
+    /// taken away for about 7.5 ms every 10 s instead: README "What the CPUs do while the nodes
+    /// sleep").
+    #[arg(long, value_enum, default_value_t = crate::sched::IdleMode::Halt)]
+    pub idle: crate::sched::IdleMode,
+    /// SCHED_FIFO priority, 1 to 98.
+    #[arg(long, default_value_t = crate::sched::DEFAULT_PRIORITY, value_parser = clap::value_parser!(u8).range(1..=98))]
+    pub priority: u8,
+    /// Pin this node to one CPU.
+    #[arg(long)]
+    pub cpu: Option<usize>,
+    /// Continue this node's record in --out instead of starting it afresh (a node
+    /// restarted into a run that is still going).
+    #[arg(long)]
+    pub append: bool,
+    /// Started by `tactile run` (process id of the launcher): stop when it dies, log
+    /// to the file only.
+    #[arg(long, hide = true)]
+    pub supervised: Option<u32>,
+}
+
+/// Why a node stopped without completing.
+#[derive(Debug)]
+pub enum NodeError {
+    /// Bad input; nothing was started (exit 2).
+    BadInput(String),
+    /// A failure while running (exit 1).
+    Failed(String),
+}
+
+impl NodeError {
+    /// The exit status.
+    pub fn code(&self) -> u8 {
+        match self {
+            NodeError::BadInput(_) => EXIT_BAD_INPUT,
+            NodeError::Failed(_) => EXIT_FAILURE,
+        }
+    }
+}
+
+impl std::fmt::Display for NodeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NodeError::BadInput(m) | NodeError::Failed(m) => f.write_str(m),
+        }
+    }
+}
+
+/// Maps a node's outcome to its exit status and one line on stderr.
+pub fn exit(role: Role, outcome: Result<bool, NodeError>) -> ExitCode {
+    match outcome {
+        Ok(true) => ExitCode::from(EXIT_OK),
+        Ok(false) => ExitCode::from(EXIT_INTERRUPTED),
+        Err(e) => {
+            tracing::error!("{e}");
+            eprintln!("tactile-{role}: {e}");
+            ExitCode::from(e.code())
+        }
+    }
+}
+
+/// Parses a node's command line; on an error prints clap's message and returns the
+/// exit status (2 for bad arguments, 0 for --help and --version).
+pub fn parse<T: clap::Parser>() -> Result<T, ExitCode> {
+    // First thing, while the node has one thread.
+    #[cfg(feature = "zenoh")]
+    crate::zlink::default_runtime();
+    T::try_parse().map_err(|e| {
+        let _ = e.print();
+        ExitCode::from(if e.use_stderr() {
+            EXIT_BAD_INPUT
+        } else {
+            EXIT_OK
+        })
+    })
+}
