@@ -3,7 +3,7 @@
 //! repeats; checked like any scenario field. (Reordering on and off is a unit test of
 //! the channel.)
 //! (Each model's statistics against its closed form are unit tests in
-//! common/src/netem.rs, over 100,000 draws.)
+//! common/netem/src/, over 100,000 draws.)
 
 use crate::util;
 

@@ -3,7 +3,7 @@
 //! The paper's figure names four lengths: the two arm segments `L1` and `L2`, the
 //! offset `L3` of the first joint above the base, and `L4 = L1 + A`. The paper's text
 //! gives `L1 = 0.135` "mm" (it means metres), but the waypoints printed in its Results
-//! section are reproduced exactly only by `L1 = L2 = 0.132 m` (see DESIGN.md, errata).
+//! section are reproduced exactly only by `L1 = L2 = 0.132 m` (the paper's errata: docs/08-kernels-and-the-paper.md).
 //! Hence two presets: [`Geometry::PAPER`] reproduces the paper's results, and
 //! [`Geometry::OMNI`] carries the published Omni lengths.
 

@@ -71,7 +71,7 @@ pub struct NodeArgs {
     #[arg(long)]
     pub spin_us: Option<u64>,
     /// Realtime: stop sleeping this long before a sample is due, then poll. Default
-    /// 200 us, at most 40 % of a sampling period (measured, README "Waiting").
+    /// 200 us, at most 40 % of a sampling period (measured, docs/07-latency.md, "Waiting").
     #[arg(long)]
     pub wake_early_us: Option<u64>,
     /// Scheduling: fifo (SCHED_FIFO with memory locked, where permitted; otherwise
@@ -82,7 +82,7 @@ pub struct NodeArgs {
     /// What the node's CPU does while a realtime node under SCHED_FIFO sleeps: halt
     /// (the kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so
     /// a halted CPU is not woken late; on these virtual machines a CPU kept busy is
-    /// taken away for about 7.5 ms every 10 s instead: README "What the CPUs do while the nodes
+    /// taken away for about 7.5 ms every 10 s instead: docs/07-latency.md, "What the CPUs do while the nodes
     /// sleep").
     #[arg(long, value_enum, default_value_t = crate::sched::IdleMode::Halt)]
     pub idle: crate::sched::IdleMode,
@@ -156,4 +156,24 @@ pub fn parse<T: clap::Parser>() -> Result<T, ExitCode> {
             EXIT_OK
         })
     })
+}
+
+/// Node arguments as the tests write them.
+#[cfg(test)]
+pub(crate) mod testing {
+    use super::NodeArgs;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Cli {
+        #[command(flatten)]
+        node: NodeArgs,
+    }
+
+    /// A node's arguments with `--scenario s.toml --out o` and `extra`.
+    pub fn args(extra: &[&str]) -> NodeArgs {
+        let mut v = vec!["node", "--scenario", "s.toml", "--out", "o"];
+        v.extend_from_slice(extra);
+        Cli::parse_from(v).node
+    }
 }

@@ -21,7 +21,7 @@ fn udp_ports(a: &NodeArgs) -> Result<crate::udp::UdpPorts, NodeError> {
 
 /// What a build without the `zenoh` feature answers to `--link zenoh`.
 pub const NO_ZENOH: &str = "--link zenoh: this build has no Zenoh link; build with \
-`cargo build --release --workspace --features zenoh` (README, Across hosts)";
+`cargo build --release --workspace --features zenoh` (docs/03-across-hosts.md)";
 
 /// The Zenoh endpoints of the arguments.
 #[cfg(feature = "zenoh")]
@@ -201,20 +201,7 @@ mod zenoh_open {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::args::NodeArgs;
-    use clap::Parser;
-
-    #[derive(Debug, Parser)]
-    struct Cli {
-        #[command(flatten)]
-        node: NodeArgs,
-    }
-
-    fn args(extra: &[&str]) -> NodeArgs {
-        let mut v = vec!["node", "--scenario", "s.toml", "--out", "o"];
-        v.extend_from_slice(extra);
-        Cli::parse_from(v).node
-    }
+    use crate::args::testing::args;
 
     #[test]
     fn the_zenoh_link_is_checked_or_refused_by_the_build() {

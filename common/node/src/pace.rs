@@ -3,8 +3,8 @@
 //! A process that polls all the time is preempted by whatever else wants its CPU and
 //! waits out a scheduler tick (the loop's old 4 ms tail); under SCHED_FIFO it hits the
 //! kernel's real-time throttle instead. A process that sleeps between samples and
-//! polls only around the instant a sample is due has neither problem (DESIGN.md,
-//! "Real-time on these machines"). The master knows its ticks; the emulator and the
+//! polls only around the instant a sample is due has neither problem (docs/07-latency.md,
+//! "Waiting"). The master knows its ticks; the emulator and the
 //! slave learn when samples arrive from the arrivals themselves, with a [`Pacer`],
 //! which keeps working when arrivals drift (another host's clock) or jitter (a real
 //! network).

@@ -88,7 +88,7 @@ pub fn prepare(role: Role, args: &NodeArgs) -> Result<Prepared, NodeError> {
 }
 
 /// The wake-up margin and the poll budget: as given, or the measured defaults
-/// (README "Waiting"). Lockstep never sleeps: it polls two sampling periods, then
+/// (docs/07-latency.md, "Waiting"). Lockstep never sleeps: it polls two sampling periods, then
 /// blocks.
 pub fn waiting(
     scenario: &Scenario,
@@ -274,20 +274,8 @@ pub fn new_run_token() -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::args::testing::args;
     use crate::args::NodeArgs;
-    use clap::Parser;
-
-    #[derive(Debug, Parser)]
-    struct Cli {
-        #[command(flatten)]
-        node: NodeArgs,
-    }
-
-    fn args(extra: &[&str]) -> NodeArgs {
-        let mut v = vec!["node", "--scenario", "s.toml", "--out", "o"];
-        v.extend_from_slice(extra);
-        Cli::parse_from(v).node
-    }
 
     #[test]
     fn a_realtime_node_must_sleep_in_every_period() {

@@ -162,7 +162,7 @@ fn prefault_stack() {
 /// Any thread's wake-up preempts a SCHED_IDLE thread at once, so it takes nothing from
 /// the loop. But it is not the default: here the hypervisor takes a CPU that never
 /// idles away for about 7.5 ms every 10 s, and the loop misses 11 to 12 deadlines in
-/// 20 s where with halting CPUs it missed none (README "What the CPUs do while the
+/// 20 s where with halting CPUs it missed none (docs/07-latency.md, "What the CPUs do while the
 /// nodes sleep"). On a machine whose cores are the loop's own it is what the kernel's
 /// `idle=poll` does, for these CPUs only. The spin has no `pause` hint: on these machines a
 /// pause loop makes the hypervisor take the CPU away (pause-loop exiting), which

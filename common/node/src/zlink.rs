@@ -6,7 +6,7 @@
 //! node talks to exactly the peers named: peers do not route for each other, so each
 //! node connects to the nodes it exchanges samples with). Every stream is a key, `tactile/<prefix>/<c|v|h|q>`;
 //! every payload is one frame of the wire format ([`crate::wire`]). Set for latency by
-//! measurement (README, "Across hosts"): the low-latency unicast transport, and
+//! measurement (docs/03-across-hosts.md): the low-latency unicast transport, and
 //! publishers with `express` (no batching: a 1 kHz sample must not wait for company;
 //! batching put 15 ms in the p99.9), priority `RealTime` (it matters only where QoS is
 //! on) and congestion control `Block` (`Drop` measured no faster, and a sample must
@@ -88,7 +88,7 @@ impl ZenohOptions {
 /// list of `qos` (Zenoh's default transport with QoS priorities instead of the
 /// low-latency one), `batched` (express off), `data` (priority Data instead of
 /// RealTime, with `qos`), `drop` (congestion control Drop instead of Block)). Unset in
-/// normal use: the defaults are the measured choice (README, "Across hosts"); every
+/// normal use: the defaults are the measured choice (docs/03-across-hosts.md); every
 /// node of a run must have the same.
 fn tuning() -> Vec<&'static str> {
     static TUNING: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
@@ -107,7 +107,7 @@ fn tuning() -> Vec<&'static str> {
 /// that lands then wakes one of several threads, which the node's own thread waits on.
 /// With one runtime thread the Zenoh loop across two namespaces measured 80.6 and
 /// 83.4 us at p50 against 114.0 with the default (interleaved 5,000-sample benches;
-/// README "Across hosts").
+/// docs/03-across-hosts.md).
 pub const RUNTIME: &str =
     "(rx: (handover: app), tx: (handover: app), net: (handover: app), acc: (handover: app))";
 

@@ -55,7 +55,7 @@ impl Default for ControlConfig {
             kind: ControlKind::None,
             wave_impedance: 10.0,
             // Measured on wall-delay over floors 1e-5..1e-3 m/s and caps 200..1e4 N s/m: these
-            // kept the channel's energy closest to zero without a codec (README). Larger caps make
+            // kept the channel's energy closest to zero without a codec (docs/05-control.md). Larger caps make
             // the force chatter between full and zero, and the sampling's prediction error grows.
             velocity_floor: 1.0e-3,
             max_damping: 200.0,

@@ -38,7 +38,7 @@ pub struct Percentiles {
 #[derive(Debug, Clone)]
 pub struct Latency {
     hist: Histogram<u64>,
-    /// Values below zero clamped to zero (possible for overhead, see README).
+    /// Values below zero clamped to zero (possible for overhead, see docs/06-records-and-reports.md).
     pub negative: u64,
 }
 

@@ -23,7 +23,7 @@ use tactile_scenario::Scenario;
 pub struct Supervision {
     /// iceoryx2 prefix of the run.
     pub prefix: String,
-    /// Poll budget of every process (None: each node's default, README "Waiting").
+    /// Poll budget of every process (None: each node's default, docs/07-latency.md, "Waiting").
     pub spin: Option<Duration>,
     /// How long before a sample is due each node wakes (None: each node's default).
     pub wake_early: Option<Duration>,
