@@ -16,5 +16,6 @@ mod hosts;
 mod layout;
 mod loop_processes;
 mod nodes;
+mod records;
 mod scheduling;
 mod sweep;

@@ -6,6 +6,7 @@
 pub mod args;
 pub mod exit;
 pub mod files;
+pub mod frames;
 pub mod ipc;
 pub mod link;
 pub mod lock;

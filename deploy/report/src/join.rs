@@ -16,7 +16,7 @@ use tactile_messages::samples::{stage, LATE_WINDOW};
 use tactile_messages::Role;
 use tactile_network_emulator::emulator::{Direction, Passage};
 use tactile_network_emulator::process::EmulatorTotals;
-use tactile_node::record::{Record, RecordReader, Start, Totals};
+use tactile_node::record::{Damage, Record, RecordReader, Start, Totals};
 use tactile_node::recorder::record_path;
 use tactile_slave::record::{SlaveSample, SlaveTotals, Step};
 
@@ -44,8 +44,11 @@ pub struct NodeLog<C> {
     pub stops: Vec<Option<String>>,
     /// Highest sample number in the record.
     pub last_sample: Option<u64>,
-    /// Byte offset of a torn last frame, if any.
-    pub truncated_at: Option<u64>,
+    /// Stretches of the record that held no whole frame (torn by a kill, corrupted),
+    /// skipped: the first few, where and how long.
+    pub damage: Vec<Damage>,
+    /// Bytes and stretches skipped in all.
+    pub damaged: (u64, u64),
     /// Sample records that matched no sample of the master (outside the window).
     pub unjoined: u64,
 }
@@ -61,7 +64,8 @@ impl<C> Default for NodeLog<C> {
             counters: Vec::new(),
             stops: Vec::new(),
             last_sample: None,
-            truncated_at: None,
+            damage: Vec::new(),
+            damaged: (0, 0),
             unjoined: 0,
         }
     }
@@ -123,11 +127,9 @@ impl<C: Clone> NodeLog<C> {
         match self.stops.last() {
             None => "no start recorded".into(),
             Some(Some(reason)) => format!("{reason}, {last}"),
-            Some(None) => format!(
-                "record ends {last} without a stop: the node was killed or crashed{}",
-                self.truncated_at
-                    .map_or(String::new(), |b| format!(" (torn frame at byte {b})"))
-            ),
+            Some(None) => {
+                format!("record ends {last} without a stop: the node was killed or crashed")
+            }
         }
     }
 }
@@ -173,8 +175,9 @@ where
             let next = reader
                 .next_record()
                 .map_err(|e| Error::Failed(e.to_string()))?;
+            self.log.damage = reader.damage().to_vec();
+            self.log.damaged = reader.damaged();
             let Some(rec) = next else {
-                self.log.truncated_at = reader.truncated_at;
                 self.reader = None;
                 return Ok(());
             };

@@ -101,6 +101,13 @@ pub struct NodeSummary {
     pub ended: String,
     /// Sample records that matched no sample of the master.
     pub unjoined: u64,
+    /// Bytes of its record that held no whole frame (a torn tail, corruption),
+    /// skipped; every whole frame around them was read.
+    pub damaged_bytes: u64,
+    /// Damaged stretches skipped, with the first few as `[offset, bytes]`.
+    pub damaged_stretches: u64,
+    /// Where the first damaged stretches are: `[byte offset, length]`.
+    pub damage: Vec<[u64; 2]>,
     /// Its scheduling (policy, priority, CPU, wake-up margin, poll budget) as its
     /// last start recorded it; `note` says what the kernel refused.
     pub sched: tactile_node::sched::Sched,
@@ -294,6 +301,20 @@ pub fn render(s: &Summary, out: &Path) -> String {
             n.ended,
             sched_line(&n.sched)
         );
+        if n.damaged_stretches > 0 {
+            let at: Vec<String> = n
+                .damage
+                .iter()
+                .map(|[o, b]| format!("{b} at byte {o}"))
+                .collect();
+            let _ = writeln!(
+                t,
+                "node {role}: record damaged: {} bytes in {} stretches skipped ({}); every whole frame read",
+                n.damaged_bytes,
+                n.damaged_stretches,
+                at.join(", ")
+            );
+        }
     }
     for e in &s.events {
         let _ = writeln!(t, "event: {e}");

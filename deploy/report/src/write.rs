@@ -100,6 +100,9 @@ where
         last_sample: log.last_sample,
         ended: log.ending(),
         unjoined: log.unjoined,
+        damaged_bytes: log.damaged.0,
+        damaged_stretches: log.damaged.1,
+        damage: log.damage.iter().map(|d| [d.offset, d.bytes]).collect(),
         sched: log
             .starts
             .last()

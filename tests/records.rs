@@ -1,0 +1,168 @@
+//! Records that survive what happens to files: a node killed mid-frame and restarted
+//! into its torn record, and bytes corrupted in the middle of a record. Every whole
+//! frame is read; the report says what was skipped.
+
+use crate::util;
+
+use std::path::Path;
+use std::process::{Child, Stdio};
+use std::time::{Duration, Instant};
+use tactile_node::record::{Record, RecordReader};
+use tactile_slave::record::{SlaveSample, SlaveTotals};
+use util::{column, Sandbox};
+
+type SlaveRecord = Record<SlaveSample, SlaveTotals>;
+
+/// Every record of a slave's file, with the bytes and stretches skipped.
+fn slave_records(path: &Path) -> (Vec<SlaveRecord>, (u64, u64)) {
+    let mut r = RecordReader::<SlaveRecord>::open(path).expect("a record");
+    let mut all = Vec::new();
+    while let Some(rec) = r.next_record().expect("readable") {
+        all.push(rec);
+    }
+    (all, r.damaged())
+}
+
+fn start_node(sb: &Sandbox, role: &str, scenario: &Path, dir: &str, extra: &[&str]) -> Child {
+    let mut args = vec![
+        "--scenario",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        dir,
+    ];
+    args.extend(["--prefix", &sb.prefix]);
+    args.extend_from_slice(extra);
+    sb.node(&format!("tactile-{role}"), &args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start node")
+}
+
+fn finish(child: Child) -> (Option<i32>, String) {
+    let o = child.wait_with_output().expect("wait");
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    (o.status.code(), err)
+}
+
+/// The issue's reproduction: three nodes by hand at 1 kHz, the slave killed with
+/// SIGKILL, seven bytes cut off its record, the slave restarted with `--append`, and
+/// the report: both segments' whole frames are there, nothing lost but the torn one.
+#[test]
+fn a_torn_record_appended_to_keeps_every_whole_frame_of_both_segments() {
+    let sb = Sandbox::new("tornappend");
+    let scenario = sb.write("s.toml", &util::paper_1khz(5000));
+    let master = start_node(&sb, "master", &scenario, "m", &[]);
+    let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
+    let slave = start_node(&sb, "slave", &scenario, "s", &[]);
+    let rec = sb.path("s").join("slave.rec");
+    let start = Instant::now();
+    while std::fs::metadata(&rec).map_or(0, |m| m.len()) < 200_000 {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "the slave never got going"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let pid = rustix::process::Pid::from_raw(slave.id() as i32).expect("pid");
+    let _ = rustix::process::kill_process(pid, rustix::process::Signal::KILL);
+    let (code, _) = finish(slave);
+    assert_eq!(code, None, "killed by a signal");
+    let (before, damaged) = slave_records(&rec);
+    assert_eq!(damaged, (0, 0), "a SIGKILL between writes tears nothing");
+    let len = std::fs::metadata(&rec).expect("record").len();
+    let f = std::fs::OpenOptions::new()
+        .write(true)
+        .open(&rec)
+        .expect("open");
+    f.set_len(len - 7).expect("cut");
+    drop(f);
+    let (torn, damaged) = slave_records(&rec);
+    assert_eq!(
+        torn[..],
+        before[..before.len() - 1],
+        "only the torn frame is lost"
+    );
+    assert_eq!(damaged.1, 1, "the torn tail is one damaged stretch");
+    let slave = start_node(&sb, "slave", &scenario, "s", &["--append"]);
+    for (role, child) in [("slave", slave), ("master", master), ("emulator", emulator)] {
+        let (code, err) = finish(child);
+        assert_eq!(code, Some(0), "{role}: {err}");
+    }
+    let (after, damaged) = slave_records(&rec);
+    assert_eq!(damaged, (0, 0), "the append trimmed the torn tail first");
+    assert_eq!(after[..torn.len()], torn[..], "the first segment is intact");
+    let starts = after
+        .iter()
+        .filter(|r| matches!(r, Record::Start(_)))
+        .count();
+    assert_eq!(starts, 2, "two segments");
+    let o = sb.tactile(&["report", "m", "e", "s", "--out", "r"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = sb.json("r", "summary.json");
+    let node = &s["nodes"]["slave"];
+    assert_eq!(node["pids"].as_array().map(Vec::len), Some(2), "{node}");
+    assert_eq!(node["damaged_stretches"], 0, "{node}");
+    // Every step either segment recorded is in the trace.
+    let steps: Vec<u64> = after
+        .iter()
+        .filter_map(|r| match r {
+            Record::Sample(SlaveSample::Step(s)) => Some(s.n),
+            _ => None,
+        })
+        .collect();
+    let v3 = column(&sb.trace("r"), "v_3");
+    let missing: Vec<&u64> = steps
+        .iter()
+        .filter(|n| v3.get(**n as usize).is_none_or(|v| *v == 0.0))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "steps recorded but not reported: {missing:?}"
+    );
+    sb.assert_no_leftover_processes();
+}
+
+/// Bytes corrupted in the middle of a record cost the frames they touch, not the
+/// report: the rest of the trace is what it was, and the summary says what it skipped.
+#[test]
+fn corrupted_bytes_mid_record_cost_only_their_frames() {
+    let sb = Sandbox::new("corrupt");
+    let scenario = sb.write("s.toml", &util::wall_delay());
+    sb.simulate(&scenario, "clean");
+    let clean = sb.trace("clean");
+    std::fs::create_dir(sb.path("bad")).expect("folder");
+    for role in ["master", "emulator", "slave"] {
+        let from = sb.path("clean").join(format!("{role}.rec"));
+        std::fs::copy(from, sb.path("bad").join(format!("{role}.rec"))).expect("copy");
+    }
+    let rec = sb.path("bad").join("slave.rec");
+    let mut bytes = std::fs::read(&rec).expect("record");
+    let mid = bytes.len() / 2;
+    for b in &mut bytes[mid..mid + 20] {
+        *b = !*b;
+    }
+    std::fs::write(&rec, &bytes).expect("write");
+    let o = sb.tactile(&["report", "bad"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("node slave: record damaged:"), "{text}");
+    let s = sb.json("bad", "summary.json");
+    assert_eq!(s["nodes"]["slave"]["damaged_stretches"], 1);
+    let lost = s["nodes"]["slave"]["damaged_bytes"]
+        .as_u64()
+        .expect("bytes");
+    assert!(
+        (20..600).contains(&lost),
+        "{lost} bytes skipped for 20 corrupted"
+    );
+    let damaged = sb.trace("bad");
+    let changed = clean
+        .lines()
+        .zip(damaged.lines())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(clean.lines().count(), damaged.lines().count());
+    assert!((1..=2).contains(&changed), "{changed} rows differ");
+}
