@@ -4,11 +4,10 @@
 
 use crate::util;
 
-use std::path::Path;
-use std::process::{Child, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
 use tactile_report::trace::signal_columns;
-use util::{column, pid_of, Sandbox};
+use util::{column, finish, kill_once_recorded, pid_of, start_node, Sandbox};
 
 /// The paper scenario in lockstep with a noisy, delayed network.
 fn lockstep(samples: u64) -> String {
@@ -19,33 +18,6 @@ fn lockstep(samples: u64) -> String {
             "[network.forward]\ndelay = [0, 0, 0]\nnoise_std = [0.0, 0.0, 0.0]",
             "[network.forward]\ndelay = [2, 3, 1]\nnoise_std = [0.0005, 0.001, 0.0]",
         )
-}
-
-/// Starts node `role` by hand with its own output folder `dir`.
-fn start_node(sb: &Sandbox, role: &str, scenario: &Path, dir: &str, extra: &[&str]) -> Child {
-    let mut args = vec![
-        "--scenario",
-        scenario.to_str().expect("utf-8"),
-        "--out",
-        dir,
-        "--prefix",
-        &sb.prefix,
-    ];
-    args.extend_from_slice(extra);
-    sb.node(&format!("tactile-{role}"), &args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start node")
-}
-
-fn finish(child: Child) -> (Option<i32>, String) {
-    let o = child.wait_with_output().expect("wait");
-    (
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
 }
 
 fn report(sb: &Sandbox, dirs: &[&str], out: &str) -> std::process::Output {
@@ -130,22 +102,7 @@ fn a_killed_slave_leaves_every_sample_it_took_in_its_record() {
     let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
     let slave = start_node(&sb, "slave", &scenario, "s", &[]);
     // Kill the slave (SIGKILL: no chance to flush anything) once it is well under way.
-    let rec = sb.path("s").join("slave.rec");
-    let start = Instant::now();
-    while std::fs::metadata(&rec).map_or(0, |m| m.len()) < 100_000 {
-        assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "the slave never got going"
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    let pid = slave.id() as i32;
-    let _ = rustix::process::kill_process(
-        rustix::process::Pid::from_raw(pid).expect("pid"),
-        rustix::process::Signal::KILL,
-    );
-    let (code, _) = finish(slave);
-    assert_eq!(code, None, "killed by a signal");
+    kill_once_recorded(slave, &sb.path("s").join("slave.rec"), 100_000);
     // The master breaks, runs to its end with zero torque; the emulator follows it.
     let (code, err) = finish(master);
     assert_eq!(code, Some(0), "{err}");

@@ -5,11 +5,9 @@
 use crate::util;
 
 use std::path::Path;
-use std::process::{Child, Stdio};
-use std::time::{Duration, Instant};
 use tactile_node::record::{Record, RecordReader};
 use tactile_slave::record::{SlaveSample, SlaveTotals};
-use util::{column, Sandbox};
+use util::{column, finish, kill_once_recorded, start_node, Sandbox};
 
 type SlaveRecord = Record<SlaveSample, SlaveTotals>;
 
@@ -23,29 +21,6 @@ fn slave_records(path: &Path) -> (Vec<SlaveRecord>, (u64, u64)) {
     (all, r.damaged())
 }
 
-fn start_node(sb: &Sandbox, role: &str, scenario: &Path, dir: &str, extra: &[&str]) -> Child {
-    let mut args = vec![
-        "--scenario",
-        scenario.to_str().expect("utf-8"),
-        "--out",
-        dir,
-    ];
-    args.extend(["--prefix", &sb.prefix]);
-    args.extend_from_slice(extra);
-    sb.node(&format!("tactile-{role}"), &args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start node")
-}
-
-fn finish(child: Child) -> (Option<i32>, String) {
-    let o = child.wait_with_output().expect("wait");
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    (o.status.code(), err)
-}
-
 /// The reproduction: three nodes by hand at 1 kHz, the slave killed with
 /// SIGKILL, seven bytes cut off its record, the slave restarted with `--append`, and
 /// the report: both segments' whole frames are there, nothing lost but the torn one.
@@ -57,18 +32,7 @@ fn a_torn_record_appended_to_keeps_every_whole_frame_of_both_segments() {
     let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
     let slave = start_node(&sb, "slave", &scenario, "s", &[]);
     let rec = sb.path("s").join("slave.rec");
-    let start = Instant::now();
-    while std::fs::metadata(&rec).map_or(0, |m| m.len()) < 200_000 {
-        assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "the slave never got going"
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    let pid = rustix::process::Pid::from_raw(slave.id() as i32).expect("pid");
-    let _ = rustix::process::kill_process(pid, rustix::process::Signal::KILL);
-    let (code, _) = finish(slave);
-    assert_eq!(code, None, "killed by a signal");
+    kill_once_recorded(slave, &rec, 200_000);
     let (before, damaged) = slave_records(&rec);
     assert_eq!(damaged, (0, 0), "a SIGKILL between writes tears nothing");
     let len = std::fs::metadata(&rec).expect("record").len();

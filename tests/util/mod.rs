@@ -205,3 +205,54 @@ pub fn paper_1khz(samples: u64) -> String {
         .replace("rate_hz = 100.0", "rate_hz = 1000.0")
         .replace("samples = 1200", &format!("samples = {samples}"))
 }
+
+/// Starts node `role` by hand with its own output folder `dir` (relative to the
+/// sandbox), under the sandbox's prefix.
+pub fn start_node(
+    sb: &Sandbox,
+    role: &str,
+    scenario: &Path,
+    dir: &str,
+    extra: &[&str],
+) -> std::process::Child {
+    let mut args = vec![
+        "--scenario",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        dir,
+    ];
+    args.extend(["--prefix", &sb.prefix]);
+    args.extend_from_slice(extra);
+    sb.node(&format!("tactile-{role}"), &args)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start node")
+}
+
+/// Waits for a node to end: its exit status and its stderr.
+pub fn finish(child: std::process::Child) -> (Option<i32>, String) {
+    let o = child.wait_with_output().expect("wait");
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// Kills `node` with SIGKILL (no chance to flush anything) once its record `rec` has
+/// grown past `bytes`, and waits for it.
+pub fn kill_once_recorded(node: std::process::Child, rec: &Path, bytes: u64) {
+    let start = std::time::Instant::now();
+    while std::fs::metadata(rec).map_or(0, |m| m.len()) < bytes {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(20),
+            "the node never got going"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let pid = rustix::process::Pid::from_raw(node.id() as i32).expect("pid");
+    let _ = rustix::process::kill_process(pid, rustix::process::Signal::KILL);
+    let (code, _) = finish(node);
+    assert_eq!(code, None, "killed by a signal");
+}
