@@ -214,6 +214,7 @@ fn a_new_run_after_a_crash_starts_cleanly() {
 #[test]
 fn a_full_subscriber_buffer_loses_exactly_the_overwritten_samples() {
     let sb = Sandbox::new("overflow");
+    let _lock = tactile_node::lock::take(&sb.prefix, "run", "this test").expect("lock");
     let node = ipc::node(&sb.prefix, "test").expect("node");
     let out: Outbox<Forward> = Outbox::open(&node, "overflow", "nobody").expect("outbox");
     let inbox: Inbox<Forward> = Inbox::open(&node, "overflow").expect("inbox");

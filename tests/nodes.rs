@@ -4,6 +4,7 @@
 
 use crate::util;
 
+use std::path::Path;
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 use tactile_report::trace::signal_columns;
@@ -236,7 +237,11 @@ fn a_prefix_in_use_is_refused_and_names_its_holder() {
     let scenario = sb.write("s.toml", &util::paper_1khz(1000));
     // A slave started by hand holds the prefix.
     let slave = start_node(&sb, "slave", &scenario, "hand", &[]);
-    std::thread::sleep(Duration::from_millis(300));
+    util::wait_for(
+        "the hand slave holds its lock",
+        Duration::from_secs(10),
+        || tactile_node::lock::in_use(&sb.prefix).is_err(),
+    );
     // A second slave by hand is refused before it starts.
     let o = sb
         .node(
@@ -259,18 +264,24 @@ fn a_prefix_in_use_is_refused_and_names_its_holder() {
         "{err}"
     );
     assert!(!sb.path("second").join("slave.rec").exists());
-    // A launcher on the same prefix: its own slave refuses, and the run stops with
-    // that node's message (exit 2), without restarting it.
+    // A launcher on the same prefix is refused before it starts or writes anything,
+    // and the hand run it would have disturbed completes.
+    let master = start_node(&sb, "master", &scenario, "hand-m", &[]);
+    let emulator = start_node(&sb, "emulator", &scenario, "hand-e", &[]);
     let o = sb.tactile(&[
         "run", "s.toml", "--out", "run", "--prefix", &sb.prefix, "-q",
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("slave") && err.contains("in use"), "{err}");
-    assert!(!err.contains("restarted"), "{err}");
-    let mut slave = slave;
-    let _ = slave.kill();
-    let _ = slave.wait();
+    assert!(err.contains("in use") && err.contains("pid"), "{err}");
+    assert!(
+        !sb.path("run").exists(),
+        "the refused launcher wrote nothing"
+    );
+    for (role, child) in [("master", master), ("emulator", emulator), ("slave", slave)] {
+        let (code, err) = finish(child);
+        assert_eq!(code, Some(0), "the hand {role} completes: {err}");
+    }
     sb.assert_no_leftover_processes();
     // Two launchers: the second refuses and names the first.
     let mut first = sb
@@ -516,4 +527,55 @@ fn unreadable_and_absurd_input_files_are_refused() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("not a regular file"), "{err}");
+}
+
+#[test]
+fn a_run_leaves_nothing_behind_and_cleans_only_dead_runs() {
+    let sb = Sandbox::new("leftover");
+    let scenario = sb.write("s.toml", &lockstep(300));
+    let root = Path::new(tactile_node::ipc::ROOT);
+    // A dead run's leftovers (a lock nobody holds, its iceoryx2 folder) and a live
+    // run's (its lock held by this test).
+    let dead = format!("{}d", sb.prefix);
+    let live = format!("{}l", sb.prefix);
+    for p in [&dead, &live] {
+        std::fs::create_dir_all(root.join(p)).expect("folder");
+        std::fs::write(root.join(p).join("node"), "x").expect("file");
+    }
+    std::fs::create_dir_all(root.join("locks")).expect("locks");
+    let dead_lock = root.join("locks").join(format!("{dead}.slave.lock"));
+    std::fs::write(&dead_lock, "a killed slave").expect("lock");
+    let held = tactile_node::lock::take(&live, "slave", "a live slave").expect("take");
+    sb.run(&scenario, "out");
+    let mine: Vec<String> = std::fs::read_dir(root.join("locks"))
+        .expect("locks")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(&format!("{}.", sb.prefix)))
+        .collect();
+    assert!(mine.is_empty(), "the run's locks are gone: {mine:?}");
+    assert!(
+        !root.join(&sb.prefix).exists(),
+        "the run's iceoryx2 folder is gone"
+    );
+    let shm = std::fs::read_dir("/dev/shm")
+        .expect("/dev/shm")
+        .flatten()
+        .any(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with(&format!("{}_", sb.prefix))
+        });
+    assert!(!shm, "the run's shared memory is gone");
+    assert!(
+        !root.join(&dead).exists() && !dead_lock.exists(),
+        "a dead run's are cleaned"
+    );
+    assert!(
+        root.join(&live).join("node").exists(),
+        "a live run's are kept"
+    );
+    assert!(held.path.exists());
+    drop(held);
+    tactile_node::ipc::remove_run_files(&live);
 }

@@ -256,3 +256,13 @@ pub fn kill_once_recorded(node: std::process::Child, rec: &Path, bytes: u64) {
     let (code, _) = finish(node);
     assert_eq!(code, None, "killed by a signal");
 }
+
+/// Waits until `ready` holds, failing the test with `what` after `limit`: tests wait
+/// for a signal (a lock held, a file grown, a log line), never a fixed sleep.
+pub fn wait_for(what: &str, limit: std::time::Duration, mut ready: impl FnMut() -> bool) {
+    let start = std::time::Instant::now();
+    while !ready() {
+        assert!(start.elapsed() < limit, "{what}: not within {limit:?}");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}

@@ -5,10 +5,16 @@
 //! when the process dies, however it dies, so a crash never leaves a stale lock. A
 //! second node of the same role under the same prefix, or a second launcher, finds
 //! the lock held and refuses to start, naming the process that holds it: two runs
-//! with one prefix would otherwise read each other's samples.
+//! with one prefix would otherwise read each other's samples. A launcher asks
+//! [`in_use`] for every lock of its prefix before it starts or writes anything.
+//!
+//! A lock removes its file when released; a process that takes a lock checks that
+//! the file it locked is still the one at the path (it may have been removed between
+//! the open and the lock), so removal never lets two holders in. Files left by killed
+//! processes are removed by [`clean_stale`].
 
 use rustix::fs::{flock, FlockOperation};
-use std::io::{Read, Seek, Write};
+use std::io::{Seek, Write};
 use std::path::PathBuf;
 
 /// Longest prefix accepted. It names shared-memory objects and files, and iceoryx2's
@@ -41,12 +47,114 @@ pub fn check_prefix(prefix: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// A held lock; released when dropped or when the process ends.
+/// A held lock; released (and its file removed) when dropped, released by the kernel
+/// when the process ends.
 #[derive(Debug)]
 pub struct Lock {
-    _file: std::fs::File,
+    file: std::fs::File,
     /// The lock file.
     pub path: PathBuf,
+}
+
+impl Drop for Lock {
+    fn drop(&mut self) {
+        // Removed while still held: a process waiting on this file finds it gone and
+        // opens a new one (see `locked_file`).
+        let _ = std::fs::remove_file(&self.path);
+        let _ = flock(&self.file, FlockOperation::Unlock);
+    }
+}
+
+/// The locks of one run: the launcher's and one per node.
+pub const RUN_LOCKS: [&str; 4] = ["run", "master", "emulator", "slave"];
+
+/// True if `file` is still the file at `path` (not removed or replaced since opened).
+fn still_at(file: &std::fs::File, path: &std::path::Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Opens `path` (creating it with `create`) and locks it without waiting: `Ok(None)`
+/// if another process holds it, the open file if this one does now.
+fn locked_file(path: &std::path::Path, create: bool) -> std::io::Result<Option<std::fs::File>> {
+    loop {
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(create)
+            .truncate(false)
+            .open(path)?;
+        if flock(&file, FlockOperation::NonBlockingLockExclusive).is_err() {
+            return Ok(None);
+        }
+        if still_at(&file, path) {
+            return Ok(Some(file));
+        }
+        if !create {
+            return Err(std::io::ErrorKind::NotFound.into());
+        }
+    }
+}
+
+/// Who holds `<prefix>.<what>.lock`, if anyone (a description, or "another process").
+fn holder(path: &std::path::Path) -> Option<String> {
+    match locked_file(path, false) {
+        Ok(Some(file)) => {
+            drop(Lock {
+                file,
+                path: path.to_path_buf(),
+            });
+            None
+        }
+        Ok(None) => {
+            let who = std::fs::read_to_string(path).unwrap_or_default();
+            let who = who.trim();
+            Some(if who.is_empty() {
+                "another process".into()
+            } else {
+                who.into()
+            })
+        }
+        Err(_) => None,
+    }
+}
+
+/// Refuses a prefix that any process of a run holds (a launcher or any node started
+/// by hand), naming the holder; creates nothing. Checked before a launcher starts
+/// anything, so a refused run never touches the live one.
+pub fn in_use(prefix: &str) -> Result<(), String> {
+    check_prefix(prefix)?;
+    for what in RUN_LOCKS {
+        if let Some(who) = holder(&lock_dir().join(format!("{prefix}.{what}.lock"))) {
+            return Err(in_use_message(prefix, &who));
+        }
+    }
+    Ok(())
+}
+
+fn in_use_message(prefix: &str, who: &str) -> String {
+    format!("prefix {prefix:?} is in use: {who} holds it; wait for that run to end or choose another --prefix")
+}
+
+/// True if no process holds any lock of `prefix`.
+pub fn idle(prefix: &str) -> bool {
+    RUN_LOCKS
+        .iter()
+        .all(|what| holder(&lock_dir().join(format!("{prefix}.{what}.lock"))).is_none())
+}
+
+/// Removes the lock files that no live process holds (left by killed processes).
+pub fn clean_stale() {
+    let Ok(dir) = std::fs::read_dir(lock_dir()) else {
+        return;
+    };
+    for entry in dir.flatten() {
+        // `holder` takes a free lock and drops it, which removes the file.
+        let _ = holder(&entry.path());
+    }
 }
 
 fn lock_dir() -> PathBuf {
@@ -55,31 +163,21 @@ fn lock_dir() -> PathBuf {
 
 /// Takes `<prefix>.<what>.lock`, writing `holder` (a description of this process) into
 /// it; if another process holds it, the error says who.
-pub fn take(prefix: &str, what: &str, holder: &str) -> Result<Lock, String> {
+pub fn take(prefix: &str, what: &str, holder_text: &str) -> Result<Lock, String> {
     check_prefix(prefix)?;
     let dir = lock_dir();
     std::fs::create_dir_all(&dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
     let path = dir.join(format!("{prefix}.{what}.lock"));
-    let mut file = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(&path)
-        .map_err(|e| format!("opening {}: {e}", path.display()))?;
-    if flock(&file, FlockOperation::NonBlockingLockExclusive).is_err() {
-        let mut who = String::new();
-        let _ = file.read_to_string(&mut who);
-        let who = who.trim();
-        return Err(format!(
-            "prefix {prefix:?} is in use: {} holds it; wait for that run to end or choose another --prefix",
-            if who.is_empty() { "another process" } else { who }
-        ));
-    }
+    let opened =
+        locked_file(&path, true).map_err(|e| format!("opening {}: {e}", path.display()))?;
+    let Some(mut file) = opened else {
+        let who = holder(&path).unwrap_or_else(|| "another process".into());
+        return Err(in_use_message(prefix, &who));
+    };
     let _ = file.set_len(0);
     let _ = file.rewind();
-    let _ = file.write_all(holder.as_bytes());
-    Ok(Lock { _file: file, path })
+    let _ = file.write_all(holder_text.as_bytes());
+    Ok(Lock { file, path })
 }
 
 #[cfg(test)]
@@ -102,6 +200,42 @@ mod tests {
         let e = take(&p, "master", "B").expect_err("second");
         assert!(e.contains("the master of run A (pid 1)"), "{e}");
         drop(held);
-        take(&p, "master", "B").expect("free again");
+        let again = take(&p, "master", "B").expect("free again");
+        assert!(again.path.exists());
+        let path = again.path.clone();
+        drop(again);
+        assert!(!path.exists(), "a released lock removes its file");
+    }
+
+    #[test]
+    fn in_use_sees_every_lock_of_a_run_and_creates_nothing() {
+        let p = format!("inuse{}", std::process::id());
+        assert_eq!(in_use(&p), Ok(()));
+        for what in RUN_LOCKS {
+            assert!(!lock_dir().join(format!("{p}.{what}.lock")).exists());
+        }
+        let slave = take(&p, "slave", "a slave by hand (pid 7)").expect("take");
+        let e = in_use(&p).expect_err("held");
+        assert!(e.contains("a slave by hand (pid 7)"), "{e}");
+        assert!(!idle(&p));
+        drop(slave);
+        assert!(idle(&p));
+    }
+
+    #[test]
+    fn stale_lock_files_are_removed_held_ones_kept() {
+        let p = format!("stale{}", std::process::id());
+        let dir = lock_dir();
+        std::fs::create_dir_all(&dir).expect("dir");
+        let stale = dir.join(format!("{p}.master.lock"));
+        std::fs::write(&stale, "a killed master").expect("write");
+        let held = take(&p, "slave", "alive").expect("take");
+        clean_stale();
+        assert!(!stale.exists(), "a lock nobody holds is removed");
+        assert!(held.path.exists(), "a held lock is kept");
+        assert_eq!(
+            std::fs::read_to_string(&held.path).ok().as_deref(),
+            Some("alive")
+        );
     }
 }

@@ -13,7 +13,6 @@ pub use links::Links;
 pub use scenario::{load_scenario, parse_sets, prepare_out, Loaded, PAPER_SCENARIO};
 pub use supervise::run_processes;
 
-use std::path::Path;
 use std::time::Duration;
 use tactile_node::args::LinkKind;
 use tactile_scenario::Scenario;
@@ -72,21 +71,19 @@ pub fn two_cpus() -> bool {
     rustix::thread::sched_getaffinity(None).is_ok_and(|s| s.is_set(0) && s.is_set(1))
 }
 
-/// Removes the shared memory of earlier runs whose launcher is gone (a crashed or
-/// killed run leaves it behind; iceoryx2 would clean it only for the same prefix).
+/// Removes what runs that have ended left behind: lock files nobody holds, and the
+/// shared memory and iceoryx2 folders of every prefix no live process holds a lock of
+/// (a crashed or killed run leaves them; iceoryx2 would clean them only for the same
+/// prefix). A live run's are never touched: each of its processes holds its lock.
 pub fn clean_stale_runs() {
+    tactile_node::lock::clean_stale();
     let Ok(dir) = std::fs::read_dir(tactile_node::ipc::ROOT) else {
         return;
     };
     for entry in dir.flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
-        let Some(pid) = name
-            .strip_prefix("tactile")
-            .and_then(|p| p.parse::<i32>().ok())
-        else {
-            continue;
-        };
-        if !Path::new(&format!("/proc/{pid}")).exists() {
+        let is_prefix = tactile_node::lock::check_prefix(&name).is_ok() && entry.path().is_dir();
+        if is_prefix && name != "locks" && tactile_node::lock::idle(&name) {
             tactile_node::ipc::remove_run_files(&name);
         }
     }

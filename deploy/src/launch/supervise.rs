@@ -346,15 +346,18 @@ impl<'a> Supervisor<'a> {
 /// Runs the scenario's three node programs; returns the summary (which says whether
 /// the run failed: a process died, or a stop request cut it short).
 pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<Summary, Error> {
-    let dir = nodes::node_dir()?;
-    tactile_node::lock::check_prefix(&sup.prefix).map_err(Error::BadInput)?;
-    prepare_out(out, &loaded.inputs)?;
+    // Every check that can refuse the run comes before anything starts or is written:
+    // a prefix held by any process (a launcher, a node started by hand), the output
+    // folder, the node programs.
+    tactile_node::lock::in_use(&sup.prefix).map_err(Error::BadInput)?;
     let holder = format!(
         "tactile run (pid {}, writing to {})",
         std::process::id(),
         out.display()
     );
     let _lock = tactile_node::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
+    let dir = nodes::node_dir()?;
+    prepare_out(out, &loaded.inputs)?;
     // The nodes run the scenario as written here, relative paths made absolute, so
     // the copy also runs again as it is from any folder.
     let scenario_file = out.join("scenario.toml");

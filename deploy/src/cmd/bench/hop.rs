@@ -51,6 +51,9 @@ fn hop_spin(sup: &Supervision, rate: f64) -> Duration {
 /// Ping-pong with an echo process at `rate` for `n` round trips.
 pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
     let prefix = format!("{}h", sup.prefix);
+    // Held while the hop runs, so no cleaner takes its shared memory for a dead run's.
+    let _lock = tactile_node::lock::take(&prefix, "run", "tactile bench's bare hop")
+        .map_err(Error::BadInput)?;
     let exe = std::env::current_exe().map_err(Error::io("locating the tactile executable"))?;
     let mut cmd = if sup.pin {
         let mut c = Command::new("taskset");
