@@ -18,4 +18,5 @@ mod loop_processes;
 mod nodes;
 mod records;
 mod scheduling;
+mod signals;
 mod sweep;

@@ -56,6 +56,8 @@ pub fn main() -> ExitCode {
     };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of stdout has gone (`| head`): it has all it wanted.
+        Err(Error::Io { source, .. }) if crate::say::closed_pipe(&source) => ExitCode::SUCCESS,
         Err(e) => {
             let _ = writeln!(std::io::stderr(), "tactile: {e}");
             ExitCode::from(e.exit_code())

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod cmd;
 pub mod error;
 pub mod launch;
+pub mod say;
 
 /// The user guide (`docs/`), one module per chapter, so its Rust examples run as
 /// doctests and the guide reads in rustdoc beside the code.

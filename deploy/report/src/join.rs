@@ -10,6 +10,7 @@
 use crate::trace::{Stamps, TraceRow};
 use crate::Error;
 use std::collections::BTreeMap;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use tactile_master::record::{Answer, MasterSample, MasterTotals, Miss, Sent};
 use tactile_messages::samples::{stage, LATE_WINDOW};
@@ -390,9 +391,11 @@ fn row(
 }
 
 /// Joins the records found in `dirs`, handing each sample's row to `each` in order.
+/// `each` may stop the join early (a stop request): the logs then hold what was read
+/// so far.
 pub fn join(
     dirs: &[PathBuf],
-    mut each: impl FnMut(&TraceRow) -> Result<(), Error>,
+    mut each: impl FnMut(&TraceRow) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
     let [m, e, s] = locate(dirs)?;
     let mut master = Source::<MasterSample, MasterTotals>::open(m, master_key)?;
@@ -421,13 +424,20 @@ pub fn join(
             SlaveSample::Step(s) => Some(*s),
             SlaveSample::Hold(_) => None,
         });
-        each(&row(
+        let flow = each(&row(
             &sent,
             answer.as_ref(),
             miss.as_ref(),
             &passages,
             step.as_ref(),
         ))?;
+        if flow.is_break() {
+            return Ok(Logs {
+                master: master.log,
+                emulator: emulator.log,
+                slave: slave.log,
+            });
+        }
         n += 1;
     }
     let logs = Logs {

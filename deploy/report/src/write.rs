@@ -13,7 +13,11 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write as _;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 use tactile_messages::Role;
 use tactile_scenario::Scenario;
 
@@ -31,6 +35,23 @@ pub struct Launch {
     pub interrupted: bool,
     /// Write no trace.csv (long runs).
     pub no_trace: bool,
+    /// A stop request (SIGINT, SIGTERM): set, the report is written from the samples
+    /// joined so far and says it was interrupted.
+    pub stop: Option<Arc<AtomicBool>>,
+    /// Past this instant the report stops joining and is written from what it has
+    /// (a run stopped by a signal must end within a second; its records keep every
+    /// sample for `tactile report`).
+    pub until: Option<Instant>,
+}
+
+impl Launch {
+    /// The report of a run a stop request cut short: interrupted, and written within
+    /// a moment from what can be joined by then.
+    pub fn interrupted(mut self) -> Launch {
+        self.interrupted = true;
+        self.until = Some(Instant::now() + Duration::from_millis(700));
+        self
+    }
 }
 
 pub fn write_file(path: &Path, text: &str) -> Result<(), Error> {
@@ -274,7 +295,20 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     };
     let mut line = String::with_capacity(2048);
     let mut t0 = None;
+    let stopped = || {
+        launch
+            .stop
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::SeqCst))
+            || launch.until.is_some_and(|u| Instant::now() >= u)
+    };
+    let mut cut_short = None;
     let logs = join::join(dirs, |row| {
+        // Looked at every 1024 samples: a clock read per sample would cost.
+        if row.n % 1024 == 0 && stopped() {
+            cut_short = Some(row.n);
+            return Ok(ControlFlow::Break(()));
+        }
         analysis.add(row);
         series.add(row, t_s);
         if let Some(w) = trace.as_mut() {
@@ -284,7 +318,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
             w.write_all(line.as_bytes())
                 .map_err(Error::io("writing trace.csv"))?;
         }
-        Ok(())
+        Ok(ControlFlow::Continue(()))
     })?;
     if let Some(mut w) = trace {
         w.flush().map_err(Error::io("writing trace.csv"))?;
@@ -314,7 +348,15 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     )?;
     plot("positions and forces", series.write(out))?;
     write_file(&out.join("scenario.toml"), &start.scenario_toml)?;
-    let summary = summarise(&scenario, runner, &analysis, &logs, launch);
+    let mut summary = summarise(&scenario, runner, &analysis, &logs, launch);
+    if let Some(n) = cut_short {
+        summary.interrupted = true;
+        let dirs: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
+        summary.events.push(format!(
+            "report cut short at sample {n} by a stop request: `tactile report {}` reports every sample the records hold",
+            dirs.join(" ")
+        ));
+    }
     write_json(&out.join("summary.json"), &summary)?;
     Ok(summary)
 }

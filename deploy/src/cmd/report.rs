@@ -32,11 +32,17 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
             .and_then(Path::parent)
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
     };
+    let stop =
+        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let launch = Launch {
         no_trace: args.no_trace,
+        stop: Some(stop),
         ..Launch::default()
     };
     let summary = write_report(&args.dirs, &out, &launch)?;
-    print!("{}", render(&summary, &out));
+    crate::out!("{}", render(&summary, &out));
+    if summary.interrupted {
+        return Err(Error::Interrupted);
+    }
     Ok(())
 }

@@ -80,14 +80,19 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
     let sets = parse_sets(&args.set)?;
     let loaded = load_scenario(args.scenario.as_deref(), &sets)?;
     for w in loaded.scenario.warnings() {
-        eprintln!("tactile: warning: {w}");
+        crate::noteln!("tactile: warning: {w}");
     }
     let summary = if args.in_process {
         prepare_out(&args.out, &loaded.inputs)?;
-        launch::sim::simulate(&loaded.scenario, &loaded.base_dir, &args.out)?;
+        let completed = launch::sim::simulate(&loaded.scenario, &loaded.base_dir, &args.out)?;
         let launch = Launch {
             no_trace: args.no_trace,
             ..Launch::default()
+        };
+        let launch = if completed {
+            launch
+        } else {
+            launch.interrupted()
         };
         write_report(std::slice::from_ref(&args.out), &args.out, &launch)?
     } else {
@@ -110,7 +115,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
         };
         launch::run_processes(&loaded, &args.out, &sup)?
     };
-    print!("{}", render(&summary, &args.out));
+    crate::out!("{}", render(&summary, &args.out));
     if summary.interrupted {
         return Err(Error::Interrupted);
     }

@@ -81,16 +81,26 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         &mut csv,
         header(&axes).as_bytes(),
     ))?;
+    let stop =
+        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let mut rows = Vec::new();
     for (k, (c, l)) in combos.iter().zip(&loaded).enumerate() {
+        if stop.load(std::sync::atomic::Ordering::SeqCst) {
+            break;
+        }
         let dir = args.out.join(format!("run-{k:04}"));
-        eprintln!(
+        crate::noteln!(
             "tactile sweep: run {}/{}: {}",
             k + 1,
             combos.len(),
             describe(&axes, c)
         );
         let summary = run_one(l, &dir, args)?;
+        if summary.interrupted {
+            // Cut short: its folder holds the report of what ran; the table keeps
+            // only whole runs.
+            break;
+        }
         let json = serde_json::to_value(&summary)
             .map_err(|e| Error::Failed(format!("summary of {}: {e}", dir.display())))?;
         let values = sweep::values(&json);
@@ -99,13 +109,18 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
             row(k, &axes, c, &values).as_bytes(),
         ))?;
         rows.push((c.clone(), values));
-        if summary.interrupted {
-            return Err(Error::Interrupted);
-        }
     }
     tactile_report::plots::sweep_plots(&args.out, &axes, &rows)
         .map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))?;
-    println!(
+    if rows.len() < combos.len() {
+        crate::noteln!(
+            "tactile sweep: stopped by a signal after {} of {} runs; sweep.csv and the plots hold those",
+            rows.len(),
+            combos.len()
+        );
+        return Err(Error::Interrupted);
+    }
+    crate::outln!(
         "tactile sweep: {} runs; sweep.csv and one plot per metric in {}",
         combos.len(),
         args.out.display()
@@ -135,6 +150,11 @@ fn run_one(
         return launch::run_processes(l, dir, &sup);
     }
     prepare_out(dir, &l.inputs)?;
-    launch::sim::simulate(&l.scenario, &l.base_dir, dir)?;
+    let completed = launch::sim::simulate(&l.scenario, &l.base_dir, dir)?;
+    let launch = if completed {
+        launch
+    } else {
+        launch.interrupted()
+    };
     Ok(write_report(&[dir.to_path_buf()], dir, &launch)?)
 }

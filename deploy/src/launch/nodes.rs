@@ -101,13 +101,13 @@ pub fn node_dir() -> Result<PathBuf, Error> {
     let mut why = None;
     if in_cargo_target {
         if !all_in(&dir) {
-            eprintln!("tactile: building the node programs (once)...");
+            crate::noteln!("tactile: building the node programs (once)...");
         }
         why = cargo_build(&dir).err();
     }
     if all_in(&dir) {
         if let Some(w) = &why {
-            eprintln!(
+            crate::noteln!(
                 "tactile: warning: could not rebuild the node programs, using those in {}: {w}",
                 dir.display()
             );

@@ -8,6 +8,7 @@
 
 use crate::error::Error;
 use std::path::Path;
+use std::sync::atomic::Ordering;
 use tactile_master::hmd::Master;
 use tactile_master::operator::OperatorSource;
 use tactile_master::process::MasterRecorder;
@@ -56,8 +57,12 @@ fn failed(e: NodeError) -> Error {
 }
 
 /// Runs `scenario` in-process, writing the three records into `out`; `base_dir`
-/// resolves a trajectory file's path.
-pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<(), Error> {
+/// resolves a trajectory file's path. A stop request (SIGINT, SIGTERM) ends it after
+/// the sample in hand, its records closed as `interrupted`; returns whether it ran
+/// to the end.
+pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<bool, Error> {
+    let stop =
+        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let source = OperatorSource::load(&scenario.operator, base_dir)
         .map_err(|e| Error::BadInput(e.to_string()))?;
     let bad = |e: tactile_scenario::ScenarioError| Error::BadInput(e.to_string());
@@ -80,7 +85,12 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<(), 
     srec.run(SIM_RUN).map_err(failed)?;
     let t_s_ns = scenario.t_s_ns();
     let began = now_ns();
+    let mut reason = "completed";
     for n in 0..scenario.samples {
+        if stop.load(Ordering::Relaxed) {
+            reason = "interrupted";
+            break;
+        }
         let now = n * t_s_ns;
         let (c, sent) = master.forward(n, now);
         mrec.sample(MasterSample::Sent(sent)).map_err(failed)?;
@@ -110,16 +120,16 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<(), 
         elapsed_ns: now_ns().saturating_sub(began),
         ..MasterTotals::default()
     };
-    mrec.stop(totals, "completed").map_err(failed)?;
+    mrec.stop(totals, reason).map_err(failed)?;
     let et = EmulatorTotals {
         counters: emulator.counters(),
         ..EmulatorTotals::default()
     };
-    erec.stop(et, "completed").map_err(failed)?;
+    erec.stop(et, reason).map_err(failed)?;
     let st = SlaveTotals {
         counters: slave.counters(),
         ..SlaveTotals::default()
     };
-    srec.stop(st, "completed").map_err(failed)?;
-    Ok(())
+    srec.stop(st, reason).map_err(failed)?;
+    Ok(reason == "completed")
 }

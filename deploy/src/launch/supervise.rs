@@ -5,6 +5,7 @@
 use super::links::node_command;
 use super::{nodes, prepare_out, survivor_grace, two_cpus, Loaded, Supervision};
 use crate::error::Error;
+use signal_hook::consts::{SIGINT, SIGTERM};
 use std::io::Write as _;
 use std::path::Path;
 use std::process::{Child, ExitStatus, Stdio};
@@ -36,6 +37,14 @@ pub fn describe(status: ExitStatus) -> String {
         (None, Some(s)) => format!("was killed by signal {s}"),
         _ => "ended".to_string(),
     }
+}
+
+/// True if a node ended because of a stop request: its own exit status for one
+/// (130), or killed by SIGINT or SIGTERM.
+fn stopped_by_signal(status: ExitStatus) -> bool {
+    use std::os::unix::process::ExitStatusExt;
+    status.code() == Some(i32::from(EXIT_INTERRUPTED))
+        || matches!(status.signal(), Some(s) if s == SIGINT || s == SIGTERM)
 }
 
 /// One node program under supervision.
@@ -229,6 +238,17 @@ impl<'a> Supervisor<'a> {
             self.procs[k].status = Some(status);
             return false;
         }
+        if stopped_by_signal(status) {
+            // Asked to stop (the terminal's Ctrl-C reaches every process of the group,
+            // maybe before the launcher looks): not a death, not restarted.
+            self.procs[k].status = Some(status);
+            let at = self.elapsed_s();
+            let how = describe(status);
+            self.watch.events.push(format!(
+                "{role} {how} after {at:.2} s: a stop request, not restarted"
+            ));
+            return false;
+        }
         self.on_death(k, status)
     }
 
@@ -281,8 +301,8 @@ impl<'a> Supervisor<'a> {
         }
         let el = self.elapsed_s();
         match expected_s {
-            Some(total) => eprint!("\r  running: {el:5.1} s of {total:.1} s"),
-            None => eprint!("\r  running (lockstep): {el:5.1} s"),
+            Some(total) => crate::note!("\r  running: {el:5.1} s of {total:.1} s"),
+            None => crate::note!("\r  running (lockstep): {el:5.1} s"),
         }
         let _ = std::io::stderr().flush();
     }
@@ -294,7 +314,7 @@ impl<'a> Supervisor<'a> {
             Mode::Lockstep => None,
         };
         while self.watch.master.is_none() {
-            if stop.swap(false, Ordering::SeqCst) {
+            if stop.load(Ordering::SeqCst) {
                 self.on_stop_request();
             }
             self.poll()?;
@@ -302,7 +322,7 @@ impl<'a> Supervisor<'a> {
             std::thread::sleep(POLL);
         }
         if self.sup.progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-            eprintln!();
+            crate::noteln!();
         }
         self.after_master(scenario);
         Ok(())
@@ -407,8 +427,13 @@ fn report(out: &Path, w: Watch, no_trace: bool) -> Result<Summary, Error> {
     let launch = Launch {
         events: w.events,
         failed: w.failed,
-        interrupted: w.interrupted,
         no_trace,
+        ..Launch::default()
+    };
+    let launch = if w.interrupted {
+        launch.interrupted()
+    } else {
+        launch
     };
     Ok(write_report(&[out.to_path_buf()], out, &launch)?)
 }

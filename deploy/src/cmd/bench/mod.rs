@@ -278,7 +278,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     let stop =
         tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     if !cfg!(feature = "zenoh") {
-        eprintln!(
+        crate::noteln!(
             "tactile bench: no Zenoh loop: this build has no Zenoh link (build with --features zenoh)"
         );
     }
@@ -301,7 +301,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     }
     let report = bench.finish(rates)?;
     write_json(&args.out.join("bench.json"), &report)?;
-    print!("{}", render(&report));
+    crate::out!("{}", render(&report));
     Ok(())
 }
 
@@ -329,7 +329,7 @@ impl Bench<'_> {
             loops.extend(self.across_hosts(&sc, pair)?);
         }
         percentile_plot(&self.args.out, rate, &loops)?;
-        eprintln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
+        crate::noteln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
         let (hop, hop_misses) = hop::bare_hop(rate, self.args.samples, &self.sup)?;
         let mut r = RateResult {
             rate_hz: rate,
@@ -358,7 +358,7 @@ impl Bench<'_> {
         .filter(|&(_, l)| zenoh_built(l))
         {
             let (rate, n) = (sc.rate_hz, sc.samples);
-            eprintln!("tactile bench: {rate} Hz, {n} samples: {name} loop");
+            crate::noteln!("tactile bench: {rate} Hz, {n} samples: {name} loop");
             let out = self.args.out.join(format!("{name}-{rate}"));
             let s = trio(sc, &out, &self.sup, link)?;
             loops.push(loop_result(name, s)?);
@@ -378,9 +378,10 @@ impl Bench<'_> {
         .filter(|&(_, l)| zenoh_built(l))
         {
             let rate = sc.rate_hz;
-            eprintln!(
+            crate::noteln!(
                 "tactile bench: {rate} Hz: {name} loop, master in {}, emulator and slave in {}",
-                pair.names[0], pair.names[1]
+                pair.names[0],
+                pair.names[1]
             );
             let wrap = [pair.exec(0), pair.exec(1), pair.exec(1)];
             let links = crate::launch::Links::across(link, pair);
@@ -398,7 +399,7 @@ impl Bench<'_> {
 
     /// The lockstep throughput and the machine's own stalls, with the rates' results.
     fn finish(&self, rates: Vec<RateResult>) -> Result<BenchReport, Error> {
-        eprintln!("tactile bench: lockstep throughput");
+        crate::noteln!("tactile bench: lockstep throughput");
         let n = self.args.lockstep_samples;
         let sc = scenario(1000.0, n, Mode::Lockstep)?;
         let lock = trio(
@@ -409,7 +410,7 @@ impl Bench<'_> {
         )?;
         let machine = if self.args.probe_s > 0.0 {
             let s = self.args.probe_s;
-            eprintln!("tactile bench: the machine's own stalls, {s} s per CPU");
+            crate::noteln!("tactile bench: the machine's own stalls, {s} s per CPU");
             stalls::probe(s, true, self.stop)
         } else {
             stalls::StallReport {

@@ -1,0 +1,167 @@
+//! Stopping when asked: SIGINT to an in-process run, to a sweep and to the whole
+//! process group of a launcher (the terminal's Ctrl-C) ends each with exit 130 and the
+//! report of what ran; a closed stdout ends a command quietly.
+
+use crate::util;
+
+use std::os::unix::process::CommandExt;
+use std::process::{Child, Stdio};
+use std::time::{Duration, Instant};
+use util::{wait_for, Sandbox};
+
+fn signal(pid: i32, sig: rustix::process::Signal) {
+    let pid = rustix::process::Pid::from_raw(pid).expect("pid");
+    let _ = rustix::process::kill_process(pid, sig);
+}
+
+fn finish(child: Child) -> (Option<i32>, String) {
+    let o = child.wait_with_output().expect("wait");
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    (o.status.code(), err)
+}
+
+/// A million samples in-process, stopped by SIGINT once the records are growing: it
+/// ends with 130 soon after (the issue asks for a second; the bound here leaves room
+/// for a loaded CI machine), its records say `interrupted`, and the report of what
+/// ran is written.
+#[test]
+fn sigint_stops_an_in_process_run_with_a_report_of_what_ran() {
+    let sb = Sandbox::new("siginproc");
+    let text = util::wall_delay().replace("samples = 8000", "samples = 1000000");
+    let scenario = sb.write("s.toml", &text);
+    let child = sb
+        .command(&["run", "s.toml", "--in-process", "--out", "run"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start");
+    let rec = sb.path("run").join("master.rec");
+    wait_for("the run's records grow", Duration::from_secs(30), || {
+        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 1_000_000)
+    });
+    let asked = Instant::now();
+    signal(child.id() as i32, rustix::process::Signal::INT);
+    let (code, err) = finish(child);
+    let took = asked.elapsed();
+    assert_eq!(code, Some(130), "{err}");
+    assert!(
+        took < Duration::from_secs(3),
+        "stopped {took:?} after SIGINT"
+    );
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["interrupted"], true, "{s}");
+    assert_eq!(s["failed"], false, "{s}");
+    let ended = s["nodes"]["master"]["ended"].as_str().expect("ended");
+    assert!(ended.starts_with("interrupted"), "{ended}");
+    assert!(s["samples_sent"].as_u64().is_some_and(|n| n > 0), "{s}");
+    drop(scenario);
+}
+
+/// A sweep stopped by SIGINT after its first run: exit 130, `sweep.csv` holds the
+/// runs that finished (and no partial one), no panic.
+#[test]
+fn sigint_stops_a_sweep_keeping_its_finished_rows() {
+    let sb = Sandbox::new("sigsweep");
+    let text = util::wall_delay().replace("samples = 8000", "samples = 200000");
+    sb.write("s.toml", &text);
+    let child = sb
+        .command(&[
+            "sweep",
+            "s.toml",
+            "--set",
+            "control.kind=none,tdpa,wave,none,tdpa,wave",
+            "--out",
+            "sw",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start");
+    let second = sb.path("sw").join("run-0001").join("master.rec");
+    wait_for("the second run starts", Duration::from_secs(60), || {
+        second.exists()
+    });
+    signal(child.id() as i32, rustix::process::Signal::INT);
+    let (code, err) = finish(child);
+    assert_eq!(code, Some(130), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("stopped by a signal after 1 of 6 runs"),
+        "{err}"
+    );
+    let table = std::fs::read_to_string(sb.path("sw").join("sweep.csv")).expect("sweep.csv");
+    assert_eq!(
+        table.lines().count(),
+        2,
+        "header and the finished run:\n{table}"
+    );
+}
+
+/// The terminal's Ctrl-C reaches the launcher and its nodes at once: exit 130, the
+/// run `interrupted`, not `failed`, and no node restarted.
+#[test]
+fn ctrl_c_to_the_process_group_is_a_stop_not_a_failure() {
+    let sb = Sandbox::new("sigpgrp");
+    let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
+    let child = sb
+        .command(&["run", scenario.to_str().expect("utf-8"), "--out", "run"])
+        .args(["--prefix", &sb.prefix, "-q"])
+        .process_group(0)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start");
+    let rec = sb.path("run").join("slave.rec");
+    wait_for("the loop runs", Duration::from_secs(20), || {
+        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 100_000)
+    });
+    let group = rustix::process::Pid::from_raw(child.id() as i32).expect("pid");
+    let _ = rustix::process::kill_process_group(group, rustix::process::Signal::INT);
+    let (code, err) = finish(child);
+    assert_eq!(code, Some(130), "{err}");
+    sb.assert_no_leftover_processes();
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["interrupted"], true, "{s}");
+    assert_eq!(s["failed"], false, "{s}");
+    let events = s["events"].to_string();
+    assert!(!events.contains("restart"), "{events}");
+}
+
+/// `tactile sweep ... | head -1`: the reader goes away; the sweep ends quietly.
+#[test]
+fn a_closed_stdout_ends_quietly() {
+    let sb = Sandbox::new("sigpipe");
+    sb.write("s.toml", &util::wall_delay());
+    let mut child = sb
+        .command(&[
+            "sweep",
+            "s.toml",
+            "--set",
+            "control.kind=none,tdpa",
+            "--out",
+            "sw",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start");
+    drop(child.stdout.take());
+    let (code, err) = finish(child);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let mut kernels = sb
+        .command(&["kernels", "fk"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start");
+    drop(kernels.stdout.take());
+    let rows = "theta1,theta2,theta3\n".to_string() + &"0.1,0.2,0.3\n".repeat(200_000);
+    if let Some(mut stdin) = kernels.stdin.take() {
+        let _ = std::io::Write::write_all(&mut stdin, rows.as_bytes());
+    }
+    let (code, err) = finish(kernels);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.is_empty(), "{err}");
+}
