@@ -36,10 +36,11 @@ fn run(sb: &Sandbox, scenario: &Path, extra: &[&str]) -> Output {
         scenario.to_str().expect("utf-8 path"),
         "--out",
         out.to_str().expect("utf-8 path"),
-        "--prefix",
-        &sb.prefix,
-        "-q",
     ];
+    // A prefix names the processes' shared memory: refused with --in-process.
+    if !extra.contains(&"--in-process") {
+        args.extend(["--prefix", &sb.prefix, "-q"]);
+    }
     args.extend_from_slice(extra);
     sb.tactile(&args)
 }
@@ -631,5 +632,111 @@ fn bad_operators_are_refused() {
                 vec!["path.toml", "operator.path"],
             ),
         ],
+    );
+}
+
+#[test]
+fn every_magnitude_has_a_bound_named_in_the_error() {
+    let sb = Sandbox::new("bounds");
+    assert_all_refused(
+        &sb,
+        &[
+            (
+                "noise_huge.toml",
+                format!("{BASE}[network.forward]\nnoise_std = [0.0, 5.0, 0.0]\n"),
+                vec![
+                    "noise_huge.toml",
+                    "network.forward.noise_std[1]",
+                    "beyond 1",
+                ],
+            ),
+            (
+                "hand_mass.toml",
+                format!("{BASE}[master.hand]\nmass = 200.0\n"),
+                vec!["hand_mass.toml", "master.hand.mass", "beyond 10"],
+            ),
+            (
+                "gain.toml",
+                format!("{BASE}[slave.controller]\nkp = [6.0, 6.0, 1e9]\n"),
+                vec!["gain.toml", "slave.controller.kp[2]"],
+            ),
+            (
+                "sphere.toml",
+                format!(
+                    "{BASE}[[environment.objects]]\nkind = \"sphere\"\ncenter = [0.0, 0.0, 5e3]\n\
+                     radius = 0.01\nstiffness = [100.0, 100.0, 100.0]\n"
+                ),
+                vec!["sphere.toml", "environment.objects[0].center[2]"],
+            ),
+        ],
+    );
+}
+
+#[test]
+fn delays_and_schedules_past_the_run_load_with_a_warning() {
+    let sb = Sandbox::new("pastrun");
+    let late =
+        format!("{BASE}[network.forward]\ndelay = [2000, 0, 0]\nschedule = [[5000, 1, 1, 1]]\n");
+    let scenario = sb.write("late.toml", &late);
+    let o = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        "late",
+    ]);
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("network.forward.delay[0] = 2000 samples"),
+        "{err}"
+    );
+    assert!(
+        err.contains("network.forward.schedule[0] starts at sample 5000"),
+        "{err}"
+    );
+}
+
+#[test]
+fn an_out_that_is_a_file_a_key_swept_twice_and_options_that_do_nothing_are_refused() {
+    let sb = Sandbox::new("argsbad");
+    let scenario = sb.write("s.toml", BASE);
+    sb.write("afile", "not a folder");
+    let s = scenario.to_str().expect("utf-8");
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["run", s, "--in-process", "--out", "afile"],
+            "is a file, not a folder",
+        ),
+        (
+            &["sweep", s, "--set", "seed=1,2", "--out", "afile"],
+            "is a file, not a folder",
+        ),
+        (
+            &[
+                "sweep", s, "--set", "seed=1,2", "--set", "seed=3", "--out", "sw",
+            ],
+            "swept twice",
+        ),
+        (
+            &["run", s, "--in-process", "--prefix", "abc"],
+            "cannot be used with",
+        ),
+        (
+            &["run", s, "--in-process", "--link", "udp"],
+            "cannot be used with",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = sb.tactile(args);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    assert!(!sb.path("sw").exists(), "a refused sweep writes nothing");
+    assert_eq!(
+        std::fs::read_to_string(sb.path("afile")).ok().as_deref(),
+        Some("not a folder")
     );
 }

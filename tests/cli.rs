@@ -201,3 +201,27 @@ fn paper_table_as_json() {
         "{text}"
     );
 }
+
+#[test]
+fn a_line_without_end_an_endless_cell_and_an_overflow_are_refused_briefly() {
+    // A megabyte without a newline: refused at 4096 bytes, not read into memory.
+    let endless = format!("theta1,theta2,theta3\n{}", "1".repeat(1 << 20));
+    let o = kernels(&["fk"], &endless);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("line 2: longer than 4096 bytes"), "{err}");
+    assert!(o.stdout.is_empty());
+    // A bad cell is quoted short.
+    let cell = format!("theta1,theta2,theta3\n0,{},0\n", "x".repeat(3000));
+    let o = kernels(&["fk"], &cell);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.len() < 200 && err.contains("xxx..."), "{err}");
+    // A result past f64 is an error naming the line, never a NaN or infinity printed.
+    let huge = "x_obj,y_obj,z_obj,x_env,y_env,z_env,hx,hy,hz\n0,0,0,0,0,0,1,1,1\n1e308,0,0,-1e308,0,0,10,10,10\n";
+    let o = kernels(&["fbf"], huge);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("line 3") && err.contains("overflows"), "{err}");
+    assert!(o.stdout.is_empty());
+}

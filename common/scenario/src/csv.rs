@@ -51,13 +51,25 @@ pub enum CsvError {
     },
 }
 
+/// Longest text of a bad cell or header an error quotes: the rest is elided, so a
+/// line of garbage gives a readable message, not a megabyte.
+pub const QUOTED: usize = 40;
+
+/// `text` cut to [`QUOTED`] characters, with `...` when cut.
+pub fn shortened(text: &str) -> String {
+    match text.char_indices().nth(QUOTED) {
+        Some((at, _)) => format!("{}...", &text[..at]),
+        None => text.to_string(),
+    }
+}
+
 /// Checks a header line (already known to be line `line`) against `columns`.
 pub fn check_header(line: usize, text: &str, columns: &[&str]) -> Result<(), CsvError> {
     let got: Vec<&str> = text.split(',').map(str::trim).collect();
     if got != columns {
         return Err(CsvError::Header {
             line,
-            found: text.trim().to_string(),
+            found: shortened(text.trim()),
             expected: columns.join(","),
         });
     }
@@ -86,7 +98,7 @@ pub fn parse_row(
             line,
             column: k + 1,
             name: (*name).to_string(),
-            text: (*cell).to_string(),
+            text: shortened(cell),
             what,
         };
         match cell.parse::<f64>() {
@@ -121,6 +133,18 @@ pub fn parse(text: &str, columns: &[&str]) -> Result<Vec<Vec<f64>>, CsvError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_bad_cell_is_quoted_short() {
+        let long = "x".repeat(10_000);
+        let e = parse_row(3, &format!("1,{long},2"), &["a", "b", "c"], &mut Vec::new());
+        let text = e.expect_err("not a number").to_string();
+        assert!(
+            text.len() < 120 && text.contains("xxx...") && text.contains("line 3"),
+            "{text}"
+        );
+        assert_eq!(shortened("short"), "short");
+    }
 
     #[test]
     fn parses_and_locates_errors() {

@@ -6,6 +6,7 @@
 //! delay, a zero rate, negative noise) is refused with the field's dotted path before
 //! anything starts. The defaults reproduce the paper's setup.
 
+mod bounds;
 mod control;
 pub mod csv;
 mod device;
@@ -163,7 +164,7 @@ impl Scenario {
     }
 
     /// Things that load but deserve a word: stiffness above the device's nominal
-    /// maximum.
+    /// maximum, a delay or a schedule entry beyond the run's length.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
         for (k, o) in self.environment.objects.iter().enumerate() {
@@ -171,6 +172,28 @@ impl Scenario {
                 if *h > NOMINAL_MAX_STIFFNESS {
                     w.push(format!(
                         "environment.objects[{k}].stiffness[{i}] = {h} N/m is above the device's nominal {NOMINAL_MAX_STIFFNESS} N/m: contact may buzz"
+                    ));
+                }
+            }
+        }
+        for (name, c) in [
+            ("forward", &self.network.forward),
+            ("backward", &self.network.backward),
+        ] {
+            for (i, d) in c.delay.iter().enumerate() {
+                if *d > 0 && *d as u64 >= self.samples {
+                    w.push(format!(
+                        "network.{name}.delay[{i}] = {d} samples is not shorter than the run ({} samples): no value of that signal arrives",
+                        self.samples
+                    ));
+                }
+            }
+            for (k, e) in c.schedule.iter().enumerate() {
+                if e[0] as u64 >= self.samples {
+                    w.push(format!(
+                        "network.{name}.schedule[{k}] starts at sample {}, after the run's last ({}): it never takes effect",
+                        e[0],
+                        self.samples - 1
                     ));
                 }
             }

@@ -58,6 +58,18 @@ pub fn write_file(path: &Path, text: &str) -> Result<(), Error> {
     std::fs::write(path, text).map_err(Error::io(format!("writing {}", path.display())))
 }
 
+/// Makes the output folder `out`; a path that exists and is not a folder is bad input
+/// (a typo naming a file must not become a confusing I/O failure).
+pub fn make_out_dir(out: &Path) -> Result<(), Error> {
+    if out.exists() && !out.is_dir() {
+        return Err(Error::BadInput(format!(
+            "--out {}: is a file, not a folder",
+            out.display()
+        )));
+    }
+    std::fs::create_dir_all(out).map_err(Error::io(format!("creating {}", out.display())))
+}
+
 /// Writes `value` as pretty JSON to `path`.
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), Error> {
     let mut text = serde_json::to_string_pretty(value)
@@ -272,7 +284,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
             master.display()
         ))
     })?;
-    std::fs::create_dir_all(out).map_err(Error::io(format!("creating {}", out.display())))?;
+    make_out_dir(out)?;
     let t_s = scenario.t_s();
     // The in-process simulation's stamps are synthetic: no stage times from them.
     let runner = if start.link == IN_PROCESS {

@@ -8,7 +8,7 @@
 use super::datapath::{ArithArg, DatapathArgs, Module};
 use crate::error::Error;
 use clap::Args;
-use std::io::{BufRead, Write};
+use std::io::{BufRead, Read, Write};
 use tactile_math::arith::ArithKind;
 use tactile_math::engine::Engine;
 use tactile_math::kernels::IkStatus;
@@ -63,6 +63,44 @@ fn push_float(out: &mut String, v: f64, kind: ArithKind) {
     };
 }
 
+/// Longest input line read, bytes: a kernel row is a few numbers, so a longer line is
+/// not a row (and is refused before it fills memory).
+pub const MAX_LINE: usize = 4096;
+
+/// Reads lines of at most [`MAX_LINE`] bytes, numbering them from 1.
+struct Lines<R> {
+    input: R,
+    n: usize,
+    buf: Vec<u8>,
+}
+
+impl<R: BufRead> Lines<R> {
+    /// The next line (without its end), `None` at the end of the input.
+    fn next_line(&mut self) -> Result<Option<(usize, String)>, Error> {
+        self.n += 1;
+        let n = self.n;
+        self.buf.clear();
+        let limit = (MAX_LINE + 1) as u64;
+        let got = (&mut self.input)
+            .take(limit)
+            .read_until(b'\n', &mut self.buf)
+            .map_err(Error::io(format!("reading line {n} of stdin")))?;
+        if got == 0 {
+            return Ok(None);
+        }
+        if self.buf.last() == Some(&b'\n') {
+            self.buf.pop();
+        } else if got as u64 == limit {
+            return Err(Error::BadInput(format!(
+                "line {n}: longer than {MAX_LINE} bytes: not a row of numbers"
+            )));
+        }
+        let text = String::from_utf8(std::mem::take(&mut self.buf))
+            .map_err(|_| Error::BadInput(format!("line {n}: not UTF-8 text")))?;
+        Ok(Some((n, text.trim_end_matches('\r').to_string())))
+    }
+}
+
 /// Evaluates `args.module` over the CSV on `input`, writing CSV to `output`.
 pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> Result<(), Error> {
     let kind = ArithKind::from(args.arith);
@@ -71,12 +109,15 @@ pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> 
     let module = args.module;
     let in_cols = module.input_columns();
 
-    let mut lines = input.lines().enumerate();
+    let mut lines = Lines {
+        input,
+        n: 0,
+        buf: Vec::new(),
+    };
     let mut header = None;
-    for (i, line) in lines.by_ref() {
-        let line = line.map_err(Error::io(format!("reading line {} of stdin", i + 1)))?;
+    while let Some((n, line)) = lines.next_line()? {
         if !line.trim().is_empty() {
-            header = Some((i + 1, line));
+            header = Some((n, line));
             break;
         }
     }
@@ -94,9 +135,7 @@ pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> 
     out.push_str(&module.output_columns().join(","));
     out.push('\n');
     let mut v = Vec::with_capacity(in_cols.len());
-    for (i, line) in lines {
-        let lineno = i + 1;
-        let line = line.map_err(Error::io(format!("reading line {lineno} of stdin")))?;
+    while let Some((lineno, line)) = lines.next_line()? {
         if line.trim().is_empty() {
             continue;
         }
@@ -114,6 +153,13 @@ pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> 
                 None,
             ),
         };
+        if let Some(k) = values.iter().position(|x| !x.is_finite()) {
+            let name = module.output_columns()[k];
+            return Err(Error::BadInput(format!(
+                "line {lineno}: {name} overflows ({}): the inputs are beyond what the kernel can compute",
+                values[k]
+            )));
+        }
         for (k, x) in values.iter().enumerate() {
             if k > 0 {
                 out.push(',');

@@ -37,8 +37,13 @@ pub struct RunArgs {
     /// and polls (default 200, at most 40 % of a period).
     #[arg(long)]
     pub wake_early_us: Option<u64>,
-    /// Run master, emulator and slave in this process, without shared memory.
-    #[arg(long)]
+    /// Run master, emulator and slave in this process, without shared memory (the
+    /// options about processes, links, waiting and scheduling do not apply and are
+    /// refused with it).
+    #[arg(long, conflicts_with_all = [
+        "prefix", "spin_us", "wake_early_us", "max_restarts", "link", "udp", "no_pin",
+        "sched", "idle",
+    ])]
     pub in_process: bool,
     /// No progress line.
     #[arg(long, short)]

@@ -51,6 +51,14 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         .iter()
         .map(|a| axis(a).map_err(Error::BadInput))
         .collect::<Result<Vec<_>, _>>()?;
+    for (k, a) in axes.iter().enumerate() {
+        if axes[..k].iter().any(|b| b.key == a.key) {
+            return Err(Error::BadInput(format!(
+                "--set {}: the key is swept twice; give all its values in one --set KEY=V1,V2,...",
+                a.key
+            )));
+        }
+    }
     let count = axes
         .iter()
         .try_fold(1usize, |n, a| n.checked_mul(a.values.len()))
@@ -69,8 +77,7 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         .iter()
         .map(|c| load_scenario(Some(&args.scenario), &sets_of(&axes, c)))
         .collect::<Result<Vec<_>, _>>()?;
-    std::fs::create_dir_all(&args.out)
-        .map_err(Error::io(format!("creating {}", args.out.display())))?;
+    tactile_report::write::make_out_dir(&args.out)?;
     // The table grows a row as each run ends, so a sweep cut short keeps what ran.
     let table = args.out.join("sweep.csv");
     let mut csv = std::fs::File::create(&table)

@@ -99,7 +99,7 @@ pub fn output_files(out: &Path) -> Vec<PathBuf> {
 /// its inputs, then removes the files of an earlier run, so the folder never mixes
 /// two runs' files.
 pub fn prepare_out(out: &Path, inputs: &[PathBuf]) -> Result<(), Error> {
-    std::fs::create_dir_all(out).map_err(Error::io(format!("creating {}", out.display())))?;
+    tactile_report::write::make_out_dir(out)?;
     let outputs = output_files(out);
     for i in inputs {
         if let Some(o) = outputs.iter().find(|o| same_file(o, i)) {

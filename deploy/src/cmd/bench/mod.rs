@@ -266,8 +266,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             args.probe_s
         )));
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(Error::io(format!("creating {}", args.out.display())))?;
+    tactile_report::write::make_out_dir(&args.out)?;
     crate::launch::clean_stale_runs();
     let prefix = args
         .prefix
