@@ -31,8 +31,8 @@ fn run(sb: &Sandbox, text: &str, extra: &[&str]) -> (String, serde_json::Value) 
 
 #[test]
 fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
-    if !is_root() {
-        eprintln!("SKIPPED: not root, so SCHED_FIFO is not permitted here");
+    if !util::fifo_permitted() {
+        util::cannot("SCHED_FIFO is not permitted here");
         return;
     }
     let sb = Sandbox::new("fifo");
@@ -65,7 +65,7 @@ fn where_sched_fifo_is_refused_the_nodes_run_sched_other_and_say_so() {
     // no program it starts gets them back) is refused SCHED_FIFO like any user.
     let setpriv = std::path::Path::new("/usr/bin/setpriv");
     if !is_root() || !setpriv.exists() {
-        eprintln!("SKIPPED: needs root and setpriv to take the privilege away");
+        util::cannot("taking SCHED_FIFO away needs root and /usr/bin/setpriv");
         return;
     }
     let sb = Sandbox::new("nofifo");
@@ -124,8 +124,8 @@ fn lockstep_runs_sched_other_whatever_is_asked() {
 
 #[test]
 fn idle_poll_keeps_the_cpus_awake_and_the_summary_says_so() {
-    if !is_root() {
-        eprintln!("SKIPPED: not root, so SCHED_FIFO is not permitted here");
+    if !util::fifo_permitted() {
+        util::cannot("SCHED_FIFO is not permitted here");
         return;
     }
     let sb = Sandbox::new("awake");

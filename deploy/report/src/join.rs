@@ -467,3 +467,7 @@ fn check_one_run(logs: &Logs) -> Result<(), Error> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+#[path = "join_tests.rs"]
+mod tests;
