@@ -25,7 +25,7 @@ fn kernels(args: &[&str], stdin: &str) -> Output {
     if let Err(e) = written {
         assert_eq!(e.kind(), std::io::ErrorKind::BrokenPipe, "write stdin: {e}");
     }
-    child.wait_with_output().expect("wait")
+    util::wait_within(child, util::LIMIT)
 }
 
 fn ok_stdout(o: &Output) -> String {

@@ -48,7 +48,7 @@ fn kill_mid_run(sb: &Sandbox, role: &str, after: Duration) {
 }
 
 fn finish(child: Child) -> (Option<i32>, String, String) {
-    let o = child.wait_with_output().expect("wait");
+    let o = util::wait_within(child, util::LIMIT);
     (
         o.status.code(),
         String::from_utf8_lossy(&o.stdout).to_string(),

@@ -63,7 +63,7 @@ fn spawn(mut c: Command, sb: &Sandbox) -> Child {
 }
 
 fn finish(child: Child, name: &str) {
-    let o = child.wait_with_output().expect("wait");
+    let o = util::wait_within(child, util::LIMIT);
     assert_eq!(
         o.status.code(),
         Some(0),

@@ -14,6 +14,7 @@ mod cli;
 mod faults;
 mod hosts;
 mod layout;
+mod lifecycle;
 mod loop_processes;
 mod nodes;
 mod records;

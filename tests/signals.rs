@@ -15,7 +15,7 @@ fn signal(pid: i32, sig: rustix::process::Signal) {
 }
 
 fn finish(child: Child) -> (Option<i32>, String) {
-    let o = child.wait_with_output().expect("wait");
+    let o = util::wait_within(child, util::LIMIT);
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     (o.status.code(), err)
 }

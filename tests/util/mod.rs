@@ -10,6 +10,55 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 static COUNTER: AtomicU32 = AtomicU32::new(0);
 
+/// The longest any command of a test may take: past it the command is killed and the
+/// test fails, so a hung process never hangs CI.
+pub const LIMIT: std::time::Duration = std::time::Duration::from_secs(300);
+
+/// Runs `cmd` to its end and returns its output; kills it and fails the test if it
+/// takes longer than `limit`.
+pub fn output_within(mut cmd: Command, limit: std::time::Duration) -> Output {
+    let child = cmd
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start");
+    wait_within(child, limit)
+}
+
+/// Waits for `child` and returns its output; kills it and fails the test if it takes
+/// longer than `limit`.
+pub fn wait_within(child: std::process::Child, limit: std::time::Duration) -> Output {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let pid = rustix::process::Pid::from_raw(child.id() as i32).expect("pid");
+    let done = Arc::new(AtomicBool::new(false));
+    let timed_out = Arc::new(AtomicBool::new(false));
+    let watchdog = {
+        let (done, timed_out) = (Arc::clone(&done), Arc::clone(&timed_out));
+        std::thread::spawn(move || {
+            let start = std::time::Instant::now();
+            while !done.load(Ordering::SeqCst) {
+                if start.elapsed() > limit {
+                    timed_out.store(true, Ordering::SeqCst);
+                    let _ = rustix::process::kill_process(pid, rustix::process::Signal::KILL);
+                    return;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+        })
+    };
+    let out = child.wait_with_output().expect("wait");
+    done.store(true, Ordering::SeqCst);
+    let _ = watchdog.join();
+    assert!(
+        !timed_out.load(Ordering::SeqCst),
+        "a command ran past {limit:?} and was killed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// One test's sandbox.
 pub struct Sandbox {
     /// Temporary folder, removed on drop.
@@ -60,9 +109,9 @@ impl Sandbox {
         c
     }
 
-    /// Runs `tactile` with `args`.
+    /// Runs `tactile` with `args`, within [`LIMIT`].
     pub fn tactile(&self, args: &[&str]) -> Output {
-        self.command(args).output().expect("start tactile")
+        output_within(self.command(args), LIMIT)
     }
 
     /// `tactile run SCENARIO --out OUT --prefix PREFIX -q`; asserts success and that no
@@ -233,7 +282,7 @@ pub fn start_node(
 
 /// Waits for a node to end: its exit status and its stderr.
 pub fn finish(child: std::process::Child) -> (Option<i32>, String) {
-    let o = child.wait_with_output().expect("wait");
+    let o = wait_within(child, LIMIT);
     (
         o.status.code(),
         String::from_utf8_lossy(&o.stderr).into_owned(),

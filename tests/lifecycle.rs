@@ -1,0 +1,155 @@
+//! A node's and a run's life as documented: a node stopped by SIGINT (exit 130), a
+//! master whose peers never come (exit 1), restarts exhausted, counters summed over a
+//! restarted node's segments, and a sweep of process runs.
+
+use crate::util;
+
+use std::path::Path;
+use std::time::Duration;
+use tactile_node::record::{Record, RecordReader};
+use tactile_slave::record::{SlaveSample, SlaveTotals};
+use util::{finish, kill_once_recorded, start_node, wait_for, Sandbox};
+
+#[test]
+fn a_node_stopped_by_sigint_exits_130_with_its_record_closed() {
+    let sb = Sandbox::new("node130");
+    let scenario = sb.write("s.toml", &util::paper_1khz(1000));
+    let slave = start_node(&sb, "slave", &scenario, "s", &[]);
+    wait_for("the slave holds its lock", Duration::from_secs(10), || {
+        tactile_node::lock::in_use(&sb.prefix).is_err()
+    });
+    let pid = rustix::process::Pid::from_raw(slave.id() as i32).expect("pid");
+    let _ = rustix::process::kill_process(pid, rustix::process::Signal::INT);
+    let (code, err) = finish(slave);
+    assert_eq!(code, Some(130), "{err}");
+    let log = std::fs::read_to_string(sb.path("s").join("slave.log")).expect("log");
+    assert!(log.contains("stop: interrupted"), "{log}");
+}
+
+#[test]
+fn a_master_whose_peers_never_come_exits_1_naming_them() {
+    let sb = Sandbox::new("startup");
+    let scenario = sb.write("s.toml", &util::paper_1khz(1000));
+    let master = start_node(&sb, "master", &scenario, "m", &["--startup-timeout-s", "1"]);
+    let (code, err) = finish(master);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("no answer from the emulator and slave within 1.0 s"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_node_that_dies_past_its_restarts_ends_the_run_as_failed() {
+    let sb = Sandbox::new("norestart");
+    let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
+    let out = sb.path("run");
+    let child = sb
+        .command(&["run", scenario.to_str().expect("utf-8"), "--out"])
+        .arg(&out)
+        .args(["--prefix", &sb.prefix, "-q", "--max-restarts", "0"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start");
+    wait_for("the slave runs", Duration::from_secs(20), || {
+        util::pid_of(&sb.prefix, "slave").is_some()
+    });
+    let slave = util::pid_of(&sb.prefix, "slave").expect("slave");
+    wait_for("the slave records", Duration::from_secs(20), || {
+        std::fs::metadata(out.join("slave.rec")).is_ok_and(|m| m.len() > 50_000)
+    });
+    let pid = rustix::process::Pid::from_raw(slave).expect("pid");
+    let _ = rustix::process::kill_process(pid, rustix::process::Signal::KILL);
+    let o = util::wait_within(child, util::LIMIT);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("no restarts left"), "{err}");
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["failed"], true);
+    assert!(
+        !s["events"].to_string().contains("restarted"),
+        "{}",
+        s["events"]
+    );
+    sb.assert_no_leftover_processes();
+}
+
+/// Each segment's last counters, read from the record itself.
+fn segment_counters(rec: &Path) -> Vec<SlaveTotals> {
+    let mut r = RecordReader::<Record<SlaveSample, SlaveTotals>>::open(rec).expect("record");
+    let mut segments: Vec<Option<SlaveTotals>> = Vec::new();
+    while let Some(x) = r.next_record().expect("readable") {
+        match x {
+            Record::Start(_) => segments.push(None),
+            Record::Counters(t) => {
+                if let Some(last) = segments.last_mut() {
+                    *last = Some(t.counters);
+                }
+            }
+            _ => {}
+        }
+    }
+    segments.into_iter().flatten().collect()
+}
+
+#[test]
+fn a_restarted_nodes_counters_are_summed_over_its_segments() {
+    let sb = Sandbox::new("segments");
+    let scenario = sb.write("s.toml", &util::paper_1khz(6000));
+    let master = start_node(&sb, "master", &scenario, "m", &[]);
+    let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
+    let slave = start_node(&sb, "slave", &scenario, "s", &[]);
+    let rec = sb.path("s").join("slave.rec");
+    // Past a second, so the first segment has written its counters.
+    kill_once_recorded(slave, &rec, 700_000);
+    let slave = start_node(&sb, "slave", &scenario, "s", &["--append"]);
+    for (role, child) in [("master", master), ("emulator", emulator), ("slave", slave)] {
+        let (code, err) = finish(child);
+        assert_eq!(code, Some(0), "{role}: {err}");
+    }
+    let o = sb.tactile(&["report", "m", "e", "s", "--out", "r"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let segments = segment_counters(&rec);
+    assert_eq!(segments.len(), 2, "two segments with counters");
+    let s = sb.json("r", "summary.json");
+    let steps: u64 = segments.iter().map(|t| t.counters.steps).sum();
+    let received: u64 = segments.iter().map(|t| t.v_in.received).sum();
+    assert!(segments.iter().all(|t| t.counters.steps > 0));
+    assert_eq!(
+        util::num(&s["slave"]["counters"]["steps"]),
+        steps as f64,
+        "{}",
+        s["slave"]
+    );
+    assert_eq!(util::num(&s["slave"]["v_in"]["received"]), received as f64);
+    sb.assert_no_leftover_processes();
+}
+
+#[test]
+fn a_sweep_of_process_runs_tabulates_each() {
+    let sb = Sandbox::new("sweepproc");
+    sb.write("s.toml", &util::paper_1khz(300));
+    let o = sb.tactile(&[
+        "sweep",
+        "s.toml",
+        "--set",
+        "control.kind=none,tdpa",
+        "--processes",
+        "--out",
+        "sw",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let table = std::fs::read_to_string(sb.path("sw").join("sweep.csv")).expect("sweep.csv");
+    assert_eq!(table.lines().count(), 3, "{table}");
+    for k in 0..2 {
+        let run = sb.path("sw").join(format!("run-{k:04}"));
+        for role in ["master", "emulator", "slave"] {
+            assert!(run.join(format!("{role}.rec")).is_file(), "{k}: {role}");
+        }
+        let s = sb.json(&format!("sw/run-{k:04}"), "summary.json");
+        assert_eq!(s["runner"], "processes", "{s}");
+        assert_eq!(util::num(&s["samples_received"]), 300.0);
+    }
+}
