@@ -453,3 +453,135 @@ fn garbage_datagrams_at_a_udp_node_are_counted_and_dropped() {
     assert_eq!(v["malformed"], 4 * 50, "{v}");
     assert_eq!(v["wrong_version"], 50, "{v}");
 }
+
+/// A PKI for the hosts' addresses, or None (after saying why) without openssl.
+fn pki(dir: &std::path::Path, name: &str, ips: &[String]) -> Option<[std::path::PathBuf; 3]> {
+    match tactile::launch::pki::make(dir, name, ips) {
+        Ok(files) => Some(files),
+        Err(e) if e.starts_with("running openssl") => {
+            util::cannot(&format!(
+                "openssl is needed to make the test certificates ({e})"
+            ));
+            None
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// Master on host A and emulator on host B over mutually authenticated TLS: the loop
+/// completes with nothing lost while a peer with a certificate of another CA, and one
+/// without any (plain TCP), try the master's port and are refused at the handshake.
+#[test]
+fn mutual_tls_admits_the_run_and_refuses_strangers() {
+    let Some(hosts) = Hosts::new("t") else {
+        return;
+    };
+    let sb = Sandbox::new("hoststls");
+    let Some(run_pki) = pki(&sb.path("pki"), "run", &hosts.addrs) else {
+        return;
+    };
+    let mut rogue_pki = pki(&sb.path("rogue"), "rogue", &hosts.addrs).expect("rogue pki");
+    // The stranger trusts the run's CA (so it would accept the master) but holds a
+    // certificate of its own CA: the master must refuse it.
+    let both = sb.path("rogue").join("both.pem");
+    let cas = [&run_pki[0], &rogue_pki[0]].map(|f| std::fs::read_to_string(f).expect("ca"));
+    std::fs::write(&both, cas.concat()).expect("both CAs");
+    rogue_pki[0] = both;
+    let scenario = sb.write("s.toml", &util::paper_1khz(4000));
+    let s = scenario.to_str().expect("utf-8");
+    let a = format!("tls/{}:7447", hosts.addrs[0]);
+    let p = sb.prefix.clone();
+    let tls = tactile::launch::pki::args(&run_pki);
+    let tls: Vec<&str> = tls.iter().map(String::as_str).collect();
+    let common = |dir: &'static str| vec!["--scenario", s, "--out", dir, "--prefix", &p];
+    let mut m = common("a-master");
+    m.extend(["--link", "zenoh", "--listen", &a]);
+    m.extend(&tls);
+    let mut e = common("b-emulator");
+    e.extend([
+        "--master-link",
+        "zenoh",
+        "--connect",
+        &a,
+        "--slave-link",
+        "iceoryx2",
+    ]);
+    e.extend(&tls);
+    let slave = spawn(hosts.on(1, "tactile-slave", &common("b-slave")), &sb);
+    let emulator = spawn(hosts.on(1, "tactile-emulator", &e), &sb);
+    let master = spawn(hosts.on(0, "tactile-master", &m), &sb);
+    let rec = sb.path("a-master").join("master.rec");
+    util::wait_for("the loop runs over TLS", Duration::from_secs(30), || {
+        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 200_000)
+    });
+    // Strangers on host B, under other prefixes (the run's are locked): one with a
+    // certificate of another CA, one in clear.
+    let rogue = tactile::launch::pki::args(&rogue_pki);
+    let (p1, p2) = (format!("{p}r"), format!("{p}s"));
+    let mut r1 = vec!["--scenario", s, "--out", "rogue1", "--prefix", &p1];
+    r1.extend(["--link", "zenoh", "--connect", &a]);
+    r1.extend(rogue.iter().map(String::as_str));
+    let clear = format!("tcp/{}:7447", hosts.addrs[0]);
+    let r2 = vec![
+        "--scenario",
+        s,
+        "--out",
+        "rogue2",
+        "--prefix",
+        &p2,
+        "--link",
+        "zenoh",
+        "--connect",
+        &clear,
+    ];
+    let rogues = [
+        spawn(hosts.on(1, "tactile-slave", &r1), &sb),
+        spawn(hosts.on(1, "tactile-slave", &r2), &sb),
+    ];
+    let log = sb.path("a-master").join("master.log");
+    // rustls at the master: a certificate of an unknown CA, and TLS records that are
+    // not TLS (the stranger in clear).
+    let refused = |l: &str| l.contains("UnknownIssuer") && l.contains("InvalidContentType");
+    let start = Instant::now();
+    while !std::fs::read_to_string(&log).is_ok_and(|l| refused(&l)) {
+        if start.elapsed() > Duration::from_secs(20) {
+            let read = |p: std::path::PathBuf| std::fs::read_to_string(p).unwrap_or_default();
+            panic!(
+                "the master did not refuse both strangers:\nmaster:\n{}\nrogue1:\n{}\nrogue2:\n{}",
+                read(log.clone()),
+                read(sb.path("rogue1").join("slave.log")),
+                read(sb.path("rogue2").join("slave.log"))
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    finish(master, "master");
+    finish(emulator, "emulator");
+    finish(slave, "slave");
+    for r in rogues {
+        let pid = rustix::process::Pid::from_raw(r.id() as i32).expect("pid");
+        let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
+        let _ = util::wait_within(r, util::LIMIT);
+    }
+    let o = sb.tactile(&[
+        "report",
+        "a-master",
+        "b-emulator",
+        "b-slave",
+        "--out",
+        "report",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sum = sb.json("report", "summary.json");
+    assert_eq!(sum["samples_lost"], 0, "{}", sum["channels"]);
+    for stream in ["c", "v", "h", "q"] {
+        assert_eq!(sum["channels"][stream]["received"], 4000, "{stream}");
+    }
+    let link = sum["nodes"]["master"]["link"].as_str().expect("link");
+    assert!(link.contains("mutual TLS"), "{link}");
+    for r in ["rogue1", "rogue2"] {
+        let (log, _) = (sb.path(r).join("slave.log"), ());
+        let text = std::fs::read_to_string(log).unwrap_or_default();
+        assert!(!text.contains("joined run"), "{r} joined:\n{text}");
+    }
+}

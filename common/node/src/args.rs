@@ -65,6 +65,18 @@ pub struct NodeArgs {
     /// Let Zenoh find peers by multicast scouting too (off: only the endpoints given).
     #[arg(long)]
     pub scout: bool,
+    /// Zenoh over TLS with mutual authentication: the run's certificate authority
+    /// (PEM). Every peer must present a certificate it signed, or is refused at the
+    /// handshake. With --tls-cert and --tls-key; every endpoint is then `tls/...`.
+    #[arg(long, requires_all = ["tls_cert", "tls_key"])]
+    pub tls_ca: Option<PathBuf>,
+    /// This node's certificate (PEM, signed by --tls-ca; its SubjectAltName holds the
+    /// addresses peers reach it by).
+    #[arg(long, requires_all = ["tls_ca", "tls_key"])]
+    pub tls_cert: Option<PathBuf>,
+    /// This node's private key (PEM, unencrypted).
+    #[arg(long, requires_all = ["tls_ca", "tls_cert"])]
+    pub tls_key: Option<PathBuf>,
     /// Microseconds to poll (yielding the CPU) before blocking on the wake-up event.
     /// Default: twice --wake-early-us in realtime (the node wakes that long before a
     /// sample is due), two sampling periods in lockstep; 0 blocks at once.

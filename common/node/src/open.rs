@@ -26,11 +26,59 @@ pub const NO_ZENOH: &str = "--link zenoh: this build has no Zenoh link; build wi
 /// The Zenoh endpoints of the arguments.
 #[cfg(feature = "zenoh")]
 pub fn zenoh_options(a: &NodeArgs) -> crate::zlink::ZenohOptions {
+    let tls = match (&a.tls_ca, &a.tls_cert, &a.tls_key) {
+        (Some(ca), Some(cert), Some(key)) => Some(crate::zlink::TlsFiles {
+            ca: ca.clone(),
+            cert: cert.clone(),
+            key: key.clone(),
+        }),
+        _ => None,
+    };
     crate::zlink::ZenohOptions {
         listen: a.listen.clone(),
         connect: a.connect.clone(),
         scout: a.scout,
+        tls,
     }
+}
+
+/// Checks the TLS options: the three files readable, every endpoint `tls/` with
+/// them and none without.
+fn check_tls(a: &NodeArgs) -> Result<(), NodeError> {
+    let tls = a.tls_ca.is_some();
+    for (what, file) in [
+        ("--tls-ca", &a.tls_ca),
+        ("--tls-cert", &a.tls_cert),
+        ("--tls-key", &a.tls_key),
+    ] {
+        if let Some(f) = file {
+            crate::files::read_text(f, what, 1 << 20).map_err(NodeError::BadInput)?;
+        }
+    }
+    for e in a.listen.iter().chain(&a.connect) {
+        let is_tls = e.starts_with("tls/");
+        if tls && !is_tls {
+            return Err(NodeError::BadInput(format!(
+                "Zenoh endpoint {e:?}: with --tls-ca every endpoint is tls/ADDRESS:PORT (nothing joins in clear)"
+            )));
+        }
+        if is_tls && !tls {
+            return Err(NodeError::BadInput(format!(
+                "Zenoh endpoint {e:?}: a tls/ endpoint needs --tls-ca, --tls-cert and --tls-key"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// True if every Zenoh endpoint stays on this host (loopback): plain TCP there is
+/// only as open as the host.
+pub fn loopback_only(a: &NodeArgs) -> bool {
+    a.listen.iter().chain(&a.connect).all(|e| {
+        e.split_once('/')
+            .and_then(|(_, addr)| addr.parse::<std::net::SocketAddr>().ok())
+            .is_some_and(|s| s.ip().is_loopback())
+    })
 }
 
 /// Checks the options of the links in use, before anything starts.
@@ -49,14 +97,16 @@ pub fn check_link_args(a: &NodeArgs, links: &[LinkKind]) -> Result<(), NodeError
         }
         for e in a.listen.iter().chain(&a.connect) {
             let ok = e.split_once('/').is_some_and(|(proto, addr)| {
-                matches!(proto, "tcp" | "udp") && addr.parse::<std::net::SocketAddr>().is_ok()
+                matches!(proto, "tcp" | "udp" | "tls")
+                    && addr.parse::<std::net::SocketAddr>().is_ok()
             });
             if !ok {
                 return Err(NodeError::BadInput(format!(
-                    "Zenoh endpoint {e:?}: expected tcp/ADDRESS:PORT or udp/ADDRESS:PORT"
+                    "Zenoh endpoint {e:?}: expected tcp/ADDRESS:PORT, udp/ADDRESS:PORT or tls/ADDRESS:PORT"
                 )));
             }
         }
+        check_tls(a)?;
         #[cfg(feature = "zenoh")]
         zenoh_options(a)
             .config()
@@ -134,10 +184,21 @@ pub fn slave_link(
 /// Opening the Zenoh links, in a build with the `zenoh` feature.
 #[cfg(feature = "zenoh")]
 mod zenoh_open {
-    use super::{opened, zenoh_options, NodeArgs, NodeError};
+    use super::{loopback_only, opened, NodeArgs, NodeError};
     use crate::link::WaitPolicy;
     use crate::link::{EmulatorLink, MasterLink, SlaveLink};
-    use crate::zlink::{ZenohEmulator, ZenohMaster, ZenohSlave};
+    use crate::zlink::{ZenohEmulator, ZenohMaster, ZenohOptions, ZenohSlave};
+
+    /// The options, with a warning when the run is open to anyone on the path.
+    fn zenoh_options(a: &NodeArgs) -> ZenohOptions {
+        if a.tls_ca.is_none() && !loopback_only(a) {
+            tracing::warn!(
+                "Zenoh in clear across hosts: any peer that reaches {:?} can read this run and inject samples into it; on a network you do not trust give --tls-ca, --tls-cert and --tls-key (docs/03-across-hosts.md)",
+                a.listen.iter().chain(&a.connect).collect::<Vec<_>>()
+            );
+        }
+        super::zenoh_options(a)
+    }
 
     pub fn master(
         a: &NodeArgs,

@@ -228,10 +228,15 @@ pub fn describe_link(a: &NodeArgs) -> String {
         LinkKind::Iceoryx2 => "iceoryx2".into(),
         LinkKind::Udp => format!("udp ports {} on {}", a.udp_ports, a.udp_hosts),
         LinkKind::Zenoh => format!(
-            "zenoh (listen {:?}, connect {:?}{})",
+            "zenoh (listen {:?}, connect {:?}{}{})",
             a.listen,
             a.connect,
-            if a.scout { ", scouting" } else { "" }
+            if a.scout { ", scouting" } else { "" },
+            if a.tls_ca.is_some() {
+                ", mutual TLS"
+            } else {
+                ""
+            }
         ),
     }
 }

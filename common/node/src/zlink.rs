@@ -46,6 +46,19 @@ pub struct ZenohOptions {
     pub connect: Vec<String>,
     /// Discover peers by multicast scouting too.
     pub scout: bool,
+    /// Mutually authenticated TLS: the run's CA, this node's certificate and key.
+    pub tls: Option<TlsFiles>,
+}
+
+/// The files of a node's TLS identity (PEM).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TlsFiles {
+    /// The run's certificate authority: a peer must present a certificate it signed.
+    pub ca: std::path::PathBuf,
+    /// This node's certificate.
+    pub cert: std::path::PathBuf,
+    /// This node's private key.
+    pub key: std::path::PathBuf,
 }
 
 impl ZenohOptions {
@@ -80,6 +93,22 @@ impl ZenohOptions {
         // Keep trying to reach a peer that is not up yet (nodes start in any order).
         set(&mut c, "connect/timeout_ms", "-1")?;
         set(&mut c, "connect/exit_on_failure", "false")?;
+        if let Some(t) = &self.tls {
+            // Both sides present a certificate of the run's CA (mutual TLS: a listener
+            // refuses a peer without one at the handshake), the server's name is
+            // checked against the address connected to, and no other protocol is
+            // accepted, so nobody joins over plain TCP.
+            let path = |p: &std::path::Path| format!("{:?}", p.display().to_string());
+            let tls = "transport/link/tls";
+            set(&mut c, &format!("{tls}/root_ca_certificate"), &path(&t.ca))?;
+            for side in ["listen", "connect"] {
+                set(&mut c, &format!("{tls}/{side}_certificate"), &path(&t.cert))?;
+                set(&mut c, &format!("{tls}/{side}_private_key"), &path(&t.key))?;
+            }
+            set(&mut c, &format!("{tls}/enable_mtls"), "true")?;
+            set(&mut c, &format!("{tls}/verify_name_on_connect"), "true")?;
+            set(&mut c, "transport/link/protocols", "[\"tls\"]")?;
+        }
         Ok(c)
     }
 }

@@ -49,6 +49,21 @@ impl Links {
         &self.args[role.index()]
     }
 
+    /// [`Links::across`] over Zenoh with mutual TLS: every node with the identity
+    /// `tls` (its `--tls-*` options), every endpoint `tls/`.
+    pub fn across_tls(hosts: &super::netns::Pair, tls: &[String]) -> Links {
+        let mut l = Links::across(LinkKind::Zenoh, hosts);
+        for args in &mut l.args {
+            for a in args.iter_mut() {
+                if let Some(rest) = a.strip_prefix("tcp/") {
+                    *a = format!("tls/{rest}");
+                }
+            }
+            args.extend(tls.iter().cloned());
+        }
+        l
+    }
+
     /// Master on host 0 of `hosts`, emulator and slave on host 1, every hop on
     /// `kind` (Zenoh or UDP) across the veth pair.
     pub fn across(kind: LinkKind, hosts: &super::netns::Pair) -> Links {

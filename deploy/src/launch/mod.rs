@@ -5,6 +5,7 @@
 pub mod links;
 pub mod netns;
 pub mod nodes;
+pub mod pki;
 pub mod scenario;
 pub mod sim;
 pub mod supervise;

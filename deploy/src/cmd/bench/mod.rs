@@ -144,8 +144,9 @@ pub struct BenchArgs {
     /// iceoryx2 prefix of the bench's runs (default: one per invocation).
     #[arg(long)]
     pub prefix: Option<String>,
-    /// Also run the Zenoh and UDP loops across two hosts: two network namespaces
-    /// joined by a veth pair (made and removed by the bench; needs root).
+    /// Also run the loops across two hosts: Zenoh in clear, Zenoh over mutual TLS
+    /// (certificates made with `openssl` for the run) and UDP, in two network
+    /// namespaces joined by a veth pair (made and removed by the bench; needs root).
     #[arg(long)]
     pub hosts: bool,
 }
@@ -341,6 +342,7 @@ impl Bench<'_> {
         r.ratio("iceoryx2", "udp");
         r.ratio("zenoh", "udp");
         r.ratio("zenoh-hosts", "udp-hosts");
+        r.ratio("zenoh-tls-hosts", "zenoh-hosts");
         Ok(r)
     }
 
@@ -367,15 +369,36 @@ impl Bench<'_> {
     }
 
     /// The loops across the two namespaces (which share the CPUs: not pinned).
+    /// Zenoh in clear and over mutual TLS (with a throwaway PKI for the two hosts,
+    /// where `openssl` is installed), and UDP.
     fn across_hosts(&self, sc: &Scenario, pair: &Pair) -> Result<Vec<LoopResult>, Error> {
         let mut loops = Vec::new();
+        let tls = if zenoh_built(LinkKind::Zenoh) {
+            match crate::launch::pki::make(&self.args.out.join("pki"), "bench", &pair.addrs) {
+                Ok(files) => Some(crate::launch::pki::args(&files)),
+                Err(e) => {
+                    crate::noteln!("tactile bench: no TLS loop: {e}");
+                    None
+                }
+            }
+        } else {
+            None
+        };
+        let links = |name: &str| match (name, &tls) {
+            ("zenoh-tls-hosts", Some(t)) => Some(crate::launch::Links::across_tls(pair, t)),
+            ("zenoh-tls-hosts", None) => None,
+            ("zenoh-hosts", _) => Some(crate::launch::Links::across(LinkKind::Zenoh, pair)),
+            _ => Some(crate::launch::Links::across(LinkKind::Udp, pair)),
+        };
         for (name, link) in [
             ("zenoh-hosts", LinkKind::Zenoh),
+            ("zenoh-tls-hosts", LinkKind::Zenoh),
             ("udp-hosts", LinkKind::Udp),
         ]
         .into_iter()
         .filter(|&(_, l)| zenoh_built(l))
         {
+            let Some(links) = links(name) else { continue };
             let rate = sc.rate_hz;
             crate::noteln!(
                 "tactile bench: {rate} Hz: {name} loop, master in {}, emulator and slave in {}",
@@ -383,7 +406,7 @@ impl Bench<'_> {
                 pair.names[1]
             );
             let wrap = [pair.exec(0), pair.exec(1), pair.exec(1)];
-            let links = crate::launch::Links::across(link, pair);
+            debug_assert_eq!(links.kind, link);
             let out = self.args.out.join(format!("{name}-{rate}"));
             let sup = Supervision {
                 pin: false,
