@@ -169,8 +169,11 @@ fn sigterm_to_the_launcher_stops_everything_and_writes_the_report() {
     let sb = Sandbox::new("sigterm");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let child = spawn_run(&sb, &scenario, "run");
-    wait_for_master(&sb);
-    std::thread::sleep(Duration::from_millis(1000));
+    // Once the loop has run for a while (its slave has recorded about a second).
+    let rec = sb.path("run").join("slave.rec");
+    util::wait_for("the loop runs", Duration::from_secs(20), || {
+        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 300_000)
+    });
     kill(child.id() as i32, rustix::process::Signal::TERM);
     let (code, stdout, stderr) = finish(child);
     sb.assert_no_leftover_processes();
@@ -201,7 +204,11 @@ fn a_new_run_after_a_crash_starts_cleanly() {
         kill(pid, rustix::process::Signal::KILL);
     }
     let _ = finish(child);
-    std::thread::sleep(Duration::from_millis(100));
+    util::wait_for("the killed nodes are gone", Duration::from_secs(10), || {
+        ["master", "emulator", "slave"]
+            .iter()
+            .all(|r| pid_of(&sb, r).is_none())
+    });
     sb.assert_no_leftover_processes();
     // Stale shared memory of the crashed run is still there; the same prefix must work.
     let again = sb.write("again.toml", &util::paper_1khz(500));

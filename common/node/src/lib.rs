@@ -22,4 +22,6 @@ mod sys;
 pub mod udp;
 pub mod wire;
 #[cfg(feature = "zenoh")]
+mod zconfig;
+#[cfg(feature = "zenoh")]
 pub mod zlink;
