@@ -100,12 +100,14 @@ pub fn node(prefix: &str, name: &str) -> Result<Node<ipc::Service>, LinkError> {
     Ok(node)
 }
 
-/// True once SIGINT or SIGTERM was received (consumes the request).
+/// True once SIGINT or SIGTERM was received: by iceoryx2's handler (which consumes
+/// the request) or, before iceoryx2 installed it, by the node's own stop flag.
 pub fn termination_requested(node: &Node<ipc::Service>) -> bool {
-    matches!(
-        node.wait(Duration::ZERO),
-        Err(NodeWaitFailure::TerminationRequest)
-    )
+    crate::signals::stop_requested()
+        || matches!(
+            node.wait(Duration::ZERO),
+            Err(NodeWaitFailure::TerminationRequest)
+        )
 }
 
 fn service_name(stream: &str) -> Result<ServiceName, LinkError> {

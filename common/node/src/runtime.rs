@@ -43,6 +43,9 @@ pub struct Prepared {
 /// fails: the error is bad input (exit 2).
 pub fn prepare(role: Role, args: &NodeArgs) -> Result<Prepared, NodeError> {
     let bad = NodeError::BadInput;
+    // From here on a stop request is never fatal: it is noticed by the loop (or by
+    // iceoryx2's handler, once the link installs it) and the record is closed.
+    crate::signals::stop_flag().map_err(|e| bad(format!("installing signal handlers: {e}")))?;
     lock::check_prefix(&args.prefix).map_err(bad)?;
     let (scenario, base_dir) = crate::files::load_scenario(&args.scenario).map_err(bad)?;
     check_link_args(args, &[args.link])?;
