@@ -556,12 +556,13 @@ fn a_run_leaves_nothing_behind_and_cleans_only_dead_runs() {
         std::fs::create_dir_all(root.join(p)).expect("folder");
         std::fs::write(root.join(p).join("node"), "x").expect("file");
     }
-    std::fs::create_dir_all(root.join("locks")).expect("locks");
-    let dead_lock = root.join("locks").join(format!("{dead}.slave.lock"));
+    let locks = tactile_node::lock::lock_dir();
+    std::fs::create_dir_all(&locks).expect("locks");
+    let dead_lock = locks.join(format!("{dead}.slave.lock"));
     std::fs::write(&dead_lock, "a killed slave").expect("lock");
     let held = tactile_node::lock::take(&live, "slave", "a live slave").expect("take");
     sb.run(&scenario, "out");
-    let mine: Vec<String> = std::fs::read_dir(root.join("locks"))
+    let mine: Vec<String> = std::fs::read_dir(&locks)
         .expect("locks")
         .flatten()
         .map(|e| e.file_name().to_string_lossy().into_owned())
@@ -578,7 +579,7 @@ fn a_run_leaves_nothing_behind_and_cleans_only_dead_runs() {
         .any(|e| {
             e.file_name()
                 .to_string_lossy()
-                .starts_with(&format!("{}_", sb.prefix))
+                .starts_with(&format!("{}.", sb.prefix))
         });
     assert!(!shm, "the run's shared memory is gone");
     assert!(

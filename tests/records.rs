@@ -129,4 +129,23 @@ fn corrupted_bytes_mid_record_cost_only_their_frames() {
         .count();
     assert_eq!(clean.lines().count(), damaged.lines().count());
     assert!((1..=2).contains(&changed), "{changed} rows differ");
+    // The master's record damaged too: its lost samples are gaps, the rest reported.
+    let rec = sb.path("bad").join("master.rec");
+    let mut bytes = std::fs::read(&rec).expect("record");
+    let mid = bytes.len() / 2;
+    for b in &mut bytes[mid..mid + 20] {
+        *b = !*b;
+    }
+    std::fs::write(&rec, &bytes).expect("write");
+    let o = sb.tactile(&["report", "bad"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = sb.json("bad", "summary.json");
+    assert_eq!(
+        s["nodes"]["master"]["damaged_stretches"], 1,
+        "{}",
+        s["nodes"]["master"]
+    );
+    let rows = sb.trace("bad").lines().count();
+    let all = clean.lines().count();
+    assert!(rows + 2 >= all && rows < all, "{rows} rows of {all}");
 }

@@ -11,7 +11,7 @@
 
 use serde::de::DeserializeOwned;
 use serde::Serialize;
-use std::io::{BufReader, Read, Seek, SeekFrom, Write};
+use std::io::{BufReader, Read, Write};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -95,7 +95,11 @@ impl<T: Serialize> RecordWriter<T> {
     /// restarted node of the same run) after trimming a torn tail; a file that is not
     /// a record of this format is never touched.
     pub fn create(path: &Path, append: bool) -> std::io::Result<Self> {
-        let file = if append && path.exists() {
+        // A file killed before its magic was whole holds nothing: started afresh.
+        let started = std::fs::read(path)
+            .map(|b| b.len() >= MAGIC.len() || !MAGIC.starts_with(&b))
+            .unwrap_or(false);
+        let file = if append && path.exists() && started {
             let end = whole_end(path)?;
             let f = std::fs::OpenOptions::new().append(true).open(path)?;
             f.set_len(end)?;
@@ -118,6 +122,16 @@ impl<T: Serialize> RecordWriter<T> {
         self.buf.clear();
         bincode::serde::encode_into_std_write(record, &mut self.buf, config())
             .map_err(std::io::Error::other)?;
+        if self.buf.len() > MAX_FRAME as usize {
+            // A reader would take it for damage: refuse it here instead.
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!(
+                    "a record of {} bytes is longer than a frame may be",
+                    self.buf.len()
+                ),
+            ));
+        }
         self.file.write_all(&frame(&self.buf))
     }
 
@@ -141,6 +155,8 @@ fn whole_end(path: &Path) -> std::io::Result<u64> {
 #[derive(Debug)]
 struct Frames {
     input: BufReader<std::fs::File>,
+    /// Where the next byte read from `input` comes from.
+    pos: u64,
     /// Offset of the next frame.
     offset: u64,
     len: u64,
@@ -176,6 +192,7 @@ impl Frames {
         }
         Ok(Frames {
             input,
+            pos: MAGIC.len() as u64,
             offset: MAGIC.len() as u64,
             len: meta.len(),
             body: Vec::new(),
@@ -196,7 +213,18 @@ impl Frames {
                 Err(e) => return Err(e),
             }
         }
+        self.pos += got as u64;
         Ok(got)
+    }
+
+    /// Moves the input to `at`; frames read in order need no seek, and a move within
+    /// the buffer keeps it.
+    fn move_to(&mut self, at: u64) -> std::io::Result<()> {
+        if at != self.pos {
+            self.input.seek_relative(at as i64 - self.pos as i64)?;
+            self.pos = at;
+        }
+        Ok(())
     }
 
     /// Whether a whole frame starts at `at`; if so its body is in `self.body` and
@@ -205,7 +233,7 @@ impl Frames {
         if at + HEADER as u64 > self.len {
             return Ok(false);
         }
-        self.input.seek(SeekFrom::Start(at))?;
+        self.move_to(at)?;
         let mut h = [0u8; HEADER];
         if self.read_full(&mut h)? < HEADER || h[..4] != SYNC {
             return Ok(false);
@@ -228,7 +256,7 @@ impl Frames {
         let mut at = from;
         let mut chunk = vec![0u8; 1 << 16];
         while at + HEADER as u64 <= self.len {
-            self.input.seek(SeekFrom::Start(at))?;
+            self.move_to(at)?;
             let n = self.read_full(&mut chunk)?;
             let Some(k) = chunk[..n].windows(SYNC.len()).position(|w| w == SYNC) else {
                 // Keep the last bytes: a sync word may straddle the chunks.
@@ -376,6 +404,17 @@ mod tests {
         assert_eq!(got.len(), 50);
         assert_eq!(got.last(), Some(&100));
         assert_eq!(damaged, 0, "the append trimmed the torn frame");
+    }
+
+    #[test]
+    fn a_record_killed_before_its_magic_was_whole_starts_afresh_on_append() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("x.rec");
+        std::fs::write(&path, &MAGIC[..3]).expect("write");
+        let mut w = RecordWriter::<R>::create(&path, true).expect("append");
+        w.write(&(1, String::new())).expect("write");
+        drop(w);
+        assert_eq!(read(&path), (vec![1], 0));
     }
 
     #[test]

@@ -1,13 +1,9 @@
-//! The iceoryx2 link: shared-memory wiring shared by the three processes.
-//!
-//! It lives in `tactile-node` because all three processes must agree on service
-//! names, buffer sizes and overflow policy, or they cannot connect. Each stream is a publish-subscribe service plus an
-//! event service of the same name: the sender publishes then notifies, the receiver
-//! spins for a short budget and then blocks on the event.
-//!
-//! Isolation: every run (and every test) uses its own `prefix`, which names both the
-//! shared-memory objects and the folder of node and service files, so runs never see
-//! each other.
+//! The iceoryx2 link: shared-memory wiring all three processes agree on (service
+//! names, buffer sizes, overflow policy). Each stream is a publish-subscribe service
+//! plus an event service of the same name: the sender publishes then notifies, the
+//! receiver spins for a short budget and then blocks on the event. Every run (and
+//! every test) has its own `prefix`, naming its shared-memory objects and its folder
+//! of node and service files, so runs never see each other.
 
 use iceoryx2::config::Config;
 use iceoryx2::node::NodeWaitFailure;
@@ -76,7 +72,7 @@ pub fn config(prefix: &str) -> Result<Config, LinkError> {
         format!("root path {root}"),
     )?);
     cfg.global.prefix = map(
-        FileName::new(format!("{prefix}_").as_bytes()),
+        FileName::new(format!("{prefix}.").as_bytes()),
         format!("prefix {prefix:?}"),
     )?;
     Ok(cfg)
@@ -103,11 +99,11 @@ pub fn node(prefix: &str, name: &str) -> Result<Node<ipc::Service>, LinkError> {
 /// True once SIGINT or SIGTERM was received: by iceoryx2's handler (which consumes
 /// the request) or, before iceoryx2 installed it, by the node's own stop flag.
 pub fn termination_requested(node: &Node<ipc::Service>) -> bool {
-    crate::signals::stop_requested()
-        || matches!(
-            node.wait(Duration::ZERO),
-            Err(NodeWaitFailure::TerminationRequest)
-        )
+    let iox = matches!(
+        node.wait(Duration::ZERO),
+        Err(NodeWaitFailure::TerminationRequest)
+    );
+    iox || crate::signals::stop_requested()
 }
 
 fn service_name(stream: &str) -> Result<ServiceName, LinkError> {
@@ -347,7 +343,8 @@ pub fn dead_nodes(prefix: &str) -> Result<Vec<String>, LinkError> {
 
 /// Removes the shared-memory objects and files of a run (after all its processes ended).
 pub fn remove_run_files(prefix: &str) {
-    let shm_prefix = format!("{prefix}_");
+    // `.` ends the prefix: no prefix holds one, so `exp` never matches `exp_2`'s.
+    let shm_prefix = format!("{prefix}.");
     if let Ok(dir) = std::fs::read_dir("/dev/shm") {
         for entry in dir.flatten() {
             if entry.file_name().to_string_lossy().starts_with(&shm_prefix) {

@@ -118,7 +118,12 @@ fn holder(path: &std::path::Path) -> Option<String> {
                 who.into()
             })
         }
-        Err(_) => None,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        // A lock file this process may not open is someone's: never taken for free.
+        Err(e) => Some(format!(
+            "a process this one cannot see ({}: {e})",
+            path.display()
+        )),
     }
 }
 
@@ -128,7 +133,7 @@ fn holder(path: &std::path::Path) -> Option<String> {
 pub fn in_use(prefix: &str) -> Result<(), String> {
     check_prefix(prefix)?;
     for what in RUN_LOCKS {
-        if let Some(who) = holder(&lock_dir().join(format!("{prefix}.{what}.lock"))) {
+        if let Some(who) = holder(&lock_path(prefix, what)) {
             return Err(in_use_message(prefix, &who));
         }
     }
@@ -139,11 +144,20 @@ fn in_use_message(prefix: &str, who: &str) -> String {
     format!("prefix {prefix:?} is in use: {who} holds it; wait for that run to end or choose another --prefix")
 }
 
+/// Every lock of run `prefix`, if no other process holds any (held while the caller
+/// removes what a dead run left, so no node of that prefix starts meanwhile).
+pub fn take_all(prefix: &str, holder_text: &str) -> Option<Vec<Lock>> {
+    RUN_LOCKS
+        .iter()
+        .map(|what| take(prefix, what, holder_text).ok())
+        .collect()
+}
+
 /// True if no process holds any lock of `prefix`.
 pub fn idle(prefix: &str) -> bool {
     RUN_LOCKS
         .iter()
-        .all(|what| holder(&lock_dir().join(format!("{prefix}.{what}.lock"))).is_none())
+        .all(|what| holder(&lock_path(prefix, what)).is_none())
 }
 
 /// Removes the lock files that no live process holds (left by killed processes).
@@ -157,8 +171,15 @@ pub fn clean_stale() {
     }
 }
 
-fn lock_dir() -> PathBuf {
-    PathBuf::from(crate::ipc::ROOT).join("locks")
+/// The lock files' folder: a name no prefix can take (prefixes start with a letter or
+/// a digit), so no run's iceoryx2 folder is ever it.
+pub fn lock_dir() -> PathBuf {
+    PathBuf::from(crate::ipc::ROOT).join(".locks")
+}
+
+/// The lock file of `what` in run `prefix`.
+fn lock_path(prefix: &str, what: &str) -> PathBuf {
+    lock_dir().join(format!("{prefix}.{what}.lock"))
 }
 
 /// Takes `<prefix>.<what>.lock`, writing `holder` (a description of this process) into
@@ -167,9 +188,18 @@ pub fn take(prefix: &str, what: &str, holder_text: &str) -> Result<Lock, String>
     check_prefix(prefix)?;
     let dir = lock_dir();
     std::fs::create_dir_all(&dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
-    let path = dir.join(format!("{prefix}.{what}.lock"));
-    let opened =
-        locked_file(&path, true).map_err(|e| format!("opening {}: {e}", path.display()))?;
+    let path = lock_path(prefix, what);
+    // A free lock may be held for a moment by another process's probe (`holder`):
+    // a few tries over 50 ms before it counts as in use.
+    let mut opened = None;
+    for _ in 0..10 {
+        opened =
+            locked_file(&path, true).map_err(|e| format!("opening {}: {e}", path.display()))?;
+        if opened.is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
     let Some(mut file) = opened else {
         let who = holder(&path).unwrap_or_else(|| "another process".into());
         return Err(in_use_message(prefix, &who));

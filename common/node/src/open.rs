@@ -74,11 +74,12 @@ fn check_tls(a: &NodeArgs) -> Result<(), NodeError> {
 /// True if every Zenoh endpoint stays on this host (loopback): plain TCP there is
 /// only as open as the host.
 pub fn loopback_only(a: &NodeArgs) -> bool {
-    a.listen.iter().chain(&a.connect).all(|e| {
-        e.split_once('/')
-            .and_then(|(_, addr)| addr.parse::<std::net::SocketAddr>().ok())
-            .is_some_and(|s| s.ip().is_loopback())
-    })
+    !a.scout
+        && a.listen.iter().chain(&a.connect).all(|e| {
+            e.split_once('/')
+                .and_then(|(_, addr)| addr.parse::<std::net::SocketAddr>().ok())
+                .is_some_and(|s| s.ip().is_loopback())
+        })
 }
 
 /// Checks the options of the links in use, before anything starts.

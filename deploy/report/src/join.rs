@@ -176,10 +176,8 @@ where
             let next = reader
                 .next_record()
                 .map_err(|e| Error::Failed(e.to_string()))?;
-            self.log.damage = reader.damage().to_vec();
-            self.log.damaged = reader.damaged();
             let Some(rec) = next else {
-                self.reader = None;
+                self.close();
                 return Ok(());
             };
             if let Some(s) = self.log.take(rec) {
@@ -191,6 +189,26 @@ where
             }
         }
         Ok(())
+    }
+
+    /// Stops reading, keeping what the reader skipped as damage.
+    fn close(&mut self) {
+        if let Some(reader) = self.reader.take() {
+            self.log.damage = reader.damage().to_vec();
+            self.log.damaged = reader.damaged();
+        }
+    }
+
+    /// True if records of samples after `n` are waiting (a sample missing from the
+    /// record is a gap, not its end).
+    fn has_after(&self, n: u64) -> bool {
+        self.ahead.keys().next_back().is_some_and(|&k| k > n)
+    }
+
+    /// The log as read so far (a join cut short).
+    fn into_log(mut self) -> NodeLog<C> {
+        self.close();
+        self.log
     }
 
     /// The records of sample `n`; records of earlier samples are counted as unjoined.
@@ -408,6 +426,12 @@ pub fn join(
             MasterSample::Sent(s) => Some(*s),
             _ => None,
         }) else {
+            // A sample the master's record lost (a damaged stretch): skipped, the
+            // rest joined; past the last one, the end.
+            if master.has_after(n) {
+                n += 1;
+                continue;
+            }
             break;
         };
         let answer = items.iter().find_map(|x| match x {
@@ -432,11 +456,13 @@ pub fn join(
             step.as_ref(),
         ))?;
         if flow.is_break() {
-            return Ok(Logs {
-                master: master.log,
-                emulator: emulator.log,
-                slave: slave.log,
-            });
+            let logs = Logs {
+                master: master.into_log(),
+                emulator: emulator.into_log(),
+                slave: slave.into_log(),
+            };
+            check_one_run(&logs)?;
+            return Ok(logs);
         }
         n += 1;
     }

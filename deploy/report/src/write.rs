@@ -50,6 +50,9 @@ impl Launch {
     pub fn interrupted(mut self) -> Launch {
         self.interrupted = true;
         self.until = Some(Instant::now() + Duration::from_millis(700));
+        // The request that cut the run is in the flag already: the deadline bounds
+        // this report instead.
+        self.stop = None;
         self
     }
 }

@@ -92,6 +92,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
         let completed = launch::sim::simulate(&loaded.scenario, &loaded.base_dir, &args.out)?;
         let launch = Launch {
             no_trace: args.no_trace,
+            stop: tactile_node::signals::stop_flag().ok(),
             ..Launch::default()
         };
         let launch = if completed {

@@ -149,6 +149,7 @@ fn run_one(
 ) -> Result<tactile_report::summary::Summary, Error> {
     let launch = Launch {
         no_trace: !args.trace,
+        stop: tactile_node::signals::stop_flag().ok(),
         ..Launch::default()
     };
     if args.processes {

@@ -84,7 +84,12 @@ pub fn clean_stale_runs() {
     for entry in dir.flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
         let is_prefix = tactile_node::lock::check_prefix(&name).is_ok() && entry.path().is_dir();
-        if is_prefix && name != "locks" && tactile_node::lock::idle(&name) {
+        if !is_prefix {
+            continue;
+        }
+        // Every lock of the prefix held while its files go, so no node of it starts
+        // meanwhile (one that tries finds its prefix in use).
+        if let Some(_locks) = tactile_node::lock::take_all(&name, "tactile cleaning a dead run") {
             tactile_node::ipc::remove_run_files(&name);
         }
     }

@@ -203,6 +203,11 @@ impl<'a> Supervisor<'a> {
     fn restart_due(&mut self) -> Result<(), Error> {
         let now = Instant::now();
         for k in 0..self.procs.len() {
+            if self.watch.interrupted {
+                // A stop was asked for while it waited: it stays stopped.
+                self.procs[k].restart_at = None;
+                continue;
+            }
             if self.procs[k].restart_at.is_some_and(|at| now >= at) {
                 let role = self.procs[k].role;
                 self.procs[k].restart_at = None;
@@ -247,6 +252,8 @@ impl<'a> Supervisor<'a> {
             self.watch.events.push(format!(
                 "{role} {how} after {at:.2} s: a stop request, not restarted"
             ));
+            // Someone stopped this node (or the whole group): the run stops with it.
+            self.on_stop_request();
             return false;
         }
         self.on_death(k, status)
@@ -317,7 +324,13 @@ impl<'a> Supervisor<'a> {
             if stop.load(Ordering::SeqCst) {
                 self.on_stop_request();
             }
-            self.poll()?;
+            if let Err(e) = self.poll() {
+                // A restart that cannot start: nothing may run on without a launcher.
+                self.procs
+                    .iter_mut()
+                    .for_each(|p| p.stop(Duration::from_secs(1)));
+                return Err(e);
+            }
             self.progress(expected_s);
             std::thread::sleep(POLL);
         }
@@ -428,6 +441,7 @@ fn report(out: &Path, w: Watch, no_trace: bool) -> Result<Summary, Error> {
         events: w.events,
         failed: w.failed,
         no_trace,
+        stop: tactile_node::signals::stop_flag().ok(),
         ..Launch::default()
     };
     let launch = if w.interrupted {
