@@ -88,6 +88,16 @@ fn a_torn_record_appended_to_keeps_every_whole_frame_of_both_segments() {
     sb.assert_no_leftover_processes();
 }
 
+/// Inverts 20 bytes in the middle of the record `rec`.
+fn corrupt_middle(rec: &Path) {
+    let mut bytes = std::fs::read(rec).expect("record");
+    let mid = bytes.len() / 2;
+    for b in &mut bytes[mid..mid + 20] {
+        *b = !*b;
+    }
+    std::fs::write(rec, &bytes).expect("write");
+}
+
 /// Bytes corrupted in the middle of a record cost the frames they touch, not the
 /// report: the rest of the trace is what it was, and the summary says what it skipped.
 #[test]
@@ -101,13 +111,7 @@ fn corrupted_bytes_mid_record_cost_only_their_frames() {
         let from = sb.path("clean").join(format!("{role}.rec"));
         std::fs::copy(from, sb.path("bad").join(format!("{role}.rec"))).expect("copy");
     }
-    let rec = sb.path("bad").join("slave.rec");
-    let mut bytes = std::fs::read(&rec).expect("record");
-    let mid = bytes.len() / 2;
-    for b in &mut bytes[mid..mid + 20] {
-        *b = !*b;
-    }
-    std::fs::write(&rec, &bytes).expect("write");
+    corrupt_middle(&sb.path("bad").join("slave.rec"));
     let o = sb.tactile(&["report", "bad"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = String::from_utf8_lossy(&o.stdout);
@@ -130,13 +134,7 @@ fn corrupted_bytes_mid_record_cost_only_their_frames() {
     assert_eq!(clean.lines().count(), damaged.lines().count());
     assert!((1..=2).contains(&changed), "{changed} rows differ");
     // The master's record damaged too: its lost samples are gaps, the rest reported.
-    let rec = sb.path("bad").join("master.rec");
-    let mut bytes = std::fs::read(&rec).expect("record");
-    let mid = bytes.len() / 2;
-    for b in &mut bytes[mid..mid + 20] {
-        *b = !*b;
-    }
-    std::fs::write(&rec, &bytes).expect("write");
+    corrupt_middle(&sb.path("bad").join("master.rec"));
     let o = sb.tactile(&["report", "bad"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let s = sb.json("bad", "summary.json");
