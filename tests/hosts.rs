@@ -534,10 +534,11 @@ fn mutual_tls_admits_the_run_and_refuses_strangers() {
         "--connect",
         &clear,
     ];
-    let rogues = [
+    // Killed however the test ends: a stranger never finds its master and would wait.
+    let rogues = Killed(vec![
         spawn(hosts.on(1, "tactile-slave", &r1), &sb),
         spawn(hosts.on(1, "tactile-slave", &r2), &sb),
-    ];
+    ]);
     let log = sb.path("a-master").join("master.log");
     // rustls at the master: a certificate of an unknown CA, and TLS records that are
     // not TLS (the stranger in clear).
@@ -558,11 +559,7 @@ fn mutual_tls_admits_the_run_and_refuses_strangers() {
     finish(master, "master");
     finish(emulator, "emulator");
     finish(slave, "slave");
-    for r in rogues {
-        let pid = rustix::process::Pid::from_raw(r.id() as i32).expect("pid");
-        let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
-        let _ = util::wait_within(r, util::LIMIT);
-    }
+    drop(rogues);
     let o = sb.tactile(&[
         "report",
         "a-master",
@@ -583,5 +580,27 @@ fn mutual_tls_admits_the_run_and_refuses_strangers() {
         let (log, _) = (sb.path(r).join("slave.log"), ());
         let text = std::fs::read_to_string(log).unwrap_or_default();
         assert!(!text.contains("joined run"), "{r} joined:\n{text}");
+    }
+}
+
+/// Child processes killed (and reaped) when dropped, also when a test panics.
+struct Killed(Vec<Child>);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        // SIGTERM first, so each closes its record and releases its lock.
+        for c in &self.0 {
+            if let Some(pid) = rustix::process::Pid::from_raw(c.id() as i32) {
+                let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
+            }
+        }
+        let until = Instant::now() + Duration::from_secs(3);
+        for c in &mut self.0 {
+            while Instant::now() < until && matches!(c.try_wait(), Ok(None)) {
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            let _ = c.kill();
+            let _ = c.wait();
+        }
     }
 }
