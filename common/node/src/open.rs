@@ -191,7 +191,7 @@ mod zenoh_open {
     use crate::zlink::{ZenohEmulator, ZenohMaster, ZenohOptions, ZenohSlave};
 
     /// The options, with a warning when the run is open to anyone on the path.
-    fn zenoh_options(a: &NodeArgs) -> ZenohOptions {
+    fn options_warned(a: &NodeArgs) -> ZenohOptions {
         if a.tls_ca.is_none() && !loopback_only(a) {
             tracing::warn!(
                 "Zenoh in clear across hosts: any peer that reaches {:?} can read this run and inject samples into it; on a network you do not trust give --tls-ca, --tls-cert and --tls-key (docs/03-across-hosts.md)",
@@ -206,7 +206,7 @@ mod zenoh_open {
         direct: bool,
         wait: WaitPolicy,
     ) -> Result<Box<dyn MasterLink>, NodeError> {
-        let o = zenoh_options(a);
+        let o = options_warned(a);
         Ok(Box::new(opened(ZenohMaster::open(
             &o, &a.prefix, direct, wait,
         ))?))
@@ -218,7 +218,7 @@ mod zenoh_open {
         slave_on_iceoryx2: bool,
         wait: WaitPolicy,
     ) -> Result<Box<dyn EmulatorLink>, NodeError> {
-        let o = zenoh_options(a);
+        let o = options_warned(a);
         Ok(Box::new(opened(ZenohEmulator::open(
             &o,
             &a.prefix,
@@ -229,7 +229,7 @@ mod zenoh_open {
     }
 
     pub fn slave(a: &NodeArgs, wait: WaitPolicy) -> Result<Box<dyn SlaveLink>, NodeError> {
-        let o = zenoh_options(a);
+        let o = options_warned(a);
         Ok(Box::new(opened(ZenohSlave::open(&o, &a.prefix, wait))?))
     }
 }
