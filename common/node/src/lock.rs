@@ -147,9 +147,14 @@ fn in_use_message(prefix: &str, who: &str) -> String {
 /// Every lock of run `prefix`, if no other process holds any (held while the caller
 /// removes what a dead run left, so no node of that prefix starts meanwhile).
 pub fn take_all(prefix: &str, holder_text: &str) -> Option<Vec<Lock>> {
+    // Asked first, then taken without waiting: a live run's locks are never held here
+    // for longer than a probe, or one of its nodes starting now could be refused.
+    if !idle(prefix) {
+        return None;
+    }
     RUN_LOCKS
         .iter()
-        .map(|what| take(prefix, what, holder_text).ok())
+        .map(|what| take_with(prefix, what, holder_text, 1).ok())
         .collect()
 }
 
@@ -185,20 +190,26 @@ fn lock_path(prefix: &str, what: &str) -> PathBuf {
 /// Takes `<prefix>.<what>.lock`, writing `holder` (a description of this process) into
 /// it; if another process holds it, the error says who.
 pub fn take(prefix: &str, what: &str, holder_text: &str) -> Result<Lock, String> {
+    // A free lock may be held for a moment by another process's probe (`holder`,
+    // `take_all`): 40 tries over 200 ms before it counts as in use.
+    take_with(prefix, what, holder_text, 40)
+}
+
+fn take_with(prefix: &str, what: &str, holder_text: &str, tries: u32) -> Result<Lock, String> {
     check_prefix(prefix)?;
     let dir = lock_dir();
     std::fs::create_dir_all(&dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
     let path = lock_path(prefix, what);
-    // A free lock may be held for a moment by another process's probe (`holder`):
-    // a few tries over 50 ms before it counts as in use.
     let mut opened = None;
-    for _ in 0..10 {
+    for k in 0..tries {
+        if k > 0 {
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
         opened =
             locked_file(&path, true).map_err(|e| format!("opening {}: {e}", path.display()))?;
         if opened.is_some() {
             break;
         }
-        std::thread::sleep(std::time::Duration::from_millis(5));
     }
     let Some(mut file) = opened else {
         let who = holder(&path).unwrap_or_else(|| "another process".into());
