@@ -72,6 +72,18 @@ fn finish(child: Child, name: &str) {
     );
 }
 
+/// Waits for the master, emulator and slave (each must complete) and returns the
+/// summary of `tactile report` over their folders (a-master, b-emulator, b-slave).
+fn report_of(sb: &Sandbox, nodes: [Child; 3]) -> serde_json::Value {
+    for (child, name) in nodes.into_iter().zip(["master", "emulator", "slave"]) {
+        finish(child, name);
+    }
+    let dirs = ["a-master", "b-emulator", "b-slave"];
+    let o = sb.tactile(&["report", dirs[0], dirs[1], dirs[2], "--out", "report"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    sb.json("report", "summary.json")
+}
+
 /// A free TCP port on loopback.
 fn free_port() -> u16 {
     let l = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
@@ -106,19 +118,7 @@ fn master_here_slave_there(all_zenoh: bool) {
     let slave = spawn(hosts.on(1, "tactile-slave", &sl), &sb);
     let emulator = spawn(hosts.on(1, "tactile-emulator", &e), &sb);
     let master = spawn(hosts.on(0, "tactile-master", &m), &sb);
-    finish(master, "master");
-    finish(emulator, "emulator");
-    finish(slave, "slave");
-    let o = sb.tactile(&[
-        "report",
-        "a-master",
-        "b-emulator",
-        "b-slave",
-        "--out",
-        "report",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let s = sb.json("report", "summary.json");
+    let s = report_of(&sb, [master, emulator, slave]);
     let received = column(&sb.trace("report"), "received");
     let lost: Vec<usize> = (0..received.len())
         .filter(|&n| received[n] == 0.0)
@@ -556,20 +556,8 @@ fn mutual_tls_admits_the_run_and_refuses_strangers() {
         }
         std::thread::sleep(Duration::from_millis(20));
     }
-    finish(master, "master");
-    finish(emulator, "emulator");
-    finish(slave, "slave");
+    let sum = report_of(&sb, [master, emulator, slave]);
     drop(rogues);
-    let o = sb.tactile(&[
-        "report",
-        "a-master",
-        "b-emulator",
-        "b-slave",
-        "--out",
-        "report",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let sum = sb.json("report", "summary.json");
     assert_eq!(sum["samples_lost"], 0, "{}", sum["channels"]);
     for stream in ["c", "v", "h", "q"] {
         assert_eq!(sum["channels"][stream]["received"], 4000, "{stream}");

@@ -5,19 +5,13 @@
 use crate::util;
 
 use std::os::unix::process::CommandExt;
-use std::process::{Child, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
-use util::{wait_for, Sandbox};
+use util::{finish, wait_for, Sandbox};
 
 fn signal(pid: i32, sig: rustix::process::Signal) {
     let pid = rustix::process::Pid::from_raw(pid).expect("pid");
     let _ = rustix::process::kill_process(pid, sig);
-}
-
-fn finish(child: Child) -> (Option<i32>, String) {
-    let o = util::wait_within(child, util::LIMIT);
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    (o.status.code(), err)
 }
 
 /// A million samples in-process, stopped by SIGINT once the records are growing: it

@@ -302,8 +302,13 @@ impl<'a> Supervisor<'a> {
         Ok(())
     }
 
+    /// A progress line is asked for and stderr is a terminal.
+    fn shows_progress(&self) -> bool {
+        self.sup.progress && std::io::IsTerminal::is_terminal(&std::io::stderr())
+    }
+
     fn progress(&self, expected_s: Option<f64>) {
-        if !self.sup.progress || !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        if !self.shows_progress() {
             return;
         }
         let el = self.elapsed_s();
@@ -334,7 +339,7 @@ impl<'a> Supervisor<'a> {
             self.progress(expected_s);
             std::thread::sleep(POLL);
         }
-        if self.sup.progress && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        if self.shows_progress() {
             crate::noteln!();
         }
         self.after_master(scenario);
