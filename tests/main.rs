@@ -12,6 +12,7 @@ mod bilateral;
 mod channels;
 mod cli;
 mod faults;
+mod hdl;
 mod hosts;
 mod layout;
 mod lifecycle;

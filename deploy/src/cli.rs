@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch for `tactile`.
 
 use crate::cmd::bench::{BenchArgs, EchoArgs};
+use crate::cmd::hdl::HdlArgs;
 use crate::cmd::kernels::KernelsArgs;
 use crate::cmd::paper::PaperArgs;
 use crate::cmd::report::ReportArgs;
@@ -39,6 +40,9 @@ pub enum Command {
     /// Run a scenario for every combination of values (--set KEY=V1,V2,...), and
     /// tabulate and plot the runs' metrics.
     Sweep(SweepArgs),
+    /// The paper's trigonometric block as RTL: Verilog, test vectors from the model,
+    /// co-simulation (Icarus Verilog) and synthesis (Yosys, Virtex-6).
+    Hdl(HdlArgs),
     /// The echo side of `tactile bench`'s bare iceoryx2 hop (started by the bench).
     #[command(hide = true)]
     BenchEcho(EchoArgs),
@@ -78,6 +82,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
             crate::cmd::paper::run(&args, &mut stdout)
         }
         Command::Run(args) => crate::cmd::run::main(&args),
+        Command::Hdl(args) => crate::cmd::hdl::main(&args),
         Command::Bench(args) => crate::cmd::bench::main(&args),
         Command::Report(args) => crate::cmd::report::main(&args),
         Command::Sweep(args) => crate::cmd::sweep::main(&args),

@@ -60,9 +60,9 @@ impl From<RoundingArg> for Rounding {
     }
 }
 
-/// Fixed-point format of the CORDIC block and the device geometry.
+/// Fixed-point format of the CORDIC block (the hybrid model's and the RTL's).
 #[derive(Debug, Clone, Args)]
-pub struct DatapathArgs {
+pub struct FormatArgs {
     /// Word length V of the signed fixed-point format [sV.N].
     #[arg(long, default_value_t = CordicConfig::S16_13.word)]
     pub word: u32,
@@ -73,22 +73,34 @@ pub struct DatapathArgs {
     #[arg(long)]
     pub iterations: Option<u32>,
     /// Rounding in the float-to-fixed conversion and every shift.
-    #[arg(long, value_enum)]
-    pub rounding: Option<RoundingArg>,
+    #[arg(long, value_enum, default_value_t = RoundingArg::Nearest)]
+    pub rounding: RoundingArg,
+}
+
+/// Fixed-point format of the CORDIC block and the device geometry.
+#[derive(Debug, Clone, Args)]
+pub struct DatapathArgs {
+    /// Fixed-point format.
+    #[command(flatten)]
+    pub format: FormatArgs,
     /// Device geometry: `paper`, `omni`, or a TOML file with l1, l2, l3, a (metres).
     #[arg(long, default_value = "paper")]
     pub device: String,
 }
 
+impl FormatArgs {
+    /// The validated CORDIC configuration: the model's own check and error.
+    pub fn cordic(&self) -> Result<CordicConfig, Error> {
+        let rounding = Rounding::from(self.rounding);
+        CordicConfig::new(self.word, self.frac, self.iterations, rounding)
+            .map_err(|e| Error::BadInput(format!("bad fixed-point format: {e}")))
+    }
+}
+
 impl DatapathArgs {
     /// The validated CORDIC configuration.
     pub fn cordic(&self) -> Result<CordicConfig, Error> {
-        let rounding = self
-            .rounding
-            .map(Rounding::from)
-            .unwrap_or(CordicConfig::S16_13.rounding);
-        CordicConfig::new(self.word, self.frac, self.iterations, rounding)
-            .map_err(|e| Error::BadInput(format!("bad fixed-point format: {e}")))
+        self.format.cordic()
     }
 
     /// The device geometry: a preset or a validated file.

@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod datapath;
+pub mod hdl;
 pub mod kernels;
 pub mod paper;
 pub mod report;

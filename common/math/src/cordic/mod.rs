@@ -454,6 +454,7 @@ impl Cordic {
 mod batch;
 mod bounds;
 mod datapath;
+pub mod hdl;
 
 /// Whether `angle` takes the fast range reduction (false for NaN and infinities).
 #[inline(always)]

@@ -1,0 +1,287 @@
+//! The open tools that hold the RTL against the model: Icarus Verilog runs the
+//! testbench over the vectors, Yosys synthesizes each function for Virtex-6 (the
+//! paper's family). Each run works in a fresh folder of its own.
+
+use super::{latency, model, vectors, write_rtl, Function, MODULES};
+use crate::cmd::datapath::FormatArgs;
+use crate::error::Error;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Arguments of `tactile hdl cosim`.
+#[derive(Debug, Args)]
+pub struct CosimArgs {
+    /// Functions to run (default: all three).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub function: Vec<Function>,
+    /// Samples beyond the edge cases, per function.
+    #[arg(long, default_value_t = 20_000)]
+    pub count: usize,
+    /// Seed of the random inputs.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// A Verilog macro to define when compiling the RTL (repeatable): the RTL's
+    /// deliberately wrong variants are TFB_MUTANT_SHIFT (one iteration shifts one bit
+    /// too far) and TFB_MUTANT_ROUND (shifts truncate where they must round).
+    #[arg(long = "define", value_name = "MACRO")]
+    pub defines: Vec<String>,
+    /// Keep the work folder (RTL, vectors, simulator) here instead of a temporary one.
+    #[arg(long)]
+    pub keep: Option<PathBuf>,
+    /// Fixed-point format.
+    #[command(flatten)]
+    pub format: FormatArgs,
+}
+
+/// Arguments of `tactile hdl synth`.
+#[derive(Debug, Args)]
+pub struct SynthArgs {
+    /// Functions to synthesize (default: all three).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub function: Vec<Function>,
+    /// Keep the work folder (RTL, scripts, Yosys logs) here.
+    #[arg(long)]
+    pub keep: Option<PathBuf>,
+    /// Fixed-point format.
+    #[command(flatten)]
+    pub format: FormatArgs,
+}
+
+/// A work folder, removed on drop unless the user asked to keep it.
+struct Work {
+    dir: PathBuf,
+    keep: bool,
+}
+
+impl Work {
+    fn new(keep: Option<&Path>) -> Result<Work, Error> {
+        let (dir, kept) = match keep {
+            Some(d) => (d.to_path_buf(), true),
+            None => {
+                let nanos = std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map_or(0, |d| d.subsec_nanos());
+                let name = format!("tactile-hdl-{}-{nanos}", std::process::id());
+                (std::env::temp_dir().join(name), false)
+            }
+        };
+        std::fs::create_dir_all(&dir).map_err(Error::io(format!("creating {}", dir.display())))?;
+        Ok(Work { dir, keep: kept })
+    }
+}
+
+impl Drop for Work {
+    fn drop(&mut self) {
+        if !self.keep {
+            let _ = std::fs::remove_dir_all(&self.dir);
+        }
+    }
+}
+
+/// Runs a tool, naming it and the package to install when it is missing.
+fn tool(cmd: &mut Command, name: &str, package: &str) -> Result<String, Error> {
+    let out = cmd.output().map_err(|e| {
+        Error::Failed(format!(
+            "cannot run {name} ({e}): install it (Debian: apt-get install {package})"
+        ))
+    })?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        return Err(Error::Failed(format!(
+            "{name} failed ({}):\n{}{}",
+            out.status,
+            tail(&text, 20),
+            tail(&err, 20)
+        )));
+    }
+    Ok(text)
+}
+
+fn tail(text: &str, lines: usize) -> String {
+    let all: Vec<&str> = text.lines().collect();
+    let mut s = all[all.len().saturating_sub(lines)..].join("\n");
+    if !s.is_empty() {
+        s.push('\n');
+    }
+    s
+}
+
+fn chosen(functions: &[Function]) -> Vec<Function> {
+    if functions.is_empty() {
+        Function::ALL.to_vec()
+    } else {
+        functions.to_vec()
+    }
+}
+
+/// Co-simulation of one function: `(vectors, mismatches)` from the testbench's line.
+fn cosim_one(
+    work: &Path,
+    function: Function,
+    text: &str,
+    n: usize,
+    defines: &[String],
+) -> Result<(usize, usize), Error> {
+    let name = function.name();
+    let vec_path = work.join(format!("{name}.hex"));
+    std::fs::write(&vec_path, text)
+        .map_err(Error::io(format!("writing {}", vec_path.display())))?;
+    let sim = work.join(format!("{name}.vvp"));
+    let mut cc = Command::new("iverilog");
+    cc.current_dir(work)
+        .args(["-g2005", "-I", ".", "-o"])
+        .arg(&sim)
+        .arg(format!("-D{}", function.define()))
+        .arg(format!("-DMAXWORDS={}", (n * 9).next_power_of_two()));
+    for d in defines {
+        cc.arg(format!("-D{d}"));
+    }
+    cc.arg("tb_tfb.v").args(MODULES);
+    tool(&mut cc, "iverilog", "iverilog")?;
+    let mut run = Command::new("vvp");
+    run.current_dir(work)
+        .args(["-n"])
+        .arg(&sim)
+        .arg(format!("+vectors={}", vec_path.display()))
+        .arg(format!("+count={n}"));
+    let out = tool(&mut run, "vvp", "iverilog")?;
+    let last = out
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix(&format!("tfb-cosim: {name} ")))
+        .ok_or_else(|| {
+            Error::Failed(format!("the testbench gave no result:\n{}", tail(&out, 20)))
+        })?;
+    let field = |key: &str| -> Option<usize> {
+        last.split_whitespace()
+            .find_map(|f| f.strip_prefix(key))
+            .and_then(|v| v.parse().ok())
+    };
+    match (field("vectors="), field("mismatches=")) {
+        (Some(v), Some(m)) => {
+            for l in out.lines().filter(|l| l.contains("mismatch at")) {
+                crate::noteln!("{l}");
+            }
+            Ok((v, m))
+        }
+        _ => Err(Error::Failed(format!(
+            "unreadable testbench result: {last}"
+        ))),
+    }
+}
+
+/// `tactile hdl cosim`.
+pub fn cosim_main(args: &CosimArgs) -> Result<(), Error> {
+    let cfg = args.format.cordic()?;
+    let (cordic, k) = model(cfg)?;
+    let work = Work::new(args.keep.as_deref())?;
+    write_rtl(&work.dir, &k)?;
+    let mut failed = 0;
+    for f in chosen(&args.function) {
+        let (text, n) = vectors(&cordic, &k, f, args.count, args.seed);
+        let (v, m) = cosim_one(&work.dir, f, &text, n, &args.defines)?;
+        crate::outln!(
+            "{:<7} [s{}.{}] {} iterations {:<8} {v} vectors, {m} mismatches (latency {} clocks)",
+            f.name(),
+            cfg.word,
+            cfg.frac,
+            cfg.iterations,
+            format!("{:?}", cfg.rounding).to_lowercase(),
+            latency(f, &cfg)
+        );
+        if v != n {
+            return Err(Error::Failed(format!(
+                "{}: the testbench compared {v} of {n} vectors",
+                f.name()
+            )));
+        }
+        failed += m;
+    }
+    if failed > 0 {
+        return Err(Error::Failed(format!(
+            "co-simulation: {failed} outputs differ from the model"
+        )));
+    }
+    Ok(())
+}
+
+/// Resources of one synthesized function, from Yosys's `stat`.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct Resources {
+    /// Flip-flops (FDRE, FDSE, FDCE, FDPE).
+    pub registers: u64,
+    /// LUTs used as logic (LUT1..LUT6).
+    pub luts: u64,
+    /// LUTs used as shift registers (SRL16E, SRLC32E): delay lines.
+    pub srls: u64,
+    /// DSP48E1 slices.
+    pub dsps: u64,
+    /// CARRY4 chains.
+    pub carry: u64,
+}
+
+/// Parses the cell counts of Yosys's `stat` (the flattened top's list).
+pub fn parse_stat(text: &str) -> Resources {
+    let mut r = Resources::default();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        let (Some(cell), Some(n), None) = (it.next(), it.next(), it.next()) else {
+            continue;
+        };
+        let Ok(n) = n.parse::<u64>() else { continue };
+        match cell {
+            "FDRE" | "FDSE" | "FDCE" | "FDPE" => r.registers += n,
+            c if c.starts_with("LUT") && c.len() == 4 => r.luts += n,
+            "SRL16E" | "SRLC32E" => r.srls += n,
+            "DSP48E1" => r.dsps += n,
+            "CARRY4" => r.carry += n,
+            _ => {}
+        }
+    }
+    r
+}
+
+/// `tactile hdl synth`.
+pub fn synth_main(args: &SynthArgs) -> Result<(), Error> {
+    let cfg = args.format.cordic()?;
+    let (_, k) = model(cfg)?;
+    let work = Work::new(args.keep.as_deref())?;
+    write_rtl(&work.dir, &k)?;
+    crate::outln!(
+        "| function | format | rounding | registers | LUTs | SRLs | DSP48E1 | CARRY4 | latency (clocks) |"
+    );
+    crate::outln!("|---|---|---|---:|---:|---:|---:|---:|---:|");
+    for f in chosen(&args.function) {
+        let stat = work.dir.join(format!("{}.stat", f.name()));
+        let script = format!(
+            "read_verilog -I . {modules} tfb_top.v; \
+             synth_xilinx -family xc6v -flatten -top top_{name}; tee -q -o {stat} stat",
+            modules = MODULES.join(" "),
+            name = f.name(),
+            stat = stat.display()
+        );
+        let mut y = Command::new("yosys");
+        y.current_dir(&work.dir).args(["-q", "-p", &script]);
+        tool(&mut y, "yosys", "yosys")?;
+        let text = std::fs::read_to_string(&stat)
+            .map_err(Error::io(format!("reading {}", stat.display())))?;
+        let r = parse_stat(&text);
+        crate::outln!(
+            "| {} | [s{}.{}] {} it. | {} | {} | {} | {} | {} | {} | {} |",
+            f.name(),
+            cfg.word,
+            cfg.frac,
+            cfg.iterations,
+            format!("{:?}", cfg.rounding).to_lowercase(),
+            r.registers,
+            r.luts,
+            r.srls,
+            r.dsps,
+            r.carry,
+            latency(f, &cfg)
+        );
+    }
+    Ok(())
+}

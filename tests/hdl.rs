@@ -1,0 +1,171 @@
+//! The TFB's RTL against the hybrid model (`tactile hdl`): Icarus Verilog runs the
+//! Verilog over the model's vectors and every output and stage value must match bit
+//! for bit, in three formats and both roundings; the RTL's deliberately wrong variants
+//! must not; Yosys must synthesize it for Virtex-6 with its pipeline intact.
+
+use crate::util::{cannot, Sandbox};
+use std::process::Command;
+
+fn have(tool: &str) -> bool {
+    Command::new(tool).arg("-V").output().is_ok()
+}
+
+/// `(function, vectors, mismatches)` from `tactile hdl cosim`'s lines.
+fn results(stdout: &str) -> Vec<(String, usize, usize)> {
+    stdout
+        .lines()
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            let at = |key: &str| f.iter().position(|w| w.starts_with(key));
+            let (v, m) = (at("vectors,")?, at("mismatches")?);
+            Some((
+                f[0].to_string(),
+                f[v - 1].parse().ok()?,
+                f[m - 1].parse().ok()?,
+            ))
+        })
+        .collect()
+}
+
+fn cosim(sb: &Sandbox, args: &[&str]) -> (bool, Vec<(String, usize, usize)>, String) {
+    let keep = sb.path(&format!("work-{}", args.join("-")));
+    let keep = keep.to_str().expect("utf-8 path");
+    let mut all = vec!["hdl", "cosim", "--keep", keep];
+    all.extend_from_slice(args);
+    let out = sb.tactile(&all);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    (out.status.success(), results(&stdout), stdout + &stderr)
+}
+
+#[test]
+fn the_rtl_matches_the_model_bit_for_bit_in_six_formats() {
+    if !have("iverilog") {
+        return cannot("iverilog is not installed");
+    }
+    let sb = Sandbox::new("hdl-cosim");
+    let mut total = 0;
+    for (word, frac) in [("16", "13"), ("24", "21"), ("32", "29")] {
+        for rounding in ["nearest", "truncate"] {
+            let args = ["--word", word, "--frac", frac, "--rounding", rounding];
+            let (ok, r, text) = cosim(&sb, &[&args[..], &["--count", "6000"]].concat());
+            assert!(ok, "[s{word}.{frac}] {rounding}:\n{text}");
+            assert_eq!(r.len(), 3, "three functions:\n{text}");
+            for (f, vectors, mismatches) in r {
+                // The edge cases (at least 46 per function) and the 6000 others.
+                assert!(vectors > 6000, "{f}: {vectors} vectors");
+                assert_eq!(mismatches, 0, "{f} [s{word}.{frac}] {rounding}");
+                total += vectors;
+            }
+        }
+    }
+    assert!(total > 6 * 3 * 6000);
+}
+
+#[test]
+fn a_wrong_rtl_is_caught_by_the_same_test() {
+    if !have("iverilog") {
+        return cannot("iverilog is not installed");
+    }
+    let sb = Sandbox::new("hdl-mutant");
+    for mutant in ["TFB_MUTANT_SHIFT", "TFB_MUTANT_ROUND"] {
+        let (ok, r, text) = cosim(&sb, &["--count", "2000", "--define", mutant]);
+        assert!(!ok, "{mutant} passed:\n{text}");
+        assert!(text.contains("outputs differ from the model"), "{text}");
+        assert_eq!(r.len(), 3, "{text}");
+        for (f, vectors, mismatches) in r {
+            assert!(
+                mismatches > vectors / 20,
+                "{mutant} {f}: only {mismatches} of {vectors}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_format_the_model_refuses_the_generator_refuses_alike() {
+    let sb = Sandbox::new("hdl-refuse");
+    for bad in [
+        &["--word", "40"][..],
+        &["--word", "16", "--frac", "14"],
+        &["--iterations", "20"],
+    ] {
+        let model = sb.tactile(&[&["paper"][..], bad].concat());
+        let out = sb.path("rtl");
+        let rtl = sb.tactile(
+            &[
+                &["hdl", "rtl", "--out", out.to_str().expect("utf-8")][..],
+                bad,
+            ]
+            .concat(),
+        );
+        assert_eq!(model.status.code(), Some(2), "{bad:?}");
+        assert_eq!(rtl.status.code(), Some(2), "{bad:?}");
+        assert_eq!(rtl.stderr, model.stderr, "{bad:?}");
+        assert!(String::from_utf8_lossy(&rtl.stderr).contains("bad fixed-point format"));
+        assert!(!out.exists(), "nothing written for {bad:?}");
+    }
+}
+
+#[test]
+fn vectors_follow_the_seed_and_name_their_fields() {
+    let sb = Sandbox::new("hdl-vectors");
+    let run = |seed: &str| {
+        let out = sb.tactile(&[
+            "hdl",
+            "vectors",
+            "--function",
+            "atan2",
+            "--count",
+            "500",
+            "--seed",
+            seed,
+        ]);
+        assert!(out.status.success());
+        String::from_utf8(out.stdout).expect("utf-8")
+    };
+    let (a, b, c) = (run("7"), run("7"), run("8"));
+    assert_eq!(a, b, "same seed, same vectors");
+    assert_ne!(a, c, "another seed, other random inputs");
+    assert!(a.contains("// fields: y x stages x_code y_code z_code angle"));
+    let lines: Vec<&str> = a.lines().filter(|l| !l.starts_with("//")).collect();
+    // 18 x 18 special pairs (axes, infinities, NaN, extremes) and the 500.
+    assert_eq!(lines.len(), 18 * 18 + 500);
+    // atan2(+0, -1) is pi: y = +0, x = -1.0, output floor(pi 2^13) 2^-13 as f32.
+    let pi_line = lines
+        .iter()
+        .find(|l| l.starts_with("00000000 bf800000 "))
+        .expect("the negative x axis");
+    assert!(
+        pi_line.ends_with(&format!("{:08x}", (25735.0f32 / 8192.0).to_bits())),
+        "{pi_line}"
+    );
+}
+
+#[test]
+fn yosys_synthesizes_the_pipeline_for_virtex6() {
+    if !have("yosys") {
+        return cannot("yosys is not installed");
+    }
+    let sb = Sandbox::new("hdl-synth");
+    let out = sb.tactile(&["hdl", "synth", "--function", "sincos"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let row: Vec<&str> = text
+        .lines()
+        .find(|l| l.starts_with("| sincos"))
+        .expect("a sincos row")
+        .split('|')
+        .map(str::trim)
+        .collect();
+    let n = |i: usize| row[i].parse::<u64>().expect("a count");
+    // 14 iterations each register x, y and z (16 bits): at least 672 flip-flops
+    // survive unless synthesis removed the pipeline.
+    assert!(n(4) >= 14 * 3 * 16, "registers {}", n(4));
+    assert!(n(5) > 14 * 3 * 16, "LUTs {}", n(5));
+    assert_eq!(n(9), 19, "latency");
+}
