@@ -30,4 +30,6 @@ pub mod guide {
     pub mod latency {}
     #[doc = include_str!("../../docs/08-kernels-and-the-paper.md")]
     pub mod kernels_and_the_paper {}
+    #[doc = include_str!("../../docs/09-the-hardware.md")]
+    pub mod the_hardware {}
 }
