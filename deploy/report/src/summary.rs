@@ -12,9 +12,10 @@ use tactile_scenario::Mode;
 use tactile_slave::record::SlaveTotals;
 
 /// Files a report writes into its folder.
-pub const REPORT_FILES: [&str; 10] = [
+pub const REPORT_FILES: [&str; 11] = [
     "summary.json",
     "trace.csv",
+    "run.mcap",
     "round_trip.hgrm",
     "overhead.hgrm",
     "latency.svg",

@@ -7,8 +7,8 @@ use crate::metrics::Packets;
 use crate::plots::{self, Series};
 pub use crate::summary::REPORT_FILES;
 use crate::summary::{ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
-use crate::trace;
 use crate::Error;
+use crate::{recording, trace};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -19,6 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_messages::Role;
+use tactile_node::record::Start;
 use tactile_scenario::Scenario;
 
 /// The link name an in-process simulation records.
@@ -267,26 +268,36 @@ fn summarise(
     }
 }
 
-/// Joins the records in `dirs` and writes the report into `out`: summary, trace,
-/// histograms, plots and the scenario as run. Returns the summary.
-pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Summary, Error> {
+/// The nodes' start records and the scenario the master recorded.
+fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
     let found = join::locate(dirs)?;
     let master = found[0]
         .clone()
         .ok_or_else(|| Error::BadInput("no master record".into()))?;
     let starts = join::starts(&found)?;
+    let text = starts[0]
+        .as_ref()
+        .map(|s| s.scenario_toml.clone())
+        .ok_or_else(|| Error::BadInput("no master record".into()))?;
+    let scenario = Scenario::from_toml_str(&text).map_err(|e| {
+        Error::BadInput(format!(
+            "{}: the scenario recorded is not valid: {e}",
+            master.display()
+        ))
+    })?;
+    Ok((starts, scenario))
+}
+
+/// Joins the records in `dirs` and writes the report into `out`: summary, trace,
+/// histograms, plots and the scenario as run. Returns the summary.
+pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Summary, Error> {
+    let (starts, scenario) = recorded(dirs)?;
     let domains = starts
         .clone()
         .map(|s| s.map_or_else(String::new, |s| s.clock));
     let start = starts[0]
         .clone()
         .ok_or_else(|| Error::BadInput("no master record".into()))?;
-    let scenario = Scenario::from_toml_str(&start.scenario_toml).map_err(|e| {
-        Error::BadInput(format!(
-            "{}: the scenario recorded is not valid: {e}",
-            master.display()
-        ))
-    })?;
     make_out_dir(out)?;
     let t_s = scenario.t_s();
     // The in-process simulation's stamps are synthetic: no stage times from them.
@@ -307,6 +318,12 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
         writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
         Some(w)
+    };
+    let mut recording = if launch.no_trace {
+        let _ = std::fs::remove_file(out.join(recording::FILE));
+        None
+    } else {
+        Some(recording::create(out, &scenario).map_err(Error::io("writing run.mcap"))?)
     };
     let mut line = String::with_capacity(2048);
     let mut t0 = None;
@@ -333,10 +350,16 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
             w.write_all(line.as_bytes())
                 .map_err(Error::io("writing trace.csv"))?;
         }
+        if let Some(r) = recording.as_mut() {
+            r.add(row).map_err(Error::io("writing run.mcap"))?;
+        }
         Ok(ControlFlow::Continue(()))
     })?;
     if let Some(mut w) = trace {
         w.flush().map_err(Error::io("writing trace.csv"))?;
+    }
+    if let Some(r) = recording {
+        recording::commit(r, out).map_err(Error::io("writing run.mcap"))?;
     }
     analysis.finish();
     let round_trip = analysis.round_trip.hgrm();
@@ -374,4 +397,20 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     }
     write_json(&out.join("summary.json"), &summary)?;
     Ok(summary)
+}
+
+/// Joins the records in `dirs` and writes only `out/run.mcap` (old records converted
+/// without redoing the report). Returns the number of samples recorded.
+pub fn write_recording(dirs: &[PathBuf], out: &Path) -> Result<u64, Error> {
+    let (_, scenario) = recorded(dirs)?;
+    make_out_dir(out)?;
+    let mut rec = recording::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
+    let mut samples = 0;
+    join::join(dirs, |row| {
+        samples += 1;
+        rec.add(row).map_err(Error::io("writing run.mcap"))?;
+        Ok(ControlFlow::Continue(()))
+    })?;
+    recording::commit(rec, out).map_err(Error::io("writing run.mcap"))?;
+    Ok(samples)
 }

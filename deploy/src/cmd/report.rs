@@ -6,7 +6,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use tactile_report::join;
 use tactile_report::summary::render;
-use tactile_report::write::{write_report, Launch};
+use tactile_report::write::{write_recording, write_report, Launch};
 
 /// Arguments of `tactile report`.
 #[derive(Debug, Args)]
@@ -17,9 +17,14 @@ pub struct ReportArgs {
     /// Folder for the report (default: the master's folder).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write no trace.csv (a long run's trace is about 1 kB per sample).
-    #[arg(long)]
+    /// Write no trace.csv and no run.mcap (a long run's trace is about 1 kB per
+    /// sample).
+    #[arg(long, conflicts_with = "mcap_only")]
     pub no_trace: bool,
+    /// Write only run.mcap, the run as ROS 2 messages for Foxglove, Rerun and
+    /// `ros2 bag` (converts old records without redoing the report).
+    #[arg(long)]
+    pub mcap_only: bool,
 }
 
 /// `tactile report DIR... [--out OUT]`.
@@ -32,6 +37,14 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
             .and_then(Path::parent)
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
     };
+    if args.mcap_only {
+        let samples = write_recording(&args.dirs, &out)?;
+        crate::outln!(
+            "wrote {}: {samples} samples",
+            out.join(tactile_report::recording::FILE).display()
+        );
+        return Ok(());
+    }
     let stop =
         tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let launch = Launch {

@@ -1,0 +1,352 @@
+//! The message types, each with its ROS 2 type name, schema and CDR encoding (fields
+//! in their definition's order, [`crate::schema`]). Vectors are `[x, y, z]`,
+//! quaternions `[x, y, z, w]`.
+
+use crate::cdr::CdrWriter;
+
+/// A message Tactile publishes or records.
+pub trait Message {
+    /// The ROS 2 type, `pkg/msg/Type`.
+    const TYPE: &'static str;
+    /// Appends the fields (the writer holds the encapsulation header).
+    fn encode(&self, w: &mut CdrWriter);
+    /// The whole message in CDR.
+    fn to_cdr(&self) -> Vec<u8> {
+        let mut w = CdrWriter::new();
+        self.encode(&mut w);
+        w.bytes().to_vec()
+    }
+}
+
+/// `builtin_interfaces/Time` (and `Duration`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Time {
+    /// Whole seconds.
+    pub sec: i32,
+    /// Nanoseconds, `< 1e9`.
+    pub nanosec: u32,
+}
+
+impl Time {
+    /// From nanoseconds (saturating at i32 seconds, year 2038).
+    pub fn from_ns(ns: u64) -> Time {
+        Time {
+            sec: i32::try_from(ns / 1_000_000_000).unwrap_or(i32::MAX),
+            nanosec: (ns % 1_000_000_000) as u32,
+        }
+    }
+
+    fn encode(&self, w: &mut CdrWriter) {
+        w.i32(self.sec);
+        w.u32(self.nanosec);
+    }
+}
+
+/// `std_msgs/Header`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Header {
+    /// When the data holds.
+    pub stamp: Time,
+    /// The frame the data is expressed in.
+    pub frame_id: String,
+}
+
+impl Header {
+    /// A header at `ns` in `frame`.
+    pub fn at(ns: u64, frame: &str) -> Header {
+        Header {
+            stamp: Time::from_ns(ns),
+            frame_id: frame.to_string(),
+        }
+    }
+
+    fn encode(&self, w: &mut CdrWriter) {
+        self.stamp.encode(w);
+        w.string(&self.frame_id);
+    }
+}
+
+fn vec3(w: &mut CdrWriter, v: &[f64; 3]) {
+    v.iter().for_each(|x| w.f64(*x));
+}
+
+fn quat(w: &mut CdrWriter, q: &[f64; 4]) {
+    q.iter().for_each(|x| w.f64(*x));
+}
+
+fn f64s(w: &mut CdrWriter, v: &[f64]) {
+    w.seq_len(v.len());
+    v.iter().for_each(|x| w.f64(*x));
+}
+
+/// The identity rotation.
+pub const IDENTITY: [f64; 4] = [0.0, 0.0, 0.0, 1.0];
+
+/// `std_msgs/msg/String`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StringMsg {
+    /// The text.
+    pub data: String,
+}
+
+impl Message for StringMsg {
+    const TYPE: &'static str = "std_msgs/msg/String";
+    fn encode(&self, w: &mut CdrWriter) {
+        w.string(&self.data);
+    }
+}
+
+/// `sensor_msgs/msg/JointState`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointState {
+    /// Stamp and frame.
+    pub header: Header,
+    /// Joint names.
+    pub name: Vec<String>,
+    /// Angles, rad.
+    pub position: Vec<f64>,
+    /// Angular velocities, rad/s.
+    pub velocity: Vec<f64>,
+    /// Torques, N m.
+    pub effort: Vec<f64>,
+}
+
+impl Message for JointState {
+    const TYPE: &'static str = "sensor_msgs/msg/JointState";
+    fn encode(&self, w: &mut CdrWriter) {
+        self.header.encode(w);
+        w.seq_len(self.name.len());
+        self.name.iter().for_each(|n| w.string(n));
+        f64s(w, &self.position);
+        f64s(w, &self.velocity);
+        f64s(w, &self.effort);
+    }
+}
+
+/// `geometry_msgs/msg/PoseStamped`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PoseStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// Position, m.
+    pub position: [f64; 3],
+    /// Orientation.
+    pub orientation: [f64; 4],
+}
+
+impl Message for PoseStamped {
+    const TYPE: &'static str = "geometry_msgs/msg/PoseStamped";
+    fn encode(&self, w: &mut CdrWriter) {
+        self.header.encode(w);
+        vec3(w, &self.position);
+        quat(w, &self.orientation);
+    }
+}
+
+/// `geometry_msgs/msg/WrenchStamped`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct WrenchStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// Force, N.
+    pub force: [f64; 3],
+    /// Torque, N m.
+    pub torque: [f64; 3],
+}
+
+impl Message for WrenchStamped {
+    const TYPE: &'static str = "geometry_msgs/msg/WrenchStamped";
+    fn encode(&self, w: &mut CdrWriter) {
+        self.header.encode(w);
+        vec3(w, &self.force);
+        vec3(w, &self.torque);
+    }
+}
+
+/// `geometry_msgs/TransformStamped`: `child_frame_id` in `header.frame_id`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TransformStamped {
+    /// Stamp and parent frame.
+    pub header: Header,
+    /// The frame this transform places.
+    pub child_frame_id: String,
+    /// Its origin in the parent, m.
+    pub translation: [f64; 3],
+    /// Its rotation in the parent.
+    pub rotation: [f64; 4],
+}
+
+/// `tf2_msgs/msg/TFMessage`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TfMessage {
+    /// The transforms.
+    pub transforms: Vec<TransformStamped>,
+}
+
+impl Message for TfMessage {
+    const TYPE: &'static str = "tf2_msgs/msg/TFMessage";
+    fn encode(&self, w: &mut CdrWriter) {
+        w.seq_len(self.transforms.len());
+        for t in &self.transforms {
+            t.header.encode(w);
+            w.string(&t.child_frame_id);
+            vec3(w, &t.translation);
+            quat(w, &t.rotation);
+        }
+    }
+}
+
+/// `visualization_msgs/Marker`, the fields a shape needs (the rest empty).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Marker {
+    /// Stamp and frame.
+    pub header: Header,
+    /// Namespace.
+    pub ns: String,
+    /// Id within the namespace.
+    pub id: i32,
+    /// Shape: [`Marker::CUBE`], [`Marker::SPHERE`], ...
+    pub kind: i32,
+    /// Centre, m.
+    pub position: [f64; 3],
+    /// Orientation.
+    pub orientation: [f64; 4],
+    /// Size along the marker's axes, m.
+    pub scale: [f64; 3],
+    /// RGBA, 0 to 1.
+    pub color: [f32; 4],
+}
+
+impl Marker {
+    /// A box.
+    pub const CUBE: i32 = 1;
+    /// A sphere (an ellipsoid by `scale`).
+    pub const SPHERE: i32 = 2;
+
+    fn encode(&self, w: &mut CdrWriter) {
+        self.header.encode(w);
+        w.string(&self.ns);
+        w.i32(self.id);
+        w.i32(self.kind);
+        w.i32(0); // ADD
+        vec3(w, &self.position);
+        quat(w, &self.orientation);
+        vec3(w, &self.scale);
+        self.color.iter().for_each(|c| w.f32(*c));
+        Time::default().encode(w); // lifetime 0: forever
+        w.bool(false); // frame_locked
+        w.seq_len(0); // points
+        w.seq_len(0); // colors
+        w.string(""); // texture_resource
+        Header::default().encode(w); // texture: header, format, data
+        w.string("");
+        w.seq_len(0);
+        w.seq_len(0); // uv_coordinates
+        w.string(""); // text
+        w.string(""); // mesh_resource
+        w.string(""); // mesh_file: filename, data
+        w.seq_len(0);
+        w.bool(false); // mesh_use_embedded_materials
+    }
+}
+
+/// `visualization_msgs/msg/MarkerArray`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MarkerArray {
+    /// The markers.
+    pub markers: Vec<Marker>,
+}
+
+impl Message for MarkerArray {
+    const TYPE: &'static str = "visualization_msgs/msg/MarkerArray";
+    fn encode(&self, w: &mut CdrWriter) {
+        w.seq_len(self.markers.len());
+        self.markers.iter().for_each(|m| m.encode(w));
+    }
+}
+
+/// `tactile_msgs/msg/SampleTiming`: one sample's timing and channel state.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SampleTiming {
+    /// Sample number n.
+    pub sample: u64,
+    /// Whether q(n) came back.
+    pub answered: bool,
+    /// Round trip, ns (0 without an answer).
+    pub round_trip_ns: i64,
+    /// Round trip minus the injected delay, ns.
+    pub overhead_ns: i64,
+    /// Delay injected into v(n) per axis, samples.
+    pub delay_forward: [u32; 3],
+    /// Delay injected into q(n) per axis, samples.
+    pub delay_backward: [u32; 3],
+    /// Flags of v(n) as the slave received it (1024: not sent, the deadband held it).
+    pub flags_forward: u32,
+    /// Flags of q(n) as the master received it.
+    pub flags_backward: u32,
+    /// The master's own flags.
+    pub flags_master: u32,
+    /// The master's passivity observer per axis, J.
+    pub observer_master: [f64; 3],
+    /// The slave's passivity observer per axis, J.
+    pub observer_slave: [f64; 3],
+}
+
+impl Message for SampleTiming {
+    const TYPE: &'static str = "tactile_msgs/msg/SampleTiming";
+    fn encode(&self, w: &mut CdrWriter) {
+        w.u64(self.sample);
+        w.bool(self.answered);
+        w.i64(self.round_trip_ns);
+        w.i64(self.overhead_ns);
+        self.delay_forward.iter().for_each(|d| w.u32(*d));
+        self.delay_backward.iter().for_each(|d| w.u32(*d));
+        w.u32(self.flags_forward);
+        w.u32(self.flags_backward);
+        w.u32(self.flags_master);
+        vec3(w, &self.observer_master);
+        vec3(w, &self.observer_slave);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cdr::CdrReader;
+
+    #[test]
+    fn a_joint_state_reads_back_field_by_field() {
+        let js = JointState {
+            header: Header::at(1_500_000_001, "base"),
+            name: vec!["j1".into()],
+            position: vec![0.25],
+            velocity: vec![],
+            effort: vec![-1.0],
+        };
+        let b = js.to_cdr();
+        let mut r = CdrReader::new(&b).expect("header");
+        assert_eq!((r.i32(), r.u32()), (Ok(1), Ok(500_000_001)));
+        assert_eq!(r.string().as_deref(), Ok("base"));
+        assert_eq!(r.seq_len(), Ok(1));
+        assert_eq!(r.string().as_deref(), Ok("j1"));
+        assert_eq!((r.seq_len(), r.f64()), (Ok(1), Ok(0.25)));
+        assert_eq!(r.seq_len(), Ok(0));
+        assert_eq!((r.seq_len(), r.f64()), (Ok(1), Ok(-1.0)));
+        assert!(r.u8().is_err(), "nothing after the last field");
+    }
+
+    #[test]
+    fn every_type_has_a_schema() {
+        for t in [
+            StringMsg::TYPE,
+            JointState::TYPE,
+            PoseStamped::TYPE,
+            WrenchStamped::TYPE,
+            TfMessage::TYPE,
+            MarkerArray::TYPE,
+            SampleTiming::TYPE,
+        ] {
+            assert!(crate::schema::ros2msg(t).is_some(), "{t}");
+        }
+    }
+}

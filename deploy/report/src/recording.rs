@@ -1,0 +1,304 @@
+//! `run.mcap`: the run as ROS 2 messages (tactile-ros's topics) in an MCAP file,
+//! streamed sample by sample from the joined records, so Foxglove, Rerun and
+//! `ros2 bag` open it. Log time is the sample's time on the master's clock (its tick
+//! stamp); publish time the stamp of the stage that produced the message (the slave's
+//! send for its messages, the master's receive for q(n)), or the log time where that
+//! stage was not passed. Header stamps are the log time.
+
+use crate::mcap::McapWriter;
+use crate::trace::TraceRow;
+use std::io::{self, Write};
+use tactile_math::geometry::Geometry;
+use tactile_messages::samples::stage;
+use tactile_ros::msg::{
+    Header, JointState, Marker, MarkerArray, PoseStamped, SampleTiming, StringMsg, TfMessage,
+    TransformStamped, WrenchStamped, IDENTITY,
+};
+use tactile_ros::topics::TOPICS;
+use tactile_ros::{arm, schema, urdf, CdrWriter, Message};
+use tactile_scenario::Object;
+use tactile_scenario::Scenario;
+
+/// The recording's file name in a report folder.
+pub const FILE: &str = "run.mcap";
+
+/// Writes a run's messages to an MCAP file.
+#[derive(Debug)]
+pub struct Recording<W: Write> {
+    mcap: McapWriter<W>,
+    channels: Vec<u16>,
+    geometry: Geometry,
+    objects: Vec<Object>,
+    rate_hz: u64,
+    t_s_ns: f64,
+    /// The previous sample: n and both arms' angles (for the velocities).
+    prev: Option<(u64, [f64; 3], [f64; 3])>,
+    sequence: u32,
+    cdr: CdrWriter,
+}
+
+impl<W: Write> Recording<W> {
+    /// Starts the file with a channel per topic.
+    pub fn new(out: W, scenario: &Scenario) -> io::Result<Self> {
+        let geometry = scenario.device.geometry().map_err(io::Error::other)?;
+        let library = concat!("tactile ", env!("CARGO_PKG_VERSION"));
+        let mut mcap = McapWriter::new(out, "ros2", library)?;
+        let mut schemas: Vec<(&str, u16)> = Vec::new();
+        let mut channels = Vec::new();
+        for t in TOPICS {
+            let id = match schemas.iter().find(|(ty, _)| *ty == t.ty) {
+                Some((_, id)) => *id,
+                None => {
+                    let text = schema::ros2msg(t.ty).unwrap_or_default();
+                    let id = mcap.schema(t.ty, "ros2msg", text.as_bytes())?;
+                    schemas.push((t.ty, id));
+                    id
+                }
+            };
+            channels.push(mcap.channel(t.name, id, "cdr")?);
+        }
+        Ok(Recording {
+            mcap,
+            channels,
+            geometry,
+            objects: scenario.environment.objects.clone(),
+            rate_hz: (scenario.rate_hz.round() as u64).max(1),
+            t_s_ns: scenario.t_s() * 1e9,
+            prev: None,
+            sequence: 0,
+            cdr: CdrWriter::new(),
+        })
+    }
+
+    fn put<M: Message>(&mut self, topic: &str, m: &M, log: u64, publish: u64) -> io::Result<()> {
+        let k = TOPICS.iter().position(|t| t.name == topic).unwrap_or(0);
+        self.cdr.reset();
+        m.encode(&mut self.cdr);
+        self.sequence = self.sequence.wrapping_add(1);
+        self.mcap.message(
+            self.channels[k],
+            self.sequence,
+            log,
+            publish,
+            self.cdr.bytes(),
+        )
+    }
+
+    /// Adds one sample's messages.
+    pub fn add(&mut self, row: &TraceRow) -> io::Result<()> {
+        let tick = row.stamps[stage::MASTER_TICK];
+        let log = if tick > 0 {
+            tick
+        } else {
+            (row.n as f64 * self.t_s_ns) as u64
+        };
+        let at = |s: usize| match row.stamps[s] {
+            0 => log,
+            t => t,
+        };
+        if self.prev.is_none() {
+            self.first(log)?;
+        }
+        if row.n % self.rate_hz == 0 || self.prev.is_none() {
+            self.environment(log)?;
+        }
+        let (vm, vs) = self.velocities(row);
+        let g = self.geometry;
+        let mut tf = TfMessage::default();
+        for (name, theta) in [("master", row.theta_md), ("slave", row.theta_sd)] {
+            for (parent, child, translation, rotation) in arm::links(&g, name, theta) {
+                tf.transforms.push(TransformStamped {
+                    header: Header::at(log, &parent),
+                    child_frame_id: child,
+                    translation,
+                    rotation,
+                });
+            }
+        }
+        self.put("/tf", &tf, log, log)?;
+        let joints = |a: &str, p: [f64; 3], v: [f64; 3], e: [f64; 3]| JointState {
+            header: Header::at(log, ""),
+            name: ["joint1", "joint2", "joint3"]
+                .map(|j| arm::name(a, j))
+                .to_vec(),
+            position: p.to_vec(),
+            velocity: v.to_vec(),
+            effort: e.to_vec(),
+        };
+        let master_at = at(stage::MASTER_TICK);
+        let slave_at = at(stage::SLAVE_SEND);
+        let back_at = at(stage::MASTER_RECV);
+        self.put(
+            "/master/joint_states",
+            &joints("master", row.theta_md, vm, row.tau),
+            log,
+            master_at,
+        )?;
+        self.put(
+            "/slave/joint_states",
+            &joints("slave", row.theta_sd, vs, row.u),
+            log,
+            slave_at,
+        )?;
+        let pose = |frame: &str, p: [f64; 3]| PoseStamped {
+            header: Header::at(log, frame),
+            position: p,
+            orientation: IDENTITY,
+        };
+        self.put(
+            "/master/target",
+            &pose("master_base", row.target),
+            log,
+            master_at,
+        )?;
+        self.put(
+            "/master/handle",
+            &pose("master_base", row.handle),
+            log,
+            master_at,
+        )?;
+        self.put("/slave/tool", &pose("slave_base", row.tool), log, slave_at)?;
+        let wrench = |frame: &str, f: [f64; 3]| WrenchStamped {
+            header: Header::at(log, frame),
+            force: f,
+            torque: [0.0; 3],
+        };
+        self.put("/slave/force", &wrench("slave_base", row.h), log, slave_at)?;
+        self.put("/master/force", &wrench("master_base", row.q), log, back_at)?;
+        self.put(
+            "/master/felt",
+            &wrench("master_base", row.felt),
+            log,
+            back_at,
+        )?;
+        let timing = SampleTiming {
+            sample: row.n,
+            answered: row.received,
+            round_trip_ns: i64::try_from(row.round_trip_ns).unwrap_or(i64::MAX),
+            overhead_ns: row.overhead_ns,
+            delay_forward: row.delay_f,
+            delay_backward: row.delay_b,
+            flags_forward: row.flags_f,
+            flags_backward: row.flags_b,
+            flags_master: row.flags_m,
+            observer_master: row.observer_m,
+            observer_slave: row.observer_s,
+        };
+        self.put("/tactile/timing", &timing, log, at(stage::MASTER_DONE))
+    }
+
+    /// Backward differences of both arms' angles, rad/s (0 at the first sample).
+    fn velocities(&mut self, row: &TraceRow) -> ([f64; 3], [f64; 3]) {
+        let v = match self.prev {
+            Some((n, m, s)) if row.n > n => {
+                let dt = (row.n - n) as f64 * self.t_s_ns * 1e-9;
+                (
+                    [0, 1, 2].map(|k| (row.theta_md[k] - m[k]) / dt),
+                    [0, 1, 2].map(|k| (row.theta_sd[k] - s[k]) / dt),
+                )
+            }
+            _ => ([0.0; 3], [0.0; 3]),
+        };
+        self.prev = Some((row.n, row.theta_md, row.theta_sd));
+        v
+    }
+
+    /// The messages sent once: the URDF and the transforms that never move.
+    fn first(&mut self, log: u64) -> io::Result<()> {
+        let description = StringMsg {
+            data: urdf::urdf(&self.geometry),
+        };
+        self.put("/robot_description", &description, log, log)?;
+        let transforms = arm::fixed(&self.geometry)
+            .into_iter()
+            .map(|(parent, child, translation, rotation)| TransformStamped {
+                header: Header::at(log, &parent),
+                child_frame_id: child,
+                translation,
+                rotation,
+            })
+            .collect();
+        self.put("/tf_static", &TfMessage { transforms }, log, log)
+    }
+
+    fn environment(&mut self, log: u64) -> io::Result<()> {
+        let markers = self
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(k, o)| marker(o, k as i32, log))
+            .collect();
+        self.put("/slave/environment", &MarkerArray { markers }, log, log)
+    }
+
+    /// Writes the summary and the footer.
+    pub fn finish(self) -> io::Result<W> {
+        self.mcap.finish()
+    }
+}
+
+/// A recording being written to `dir/run.mcap.partial`, renamed to `run.mcap` when
+/// it is whole, so a report that fails half-way leaves no truncated recording.
+pub type FileRecording = Recording<std::io::BufWriter<std::fs::File>>;
+
+/// Starts `dir/run.mcap.partial`.
+pub fn create(dir: &std::path::Path, scenario: &Scenario) -> io::Result<FileRecording> {
+    let f = std::fs::File::create(dir.join(format!("{FILE}.partial")))?;
+    Recording::new(std::io::BufWriter::with_capacity(1 << 16, f), scenario)
+}
+
+/// Finishes a recording from [`create`] and gives it its name.
+pub fn commit(rec: FileRecording, dir: &std::path::Path) -> io::Result<()> {
+    let w = rec.finish()?;
+    w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+    std::fs::rename(dir.join(format!("{FILE}.partial")), dir.join(FILE))
+}
+
+/// An object as a marker: a sphere, a box, or a plane as a thin 0.3 m square.
+fn marker(o: &Object, id: i32, log: u64) -> Marker {
+    let (kind, position, orientation, scale) = match o {
+        Object::Sphere { center, radius, .. } => {
+            (Marker::SPHERE, *center, IDENTITY, [2.0 * radius; 3])
+        }
+        Object::Box {
+            center,
+            half_extents,
+            ..
+        } => (
+            Marker::CUBE,
+            *center,
+            IDENTITY,
+            half_extents.map(|h| 2.0 * h),
+        ),
+        Object::Plane { point, normal, .. } => {
+            (Marker::CUBE, *point, z_to(*normal), [0.3, 0.3, 0.002])
+        }
+    };
+    Marker {
+        header: Header::at(log, "slave_base"),
+        ns: "environment".into(),
+        id,
+        kind,
+        position,
+        orientation,
+        scale,
+        color: [0.6, 0.6, 0.65, 0.5],
+    }
+}
+
+/// The rotation taking z to the unit vector along `n`.
+fn z_to(n: [f64; 3]) -> [f64; 4] {
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if len == 0.0 || !len.is_finite() {
+        return IDENTITY;
+    }
+    let [x, y, z] = n.map(|v| v / len);
+    // Half-way quaternion between z and n: axis z x n, angle acos(z . n).
+    let w = 1.0 + z;
+    if w < 1e-12 {
+        return [1.0, 0.0, 0.0, 0.0]; // n = -z: half a turn about x
+    }
+    let q = [-y, x, 0.0, w];
+    let norm = (q[0] * q[0] + q[1] * q[1] + w * w).sqrt();
+    q.map(|v| v / norm)
+}
