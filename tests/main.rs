@@ -18,6 +18,7 @@ mod layout;
 mod lifecycle;
 mod loop_processes;
 mod nodes;
+mod recordings;
 mod records;
 mod scheduling;
 mod signals;

@@ -32,4 +32,6 @@ pub mod guide {
     pub mod kernels_and_the_paper {}
     #[doc = include_str!("../../docs/09-the-hardware.md")]
     pub mod the_hardware {}
+    #[doc = include_str!("../../docs/10-recordings.md")]
+    pub mod recordings {}
 }

@@ -1,7 +1,9 @@
 //! `run.mcap`: the run as ROS 2 messages (tactile-ros's topics) in an MCAP file,
 //! streamed sample by sample from the joined records, so Foxglove, Rerun and
 //! `ros2 bag` open it. Log time is the sample's time on the master's clock (its tick
-//! stamp); publish time the stamp of the stage that produced the message (the slave's
+//! stamp); in lockstep, where samples run as fast as the machine goes, it is the
+//! sample's nominal time on that clock (`n t_s` after the first tick), so a viewer
+//! plays the run at the speed it simulates. Publish time the stamp of the stage that produced the message (the slave's
 //! send for its messages, the master's receive for q(n)), or the log time where that
 //! stage was not passed. Header stamps are the log time.
 
@@ -17,7 +19,7 @@ use tactile_ros::msg::{
 use tactile_ros::topics::TOPICS;
 use tactile_ros::{arm, schema, urdf, CdrWriter, Message};
 use tactile_scenario::Object;
-use tactile_scenario::Scenario;
+use tactile_scenario::{Mode, Scenario};
 
 /// The recording's file name in a report folder.
 pub const FILE: &str = "run.mcap";
@@ -31,6 +33,8 @@ pub struct Recording<W: Write> {
     objects: Vec<Object>,
     rate_hz: u64,
     t_s_ns: f64,
+    /// Lockstep: log times are nominal, `n t_s` after the first sample's tick.
+    nominal: Option<Option<u64>>,
     /// The previous sample: n and both arms' angles (for the velocities).
     prev: Option<(u64, [f64; 3], [f64; 3])>,
     sequence: u32,
@@ -64,6 +68,7 @@ impl<W: Write> Recording<W> {
             objects: scenario.environment.objects.clone(),
             rate_hz: (scenario.rate_hz.round() as u64).max(1),
             t_s_ns: scenario.t_s() * 1e9,
+            nominal: (scenario.mode == Mode::Lockstep).then_some(None),
             prev: None,
             sequence: 0,
             cdr: CdrWriter::new(),
@@ -87,10 +92,12 @@ impl<W: Write> Recording<W> {
     /// Adds one sample's messages.
     pub fn add(&mut self, row: &TraceRow) -> io::Result<()> {
         let tick = row.stamps[stage::MASTER_TICK];
-        let log = if tick > 0 {
-            tick
-        } else {
-            (row.n as f64 * self.t_s_ns) as u64
+        let nominal = (row.n as f64 * self.t_s_ns) as u64;
+        let log = match &mut self.nominal {
+            // The origin is the first sample's tick less its own nominal time.
+            Some(origin) => *origin.get_or_insert(tick.saturating_sub(nominal)) + nominal,
+            None if tick > 0 => tick,
+            None => nominal,
         };
         let at = |s: usize| match row.stamps[s] {
             0 => log,
@@ -252,6 +259,11 @@ pub fn commit(rec: FileRecording, dir: &std::path::Path) -> io::Result<()> {
     let w = rec.finish()?;
     w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
     std::fs::rename(dir.join(format!("{FILE}.partial")), dir.join(FILE))
+}
+
+/// Removes a recording [`create`] started, after a failure.
+pub fn discard(dir: &std::path::Path) {
+    let _ = std::fs::remove_file(dir.join(format!("{FILE}.partial")));
 }
 
 /// An object as a marker: a sphere, a box, or a plane as a thin 0.3 m square.

@@ -354,7 +354,8 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
             r.add(row).map_err(Error::io("writing run.mcap"))?;
         }
         Ok(ControlFlow::Continue(()))
-    })?;
+    })
+    .inspect_err(|_| recording::discard(out))?;
     if let Some(mut w) = trace {
         w.flush().map_err(Error::io("writing trace.csv"))?;
     }
@@ -410,7 +411,8 @@ pub fn write_recording(dirs: &[PathBuf], out: &Path) -> Result<u64, Error> {
         samples += 1;
         rec.add(row).map_err(Error::io("writing run.mcap"))?;
         Ok(ControlFlow::Continue(()))
-    })?;
+    })
+    .inspect_err(|_| recording::discard(out))?;
     recording::commit(rec, out).map_err(Error::io("writing run.mcap"))?;
     Ok(samples)
 }

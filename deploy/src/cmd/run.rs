@@ -16,7 +16,7 @@ pub struct RunArgs {
     /// Scenario file (TOML); without one, the built-in paper scenario
     /// (deploy/scenarios/paper.toml).
     pub scenario: Option<PathBuf>,
-    /// Folder for summary.json, trace.csv, histograms and plots.
+    /// Folder for summary.json, trace.csv, run.mcap, histograms and plots.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
     /// Change the scenario: KEY is a dotted path (network.forward.delay,
@@ -74,7 +74,8 @@ pub struct RunArgs {
     /// taken away for about 7.5 ms every 10 s instead: docs/07-latency.md).
     #[arg(long, value_enum, default_value_t = tactile_node::sched::IdleMode::Halt)]
     pub idle: tactile_node::sched::IdleMode,
-    /// Write no trace.csv (a long run's trace is about 1 kB per sample); everything
+    /// Write no trace.csv and no run.mcap (a long run's trace is about 1 kB per
+    /// sample, its recording about 0.75 kB); everything
     /// else is reported.
     #[arg(long)]
     pub no_trace: bool,

@@ -39,7 +39,8 @@ pub struct SweepArgs {
     /// its real time) instead of running them in-process.
     #[arg(long)]
     pub processes: bool,
-    /// Write each run's trace.csv too (about 1 kB per sample).
+    /// Write each run's trace.csv and run.mcap too (about 1 kB and 0.75 kB per
+    /// sample).
     #[arg(long)]
     pub trace: bool,
 }

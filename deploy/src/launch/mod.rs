@@ -42,7 +42,7 @@ pub struct Supervision {
     pub sched: tactile_node::sched::Policy,
     /// What each node's CPU does while the node sleeps (realtime, SCHED_FIFO).
     pub idle: tactile_node::sched::IdleMode,
-    /// Write no trace.csv.
+    /// Write no trace.csv and no run.mcap.
     pub no_trace: bool,
 }
 
