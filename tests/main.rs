@@ -22,4 +22,5 @@ mod recordings;
 mod records;
 mod scheduling;
 mod signals;
+mod summaries;
 mod sweep;

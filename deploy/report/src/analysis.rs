@@ -267,6 +267,9 @@ pub struct Analysis {
     pub round_trip: Latency,
     /// Round trip minus injected delay.
     pub overhead: Latency,
+    /// Round trip in samples: n minus the oldest sample q(n) started from (the
+    /// measure of a lockstep run, whose wall-clock time is not the loop's).
+    pub round_trip_samples: Latency,
     /// Per stage, in [`STAGES`] order.
     pub stages: Vec<Latency>,
     /// Tracking and forces.
@@ -293,6 +296,7 @@ impl Analysis {
         Analysis {
             round_trip: Latency::default(),
             overhead: Latency::default(),
+            round_trip_samples: Latency::default(),
             stages: vec![Latency::default(); STAGES.len()],
             motion: Motion::default(),
             bilateral: crate::metrics::Bilateral::default(),
@@ -339,6 +343,9 @@ impl Analysis {
         if (row.flags_b | row.flags_f) & FLAG_SUBSTITUTED == 0 {
             self.round_trip.record(row.round_trip_ns as i64);
             self.overhead.record(row.overhead_ns);
+            let oldest = row.q_origin.iter().copied().min().unwrap_or(row.n);
+            self.round_trip_samples
+                .record(row.n.saturating_sub(oldest) as i64);
         }
         if !self.with_stages {
             return;

@@ -364,6 +364,7 @@ fn row(
         r.dissipated_m = a.dissipated_j;
         r.port_net_m = a.port_net_j;
         r.q_from = a.q.sent_seq;
+        r.q_origin = a.q.origin_seq;
         r.round_trip_ns = a.round_trip_ns;
         r.overhead_ns = a.overhead_ns;
         r.stamps = Stamps(a.stamps);

@@ -168,7 +168,8 @@ impl Bilateral {
             let depth = distance(row.surface, row.tool);
             self.contact.max_penetration_m = self.contact.max_penetration_m.max(depth);
         }
-        if row.flags_f & FLAG_CORRUPTED != 0 {
+        // A corrupted or rejected v(n) asked the slave nothing: it held.
+        if row.flags_f & (FLAG_CORRUPTED | FLAG_REJECTED) != 0 {
             return;
         }
         // The master's handle where each value of v(n) left it; for a value the

@@ -144,8 +144,16 @@ pub struct Summary {
     pub run: Option<String>,
     /// Round trip on the master's clock, ns; null when nothing came back.
     pub round_trip_ns: Option<Percentiles>,
-    /// Round trip minus the injected delay, ns; null when nothing came back.
+    /// Round trip in samples (n minus the oldest sample q(n) started from); in
+    /// lockstep this is the round trip, `round_trip_ms_nominal` its time.
+    pub round_trip_samples: Option<Percentiles>,
+    /// Lockstep: the round trip's p50 in samples times t_s, ms; null in real time.
+    pub round_trip_ms_nominal: Option<f64>,
+    /// Round trip minus the injected delay, ns; null when nothing came back, and in
+    /// lockstep (see `overhead_na`).
     pub overhead_ns: Option<Percentiles>,
+    /// Why `overhead_ns` is null when samples did come back.
+    pub overhead_na: Option<&'static str>,
     /// Overheads below zero (tick jitter), clamped to zero in the histogram.
     pub overhead_negative: u64,
     /// Per-stage times, ns (stages with no data, and stages between two nodes on
@@ -207,9 +215,21 @@ pub fn render(s: &Summary, out: &Path) -> String {
         "Tactile run {:?}: {:?} at {} Hz, {} arithmetic, {}",
         s.scenario, s.mode, s.rate_hz, s.arithmetic, s.runner
     );
+    if let (Some(p), Some(ms)) = (&s.round_trip_samples, s.round_trip_ms_nominal) {
+        let _ = writeln!(
+            t,
+            "round trip (lockstep): {} samples p50 ({ms:.1} ms nominal), p99 {}, max {} ({} answers)",
+            p.p50, p.p99, p.max, p.count
+        );
+    }
+    if let Some(why) = s.overhead_na {
+        let _ = writeln!(t, "system overhead: n/a ({why})");
+    }
     let _ = writeln!(t, "{}", us_header());
-    let _ = writeln!(t, "{}", us_line("round trip", s.round_trip_ns.as_ref()));
-    let _ = writeln!(t, "{}", us_line("system overhead", s.overhead_ns.as_ref()));
+    if s.overhead_na.is_none() {
+        let _ = writeln!(t, "{}", us_line("round trip", s.round_trip_ns.as_ref()));
+        let _ = writeln!(t, "{}", us_line("system overhead", s.overhead_ns.as_ref()));
+    }
     for (name, p) in &s.stages_ns {
         let _ = writeln!(t, "{}", us_line(&format!("  {name}"), Some(p)));
     }
@@ -280,11 +300,24 @@ pub fn render(s: &Summary, out: &Path) -> String {
         s.packets.forward,
         s.packets.backward
     );
+    if let Some(e) = &s.emulator {
+        let c = &e.counters;
+        let _ = writeln!(
+            t,
+            "network forward: {} packets lost, {} samples substituted, {} dropped, {} duplicated, {} corrupted",
+            c.forward_packets_lost, c.forward_substituted, c.forward_dropped, c.forward_duplicated, c.forward_corrupted
+        );
+        let _ = writeln!(
+            t,
+            "network backward: {} packets lost, {} samples substituted, {} dropped, {} duplicated, {} corrupted",
+            c.backward_packets_lost, c.backward_substituted, c.backward_dropped, c.backward_duplicated, c.backward_corrupted
+        );
+    }
     let mc = &m.totals.counters;
     let _ = writeln!(
         t,
-        "master: {} force clamps, {} torque clamps, {} rejected, {} held, {} peer-lost samples",
-        mc.force_clamps, mc.torque_clamps, mc.rejected, mc.held_samples, mc.peer_lost_samples
+        "master: {} operator targets clamped, {} force clamps, {} torque clamps, {} rejected, {} held, {} peer-lost samples",
+        mc.operator_clamped, mc.force_clamps, mc.torque_clamps, mc.rejected, mc.held_samples, mc.peer_lost_samples
     );
     if let Some(sl) = &s.slave {
         let c = &sl.counters;

@@ -189,6 +189,9 @@ trace_row! {
     observer_s: [f64; 3],
     /// The slave step each value of q(n) was produced at.
     q_from: [u64; 3],
+    /// The master sample each value of q(n) started from: n minus the oldest is the
+    /// round trip in samples.
+    q_origin: [u64; 3],
     /// Flags of v(n) as received.
     flags_f: u32,
     /// Flags of q(n) as received.

@@ -166,6 +166,11 @@ fn logs_missing(logs: &Logs, k: usize) -> bool {
     }
 }
 
+/// Why a lockstep run has no system overhead.
+pub const LOCKSTEP_OVERHEAD: &str = "lockstep: each sample starts when the last is done, so the \
+     wall-clock time of a round trip holds the other samples computed meanwhile, not the \
+     injected delay; the round trip is in samples";
+
 /// The summary from the joined statistics and the nodes' logs.
 fn summarise(
     scenario: &Scenario,
@@ -209,6 +214,7 @@ fn summarise(
         + events(Role::Emulator, &logs.emulator, &mut ev)
         + events(Role::Slave, &logs.slave, &mut ev);
     let elapsed = master_totals.elapsed_ns;
+    let lockstep = scenario.mode == tactile_scenario::Mode::Lockstep;
     Summary {
         scenario: scenario.name.clone(),
         mode: scenario.mode,
@@ -217,7 +223,13 @@ fn summarise(
         runner,
         run: logs.master.runs.first().map(|t| format!("{t:016x}")),
         round_trip_ns: a.round_trip.percentiles(),
-        overhead_ns: a.overhead.percentiles(),
+        round_trip_samples: a.round_trip_samples.percentiles(),
+        round_trip_ms_nominal: lockstep
+            .then(|| a.round_trip_samples.percentiles())
+            .flatten()
+            .map(|p| p.p50 as f64 * scenario.t_s() * 1e3),
+        overhead_ns: a.overhead.percentiles().filter(|_| !lockstep),
+        overhead_na: (lockstep && a.received > 0).then_some(LOCKSTEP_OVERHEAD),
         overhead_negative: a.overhead.negative,
         clocks: Clocks {
             shared: (0..3).all(|k| a.same_clock(0, k) || logs_missing(logs, k)),

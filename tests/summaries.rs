@@ -1,0 +1,64 @@
+//! What the summary says, checked against what the run did: a lockstep run's round
+//! trip in samples with the overhead n/a; the emulator's losses in the text.
+
+use crate::util::{self, Sandbox};
+
+#[test]
+fn lockstep_reports_its_round_trip_in_samples_and_no_overhead() {
+    let sb = Sandbox::new("lockstep-rt");
+    // 25 samples each way at 1 kHz: 50 samples, 50 ms nominal.
+    let s = sb.write(
+        "s.toml",
+        &util::wall_delay().replace("samples = 8000", "samples = 400"),
+    );
+    let o = sb.tactile(&["run", s.to_str().expect("utf-8"), "--out", "out"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}");
+    assert!(
+        text.contains("round trip (lockstep): 50 samples p50 (50.0 ms nominal)"),
+        "{text}"
+    );
+    assert!(text.contains("system overhead: n/a (lockstep"), "{text}");
+    assert!(
+        !text.contains("\nround trip   "),
+        "no wall-clock round trip row: {text}"
+    );
+    let j = sb.json("out", "summary.json");
+    assert_eq!(j["round_trip_samples"]["p50"], 50);
+    assert_eq!(j["round_trip_ms_nominal"], 50.0);
+    assert!(j["overhead_ns"].is_null());
+    assert!(j["overhead_na"]
+        .as_str()
+        .is_some_and(|w| w.starts_with("lockstep")));
+    // In real time the overhead stays, and no nominal round trip is claimed.
+    let rt = sb.write("rt.toml", &util::paper_1khz(300));
+    let o = sb.tactile(&["run", rt.to_str().expect("utf-8"), "--out", "rt", "-q"]);
+    assert!(o.status.success());
+    let j = sb.json("rt", "summary.json");
+    assert!(j["overhead_ns"]["p50"].is_u64());
+    assert!(j["overhead_na"].is_null() && j["round_trip_ms_nominal"].is_null());
+}
+
+#[test]
+fn the_text_says_what_the_network_lost() {
+    let sb = Sandbox::new("replay-lost");
+    // A replayed network that loses every third packet of 1200.
+    let mut csv = String::from("delay,lost\n");
+    for k in 0..1200 {
+        csv.push_str(&format!("2,{}\n", u8::from(k % 3 == 0)));
+    }
+    sb.write("net.csv", &csv);
+    let text = util::paper_1khz(1200).replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        + "\n[network.forward.replay]\npath = \"net.csv\"\n";
+    let s = sb.write("s.toml", &text);
+    let o = sb.tactile(&["run", s.to_str().expect("utf-8"), "--out", "out"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{out}");
+    let j = sb.json("out", "summary.json");
+    let lost = j["emulator"]["counters"]["forward_packets_lost"]
+        .as_u64()
+        .expect("count");
+    assert_eq!(lost, 400, "every third of 1200");
+    assert!(out.contains("network forward: 400 packets lost"), "{out}");
+    assert!(out.contains("network backward: 0 packets lost"), "{out}");
+}
