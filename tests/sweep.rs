@@ -119,3 +119,146 @@ fn a_bad_value_anywhere_in_a_sweep_stops_it_before_any_run() {
     );
     assert!(!sb.path("sw").exists(), "nothing ran");
 }
+
+/// `tactile sweep` over the paper scenario with two axes (3 x 2 = 6 combinations),
+/// extra arguments, into `out`; asserts success.
+fn sweep(sb: &Sandbox, out: &str, extra: &[&str]) -> std::process::Output {
+    let s = sb.path("s.toml");
+    if !s.exists() {
+        // Network noise makes the metrics depend on the seed.
+        let text = scenario(600).replace(
+            "[network.forward]\ndelay = [0, 0, 0]\nnoise_std = [0.0, 0.0, 0.0]",
+            "[network.forward]\ndelay = [0, 0, 0]\nnoise_std = [0.0005, 0.0005, 0.0005]",
+        );
+        assert!(text.contains("0.0005"), "the scenario's noise line changed");
+        sb.write("s.toml", &text);
+    }
+    let mut args = vec![
+        "sweep",
+        s.to_str().expect("utf-8"),
+        "--set",
+        "network.forward.delay=[0,0,0],[5,5,5],[20,20,20]",
+        "--set",
+        "control.kind=none,tdpa",
+        "--out",
+        out,
+    ];
+    args.extend_from_slice(extra);
+    let o = sb.tactile(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
+fn read(sb: &Sandbox, out: &str, file: &str) -> String {
+    std::fs::read_to_string(sb.path(out).join(file)).expect(file)
+}
+
+#[test]
+fn parallel_sharded_and_resumed_sweeps_give_the_same_table() {
+    let sb = Sandbox::new("sweep-par");
+    sweep(&sb, "one", &["--jobs", "1"]);
+    let table = read(&sb, "one", "sweep.csv");
+    assert_eq!(table.lines().count(), 1 + 6);
+    sweep(&sb, "two", &["--jobs", "2"]);
+    assert_eq!(
+        read(&sb, "two", "sweep.csv"),
+        table,
+        "--jobs 2 equals --jobs 1"
+    );
+    // Four shards (6 combinations: 2, 2, 1, 1), merged: the same table.
+    let shards: Vec<String> = (1..=4).map(|k| format!("shard{k}")).collect();
+    for (k, dir) in shards.iter().enumerate() {
+        sweep(&sb, dir, &["--shard", &format!("{}/4", k + 1)]);
+    }
+    let mut args = vec!["sweep", "--merge"];
+    args.extend(shards.iter().map(String::as_str));
+    args.extend(["--out", "merged"]);
+    let o = sb.tactile(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        read(&sb, "merged", "sweep.csv"),
+        table,
+        "merged shards equal the whole"
+    );
+    assert!(sb.path("merged").join("sweep-position_rms_m.svg").exists());
+    // Three shards of four are not the whole: merged, the missing runs are named.
+    let o = sb.tactile(&[
+        "sweep", "--merge", "shard1", "shard2", "shard3", "--out", "part",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("run-0003"));
+    // Resume: a run whose report is gone is run again, the others are kept.
+    std::fs::remove_file(sb.path("one").join("run-0004").join("summary.json")).expect("rm");
+    let o = sweep(&sb, "one", &["--resume"]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("5 runs kept from before"));
+    assert_eq!(read(&sb, "one", "sweep.csv"), table);
+    // A slice of another sweep is refused.
+    std::fs::create_dir(sb.path("other")).expect("mkdir");
+    let spec = read(&sb, "shard4", "sweep.json")
+        .replace("control.kind=none,tdpa", "control.kind=none,wave");
+    sb.write("other/sweep.json", &spec);
+    let o = sb.tactile(&["sweep", "--merge", "shard1", "other", "--out", "bad"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("a slice of another sweep"));
+}
+
+#[test]
+fn seeds_give_a_mean_and_an_interval_per_metric() {
+    let sb = Sandbox::new("sweep-seeds");
+    sweep(&sb, "s3", &["--seeds", "3"]);
+    let table = read(&sb, "s3", "sweep.csv");
+    let header: Vec<&str> = table.lines().next().expect("header").split(',').collect();
+    assert_eq!(header[3], "seeds");
+    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let rows: Vec<Vec<String>> = table.lines().skip(1).map(cells).collect();
+    assert_eq!(rows.len(), 6);
+    // Seed-independent: samples sent; seed-dependent: tracking with network noise.
+    let (sent, sent_ci) = (col("samples_sent_mean"), col("samples_sent_ci95"));
+    let (track, track_ci) = (col("tracking_rms_m_mean"), col("tracking_rms_m_ci95"));
+    for r in &rows {
+        assert_eq!(r[3], "3");
+        assert_eq!((r[sent].as_str(), r[sent_ci].as_str()), ("600", "0"));
+        let ci: f64 = r[track_ci].parse().expect("interval");
+        let mean: f64 = r[track].parse().expect("mean");
+        assert!(ci > 0.0 && ci < mean, "{ci} of {mean}");
+    }
+    // runs.csv: every run, its seed; the mean is theirs.
+    let runs = read(&sb, "s3", "runs.csv");
+    assert_eq!(runs.lines().count(), 1 + 18);
+    assert!(runs.starts_with("run,seed,"));
+    let rc = runs
+        .lines()
+        .next()
+        .expect("h")
+        .split(',')
+        .position(|h| h == "tracking_rms_m")
+        .expect("col");
+    let first: Vec<f64> = runs
+        .lines()
+        .skip(1)
+        .filter(|l| l.starts_with("0,"))
+        .map(|l| cells(l)[rc].parse().expect("f64"))
+        .collect();
+    assert_eq!(first.len(), 3);
+    let mean: f64 = rows[0][track].parse().expect("mean");
+    assert!((first.iter().sum::<f64>() / 3.0 - mean).abs() < 1e-15);
+    assert!(sb
+        .path("s3")
+        .join("run-0000-s2")
+        .join("summary.json")
+        .exists());
+}
+
+/// A CSV line's cells, commas inside quotes kept (`"[0,0,0]"`).
+fn cells(line: &str) -> Vec<String> {
+    let (mut out, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+    for ch in line.chars() {
+        match ch {
+            '"' => quoted = !quoted,
+            ',' if !quoted => out.push(std::mem::take(&mut cur)),
+            c => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out
+}

@@ -15,6 +15,7 @@ pub mod plots;
 pub mod recording;
 pub mod summary;
 pub mod sweep;
+pub mod sweep_plots;
 pub mod trace;
 pub mod write;
 

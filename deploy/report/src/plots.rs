@@ -337,51 +337,6 @@ pub fn percentile_plot(
     root.present().map_err(err)
 }
 
-/// `sweep-METRIC.svg` for every metric of a sweep: the metric against the first
-/// swept key (its values' positions when they are not numbers), one line per value of
-/// the second key. A run without a value for the metric leaves a gap.
-pub fn sweep_plots(
-    out: &Path,
-    axes: &[crate::sweep::Axis],
-    rows: &[(Vec<usize>, Vec<Option<f64>>)],
-) -> PlotResult {
-    let Some(first) = axes.first() else {
-        return Ok(());
-    };
-    let numeric: Option<Vec<f64>> = first.values.iter().map(|v| v.parse().ok()).collect();
-    let x_of = |i: usize| numeric.as_ref().map_or(i as f64, |n| n[i]);
-    let lines = axes.get(1).map_or(1, |a| a.values.len());
-    for (m, (name, _)) in crate::sweep::METRICS.iter().enumerate() {
-        let mut series = Vec::new();
-        for line in 0..lines {
-            let mut pts: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|(c, _)| c.get(1).is_none_or(|&l| l == line))
-                .filter_map(|(c, v)| v[m].map(|y| (x_of(c[0]), y)))
-                .collect();
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let label = axes.get(1).map_or_else(
-                || name.to_string(),
-                |a| format!("{}={}", a.key, a.values[line]),
-            );
-            series.push((label, LOOP_COLOURS[line % LOOP_COLOURS.len()], false, pts));
-        }
-        let x_desc = if numeric.is_some() {
-            first.key.clone()
-        } else {
-            format!("{} (0: {})", first.key, first.values.join(", "))
-        };
-        xy_plot(
-            &out.join(format!("sweep-{name}.svg")),
-            &format!("{name} against {}", first.key),
-            &x_desc,
-            name,
-            &series,
-        )?;
-    }
-    Ok(())
-}
-
 type Line = (String, RGBColor, bool, Vec<(f64, f64)>);
 
 fn time_series(path: &Path, title: &str, y_desc: &str, series: &[Line]) -> PlotResult {

@@ -121,6 +121,88 @@ pub fn row(k: usize, axes: &[Axis], combo: &[usize], values: &[Option<f64>]) -> 
     cols.join(",") + "\n"
 }
 
+/// The header of `sweep.csv` for a sweep repeated over `seeds` seeds: per metric its
+/// mean and the half width of its 95 % confidence interval, and the runs averaged.
+pub fn header_seeds(axes: &[Axis]) -> String {
+    let mut cols: Vec<String> = vec!["run".into()];
+    cols.extend(axes.iter().map(|a| csv_field(&a.key)));
+    cols.push("seeds".into());
+    for (n, _) in METRICS {
+        cols.push(format!("{n}_mean"));
+        cols.push(format!("{n}_ci95"));
+    }
+    cols.join(",") + "\n"
+}
+
+/// One combination's line of `sweep.csv` over its seeds' values (one `Vec` per run).
+pub fn row_seeds(k: usize, axes: &[Axis], combo: &[usize], runs: &[Vec<Option<f64>>]) -> String {
+    let mut cols: Vec<String> = vec![k.to_string()];
+    cols.extend(
+        axes.iter()
+            .zip(combo)
+            .map(|(a, &i)| csv_field(&a.values[i])),
+    );
+    cols.push(runs.len().to_string());
+    for m in 0..METRICS.len() {
+        let v: Vec<f64> = runs
+            .iter()
+            .filter_map(|r| r.get(m).copied().flatten())
+            .collect();
+        let (mean, ci) = mean_ci95(&v).map_or((None, None), |(a, b)| (Some(a), b));
+        cols.push(mean.map_or_else(String::new, |x| format!("{x}")));
+        cols.push(ci.map_or_else(String::new, |x| format!("{x}")));
+    }
+    cols.join(",") + "\n"
+}
+
+/// Two-sided 95 % quantiles of Student's t for 1 to 30 degrees of freedom.
+const T95: [f64; 30] = [
+    12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+    2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+    2.052, 2.048, 2.045, 2.042,
+];
+
+/// Student's t 95 % quantile for `df` degrees of freedom (beyond 30, the normal's 1.96
+/// plus the first-order correction 2.4/df, within 0.2 % of the exact value).
+pub fn t95(df: usize) -> f64 {
+    match df {
+        0 => f64::NAN,
+        1..=30 => T95[df - 1],
+        _ => 1.96 + 2.4 / df as f64,
+    }
+}
+
+/// Mean of `v` and the half width of its 95 % confidence interval (Student's t with
+/// the sample standard deviation); `None` without values, no interval for one value.
+pub fn mean_ci95(v: &[f64]) -> Option<(f64, Option<f64>)> {
+    let n = v.len();
+    if n == 0 {
+        return None;
+    }
+    let mean = v.iter().sum::<f64>() / n as f64;
+    if n == 1 {
+        return Some((mean, None));
+    }
+    let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
+    Some((mean, Some(t95(n - 1) * (var / n as f64).sqrt())))
+}
+
+/// A swept value as a number for a plot's axis: the number itself, or a vector's
+/// elements' mean (`[25,25,25]` is 25); `None` for words.
+pub fn numeric(value: &str) -> Option<f64> {
+    let v = value.trim();
+    if let Ok(x) = v.parse::<f64>() {
+        return Some(x);
+    }
+    let inner = v.strip_prefix('[')?.strip_suffix(']')?;
+    let xs: Vec<f64> = inner
+        .split(',')
+        .map(|e| e.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .ok()?;
+    (!xs.is_empty()).then(|| xs.iter().sum::<f64>() / xs.len() as f64)
+}
+
 /// A CSV field, quoted when it holds a comma or a quote.
 fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
@@ -153,6 +235,58 @@ mod tests {
             describe(&axes, &c[5]),
             "network.forward.delay=[10,10,10] mode=lockstep"
         );
+    }
+
+    #[test]
+    fn vector_values_are_numbers_on_an_axis() {
+        assert_eq!(numeric("25"), Some(25.0));
+        assert_eq!(numeric("[25,25,25]"), Some(25.0));
+        assert_eq!(numeric("[0, 3, 6]"), Some(3.0));
+        assert_eq!(numeric("tdpa"), None);
+        assert_eq!(numeric("[a,b]"), None);
+    }
+
+    /// A metric of known variance: normal values (Box-Muller over a seeded LCG),
+    /// mean 10, sigma 2. The interval covers the true mean 95 % of the time, and its
+    /// width shrinks as t(N-1) sigma / sqrt(N).
+    #[test]
+    fn the_interval_covers_the_mean_as_often_as_it_says() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((seed >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        let mut normal = move || {
+            let (u, v) = (uniform(), uniform());
+            10.0 + 2.0 * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+        };
+        for n in [5usize, 20] {
+            let (mut covered, mut width) = (0, 0.0);
+            let trials = 4000;
+            for _ in 0..trials {
+                let v: Vec<f64> = (0..n).map(|_| normal()).collect();
+                let (mean, ci) = mean_ci95(&v).expect("values");
+                let ci = ci.expect("n > 1");
+                covered += usize::from((mean - 10.0).abs() <= ci);
+                width += ci / trials as f64;
+            }
+            let coverage = covered as f64 / trials as f64;
+            assert!(
+                (0.935..=0.965).contains(&coverage),
+                "n {n}: coverage {coverage}"
+            );
+            // E[s] = c4 sigma; c4 is 0.940 for n = 5, 0.987 for n = 20.
+            let c4 = if n == 5 { 0.9400 } else { 0.9869 };
+            let expected = t95(n - 1) * 2.0 * c4 / (n as f64).sqrt();
+            assert!(
+                (width / expected - 1.0).abs() < 0.03,
+                "n {n}: {width} vs {expected}"
+            );
+        }
+        assert_eq!(mean_ci95(&[3.0]), Some((3.0, None)));
+        assert_eq!(mean_ci95(&[]), None);
     }
 
     #[test]

@@ -1,0 +1,167 @@
+//! `sweep-METRIC.svg`: each metric of a sweep against the first swept key, one line
+//! per value of the second, a marker at every run, and with `--seeds` the 95 %
+//! confidence interval as an error bar. Vector values (`[25,25,25]`) sit at their
+//! elements' mean on a numeric axis; words at their positions 0, 1, 2, ...
+
+use crate::sweep::{numeric, Axis, METRICS};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// The line colours (the plots' own palette, colour-blind safe).
+const COLOURS: [RGBColor; 6] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+];
+
+/// One combination's values: its value index on each axis, and per metric the mean
+/// and (with seeds) the interval's half width.
+pub type Point = (Vec<usize>, Vec<(Option<f64>, Option<f64>)>);
+
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+/// Writes `sweep-METRIC.svg` for every metric into `out`.
+pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<(), String> {
+    let Some(first) = axes.first() else {
+        return Ok(());
+    };
+    let nums: Option<Vec<f64>> = first.values.iter().map(|v| numeric(v)).collect();
+    let x_of = |i: usize| nums.as_ref().map_or(i as f64, |n| n[i]);
+    let x_desc = if nums.is_some() {
+        first.key.clone()
+    } else {
+        format!("{} (0: {})", first.key, first.values.join(", "))
+    };
+    let lines = axes.get(1).map_or(1, |a| a.values.len());
+    for (m, (name, _)) in METRICS.iter().enumerate() {
+        let mut series = Vec::new();
+        for line in 0..lines {
+            let mut pts: Vec<(f64, f64, f64)> = points
+                .iter()
+                .filter(|(c, _)| c.get(1).is_none_or(|&l| l == line))
+                .filter_map(|(c, v)| {
+                    let (mean, ci) = v[m];
+                    mean.map(|y| (x_of(c[0]), y, ci.unwrap_or(0.0)))
+                })
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let label = axes.get(1).map_or_else(
+                || name.to_string(),
+                |a| format!("{}={}", a.key, a.values[line]),
+            );
+            series.push((label, COLOURS[line % COLOURS.len()], pts));
+        }
+        plot(
+            &out.join(format!("sweep-{name}.svg")),
+            name,
+            &first.key,
+            &x_desc,
+            &series,
+        )?;
+    }
+    Ok(())
+}
+
+type Series = (String, RGBColor, Vec<(f64, f64, f64)>);
+
+/// The ranges the points and their error bars span, padded.
+fn ranges(series: &[Series]) -> Option<((f64, f64), (f64, f64))> {
+    let all = series.iter().flat_map(|s| s.2.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y, e) in all {
+        (x0, x1) = (x0.min(x), x1.max(x));
+        (y0, y1) = (y0.min(y - e), y1.max(y + e));
+    }
+    if !x0.is_finite() || !y0.is_finite() {
+        return None;
+    }
+    let px = ((x1 - x0) * 0.05).max(0.5);
+    let py = ((y1 - y0) * 0.08).max(y1.abs().max(1e-9) * 0.05);
+    Some(((x0 - px, x1 + px), (y0 - py, y1 + py)))
+}
+
+fn plot(path: &Path, name: &str, key: &str, x_desc: &str, series: &[Series]) -> Result<(), String> {
+    let root = SVGBackend::new(path, (crate::plots::WIDTH, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let Some(((x0, x1), (y0, y1))) = ranges(series) else {
+        return root.present().map_err(err);
+    };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{name} against {key}"), ("sans-serif", 20))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(name)
+        .y_label_formatter(&|v| tick(*v))
+        .x_label_formatter(&|v| tick(*v))
+        .draw()
+        .map_err(err)?;
+    for (label, colour, pts) in series {
+        let style = ShapeStyle::from(*colour).stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(pts.iter().map(|p| (p.0, p.1)), style))
+            .map_err(err)?
+            .label(label.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        chart
+            .draw_series(
+                pts.iter()
+                    .map(|p| Circle::new((p.0, p.1), 4, style.filled())),
+            )
+            .map_err(err)?;
+        chart
+            .draw_series(
+                pts.iter()
+                    .filter(|p| p.2 > 0.0)
+                    .map(|p| ErrorBar::new_vertical(p.0, p.1 - p.2, p.1, p.1 + p.2, style, 8)),
+            )
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)
+}
+
+/// A tick label without "-0" and without a float's noise digits.
+fn tick(v: f64) -> String {
+    let s = format!("{:.6}", v);
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_never_say_minus_zero() {
+        assert_eq!(tick(-0.0), "0");
+        assert_eq!(tick(-1e-9), "0");
+        assert_eq!(tick(2.5), "2.5");
+        assert_eq!(tick(-3.0), "-3");
+    }
+}

@@ -1,0 +1,178 @@
+//! Running a sweep's runs: `--jobs` at once on a shared counter, each in its own
+//! folder, progress with an estimate of the time left, and `--resume` keeping the
+//! runs that already ended.
+
+use super::{run_dir, sets_of, SweepArgs};
+use crate::error::Error;
+use crate::launch::{self, load_scenario, prepare_out, Loaded};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+use tactile_report::sweep::{describe, values, Axis};
+use tactile_report::write::{write_report, Launch};
+
+/// One run of the sweep.
+#[derive(Debug)]
+pub struct Work {
+    /// Its combination's index in the whole grid.
+    pub k: usize,
+    /// Its seed's index (0 without `--seeds`).
+    pub seed: usize,
+    /// Its folder.
+    pub dir: PathBuf,
+    /// `KEY=VALUE ...` for the progress line.
+    pub what: String,
+    /// Its scenario, checked.
+    pub loaded: Loaded,
+}
+
+/// Every run of combinations `mine`, its scenario loaded and checked.
+pub fn plan(
+    scenario: &Path,
+    axes: &[Axis],
+    combos: &[Vec<usize>],
+    mine: &[usize],
+    args: &SweepArgs,
+) -> Result<Vec<Work>, Error> {
+    let base = load_scenario(Some(scenario), &[])?.scenario.seed;
+    let mut work = Vec::with_capacity(mine.len() * args.seeds);
+    for &k in mine {
+        for s in 0..args.seeds {
+            let seed = (args.seeds > 1).then(|| base.wrapping_add(s as u64));
+            let loaded = load_scenario(Some(scenario), &sets_of(axes, &combos[k], seed)?)?;
+            let mut what = describe(axes, &combos[k]);
+            if let Some(x) = seed {
+                what += &format!(" seed={x}");
+            }
+            work.push(Work {
+                k,
+                seed: s,
+                dir: run_dir(&args.out, k, s, args.seeds),
+                what,
+                loaded,
+            });
+        }
+    }
+    Ok(work)
+}
+
+/// A run's metrics read back from its folder's `summary.json`; `None` unless the
+/// run ended (a stop request did not cut it short; a run whose node died did end, and
+/// its summary says so).
+pub fn finished(dir: &Path) -> Option<Vec<Option<f64>>> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let json: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let whole = json["interrupted"] == false;
+    whole.then(|| values(&json))
+}
+
+/// Runs `work` on `jobs` threads; each entry of the result is the run's metrics, or
+/// `None` for a run a stop request kept from ending.
+pub fn run_all(
+    work: &[Work],
+    jobs: usize,
+    args: &SweepArgs,
+) -> Result<Vec<Option<Vec<Option<f64>>>>, Error> {
+    let stop =
+        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
+    let results: Mutex<Vec<Option<Vec<Option<f64>>>>> = Mutex::new(vec![None; work.len()]);
+    let mut todo = Vec::new();
+    for (i, w) in work.iter().enumerate() {
+        match finished(&w.dir).filter(|_| args.resume) {
+            Some(v) => lock(&results)[i] = Some(v),
+            None => todo.push(i),
+        }
+    }
+    if todo.len() < work.len() {
+        crate::noteln!(
+            "tactile sweep: {} runs kept from before (--resume)",
+            work.len() - todo.len()
+        );
+    }
+    let next = AtomicUsize::new(0);
+    let ended = AtomicUsize::new(0);
+    let failed: Mutex<Option<Error>> = Mutex::new(None);
+    let abort = AtomicBool::new(false);
+    let start = Instant::now();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.min(todo.len()).max(1) {
+            scope.spawn(|| loop {
+                let j = next.fetch_add(1, Ordering::SeqCst);
+                if j >= todo.len() || stop.load(Ordering::SeqCst) || abort.load(Ordering::SeqCst) {
+                    break;
+                }
+                let w = &work[todo[j]];
+                match run_one(w, args) {
+                    Ok(Some(v)) => lock(&results)[todo[j]] = Some(v),
+                    Ok(None) => {}
+                    Err(e) => {
+                        abort.store(true, Ordering::SeqCst);
+                        lock(&failed).get_or_insert(e);
+                        break;
+                    }
+                }
+                let n = ended.fetch_add(1, Ordering::SeqCst) + 1;
+                progress(n, todo.len(), start, w);
+            });
+        }
+    });
+    if let Some(e) = lock(&failed).take() {
+        return Err(e);
+    }
+    Ok(results.into_inner().unwrap_or_else(|p| p.into_inner()))
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// `tactile sweep: 12/40 runs, 0:31 elapsed, about 1:12 left (run-0011: ...)`.
+fn progress(n: usize, total: usize, start: Instant, w: &Work) {
+    let elapsed = start.elapsed().as_secs_f64();
+    let left = elapsed / n as f64 * (total - n) as f64;
+    let mmss = |s: f64| format!("{}:{:02}", (s / 60.0) as u64, (s % 60.0) as u64);
+    crate::noteln!(
+        "tactile sweep: {n}/{total} runs, {} elapsed, about {} left ({}: {})",
+        mmss(elapsed),
+        mmss(left),
+        w.dir
+            .file_name()
+            .map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
+        w.what
+    );
+}
+
+/// One run and its report; its metrics as its `summary.json` holds them, or `None` if
+/// a stop request cut it short.
+fn run_one(w: &Work, args: &SweepArgs) -> Result<Option<Vec<Option<f64>>>, Error> {
+    let l = &w.loaded;
+    let summary = if args.processes {
+        launch::clean_stale_runs();
+        let sup = launch::sweep_supervision(!args.trace);
+        launch::run_processes(l, &w.dir, &sup)?
+    } else {
+        let launch = Launch {
+            no_trace: !args.trace,
+            stop: tactile_node::signals::stop_flag().ok(),
+            ..Launch::default()
+        };
+        prepare_out(&w.dir, &l.inputs)?;
+        let completed = launch::sim::simulate(&l.scenario, &l.base_dir, &w.dir)?;
+        let launch = if completed {
+            launch
+        } else {
+            launch.interrupted()
+        };
+        write_report(std::slice::from_ref(&w.dir), &w.dir, &launch)?
+    };
+    if summary.interrupted {
+        return Ok(None);
+    }
+    finished(&w.dir).map(Some).ok_or_else(|| {
+        Error::Failed(format!(
+            "{}: no whole summary.json after the run",
+            w.dir.display()
+        ))
+    })
+}

@@ -1,0 +1,250 @@
+//! `tactile sweep`: one scenario run for every combination of the values given to
+//! `--set KEY=V1,V2,...` (each repeated over `--seeds` seeds), a table of their metrics
+//! (`sweep.csv`) and a plot per metric against the first swept key, one line per
+//! value of the second.
+//!
+//! Each run is an ordinary run with its own folder and full report (without its
+//! trace); its row in `sweep.csv` is read back from its `summary.json`, picked by the
+//! paths in [`sweep::METRICS`], so the table never says anything the summaries do not,
+//! and a table made from the folders (`--resume`, `--merge`) equals one made as the
+//! runs ended. Runs go in-process by default (the same library code as the node
+//! programs, bit-for-bit the lockstep trio), `--jobs` of them at once, each on its own
+//! scenario and seed, so the results do not depend on the order they finish in;
+//! `--processes` starts the three programs for every run instead, one run at a time.
+//! `--shard K/N` runs one slice of the grid and `--merge` joins the slices' folders,
+//! so a scheduler can spread a study over many machines (docs/01-the-loop.md).
+
+mod exec;
+mod table;
+
+use crate::error::Error;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use tactile_report::sweep::{axis, combinations, Axis};
+use tactile_scenario::overrides::Set;
+
+/// Most runs one sweep may ask for: beyond this a typo in a list is likelier than a
+/// plan, and the folder would hold more reports than anyone reads.
+pub const MAX_RUNS: usize = 10_000;
+
+/// Arguments of `tactile sweep`.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Scenario file (TOML) every run starts from.
+    #[arg(required_unless_present = "merge")]
+    pub scenario: Option<PathBuf>,
+    /// A swept key and its values, KEY=V1,V2,... (commas inside brackets or quotes
+    /// belong to the value: network.forward.delay=[0,0,0],[5,5,5]). Repeatable: every
+    /// combination runs. The first key is the plots' x axis, the second their lines.
+    #[arg(long, value_name = "KEY=V1,V2,...", required_unless_present = "merge")]
+    pub set: Vec<String>,
+    /// Folder for sweep.csv, the plots, and one folder per run (run-0000, ...).
+    #[arg(long, default_value = "sweep-out")]
+    pub out: PathBuf,
+    /// Start the three node programs for every run (in realtime, each run then takes
+    /// its real time), one run at a time, instead of running them in-process.
+    #[arg(long)]
+    pub processes: bool,
+    /// Write each run's trace.csv and run.mcap too (about 1 kB and 0.75 kB per
+    /// sample).
+    #[arg(long)]
+    pub trace: bool,
+    /// Runs at once [default: the CPUs this process may use; 1 with --processes].
+    /// The results equal --jobs 1's: every run has its own scenario and seed.
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// Repeat every combination over N seeds (the scenario's seed, then +1, +2, ...):
+    /// sweep.csv gives each metric's mean and 95 % confidence half width over them,
+    /// runs.csv every run, the plots error bars.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seeds: usize,
+    /// Keep the runs whose folders already hold a whole report (a sweep cut short, or
+    /// run again with more seeds) and run only the others.
+    #[arg(long)]
+    pub resume: bool,
+    /// Run one slice of the grid, K of N (1 <= K <= N): combinations K-1, K-1+N,
+    /// K-1+2N, ... with all their seeds. `--merge` joins the slices' folders.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Join the folders of a sharded sweep into --out: the same sweep.csv and plots as
+    /// the sweep run whole.
+    #[arg(long, value_name = "DIR", num_args = 1.., conflicts_with_all = ["scenario", "set", "shard", "resume", "processes", "trace", "jobs"])]
+    pub merge: Vec<PathBuf>,
+}
+
+/// What a sweep is, as its folder records it (`sweep.json`), so `--merge` and
+/// `--resume` join only slices of the same sweep.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Spec {
+    /// The scenario file as given.
+    pub scenario: String,
+    /// FNV-1a hash of the scenario file's text: slices of another scenario are refused.
+    pub scenario_hash: String,
+    /// The `--set` arguments, in order.
+    pub sets: Vec<String>,
+    /// Seeds per combination.
+    pub seeds: usize,
+    /// Combinations in the whole grid.
+    pub combinations: usize,
+    /// This folder's slice, `[K, N]`, or null for the whole grid.
+    pub shard: Option<[usize; 2]>,
+}
+
+/// `tactile sweep`.
+pub fn main(args: &SweepArgs) -> Result<(), Error> {
+    if !args.merge.is_empty() {
+        return table::merge(&args.merge, &args.out);
+    }
+    let scenario = args
+        .scenario
+        .as_deref()
+        .ok_or_else(|| Error::BadInput("a scenario file is needed".into()))?;
+    let axes = parse_axes(&args.set)?;
+    if args.seeds == 0 || args.seeds > 1000 {
+        return Err(Error::BadInput(format!(
+            "--seeds {}: give 1 to 1000",
+            args.seeds
+        )));
+    }
+    if args.seeds > 1 && axes.iter().any(|a| a.key == "seed") {
+        return Err(Error::BadInput(
+            "--set seed=... and --seeds: sweep the seed one way or the other".into(),
+        ));
+    }
+    let combos = combinations(&axes);
+    if combos.len().saturating_mul(args.seeds) > MAX_RUNS {
+        return Err(Error::BadInput(format!(
+            "{} combinations x {} seeds: more than the {MAX_RUNS} runs a sweep may run",
+            combos.len(),
+            args.seeds
+        )));
+    }
+    let shard = args.shard.as_deref().map(parse_shard).transpose()?;
+    let jobs = match (args.jobs, args.processes) {
+        (Some(0), _) => return Err(Error::BadInput("--jobs 0: give at least 1".into())),
+        (Some(n), true) if n > 1 => {
+            return Err(Error::BadInput(
+                "--processes runs take the machine's CPUs one run at a time: --jobs 1".into(),
+            ))
+        }
+        (Some(n), _) => n,
+        (None, true) => 1,
+        (None, false) => tactile_node::sched::allowed_cpus().map_or(1, |c| c.len().max(1)),
+    };
+    let spec = Spec {
+        scenario: scenario.display().to_string(),
+        scenario_hash: file_hash(scenario)?,
+        sets: args.set.clone(),
+        seeds: args.seeds,
+        combinations: combos.len(),
+        shard: shard.map(|(k, n)| [k, n]),
+    };
+    let mine: Vec<usize> = (0..combos.len())
+        .filter(|k| shard.is_none_or(|(s, n)| k % n == s - 1))
+        .collect();
+    // Every run's scenario is checked before the first starts, so a bad value is bad
+    // input (exit 2) with nothing run.
+    let work = exec::plan(scenario, &axes, &combos, &mine, args)?;
+    tactile_report::write::make_out_dir(&args.out)?;
+    table::check_resume(&args.out, &spec, args.resume)?;
+    table::write_spec(&args.out, &spec)?;
+    let done = exec::run_all(&work, jobs, args)?;
+    let complete = done.iter().all(Option::is_some);
+    let results: Vec<_> = work
+        .iter()
+        .zip(done)
+        .filter_map(|(w, d)| d.map(|v| (w.k, w.seed, v)))
+        .collect();
+    table::write_tables(&args.out, &axes, args.seeds, &results)?;
+    if !complete {
+        crate::noteln!(
+            "tactile sweep: stopped by a signal after {} of {} runs; sweep.csv and the plots hold the combinations whose runs all ended; --resume runs the rest",
+            results.len(),
+            work.len()
+        );
+        return Err(Error::Interrupted);
+    }
+    crate::outln!(
+        "tactile sweep: {} runs{}; sweep.csv and one plot per metric in {}",
+        work.len(),
+        shard.map_or_else(String::new, |(k, n)| format!(" (shard {k}/{n})")),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The axes of `--set`s, each key once.
+pub fn parse_axes(sets: &[String]) -> Result<Vec<Axis>, Error> {
+    let axes = sets
+        .iter()
+        .map(|a| axis(a).map_err(Error::BadInput))
+        .collect::<Result<Vec<_>, _>>()?;
+    for (k, a) in axes.iter().enumerate() {
+        if axes[..k].iter().any(|b| b.key == a.key) {
+            return Err(Error::BadInput(format!(
+                "--set {}: the key is swept twice; give all its values in one --set KEY=V1,V2,...",
+                a.key
+            )));
+        }
+    }
+    let count = axes
+        .iter()
+        .try_fold(1usize, |n, a| n.checked_mul(a.values.len()))
+        .filter(|&n| n <= MAX_RUNS);
+    if count.is_none() {
+        let sizes: Vec<String> = axes.iter().map(|a| a.values.len().to_string()).collect();
+        return Err(Error::BadInput(format!(
+            "{} combinations: more than the {MAX_RUNS} a sweep may run",
+            sizes.join(" x ")
+        )));
+    }
+    Ok(axes)
+}
+
+/// `K/N` with `1 <= K <= N`.
+fn parse_shard(s: &str) -> Result<(usize, usize), Error> {
+    let bad = || Error::BadInput(format!("--shard {s}: expected K/N with 1 <= K <= N"));
+    let (k, n) = s.split_once('/').ok_or_else(bad)?;
+    let (k, n): (usize, usize) = (
+        k.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if k == 0 || k > n {
+        return Err(bad());
+    }
+    Ok((k, n))
+}
+
+/// FNV-1a of a file's bytes, hex.
+fn file_hash(path: &Path) -> Result<String, Error> {
+    let bytes = std::fs::read(path).map_err(|e| {
+        Error::BadInput(format!("{}: cannot read the scenario: {e}", path.display()))
+    })?;
+    let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    Ok(format!("{h:016x}"))
+}
+
+/// The `--set`s of one run: the combination's values, and its seed when seeds vary.
+fn sets_of(axes: &[Axis], combo: &[usize], seed: Option<u64>) -> Result<Vec<Set>, Error> {
+    let mut sets: Vec<Set> = axes
+        .iter()
+        .zip(combo)
+        .map(|(a, &i)| a.sets[i].clone())
+        .collect();
+    if let Some(s) = seed {
+        sets.push(Set::parse(&format!("seed={s}")).map_err(Error::BadInput)?);
+    }
+    Ok(sets)
+}
+
+/// A run's folder: `run-0007`, or `run-0007-s2` for the third seed.
+pub fn run_dir(out: &Path, k: usize, seed: usize, seeds: usize) -> PathBuf {
+    if seeds == 1 {
+        out.join(format!("run-{k:04}"))
+    } else {
+        out.join(format!("run-{k:04}-s{seed}"))
+    }
+}

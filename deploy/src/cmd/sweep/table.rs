@@ -1,0 +1,171 @@
+//! A sweep's tables and plots from its runs' metrics, and `--merge`, which makes the
+//! same from the folders of a sharded sweep. `sweep.json` records what the sweep is,
+//! so slices of different sweeps are never joined.
+
+use super::{parse_axes, run_dir, Spec};
+use crate::error::Error;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use tactile_report::sweep::{
+    combinations, header, header_seeds, mean_ci95, row, row_seeds, Axis, METRICS,
+};
+use tactile_report::sweep_plots::{sweep_plots, Point};
+
+/// A run's result: combination, seed index, metrics.
+pub type Result3 = (usize, usize, Vec<Option<f64>>);
+
+fn write(path: &Path, text: &str) -> Result<(), Error> {
+    std::fs::write(path, text).map_err(Error::io(format!("writing {}", path.display())))
+}
+
+/// Records the sweep in `out/sweep.json`.
+pub fn write_spec(out: &Path, spec: &Spec) -> Result<(), Error> {
+    let text = serde_json::to_string_pretty(spec)
+        .map_err(|e| Error::Failed(format!("sweep.json: {e}")))?;
+    write(&out.join("sweep.json"), &(text + "\n"))
+}
+
+fn read_spec(dir: &Path) -> Result<Spec, Error> {
+    let path = dir.join("sweep.json");
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| Error::BadInput(format!("{}: not a sweep's folder ({e})", path.display())))?;
+    serde_json::from_str(&text).map_err(|e| Error::BadInput(format!("{}: {e}", path.display())))
+}
+
+/// With `--resume`, the folder must hold this same sweep (any slice of it); without,
+/// a folder of another sweep is left alone rather than mixed into.
+pub fn check_resume(out: &Path, spec: &Spec, resume: bool) -> Result<(), Error> {
+    let Ok(old) = read_spec(out) else {
+        return Ok(());
+    };
+    let same = old.scenario_hash == spec.scenario_hash && old.sets == spec.sets;
+    if !same {
+        return Err(Error::BadInput(format!(
+            "{}: holds another sweep (its scenario or --set differ); choose another --out",
+            out.display()
+        )));
+    }
+    if !resume && old.seeds == spec.seeds {
+        crate::noteln!("tactile sweep: {} holds this sweep already; its runs are run again (--resume keeps them)", out.display());
+    }
+    Ok(())
+}
+
+/// `sweep.csv` (and with seeds `runs.csv`) and the plots, from `results` in any order:
+/// rows follow the grid, and a combination appears once all its seeds ended.
+pub fn write_tables(
+    out: &Path,
+    axes: &[Axis],
+    seeds: usize,
+    results: &[Result3],
+) -> Result<(), Error> {
+    let combos = combinations(axes);
+    let mut by: BTreeMap<usize, BTreeMap<usize, &Vec<Option<f64>>>> = BTreeMap::new();
+    for (k, s, v) in results {
+        by.entry(*k).or_default().insert(*s, v);
+    }
+    let mut points: Vec<Point> = Vec::new();
+    let mut csv = if seeds == 1 {
+        header(axes)
+    } else {
+        header_seeds(axes)
+    };
+    let mut runs = header(axes).replacen("run,", "run,seed,", 1);
+    for (&k, per_seed) in &by {
+        let combo = &combos[k];
+        let values: Vec<Vec<Option<f64>>> = per_seed.values().map(|v| (*v).clone()).collect();
+        for (s, v) in per_seed {
+            runs += &row(k, axes, combo, v).replacen(&format!("{k},"), &format!("{k},{s},"), 1);
+        }
+        if per_seed.len() < seeds {
+            continue;
+        }
+        if seeds == 1 {
+            csv += &row(k, axes, combo, &values[0]);
+        } else {
+            csv += &row_seeds(k, axes, combo, &values);
+        }
+        let stats = (0..METRICS.len())
+            .map(|m| {
+                let v: Vec<f64> = values.iter().filter_map(|r| r[m]).collect();
+                mean_ci95(&v).map_or((None, None), |(a, b)| (Some(a), b))
+            })
+            .collect();
+        points.push((combo.clone(), stats));
+    }
+    write(&out.join("sweep.csv"), &csv)?;
+    if seeds > 1 {
+        write(&out.join("runs.csv"), &runs)?;
+    }
+    sweep_plots(out, axes, &points).map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))
+}
+
+/// `tactile sweep --merge DIR... --out OUT`.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
+    let specs = dirs
+        .iter()
+        .map(|d| read_spec(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let first = &specs[0];
+    for (d, s) in dirs.iter().zip(&specs) {
+        let same = s.scenario_hash == first.scenario_hash
+            && s.sets == first.sets
+            && s.seeds == first.seeds;
+        if !same {
+            return Err(Error::BadInput(format!(
+                "{}: a slice of another sweep (scenario, --set or --seeds differ from {})",
+                d.display(),
+                dirs[0].display()
+            )));
+        }
+    }
+    let axes = parse_axes(&first.sets)?;
+    let mut results = Vec::new();
+    let mut missing = Vec::new();
+    for k in 0..first.combinations {
+        for s in 0..first.seeds {
+            let found: Vec<_> = dirs
+                .iter()
+                .filter_map(|d| super::exec::finished(&run_dir(d, k, s, first.seeds)))
+                .collect();
+            match found.len() {
+                0 => missing.push(
+                    run_dir(Path::new(""), k, s, first.seeds)
+                        .display()
+                        .to_string(),
+                ),
+                1 => results.extend(found.into_iter().map(|v| (k, s, v))),
+                _ => {
+                    return Err(Error::BadInput(format!(
+                        "combination {k}, seed {s}: in more than one folder"
+                    )))
+                }
+            }
+        }
+    }
+    tactile_report::write::make_out_dir(out)?;
+    write_spec(
+        out,
+        &Spec {
+            shard: None,
+            ..first.clone()
+        },
+    )?;
+    write_tables(out, &axes, first.seeds, &results)?;
+    if !missing.is_empty() {
+        let shown: Vec<_> = missing.iter().take(5).cloned().collect();
+        return Err(Error::Failed(format!(
+            "{} runs are in none of the folders ({}{}); sweep.csv holds the rest",
+            missing.len(),
+            shown.join(", "),
+            if missing.len() > 5 { ", ..." } else { "" }
+        )));
+    }
+    crate::outln!(
+        "tactile sweep: merged {} runs from {} folders into {}",
+        results.len(),
+        dirs.len(),
+        out.display()
+    );
+    Ok(())
+}
