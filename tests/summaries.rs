@@ -62,3 +62,69 @@ fn the_text_says_what_the_network_lost() {
     assert!(out.contains("network forward: 400 packets lost"), "{out}");
     assert!(out.contains("network backward: 0 packets lost"), "{out}");
 }
+
+#[test]
+fn an_output_folder_holds_its_inputs_and_reruns_from_them() {
+    let sb = Sandbox::new("bundle");
+    let mut csv = String::from("delay,lost\n");
+    for k in 0..600 {
+        csv.push_str(&format!("{},{}\n", 3 + k % 4, u8::from(k % 11 == 0)));
+    }
+    sb.write("net.csv", &csv);
+    let text = util::paper_1khz(600).replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        + "\n[network.forward.replay]\npath = \"net.csv\"\n";
+    let s = sb.write("s.toml", &text);
+    let s = s.to_str().expect("utf-8");
+    for (out, how) in [("proc", None), ("sim", Some("--in-process"))] {
+        let mut args = vec!["run", s, "--out", out, "-q"];
+        args.extend(how);
+        let o = sb.tactile(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let copy = sb.path(out).join("inputs").join("net.csv");
+        assert_eq!(std::fs::read_to_string(&copy).expect("copy"), csv, "{out}");
+        let ran = std::fs::read_to_string(sb.path(out).join("scenario.toml")).expect("toml");
+        assert!(ran.contains("path = \"inputs/net.csv\""), "{out}: {ran}");
+    }
+    // The original edited, the folder's scenario reruns what ran.
+    sb.write("net.csv", "delay,lost\n9,0\n");
+    let again = sb.path("sim").join("scenario.toml");
+    let o = sb.tactile(&[
+        "run",
+        again.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        "again",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let signals = |d: &str| tactile_report::trace::signal_columns(&sb.trace(d));
+    assert_eq!(
+        signals("again"),
+        signals("sim"),
+        "the rerun reads the copies"
+    );
+    // A folder's copies are never the input of a run into that same folder.
+    let o = sb.tactile(&[
+        "run",
+        again.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        "again",
+        "-q",
+    ]);
+    assert!(o.status.success(), "into another folder it runs");
+    let into_itself = sb.path("again").join("scenario.toml");
+    let o = sb.tactile(&[
+        "run",
+        into_itself.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        "again",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}

@@ -141,18 +141,37 @@ impl Scenario {
     /// (the scenario file's folder), so a copy of it runs from any folder.
     pub fn resolved(&self, base_dir: &std::path::Path) -> Scenario {
         let mut s = self.clone();
-        let absolute = |path: &mut String| {
+        for path in s.input_paths_mut() {
             let p = std::path::Path::new(path.as_str());
             if p.is_relative() {
                 *path = base_dir.join(p).display().to_string();
             }
-        };
-        if let Operator::Csv { path } = &mut s.operator {
-            absolute(path);
         }
-        for c in [&mut s.network.forward, &mut s.network.backward] {
+        s
+    }
+
+    /// The paths of every file the scenario reads (a trajectory, recorded networks):
+    /// the one list a run's output copies and a rerun resolves.
+    pub fn input_paths_mut(&mut self) -> Vec<&mut String> {
+        let mut v = Vec::new();
+        if let Operator::Csv { path, .. } = &mut self.operator {
+            v.push(path);
+        }
+        for c in [&mut self.network.forward, &mut self.network.backward] {
             if let Some(r) = &mut c.replay {
-                absolute(&mut r.path);
+                v.push(&mut r.path);
+            }
+        }
+        v
+    }
+
+    /// The scenario with input paths inside `dir` made relative to it: a run's
+    /// `scenario.toml` refers to the copies beside it, so the folder reruns anywhere.
+    pub fn relative_to(&self, dir: &std::path::Path) -> Scenario {
+        let mut s = self.clone();
+        for path in s.input_paths_mut() {
+            if let Ok(rel) = std::path::Path::new(path.as_str()).strip_prefix(dir) {
+                *path = rel.display().to_string();
             }
         }
         s

@@ -398,7 +398,12 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         ),
     )?;
     plot("positions and forces", series.write(out))?;
-    write_file(&out.join("scenario.toml"), &start.scenario_toml)?;
+    // Inputs copied into the folder are referred to relatively, so it reruns anywhere.
+    let here = std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
+    write_file(
+        &out.join("scenario.toml"),
+        &scenario.relative_to(&here).to_toml(),
+    )?;
     let mut summary = summarise(&scenario, runner, &analysis, &logs, launch);
     if let Some(n) = cut_short {
         summary.interrupted = true;

@@ -89,8 +89,8 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
         crate::noteln!("tactile: warning: {w}");
     }
     let summary = if args.in_process {
-        prepare_out(&args.out, &loaded.inputs)?;
-        let completed = launch::sim::simulate(&loaded.scenario, &loaded.base_dir, &args.out)?;
+        let bundled = prepare_out(&args.out, &loaded)?;
+        let completed = launch::sim::simulate(&bundled.scenario, &bundled.base_dir, &args.out)?;
         let launch = Launch {
             no_trace: args.no_trace,
             stop: tactile_node::signals::stop_flag().ok(),

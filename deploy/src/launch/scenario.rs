@@ -97,17 +97,26 @@ pub fn output_files(out: &Path) -> Vec<PathBuf> {
 
 /// Makes `out` ready for a new run: refuses if a file the run would write is one of
 /// its inputs, then removes the files of an earlier run, so the folder never mixes
-/// two runs' files.
-pub fn prepare_out(out: &Path, inputs: &[PathBuf]) -> Result<(), Error> {
+/// two runs' files, and copies the inputs in (see [`bundle`]). Returns the scenario to
+/// run: the one that reads the copies.
+pub fn prepare_out(out: &Path, loaded: &Loaded) -> Result<Loaded, Error> {
     tactile_report::write::make_out_dir(out)?;
     let outputs = output_files(out);
-    for i in inputs {
+    let copies = out.join(INPUTS);
+    for i in &loaded.inputs {
         if let Some(o) = outputs.iter().find(|o| same_file(o, i)) {
             return Err(Error::BadInput(format!(
                 "--out {}: the run would overwrite its input {} (as {}); choose another output folder",
                 out.display(),
                 i.display(),
                 o.display()
+            )));
+        }
+        if within(i, &copies) {
+            return Err(Error::BadInput(format!(
+                "--out {}: its {INPUTS}/ holds the input {} this run would replace; choose another output folder",
+                out.display(),
+                i.display()
             )));
         }
     }
@@ -118,5 +127,65 @@ pub fn prepare_out(out: &Path, inputs: &[PathBuf]) -> Result<(), Error> {
             Err(e) => return Err(Error::io(format!("removing {}", o.display()))(e)),
         }
     }
-    Ok(())
+    match std::fs::remove_dir_all(&copies) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(Error::io(format!("removing {}", copies.display()))(e)),
+    }
+    bundle(out, loaded)
+}
+
+/// The folder of a run's output that holds copies of its input files.
+pub const INPUTS: &str = "inputs";
+
+/// True if `path` lies in `dir` (both as the file system resolves them).
+fn within(path: &Path, dir: &Path) -> bool {
+    match (std::fs::canonicalize(path), std::fs::canonicalize(dir)) {
+        (Ok(p), Ok(d)) => p.starts_with(d),
+        _ => false,
+    }
+}
+
+/// Copies the scenario's input files into `out/inputs/` and points the scenario at
+/// the copies (absolute paths, which the nodes need; the report's `scenario.toml`
+/// makes them relative again), so the output folder holds everything a rerun reads
+/// and editing an original input never changes a rerun.
+fn bundle(out: &Path, loaded: &Loaded) -> Result<Loaded, Error> {
+    let mut scenario = loaded.scenario.resolved(&loaded.base_dir);
+    let dir = std::fs::canonicalize(out)
+        .map_err(Error::io(format!("resolving {}", out.display())))?
+        .join(INPUTS);
+    let mut copied: Vec<(PathBuf, PathBuf)> = Vec::new();
+    for path in scenario.input_paths_mut() {
+        let src = PathBuf::from(path.as_str());
+        let target = match copied.iter().find(|(s, _)| *s == src) {
+            Some((_, t)) => t.clone(),
+            None => {
+                let name = src
+                    .file_name()
+                    .map_or_else(|| "input".into(), |n| n.to_string_lossy().into_owned());
+                let mut target = dir.join(&name);
+                if copied.iter().any(|(_, t)| *t == target) {
+                    target = dir.join(format!("{}-{name}", copied.len()));
+                }
+                std::fs::create_dir_all(&dir)
+                    .map_err(Error::io(format!("creating {}", dir.display())))?;
+                std::fs::copy(&src, &target).map_err(Error::io(format!(
+                    "copying {} into {}",
+                    src.display(),
+                    dir.display()
+                )))?;
+                copied.push((src, target.clone()));
+                target
+            }
+        };
+        *path = target.display().to_string();
+    }
+    Ok(Loaded {
+        scenario,
+        base_dir: dir
+            .parent()
+            .map_or_else(|| out.to_path_buf(), Path::to_path_buf),
+        inputs: loaded.inputs.clone(),
+    })
 }

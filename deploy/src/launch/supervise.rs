@@ -395,11 +395,11 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     );
     let _lock = tactile_node::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
     let dir = nodes::node_dir()?;
-    prepare_out(out, &loaded.inputs)?;
-    // The nodes run the scenario as written here, relative paths made absolute, so
-    // the copy also runs again as it is from any folder.
+    let bundled = prepare_out(out, loaded)?;
+    // The nodes run the scenario as written here, reading the copies of its inputs
+    // (absolute paths); the report's scenario.toml refers to them relatively.
     let scenario_file = out.join("scenario.toml");
-    let text = loaded.scenario.resolved(&loaded.base_dir).to_toml();
+    let text = bundled.scenario.to_toml();
     std::fs::write(&scenario_file, text)
         .map_err(Error::io(format!("writing {}", scenario_file.display())))?;
     let mut notes = Vec::new();

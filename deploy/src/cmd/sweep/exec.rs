@@ -157,8 +157,8 @@ fn run_one(w: &Work, args: &SweepArgs) -> Result<Option<Vec<Option<f64>>>, Error
             stop: tactile_node::signals::stop_flag().ok(),
             ..Launch::default()
         };
-        prepare_out(&w.dir, &l.inputs)?;
-        let completed = launch::sim::simulate(&l.scenario, &l.base_dir, &w.dir)?;
+        let bundled = prepare_out(&w.dir, l)?;
+        let completed = launch::sim::simulate(&bundled.scenario, &bundled.base_dir, &w.dir)?;
         let launch = if completed {
             launch
         } else {
