@@ -128,3 +128,43 @@ fn an_output_folder_holds_its_inputs_and_reruns_from_them() {
         String::from_utf8_lossy(&o.stderr)
     );
 }
+
+#[test]
+fn check_prints_the_scenario_as_it_would_run_and_what_it_writes() {
+    let sb = Sandbox::new("check");
+    let s = sb.write("s.toml", &util::wall_delay());
+    let s = s.to_str().expect("utf-8");
+    let o = sb.tactile(&["check", s, "--set", "samples=4000"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let resolved = String::from_utf8(o.stdout).expect("utf-8");
+    let said = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        said.contains("runs 4000 samples at 1000 Hz in lockstep: 4.0 s of simulated time"),
+        "{said}"
+    );
+    assert!(
+        said.contains("master.rec 1.9 MB") && said.contains("trace.csv 4.7 MB"),
+        "{said}"
+    );
+    assert!(!said.contains("warning"), "{said}");
+    // What it prints is the scenario, every default filled in: it runs as it is.
+    let copy = sb.write("resolved.toml", &resolved);
+    assert!(resolved.contains("samples = 4000") && resolved.contains("[slave.controller]"));
+    let o = sb.tactile(&[
+        "run",
+        copy.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        "r",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(sb.json("r", "summary.json")["samples_sent"], 4000);
+    // A long run is warned about; a bad one is bad input and prints nothing.
+    let o = sb.tactile(&["check", s, "--set", "samples=2000000"]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("warning: the run writes about 6.20 GB"));
+    let o = sb.tactile(&["check", s, "--set", "rate_hz=5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("rate_hz"));
+}

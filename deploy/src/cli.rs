@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch for `tactile`.
 
 use crate::cmd::bench::{BenchArgs, EchoArgs};
+use crate::cmd::check::CheckArgs;
 use crate::cmd::hdl::HdlArgs;
 use crate::cmd::kernels::KernelsArgs;
 use crate::cmd::paper::PaperArgs;
@@ -31,6 +32,9 @@ pub enum Command {
     Paper(PaperArgs),
     /// Run a scenario: start the master, emulator and slave programs, and report.
     Run(RunArgs),
+    /// Check a scenario without running it: print it resolved (defaults filled in,
+    /// --set applied), its duration, the size of what it writes, its warnings.
+    Check(CheckArgs),
     /// Measure the loop's own overhead at 1 and 10 kHz beside UDP and a bare iceoryx2
     /// hop, and the lockstep throughput.
     Bench(BenchArgs),
@@ -83,6 +87,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         }
         Command::Run(args) => crate::cmd::run::main(&args),
         Command::Hdl(args) => crate::cmd::hdl::main(&args),
+        Command::Check(args) => crate::cmd::check::main(&args),
         Command::Bench(args) => crate::cmd::bench::main(&args),
         Command::Report(args) => crate::cmd::report::main(&args),
         Command::Sweep(args) => crate::cmd::sweep::main(&args),

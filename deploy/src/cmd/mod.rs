@@ -1,6 +1,7 @@
 //! One module per `tactile` subcommand, each owning its arguments and its `main`.
 
 pub mod bench;
+pub mod check;
 pub mod datapath;
 pub mod hdl;
 pub mod kernels;
