@@ -43,14 +43,7 @@ fn lockstep_reports_its_round_trip_in_samples_and_no_overhead() {
 fn the_text_says_what_the_network_lost() {
     let sb = Sandbox::new("replay-lost");
     // A replayed network that loses every third packet of 1200.
-    let mut csv = String::from("delay,lost\n");
-    for k in 0..1200 {
-        csv.push_str(&format!("2,{}\n", u8::from(k % 3 == 0)));
-    }
-    sb.write("net.csv", &csv);
-    let text = util::paper_1khz(1200).replace("mode = \"realtime\"", "mode = \"lockstep\"")
-        + "\n[network.forward.replay]\npath = \"net.csv\"\n";
-    let s = sb.write("s.toml", &text);
+    let (s, _) = replayed(&sb, 1200, |k| (2, k % 3 == 0));
     let o = sb.tactile(&["run", s.to_str().expect("utf-8"), "--out", "out"]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{out}");
@@ -66,14 +59,7 @@ fn the_text_says_what_the_network_lost() {
 #[test]
 fn an_output_folder_holds_its_inputs_and_reruns_from_them() {
     let sb = Sandbox::new("bundle");
-    let mut csv = String::from("delay,lost\n");
-    for k in 0..600 {
-        csv.push_str(&format!("{},{}\n", 3 + k % 4, u8::from(k % 11 == 0)));
-    }
-    sb.write("net.csv", &csv);
-    let text = util::paper_1khz(600).replace("mode = \"realtime\"", "mode = \"lockstep\"")
-        + "\n[network.forward.replay]\npath = \"net.csv\"\n";
-    let s = sb.write("s.toml", &text);
+    let (s, csv) = replayed(&sb, 600, |k| (3 + k % 4, k % 11 == 0));
     let s = s.to_str().expect("utf-8");
     for (out, how) in [("proc", None), ("sim", Some("--in-process"))] {
         let mut args = vec!["run", s, "--out", out, "-q"];
@@ -103,16 +89,7 @@ fn an_output_folder_holds_its_inputs_and_reruns_from_them() {
         signals("sim"),
         "the rerun reads the copies"
     );
-    // A folder's copies are never the input of a run into that same folder.
-    let o = sb.tactile(&[
-        "run",
-        again.to_str().expect("utf-8"),
-        "--in-process",
-        "--out",
-        "again",
-        "-q",
-    ]);
-    assert!(o.status.success(), "into another folder it runs");
+    // A folder's scenario never runs into that same folder (it would overwrite it).
     let into_itself = sb.path("again").join("scenario.toml");
     let o = sb.tactile(&[
         "run",
@@ -167,4 +144,22 @@ fn check_prints_the_scenario_as_it_would_run_and_what_it_writes() {
     assert_eq!(o.status.code(), Some(2));
     assert!(o.stdout.is_empty());
     assert!(String::from_utf8_lossy(&o.stderr).contains("rate_hz"));
+}
+
+/// The paper scenario in lockstep, `samples` long, its forward network replayed from
+/// `net.csv` (delay and loss of packet k from `net`); returns the scenario and the CSV.
+fn replayed(
+    sb: &Sandbox,
+    samples: u64,
+    net: impl Fn(u64) -> (u64, bool),
+) -> (std::path::PathBuf, String) {
+    let mut csv = String::from("delay,lost\n");
+    for k in 0..samples {
+        let (delay, lost) = net(k);
+        csv.push_str(&format!("{delay},{}\n", u8::from(lost)));
+    }
+    sb.write("net.csv", &csv);
+    let text = util::paper_1khz(samples).replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        + "\n[network.forward.replay]\npath = \"net.csv\"\n";
+    (sb.write("s.toml", &text), csv)
 }
