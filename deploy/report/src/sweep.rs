@@ -105,9 +105,10 @@ pub fn header(axes: &[Axis]) -> String {
     cols.join(",") + "\n"
 }
 
-/// One run's line of `sweep.csv`.
-pub fn row(k: usize, axes: &[Axis], combo: &[usize], values: &[Option<f64>]) -> String {
-    let mut cols: Vec<String> = vec![k.to_string()];
+/// One run's line of `sweep.csv` (`lead`: its first cells, the run's number, and in
+/// `runs.csv` its seed too).
+pub fn row(lead: &str, axes: &[Axis], combo: &[usize], values: &[Option<f64>]) -> String {
+    let mut cols: Vec<String> = vec![lead.to_string()];
     cols.extend(
         axes.iter()
             .zip(combo)

@@ -75,13 +75,13 @@ pub fn write_tables(
         let combo = &combos[k];
         let values: Vec<Vec<Option<f64>>> = per_seed.values().map(|v| (*v).clone()).collect();
         for (s, v) in per_seed {
-            runs += &row(k, axes, combo, v).replacen(&format!("{k},"), &format!("{k},{s},"), 1);
+            runs += &row(&format!("{k},{s}"), axes, combo, v);
         }
         if per_seed.len() < seeds {
             continue;
         }
         if seeds == 1 {
-            csv += &row(k, axes, combo, &values[0]);
+            csv += &row(&k.to_string(), axes, combo, &values[0]);
         } else {
             csv += &row_seeds(k, axes, combo, &values);
         }
