@@ -12,6 +12,8 @@ use crate::trace::TraceRow;
 use plotters::prelude::*;
 use std::path::Path;
 
+mod timeplot;
+
 type PlotResult = Result<(), String>;
 
 fn err(e: impl std::fmt::Display) -> String {
@@ -154,20 +156,21 @@ impl Series {
             }
             v
         };
-        time_series(
+        timeplot::time_series(
             &out.join("positions.svg"),
             "Master handle and slave tool position",
             "position (m)",
             &series(&self.handle, &self.tool, "master handle", "slave tool", ""),
         )?;
-        time_series(
+        timeplot::time_series(
             &out.join("forces.svg"),
             "Contact force (slave) and feedback force (master)",
             "force (N)",
             &series(&self.felt, &self.force, "felt", "slave h(n)", "F"),
         )?;
         let grey = RGBColor(90, 90, 90);
-        time_series(
+        // No line here is another's reference: all are drawn plain.
+        timeplot::time_series(
             &out.join("passivity.svg"),
             "Channel energy (below zero: the channel made energy), observers, dissipation",
             "energy (mJ)",
@@ -193,7 +196,7 @@ impl Series {
                 (
                     "dissipated by the control".into(),
                     grey,
-                    true,
+                    false,
                     self.dissipated.points(),
                 ),
             ],
@@ -297,9 +300,12 @@ pub fn percentile_plot(
     }
     let x_max = 10f64.powf(x_max.log10().ceil());
     let (lo, hi) = ((lo * 0.8).max(0.01), (hi * 1.25).max(lo * 10.0).max(0.1));
+    // The right margin holds the half of the last tick label ("99.99%") that lies
+    // past the axis's end.
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
         .margin(10)
+        .margin_right(40)
         .x_label_area_size(40)
         .y_label_area_size(70)
         .build_cartesian_2d((1.0..x_max).log_scale(), (lo..hi).log_scale())
@@ -338,10 +344,6 @@ pub fn percentile_plot(
 }
 
 type Line = (String, RGBColor, bool, Vec<(f64, f64)>);
-
-fn time_series(path: &Path, title: &str, y_desc: &str, series: &[Line]) -> PlotResult {
-    xy_plot(path, title, "time (s)", y_desc, series)
-}
 
 /// Lines of (x, y) points with a legend, on linear axes from 0 to the largest x.
 fn xy_plot(path: &Path, title: &str, x_desc: &str, y_desc: &str, series: &[Line]) -> PlotResult {
