@@ -16,6 +16,7 @@ mod hdl;
 mod hosts;
 mod layout;
 mod lifecycle;
+mod logs;
 mod loop_processes;
 mod nodes;
 mod recordings;

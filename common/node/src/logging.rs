@@ -1,13 +1,15 @@
 //! A node's log: `tracing` events into `<role>.log` in the node's output folder, and,
-//! when the node runs by hand on a terminal, also to stderr. `RUST_LOG` sets the level
-//! (default `info`).
+//! when the node runs by hand, also to stderr (in colour only on a terminal). Neither
+//! file nor redirected stderr gets colour codes. `RUST_LOG` sets the level (default
+//! `info`).
 
+use std::io::IsTerminal;
 use std::path::Path;
 use tracing_subscriber::layer::SubscriberExt;
 use tracing_subscriber::util::SubscriberInitExt;
 use tracing_subscriber::{fmt, EnvFilter, Layer};
 
-/// Installs the node's logger; `to_stderr` adds a terminal copy. Returns an error line
+/// Installs the node's logger; `to_stderr` adds a copy on stderr. Returns an error line
 /// if the log file cannot be opened.
 pub fn init(dir: &Path, role: tactile_messages::Role, to_stderr: bool) -> Result<(), String> {
     let path = dir.join(format!("{role}.log"));
@@ -22,9 +24,15 @@ pub fn init(dir: &Path, role: tactile_messages::Role, to_stderr: bool) -> Result
         .with_ansi(false)
         .with_target(false)
         .with_filter(filter());
+    // Colours only for a terminal: a node started by hand with its stderr sent to a
+    // file (`2> master.err`, a pipe, ssh, a service's journal) would write escape
+    // codes into it, which tracing does by default. NO_COLOR is kept as tracing keeps it.
+    let ansi = std::io::stderr().is_terminal()
+        && std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
     let stderr_layer = to_stderr.then(|| {
         fmt::layer()
             .with_writer(std::io::stderr)
+            .with_ansi(ansi)
             .with_target(false)
             .with_filter(filter())
     });
