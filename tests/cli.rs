@@ -225,3 +225,64 @@ fn a_line_without_end_an_endless_cell_and_an_overflow_are_refused_briefly() {
     assert!(err.contains("line 3") && err.contains("overflows"), "{err}");
     assert!(o.stdout.is_empty());
 }
+
+/// The long options a help text lists: the `--name` at the head of each option line
+/// (`-q, --quiet`, `--out <OUT>`), before the words that describe it.
+fn listed_options(help: &str) -> Vec<String> {
+    help.lines()
+        .flat_map(|l| {
+            l.split_whitespace()
+                .take_while(|w| w.starts_with(['-', '<', '[']))
+                .filter(|w| w.starts_with("--") && w.len() > 2)
+                .map(|w| w.trim_end_matches(',').to_string())
+        })
+        .collect()
+}
+
+/// Every `--name` a help text mentions, in its prose as in its option lines.
+fn mentioned_options(help: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for (at, _) in help.match_indices("--") {
+        let before = help[..at].chars().next_back();
+        if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '-') {
+            continue;
+        }
+        let name: String = help[at + 2..]
+            .chars()
+            .take_while(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == '-')
+            .collect();
+        if name.starts_with(|c: char| c.is_ascii_lowercase()) {
+            out.push(format!("--{name}"));
+        }
+    }
+    out
+}
+
+/// clap prints doc comments as help: no rustdoc link syntax may reach the user, and
+/// no option of another program (the nodes' --udp-hosts) may be named as if it were
+/// the command's own.
+#[test]
+fn help_texts_name_only_their_own_options_and_no_rustdoc_links() {
+    for cmd in ["run", "sweep", "report", "kernels", "paper"] {
+        let o = Command::new(env!("CARGO_BIN_EXE_tactile"))
+            .args([cmd, "--help"])
+            .output()
+            .expect("run");
+        assert!(o.status.success(), "tactile {cmd} --help");
+        let help = String::from_utf8(o.stdout).expect("utf-8");
+        for bad in ["udp-hosts", "](", "[`", "`crate::"] {
+            assert!(
+                !help.contains(bad),
+                "tactile {cmd} --help says {bad:?}:\n{help}"
+            );
+        }
+        let listed = listed_options(&help);
+        assert!(listed.contains(&"--help".to_string()), "{listed:?}");
+        for name in mentioned_options(&help) {
+            assert!(
+                listed.contains(&name),
+                "tactile {cmd} --help names {name}, not one of its options {listed:?}:\n{help}"
+            );
+        }
+    }
+}

@@ -16,9 +16,11 @@ use crate::exit::{EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK};
 pub enum LinkKind {
     /// iceoryx2 zero-copy shared memory (one host).
     Iceoryx2,
-    /// UDP datagrams (the reference most stacks use); loopback unless --udp-hosts.
+    /// UDP datagrams (the reference most stacks use).
+    // No option is named in these comments: clap prints them as the values' help in
+    // `tactile run`, which has none of the nodes' --udp-hosts, --listen, --connect.
     Udp,
-    /// Zenoh (across hosts): --listen and --connect name the endpoints.
+    /// Zenoh (a build with the zenoh feature), on one host or across hosts.
     Zenoh,
 }
 

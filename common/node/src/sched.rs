@@ -35,8 +35,8 @@ impl Policy {
 /// What a CPU does while the realtime node on it sleeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum IdleMode {
-    /// A SCHED_IDLE thread keeps the CPU busy, so the virtual machine never halts it
-    /// ([`KeepAwake`]).
+    /// A SCHED_IDLE thread keeps the CPU busy, so the virtual machine never halts it.
+    // (KeepAwake does it; no link here: clap prints this comment as the value's help.)
     Poll,
     /// The kernel's idle: the CPU halts until its next interrupt (the default).
     Halt,

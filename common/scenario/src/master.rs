@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct MasterConfig {
-    /// Largest force the operator is made to feel, N, per axis (the Omni: ~3.3 N).
+    /// Largest force the operator is made to feel, N (the Omni: ~3.3 N): one number,
+    /// each axis's force clamped to it (unlike `torque_limit`, one per joint).
     pub force_limit: f64,
     /// Largest torque commanded on a master joint, N m.
     pub torque_limit: [f64; 3],
