@@ -13,6 +13,7 @@ use plotters::prelude::*;
 use std::path::Path;
 
 mod timeplot;
+pub(crate) use timeplot::tick;
 
 type PlotResult = Result<(), String>;
 
@@ -262,7 +263,7 @@ pub fn read_hgrm(text: &str) -> Vec<(f64, f64)> {
 }
 
 /// Colours of the loops in a percentile plot.
-const LOOP_COLOURS: [RGBColor; 6] = [
+pub(crate) const LOOP_COLOURS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -343,63 +344,8 @@ pub fn percentile_plot(
     root.present().map_err(err)
 }
 
+/// A series: label, colour, whether it is a reference (see `timeplot`), points.
 type Line = (String, RGBColor, bool, Vec<(f64, f64)>);
-
-/// Lines of (x, y) points with a legend, on linear axes from 0 to the largest x.
-fn xy_plot(path: &Path, title: &str, x_desc: &str, y_desc: &str, series: &[Line]) -> PlotResult {
-    let root = SVGBackend::new(path, (WIDTH, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let (mut lo, mut hi, mut t_end) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-    for (_, _, _, v) in series {
-        for (t, x) in v {
-            lo = lo.min(*x);
-            hi = hi.max(*x);
-            t_end = t_end.max(*t);
-        }
-    }
-    if !lo.is_finite() {
-        return root.present().map_err(err);
-    }
-    let pad = ((hi - lo) * 0.05).max(1e-6);
-    let t_end = t_end.max(1e-3);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 20))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .draw()
-        .map_err(err)?;
-    for (label, colour, reference, v) in series {
-        // The reference series (target, felt force) are drawn lighter and thinner, so
-        // they read apart from the measured ones, in the legend too. Not dashed: a
-        // thinned series zig-zags between each bucket's extremes, and dashing that
-        // path would write thousands of dashes.
-        let style = if *reference {
-            ShapeStyle::from(colour.mix(0.45)).stroke_width(1)
-        } else {
-            ShapeStyle::from(colour).stroke_width(2)
-        };
-        let legend = move |(x, y): (i32, i32)| PathElement::new(vec![(x, y), (x + 20, y)], style);
-        chart
-            .draw_series(LineSeries::new(v.iter().copied(), style))
-            .map_err(err)?
-            .label(label.as_str())
-            .legend(legend);
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
-    root.present().map_err(err)
-}
 
 #[cfg(test)]
 mod tests {

@@ -3,19 +3,10 @@
 //! confidence interval as an error bar. Vector values (`[25,25,25]`) sit at their
 //! elements' mean on a numeric axis; words at their positions 0, 1, 2, ...
 
+use crate::plots::{tick, LOOP_COLOURS};
 use crate::sweep::{numeric, Axis, METRICS};
 use plotters::prelude::*;
 use std::path::Path;
-
-/// The line colours (the plots' own palette, colour-blind safe).
-const COLOURS: [RGBColor; 6] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
-];
 
 /// One combination's values: its value index on each axis, and per metric the mean
 /// and (with seeds) the interval's half width.
@@ -54,7 +45,7 @@ pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<(), St
                 || name.to_string(),
                 |a| format!("{}={}", a.key, a.values[line]),
             );
-            series.push((label, COLOURS[line % COLOURS.len()], pts));
+            series.push((label, LOOP_COLOURS[line % LOOP_COLOURS.len()], pts));
         }
         plot(
             &out.join(format!("sweep-{name}.svg")),
@@ -107,8 +98,8 @@ fn plot(path: &Path, name: &str, key: &str, x_desc: &str, series: &[Series]) -> 
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(name)
-        .y_label_formatter(&|v| tick(*v))
-        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&tick)
+        .x_label_formatter(&tick)
         .draw()
         .map_err(err)?;
     for (label, colour, pts) in series {
@@ -140,28 +131,4 @@ fn plot(path: &Path, name: &str, key: &str, x_desc: &str, series: &[Series]) -> 
         .draw()
         .map_err(err)?;
     root.present().map_err(err)
-}
-
-/// A tick label without "-0" and without a float's noise digits.
-fn tick(v: f64) -> String {
-    let s = format!("{:.6}", v);
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".into()
-    } else {
-        s.to_string()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn ticks_never_say_minus_zero() {
-        assert_eq!(tick(-0.0), "0");
-        assert_eq!(tick(-1e-9), "0");
-        assert_eq!(tick(2.5), "2.5");
-        assert_eq!(tick(-3.0), "-3");
-    }
 }

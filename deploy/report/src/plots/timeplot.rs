@@ -20,7 +20,7 @@ const LEFT: i32 = 10 + 70;
 
 /// A tick label as plotters writes it, except that a tick at zero never reads "-0.0":
 /// the ticks are sums of steps, and the one at zero can come out a hair below it.
-pub(super) fn tick(v: &f64) -> String {
+pub(crate) fn tick(v: &f64) -> String {
     let s = RangedCoordf64::format(v);
     match s.strip_prefix('-') {
         Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_string(),
