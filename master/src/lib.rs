@@ -7,3 +7,4 @@ pub mod node;
 pub mod operator;
 pub mod process;
 pub mod record;
+pub mod trajectory;

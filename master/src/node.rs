@@ -54,8 +54,11 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
         ));
     }
     let p = prepare(Role::Master, a)?;
-    OperatorSource::load(&p.scenario.operator, &p.base_dir)
+    let source = OperatorSource::load(&p.scenario.operator, &p.base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: operator: {e}", a.scenario.display())))?;
+    for w in source.warnings(p.scenario.samples, p.scenario.t_s()) {
+        tracing::warn!("{w}");
+    }
     let mut rec = Recorder::open(&a.out, Role::Master, a.append)?;
     rec.start(start_record(Role::Master, a, &p))?;
     let opts = MasterOptions {

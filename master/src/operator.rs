@@ -5,11 +5,11 @@
 //! ([`OperatorSource::load`]); everything after that is pure and indexed by sample, so
 //! a run repeats exactly.
 
+pub use crate::trajectory::OperatorError;
+use crate::trajectory::Trajectory;
 use std::path::Path;
 use tactile_math::validation::{paper_joint_path, MOVE_S};
-use tactile_scenario::csv;
 use tactile_scenario::Operator;
-use thiserror::Error;
 
 /// What the operator commands at one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,28 +18,6 @@ pub enum Target {
     Joints([f64; 3]),
     /// Tool position, m.
     Position([f64; 3]),
-}
-
-/// A trajectory file that cannot be used.
-#[derive(Debug, Error)]
-pub enum OperatorError {
-    /// The file could not be read (missing, not a regular file, too large).
-    #[error("{0}")]
-    Read(String),
-    /// The file's content is malformed.
-    #[error("{path}: {source}")]
-    Csv {
-        /// The file.
-        path: String,
-        /// Where and what.
-        source: csv::CsvError,
-    },
-    /// The file has a header but no rows.
-    #[error("{path}: no positions after the header")]
-    NoRows {
-        /// The file.
-        path: String,
-    },
 }
 
 /// A ready trajectory.
@@ -69,8 +47,8 @@ pub enum OperatorSource {
         /// Seconds to get there.
         move_s: f64,
     },
-    /// Positions from a file, looped.
-    Positions(Vec<[f64; 3]>),
+    /// Positions from a file, held or looped after its last row.
+    File(Trajectory),
 }
 
 /// Minimum-jerk progress at fraction `tau` of a move (Flash and Hogan, 1985): zero
@@ -122,26 +100,19 @@ impl OperatorSource {
                 to: *to,
                 move_s: *move_s,
             },
-            Operator::Csv { path } => {
-                let full = base_dir.join(path);
-                let shown = full.display().to_string();
-                let text = tactile_node::files::read_text(
-                    &full,
-                    "trajectory",
-                    tactile_node::files::MAX_TRAJECTORY_BYTES,
-                )
-                .map_err(OperatorError::Read)?;
-                let rows =
-                    csv::parse(&text, &["x", "y", "z"]).map_err(|source| OperatorError::Csv {
-                        path: shown.clone(),
-                        source,
-                    })?;
-                if rows.is_empty() {
-                    return Err(OperatorError::NoRows { path: shown });
-                }
-                OperatorSource::Positions(rows.iter().map(|r| [r[0], r[1], r[2]]).collect())
+            Operator::Csv { path, end } => {
+                OperatorSource::File(Trajectory::read(&base_dir.join(path), *end)?)
             }
         })
+    }
+
+    /// What deserves a word before a run of `samples` at period `t_s`: a trajectory
+    /// file that runs out before the run does, and what then happens.
+    pub fn warnings(&self, samples: u64, t_s: f64) -> Vec<String> {
+        match self {
+            OperatorSource::File(f) => f.shortfall(samples, t_s).into_iter().collect(),
+            _ => Vec::new(),
+        }
     }
 
     /// The target at sample `n` with sampling period `t_s`.
@@ -181,9 +152,7 @@ impl OperatorSource {
                 let s = min_jerk(t / move_s);
                 Target::Position([0, 1, 2].map(|i| from[i] + s * (to[i] - from[i])))
             }
-            OperatorSource::Positions(rows) => {
-                Target::Position(rows[(n % rows.len() as u64) as usize])
-            }
+            OperatorSource::File(f) => Target::Position(f.at(n, t_s)),
         }
     }
 }
@@ -191,6 +160,7 @@ impl OperatorSource {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tactile_scenario::TrajectoryEnd;
 
     #[test]
     fn paper_path_returns_smoothly() {
@@ -244,22 +214,19 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("tactile-op-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("temp dir");
         std::fs::write(dir.join("p.csv"), "x,y,z\n0,0,0\n1,1,1\n").expect("write");
-        let s = OperatorSource::load(
-            &Operator::Csv {
-                path: "p.csv".into(),
-            },
-            &dir,
-        )
-        .expect("csv");
+        let csv = |path: &str, end| Operator::Csv {
+            path: path.into(),
+            end,
+        };
+        let s = OperatorSource::load(&csv("p.csv", TrajectoryEnd::Hold), &dir).expect("csv");
         assert_eq!(s.target(3, 0.01), Target::Position([1.0; 3]));
+        assert_eq!(s.warnings(2, 0.01), Vec::<String>::new());
+        assert_eq!(s.warnings(3, 0.01).len(), 1);
+        let s = OperatorSource::load(&csv("p.csv", TrajectoryEnd::Loop), &dir).expect("csv");
+        assert_eq!(s.target(2, 0.01), Target::Position([0.0; 3]));
         std::fs::write(dir.join("bad.csv"), "x,y,z\n0,0\n").expect("write");
-        let e = OperatorSource::load(
-            &Operator::Csv {
-                path: "bad.csv".into(),
-            },
-            &dir,
-        )
-        .expect_err("truncated");
+        let e = OperatorSource::load(&csv("bad.csv", TrajectoryEnd::Hold), &dir)
+            .expect_err("truncated");
         assert!(
             e.to_string()
                 .contains("bad.csv: line 2: expected 3 columns"),

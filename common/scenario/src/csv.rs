@@ -112,22 +112,46 @@ pub fn parse_row(
 
 /// Parses a whole document with header `columns` into rows.
 pub fn parse(text: &str, columns: &[&str]) -> Result<Vec<Vec<f64>>, CsvError> {
+    let (_, rows) = parse_located(text, &[columns])?;
+    Ok(rows.into_iter().map(|(_, r)| r).collect())
+}
+
+/// Rows with their 1-based line numbers.
+pub type LocatedRows = Vec<(usize, Vec<f64>)>;
+
+/// Parses a document whose header is one of `headers` (a file format with optional
+/// columns, such as a trajectory with or without its time column). Returns which
+/// header it had and each row with its 1-based line number, so that checks across
+/// rows (times that must increase) can name the line too.
+pub fn parse_located(text: &str, headers: &[&[&str]]) -> Result<(usize, LocatedRows), CsvError> {
+    let expected = || {
+        let names: Vec<String> = headers.iter().map(|h| h.join(",")).collect();
+        names.join(" or ")
+    };
     let mut lines = text
         .lines()
         .enumerate()
         .map(|(i, l)| (i + 1, l))
         .filter(|(_, l)| !l.trim().is_empty());
     let (hl, header) = lines.next().ok_or_else(|| CsvError::Empty {
-        expected: columns.join(","),
+        expected: expected(),
     })?;
-    check_header(hl, header, columns)?;
+    let which = headers
+        .iter()
+        .position(|h| check_header(hl, header, h).is_ok())
+        .ok_or_else(|| CsvError::Header {
+            line: hl,
+            found: shortened(header.trim()),
+            expected: expected(),
+        })?;
+    let columns = headers[which];
     let mut rows = Vec::new();
     let mut row = Vec::with_capacity(columns.len());
     for (line, text) in lines {
         parse_row(line, text, columns, &mut row)?;
-        rows.push(row.clone());
+        rows.push((line, row.clone()));
     }
-    Ok(rows)
+    Ok((which, rows))
 }
 
 #[cfg(test)]
@@ -165,5 +189,28 @@ mod tests {
         let e = parse("a,b,c\n", &cols).expect_err("malformed");
         assert!(matches!(e, CsvError::Header { line: 1, .. }));
         assert!(matches!(parse("\n\n", &cols), Err(CsvError::Empty { .. })));
+    }
+
+    #[test]
+    fn one_of_several_headers_and_rows_with_their_lines() {
+        let both: [&[&str]; 2] = [&["x", "y", "z"], &["t", "x", "y", "z"]];
+        assert_eq!(
+            parse_located("t,x,y,z\n0,1,2,3\n\n0.5,4,5,6\n", &both),
+            Ok((
+                1,
+                vec![(2, vec![0.0, 1.0, 2.0, 3.0]), (4, vec![0.5, 4.0, 5.0, 6.0])]
+            ))
+        );
+        assert_eq!(parse_located("x,y,z\n", &both), Ok((0, vec![])));
+        let e = parse_located("t,x,y\n", &both).expect_err("no such header");
+        assert_eq!(
+            e.to_string(),
+            "line 1: header is \"t,x,y\", expected x,y,z or t,x,y,z"
+        );
+        let e = parse_located("t,x,y,z\n1,2,3\n", &both).expect_err("short row");
+        assert_eq!(
+            e.to_string(),
+            "line 2: expected 4 columns (t,x,y,z), found 3"
+        );
     }
 }

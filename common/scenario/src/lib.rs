@@ -29,7 +29,7 @@ pub use network::{
     ChannelConfig, JitterConfig, JitterDistribution, LossModel, Network, ReplayConfig,
     ReplayFormat, JITTER_CAP, MAX_DELAY_SAMPLES,
 };
-pub use operator::Operator;
+pub use operator::{Operator, TrajectoryEnd};
 use serde::{Deserialize, Serialize};
 pub use slave::{
     ControllerConfig, DynamicsConfig, Environment, Object, SlaveConfig, MAX_STIFFNESS,

@@ -85,7 +85,7 @@ pub struct RunArgs {
 pub fn main(args: &RunArgs) -> Result<(), Error> {
     let sets = parse_sets(&args.set)?;
     let loaded = load_scenario(args.scenario.as_deref(), &sets)?;
-    for w in loaded.scenario.warnings() {
+    for w in &loaded.warnings {
         crate::noteln!("tactile: warning: {w}");
     }
     let summary = if args.in_process {

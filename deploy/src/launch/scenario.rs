@@ -24,6 +24,9 @@ pub struct Loaded {
     /// The files it was read from (the scenario, a trajectory), which a run must never
     /// overwrite.
     pub inputs: Vec<PathBuf>,
+    /// What loads but deserves a word before the run: the scenario's own warnings and
+    /// its inputs' (a trajectory file shorter than the run).
+    pub warnings: Vec<String>,
 }
 
 /// Reads and validates a scenario; `None` is the built-in paper scenario. A trajectory
@@ -58,8 +61,10 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
         };
         Error::BadInput(format!("{name}{with}: {}", msg.trim_end()))
     })?;
-    OperatorSource::load(&scenario.operator, &base_dir)
+    let source = OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
+    let mut warnings = scenario.warnings();
+    warnings.extend(source.warnings(scenario.samples, scenario.t_s()));
     tactile_network_emulator::replay::load(&scenario, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
@@ -68,13 +73,14 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
             inputs.push(base_dir.join(&r.path));
         }
     }
-    if let Operator::Csv { path } = &scenario.operator {
+    if let Operator::Csv { path, .. } = &scenario.operator {
         inputs.push(base_dir.join(path));
     }
     Ok(Loaded {
         scenario,
         base_dir,
         inputs,
+        warnings,
     })
 }
 

@@ -228,6 +228,7 @@ fn trio_with(
         scenario: sc.clone(),
         base_dir: std::env::current_dir().unwrap_or_else(|_| ".".into()),
         inputs: Vec::new(),
+        warnings: Vec::new(),
     };
     run_processes(&loaded, out, &sup)
 }

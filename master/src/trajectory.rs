@@ -1,0 +1,351 @@
+//! Trajectory files: positions from a CSV, played at the run's rate.
+//!
+//! A file with header `x,y,z` is one row per sample (what a file recorded at the
+//! run's own rate holds); one with header `t,x,y,z` gives each point a time, and the
+//! run takes the straight line between the rows around each sample's time, so a file
+//! recorded at 100 Hz plays at its own speed in a 1 kHz run instead of ten times too
+//! fast. What happens after the last row is the scenario's `end`: held or looped.
+//! Reading is at the edge ([`Trajectory::read`]); [`Trajectory::at`] is pure.
+
+use std::path::Path;
+use tactile_scenario::{csv, TrajectoryEnd};
+use thiserror::Error;
+
+/// The two headers a trajectory file may have.
+const HEADERS: [&[&str]; 2] = [&["x", "y", "z"], &["t", "x", "y", "z"]];
+
+/// A trajectory file that cannot be used.
+#[derive(Debug, Error)]
+pub enum OperatorError {
+    /// The file could not be read (missing, not a regular file, too large).
+    #[error("{0}")]
+    Read(String),
+    /// The file's content is malformed.
+    #[error("{path}: {source}")]
+    Csv {
+        /// The file.
+        path: String,
+        /// Where and what.
+        source: csv::CsvError,
+    },
+    /// The file has a header but no rows.
+    #[error("{path}: no positions after the header")]
+    NoRows {
+        /// The file.
+        path: String,
+    },
+    /// A time in the `t` column that cannot be (before 0, not after the row before).
+    #[error("{path}: line {line}: {problem}")]
+    Time {
+        /// The file.
+        path: String,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong with it.
+        problem: String,
+    },
+}
+
+/// A trajectory file's points, ready to play.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    /// The file, as errors and warnings name it.
+    pub shown: String,
+    /// Each row's time, s, for a timed file; `None` for one row per sample.
+    times: Option<Vec<f64>>,
+    /// Each row's position, m (never empty).
+    points: Vec<[f64; 3]>,
+    /// After the last row.
+    end: TrajectoryEnd,
+}
+
+impl Trajectory {
+    /// Reads and checks the file at `full`.
+    pub fn read(full: &Path, end: TrajectoryEnd) -> Result<Trajectory, OperatorError> {
+        let shown = full.display().to_string();
+        let text = tactile_node::files::read_text(
+            full,
+            "trajectory",
+            tactile_node::files::MAX_TRAJECTORY_BYTES,
+        )
+        .map_err(OperatorError::Read)?;
+        Trajectory::parse(&text, shown, end)
+    }
+
+    /// Parses a file's text; `shown` names the file in errors.
+    pub fn parse(
+        text: &str,
+        shown: String,
+        end: TrajectoryEnd,
+    ) -> Result<Trajectory, OperatorError> {
+        let (which, rows) =
+            csv::parse_located(text, &HEADERS).map_err(|source| OperatorError::Csv {
+                path: shown.clone(),
+                source,
+            })?;
+        if rows.is_empty() {
+            return Err(OperatorError::NoRows { path: shown });
+        }
+        let timed = which == 1;
+        let point = |r: &[f64]| -> [f64; 3] {
+            let k = usize::from(timed);
+            [r[k], r[k + 1], r[k + 2]]
+        };
+        let points = rows.iter().map(|(_, r)| point(r)).collect();
+        let times = if timed {
+            Some(check_times(&rows, &shown)?)
+        } else {
+            None
+        };
+        Ok(Trajectory {
+            shown,
+            times,
+            points,
+            end,
+        })
+    }
+
+    /// The position at sample `n` of a run with sampling period `t_s`.
+    pub fn at(&self, n: u64, t_s: f64) -> [f64; 3] {
+        let rows = self.points.len();
+        match &self.times {
+            None => {
+                let k = match self.end {
+                    TrajectoryEnd::Hold => n.min(rows as u64 - 1),
+                    TrajectoryEnd::Loop => n % rows as u64,
+                };
+                self.points[k as usize]
+            }
+            Some(times) => self.at_time(times, n as f64 * t_s),
+        }
+    }
+
+    /// A timed file at `t` seconds: the straight line between the rows around it.
+    fn at_time(&self, times: &[f64], t: f64) -> [f64; 3] {
+        let last = times[times.len() - 1];
+        let t = match self.end {
+            TrajectoryEnd::Loop if last > 0.0 => t % last,
+            _ => t,
+        };
+        // The first row at or after t; before the first row, the first point.
+        let k = times.partition_point(|&tk| tk < t);
+        if k == 0 || (k < times.len() && times[k] == t) {
+            // On a row's time, its point exactly (before the first, the first).
+            return self.points[k];
+        }
+        if k == times.len() {
+            return self.points[k - 1];
+        }
+        let (t0, t1) = (times[k - 1], times[k]);
+        let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        let (a, b) = (self.points[k - 1], self.points[k]);
+        [0, 1, 2].map(|i| a[i] + w * (b[i] - a[i]))
+    }
+
+    /// What the run will do once the file has run out, when that is before the run
+    /// ends (`samples` at period `t_s`); `None` when the file covers the run.
+    pub fn shortfall(&self, samples: u64, t_s: f64) -> Option<String> {
+        let end = self.end.name();
+        match &self.times {
+            None => {
+                let rows = self.points.len() as u64;
+                if rows >= samples {
+                    return None;
+                }
+                let what = match self.end {
+                    TrajectoryEnd::Hold => format!("its last row is held from sample {rows} on"),
+                    TrajectoryEnd::Loop => {
+                        format!("it starts again from its first row at sample {rows}, every {rows} samples")
+                    }
+                };
+                Some(format!(
+                    "operator.path: {} has {rows} rows (one per sample) for a run of {samples} samples: {what} (end = \"{end}\")",
+                    self.shown
+                ))
+            }
+            Some(times) => {
+                let last = times[times.len() - 1];
+                let run_end = (samples - 1) as f64 * t_s;
+                if last >= run_end {
+                    return None;
+                }
+                let what = match self.end {
+                    TrajectoryEnd::Loop if last > 0.0 => format!(
+                        "it starts again from t = 0 at sample {}, every {last} s",
+                        first_sample_at(last, t_s)
+                    ),
+                    _ => format!(
+                        "its last point is held from sample {} on",
+                        first_sample_after(last, t_s)
+                    ),
+                };
+                Some(format!(
+                    "operator.path: {} ends at t = {last} s, before the run's last sample at {run_end} s: {what} (end = \"{end}\")",
+                    self.shown
+                ))
+            }
+        }
+    }
+}
+
+/// The first sample whose time, computed as the run computes it, is at or after `t`.
+fn first_sample_at(t: f64, t_s: f64) -> u64 {
+    let mut n = (t / t_s).floor().max(0.0) as u64;
+    while (n as f64) * t_s < t {
+        n += 1;
+    }
+    while n > 0 && ((n - 1) as f64) * t_s >= t {
+        n -= 1;
+    }
+    n
+}
+
+/// The first sample whose time is after `t`.
+fn first_sample_after(t: f64, t_s: f64) -> u64 {
+    let n = first_sample_at(t, t_s);
+    if (n as f64) * t_s > t {
+        n
+    } else {
+        n + 1
+    }
+}
+
+/// The time column: from 0 or later, strictly increasing (each already finite: the
+/// CSV parser refuses anything else). An error names the file, the line and what is
+/// wrong with its time.
+fn check_times(rows: &[(usize, Vec<f64>)], shown: &str) -> Result<Vec<f64>, OperatorError> {
+    let bad = |line: usize, problem: String| OperatorError::Time {
+        path: shown.to_string(),
+        line,
+        problem,
+    };
+    let mut times = Vec::with_capacity(rows.len());
+    for (line, r) in rows {
+        let t = r[0];
+        match times.last() {
+            None if t < 0.0 => {
+                return Err(bad(*line, format!("t = {t} s is before 0 (times start at 0 or later)")))
+            }
+            Some(&prev) if t <= prev => {
+                return Err(bad(
+                    *line,
+                    format!("t = {t} s is not after the previous row's {prev} s (times must increase strictly)"),
+                ))
+            }
+            _ => times.push(t),
+        }
+    }
+    Ok(times)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(text: &str, end: TrajectoryEnd) -> Trajectory {
+        Trajectory::parse(text, "traj.csv".into(), end).expect("valid")
+    }
+
+    #[test]
+    fn untimed_rows_hold_or_loop_after_the_last() {
+        let text = "x,y,z\n0,0,0\n0.01,0,0\n";
+        let hold = file(text, TrajectoryEnd::Hold);
+        let x = |t: &Trajectory, n| t.at(n, 1e-3)[0];
+        assert_eq!(
+            [x(&hold, 0), x(&hold, 1), x(&hold, 2), x(&hold, 999)],
+            [0.0, 0.01, 0.01, 0.01]
+        );
+        let lp = file(text, TrajectoryEnd::Loop);
+        assert_eq!(
+            [x(&lp, 0), x(&lp, 1), x(&lp, 2), x(&lp, 3)],
+            [0.0, 0.01, 0.0, 0.01]
+        );
+        let w = hold.shortfall(1000, 1e-3).expect("shorter than the run");
+        assert!(
+            w.contains("2 rows") && w.contains("held from sample 2"),
+            "{w}"
+        );
+        let w = lp.shortfall(1000, 1e-3).expect("shorter than the run");
+        assert!(w.contains("again from its first row at sample 2"), "{w}");
+        assert_eq!(hold.shortfall(2, 1e-3), None);
+    }
+
+    #[test]
+    fn timed_rows_are_resampled_linearly() {
+        // Rows every 10 ms, run at 1 kHz: samples in between lie on the line.
+        let t = file(
+            "t,x,y,z\n0,0,0,0\n0.01,0.01,-0.02,0\n0.02,0.01,0,0\n",
+            TrajectoryEnd::Hold,
+        );
+        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-12);
+        assert_eq!(t.at(0, 1e-3), [0.0; 3]);
+        assert!(
+            close(t.at(3, 1e-3), [0.003, -0.006, 0.0]),
+            "{:?}",
+            t.at(3, 1e-3)
+        );
+        assert!(close(t.at(10, 1e-3), [0.01, -0.02, 0.0]));
+        assert!(close(t.at(15, 1e-3), [0.01, -0.01, 0.0]));
+        assert_eq!(t.at(20, 1e-3), [0.01, 0.0, 0.0]);
+        assert_eq!(t.at(500, 1e-3), [0.01, 0.0, 0.0], "held");
+        let w = t.shortfall(1000, 1e-3).expect("20 ms of a 1 s run");
+        assert!(w.contains("held from sample 21"), "{w}");
+        assert_eq!(t.shortfall(21, 1e-3), None);
+    }
+
+    #[test]
+    fn timed_rows_loop_and_may_start_late() {
+        let t = file("t,x,y,z\n0.005,1,0,0\n0.01,2,0,0\n", TrajectoryEnd::Loop);
+        let x = |n| t.at(n, 1e-3)[0];
+        assert_eq!(
+            [x(0), x(4), x(5)],
+            [1.0, 1.0, 1.0],
+            "the first point until 5 ms"
+        );
+        assert!((x(7) - 1.4).abs() < 1e-12);
+        assert_eq!(x(10), 1.0, "again from t = 0");
+        assert!((x(17) - 1.4).abs() < 1e-12);
+        let w = t.shortfall(100, 1e-3).expect("loops");
+        assert!(w.contains("from t = 0 at sample 10, every 0.01 s"), "{w}");
+        // A single timed row is a point, held or looped.
+        let one = file("t,x,y,z\n0,1,2,3\n", TrajectoryEnd::Loop);
+        assert_eq!(one.at(7, 1e-3), [1.0, 2.0, 3.0]);
+    }
+
+    #[test]
+    fn bad_times_name_the_line() {
+        let bad = |text: &str| {
+            Trajectory::parse(text, "traj.csv".into(), TrajectoryEnd::Hold)
+                .expect_err("bad times")
+                .to_string()
+        };
+        let e = bad("t,x,y,z\n0,0,0,0\n0.01,0,0,0\n0.01,0,0,0\n");
+        assert!(
+            e.starts_with("traj.csv: line 4: t = 0.01 s is not after"),
+            "{e}"
+        );
+        let e = bad("t,x,y,z\n0,0,0,0\n\n-1,0,0,0\n");
+        assert!(
+            e.starts_with("traj.csv: line 4: t = -1 s is not after"),
+            "{e}"
+        );
+        let e = bad("t,x,y,z\n-0.5,0,0,0\n");
+        assert!(e.contains("line 2: t = -0.5 s is before 0"), "{e}");
+        let e = bad("t,x,y,z\n0,0,0,0\nnan,0,0,0\n");
+        assert!(
+            e.contains("line 3, column 1 (t)") && e.contains("not a finite number"),
+            "{e}"
+        );
+        let e = bad("t,x,y\n0,0,0\n");
+        assert!(e.contains("expected x,y,z or t,x,y,z"), "{e}");
+    }
+
+    #[test]
+    fn first_samples_at_and_after_a_time() {
+        assert_eq!(first_sample_at(0.01, 1e-3), 10);
+        assert_eq!(first_sample_after(0.01, 1e-3), 11);
+        assert_eq!(first_sample_at(0.0105, 1e-3), 11);
+        assert_eq!(first_sample_after(0.0105, 1e-3), 11);
+        assert_eq!(first_sample_at(0.0, 1e-3), 0);
+    }
+}
