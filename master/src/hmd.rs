@@ -10,9 +10,10 @@
 //! the trajectory (the torques drive nothing), or `impedance`, a hand holding the
 //! simulated device ([`HeldDevice`]) that the torques push back. The channel's control
 //! ([`MasterSide`]) decides what is sent for c(n) and which force comes of q(n).
+//! Either hand reaches the trajectory from the devices' home along [`Approach`].
 
 use crate::device::HeldDevice;
-use crate::operator::{min_jerk, OperatorSource, Target};
+use crate::operator::{Approach, OperatorSource, Target};
 use crate::record::{Answer, MasterCounters, Miss, Sent};
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::{MasterForce, MasterSide};
@@ -43,9 +44,8 @@ pub struct Master {
     last_felt: [f64; 3],
     /// The impedance hand's device and where its intended position was last sample.
     held: Option<(HeldDevice, [f64; 3])>,
-    /// Where the handle starts (the devices' home), m.
-    home: [f64; 3],
-    approach_s: f64,
+    /// The way from the devices' home onto the trajectory, for either hand.
+    approach: Option<Approach>,
     control: MasterSide,
     last_theta: [f64; 3],
     codec: Deadband,
@@ -66,6 +66,12 @@ impl Master {
         // Wave variables are neither positions nor forces: the codec measures them from
         // zero, and the predictor's plausibility bound is wider.
         let wave = scenario.control.kind == ControlKind::Wave;
+        let approach = Approach::new(
+            &source,
+            home,
+            scenario.master.hand.approach_s,
+            scenario.t_s(),
+        );
         let held = (scenario.master.hand.mode == HandMode::Impedance).then(|| {
             let device = HeldDevice::new(
                 scenario.master.device.clone(),
@@ -90,8 +96,7 @@ impl Master {
             last_tau: [0.0; 3],
             last_felt: [0.0; 3],
             held,
-            home,
-            approach_s: scenario.master.hand.approach_s,
+            approach,
             last_theta: [0.0; 3],
             codec: Deadband::new(
                 &scenario.codec.forward,
@@ -164,20 +169,22 @@ impl Master {
         [0, 1, 2].map(|i| j[i][0] * d[0] + j[i][1] * d[1] + j[i][2] * d[2])
     }
 
-    /// The hand's intended position at sample n: the trajectory, blended in from the
-    /// handle's home over the approach time.
+    /// What the hand means to do at sample n: the trajectory, blended in from the
+    /// devices' home over the approach (both hands, so neither starts with a jump).
+    fn target(&self, n: u64) -> Target {
+        let a = self.source.target(n, self.t_s);
+        match &self.approach {
+            Some(approach) => approach.apply(a, n as f64 * self.t_s),
+            None => a,
+        }
+    }
+
+    /// The impedance hand's intended position at sample n.
     fn intended(&self, n: u64) -> [f64; 3] {
-        let approach_s = self.approach_s;
-        let a = match self.source.target(n, self.t_s) {
+        match self.target(n) {
             Target::Joints(theta) => self.truth.fk(theta),
             Target::Position(p) => p,
-        };
-        let s = if approach_s > 0.0 {
-            min_jerk(n as f64 * self.t_s / approach_s)
-        } else {
-            1.0
-        };
-        [0, 1, 2].map(|i| self.home[i] + s * (a[i] - self.home[i]))
+        }
     }
 
     /// The impedance hand: the device moves over the sample just ended under the hand
@@ -196,9 +203,9 @@ impl Master {
         (x_d, device.hand_force)
     }
 
-    /// The ideal hand: the handle is where the trajectory says.
+    /// The ideal hand: the handle is where the hand means it to be.
     fn ideal_hand(&mut self, n: u64) -> [f64; 3] {
-        match self.source.target(n, self.t_s) {
+        match self.target(n) {
             Target::Joints(theta) => {
                 self.theta_md = theta;
                 self.truth.fk(theta)
@@ -342,5 +349,76 @@ impl Master {
         a.round_trip_ns = done.saturating_sub(origin);
         let injected = u64::from(a.q.delay_samples[i]) * self.t_s_ns;
         a.overhead_ns = a.round_trip_ns as i64 - injected as i64;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tactile_scenario::Operator;
+
+    /// The targets of the first `samples` with `operator` and `hand`, at 1 kHz.
+    fn targets(operator: Operator, hand: HandMode, samples: u64) -> Vec<[f64; 3]> {
+        let mut sc = Scenario::paper();
+        sc.rate_hz = 1000.0;
+        sc.operator = operator;
+        sc.master.hand.mode = hand;
+        let source = OperatorSource::load(&sc.operator, std::path::Path::new(".")).expect("op");
+        let mut m = Master::new(&sc, source).expect("master");
+        (0..samples).map(|n| m.forward(n, 0).1.target).collect()
+    }
+
+    fn home() -> [f64; 3] {
+        let lengths = tactile_math::geometry::Geometry::PAPER.lengths();
+        tactile_math::kernels::fk(&lengths, &tactile_math::arith::StdTrig, [0.0; 3])
+    }
+
+    #[test]
+    fn every_hand_starts_a_circle_at_home_and_blends_onto_it() {
+        let circle = Operator::Circle {
+            center: [0.0, -0.107, -0.065],
+            radius: 0.02,
+            period_s: 2.0,
+            plane: "xz".into(),
+        };
+        let source = OperatorSource::load(&circle, std::path::Path::new(".")).expect("op");
+        for hand in [HandMode::Position, HandMode::Impedance] {
+            let t = targets(circle.clone(), hand, 1500);
+            assert_eq!(t[0], home(), "{hand:?}");
+            // Without the blend the first sample jumped 36 mm; along it no sample
+            // steps more than a tenth of a millimetre.
+            let step = t
+                .windows(2)
+                .map(|w| tactile_math::vec3::norm([0, 1, 2].map(|i| w[1][i] - w[0][i])));
+            let largest = step.fold(0.0, f64::max);
+            assert!(largest < 1e-4, "{hand:?}: {largest} m");
+            // After the approach (1 s), the circle itself.
+            let Target::Position(p) = source.target(1200, 1e-3) else {
+                panic!("a position")
+            };
+            let off = tactile_math::vec3::norm([0, 1, 2].map(|i| t[1200][i] - p[i]));
+            assert!(off < 1e-15, "{hand:?}: {off} m off the circle");
+        }
+    }
+
+    #[test]
+    fn a_trajectory_that_starts_at_home_is_not_blended() {
+        // The paper's path starts with the joints at zero: its targets are exactly
+        // the path's, under either hand.
+        for hand in [HandMode::Position, HandMode::Impedance] {
+            let t = targets(Operator::Paper, hand, 600);
+            let truth = Engine::new(
+                tactile_math::arith::ArithKind::F64,
+                tactile_math::geometry::Geometry::PAPER,
+                tactile_scenario::CordicSettings::default()
+                    .config()
+                    .expect("cordic"),
+            )
+            .expect("engine");
+            for (n, a) in t.iter().enumerate() {
+                let want = truth.fk(tactile_math::validation::paper_joint_path(n as f64 * 1e-3));
+                assert_eq!(*a, want, "{hand:?} at sample {n}");
+            }
+        }
     }
 }

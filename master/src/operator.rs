@@ -58,6 +58,52 @@ pub fn min_jerk(tau: f64) -> f64 {
     t * t * t * (10.0 - 15.0 * t + 6.0 * t * t)
 }
 
+/// The hand's way from the devices' home onto the trajectory: over `seconds` the
+/// target goes from home (the joints at zero, the handle where they put it) to the
+/// trajectory's own target along a minimum-jerk blend, so a trajectory that starts
+/// elsewhere does not command the whole distance in one sample (a circle 3.6 cm off
+/// home did, saturating the slave's torques), whichever hand holds the handle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Approach {
+    /// The handle at home, m.
+    home: [f64; 3],
+    /// Seconds the blend takes.
+    seconds: f64,
+}
+
+impl Approach {
+    /// The approach for `source`, or `None` when there is nothing to approach: a zero
+    /// duration, or a first target exactly at home. The second keeps a trajectory
+    /// that starts at home (the paper's) bit for bit what it was: blending it would
+    /// only slow its first second down.
+    pub fn new(
+        source: &OperatorSource,
+        home: [f64; 3],
+        seconds: f64,
+        t_s: f64,
+    ) -> Option<Approach> {
+        let at_home = match source.target(0, t_s) {
+            Target::Joints(theta) => theta == [0.0; 3],
+            Target::Position(p) => p == home,
+        };
+        (seconds > 0.0 && !at_home).then_some(Approach { home, seconds })
+    }
+
+    /// The target at time `t` of the run: home + s (a - home) with s the minimum-jerk
+    /// progress, joints from zero and positions from the home position. Computed so
+    /// even once s is 1 (a rounding's difference from `a`), as the impedance hand's
+    /// runs in deploy/results/ were.
+    pub fn apply(&self, a: Target, t: f64) -> Target {
+        let s = min_jerk(t / self.seconds);
+        match a {
+            Target::Joints(theta) => Target::Joints(theta.map(|q| s * q)),
+            Target::Position(p) => {
+                Target::Position([0, 1, 2].map(|i| self.home[i] + s * (p[i] - self.home[i])))
+            }
+        }
+    }
+}
+
 fn plane_axes(plane: &str) -> (usize, usize) {
     match plane {
         "yz" => (1, 2),

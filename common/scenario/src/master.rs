@@ -84,9 +84,14 @@ pub struct HandConfig {
     pub damping: f64,
     /// Stiffness pulling the handle towards the intended position, N/m.
     pub stiffness: f64,
-    /// Seconds over which the intended position blends from where the handle starts
-    /// (the devices' home) into the trajectory, so a trajectory that starts elsewhere
-    /// does not yank the handle. No effect when the trajectory starts at home.
+    /// Seconds over which the hand's target blends, along a minimum-jerk path, from
+    /// where the handle starts (the devices' home, joints at zero) into the
+    /// trajectory, under either hand mode, so a trajectory that starts elsewhere does
+    /// not command its whole distance from home in the first sample (a circle 3.6 cm
+    /// away did, saturating the slave). 0 turns it off. No effect when the
+    /// trajectory's first target is exactly home (the paper's path), which therefore
+    /// runs as it always has. The default, 1 s, takes a few centimetres at a peak of
+    /// a few cm/s, a calm reach for a hand; longer reaches deserve a longer blend.
     pub approach_s: f64,
 }
 
