@@ -439,7 +439,7 @@ fn csv_case(name: &str, csv: Option<&str>, expected: &[&str]) -> Option<String> 
 
 #[test]
 fn bad_trajectory_csv_is_located() {
-    let cases: [(&str, Option<&str>, &[&str]); 7] = [
+    let cases: [(&str, Option<&str>, &[&str]); 11] = [
         (
             "nan",
             Some("x,y,z\n0.1,0.2,-0.1\n0.1,NaN,-0.1\n"),
@@ -455,13 +455,41 @@ fn bad_trajectory_csv_is_located() {
             Some("x,y,z\n0.1,abc,-0.1\n"),
             &["line 2", "column 2"],
         ),
-        ("header", Some("x,y\n0.1,0.2\n"), &["line 1", "x,y,z"]),
+        (
+            "header",
+            Some("x,y\n0.1,0.2\n"),
+            &["line 1", "x,y,z or t,x,y,z"],
+        ),
         (
             "truncated",
             Some("x,y,z\n0.1,0.2,-0.1\n0.1,0.2,-0.1\n0.1,0.2"),
             &["line 4", "3 columns"],
         ),
         ("empty", Some("x,y,z\n"), &[]),
+        // A time column that goes back, stands still, starts before 0 or is not a number.
+        (
+            "t-back",
+            Some("t,x,y,z\n0,0.1,0.2,-0.1\n0.02,0.1,0.2,-0.1\n0.01,0.1,0.2,-0.1\n"),
+            &[
+                "line 4",
+                "t = 0.01 s is not after the previous row's 0.02 s",
+            ],
+        ),
+        (
+            "t-still",
+            Some("t,x,y,z\n0,0.1,0.2,-0.1\n\n0,0.1,0.2,-0.1\n"),
+            &["line 4", "t = 0 s is not after"],
+        ),
+        (
+            "t-negative",
+            Some("t,x,y,z\n-0.5,0.1,0.2,-0.1\n"),
+            &["line 2", "before 0"],
+        ),
+        (
+            "t-nan",
+            Some("t,x,y,z\nNaN,0.1,0.2,-0.1\n"),
+            &["line 2", "column 1 (t)"],
+        ),
         ("missing", None, &[]),
     ];
     let failures: Vec<String> = cases

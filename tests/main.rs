@@ -25,3 +25,4 @@ mod scheduling;
 mod signals;
 mod summaries;
 mod sweep;
+mod trajectories;
