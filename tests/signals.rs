@@ -51,8 +51,8 @@ fn sigint_stops_an_in_process_run_with_a_report_of_what_ran() {
     drop(scenario);
 }
 
-/// A sweep stopped by SIGINT after its first run: exit 130, `sweep.csv` holds the
-/// runs that finished (and no partial one), no panic.
+/// A sweep stopped by SIGINT after its first run (one run at a time): exit 130,
+/// `sweep.csv` holds the runs that finished (and no partial one), no panic.
 #[test]
 fn sigint_stops_a_sweep_keeping_its_finished_rows() {
     let sb = Sandbox::new("sigsweep");
@@ -64,6 +64,8 @@ fn sigint_stops_a_sweep_keeping_its_finished_rows() {
             "s.toml",
             "--set",
             "control.kind=none,tdpa,wave,none,tdpa,wave",
+            "--jobs",
+            "1",
             "--out",
             "sw",
         ])

@@ -193,5 +193,6 @@ fn bundle(out: &Path, loaded: &Loaded) -> Result<Loaded, Error> {
             .parent()
             .map_or_else(|| out.to_path_buf(), Path::to_path_buf),
         inputs: loaded.inputs.clone(),
+        warnings: loaded.warnings.clone(),
     })
 }
