@@ -78,7 +78,9 @@ fn ranges(series: &[Series]) -> Option<((f64, f64), (f64, f64))> {
     }
     let px = ((x1 - x0) * 0.05).max(0.5);
     let py = ((y1 - y0) * 0.08).max(y1.abs().max(1e-9) * 0.05);
-    Some(((x0 - px, x1 + px), (y0 - py, y1 + py)))
+    // Headroom above the data for the legend (upper right), so it covers no point.
+    let legend = (y1 - y0 + 2.0 * py) * 0.03 * (series.len() as f64 + 1.0);
+    Some(((x0 - px, x1 + px), (y0 - py, y1 + py + legend)))
 }
 
 fn plot(path: &Path, name: &str, key: &str, x_desc: &str, series: &[Series]) -> Result<(), String> {
