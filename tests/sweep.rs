@@ -262,3 +262,24 @@ fn cells(line: &str) -> Vec<String> {
     out.push(cur);
     out
 }
+
+#[test]
+fn a_sweep_says_its_scenarios_warnings_once() {
+    let sb = Sandbox::new("sweep-warn");
+    let text = util::wall_delay().replace("samples = 8000", "samples = 200");
+    let s = sb.write("s.toml", &text);
+    let o = sb.tactile(&[
+        "sweep",
+        s.to_str().expect("utf-8"),
+        "--set",
+        "environment.objects[0].stiffness=[600,600,600],[800,800,800]",
+        "--set",
+        "control.kind=none,tdpa",
+        "--out",
+        "sw",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let warned = err.matches("stiffness[0] = 800 N/m is above").count();
+    assert_eq!(warned, 1, "two runs share the warning, said once:\n{err}");
+}

@@ -146,6 +146,13 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
     // Every run's scenario is checked before the first starts, so a bad value is bad
     // input (exit 2) with nothing run.
     let work = exec::plan(scenario, &axes, &combos, &mine, args)?;
+    // What deserves a word, once however many runs share it.
+    let mut said = std::collections::BTreeSet::new();
+    for w in work.iter().flat_map(|w| &w.loaded.warnings) {
+        if said.insert(w) {
+            crate::noteln!("tactile: warning: {w}");
+        }
+    }
     tactile_report::write::make_out_dir(&args.out)?;
     table::check_resume(&args.out, &spec, args.resume)?;
     table::write_spec(&args.out, &spec)?;
