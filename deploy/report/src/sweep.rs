@@ -97,9 +97,10 @@ pub fn values(summary: &serde_json::Value) -> Vec<Option<f64>> {
         .collect()
 }
 
-/// The header of `sweep.csv`.
-pub fn header(axes: &[Axis]) -> String {
-    let mut cols: Vec<String> = vec!["run".into()];
+/// The header of `sweep.csv` (`lead`: the first columns, `run`, and in `runs.csv`
+/// `run,seed`).
+pub fn header(lead: &str, axes: &[Axis]) -> String {
+    let mut cols: Vec<String> = vec![lead.into()];
     cols.extend(axes.iter().map(|a| csv_field(&a.key)));
     cols.extend(METRICS.iter().map(|(n, _)| n.to_string()));
     cols.join(",") + "\n"
@@ -135,21 +136,36 @@ pub fn header_seeds(axes: &[Axis]) -> String {
     cols.join(",") + "\n"
 }
 
-/// One combination's line of `sweep.csv` over its seeds' values (one `Vec` per run).
-pub fn row_seeds(k: usize, axes: &[Axis], combo: &[usize], runs: &[Vec<Option<f64>>]) -> String {
+/// Each metric's mean and 95 % half width over one combination's runs (one `Vec` of
+/// metric values per run): what `sweep.csv` and the plots show with `--seeds`.
+pub fn stats(runs: &[Vec<Option<f64>>]) -> Vec<(Option<f64>, Option<f64>)> {
+    (0..METRICS.len())
+        .map(|m| {
+            let v: Vec<f64> = runs
+                .iter()
+                .filter_map(|r| r.get(m).copied().flatten())
+                .collect();
+            mean_ci95(&v).map_or((None, None), |(a, b)| (Some(a), b))
+        })
+        .collect()
+}
+
+/// One combination's line of `sweep.csv` over its `seeds` runs, from their [`stats`].
+pub fn row_seeds(
+    k: usize,
+    axes: &[Axis],
+    combo: &[usize],
+    seeds: usize,
+    stats: &[(Option<f64>, Option<f64>)],
+) -> String {
     let mut cols: Vec<String> = vec![k.to_string()];
     cols.extend(
         axes.iter()
             .zip(combo)
             .map(|(a, &i)| csv_field(&a.values[i])),
     );
-    cols.push(runs.len().to_string());
-    for m in 0..METRICS.len() {
-        let v: Vec<f64> = runs
-            .iter()
-            .filter_map(|r| r.get(m).copied().flatten())
-            .collect();
-        let (mean, ci) = mean_ci95(&v).map_or((None, None), |(a, b)| (Some(a), b));
+    cols.push(seeds.to_string());
+    for (mean, ci) in stats {
         cols.push(mean.map_or_else(String::new, |x| format!("{x}")));
         cols.push(ci.map_or_else(String::new, |x| format!("{x}")));
     }

@@ -6,9 +6,7 @@ use super::{parse_axes, run_dir, Spec};
 use crate::error::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use tactile_report::sweep::{
-    combinations, header, header_seeds, mean_ci95, row, row_seeds, Axis, METRICS,
-};
+use tactile_report::sweep::{combinations, header, header_seeds, row, row_seeds, stats, Axis};
 use tactile_report::sweep_plots::{sweep_plots, Point};
 
 /// A run's result: combination, seed index, metrics.
@@ -66,11 +64,11 @@ pub fn write_tables(
     }
     let mut points: Vec<Point> = Vec::new();
     let mut csv = if seeds == 1 {
-        header(axes)
+        header("run", axes)
     } else {
         header_seeds(axes)
     };
-    let mut runs = header(axes).replacen("run,", "run,seed,", 1);
+    let mut runs = header("run,seed", axes);
     for (&k, per_seed) in &by {
         let combo = &combos[k];
         let values: Vec<Vec<Option<f64>>> = per_seed.values().map(|v| (*v).clone()).collect();
@@ -80,17 +78,12 @@ pub fn write_tables(
         if per_seed.len() < seeds {
             continue;
         }
+        let stats = stats(&values);
         if seeds == 1 {
             csv += &row(&k.to_string(), axes, combo, &values[0]);
         } else {
-            csv += &row_seeds(k, axes, combo, &values);
+            csv += &row_seeds(k, axes, combo, values.len(), &stats);
         }
-        let stats = (0..METRICS.len())
-            .map(|m| {
-                let v: Vec<f64> = values.iter().filter_map(|r| r[m]).collect();
-                mean_ci95(&v).map_or((None, None), |(a, b)| (Some(a), b))
-            })
-            .collect();
         points.push((combo.clone(), stats));
     }
     write(&out.join("sweep.csv"), &csv)?;
