@@ -2,13 +2,12 @@
 //! its report.
 
 use crate::error::Error;
-use crate::launch::{self, load_scenario, parse_sets, prepare_out, Links, Supervision};
+use crate::launch::{self, load_scenario, parse_sets, Links, Supervision};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Duration;
 use tactile_node::args::LinkKind;
 use tactile_report::summary::render;
-use tactile_report::write::{write_report, Launch};
 
 /// Arguments of `tactile run`.
 #[derive(Debug, Args)]
@@ -89,19 +88,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
         crate::noteln!("tactile: warning: {w}");
     }
     let summary = if args.in_process {
-        let bundled = prepare_out(&args.out, &loaded)?;
-        let completed = launch::sim::simulate(&bundled.scenario, &bundled.base_dir, &args.out)?;
-        let launch = Launch {
-            no_trace: args.no_trace,
-            stop: tactile_node::signals::stop_flag().ok(),
-            ..Launch::default()
-        };
-        let launch = if completed {
-            launch
-        } else {
-            launch.interrupted()
-        };
-        write_report(std::slice::from_ref(&args.out), &args.out, &launch)?
+        launch::sim::run_in_process(&loaded, &args.out, args.no_trace)?
     } else {
         launch::clean_stale_runs();
         let sup = Supervision {

@@ -133,3 +133,30 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<bool
     srec.stop(st, reason).map_err(failed)?;
     Ok(reason == "completed")
 }
+
+/// A run in-process into `out`, as `tactile run --in-process` and each run of a sweep
+/// do it: the folder made ready (inputs copied in), the simulation, its report (cut
+/// short and marked so if a stop request ended the simulation).
+pub fn run_in_process(
+    loaded: &super::Loaded,
+    out: &Path,
+    no_trace: bool,
+) -> Result<tactile_report::summary::Summary, Error> {
+    let bundled = super::prepare_out(out, loaded)?;
+    let completed = simulate(&bundled.scenario, &bundled.base_dir, out)?;
+    let launch = tactile_report::write::Launch {
+        no_trace,
+        stop: tactile_node::signals::stop_flag().ok(),
+        ..Default::default()
+    };
+    let launch = if completed {
+        launch
+    } else {
+        launch.interrupted()
+    };
+    Ok(tactile_report::write::write_report(
+        std::slice::from_ref(&out.to_path_buf()),
+        out,
+        &launch,
+    )?)
+}

@@ -4,13 +4,12 @@
 
 use super::{run_dir, sets_of, SweepArgs};
 use crate::error::Error;
-use crate::launch::{self, load_scenario, prepare_out, Loaded};
+use crate::launch::{self, load_scenario, Loaded};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 use tactile_report::sweep::{describe, values, Axis};
-use tactile_report::write::{write_report, Launch};
 
 /// One run of the sweep.
 #[derive(Debug)]
@@ -152,19 +151,7 @@ fn run_one(w: &Work, args: &SweepArgs) -> Result<Option<Vec<Option<f64>>>, Error
         let sup = launch::sweep_supervision(!args.trace);
         launch::run_processes(l, &w.dir, &sup)?
     } else {
-        let launch = Launch {
-            no_trace: !args.trace,
-            stop: tactile_node::signals::stop_flag().ok(),
-            ..Launch::default()
-        };
-        let bundled = prepare_out(&w.dir, l)?;
-        let completed = launch::sim::simulate(&bundled.scenario, &bundled.base_dir, &w.dir)?;
-        let launch = if completed {
-            launch
-        } else {
-            launch.interrupted()
-        };
-        write_report(std::slice::from_ref(&w.dir), &w.dir, &launch)?
+        launch::sim::run_in_process(l, &w.dir, !args.trace)?
     };
     if summary.interrupted {
         return Ok(None);
