@@ -21,6 +21,7 @@ mod loop_processes;
 mod nodes;
 mod recordings;
 mod records;
+mod ros2;
 mod scheduling;
 mod signals;
 mod summaries;

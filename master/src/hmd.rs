@@ -124,6 +124,35 @@ impl Master {
             false => (self.ideal_hand(n), [0.0; 3]),
             true => self.impedance_hand(n),
         };
+        self.encode(n, now_ns, target, hand_force)
+    }
+
+    /// Sample n forward from a real device's encoders: b(n) = `theta` as measured (the
+    /// operator's hand is the real one, so the target is where the handle is).
+    pub fn forward_measured(&mut self, n: u64, now_ns: u64, theta: [f64; 3]) -> (Forward, Sent) {
+        self.theta_md = theta;
+        let handle = self.truth.fk(theta);
+        self.encode(n, now_ns, handle, [0.0; 3])
+    }
+
+    /// The torques commanded now, N m.
+    pub fn tau(&self) -> [f64; 3] {
+        self.last_tau
+    }
+
+    /// The force the operator is made to feel now (after the last answer or miss), N.
+    pub fn felt(&self) -> [f64; 3] {
+        self.last_felt
+    }
+
+    /// FK-HMD of b(n), the control and codec, and the record of the sample.
+    fn encode(
+        &mut self,
+        n: u64,
+        now_ns: u64,
+        target: [f64; 3],
+        hand_force: [f64; 3],
+    ) -> (Forward, Sent) {
         let c = self.engine.fk(self.theta_md);
         let moved = self.moved(n);
         self.control.measure(moved);

@@ -3,8 +3,10 @@
 
 pub mod device;
 pub mod hmd;
+pub mod live;
 pub mod node;
 pub mod operator;
+pub mod outside;
 pub mod process;
 pub mod record;
 pub mod trajectory;

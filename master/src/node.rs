@@ -54,6 +54,9 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
         ));
     }
     let p = prepare(Role::Master, a)?;
+    if crate::outside::needs_ros(&p.scenario) && !cfg!(feature = "zenoh") {
+        return Err(NodeError::BadInput(tactile_node::args::NO_ROS.into()));
+    }
     let source = OperatorSource::load(&p.scenario.operator, &p.base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: operator: {e}", a.scenario.display())))?;
     for w in source.warnings(p.scenario.samples, p.scenario.t_s()) {
@@ -70,7 +73,9 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
         run: new_run_token(),
     };
     let ended = master_link(a, p.spin, cli.direct).and_then(|link| {
-        run_with(&opts, link.as_ref(), &mut rec).map_err(|e| NodeError::Failed(e.to_string()))
+        let mut ros = crate::outside::RosParts::open(&opts.scenario)?;
+        run_with(&opts, link.as_ref(), &mut rec, ros.outside())
+            .map_err(|e| NodeError::Failed(e.to_string()))
     });
     match ended {
         Ok(e) => Ok(e == Ending::Completed),

@@ -9,13 +9,15 @@
 //! Lockstep: c(n + 1) goes out as soon as q(n) is back.
 
 use crate::hmd::Master;
+use crate::live::MasterLive;
 use crate::operator::{OperatorError, OperatorSource};
-use crate::record::{MasterSample, MasterTotals};
+use crate::record::{MasterSample, MasterTotals, Sent};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, LATE_WINDOW};
 use tactile_node::args::NodeError;
+use tactile_node::device::{Change, HapticDevice, LiveSink, Reading};
 use tactile_node::link::MasterLink;
 use tactile_node::link::{Idle, LinkError};
 use tactile_node::recorder::Recorder;
@@ -62,6 +64,25 @@ pub enum MasterError {
 impl From<NodeError> for MasterError {
     fn from(e: NodeError) -> Self {
         MasterError::Record(e.to_string())
+    }
+}
+
+/// What the master loop touches besides its link: a real device in place of the
+/// simulated hand and device, and the live view. Neither by default.
+#[derive(Default)]
+pub struct Outside<'a> {
+    /// The master device through its ROS 2 driver.
+    pub device: Option<&'a mut dyn HapticDevice>,
+    /// Where each k-th sample's state goes for the live view.
+    pub live: Option<&'a mut dyn LiveSink<MasterLive>>,
+}
+
+impl std::fmt::Debug for Outside<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Outside")
+            .field("device", &self.device.as_ref().map(|d| d.describe()))
+            .field("live", &self.live.is_some())
+            .finish()
     }
 }
 
@@ -170,6 +191,11 @@ struct Loop<'a, L: MasterLink + ?Sized> {
     run: u64,
     peer_timeout: u64,
     t0: u64,
+    outside: Outside<'a>,
+    /// The device's last good angles (held while it is stale or lost).
+    device_theta: [f64; 3],
+    device_lost: bool,
+    last_answer: Option<crate::record::Answer>,
 }
 
 impl<L: MasterLink + ?Sized> Loop<'_, L> {
@@ -179,7 +205,63 @@ impl<L: MasterLink + ?Sized> Loop<'_, L> {
         (t.c_out, t.q_in) = self.link.stats();
         t.q_in.foreign += self.totals.q_in.foreign;
         t.elapsed_ns = now_ns().saturating_sub(self.t0);
+        if let Some(d) = &self.outside.device {
+            t.device = d.counters();
+        }
         t
+    }
+
+    /// b(n): the simulated hand and device, or the real device's newest angles (held
+    /// while stale or lost; lost renders zero force).
+    fn forward(&mut self, n: u64, origin: u64) -> Result<(Forward, Sent), MasterError> {
+        let Some(d) = self.outside.device.as_deref_mut() else {
+            return Ok(self.master.forward(n, origin));
+        };
+        let (reading, change) = d.read(now_ns());
+        match reading {
+            Reading::Fresh(t) | Reading::Stale(t) => self.device_theta = t,
+            Reading::Lost => {}
+        }
+        self.device_lost = matches!(reading, Reading::Lost);
+        match change {
+            Change::Lost => {
+                let what = format!(
+                    "device lost: {} silent past its timeout; rendering zero force",
+                    d.describe()
+                );
+                tracing::warn!("{what}");
+                self.rec.event(n, what)?;
+            }
+            Change::Back => self
+                .rec
+                .event(n, format!("device back: {}", d.describe()))?,
+            Change::None => {}
+        }
+        Ok(self.master.forward_measured(n, origin, self.device_theta))
+    }
+
+    /// After sample n: the force to the real device (zero while it is lost), and the
+    /// live view.
+    fn after(&mut self, sent: Sent) {
+        let felt = if self.device_lost {
+            [0.0; 3]
+        } else {
+            self.master.felt()
+        };
+        if let Some(d) = self.outside.device.as_deref_mut() {
+            d.render(felt, now_ns());
+        }
+        if let Some(live) = self.outside.live.as_deref_mut() {
+            if live.due(sent.n) {
+                let answer = self.last_answer.filter(|a| a.n == sent.n);
+                live.offer(MasterLive {
+                    sent,
+                    answer,
+                    tau: self.master.tau(),
+                    felt,
+                });
+            }
+        }
     }
 
     /// Stamps q's arrival, applies KFF-HMD and records the answer. Returns the sample
@@ -209,6 +291,7 @@ impl<L: MasterLink + ?Sized> Loop<'_, L> {
             self.totals.late += 1;
         }
         self.rec.sample(MasterSample::Answer(a))?;
+        self.last_answer = Some(a);
         Ok(Some(q.seq))
     }
 
@@ -250,7 +333,7 @@ impl<L: MasterLink + ?Sized> Loop<'_, L> {
         deadline: Instant,
         realtime: bool,
     ) -> Result<bool, MasterError> {
-        let (mut c, mut sent) = self.master.forward(n, origin);
+        let (mut c, mut sent) = self.forward(n, origin)?;
         c.run = self.run;
         c.stamps[stage::MASTER_SEND] = now_ns();
         sent.send_ns = c.stamps[stage::MASTER_SEND];
@@ -261,30 +344,40 @@ impl<L: MasterLink + ?Sized> Loop<'_, L> {
             match self.link.recv(deadline)? {
                 Ok(q) => {
                     if self.absorb(q, n)? == Some(n) {
-                        return Ok(true);
+                        break;
                     }
                 }
                 Err(Idle::Timeout) => {
                     self.miss(n, realtime)?;
-                    return Ok(true);
+                    break;
                 }
                 Err(Idle::Terminate) => return Ok(false),
             }
         }
+        self.after(sent);
+        Ok(true)
     }
 }
 
 /// Runs the master loop over any link until the scenario's samples are sent (or a stop
 /// request), writing its record as it goes.
-pub fn run_with<L: MasterLink + ?Sized>(
+pub fn run_with<'a, L: MasterLink + ?Sized>(
     opts: &MasterOptions,
-    link: &L,
-    rec: &mut MasterRecorder,
+    link: &'a L,
+    rec: &'a mut MasterRecorder,
+    outside: Outside<'a>,
 ) -> Result<Ending, MasterError> {
     let sc = &opts.scenario;
     let source = OperatorSource::load(&sc.operator, &opts.base_dir)?;
     let master = Master::new(sc, source)?;
     rec.run(opts.run)?;
+    if let Some(d) = &outside.device {
+        if !wait_for_device(&**d, opts.startup_timeout)? {
+            rec.stop(MasterTotals::default(), "interrupted")?;
+            return Ok(Ending::Interrupted);
+        }
+        rec.event(0, format!("device found: {}", d.describe()))?;
+    }
     tracing::info!("waiting for the emulator and slave");
     if !probe(link, opts.run, opts.startup_timeout)? {
         rec.stop(MasterTotals::default(), "interrupted")?;
@@ -308,9 +401,14 @@ pub fn run_with<L: MasterLink + ?Sized>(
         run: opts.run,
         peer_timeout: sc.faults.peer_timeout_samples,
         t0,
+        outside,
+        device_theta: [0.0; 3],
+        device_lost: false,
+        last_answer: None,
     };
     let mut ending = Ending::Completed;
     let mut clamps = (0, 0);
+    let mut device_seen = tactile_node::device::DeviceCounters::default();
     for n in 0..sc.samples {
         // The sample's origin is its scheduled instant, not the moment the master woke:
         // a late wake-up is overhead the loop adds and must show in the round trip.
@@ -334,6 +432,14 @@ pub fn run_with<L: MasterLink + ?Sized>(
         if lp.rec.counters_due() {
             let t = lp.totals();
             log_clamps(&mut clamps, &t.counters);
+            if let Some(d) = &lp.outside.device {
+                tactile_node::device::log_second(
+                    "device",
+                    &mut device_seen,
+                    &t.device,
+                    d.take_reject(),
+                );
+            }
             lp.rec.counters(t)?;
         }
     }
@@ -361,6 +467,29 @@ pub fn run_with<L: MasterLink + ?Sized>(
     )?;
     lp.rec.stop(totals, reason)?;
     Ok(ending)
+}
+
+/// Waits until the device has sent a good message; false if a stop request came.
+fn wait_for_device(d: &dyn HapticDevice, timeout: Duration) -> Result<bool, MasterError> {
+    let stop =
+        tactile_node::signals::stop_flag().map_err(|e| MasterError::Record(e.to_string()))?;
+    let start = Instant::now();
+    tracing::info!("waiting for {}", d.describe());
+    while !d.heard() {
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Ok(false);
+        }
+        if start.elapsed() > timeout {
+            let (messages, rejected) = (d.counters().messages, d.counters().rejected);
+            return Err(MasterError::NoAnswer(format!(
+                "no usable message from {} within {:.1} s ({messages} received, {rejected} rejected): is its driver running, with the same ROS_DOMAIN_ID, reaching the same Zenoh router?",
+                d.describe(),
+                timeout.as_secs_f64()
+            )));
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    Ok(true)
 }
 
 /// Logs the force and torque clamps of the last second, if any (at most one line a

@@ -132,6 +132,9 @@ pub struct MasterTotals {
     pub q_in: InboxStats,
     /// From the first tick to now, ns.
     pub elapsed_ns: u64,
+    /// A real device (`master.backend = "ros2"`): what it delivered and how the loop
+    /// judged it; all zero with the simulated device.
+    pub device: tactile_node::device::DeviceCounters,
 }
 
 /// The master's record type.

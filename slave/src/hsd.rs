@@ -44,6 +44,17 @@ pub struct Slave {
     last_tool: [f64; 3],
     codec: Deadband,
     predictor: Predictor,
+    /// A real robot's joints (and force sensor) for the next step, in place of SD.
+    measured: Option<Measured>,
+}
+
+/// What a real robot measured for one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measured {
+    /// Joint angles theta^SD, rad.
+    pub theta: [f64; 3],
+    /// Contact force from a force-torque sensor, N (None: the environment model).
+    pub force: Option<[f64; 3]>,
 }
 
 impl Slave {
@@ -83,6 +94,7 @@ impl Slave {
             reference: [0.0; 3],
             counters: SlaveCounters::default(),
             hold_from: None,
+            measured: None,
         })
     }
 
@@ -145,6 +157,34 @@ impl Slave {
         });
     }
 
+    /// The real robot's state for the next step: SD is the robot, FCS is its own
+    /// controller (the step's `theta_ref` is what it is commanded).
+    pub fn measure(&mut self, m: Measured) {
+        self.measured = Some(m);
+    }
+
+    /// One sample of holding with a real robot: it is commanded the reference held
+    /// from when the input went silent, and `theta` is where it is.
+    pub fn hold_measured(&mut self, theta: [f64; 3]) -> HoldStep {
+        let reference = self.reference;
+        let from = *self.hold_from.get_or_insert_with(|| {
+            self.counters.holds += 1;
+            reference
+        });
+        self.counters.held_steps += 1;
+        let p0 = kernels::fk(&self.truth, &StdTrig, from);
+        let p = kernels::fk(&self.truth, &StdTrig, theta);
+        let drift = distance(p, p0);
+        self.counters.hold_drift_max_m = self.counters.hold_drift_max_m.max(drift);
+        HoldStep {
+            step: self.counters.held_steps,
+            theta_ref: from,
+            theta,
+            torque: [0.0; 3],
+            tool: p,
+        }
+    }
+
     /// One sample: v(n) in, h(n) out. Stamps are copied from `v`; the edge sets its own.
     pub fn step(&mut self, v: &Forward) -> (Backward, Step) {
         self.counters.steps += 1;
@@ -192,23 +232,36 @@ impl Slave {
             }
         }
 
-        // FCS: joint controller.
-        let state = self.dynamics.state;
-        let cmd = self
-            .controller
-            .update(self.reference, state.theta, state.velocity, self.t_s);
-        self.counters.torque_clamps += u64::from(cmd.clamped);
-
-        // SD: joint dynamics.
-        self.advance(cmd.torque);
-        let theta = self.dynamics.state.theta;
+        // FCS and SD: the joint controller and the simulated joints, or the real robot
+        // (its own controller follows the reference; its encoders say where it is).
+        let measured = self.measured.take();
+        let (theta, torque, clamps) = match measured {
+            Some(m) => (m.theta, [0.0; 3], 0),
+            None => {
+                let state = self.dynamics.state;
+                let cmd =
+                    self.controller
+                        .update(self.reference, state.theta, state.velocity, self.t_s);
+                self.counters.torque_clamps += u64::from(cmd.clamped);
+                self.advance(cmd.torque);
+                (self.dynamics.state.theta, cmd.torque, cmd.clamped)
+            }
+        };
 
         // FK-HSD in the HSD's arithmetic; ENV sensors report the surface point of the
         // object the true tool is in.
         let tool = self.engine.fk(theta);
         let contact = deepest_contact(&self.objects, kernels::fk(&self.truth, &StdTrig, theta));
-        let (force, surface, contact_object) = match contact {
-            Some(c) => {
+        let (force, surface, contact_object) = match (measured.and_then(|m| m.force), contact) {
+            (Some(f), _) => {
+                // A force-torque sensor: its force is h(n); no surface is known.
+                if f.iter().any(|x| *x != 0.0) {
+                    flags |= FLAG_CONTACT;
+                    self.counters.contact_steps += 1;
+                }
+                (f, [0.0; 3], u32::MAX)
+            }
+            (None, Some(c)) => {
                 flags |= FLAG_CONTACT;
                 self.counters.contact_steps += 1;
                 (
@@ -217,7 +270,7 @@ impl Slave {
                     c.object as u32,
                 )
             }
-            None => ([0.0; 3], [0.0; 3], u32::MAX),
+            (None, None) => ([0.0; 3], [0.0; 3], u32::MAX),
         };
 
         // h(n): the force takes the provenance of the oldest position value it used.
@@ -248,14 +301,14 @@ impl Slave {
             reference: self.control.position(),
             theta_ref: self.reference,
             theta,
-            torque: cmd.torque,
+            torque,
             tool,
             surface,
             force,
             observer,
             port_net_j: self.control.ledger().net(),
             dissipated_j,
-            clamps: cmd.clamped,
+            clamps,
             contact_object,
             flags,
         };

@@ -4,6 +4,8 @@
 pub mod device;
 pub mod environment;
 pub mod hsd;
+pub mod live;
 pub mod node;
+pub mod outside;
 pub mod process;
 pub mod record;

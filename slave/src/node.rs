@@ -33,12 +33,22 @@ pub fn main() -> ExitCode {
 pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let a = &cli.node;
     let p = prepare(Role::Slave, a)?;
+    if crate::outside::needs_ros(&p.scenario) && !cfg!(feature = "zenoh") {
+        return Err(NodeError::BadInput(tactile_node::args::NO_ROS.into()));
+    }
     let mut rec = Recorder::open(&a.out, Role::Slave, a.append)?;
     rec.start(start_record(Role::Slave, a, &p))?;
     tracing::info!("waiting for the master");
     let ended = slave_link(a, p.spin).and_then(|link| {
-        run_with(&p.scenario, link.as_ref(), &mut rec, p.wake_early)
-            .map_err(|e| NodeError::Failed(e.to_string()))
+        let mut ros = crate::outside::RosParts::open(&p.scenario)?;
+        run_with(
+            &p.scenario,
+            link.as_ref(),
+            &mut rec,
+            p.wake_early,
+            ros.outside(),
+        )
+        .map_err(|e| NodeError::Failed(e.to_string()))
     });
     ended.inspect_err(|e| {
         let _ = rec.event(0, format!("failed: {e}"));

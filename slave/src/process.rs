@@ -2,12 +2,14 @@
 //! records the step. When v(n) stops coming for the peer timeout, the slave holds its
 //! position, one step per t_s, until input returns.
 
-use crate::hsd::Slave;
+use crate::hsd::{Measured, Slave};
+use crate::live::SlaveLive;
 use crate::record::{SlaveSample, SlaveTotals};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::now_ns;
 use tactile_messages::samples::{stage, Backward, FLAG_END, FLAG_PROBE};
 use tactile_node::args::NodeError;
+use tactile_node::device::{Change, LiveSink, Reading, Robot};
 use tactile_node::link::{Idle, LinkError};
 use tactile_node::link::{RunFilter, SlaveLink};
 use tactile_node::pace::{recv_paced, Pacer};
@@ -35,6 +37,90 @@ impl From<NodeError> for SlaveError {
     }
 }
 
+/// What the slave loop touches besides its link: a real robot in place of the
+/// simulated arm, and the live view. Neither by default.
+#[derive(Default)]
+pub struct Outside<'a> {
+    /// The robot through ros2_control.
+    pub robot: Option<&'a mut dyn Robot>,
+    /// Where each k-th step goes for the live view.
+    pub live: Option<&'a mut dyn LiveSink<SlaveLive>>,
+}
+
+impl std::fmt::Debug for Outside<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Outside")
+            .field("robot", &self.robot.as_ref().map(|d| d.describe()))
+            .field("live", &self.live.is_some())
+            .finish()
+    }
+}
+
+/// The real robot as the loop keeps it: its last good angles and what it was last
+/// commanded (held while it is lost).
+struct RobotEdge<'a> {
+    robot: &'a mut dyn Robot,
+    theta: [f64; 3],
+    lost: bool,
+    commanded: Option<[f64; 3]>,
+}
+
+impl RobotEdge<'_> {
+    /// Reads the robot for this tick; says so in the record when it is lost or back.
+    fn read(&mut self, rec: &mut SlaveRecorder, n: u64) -> Result<Measured, SlaveError> {
+        let (reading, change) = self.robot.read(now_ns());
+        match reading {
+            Reading::Fresh(t) | Reading::Stale(t) => self.theta = t,
+            Reading::Lost => {}
+        }
+        self.lost = matches!(reading, Reading::Lost);
+        match change {
+            Change::Lost => {
+                let what = format!(
+                    "robot lost: {} silent past its timeout; holding its last safe reference",
+                    self.robot.describe()
+                );
+                tracing::warn!("{what}");
+                rec.event(n, what)?;
+            }
+            Change::Back => rec.event(n, format!("robot back: {}", self.robot.describe()))?,
+            Change::None => {}
+        }
+        Ok(Measured {
+            theta: self.theta,
+            force: self.robot.force().flatten(),
+        })
+    }
+
+    /// Commands `theta_ref`, or, while the robot is lost, the last reference it had.
+    fn command(&mut self, theta_ref: [f64; 3]) {
+        if !self.lost {
+            self.commanded = Some(theta_ref);
+        }
+        if let Some(r) = self.commanded {
+            self.robot.command(r, now_ns());
+        }
+    }
+}
+
+/// Waits until the robot has sent a good message; false if a stop request came.
+fn wait_for_robot(robot: &dyn Robot) -> Result<bool, SlaveError> {
+    let stop = tactile_node::signals::stop_flag().map_err(|e| SlaveError::Record(e.to_string()))?;
+    tracing::info!("waiting for {}", robot.describe());
+    let mut next_note = Instant::now() + Duration::from_secs(5);
+    while !robot.heard() {
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Ok(false);
+        }
+        if Instant::now() > next_note {
+            tracing::info!("still waiting for {}", robot.describe());
+            next_note += Duration::from_secs(5);
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    Ok(true)
+}
+
 /// The slave's recorder.
 pub type SlaveRecorder = Recorder<SlaveSample, SlaveTotals>;
 
@@ -53,8 +139,26 @@ pub fn run_with<L: SlaveLink + ?Sized>(
     link: &L,
     rec: &mut SlaveRecorder,
     wake_early: Duration,
+    outside: Outside<'_>,
 ) -> Result<bool, SlaveError> {
     let mut slave = Slave::new(scenario)?;
+    let Outside { robot, mut live } = outside;
+    let mut robot = match robot {
+        Some(r) => {
+            if !wait_for_robot(&*r)? {
+                rec.stop(SlaveTotals::default(), "interrupted")?;
+                return Ok(false);
+            }
+            rec.event(0, format!("robot found: {}", r.describe()))?;
+            Some(RobotEdge {
+                robot: r,
+                theta: [0.0; 3],
+                lost: false,
+                commanded: None,
+            })
+        }
+        None => None,
+    };
     let timeout = hold_timeout(scenario);
     let t_s = Duration::from_nanos(scenario.t_s_ns());
     // Realtime: sleep until just before v(n) is due, learned from its arrivals.
@@ -62,19 +166,24 @@ pub fn run_with<L: SlaveLink + ?Sized>(
         .then(|| Pacer::new(scenario.t_s_ns(), wake_early.as_nanos() as u64));
     let mut filter = RunFilter::default();
     let mut last_seq = 0;
-    let totals = |slave: &Slave, filter: &RunFilter| {
+    let totals = |slave: &Slave, filter: &RunFilter, robot: &Option<RobotEdge>| {
         let (mut v_in, h_out) = link.stats();
         v_in.foreign += filter.foreign;
         SlaveTotals {
             counters: slave.counters(),
             v_in,
             h_out,
+            device: robot
+                .as_ref()
+                .map(|r| r.robot.counters())
+                .unwrap_or_default(),
         }
     };
     // No input yet: wait as long as it takes for the first sample.
     let mut deadline: Option<Instant> = None;
     let mut holding = false;
     let mut clamps = (0, 0);
+    let mut robot_seen = tactile_node::device::DeviceCounters::default();
     let completed = loop {
         let until = deadline.unwrap_or_else(|| Instant::now() + Duration::from_secs(3600));
         let (got, waiting) = recv_paced(pacer.as_ref(), until, |d| link.recv(d))?;
@@ -114,6 +223,10 @@ pub fn run_with<L: SlaveLink + ?Sized>(
                     let t = v.stamps[stage::SLAVE_RECV];
                     p.arrived(v.seq, t, waiting);
                 }
+                if let Some(r) = &mut robot {
+                    let m = r.read(rec, v.seq)?;
+                    slave.measure(m);
+                }
                 let (mut h, step) = slave.step(&v);
                 h.run = v.run;
                 h.stamps[stage::SLAVE_SEND] = now_ns();
@@ -122,6 +235,14 @@ pub fn run_with<L: SlaveLink + ?Sized>(
                 // h(n) on to the master now, and write the record after (measured:
                 // the hop's p50 from 10.3 us to 1.4 us at 1 kHz under SCHED_FIFO).
                 std::thread::yield_now();
+                if let Some(r) = &mut robot {
+                    r.command(step.theta_ref);
+                }
+                if let Some(l) = live.as_deref_mut() {
+                    if l.due(step.n) {
+                        l.offer(SlaveLive { step });
+                    }
+                }
                 rec.sample(SlaveSample::Step(step))?;
                 deadline = Some(Instant::now() + timeout);
             }
@@ -133,7 +254,15 @@ pub fn run_with<L: SlaveLink + ?Sized>(
                         tracing::warn!("input silent for {timeout:?}: holding position");
                         rec.event(last_seq, "input silent: holding position")?;
                     }
-                    let held = slave.hold();
+                    let held = match &mut robot {
+                        None => slave.hold(),
+                        Some(r) => {
+                            let m = r.read(rec, last_seq)?;
+                            let held = slave.hold_measured(m.theta);
+                            r.command(held.theta_ref);
+                            held
+                        }
+                    };
                     rec.sample(SlaveSample::Hold(held))?;
                     deadline = Some(Instant::now() + t_s);
                 }
@@ -141,7 +270,15 @@ pub fn run_with<L: SlaveLink + ?Sized>(
             Err(Idle::Terminate) => break false,
         }
         if rec.counters_due() {
-            let t = totals(&slave, &filter);
+            let t = totals(&slave, &filter, &robot);
+            if let Some(r) = &robot {
+                tactile_node::device::log_second(
+                    "robot",
+                    &mut robot_seen,
+                    &t.device,
+                    r.robot.take_reject(),
+                );
+            }
             let now = (t.counters.torque_clamps, t.counters.ik_clamped);
             if now != clamps {
                 tracing::info!(
@@ -161,6 +298,6 @@ pub fn run_with<L: SlaveLink + ?Sized>(
     } else {
         "interrupted"
     };
-    rec.stop(totals(&slave, &filter), reason)?;
+    rec.stop(totals(&slave, &filter, &robot), reason)?;
     Ok(completed)
 }

@@ -101,6 +101,9 @@ pub struct SlaveTotals {
     pub v_in: InboxStats,
     /// h(n) as published.
     pub h_out: OutboxStats,
+    /// A real robot (`slave.backend = "ros2"`): what it delivered and how the loop
+    /// judged it; all zero with the simulated arm.
+    pub device: tactile_node::device::DeviceCounters,
 }
 
 /// The slave's record type.

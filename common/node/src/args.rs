@@ -156,6 +156,9 @@ pub fn exit(role: Role, outcome: Result<bool, NodeError>) -> ExitCode {
     }
 }
 
+/// What a node built without the `zenoh` feature says to a scenario that needs ROS 2.
+pub const NO_ROS: &str = "this scenario uses ROS 2 (a ros2 backend or the live view), which this build of Tactile does not include: build with `--features zenoh` (cargo build --release --features zenoh)";
+
 /// Parses a node's command line; on an error prints clap's message and returns the
 /// exit status (2 for bad arguments, 0 for --help and --version).
 pub fn parse<T: clap::Parser>() -> Result<T, ExitCode> {

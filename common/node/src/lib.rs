@@ -4,17 +4,24 @@
 //! programs. The loops themselves are in the master, emulator and slave crates.
 
 pub mod args;
+pub mod device;
 pub mod exit;
 pub mod files;
 pub mod frames;
 pub mod ipc;
 pub mod link;
+#[cfg(feature = "zenoh")]
+pub mod live;
 pub mod lock;
 pub mod logging;
 pub mod open;
 pub mod pace;
 pub mod record;
 pub mod recorder;
+#[cfg(feature = "zenoh")]
+pub mod ros2;
+#[cfg(feature = "zenoh")]
+pub mod ros2_devices;
 pub mod runtime;
 pub mod sched;
 pub mod signals;

@@ -27,6 +27,13 @@ pub fn name(arm: &str, part: &str) -> String {
     format!("{arm}_{part}")
 }
 
+/// The arm's joint names, `{arm}_joint1..3`, as JointState and the URDF name them.
+pub fn joint_names(arm: &str) -> Vec<String> {
+    ["joint1", "joint2", "joint3"]
+        .map(|j| name(arm, j))
+        .to_vec()
+}
+
 /// Rotation by `a` about x.
 pub fn rot_x(a: f64) -> [f64; 4] {
     [(a / 2.0).sin(), 0.0, 0.0, (a / 2.0).cos()]

@@ -82,7 +82,7 @@ impl CdrWriter {
 }
 
 /// Why a CDR message could not be read.
-#[derive(Debug, Error, PartialEq, Eq)]
+#[derive(Debug, Clone, Error, PartialEq, Eq)]
 pub enum CdrError {
     /// The message ends before a field does.
     #[error("message truncated at byte {at} (needs {need} more)")]
@@ -98,6 +98,9 @@ pub enum CdrError {
     /// A string without its NUL or not UTF-8.
     #[error("string at byte {0} is not NUL-terminated UTF-8")]
     BadString(usize),
+    /// Bytes left after the last field.
+    #[error("{0} bytes after the last field")]
+    Trailing(usize),
     /// A sequence longer than the reader allows.
     #[error("sequence of {len} at byte {at} exceeds the limit of {limit}")]
     TooLong {
@@ -198,6 +201,17 @@ impl<'a> CdrReader<'a> {
             });
         }
         Ok(n)
+    }
+
+    /// The end of the message: at most the 3 bytes of padding a writer may leave
+    /// (rmw pads a message to 4 bytes), and those zero.
+    pub fn finish(&self) -> Result<(), CdrError> {
+        let rest = self.buf.get(self.pos..).unwrap_or_default();
+        if rest.len() < 4 && rest.iter().all(|b| *b == 0) {
+            Ok(())
+        } else {
+            Err(CdrError::Trailing(rest.len()))
+        }
     }
 
     /// Reads a string.

@@ -7,10 +7,12 @@
 
 pub mod arm;
 pub mod cdr;
+pub mod live;
 pub mod msg;
+pub mod rmw;
 pub mod schema;
 pub mod topics;
 pub mod urdf;
 
 pub use cdr::{CdrError, CdrReader, CdrWriter};
-pub use msg::Message;
+pub use msg::{Decode, Message};

@@ -2,7 +2,7 @@
 //! in their definition's order, [`crate::schema`]). Vectors are `[x, y, z]`,
 //! quaternions `[x, y, z, w]`.
 
-use crate::cdr::CdrWriter;
+use crate::cdr::{CdrError, CdrReader, CdrWriter};
 
 /// A message Tactile publishes or records.
 pub trait Message {
@@ -15,6 +15,21 @@ pub trait Message {
         let mut w = CdrWriter::new();
         self.encode(&mut w);
         w.bytes().to_vec()
+    }
+}
+
+/// A message Tactile takes in from a device or robot: decoded field by field, every
+/// read checked, nothing left over (a peer's bytes are never trusted).
+pub trait Decode: Sized {
+    /// Reads the fields after the encapsulation header.
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError>;
+    /// The whole message from CDR bytes; trailing bytes beyond alignment padding are
+    /// an error.
+    fn from_cdr(b: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(b)?;
+        let m = Self::decode(&mut r)?;
+        r.finish()?;
+        Ok(m)
     }
 }
 
@@ -42,6 +57,20 @@ impl Time {
     }
 }
 
+impl Time {
+    /// Nanoseconds (0 for a negative time).
+    pub fn ns(&self) -> u64 {
+        u64::try_from(self.sec).unwrap_or(0) * 1_000_000_000 + u64::from(self.nanosec)
+    }
+
+    fn decode(r: &mut CdrReader<'_>) -> Result<Time, CdrError> {
+        Ok(Time {
+            sec: r.i32()?,
+            nanosec: r.u32()?,
+        })
+    }
+}
+
 /// `std_msgs/Header`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Header {
@@ -64,10 +93,26 @@ impl Header {
         self.stamp.encode(w);
         w.string(&self.frame_id);
     }
+
+    fn decode(r: &mut CdrReader<'_>) -> Result<Header, CdrError> {
+        Ok(Header {
+            stamp: Time::decode(r)?,
+            frame_id: r.string()?,
+        })
+    }
 }
 
 fn vec3(w: &mut CdrWriter, v: &[f64; 3]) {
     v.iter().for_each(|x| w.f64(*x));
+}
+
+fn read_vec3(r: &mut CdrReader<'_>) -> Result<[f64; 3], CdrError> {
+    Ok([r.f64()?, r.f64()?, r.f64()?])
+}
+
+fn read_f64s(r: &mut CdrReader<'_>) -> Result<Vec<f64>, CdrError> {
+    let n = r.seq_len()?;
+    (0..n).map(|_| r.f64()).collect()
 }
 
 fn quat(w: &mut CdrWriter, q: &[f64; 4]) {
@@ -123,6 +168,21 @@ impl Message for JointState {
     }
 }
 
+impl Decode for JointState {
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        let header = Header::decode(r)?;
+        let n = r.seq_len()?;
+        let name = (0..n).map(|_| r.string()).collect::<Result<_, _>>()?;
+        Ok(JointState {
+            header,
+            name,
+            position: read_f64s(r)?,
+            velocity: read_f64s(r)?,
+            effort: read_f64s(r)?,
+        })
+    }
+}
+
 /// `geometry_msgs/msg/PoseStamped`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PoseStamped {
@@ -160,6 +220,47 @@ impl Message for WrenchStamped {
         self.header.encode(w);
         vec3(w, &self.force);
         vec3(w, &self.torque);
+    }
+}
+
+impl Decode for WrenchStamped {
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        Ok(WrenchStamped {
+            header: Header::decode(r)?,
+            force: read_vec3(r)?,
+            torque: read_vec3(r)?,
+        })
+    }
+}
+
+/// `std_msgs/msg/Float64MultiArray` with an empty layout (a flat array, as
+/// ros2_control's forward command controllers take it).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Float64MultiArray {
+    /// The values.
+    pub data: Vec<f64>,
+}
+
+impl Message for Float64MultiArray {
+    const TYPE: &'static str = "std_msgs/msg/Float64MultiArray";
+    fn encode(&self, w: &mut CdrWriter) {
+        w.seq_len(0); // layout.dim
+        w.u32(0); // layout.data_offset
+        f64s(w, &self.data);
+    }
+}
+
+impl Decode for Float64MultiArray {
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        for _ in 0..r.seq_len()? {
+            r.string()?;
+            r.u32()?;
+            r.u32()?;
+        }
+        r.u32()?;
+        Ok(Float64MultiArray {
+            data: read_f64s(r)?,
+        })
     }
 }
 
@@ -336,6 +437,35 @@ mod tests {
     }
 
     #[test]
+    fn decoding_reads_back_what_encoding_wrote_and_refuses_the_rest() {
+        let js = JointState {
+            header: Header::at(7_000_000_123, "base"),
+            name: vec!["waist".into(), "shoulder".into()],
+            position: vec![0.5, -1.25],
+            velocity: vec![],
+            effort: vec![0.1, 0.2],
+        };
+        let b = js.to_cdr();
+        assert_eq!(JointState::from_cdr(&b), Ok(js));
+        let w = WrenchStamped {
+            header: Header::at(1, "base"),
+            force: [1.0, -2.0, 3.5],
+            torque: [0.0; 3],
+        };
+        assert_eq!(WrenchStamped::from_cdr(&w.to_cdr()), Ok(w));
+        let a = Float64MultiArray {
+            data: vec![0.1, 0.2, 0.3],
+        };
+        assert_eq!(Float64MultiArray::from_cdr(&a.to_cdr()), Ok(a));
+        for cut in 0..b.len() {
+            assert!(JointState::from_cdr(&b[..cut]).is_err(), "cut at {cut}");
+        }
+        let mut long = b.clone();
+        long.extend_from_slice(&[0; 16]);
+        assert!(JointState::from_cdr(&long).is_err(), "trailing bytes");
+    }
+
+    #[test]
     fn every_type_has_a_schema() {
         for t in [
             StringMsg::TYPE,
@@ -345,6 +475,7 @@ mod tests {
             TfMessage::TYPE,
             MarkerArray::TYPE,
             SampleTiming::TYPE,
+            Float64MultiArray::TYPE,
         ] {
             assert!(crate::schema::ros2msg(t).is_some(), "{t}");
         }

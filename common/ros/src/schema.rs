@@ -66,6 +66,18 @@ pub const DEFINITIONS: &[(&str, &str)] = &[
         "visualization_msgs/Marker[] markers\n",
     ),
     (
+        "std_msgs/MultiArrayDimension",
+        "string label\nuint32 size\nuint32 stride\n",
+    ),
+    (
+        "std_msgs/MultiArrayLayout",
+        "std_msgs/MultiArrayDimension[] dim\nuint32 data_offset\n",
+    ),
+    (
+        "std_msgs/Float64MultiArray",
+        "std_msgs/MultiArrayLayout layout\nfloat64[] data\n",
+    ),
+    (
         "tactile_msgs/SampleTiming",
         "uint64 sample\nbool answered\nint64 round_trip_ns\nint64 overhead_ns\n\
          uint32[3] delay_forward\nuint32[3] delay_backward\nuint32 flags_forward\n\

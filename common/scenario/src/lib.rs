@@ -15,6 +15,7 @@ mod master;
 mod network;
 mod operator;
 pub mod overrides;
+mod ros;
 mod slave;
 mod validate;
 
@@ -30,6 +31,10 @@ pub use network::{
     ReplayFormat, JITTER_CAP, MAX_DELAY_SAMPLES,
 };
 pub use operator::{Operator, TrajectoryEnd};
+pub use ros::{
+    topic_name, AngleUnit, Backend, JointMapConfig, LiveConfig, RosConfig, RosDeviceConfig,
+    RosRobotConfig, WatchConfig,
+};
 use serde::{Deserialize, Serialize};
 pub use slave::{
     ControllerConfig, DynamicsConfig, Environment, Object, SlaveConfig, MAX_STIFFNESS,
@@ -84,6 +89,8 @@ pub struct Scenario {
     pub control: ControlConfig,
     /// Deadband codecs per direction.
     pub codec: Codecs,
+    /// How the nodes reach ROS 2 (devices, robots, the live view).
+    pub ros: RosConfig,
 }
 
 impl Default for Scenario {
@@ -107,6 +114,7 @@ impl Default for Scenario {
             environment: Environment::default(),
             control: ControlConfig::default(),
             codec: Codecs::default(),
+            ros: RosConfig::default(),
         }
     }
 }
@@ -218,6 +226,14 @@ impl Scenario {
             }
         }
         w
+    }
+
+    /// True if any node reaches ROS 2: a ros2 backend on either side, or the live
+    /// view (such a run needs the node programs built with the `zenoh` feature).
+    pub fn uses_ros(&self) -> bool {
+        self.master.backend == Backend::Ros2
+            || self.slave.backend == Backend::Ros2
+            || self.ros.live.enabled
     }
 
     /// Sampling period t_s in seconds.

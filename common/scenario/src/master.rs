@@ -1,7 +1,9 @@
 //! `[master]` and `[faults]`: the master device's limits, the operator's hand, the
 //! master device's joints, and how a dead peer is noticed.
 
-use crate::{invalid, positive, positive3, PredictorConfig, ScenarioError};
+use crate::{
+    invalid, positive, positive3, Backend, PredictorConfig, RosDeviceConfig, ScenarioError,
+};
 use serde::{Deserialize, Serialize};
 
 /// The master device's limits (PHANToM Omni class by default).
@@ -19,6 +21,11 @@ pub struct MasterConfig {
     pub device: MasterDeviceConfig,
     /// How the master fills forces not received (CPD/JPD-HMD).
     pub predictor: PredictorConfig,
+    /// `simulated` (the hand and device above) or `ros2` (a device through its ROS 2
+    /// driver, `[master.ros2]`).
+    pub backend: Backend,
+    /// The ROS 2 device, with `backend = "ros2"`.
+    pub ros2: RosDeviceConfig,
 }
 
 impl Default for MasterConfig {
@@ -29,6 +36,8 @@ impl Default for MasterConfig {
             hand: HandConfig::default(),
             device: MasterDeviceConfig::default(),
             predictor: PredictorConfig::default(),
+            backend: Backend::default(),
+            ros2: RosDeviceConfig::default(),
         }
     }
 }
@@ -175,6 +184,7 @@ impl MasterConfig {
         positive3(&self.torque_limit, "master.torque_limit", false)?;
         self.hand.validate()?;
         self.device.validate()?;
-        self.predictor.validate("master.predictor")
+        self.predictor.validate("master.predictor")?;
+        self.ros2.validate()
     }
 }

@@ -1,8 +1,8 @@
 //! `[slave]` and `[environment]`: the slave's joint controller and dynamics, and the
 //! objects the tool can touch.
 
-use crate::PredictorConfig;
 use crate::{finite3, invalid, positive3, ScenarioError};
+use crate::{Backend, PredictorConfig, RosRobotConfig};
 use serde::{Deserialize, Serialize};
 
 /// The slave side.
@@ -15,6 +15,11 @@ pub struct SlaveConfig {
     pub dynamics: DynamicsConfig,
     /// How the slave fills positions not received (CPD-HSD).
     pub predictor: PredictorConfig,
+    /// `simulated` (the arm and environment model) or `ros2` (a robot through
+    /// ros2_control, `[slave.ros2]`).
+    pub backend: Backend,
+    /// The ROS 2 robot, with `backend = "ros2"`.
+    pub ros2: RosRobotConfig,
 }
 
 /// PD or PID per joint: u = kp e + ki integral(e) + kd de/dt, clamped to the limit.
@@ -142,7 +147,8 @@ impl SlaveConfig {
                 format!("{} s is outside 1 us to 10 ms", d.step_s),
             ));
         }
-        self.predictor.validate("slave.predictor")
+        self.predictor.validate("slave.predictor")?;
+        self.ros2.validate()
     }
 }
 

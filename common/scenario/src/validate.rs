@@ -32,6 +32,7 @@ impl Scenario {
             return Err(invalid("faults.peer_timeout_samples", "must be at least 1"));
         }
         self.environment.validate()?;
+        self.ros.validate(self.rate_hz)?;
         self.bounded()
     }
 }

@@ -125,9 +125,7 @@ impl<W: Write> Recording<W> {
         self.put("/tf", &tf, log, log)?;
         let joints = |a: &str, p: [f64; 3], v: [f64; 3], e: [f64; 3]| JointState {
             header: Header::at(log, ""),
-            name: ["joint1", "joint2", "joint3"]
-                .map(|j| arm::name(a, j))
-                .to_vec(),
+            name: arm::joint_names(a),
             position: p.to_vec(),
             velocity: v.to_vec(),
             effort: e.to_vec(),

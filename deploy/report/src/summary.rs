@@ -327,6 +327,19 @@ pub fn render(s: &Summary, out: &Path) -> String {
             c.ik_clamped, c.rejected, c.torque_clamps, c.holds
         );
     }
+    let dev = |t: &mut String, who: &str, d: &tactile_node::device::DeviceCounters| {
+        if *d != tactile_node::device::DeviceCounters::default() {
+            let _ = writeln!(
+                t,
+                "{who} over ROS 2: {} messages, {} dropped (malformed, missing joint, not finite, out of range); ticks fresh {}, stale {}, lost {} ({} losses); {} published, {} failed",
+                d.messages, d.rejected, d.fresh, d.stale, d.lost, d.losses, d.published, d.publish_errors
+            );
+        }
+    };
+    dev(&mut t, "master device", &m.totals.device);
+    if let Some(sl) = &s.slave {
+        dev(&mut t, "slave robot", &sl.device);
+    }
     for (role, n) in &s.nodes {
         let _ = writeln!(
             t,

@@ -61,6 +61,12 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
         };
         Error::BadInput(format!("{name}{with}: {}", msg.trim_end()))
     })?;
+    if scenario.uses_ros() && !cfg!(feature = "zenoh") {
+        return Err(Error::BadInput(format!(
+            "{name}: {}",
+            tactile_node::args::NO_ROS
+        )));
+    }
     let source = OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
     let mut warnings = scenario.warnings();

@@ -142,6 +142,11 @@ pub fn run_in_process(
     out: &Path,
     no_trace: bool,
 ) -> Result<tactile_report::summary::Summary, Error> {
+    if loaded.scenario.uses_ros() {
+        return Err(Error::BadInput(
+            "an in-process run simulates both devices and has no live view: a ros2 backend or ros.live needs the node programs (tactile run without --in-process)".into(),
+        ));
+    }
     let bundled = super::prepare_out(out, loaded)?;
     let completed = simulate(&bundled.scenario, &bundled.base_dir, out)?;
     let launch = tactile_report::write::Launch {

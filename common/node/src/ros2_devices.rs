@@ -1,0 +1,168 @@
+//! The master's haptic device and the slave's robot over ROS 2: subscriptions that
+//! fill an [`Inbox`] (decoded, mapped and checked on Zenoh's threads), a [`Watch`] the
+//! loop asks each tick, and the publisher of what the loop sends back.
+
+use crate::device::{
+    force_cdr, Change, DeviceCounters, HapticDevice, Inbox, JointMap, Reading, Reject, Robot, Watch,
+};
+use crate::link::LinkError;
+use crate::ros2::{wall_ns, RosNode, RosPublisher, RosSubscription};
+use std::sync::Arc;
+use tactile_ros::msg::{Float64MultiArray, Header, JointState, Message, WrenchStamped};
+use tactile_scenario::{RosDeviceConfig, RosRobotConfig};
+
+/// Three joint angles or a force, as the loop takes them.
+type Inbox3 = Arc<Inbox<[f64; 3]>>;
+
+fn joints_in(
+    node: &RosNode,
+    topic: &str,
+    map: JointMap,
+) -> Result<(Inbox3, RosSubscription), LinkError> {
+    let inbox = Inbox::new();
+    let fill = Arc::clone(&inbox);
+    let sub = node.subscribe(topic, JointState::TYPE, move |cdr, at| {
+        fill.offer(map.angles_cdr(cdr), at);
+    })?;
+    Ok((inbox, sub))
+}
+
+/// A haptic device through its ROS 2 driver.
+#[derive(Debug)]
+pub struct RosHapticDevice {
+    joints: Arc<Inbox<[f64; 3]>>,
+    _sub: RosSubscription,
+    force: RosPublisher,
+    frame: String,
+    watch: Watch,
+    topic: String,
+}
+
+impl RosHapticDevice {
+    /// Subscribes to the encoders and declares the force publisher.
+    pub fn open(node: &RosNode, cfg: &RosDeviceConfig, t_s_ns: u64) -> Result<Self, LinkError> {
+        let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
+        let (joints, sub) = joints_in(node, &cfg.joint_states, map)?;
+        Ok(RosHapticDevice {
+            joints,
+            _sub: sub,
+            force: node.publisher(&cfg.force_topic, WrenchStamped::TYPE)?,
+            frame: cfg.frame_id.clone(),
+            watch: Watch::new(&cfg.watch, t_s_ns),
+            topic: cfg.joint_states.clone(),
+        })
+    }
+}
+
+impl HapticDevice for RosHapticDevice {
+    fn heard(&self) -> bool {
+        self.joints.latest().is_some()
+    }
+
+    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change) {
+        self.watch.judge(self.joints.latest(), now_ns)
+    }
+
+    fn render(&mut self, force: [f64; 3], _now_ns: u64) {
+        let w = WrenchStamped {
+            header: Header::at(wall_ns(), &self.frame),
+            force,
+            torque: [0.0; 3],
+        };
+        let ok = self.force.put(&w.to_cdr());
+        self.watch.published(ok);
+    }
+
+    fn counters(&self) -> DeviceCounters {
+        self.watch.counters(&[self.joints.counts()])
+    }
+
+    fn take_reject(&self) -> Option<Reject> {
+        self.joints.take_reject()
+    }
+
+    fn describe(&self) -> String {
+        format!("the device on {}", self.topic)
+    }
+}
+
+/// A robot arm through ros2_control (and a force-torque sensor, if named).
+#[derive(Debug)]
+pub struct RosRobot {
+    joints: Arc<Inbox<[f64; 3]>>,
+    wrench: Option<Arc<Inbox<[f64; 3]>>>,
+    _subs: Vec<RosSubscription>,
+    command: RosPublisher,
+    map: JointMap,
+    watch: Watch,
+    topic: String,
+}
+
+impl RosRobot {
+    /// Subscribes to the joint states (and the wrench) and declares the command
+    /// publisher.
+    pub fn open(node: &RosNode, cfg: &RosRobotConfig, t_s_ns: u64) -> Result<Self, LinkError> {
+        let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
+        let (joints, sub) = joints_in(node, &cfg.joint_states, map.clone())?;
+        let mut subs = vec![sub];
+        let wrench = if cfg.wrench_topic.is_empty() {
+            None
+        } else {
+            let inbox = Inbox::new();
+            let fill = Arc::clone(&inbox);
+            subs.push(
+                node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, move |cdr, at| {
+                    fill.offer(force_cdr(cdr), at);
+                })?,
+            );
+            Some(inbox)
+        };
+        Ok(RosRobot {
+            joints,
+            wrench,
+            _subs: subs,
+            command: node.publisher(&cfg.command_topic, Float64MultiArray::TYPE)?,
+            map,
+            watch: Watch::new(&cfg.watch, t_s_ns),
+            topic: cfg.joint_states.clone(),
+        })
+    }
+}
+
+impl Robot for RosRobot {
+    fn heard(&self) -> bool {
+        self.joints.latest().is_some()
+    }
+
+    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change) {
+        self.watch.judge(self.joints.latest(), now_ns)
+    }
+
+    fn force(&self) -> Option<Option<[f64; 3]>> {
+        self.wrench.as_ref().map(|w| w.latest().map(|l| l.value))
+    }
+
+    fn command(&mut self, theta_ref: [f64; 3], _now_ns: u64) {
+        let m = Float64MultiArray {
+            data: self.map.raw(theta_ref).to_vec(),
+        };
+        let ok = self.command.put(&m.to_cdr());
+        self.watch.published(ok);
+    }
+
+    fn counters(&self) -> DeviceCounters {
+        let mut counts = vec![self.joints.counts()];
+        counts.extend(self.wrench.as_ref().map(|w| w.counts()));
+        self.watch.counters(&counts)
+    }
+
+    fn take_reject(&self) -> Option<Reject> {
+        self.joints
+            .take_reject()
+            .or_else(|| self.wrench.as_ref().and_then(|w| w.take_reject()))
+    }
+
+    fn describe(&self) -> String {
+        format!("the robot on {}", self.topic)
+    }
+}

@@ -1,0 +1,360 @@
+//! `[ros]`, `[master.ros2]` and `[slave.ros2]`: real devices and robots over ROS 2's
+//! Zenoh middleware (rmw_zenoh), and the live view of a run.
+//!
+//! A ROS 2 driver's joint conventions are not the paper's: names, order, direction,
+//! zero and unit differ from driver to driver, so each is configurable, and the map
+//! is `theta = sign * raw * unit + offset` (raw in the driver's unit, theta in the
+//! paper's radians). The defaults follow the Phantom Omni / Geomagic Touch drivers'
+//! names (`waist`, `shoulder`, `elbow`) and ros2_control's forward position
+//! controller; every one of them is to be checked against the driver at hand.
+
+use crate::{finite3, invalid, positive, ScenarioError};
+use serde::{Deserialize, Serialize};
+
+/// How the nodes reach ROS 2: one Zenoh session per node, as an rmw_zenoh node.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RosConfig {
+    /// ROS_DOMAIN_ID, 0 to 232: the first part of every key expression.
+    pub domain_id: u32,
+    /// Zenoh endpoints to connect to: rmw_zenoh's router (`ros2 run rmw_zenoh_cpp
+    /// rmw_zenohd`) listens on `tcp/127.0.0.1:7447` by default.
+    pub connect: Vec<String>,
+    /// Zenoh endpoints to listen on (none by default: the router connects the peers).
+    pub listen: Vec<String>,
+    /// The nodes' ROS namespace, `""` or `/name`.
+    pub namespace: String,
+    /// The live view: each node's state as ROS 2 topics while it runs.
+    pub live: LiveConfig,
+}
+
+impl Default for RosConfig {
+    fn default() -> Self {
+        RosConfig {
+            domain_id: 0,
+            connect: vec!["tcp/127.0.0.1:7447".into()],
+            listen: Vec::new(),
+            namespace: String::new(),
+            live: LiveConfig::default(),
+        }
+    }
+}
+
+/// `[ros.live]`: publish the run as it goes (off by default).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LiveConfig {
+    /// Publish the live view.
+    pub enabled: bool,
+    /// Messages per topic per second, at most the loop's rate (every k-th sample,
+    /// k = round(rate_hz / live rate)).
+    pub rate_hz: f64,
+}
+
+impl Default for LiveConfig {
+    fn default() -> Self {
+        LiveConfig {
+            enabled: false,
+            rate_hz: 50.0,
+        }
+    }
+}
+
+/// Which device a side runs with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Backend {
+    /// The simulated device (the master's hand and device, the slave's arm and
+    /// environment): today's loop.
+    #[default]
+    Simulated,
+    /// A device or robot over ROS 2 (`[master.ros2]`, `[slave.ros2]`).
+    Ros2,
+}
+
+/// The unit a driver reports joint angles in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum AngleUnit {
+    /// Radians (ROS's convention, REP 103).
+    #[default]
+    Rad,
+    /// Degrees.
+    Deg,
+}
+
+impl AngleUnit {
+    /// Radians per unit.
+    pub fn radians(self) -> f64 {
+        match self {
+            AngleUnit::Rad => 1.0,
+            AngleUnit::Deg => std::f64::consts::PI / 180.0,
+        }
+    }
+}
+
+/// How a driver's joint values become the paper's angles: `theta = sign * raw * unit
+/// + offset`, checked against `min..=max`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct JointMapConfig {
+    /// +1 or -1 per joint: the driver's direction against the paper's.
+    pub sign: [f64; 3],
+    /// Added after sign and unit, rad: the paper's angle at the driver's zero.
+    pub offset: [f64; 3],
+    /// `rad` or `deg`.
+    pub unit: AngleUnit,
+    /// Smallest paper angle accepted per joint, rad; a message outside is rejected.
+    pub min: [f64; 3],
+    /// Largest paper angle accepted per joint, rad.
+    pub max: [f64; 3],
+}
+
+impl Default for JointMapConfig {
+    fn default() -> Self {
+        JointMapConfig {
+            sign: [1.0; 3],
+            offset: [0.0; 3],
+            unit: AngleUnit::Rad,
+            min: [-std::f64::consts::PI; 3],
+            max: [std::f64::consts::PI; 3],
+        }
+    }
+}
+
+impl JointMapConfig {
+    fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        for (i, s) in self.sign.iter().enumerate() {
+            if *s != 1.0 && *s != -1.0 {
+                return Err(invalid(
+                    format!("{field}.sign[{i}]"),
+                    format!("{s} is not 1 or -1"),
+                ));
+            }
+        }
+        finite3(&self.offset, &format!("{field}.offset"))?;
+        finite3(&self.min, &format!("{field}.min"))?;
+        finite3(&self.max, &format!("{field}.max"))?;
+        for i in 0..3 {
+            if self.min[i] >= self.max[i] {
+                return Err(invalid(
+                    format!("{field}.max[{i}]"),
+                    format!("{} rad is not above min {} rad", self.max[i], self.min[i]),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks three joint names: non-empty and distinct.
+fn joint_names(names: &[String; 3], field: &str) -> Result<(), ScenarioError> {
+    for (i, n) in names.iter().enumerate() {
+        if n.is_empty() || names[..i].contains(n) {
+            return Err(invalid(
+                format!("{field}[{i}]"),
+                format!("{n:?}: names must be non-empty and distinct"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// When a device's samples stop being trusted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WatchConfig {
+    /// A sample older than this many loop periods is stale: held and counted.
+    pub stale_periods: u32,
+    /// Silent this long, ms, the device is lost: the master renders zero force, the
+    /// slave holds its last safe reference; counted, and the run goes on.
+    pub timeout_ms: f64,
+}
+
+impl Default for WatchConfig {
+    fn default() -> Self {
+        WatchConfig {
+            stale_periods: 3,
+            timeout_ms: 100.0,
+        }
+    }
+}
+
+impl WatchConfig {
+    fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        if self.stale_periods == 0 {
+            return Err(invalid(
+                format!("{field}.stale_periods"),
+                "must be at least 1",
+            ));
+        }
+        positive(self.timeout_ms, &format!("{field}.timeout_ms"), false)
+    }
+}
+
+/// `[master.ros2]`: a haptic device through its ROS 2 driver.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RosDeviceConfig {
+    /// The driver's `sensor_msgs/msg/JointState` topic: b(n).
+    pub joint_states: String,
+    /// Names of the joints giving theta_1, theta_2, theta_3 (the message may hold
+    /// more joints, in any order).
+    pub joints: [String; 3],
+    /// The driver's joint conventions.
+    pub map: JointMapConfig,
+    /// Where the force to render goes: `geometry_msgs/msg/WrenchStamped`, newtons,
+    /// clamped to `master.force_limit`.
+    pub force_topic: String,
+    /// `frame_id` of the force: the device's base frame.
+    pub frame_id: String,
+    /// Staleness and loss.
+    pub watch: WatchConfig,
+}
+
+impl Default for RosDeviceConfig {
+    fn default() -> Self {
+        RosDeviceConfig {
+            joint_states: "/phantom/joint_states".into(),
+            joints: ["waist".into(), "shoulder".into(), "elbow".into()],
+            map: JointMapConfig::default(),
+            force_topic: "/phantom/force_feedback".into(),
+            frame_id: "base".into(),
+            watch: WatchConfig::default(),
+        }
+    }
+}
+
+/// `[slave.ros2]`: a robot arm through ros2_control.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RosRobotConfig {
+    /// The robot's `sensor_msgs/msg/JointState` topic: theta^SD.
+    pub joint_states: String,
+    /// Names of the joints moving as theta_1, theta_2, theta_3, and the order of the
+    /// commands.
+    pub joints: [String; 3],
+    /// The robot's joint conventions.
+    pub map: JointMapConfig,
+    /// Where the joint references go: `std_msgs/msg/Float64MultiArray` for a forward
+    /// position controller, in the driver's unit.
+    pub command_topic: String,
+    /// A force-torque sensor's `geometry_msgs/msg/WrenchStamped` (newtons, in the
+    /// robot's base frame); empty: the force comes from the environment model.
+    pub wrench_topic: String,
+    /// Staleness and loss.
+    pub watch: WatchConfig,
+}
+
+impl Default for RosRobotConfig {
+    fn default() -> Self {
+        RosRobotConfig {
+            joint_states: "/joint_states".into(),
+            joints: ["joint1".into(), "joint2".into(), "joint3".into()],
+            map: JointMapConfig::default(),
+            command_topic: "/forward_position_controller/commands".into(),
+            wrench_topic: String::new(),
+            watch: WatchConfig::default(),
+        }
+    }
+}
+
+/// A ROS 2 topic name: starts with `/`, then `/`-separated tokens of letters, digits
+/// and underscores, each not starting with a digit (ROS 2's topic rules, absolute).
+pub fn topic_name(name: &str, field: &str) -> Result<(), ScenarioError> {
+    let bad = |why: &str| Err(invalid(field, format!("{name:?}: {why}")));
+    let Some(rest) = name.strip_prefix('/') else {
+        return bad("a topic name starts with /");
+    };
+    if rest.is_empty() {
+        return bad("a topic name needs at least one token after /");
+    }
+    for tok in rest.split('/') {
+        let ok = tok.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+            && !tok.is_empty()
+            && !tok.starts_with(|c: char| c.is_ascii_digit());
+        if !ok {
+            return bad("tokens are letters, digits and _, not empty, not starting with a digit");
+        }
+    }
+    Ok(())
+}
+
+impl RosConfig {
+    /// Checks the ranges; errors name `ros.*`. `rate_hz` is the loop's.
+    pub fn validate(&self, rate_hz: f64) -> Result<(), ScenarioError> {
+        if self.domain_id > 232 {
+            return Err(invalid(
+                "ros.domain_id",
+                format!("{} is outside 0..=232", self.domain_id),
+            ));
+        }
+        if !self.namespace.is_empty() {
+            topic_name(&self.namespace, "ros.namespace")?;
+        }
+        for (list, name) in [(&self.connect, "connect"), (&self.listen, "listen")] {
+            for (i, e) in list.iter().enumerate() {
+                if !e.contains('/') {
+                    return Err(invalid(
+                        format!("ros.{name}[{i}]"),
+                        format!("{e:?} is not a Zenoh endpoint like tcp/127.0.0.1:7447"),
+                    ));
+                }
+            }
+        }
+        let r = self.live.rate_hz;
+        if !r.is_finite() || r <= 0.0 || r > rate_hz {
+            return Err(invalid(
+                "ros.live.rate_hz",
+                format!("{r} Hz is outside (0, {rate_hz}] (the loop's rate)"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl RosDeviceConfig {
+    /// Checks the ranges; errors name `master.ros2.*`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        topic_name(&self.joint_states, "master.ros2.joint_states")?;
+        joint_names(&self.joints, "master.ros2.joints")?;
+        self.map.validate("master.ros2.map")?;
+        topic_name(&self.force_topic, "master.ros2.force_topic")?;
+        self.watch.validate("master.ros2.watch")
+    }
+}
+
+impl RosRobotConfig {
+    /// Checks the ranges; errors name `slave.ros2.*`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        topic_name(&self.joint_states, "slave.ros2.joint_states")?;
+        joint_names(&self.joints, "slave.ros2.joints")?;
+        self.map.validate("slave.ros2.map")?;
+        topic_name(&self.command_topic, "slave.ros2.command_topic")?;
+        if !self.wrench_topic.is_empty() {
+            topic_name(&self.wrench_topic, "slave.ros2.wrench_topic")?;
+        }
+        self.watch.validate("slave.ros2.watch")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn topic_names_follow_ros_rules() {
+        assert!(topic_name("/phantom/joint_states", "f").is_ok());
+        for bad in ["joint_states", "/", "/a//b", "/1abc", "/a-b", "/a/"] {
+            assert!(topic_name(bad, "f").is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn joint_names_must_differ() {
+        let mut d = RosDeviceConfig::default();
+        d.joints[2] = "waist".into();
+        let e = d.validate().expect_err("duplicate");
+        assert!(e.to_string().contains("master.ros2.joints[2]"), "{e}");
+    }
+}

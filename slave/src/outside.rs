@@ -1,0 +1,59 @@
+//! The slave's ROS 2 side, opened from the scenario: the node on rmw_zenoh, the real
+//! robot (`slave.backend = "ros2"`) and the live view (`ros.live`). Only in builds with
+//! the `zenoh` feature; without it a scenario that asks for either is refused before
+//! anything starts.
+
+use crate::process::Outside;
+use tactile_node::args::NodeError;
+use tactile_scenario::{Backend, Scenario};
+
+/// True if the scenario needs ROS 2 on the slave.
+pub fn needs_ros(sc: &Scenario) -> bool {
+    sc.slave.backend == Backend::Ros2 || sc.ros.live.enabled
+}
+
+/// The slave's ROS 2 parts, kept alive for the run.
+#[derive(Debug, Default)]
+pub struct RosParts {
+    #[cfg(feature = "zenoh")]
+    side: Option<
+        tactile_node::live::RosSide<tactile_node::ros2_devices::RosRobot, crate::live::SlaveLive>,
+    >,
+}
+
+impl RosParts {
+    /// Opens what the scenario asks for (nothing for a simulated run without the live
+    /// view).
+    pub fn open(sc: &Scenario) -> Result<RosParts, NodeError> {
+        if !needs_ros(sc) {
+            return Ok(RosParts::default());
+        }
+        #[cfg(feature = "zenoh")]
+        {
+            use tactile_node::ros2_devices::RosRobot;
+            let robot = (sc.slave.backend == Backend::Ros2)
+                .then_some(|n: &_| RosRobot::open(n, &sc.slave.ros2, sc.t_s_ns()));
+            let side = tactile_node::live::RosSide::open(sc, "tactile_slave", robot)
+                .map_err(|e| NodeError::Failed(e.to_string()))?;
+            Ok(RosParts { side: Some(side) })
+        }
+        #[cfg(not(feature = "zenoh"))]
+        Err(NodeError::BadInput(tactile_node::args::NO_ROS.into()))
+    }
+
+    /// The parts as the loop takes them.
+    pub fn outside(&mut self) -> Outside<'_> {
+        #[cfg(feature = "zenoh")]
+        if let Some(s) = &mut self.side {
+            use tactile_node::device::{LiveSink, Robot};
+            return Outside {
+                robot: s.device.as_mut().map(|d| d as &mut dyn Robot),
+                live: s
+                    .live
+                    .as_mut()
+                    .map(|l| l as &mut dyn LiveSink<crate::live::SlaveLive>),
+            };
+        }
+        Outside::default()
+    }
+}

@@ -1,0 +1,390 @@
+#!/usr/bin/env python3
+"""Stand-ins for a haptic device's ROS 2 driver and a robot under ros2_control, on
+rmw_zenoh's wire format, written only with eclipse-zenoh and rosbags (CDR from the
+real ROS 2 message definitions, RIHS01 hashes computed by rosbags): an implementation
+independent of Tactile's, for tests/ros2.rs.
+
+  device: publishes sensor_msgs/JointState at 1 kHz along a trajectory (CSV of t and
+          the driver's joint values), reads the WrenchStamped forces back; at set
+          times publishes junk, then goes silent. Its clock starts at the first force.
+  robot:  follows Float64MultiArray joint commands with first-order dynamics and
+          publishes its JointState at 1 kHz.
+
+Both declare rmw_zenoh's liveliness tokens, check every attachment they receive
+(33 bytes: seq, timestamp, 16-byte gid), and write a JSON report on exit.
+"""
+import argparse
+import json
+import math
+import os
+import signal
+import sys
+import threading
+import time
+
+import numpy as np
+import zenoh
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from zenoh.ext import Int64, z_deserialize, z_serialize
+
+TS = get_typestore(Stores.ROS2_JAZZY)
+TIMING = (
+    "uint64 sample\nbool answered\nint64 round_trip_ns\nint64 overhead_ns\n"
+    "uint32[3] delay_forward\nuint32[3] delay_backward\nuint32 flags_forward\n"
+    "uint32 flags_backward\nuint32 flags_master\nfloat64[3] observer_master\n"
+    "float64[3] observer_slave\n"
+)
+TS.register(get_types_from_msg(TIMING, "tactile_msgs/msg/SampleTiming"))
+
+JOINT_STATE = "sensor_msgs/msg/JointState"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
+ARRAY = "std_msgs/msg/Float64MultiArray"
+
+
+def dds(ty):
+    pkg, kind, name = ty.split("/")
+    return f"{pkg}::{kind}::dds_::{name}_"
+
+
+def key(domain, topic, ty):
+    return f"{domain}/{topic.strip('/')}/{dds(ty)}/{TS.hash_rihs01(ty)}"
+
+
+def ty_of_key(k):
+    """The ROS type of a data key expression, from its DDS name."""
+    parts = k.split("/")
+    pkg, kind, _, name = parts[-2].split("::")
+    return f"{pkg}/{kind}/{name[:-1]}", "/" + "/".join(parts[1:-2])
+
+
+class Node:
+    """A Zenoh session as an rmw_zenoh node: tokens, publishers with attachments."""
+
+    def __init__(self, name, listen, domain):
+        c = zenoh.Config()
+        c.insert_json5("mode", '"peer"')
+        c.insert_json5("scouting/multicast/enabled", "false")
+        c.insert_json5("listen/endpoints", json.dumps(listen))
+        self.s = zenoh.open(c)
+        self.domain = domain
+        self.name = name
+        self.zid = str(self.s.zid())
+        self.eid = 1
+        self.tokens = [self.s.liveliness().declare_token(
+            f"@ros2_lv/{domain}/{self.zid}/0/0/NN/%/%/{name}")]
+        self.bad_attachments = []
+
+    def token(self, kind, topic, ty):
+        k = (f"@ros2_lv/{self.domain}/{self.zid}/0/{self.eid}/{kind}/%/%/{self.name}/"
+             f"{topic.replace('/', '%')}/{dds(ty)}/{TS.hash_rihs01(ty)}/::,10:,:,:,,")
+        self.eid += 1
+        self.tokens.append(self.s.liveliness().declare_token(k))
+
+    def publisher(self, topic, ty):
+        self.token("MP", topic, ty)
+        pub = self.s.declare_publisher(key(self.domain, topic, ty))
+        gid = bytes((self.eid * 7 + i) % 256 for i in range(16))
+        seq = [0]
+
+        def put(msg):
+            seq[0] += 1
+            att = z_serialize((Int64(seq[0]), Int64(time.time_ns()), gid))
+            pub.put(bytes(TS.serialize_cdr(msg, ty)), attachment=att)
+
+        return put
+
+    def subscribe(self, topic, ty, on):
+        """Calls on(message, arrival time) for each sample, checking its attachment."""
+        self.token("MS", topic, ty)
+        last = {}
+
+        def cb(sample):
+            self.check(str(sample.key_expr), sample.attachment, last)
+            try:
+                msg = TS.deserialize_cdr(sample.payload.to_bytes(), ty)
+            except Exception as e:  # noqa: BLE001 - reported, never fatal
+                self.bad_attachments.append(f"{topic}: undecodable payload: {e}")
+                return
+            on(msg, time.monotonic())
+
+        return self.s.declare_subscriber(f"{self.domain}/{topic.strip('/')}/{dds(ty)}/*", cb)
+
+    def check(self, k, att, last):
+        """rmw_zenoh's attachment: seq from 1 rising by one per publisher, a recent
+        timestamp, a 16-byte gid."""
+        if att is None:
+            self.bad_attachments.append(f"{k}: no attachment")
+            return
+        raw = att.to_bytes()
+        if len(raw) != 33:
+            self.bad_attachments.append(f"{k}: attachment of {len(raw)} bytes")
+            return
+        seq, stamp, gid = z_deserialize(tuple[Int64, Int64, bytes], att)
+        seq, stamp = int(seq), int(stamp)
+        if len(gid) != 16 or abs(stamp - time.time_ns()) > 5e9:
+            self.bad_attachments.append(f"{k}: gid {gid.hex()} stamp {stamp}")
+        prev = last.get(gid)
+        if (prev is None and seq < 1) or (prev is not None and seq <= prev):
+            self.bad_attachments.append(f"{k}: seq {seq} after {prev}")
+        last[gid] = seq
+
+    def tokens_seen(self):
+        replies = self.s.liveliness().get("@ros2_lv/**", timeout=2.0)
+        return sorted(str(r.ok.key_expr) for r in replies if r.ok is not None)
+
+
+def check_tokens(tokens, domain):
+    """Every token of a Tactile node parsed as rmw_zenoh's graph cache parses it:
+    `@ros2_lv/<domain>/<zid>/<nid>/<eid>/<kind>/<enclave>/<ns>/<node>[/<topic>/<type>/
+    <hash>/<qos>]`, the hash the one rosbags computes for the type. Returns the
+    entities as [node, kind, topic, type] and the problems found."""
+    entities, problems = [], []
+    for t in tokens:
+        f = t.split("/")
+        if len(f) < 9 or not f[8].startswith("tactile_"):
+            continue
+        if f[0] != "@ros2_lv" or f[1] != str(domain) or not all(x for x in f):
+            problems.append(f"{t}: malformed")
+            continue
+        if not (f[3].isdigit() and f[4].isdigit()) or f[6] != "%" or f[7] != "%":
+            problems.append(f"{t}: ids, enclave or namespace")
+        kind = f[5]
+        if kind == "NN":
+            if len(f) != 9 or f[3] != f[4]:
+                problems.append(f"{t}: a node token")
+            entities.append([f[8], kind, "", ""])
+            continue
+        if kind not in ("MP", "MS") or len(f) != 13:
+            problems.append(f"{t}: an entity token")
+            continue
+        topic = f[9].replace("%", "/")
+        pkg, k, dds_, name = f[10].split("::")
+        ty = f"{pkg}/{k}/{name[:-1]}"
+        if dds_ != "dds_" or not name.endswith("_"):
+            problems.append(f"{t}: type name")
+        elif f[11] != TS.hash_rihs01(ty):
+            problems.append(f"{t}: hash {f[11]} is not rosbags' {TS.hash_rihs01(ty)}")
+        if f[12] != "::,10:,:,:,,":
+            problems.append(f"{t}: qos {f[12]}")
+        entities.append([f[8], kind, topic, ty])
+    return entities, problems
+
+
+def stamp(ns):
+    return TS.types["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
+
+
+def joint_state(names, values):
+    Header = TS.types["std_msgs/msg/Header"]
+    return TS.types[JOINT_STATE](
+        header=Header(stamp=stamp(time.time_ns()), frame_id=""),
+        name=list(names),
+        position=np.array(values, dtype=np.float64),
+        velocity=np.array([], dtype=np.float64),
+        effort=np.array([], dtype=np.float64),
+    )
+
+
+def stopping():
+    flag = threading.Event()
+    for s in (signal.SIGTERM, signal.SIGINT):
+        signal.signal(s, lambda *_: flag.set())
+    return flag
+
+
+def at_rate(hz, stop, until, step):
+    """Calls step(t) every 1/hz s on an absolute schedule until step returns False,
+    `until` seconds pass, or a signal."""
+    t0 = time.monotonic()
+    k = 0
+    while not stop.is_set() and time.monotonic() - t0 < until:
+        if step() is False:
+            return
+        k += 1
+        delay = t0 + k / hz - time.monotonic()
+        if delay > 0:
+            time.sleep(delay)
+
+
+def interpolate(rows, t):
+    if t <= rows[0][0]:
+        return rows[0][1:]
+    for a, b in zip(rows, rows[1:]):
+        if a[0] <= t <= b[0]:
+            s = (t - a[0]) / (b[0] - a[0])
+            return [x + s * (y - x) for x, y in zip(a[1:], b[1:])]
+    return rows[-1][1:]
+
+
+def device(a):
+    node = Node("touch_standin", a.listen, a.domain)
+    rows = [[float(x) for x in line.split(",")] for line in open(a.trajectory)
+            if line.strip() and not line.startswith("t")]
+    names = a.names.split(",")
+    publish_names = [a.extra_joint] + names[::-1]  # another order, one more joint
+    put_joints = node.publisher(a.joint_topic, JOINT_STATE)
+    raw_pub = node.s.declare_publisher(key(a.domain, a.joint_topic, JOINT_STATE))
+    forces = []
+    first = {}
+
+    def on_force(msg, t):
+        first.setdefault("t0", t)
+        f = msg.wrench.force
+        forces.append([t - first["t0"], f.x, f.y, f.z, msg.header.frame_id])
+
+    sub = node.subscribe(a.force_topic, WRENCH, on_force)
+    live = {}
+    live_errors = []
+
+    def on_live(sample):
+        try:
+            ty, topic = ty_of_key(str(sample.key_expr))
+            TS.deserialize_cdr(sample.payload.to_bytes(), ty)
+            live[topic] = live.get(topic, 0) + 1
+        except Exception as e:  # noqa: BLE001
+            live_errors.append(f"{sample.key_expr}: {e}")
+
+    live_sub = node.s.declare_subscriber(f"{a.domain}/**", on_live) if a.live else None
+    stop = stopping()
+    junk = {"bytes": 0, "nan": 0, "missing": 0, "range": 0}
+    state = {"tokens": [], "silent_from": None}
+
+    def send_junk(kind):
+        k = f"junk{junk[kind]}"
+        if kind == "bytes":  # not CDR at all, with a valid attachment
+            raw_pub.put(b"\x00\x01\x00\x00\xff\xff", attachment=z_serialize(
+                (Int64(1), Int64(time.time_ns()), bytes(16))))
+        elif kind == "nan":
+            put_joints(joint_state(publish_names, [0.0, math.nan, 0.0, 0.0]))
+        elif kind == "missing":
+            put_joints(joint_state([a.extra_joint] + names[:2], [0.0, 0.0, 0.0]))
+        else:  # a joint far outside any range: 1e6 driver units
+            put_joints(joint_state(publish_names, [0.0, 0.0, 1e6, 0.0]))
+        junk[kind] += 1
+        return k
+
+    def step():
+        t0 = first.get("t0")
+        t = 0.0 if t0 is None else time.monotonic() - t0
+        if t0 is not None and t > a.end_after:
+            return False
+        if t0 is not None and not state["tokens"] and t > 0.5:
+            state["tokens"] = node.tokens_seen()
+        if t0 is not None and t >= a.silent_at:
+            state["silent_from"] = state["silent_from"] or t
+            return True
+        if t0 is not None and a.junk_at <= t and sum(junk.values()) < 4 * a.junk_each:
+            send_junk(["bytes", "nan", "missing", "range"][sum(junk.values()) % 4])
+        values = interpolate(rows, t)
+        put_joints(joint_state(publish_names, [0.0] + list(values)[::-1]))
+        return True
+
+    at_rate(1000.0, stop, a.end_after + 60.0, step)
+    time.sleep(0.2)
+    entities, token_problems = check_tokens(state["tokens"], a.domain)
+    report = {
+        "entities": entities,
+        "token_problems": token_problems,
+        "forces": forces,
+        "silent_from": state["silent_from"],
+        "junk": junk,
+        "tokens": state["tokens"],
+        "bad_attachments": node.bad_attachments,
+        "live": live,
+        "live_errors": live_errors[:20],
+        "zid": node.zid,
+    }
+    del sub, live_sub
+    with open(a.report, "w") as f:
+        json.dump(report, f)
+    node.s.close()
+
+
+def robot(a):
+    node = Node("arm_standin", a.listen, a.domain)
+    names = a.names.split(",")
+    put = node.publisher(a.joint_topic, JOINT_STATE)
+    cmd = {"value": None, "count": 0, "bad": 0, "t0": None, "after_silence": []}
+    theta = [0.0, 0.0, 0.0]
+
+    def on_cmd(msg, _t):
+        data = list(msg.data)
+        if len(data) != 3 or not all(math.isfinite(x) for x in data):
+            cmd["bad"] += 1
+            return
+        cmd["value"] = data
+        cmd["count"] += 1
+        cmd["t0"] = cmd["t0"] or time.monotonic()
+        if time.monotonic() - cmd["t0"] >= a.silent_at:
+            cmd["after_silence"].append(data)
+
+    sub = node.subscribe(a.command_topic, ARRAY, on_cmd)
+    stop = stopping()
+    dt = 1e-3
+    alpha = 1.0 - math.exp(-dt / a.tau)
+
+    put_wrench = node.publisher(a.wrench_topic, WRENCH) if a.wrench_topic else None
+    state = {"last_before": None}
+
+    def step():
+        if cmd["value"] is not None:
+            for i in range(3):
+                theta[i] += alpha * (cmd["value"][i] - theta[i])
+        if cmd["t0"] is not None and time.monotonic() - cmd["t0"] >= a.silent_at:
+            return True
+        state["last_before"] = cmd["value"]
+        put(joint_state(["gripper"] + names, [0.0] + theta))
+        if put_wrench:
+            Header = TS.types["std_msgs/msg/Header"]
+            V = TS.types["geometry_msgs/msg/Vector3"]
+            put_wrench(TS.types[WRENCH](
+                header=Header(stamp=stamp(time.time_ns()), frame_id="base"),
+                wrench=TS.types["geometry_msgs/msg/Wrench"](
+                    force=V(x=a.wrench[0], y=a.wrench[1], z=a.wrench[2]),
+                    torque=V(x=0.0, y=0.0, z=0.0))))
+        return True
+
+    at_rate(1000.0, stop, a.duration, step)
+    del sub
+    with open(a.report, "w") as f:
+        json.dump({"commands": cmd["count"], "bad_commands": cmd["bad"], "theta": theta,
+                   "after_silence": cmd["after_silence"], "last_before": state["last_before"],
+                   "bad_attachments": node.bad_attachments}, f)
+    node.s.close()
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = p.add_subparsers(dest="role", required=True)
+    for role in ("device", "robot"):
+        q = sub.add_parser(role)
+        q.add_argument("--listen", action="append", required=True)
+        q.add_argument("--domain", type=int, default=0)
+        q.add_argument("--names", required=True)
+        q.add_argument("--joint-topic", required=True)
+        q.add_argument("--report", required=True)
+    d = sub.choices["device"]
+    d.add_argument("--force-topic", required=True)
+    d.add_argument("--trajectory", required=True)
+    d.add_argument("--extra-joint", default="yaw")
+    d.add_argument("--junk-at", type=float, default=1e9)
+    d.add_argument("--junk-each", type=int, default=0)
+    d.add_argument("--silent-at", type=float, default=1e9)
+    d.add_argument("--end-after", type=float, required=True)
+    d.add_argument("--live", action="store_true")
+    r = sub.choices["robot"]
+    r.add_argument("--command-topic", required=True)
+    r.add_argument("--tau", type=float, default=0.02)
+    r.add_argument("--duration", type=float, required=True)
+    r.add_argument("--silent-at", type=float, default=1e9)
+    r.add_argument("--wrench-topic", default="")
+    r.add_argument("--wrench", type=float, nargs=3, default=[0.0, 0.0, 0.0])
+    a = p.parse_args()
+    (device if a.role == "device" else robot)(a)
+
+
+if __name__ == "__main__":
+    main()
+    sys.stdout.flush()
+    # Zenoh's threads can keep the interpreter from exiting: the report is written.
+    os._exit(0)
