@@ -39,7 +39,12 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
         "lockstep throughput",
     ];
     if zenoh {
-        needles.extend(["zenoh loop", "zenoh/udp"]);
+        needles.extend([
+            "zenoh loop",
+            "zenoh/udp",
+            "live-on loop",
+            "live-on/live-off",
+        ]);
     }
     for needle in needles {
         assert!(text.contains(needle), "{needle}: {text}");
@@ -53,7 +58,7 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
     let loops = r["loops"].as_array().expect("loops");
     let names: Vec<&str> = loops.iter().filter_map(|l| l["name"].as_str()).collect();
     let expected: &[&str] = if zenoh {
-        &["iceoryx2", "udp", "zenoh"]
+        &["iceoryx2", "udp", "zenoh", "live-off", "live-on"]
     } else {
         &["iceoryx2", "udp"]
     };
@@ -69,9 +74,15 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
     let hop_misses = r["bare_hop_deadline_misses"].as_u64().expect("misses");
     assert_eq!(hop + hop_misses, 400, "{r}");
     assert!(hop > 0 && util::num(&r["bare_hop_round_trip_ns"]["p50"]) > 0.0);
-    for k in ["iceoryx2/udp", "zenoh/udp"]
+    if zenoh {
+        // Every node's live view reached the viewer: the master's six topics and the
+        // slave's three at 100 Hz over 0.4 s (the end of the run may cut the last).
+        let m = r["live_messages"].as_u64().expect("live messages");
+        assert!((9 * 38..=9 * 40).contains(&m), "{m} live messages");
+    }
+    for k in ["iceoryx2/udp", "zenoh/udp", "live-on/live-off"]
         .iter()
-        .take(1 + usize::from(zenoh))
+        .take(1 + 2 * usize::from(zenoh))
     {
         assert!(
             r["ratios"][k].as_array().is_some_and(|a| a.len() == 3),

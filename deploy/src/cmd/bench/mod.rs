@@ -8,6 +8,8 @@
 //! Everything is reported as percentiles and as ratios taken in the same run.
 
 mod hop;
+#[cfg(feature = "zenoh")]
+mod live;
 mod stalls;
 
 pub use hop::echo;
@@ -64,8 +66,11 @@ pub struct RateResult {
     /// Bare-hop round trips not back within their sampling period.
     pub bare_hop_deadline_misses: u64,
     /// Overhead ratios at p50, p99 and p99.9 taken in this run: `iceoryx2/udp`, and
-    /// `zenoh-hosts/udp-hosts` across hosts.
+    /// `zenoh-hosts/udp-hosts` across hosts, `live-on/live-off` (the live view's
+    /// cost: the iceoryx2 loop without and with it, run back to back).
     pub ratios: BTreeMap<String, [f64; 3]>,
+    /// Live-view messages the viewer received in the `live-on` loop.
+    pub live_messages: Option<u64>,
 }
 
 impl RateResult {
@@ -326,6 +331,7 @@ impl Bench<'_> {
     fn rate(&self, rate: f64, hosts: Option<&Pair>) -> Result<RateResult, Error> {
         let sc = scenario(rate, self.args.samples, Mode::Realtime)?;
         let mut loops = self.one_host(&sc)?;
+        let live_messages = self.live(&sc, &mut loops)?;
         if let Some(pair) = hosts {
             loops.extend(self.across_hosts(&sc, pair)?);
         }
@@ -339,7 +345,9 @@ impl Bench<'_> {
             bare_hop_round_trip_ns: hop.percentiles(),
             bare_hop_deadline_misses: hop_misses,
             ratios: BTreeMap::new(),
+            live_messages,
         };
+        r.ratio("live-on", "live-off");
         r.ratio("iceoryx2", "udp");
         r.ratio("zenoh", "udp");
         r.ratio("zenoh-hosts", "udp-hosts");
@@ -367,6 +375,37 @@ impl Bench<'_> {
             self.stopped()?;
         }
         Ok(loops)
+    }
+
+    /// The iceoryx2 loop without and with the live view (publishing to a viewer in
+    /// this process): what watching a run costs the loop. Messages the viewer
+    /// received, or None in a build without Zenoh.
+    fn live(&self, sc: &Scenario, loops: &mut Vec<LoopResult>) -> Result<Option<u64>, Error> {
+        #[cfg(feature = "zenoh")]
+        {
+            let viewer = live::Viewer::open()?;
+            let (rate, n) = (sc.rate_hz, sc.samples);
+            // Off, then on, back to back: the machine's noise drifts over minutes, so
+            // the pair compared is the pair run together.
+            for (name, sc) in [("live-off", sc.clone()), ("live-on", viewer.scenario(sc))] {
+                crate::noteln!(
+                    "tactile bench: {rate} Hz, {n} samples: iceoryx2 loop, {name} (live view at {} Hz)",
+                    live::LIVE_HZ.min(rate)
+                );
+                let out = self.args.out.join(format!("{name}-{rate}"));
+                let s = trio(&sc, &out, &self.sup, LinkKind::Iceoryx2)?;
+                loops.push(loop_result(name, s)?);
+                self.stopped()?;
+            }
+            // Let the last messages land.
+            std::thread::sleep(Duration::from_millis(200));
+            Ok(Some(viewer.received()))
+        }
+        #[cfg(not(feature = "zenoh"))]
+        {
+            let _ = (sc, loops);
+            Ok(None)
+        }
     }
 
     /// The loops across the two namespaces (which share the CPUs: not pinned).
@@ -521,6 +560,9 @@ fn render(r: &BenchReport) -> String {
             us_line("bare iceoryx2 (2 hops)", x.bare_hop_round_trip_ns.as_ref()),
             x.bare_hop_deadline_misses
         );
+        if let Some(m) = x.live_messages {
+            let _ = writeln!(t, "live view: {m} messages reached the viewer");
+        }
         for (k, [p50, p99, p999]) in &x.ratios {
             let _ = writeln!(t, "{k}: p50 {p50:.2}, p99 {p99:.2}, p99.9 {p999:.2}");
         }
