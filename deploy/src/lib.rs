@@ -34,4 +34,6 @@ pub mod guide {
     pub mod the_hardware {}
     #[doc = include_str!("../../docs/10-recordings.md")]
     pub mod recordings {}
+    #[doc = include_str!("../../docs/11-real-devices-and-ros2.md")]
+    pub mod real_devices_and_ros2 {}
 }

@@ -15,13 +15,20 @@ use tactile_node::runtime::{new_run_token, prepare, start_record};
 
 /// tactile-master: the operator's side (OP, MD, HMD). Sends c(n), takes q(n) back,
 /// commands the master device's torques, and records every sample.
+///
+/// The master device is simulated, or a real one through its ROS 2 driver over
+/// rmw_zenoh (`master.backend = "ros2"` and `[master.ros2]` in the scenario: topics,
+/// joint names, signs, offsets, units, staleness); `[ros.live]` publishes the
+/// master's state as ROS 2 topics while it runs. Both need a build with the `zenoh`
+/// feature; every option is in docs/11-real-devices-and-ros2.md.
 #[derive(Debug, Parser)]
 #[command(name = "tactile-master", version, about, after_help = EXIT_CODES_HELP)]
 pub struct Cli {
     /// Options every node takes.
     #[command(flatten)]
     pub node: NodeArgs,
-    /// Seconds to wait for the emulator and slave to answer before giving up.
+    /// Seconds to wait for the emulator and slave to answer (and, with a ROS 2 device,
+    /// for the device's first good message) before giving up.
     #[arg(long, default_value_t = 60.0)]
     pub startup_timeout_s: f64,
     /// No emulator: talk to the slave directly, the real network being the delay

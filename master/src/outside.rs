@@ -60,3 +60,19 @@ impl RosParts {
         Outside::default()
     }
 }
+
+#[cfg(all(test, not(feature = "zenoh")))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_build_without_zenoh_refuses_a_ros_scenario_and_runs_the_rest() {
+        let mut sc = Scenario::default();
+        assert!(RosParts::open(&sc).is_ok(), "nothing asked, nothing opened");
+        sc.ros.live.enabled = true;
+        match RosParts::open(&sc) {
+            Err(NodeError::BadInput(m)) => assert!(m.contains("--features zenoh"), "{m}"),
+            other => panic!("{other:?}"),
+        }
+    }
+}

@@ -12,6 +12,14 @@ use tactile_node::runtime::{prepare, start_record};
 
 /// tactile-slave: the remote side (HSD, SD, ENV). Follows v(n) with the slave arm,
 /// senses contact, sends the force h(n) back, and records every step.
+///
+/// The arm and its environment are simulated, or a real robot under ros2_control over
+/// rmw_zenoh (`slave.backend = "ros2"` and `[slave.ros2]` in the scenario: joint
+/// references out as Float64MultiArray, JointState and an optional force-torque
+/// WrenchStamped in); it waits for the robot's first message before it answers the
+/// master. `[ros.live]` publishes the slave's state as ROS 2 topics while it runs.
+/// Both need a build with the `zenoh` feature; every option is in
+/// docs/11-real-devices-and-ros2.md.
 #[derive(Debug, Parser)]
 #[command(name = "tactile-slave", version, about, after_help = EXIT_CODES_HELP)]
 pub struct Cli {

@@ -38,6 +38,11 @@ impl<S: LiveState> LiveView<S> {
         let thread = std::thread::Builder::new()
             .name("live-view".into())
             .spawn(move || {
+                // Below the loop: a SCHED_FIFO node's threads inherit its policy, and
+                // the view must wait for the loop, never the loop for the view.
+                if let Err(e) = crate::sched::set_thread_other() {
+                    tracing::warn!("the live view's thread stays at the node's priority: {e}");
+                }
                 let _node = node;
                 for state in rx {
                     let msgs = state.encode(wall_ns());

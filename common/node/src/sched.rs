@@ -83,6 +83,12 @@ pub fn set_thread_fifo(priority: u8) -> std::io::Result<()> {
     crate::sys::set_fifo(i32::from(priority))
 }
 
+/// SCHED_OTHER for the calling thread only: a helper thread of a SCHED_FIFO node
+/// (which it would otherwise inherit) that must never take the CPU from the loop.
+pub fn set_thread_other() -> std::io::Result<()> {
+    crate::sys::set_other()
+}
+
 /// Bytes of stack touched at start, so the loop never faults a stack page in.
 const STACK_PREFAULT: usize = 256 * 1024;
 

@@ -23,6 +23,13 @@ pub fn set_fifo(priority: i32) -> Result<()> {
     check(unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &p) })
 }
 
+/// SCHED_OTHER (the time-sharing scheduler) for the calling thread.
+pub fn set_other() -> Result<()> {
+    let p = libc::sched_param { sched_priority: 0 };
+    // SAFETY: as in `set_fifo`.
+    check(unsafe { libc::sched_setscheduler(0, libc::SCHED_OTHER, &p) })
+}
+
 /// SCHED_IDLE for the calling thread: it runs only when nothing else on its CPU wants
 /// to, and any other thread's wake-up preempts it.
 pub fn set_idle() -> Result<()> {
