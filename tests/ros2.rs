@@ -1,7 +1,8 @@
 //! Real devices over ROS 2, against an independent implementation of rmw_zenoh's wire
 //! format: stand-ins for a haptic device's driver and a robot under ros2_control
 //! written with the Python packages eclipse-zenoh and rosbags (tests/ros2_standin.py),
-//! real node processes between them.
+//! real node processes between them. Each test has its own ports and ROS domain.
+#![cfg(feature = "zenoh")]
 
 use crate::util::{self, cannot, num, Sandbox};
 use std::net::TcpListener;
@@ -18,6 +19,16 @@ fn python_ready() -> bool {
 fn free_port() -> u16 {
     let l = TcpListener::bind("127.0.0.1:0").expect("bind");
     l.local_addr().expect("addr").port()
+}
+
+/// Waits until a stand-in listens on `port` (Zenoh retries a refused connection only
+/// after a growing back-off, so the nodes start after their peers are up).
+fn listening(port: u16) {
+    util::wait_for(
+        "a stand-in's listener",
+        std::time::Duration::from_secs(30),
+        || std::net::TcpStream::connect(("127.0.0.1", port)).is_ok(),
+    );
 }
 
 fn standin(sb: &Sandbox, args: &[&str]) -> Child {
@@ -82,9 +93,9 @@ fn looped(mode: &str, samples: u64) -> String {
 const SIGN: [f64; 3] = [1.0, -1.0, 1.0];
 const OFFSET: [f64; 3] = [0.0, 0.0, 0.3];
 
-fn ros_tables(ports: [u16; 2], live: bool, master: bool) -> String {
+fn ros_tables(domain: u32, ports: [u16; 2], live: bool, master: bool) -> String {
     let mut t = format!(
-        "\n[ros]\nconnect = [\"tcp/127.0.0.1:{}\", \"tcp/127.0.0.1:{}\"]\n\n[ros.live]\nenabled = {live}\nrate_hz = 50.0\n",
+        "\n[ros]\ndomain_id = {domain}\nconnect = [\"tcp/127.0.0.1:{}\", \"tcp/127.0.0.1:{}\"]\n\n[ros.live]\nenabled = {live}\nrate_hz = 50.0\n",
         ports[0], ports[1]
     );
     if master {
@@ -168,6 +179,8 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
         &sb,
         &[
             "robot",
+            "--domain",
+            "11",
             "--listen",
             &ep(ports[1]),
             "--names",
@@ -177,7 +190,9 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
             "--command-topic",
             "/arm/commands",
             "--duration",
-            "40",
+            "60",
+            "--idle-exit",
+            "2",
             "--report",
             "robot.json",
         ],
@@ -186,6 +201,8 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
         &sb,
         &[
             "device",
+            "--domain",
+            "11",
             "--listen",
             &ep(ports[0]),
             "--names",
@@ -203,7 +220,7 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
             "--silent-at",
             "6.5",
             "--end-after",
-            "8.0",
+            "9.0",
             "--live",
             "--report",
             "device.json",
@@ -213,10 +230,12 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
         "ros.toml",
         &format!(
             "{}{}",
-            looped("realtime", 700),
-            ros_tables(ports, true, true)
+            looped("realtime", 800),
+            ros_tables(11, ports, true, true)
         ),
     );
+    listening(ports[0]);
+    listening(ports[1]);
     sb.run(&scenario, "ros");
     let d = report(&sb, device, "device.json");
     let r = report(&sb, robot, "robot.json");
@@ -245,7 +264,12 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
         .collect();
     let rt = sb.trace("ros");
     let felt = [1, 2, 3].map(|i| util::column(&rt, &format!("felt_{i}")));
-    assert_eq!(forces.len(), 700, "one force per sample");
+    assert_eq!(
+        forces.len(),
+        801,
+        "one force per sample, and a zero force when the master stops"
+    );
+    assert!(forces[800][1..].iter().all(|x| *x == 0.0));
     let silent = num(&d["silent_from"]);
     for (k, f) in forces.iter().enumerate().take_while(|(_, f)| f[0] < silent) {
         assert_eq!(
@@ -294,13 +318,13 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
     let md = &s["master"]["device"];
     assert_eq!(num(&md["losses"]), 1.0, "{md}");
     assert!(num(&md["lost"]) > 0.0 && num(&md["fresh"]) > 500.0, "{md}");
-    assert_eq!(s["nodes"]["master"]["ended"], "completed, after sample 699");
+    assert_eq!(s["nodes"]["master"]["ended"], "completed, after sample 799");
     // Junk, NaN, a missing joint, out of range: 3 of each, every one counted, none used.
     assert_eq!(num(&md["rejected"]), 12.0, "{md}");
-    assert_eq!(num(&md["published"]), 700.0, "{md}");
+    assert_eq!(num(&md["published"]), 800.0, "{md}");
 
     // The robot: one command a step, all well formed; the slave's counters.
-    assert_eq!(num(&r["commands"]), 700.0, "{r}");
+    assert_eq!(num(&r["commands"]), 800.0, "{r}");
     assert_eq!(num(&r["bad_commands"]), 0.0);
     let sd = &s["slave"]["device"];
     assert_eq!(
@@ -346,9 +370,9 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
         );
     }
 
-    // The live view: every topic, every message decoded by rosbags, at 50 Hz (350 a
+    // The live view: every topic, every message decoded by rosbags, at 50 Hz (400 a
     // topic; the view drops what its thread, below the loop's priority, cannot take
-    // in time on a busy machine, so at least 300).
+    // in time on a busy machine, so at least 340).
     let live = &d["live"];
     for t in [
         "/master/joint_states",
@@ -362,7 +386,7 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
         "/slave/force",
     ] {
         let n = live[t].as_f64().unwrap_or(0.0);
-        assert!((300.0..=350.0).contains(&n), "{t}: {n} messages of 350");
+        assert!((340.0..=400.0).contains(&n), "{t}: {n} messages of 400");
     }
     let errors: Vec<&serde_json::Value> = d["live_errors"]
         .as_array()
@@ -384,6 +408,8 @@ fn a_robot_that_goes_silent_is_held_and_its_sensor_gives_the_force() {
         &sb,
         &[
             "robot",
+            "--domain",
+            "12",
             "--listen",
             &format!("tcp/127.0.0.1:{}", ports[1]),
             "--names",
@@ -401,12 +427,14 @@ fn a_robot_that_goes_silent_is_held_and_its_sensor_gives_the_force() {
             "--silent-at",
             "2.0",
             "--duration",
-            "40",
+            "60",
+            "--idle-exit",
+            "2",
             "--report",
             "robot.json",
         ],
     );
-    let tables = ros_tables(ports, false, false).replace(
+    let tables = ros_tables(12, ports, false, false).replace(
         "command_topic = \"/arm/commands\"\n",
         "command_topic = \"/arm/commands\"\nwrench_topic = \"/arm/wrench\"\n",
     );
@@ -414,6 +442,7 @@ fn a_robot_that_goes_silent_is_held_and_its_sensor_gives_the_force() {
         "robot.toml",
         &format!("{}{tables}", looped("realtime", 400)),
     );
+    listening(ports[1]);
     sb.run(&scenario, "out");
     let r = report(&sb, robot, "robot.json");
     let s = sb.json("out", "summary.json");
@@ -444,6 +473,16 @@ fn a_robot_that_goes_silent_is_held_and_its_sensor_gives_the_force() {
 fn ros_settings_are_checked_and_need_the_node_programs() {
     let sb = Sandbox::new("ros2-bad");
     let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/paper.toml");
+    sb.assert_bad_set(
+        paper,
+        "master.ros2.watch.timeout_ms=20",
+        "master.ros2.watch.timeout_ms",
+    );
+    sb.assert_bad_set(
+        paper,
+        "master.ros2.force_map.axes=[0,0,1]",
+        "master.ros2.force_map.axes[1]",
+    );
     sb.assert_bad_set(
         paper,
         "master.ros2.joint_states=\"joint_states\"",

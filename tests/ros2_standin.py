@@ -315,6 +315,7 @@ def robot(a):
         cmd["value"] = data
         cmd["count"] += 1
         cmd["t0"] = cmd["t0"] or time.monotonic()
+        cmd["last"] = time.monotonic()
         if time.monotonic() - cmd["t0"] >= a.silent_at:
             cmd["after_silence"].append(data)
 
@@ -327,6 +328,8 @@ def robot(a):
     state = {"last_before": None}
 
     def step():
+        if a.idle_exit and cmd["t0"] is not None and time.monotonic() - cmd["last"] > a.idle_exit:
+            return False  # the run is over: commands stopped
         if cmd["value"] is not None:
             for i in range(3):
                 theta[i] += alpha * (cmd["value"][i] - theta[i])
@@ -377,6 +380,8 @@ def main():
     r.add_argument("--tau", type=float, default=0.02)
     r.add_argument("--duration", type=float, required=True)
     r.add_argument("--silent-at", type=float, default=1e9)
+    r.add_argument("--idle-exit", type=float, default=0.0,
+                   help="exit this many seconds after the last command (0: never)")
     r.add_argument("--wrench-topic", default="")
     r.add_argument("--wrench", type=float, nargs=3, default=[0.0, 0.0, 0.0])
     a = p.parse_args()

@@ -475,7 +475,12 @@ fn wait_for_device(d: &dyn HapticDevice, timeout: Duration) -> Result<bool, Mast
         tactile_node::signals::stop_flag().map_err(|e| MasterError::Record(e.to_string()))?;
     let start = Instant::now();
     tracing::info!("waiting for {}", d.describe());
+    let mut next_note = Duration::from_secs(5);
     while !d.heard() {
+        if start.elapsed() > next_note {
+            tracing::info!("still waiting for {}", d.describe());
+            next_note += Duration::from_secs(5);
+        }
         if stop.load(std::sync::atomic::Ordering::Relaxed) {
             return Ok(false);
         }

@@ -88,7 +88,7 @@ impl RobotEdge<'_> {
         }
         Ok(Measured {
             theta: self.theta,
-            force: self.robot.force().flatten(),
+            force: self.robot.force(now_ns()),
         })
     }
 

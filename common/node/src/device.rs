@@ -36,6 +36,9 @@ pub struct DeviceCounters {
     pub published: u64,
     /// Messages that could not be published.
     pub publish_errors: u64,
+    /// Ticks whose force-torque reading was older than the timeout, or not there yet:
+    /// zero force used, never a stale contact.
+    pub force_lost: u64,
 }
 
 /// Why a message was dropped.
@@ -113,10 +116,14 @@ impl JointMap {
         Ok(theta)
     }
 
-    /// The driver's values for the paper's angles (the inverse map), for commands.
+    /// The driver's values for the paper's angles (the inverse map), for commands;
+    /// each angle first clamped to the joint's `min..=max`, so a robot is never
+    /// commanded where its readings would be refused.
     pub fn raw(&self, theta: [f64; 3]) -> [f64; 3] {
-        [0, 1, 2]
-            .map(|i| (theta[i] - self.cfg.offset[i]) / (self.cfg.sign[i] * self.cfg.unit.radians()))
+        [0, 1, 2].map(|i| {
+            let t = theta[i].clamp(self.cfg.min[i], self.cfg.max[i]);
+            (t - self.cfg.offset[i]) / (self.cfg.sign[i] * self.cfg.unit.radians())
+        })
     }
 
     /// The joint names, in the paper's order.
@@ -275,6 +282,18 @@ impl Watch {
         (reading, change)
     }
 
+    /// A force-torque reading at this tick: the newest if it is within the timeout,
+    /// else zero force, counted.
+    pub fn force(&mut self, latest: Option<Latest<[f64; 3]>>, now_ns: u64) -> [f64; 3] {
+        match latest {
+            Some(l) if now_ns.saturating_sub(l.at_ns) <= self.timeout_ns => l.value,
+            _ => {
+                self.counters.force_lost += 1;
+                [0.0; 3]
+            }
+        }
+    }
+
     /// Counts one publication and its outcome.
     pub fn published(&mut self, ok: bool) {
         if ok {
@@ -318,9 +337,10 @@ pub trait Robot {
     fn heard(&self) -> bool;
     /// The joints' newest angles at this tick, judged.
     fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change);
-    /// The newest contact force, N, if the robot has a force sensor (else the
-    /// environment model gives it).
-    fn force(&self) -> Option<Option<[f64; 3]>>;
+    /// The contact force at this tick, N in the paper's frame, if the robot has a
+    /// force sensor (else the environment model gives it); zero when the sensor's
+    /// newest reading is older than the timeout.
+    fn force(&mut self, now_ns: u64) -> Option<[f64; 3]>;
     /// Sends the joint references, rad in the paper's convention.
     fn command(&mut self, theta_ref: [f64; 3], now_ns: u64);
     /// What it delivered and how it was judged.
@@ -462,6 +482,24 @@ mod tests {
         let c = w.counters(&[(5, 1)]);
         assert_eq!((c.fresh, c.stale, c.lost, c.losses), (2, 2, 3, 1));
         assert_eq!((c.messages, c.rejected), (5, 1));
+    }
+
+    #[test]
+    fn commands_stay_in_range_and_an_old_force_is_not_used() {
+        let m = map();
+        assert!(
+            (m.raw([10.0, 0.0, 0.0])[0] - 180.0).abs() < 1e-9,
+            "clamped to pi"
+        );
+        let mut w = Watch::new(&WatchConfig::default(), 1_000_000);
+        let l = Some(Latest {
+            value: [1.0, 2.0, 3.0],
+            at_ns: 0,
+        });
+        assert_eq!(w.force(l, 50_000_000), [1.0, 2.0, 3.0]);
+        assert_eq!(w.force(l, 150_000_000), [0.0; 3]);
+        assert_eq!(w.force(None, 0), [0.0; 3]);
+        assert_eq!(w.counters(&[]).force_lost, 2);
     }
 
     #[test]

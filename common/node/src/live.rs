@@ -95,6 +95,10 @@ impl<S: LiveState> Drop for LiveView<S> {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
+        let (published, dropped) = self.counts();
+        tracing::info!(
+            "live view: {published} messages published, {dropped} states dropped (the publisher behind)"
+        );
     }
 }
 

@@ -6,7 +6,8 @@
 //! Subscriptions take any type hash (`<domain>/<topic>/<type>/*`): a Jazzy driver's
 //! RIHS01 hash and a Humble one's `TypeHashNotSupported` alike, the message layouts
 //! being the same. Publishers use the exact Jazzy key, as Jazzy subscribers expect.
-//! Publications never block: congestion control `Drop`, like ROS 2 sensor streams.
+//! Publications do not wait: congestion control `Drop` with no wait before dropping,
+//! like ROS 2 sensor streams.
 
 use crate::link::LinkError;
 use std::sync::atomic::{AtomicI64, AtomicU32, Ordering};
@@ -46,6 +47,12 @@ fn config(cfg: &RosConfig) -> Result<zenoh::Config, LinkError> {
         ("scouting/multicast/enabled", "false".into()),
         ("connect/timeout_ms", "-1".into()),
         ("connect/exit_on_failure", "false".into()),
+        // A full queue drops a message at once instead of waiting up to 1 ms (Zenoh's
+        // default) for room: the loop publishes, and must not wait.
+        (
+            "transport/link/tx/queue/congestion_control/drop/wait_before_drop",
+            "0".into(),
+        ),
     ] {
         c.insert_json5(key, &value)
             .map_err(|e| err(&format!("ROS 2 Zenoh setting {key} = {value}"), e))?;

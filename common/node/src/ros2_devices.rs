@@ -34,6 +34,7 @@ pub struct RosHapticDevice {
     _sub: RosSubscription,
     force: RosPublisher,
     frame: String,
+    force_map: tactile_scenario::ForceMapConfig,
     watch: Watch,
     topic: String,
 }
@@ -48,9 +49,18 @@ impl RosHapticDevice {
             _sub: sub,
             force: node.publisher(&cfg.force_topic, WrenchStamped::TYPE)?,
             frame: cfg.frame_id.clone(),
+            force_map: cfg.force_map.clone(),
             watch: Watch::new(&cfg.watch, t_s_ns),
             topic: cfg.joint_states.clone(),
         })
+    }
+}
+
+impl Drop for RosHapticDevice {
+    /// A driver holds its last command: leave the device rendering nothing, however
+    /// the run ends.
+    fn drop(&mut self) {
+        self.render([0.0; 3], 0);
     }
 }
 
@@ -66,7 +76,7 @@ impl HapticDevice for RosHapticDevice {
     fn render(&mut self, force: [f64; 3], _now_ns: u64) {
         let w = WrenchStamped {
             header: Header::at(wall_ns(), &self.frame),
-            force,
+            force: self.force_map.to_device(force),
             torque: [0.0; 3],
         };
         let ok = self.force.put(&w.to_cdr());
@@ -94,6 +104,7 @@ pub struct RosRobot {
     _subs: Vec<RosSubscription>,
     command: RosPublisher,
     map: JointMap,
+    wrench_map: tactile_scenario::ForceMapConfig,
     watch: Watch,
     topic: String,
 }
@@ -123,6 +134,7 @@ impl RosRobot {
             _subs: subs,
             command: node.publisher(&cfg.command_topic, Float64MultiArray::TYPE)?,
             map,
+            wrench_map: cfg.wrench_map.clone(),
             watch: Watch::new(&cfg.watch, t_s_ns),
             topic: cfg.joint_states.clone(),
         })
@@ -138,8 +150,10 @@ impl Robot for RosRobot {
         self.watch.judge(self.joints.latest(), now_ns)
     }
 
-    fn force(&self) -> Option<Option<[f64; 3]>> {
-        self.wrench.as_ref().map(|w| w.latest().map(|l| l.value))
+    fn force(&mut self, now_ns: u64) -> Option<[f64; 3]> {
+        let w = self.wrench.as_ref()?;
+        let f = self.watch.force(w.latest(), now_ns);
+        Some(self.wrench_map.to_paper(f))
     }
 
     fn command(&mut self, theta_ref: [f64; 3], _now_ns: u64) {

@@ -13,7 +13,8 @@
 
 /// The RIHS01 type hashes (ROS 2 Jazzy) of the types Tactile publishes and takes, as
 /// `rosidl` generates them: sha256 of the type description. Checked against rosbags'
-/// own computation from the definitions by `tests/ros2_check.py`.
+/// own computation from the definitions by the stand-ins of `tests/ros2.rs`
+/// (`tests/ros2_standin.py` parses Tactile's tokens and compares their hashes).
 pub const TYPE_HASHES: &[(&str, &str)] = &[
     (
         "std_msgs/msg/String",

@@ -32,8 +32,8 @@ pub use network::{
 };
 pub use operator::{Operator, TrajectoryEnd};
 pub use ros::{
-    topic_name, AngleUnit, Backend, JointMapConfig, LiveConfig, RosConfig, RosDeviceConfig,
-    RosRobotConfig, WatchConfig,
+    topic_name, AngleUnit, Backend, ForceMapConfig, JointMapConfig, LiveConfig, RosConfig,
+    RosDeviceConfig, RosRobotConfig, WatchConfig,
 };
 use serde::{Deserialize, Serialize};
 pub use slave::{

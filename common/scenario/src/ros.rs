@@ -147,6 +147,65 @@ impl JointMapConfig {
     }
 }
 
+/// How a force in the paper's base frame is written in a device's base frame:
+/// `device[i] = sign[i] * paper[axes[i]]` (the identity by default). A Touch's base
+/// frame, for one, has y up where the paper has z.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ForceMapConfig {
+    /// The paper's axis (0 x, 1 y, 2 z) each device axis takes, a permutation.
+    pub axes: [usize; 3],
+    /// +1 or -1 per device axis.
+    pub sign: [f64; 3],
+}
+
+impl Default for ForceMapConfig {
+    fn default() -> Self {
+        ForceMapConfig {
+            axes: [0, 1, 2],
+            sign: [1.0; 3],
+        }
+    }
+}
+
+impl ForceMapConfig {
+    fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+        let mut seen = [false; 3];
+        for (i, a) in self.axes.iter().enumerate() {
+            if *a > 2 || seen[*a] {
+                return Err(invalid(
+                    format!("{field}.axes[{i}]"),
+                    format!("{a}: the axes are a permutation of 0, 1, 2"),
+                ));
+            }
+            seen[*a] = true;
+        }
+        for (i, s) in self.sign.iter().enumerate() {
+            if *s != 1.0 && *s != -1.0 {
+                return Err(invalid(
+                    format!("{field}.sign[{i}]"),
+                    format!("{s} is not 1 or -1"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The paper's force in the device's frame.
+    pub fn to_device(&self, f: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|i| self.sign[i] * f[self.axes[i]])
+    }
+
+    /// The device's force in the paper's frame.
+    pub fn to_paper(&self, d: [f64; 3]) -> [f64; 3] {
+        let mut f = [0.0; 3];
+        for i in 0..3 {
+            f[self.axes[i]] = self.sign[i] * d[i];
+        }
+        f
+    }
+}
+
 /// Checks three joint names: non-empty and distinct.
 fn joint_names(names: &[String; 3], field: &str) -> Result<(), ScenarioError> {
     for (i, n) in names.iter().enumerate() {
@@ -190,6 +249,21 @@ impl WatchConfig {
         }
         positive(self.timeout_ms, &format!("{field}.timeout_ms"), false)
     }
+
+    /// The timeout must outlast the stale window, or loss would come only after it.
+    pub fn validate_at(&self, field: &str, rate_hz: f64) -> Result<(), ScenarioError> {
+        let stale_ms = f64::from(self.stale_periods) * 1e3 / rate_hz;
+        if self.timeout_ms <= stale_ms {
+            return Err(invalid(
+                format!("{field}.timeout_ms"),
+                format!(
+                    "{} ms is not longer than the stale window ({} periods, {stale_ms} ms)",
+                    self.timeout_ms, self.stale_periods
+                ),
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// `[master.ros2]`: a haptic device through its ROS 2 driver.
@@ -208,6 +282,8 @@ pub struct RosDeviceConfig {
     pub force_topic: String,
     /// `frame_id` of the force: the device's base frame.
     pub frame_id: String,
+    /// The paper's axes in the device's base frame, for the force.
+    pub force_map: ForceMapConfig,
     /// Staleness and loss.
     pub watch: WatchConfig,
 }
@@ -220,6 +296,7 @@ impl Default for RosDeviceConfig {
             map: JointMapConfig::default(),
             force_topic: "/phantom/force_feedback".into(),
             frame_id: "base".into(),
+            force_map: ForceMapConfig::default(),
             watch: WatchConfig::default(),
         }
     }
@@ -242,6 +319,8 @@ pub struct RosRobotConfig {
     /// A force-torque sensor's `geometry_msgs/msg/WrenchStamped` (newtons, in the
     /// robot's base frame); empty: the force comes from the environment model.
     pub wrench_topic: String,
+    /// The paper's axes in the sensor's frame.
+    pub wrench_map: ForceMapConfig,
     /// Staleness and loss.
     pub watch: WatchConfig,
 }
@@ -254,6 +333,7 @@ impl Default for RosRobotConfig {
             map: JointMapConfig::default(),
             command_topic: "/forward_position_controller/commands".into(),
             wrench_topic: String::new(),
+            wrench_map: ForceMapConfig::default(),
             watch: WatchConfig::default(),
         }
     }
@@ -320,6 +400,7 @@ impl RosDeviceConfig {
         joint_names(&self.joints, "master.ros2.joints")?;
         self.map.validate("master.ros2.map")?;
         topic_name(&self.force_topic, "master.ros2.force_topic")?;
+        self.force_map.validate("master.ros2.force_map")?;
         self.watch.validate("master.ros2.watch")
     }
 }
@@ -334,6 +415,7 @@ impl RosRobotConfig {
         if !self.wrench_topic.is_empty() {
             topic_name(&self.wrench_topic, "slave.ros2.wrench_topic")?;
         }
+        self.wrench_map.validate("slave.ros2.wrench_map")?;
         self.watch.validate("slave.ros2.watch")
     }
 }
@@ -348,6 +430,32 @@ mod tests {
         for bad in ["joint_states", "/", "/a//b", "/1abc", "/a-b", "/a/"] {
             assert!(topic_name(bad, "f").is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn a_force_goes_to_the_device_frame_and_back() {
+        let m = ForceMapConfig {
+            axes: [1, 2, 0],
+            sign: [1.0, -1.0, 1.0],
+        };
+        let f = [1.0, 2.0, 3.0];
+        assert_eq!(m.to_device(f), [2.0, -3.0, 1.0]);
+        assert_eq!(m.to_paper(m.to_device(f)), f);
+        let bad = ForceMapConfig {
+            axes: [0, 0, 2],
+            ..ForceMapConfig::default()
+        };
+        assert!(bad.validate("m").is_err());
+    }
+
+    #[test]
+    fn a_ros2_device_runs_in_real_time_only() {
+        let mut sc = crate::Scenario::default();
+        sc.slave.backend = Backend::Ros2;
+        assert!(sc.validate().is_ok());
+        sc.mode = crate::Mode::Lockstep;
+        let e = sc.validate().expect_err("lockstep");
+        assert!(e.to_string().contains("field `mode`"), "{e}");
     }
 
     #[test]

@@ -33,6 +33,22 @@ impl Scenario {
         }
         self.environment.validate()?;
         self.ros.validate(self.rate_hz)?;
+        self.master
+            .ros2
+            .watch
+            .validate_at("master.ros2.watch", self.rate_hz)?;
+        self.slave
+            .ros2
+            .watch
+            .validate_at("slave.ros2.watch", self.rate_hz)?;
+        if self.mode == Mode::Lockstep
+            && (self.master.backend == Backend::Ros2 || self.slave.backend == Backend::Ros2)
+        {
+            return Err(invalid(
+                "mode",
+                "a device over ROS 2 runs in real time: lockstep has no clock a device follows",
+            ));
+        }
         self.bounded()
     }
 }
