@@ -17,7 +17,8 @@ use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, LATE_WINDOW};
 use tactile_node::args::NodeError;
-use tactile_node::device::{Change, HapticDevice, LiveSink, Reading};
+use tactile_node::device::{HapticDevice, LiveSink};
+use tactile_node::held::{wait_heard, Held, Waited};
 use tactile_node::link::MasterLink;
 use tactile_node::link::{Idle, LinkError};
 use tactile_node::recorder::Recorder;
@@ -192,9 +193,8 @@ struct Loop<'a, L: MasterLink + ?Sized> {
     peer_timeout: u64,
     t0: u64,
     outside: Outside<'a>,
-    /// The device's last good angles (held while it is stale or lost).
-    device_theta: [f64; 3],
-    device_lost: bool,
+    /// The real device's angles as the loop holds them.
+    device: Held,
     last_answer: Option<crate::record::Answer>,
 }
 
@@ -217,33 +217,20 @@ impl<L: MasterLink + ?Sized> Loop<'_, L> {
         let Some(d) = self.outside.device.as_deref_mut() else {
             return Ok(self.master.forward(n, origin));
         };
-        let (reading, change) = d.read(now_ns());
-        match reading {
-            Reading::Fresh(t) | Reading::Stale(t) => self.device_theta = t,
-            Reading::Lost => {}
+        let who = d.describe();
+        let seen = self
+            .device
+            .take(d.read(now_ns()), ("device", &who), "rendering zero force");
+        if let Some(what) = seen {
+            self.rec.event(n, what)?;
         }
-        self.device_lost = matches!(reading, Reading::Lost);
-        match change {
-            Change::Lost => {
-                let what = format!(
-                    "device lost: {} silent past its timeout; rendering zero force",
-                    d.describe()
-                );
-                tracing::warn!("{what}");
-                self.rec.event(n, what)?;
-            }
-            Change::Back => self
-                .rec
-                .event(n, format!("device back: {}", d.describe()))?,
-            Change::None => {}
-        }
-        Ok(self.master.forward_measured(n, origin, self.device_theta))
+        Ok(self.master.forward_measured(n, origin, self.device.theta))
     }
 
     /// After sample n: the force to the real device (zero while it is lost), and the
     /// live view.
     fn after(&mut self, sent: Sent) {
-        let felt = if self.device_lost {
+        let felt = if self.device.lost {
             [0.0; 3]
         } else {
             self.master.felt()
@@ -402,8 +389,7 @@ pub fn run_with<'a, L: MasterLink + ?Sized>(
         peer_timeout: sc.faults.peer_timeout_samples,
         t0,
         outside,
-        device_theta: [0.0; 3],
-        device_lost: false,
+        device: Held::default(),
         last_answer: None,
     };
     let mut ending = Ending::Completed;
@@ -433,7 +419,7 @@ pub fn run_with<'a, L: MasterLink + ?Sized>(
             let t = lp.totals();
             log_clamps(&mut clamps, &t.counters);
             if let Some(d) = &lp.outside.device {
-                tactile_node::device::log_second(
+                tactile_node::held::log_second(
                     "device",
                     &mut device_seen,
                     &t.device,
@@ -471,30 +457,17 @@ pub fn run_with<'a, L: MasterLink + ?Sized>(
 
 /// Waits until the device has sent a good message; false if a stop request came.
 fn wait_for_device(d: &dyn HapticDevice, timeout: Duration) -> Result<bool, MasterError> {
-    let stop =
-        tactile_node::signals::stop_flag().map_err(|e| MasterError::Record(e.to_string()))?;
-    let start = Instant::now();
-    tracing::info!("waiting for {}", d.describe());
-    let mut next_note = Duration::from_secs(5);
-    while !d.heard() {
-        if start.elapsed() > next_note {
-            tracing::info!("still waiting for {}", d.describe());
-            next_note += Duration::from_secs(5);
-        }
-        if stop.load(std::sync::atomic::Ordering::Relaxed) {
-            return Ok(false);
-        }
-        if start.elapsed() > timeout {
-            let (messages, rejected) = (d.counters().messages, d.counters().rejected);
-            return Err(MasterError::NoAnswer(format!(
-                "no usable message from {} within {:.1} s ({messages} received, {rejected} rejected): is its driver running, with the same ROS_DOMAIN_ID, reaching the same Zenoh router?",
-                d.describe(),
-                timeout.as_secs_f64()
-            )));
-        }
-        std::thread::sleep(Duration::from_millis(10));
+    let waited = wait_heard(&|| d.heard(), &d.describe(), Some(timeout))
+        .map_err(|e| MasterError::Record(e.to_string()))?;
+    if waited == Waited::TimedOut {
+        let (messages, rejected) = (d.counters().messages, d.counters().rejected);
+        return Err(MasterError::NoAnswer(format!(
+            "no usable message from {} within {:.1} s ({messages} received, {rejected} rejected): is its driver running, with the same ROS_DOMAIN_ID, reaching the same Zenoh router?",
+            d.describe(),
+            timeout.as_secs_f64()
+        )));
     }
-    Ok(true)
+    Ok(waited == Waited::Heard)
 }
 
 /// Logs the force and torque clamps of the last second, if any (at most one line a

@@ -9,7 +9,8 @@ use std::time::{Duration, Instant};
 use tactile_messages::clock::now_ns;
 use tactile_messages::samples::{stage, Backward, FLAG_END, FLAG_PROBE};
 use tactile_node::args::NodeError;
-use tactile_node::device::{Change, LiveSink, Reading, Robot};
+use tactile_node::device::{LiveSink, Robot};
+use tactile_node::held::{wait_heard, Held, Waited};
 use tactile_node::link::{Idle, LinkError};
 use tactile_node::link::{RunFilter, SlaveLink};
 use tactile_node::pace::{recv_paced, Pacer};
@@ -56,45 +57,34 @@ impl std::fmt::Debug for Outside<'_> {
     }
 }
 
-/// The real robot as the loop keeps it: its last good angles and what it was last
+/// The real robot as the loop keeps it: its angles as held and what it was last
 /// commanded (held while it is lost).
 struct RobotEdge<'a> {
     robot: &'a mut dyn Robot,
-    theta: [f64; 3],
-    lost: bool,
+    held: Held,
     commanded: Option<[f64; 3]>,
 }
 
 impl RobotEdge<'_> {
     /// Reads the robot for this tick; says so in the record when it is lost or back.
     fn read(&mut self, rec: &mut SlaveRecorder, n: u64) -> Result<Measured, SlaveError> {
-        let (reading, change) = self.robot.read(now_ns());
-        match reading {
-            Reading::Fresh(t) | Reading::Stale(t) => self.theta = t,
-            Reading::Lost => {}
-        }
-        self.lost = matches!(reading, Reading::Lost);
-        match change {
-            Change::Lost => {
-                let what = format!(
-                    "robot lost: {} silent past its timeout; holding its last safe reference",
-                    self.robot.describe()
-                );
-                tracing::warn!("{what}");
-                rec.event(n, what)?;
-            }
-            Change::Back => rec.event(n, format!("robot back: {}", self.robot.describe()))?,
-            Change::None => {}
+        let who = self.robot.describe();
+        let meanwhile = "holding its last safe reference";
+        let seen = self
+            .held
+            .take(self.robot.read(now_ns()), ("robot", &who), meanwhile);
+        if let Some(what) = seen {
+            rec.event(n, what)?;
         }
         Ok(Measured {
-            theta: self.theta,
+            theta: self.held.theta,
             force: self.robot.force(now_ns()),
         })
     }
 
     /// Commands `theta_ref`, or, while the robot is lost, the last reference it had.
     fn command(&mut self, theta_ref: [f64; 3]) {
-        if !self.lost {
+        if !self.held.lost {
             self.commanded = Some(theta_ref);
         }
         if let Some(r) = self.commanded {
@@ -103,22 +93,12 @@ impl RobotEdge<'_> {
     }
 }
 
-/// Waits until the robot has sent a good message; false if a stop request came.
+/// Waits (as long as it takes) until the robot has sent a good message; false if a
+/// stop request came.
 fn wait_for_robot(robot: &dyn Robot) -> Result<bool, SlaveError> {
-    let stop = tactile_node::signals::stop_flag().map_err(|e| SlaveError::Record(e.to_string()))?;
-    tracing::info!("waiting for {}", robot.describe());
-    let mut next_note = Instant::now() + Duration::from_secs(5);
-    while !robot.heard() {
-        if stop.load(std::sync::atomic::Ordering::Relaxed) {
-            return Ok(false);
-        }
-        if Instant::now() > next_note {
-            tracing::info!("still waiting for {}", robot.describe());
-            next_note += Duration::from_secs(5);
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    Ok(true)
+    let waited = wait_heard(&|| robot.heard(), &robot.describe(), None)
+        .map_err(|e| SlaveError::Record(e.to_string()))?;
+    Ok(waited == Waited::Heard)
 }
 
 /// The slave's recorder.
@@ -152,8 +132,7 @@ pub fn run_with<L: SlaveLink + ?Sized>(
             rec.event(0, format!("robot found: {}", r.describe()))?;
             Some(RobotEdge {
                 robot: r,
-                theta: [0.0; 3],
-                lost: false,
+                held: Held::default(),
                 commanded: None,
             })
         }
@@ -272,7 +251,7 @@ pub fn run_with<L: SlaveLink + ?Sized>(
         if rec.counters_due() {
             let t = totals(&slave, &filter, &robot);
             if let Some(r) = &robot {
-                tactile_node::device::log_second(
+                tactile_node::held::log_second(
                     "robot",
                     &mut robot_seen,
                     &t.device,

@@ -125,11 +125,6 @@ impl JointMap {
             (t - self.cfg.offset[i]) / (self.cfg.sign[i] * self.cfg.unit.radians())
         })
     }
-
-    /// The joint names, in the paper's order.
-    pub fn names(&self) -> &[String; 3] {
-        &self.names
-    }
 }
 
 /// A force from a CDR `WrenchStamped`, N; not finite is rejected.
@@ -358,26 +353,6 @@ pub trait LiveSink<S> {
     fn due(&self, n: u64) -> bool;
     /// Hands the state over (dropped and counted if the publisher is behind).
     fn offer(&mut self, state: S);
-}
-
-/// Logs, at most once a second (call it when the counters are due), the stale and
-/// lost ticks of `who` since the last call and what it sent that was dropped.
-pub fn log_second(
-    who: &str,
-    seen: &mut DeviceCounters,
-    now: &DeviceCounters,
-    reject: Option<Reject>,
-) {
-    if now.stale != seen.stale || now.lost != seen.lost || now.rejected != seen.rejected {
-        tracing::warn!(
-            "{who} in the last second: {} stale and {} lost ticks, {} messages dropped{}",
-            now.stale - seen.stale,
-            now.lost - seen.lost,
-            now.rejected - seen.rejected,
-            reject.map_or(String::new(), |r| format!(" (first: {r})"))
-        );
-    }
-    *seen = *now;
 }
 
 #[cfg(test)]

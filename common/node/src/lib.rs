@@ -8,6 +8,7 @@ pub mod device;
 pub mod exit;
 pub mod files;
 pub mod frames;
+pub mod held;
 pub mod ipc;
 pub mod link;
 #[cfg(feature = "zenoh")]

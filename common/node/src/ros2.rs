@@ -34,7 +34,7 @@ pub fn wall_ns() -> u64 {
 /// The session's Zenoh configuration: peer mode, the `[ros]` endpoints, no multicast
 /// scouting, otherwise Zenoh's defaults, which rmw_zenoh's router and nodes use (the
 /// loop link's low-latency transport would not connect to them).
-fn config(cfg: &RosConfig) -> Result<zenoh::Config, LinkError> {
+pub fn session_config(cfg: &RosConfig) -> Result<zenoh::Config, LinkError> {
     let mut c = zenoh::Config::default();
     let list = |v: &[String]| {
         let quoted: Vec<String> = v.iter().map(|e| format!("{e:?}")).collect();
@@ -79,7 +79,7 @@ impl std::fmt::Debug for RosNode {
 impl RosNode {
     /// Opens the session and declares node `name` in `[ros]`'s domain and namespace.
     pub fn open(cfg: &RosConfig, name: &str) -> Result<RosNode, LinkError> {
-        let session = zenoh::open(config(cfg)?)
+        let session = zenoh::open(session_config(cfg)?)
             .wait()
             .map_err(|e| err("opening the ROS 2 Zenoh session", e))?;
         let id = NodeId {
@@ -100,11 +100,6 @@ impl RosNode {
             next_id: AtomicU32::new(1),
             _token: token,
         })
-    }
-
-    /// The node's identity (domain, session id, name).
-    pub fn id(&self) -> &NodeId {
-        &self.id
     }
 
     /// `name` under the node's namespace (the live view's topics).
@@ -211,11 +206,6 @@ impl RosPublisher {
             .attachment(a.to_bytes().to_vec())
             .wait()
             .is_ok()
-    }
-
-    /// The topic.
-    pub fn topic(&self) -> &str {
-        &self.topic
     }
 }
 

@@ -6,7 +6,7 @@ use crate::error::Error;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use tactile_node::zlink::zenoh;
-use tactile_scenario::Scenario;
+use tactile_scenario::{RosConfig, Scenario};
 use zenoh::Wait as _;
 
 /// Messages a second each node's live view publishes in the bench.
@@ -30,14 +30,14 @@ impl Viewer {
             .port();
         let endpoint = format!("tcp/127.0.0.1:{port}");
         let failed = |e: zenoh::Error| Error::Failed(format!("the live view's viewer: {e}"));
-        let mut c = zenoh::Config::default();
-        for (k, v) in [
-            ("mode", "\"peer\"".to_string()),
-            ("listen/endpoints", format!("[{endpoint:?}]")),
-            ("scouting/multicast/enabled", "false".into()),
-        ] {
-            c.insert_json5(k, &v).map_err(failed)?;
-        }
+        // The nodes' own ROS 2 session settings, listening where they connect.
+        let cfg = RosConfig {
+            connect: Vec::new(),
+            listen: vec![endpoint.clone()],
+            ..RosConfig::default()
+        };
+        let c = tactile_node::ros2::session_config(&cfg)
+            .map_err(|e| Error::Failed(format!("the live view's viewer: {e}")))?;
         let session = zenoh::open(c).wait().map_err(failed)?;
         let received = Arc::new(AtomicU64::new(0));
         let count = Arc::clone(&received);
