@@ -7,7 +7,8 @@ use crate::util;
 use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};
 use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
-use tactile_node::ipc::{self, Inbox, Outbox};
+use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber};
+use tactile_transport::{Publish, Subscribe};
 use util::{column, Sandbox};
 
 fn spawn_run(sb: &Sandbox, scenario: &std::path::Path, out: &str) -> Child {
@@ -221,20 +222,20 @@ fn a_new_run_after_a_crash_starts_cleanly() {
 #[test]
 fn a_full_subscriber_buffer_loses_exactly_the_overwritten_samples() {
     let sb = Sandbox::new("overflow");
-    let _lock = tactile_node::lock::take(&sb.prefix, "run", "this test").expect("lock");
-    let node = ipc::node(&sb.prefix, "test").expect("node");
-    let out: Outbox<Forward> = Outbox::open(&node, "overflow", "nobody").expect("outbox");
-    let inbox: Inbox<Forward> = Inbox::open(&node, "overflow").expect("inbox");
+    let _lock = tactile_runtime::lock::take(&sb.prefix, "run", "this test").expect("lock");
+    let node = std::rc::Rc::new(ipc::node(&sb.prefix, "test").expect("node"));
+    let mut out = IpcPublisher::<Forward>::open(&node, "overflow", "nobody").expect("outbox");
+    let mut inbox = IpcSubscriber::<Forward>::open(&node, "overflow").expect("inbox");
     let total = 200u64;
     for n in 0..total {
-        let reached = out
-            .send(Forward {
-                seq: n,
-                ..Forward::default()
-            })
-            .expect("send");
-        assert_eq!(reached, 1);
+        let f = Forward {
+            seq: n,
+            ..Forward::default()
+        };
+        out.publish(f, false).expect("send");
     }
+    // Every publish reached the one subscriber.
+    assert_eq!(out.stats().no_receiver, 0);
     let mut got = Vec::new();
     while let Some(f) = inbox.try_recv().expect("recv") {
         got.push(f.seq);
@@ -249,11 +250,11 @@ fn a_full_subscriber_buffer_loses_exactly_the_overwritten_samples() {
     assert_eq!(st.overwritten, 0);
     // Now a second burst with the receiver established: every overwrite is counted.
     for n in total..total + 100 {
-        out.send(Forward {
+        let f = Forward {
             seq: n,
             ..Forward::default()
-        })
-        .expect("send");
+        };
+        out.publish(f, false).expect("send");
     }
     while inbox.try_recv().expect("recv").is_some() {}
     let st = inbox.stats();

@@ -166,7 +166,7 @@ fn master_here_slave_there(all_zenoh: bool) {
     // otherwise (ZENOH_RUNTIME), and its log says which runtimes it ran.
     for (dir, role) in [("a-master", "master"), ("b-emulator", "emulator")] {
         let log = std::fs::read_to_string(sb.path(dir).join(format!("{role}.log"))).expect("log");
-        let want = format!("Zenoh runtimes: {}", tactile_node::zlink::RUNTIME);
+        let want = format!("Zenoh runtimes: {}", tactile_transport::zenoh_link::RUNTIME);
         assert!(log.contains(&want), "{role}: {log}");
     }
 }
@@ -304,7 +304,7 @@ fn bad_payloads() -> Vec<Vec<u8>> {
         run: 1,
         ..Forward::default()
     };
-    tactile_node::wire::encode_forward(&f, &mut good).expect("encode");
+    tactile_transport::wire::encode(&f, &mut good).expect("encode");
     let mut other_version = good.clone();
     other_version[4] = other_version[4].wrapping_add(1);
     vec![
@@ -363,13 +363,15 @@ fn garbage_truncated_and_other_version_payloads_are_counted_and_dropped() {
         );
         std::thread::sleep(Duration::from_millis(5));
     }
-    let sessions: Vec<tactile_node::zlink::zenoh::Session> = at
+    let sessions: Vec<tactile_transport::zenoh_link::zenoh::Session> = at
         .iter()
         .map(|e| {
-            tactile_node::zlink::open_session(&tactile_node::zlink::ZenohOptions {
-                connect: vec![e.clone()],
-                ..Default::default()
-            })
+            tactile_transport::zenoh_link::open_session(
+                &tactile_transport::zenoh_link::ZenohOptions {
+                    connect: vec![e.clone()],
+                    ..Default::default()
+                },
+            )
             .expect("session")
         })
         .collect();
@@ -380,8 +382,10 @@ fn garbage_truncated_and_other_version_payloads_are_counted_and_dropped() {
             let key = format!("tactile/{p}/{stream}");
             for session in &sessions {
                 for b in &bad {
-                    tactile_node::zlink::zenoh::Wait::wait(session.put(key.as_str(), b.clone()))
-                        .expect("put");
+                    tactile_transport::zenoh_link::zenoh::Wait::wait(
+                        session.put(key.as_str(), b.clone()),
+                    )
+                    .expect("put");
                 }
             }
         }
@@ -414,7 +418,7 @@ fn garbage_datagrams_at_a_udp_node_are_counted_and_dropped() {
     let sb = Sandbox::new("udpjunk");
     let scenario = sb.write("s.toml", &util::paper_1khz(2000));
     let s = scenario.to_str().expect("utf-8");
-    let ports = tactile_node::udp::UdpPorts::free().expect("ports");
+    let ports = tactile_transport::udp::UdpPorts::free().expect("ports");
     let arg = ports.arg();
     let p = sb.prefix.clone();
     let args = |dir: &'static str| {
@@ -438,7 +442,7 @@ fn garbage_datagrams_at_a_udp_node_are_counted_and_dropped() {
     std::thread::sleep(Duration::from_millis(500));
     for _ in 0..50 {
         for b in bad_payloads() {
-            let _ = socket.send_to(&b, ("127.0.0.1", ports.slave));
+            let _ = socket.send_to(&b, ("127.0.0.1", ports.ports[2]));
         }
         std::thread::sleep(Duration::from_millis(5));
     }

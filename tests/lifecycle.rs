@@ -6,8 +6,8 @@ use crate::util;
 
 use std::path::Path;
 use std::time::Duration;
-use tactile_node::record::{Record, RecordReader};
-use tactile_slave::record::{SlaveSample, SlaveTotals};
+use tactile_records::slave::{SlaveSample, SlaveTotals};
+use tactile_records::{Record, RecordReader};
 use util::{finish, kill_once_recorded, start_node, wait_for, Sandbox};
 
 #[test]
@@ -16,7 +16,7 @@ fn a_node_stopped_by_sigint_exits_130_with_its_record_closed() {
     let scenario = sb.write("s.toml", &util::paper_1khz(1000));
     let slave = start_node(&sb, "slave", &scenario, "s", &[]);
     wait_for("the slave holds its lock", Duration::from_secs(10), || {
-        tactile_node::lock::in_use(&sb.prefix).is_err()
+        tactile_runtime::lock::in_use(&sb.prefix).is_err()
     });
     let pid = rustix::process::Pid::from_raw(slave.id() as i32).expect("pid");
     let _ = rustix::process::kill_process(pid, rustix::process::Signal::INT);

@@ -254,7 +254,7 @@ fn a_prefix_in_use_is_refused_and_names_its_holder() {
     util::wait_for(
         "the hand slave holds its lock",
         Duration::from_secs(10),
-        || tactile_node::lock::in_use(&sb.prefix).is_err(),
+        || tactile_runtime::lock::in_use(&sb.prefix).is_err(),
     );
     // A second slave by hand is refused before it starts.
     let o = sb
@@ -371,7 +371,7 @@ fn the_longest_prefix_allowed_runs_over_iceoryx2() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(sb.json("run", "summary.json")["samples_received"], 50);
-    tactile_node::ipc::remove_run_files(&prefix);
+    tactile_transport::ipc::remove_run_files(&prefix);
 }
 
 #[test]
@@ -547,7 +547,7 @@ fn unreadable_and_absurd_input_files_are_refused() {
 fn a_run_leaves_nothing_behind_and_cleans_only_dead_runs() {
     let sb = Sandbox::new("leftover");
     let scenario = sb.write("s.toml", &lockstep(300));
-    let root = Path::new(tactile_node::ipc::ROOT);
+    let root = Path::new(tactile_transport::ipc::ROOT);
     // A dead run's leftovers (a lock nobody holds, its iceoryx2 folder) and a live
     // run's (its lock held by this test).
     let dead = format!("{}d", sb.prefix);
@@ -556,11 +556,11 @@ fn a_run_leaves_nothing_behind_and_cleans_only_dead_runs() {
         std::fs::create_dir_all(root.join(p)).expect("folder");
         std::fs::write(root.join(p).join("node"), "x").expect("file");
     }
-    let locks = tactile_node::lock::lock_dir();
+    let locks = tactile_runtime::lock::lock_dir();
     std::fs::create_dir_all(&locks).expect("locks");
     let dead_lock = locks.join(format!("{dead}.slave.lock"));
     std::fs::write(&dead_lock, "a killed slave").expect("lock");
-    let held = tactile_node::lock::take(&live, "slave", "a live slave").expect("take");
+    let held = tactile_runtime::lock::take(&live, "slave", "a live slave").expect("take");
     sb.run(&scenario, "out");
     let mine: Vec<String> = std::fs::read_dir(&locks)
         .expect("locks")
@@ -592,5 +592,5 @@ fn a_run_leaves_nothing_behind_and_cleans_only_dead_runs() {
     );
     assert!(held.path.exists());
     drop(held);
-    tactile_node::ipc::remove_run_files(&live);
+    tactile_transport::ipc::remove_run_files(&live);
 }

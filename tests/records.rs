@@ -5,8 +5,8 @@
 use crate::util;
 
 use std::path::Path;
-use tactile_node::record::{Record, RecordReader};
-use tactile_slave::record::{SlaveSample, SlaveTotals};
+use tactile_records::slave::{SlaveSample, SlaveTotals};
+use tactile_records::{Record, RecordReader};
 use util::{column, finish, kill_once_recorded, start_node, Sandbox};
 
 type SlaveRecord = Record<SlaveSample, SlaveTotals>;

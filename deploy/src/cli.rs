@@ -12,7 +12,7 @@ use crate::error::Error;
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::process::ExitCode;
-use tactile_node::exit::EXIT_BAD_INPUT;
+use tactile_runtime::exit::EXIT_BAD_INPUT;
 
 /// Tactile: runtime and testbed for bilateral tactile-internet teleoperation.
 #[derive(Debug, Parser)]
@@ -91,12 +91,9 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Bench(args) => crate::cmd::bench::main(&args),
         Command::Report(args) => crate::cmd::report::main(&args),
         Command::Sweep(args) => crate::cmd::sweep::main(&args),
-        Command::BenchEcho(args) => crate::cmd::bench::echo(
-            &args.prefix,
-            tactile_node::link::WaitPolicy {
-                spin: std::time::Duration::from_micros(args.spin_us),
-            },
-        )
-        .map_err(|e| Error::Failed(e.to_string())),
+        Command::BenchEcho(args) => {
+            crate::cmd::bench::echo(&args.prefix, std::time::Duration::from_micros(args.spin_us))
+                .map_err(|e| Error::Failed(e.to_string()))
+        }
     }
 }

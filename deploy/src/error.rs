@@ -1,6 +1,6 @@
 //! The launcher's errors and the exit status each one maps to.
 
-use tactile_node::exit::{EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED};
+use tactile_runtime::exit::{EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED};
 use thiserror::Error;
 
 /// Everything the launcher can fail with.

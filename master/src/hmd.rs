@@ -12,9 +12,8 @@
 //! ([`MasterSide`]) decides what is sent for c(n) and which force comes of q(n).
 //! Either hand reaches the trajectory from the devices' home along [`Approach`].
 
-use crate::device::HeldDevice;
 use crate::operator::{Approach, OperatorSource, Target};
-use crate::record::{Answer, MasterCounters, Miss, Sent};
+use crate::simulated::HeldDevice;
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::{MasterForce, MasterSide};
 use tactile_math::engine::Engine;
@@ -23,6 +22,7 @@ use tactile_messages::samples::{
     stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_REJECTED,
     FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
+use tactile_records::master::{Answer, Effect, MasterCounters, Miss, Sent};
 use tactile_scenario::ControlKind;
 use tactile_scenario::{HandMode, MasterConfig, Scenario, ScenarioError};
 
@@ -320,15 +320,22 @@ impl Master {
             n: q.seq,
             q: q.signal,
             stamps: q.stamps,
+            effect: self.effect(flags, out),
+            round_trip_ns: 0,
+            overhead_ns: 0,
+            late: false,
+        }
+    }
+
+    /// What was commanded, and the books after it.
+    fn effect(&self, flags: u32, out: &MasterForce) -> Effect {
+        Effect {
             tau: self.last_tau,
             felt: self.last_felt,
             flags,
             observer: out.observer,
             port_net_j: self.control.ledger().net(),
             dissipated_j: out.dissipated,
-            round_trip_ns: 0,
-            overhead_ns: 0,
-            late: false,
         }
     }
 
@@ -358,12 +365,7 @@ impl Master {
         };
         Miss {
             n,
-            tau: self.last_tau,
-            felt: self.last_felt,
-            flags,
-            observer: out.observer,
-            port_net_j: self.control.ledger().net(),
-            dissipated_j: out.dissipated,
+            effect: self.effect(flags, &out),
         }
     }
 

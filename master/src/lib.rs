@@ -1,12 +1,13 @@
-//! The master side of the loop (the paper's OP, MD and HMD), as a library so the same
-//! code runs in the `tactile-master` program and in the in-process simulation.
+//! The master side of the loop (the paper's OP, MD and HMD): the operator's hand and
+//! its trajectories ([`operator`], [`trajectory`]), the simulated master device
+//! ([`simulated`]), the HMD kernels as a pure state machine ([`hmd`]), what the master
+//! does with each sample the loop's driver hands it ([`handler`]), and its program
+//! ([`node`]). The same handler runs in the `tactile-master` program and in the
+//! in-process simulation.
 
-pub mod device;
+pub mod handler;
 pub mod hmd;
-pub mod live;
 pub mod node;
 pub mod operator;
-pub mod outside;
-pub mod process;
-pub mod record;
+pub mod simulated;
 pub mod trajectory;

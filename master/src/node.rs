@@ -1,17 +1,17 @@
 //! The `tactile-master` program (HMD): its command line and its run, as a library so
 //! that `tactile run` and the tests can also call it.
 
+use crate::handler::MasterHandler;
+use crate::hmd::Master;
 use crate::operator::OperatorSource;
-use crate::process::{run_with, Ending, MasterOptions};
 use clap::Parser;
 use std::process::ExitCode;
 use std::time::Duration;
 use tactile_messages::Role;
-use tactile_node::args::{exit, parse, NodeArgs, NodeError};
-use tactile_node::exit::EXIT_CODES_HELP;
-use tactile_node::open::master_link;
-use tactile_node::recorder::Recorder;
-use tactile_node::runtime::{new_run_token, prepare, start_record};
+use tactile_runtime::args::{exit, parse, LinkKind, NodeArgs, NodeError};
+use tactile_runtime::exit::EXIT_CODES_HELP;
+use tactile_runtime::program::Program;
+use tactile_runtime::start::Links;
 
 /// tactile-master: the operator's side (OP, MD, HMD). Sends c(n), takes q(n) back,
 /// commands the master device's torques, and records every sample.
@@ -55,40 +55,30 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
             cli.startup_timeout_s
         )));
     }
-    if cli.direct && a.link != tactile_node::args::LinkKind::Zenoh {
+    if cli.direct && a.link.link != LinkKind::Zenoh {
         return Err(NodeError::BadInput(
             "--direct (no emulator) needs --link zenoh".into(),
         ));
     }
-    let p = prepare(Role::Master, a)?;
-    if crate::outside::needs_ros(&p.scenario) && !cfg!(feature = "zenoh") {
-        return Err(NodeError::BadInput(tactile_node::args::NO_ROS.into()));
-    }
-    let source = OperatorSource::load(&p.scenario.operator, &p.base_dir)
+    let links = Links {
+        direct: cli.direct,
+        ..Links::all(a.link.link)
+    };
+    let program = Program::prepare(Role::Master, a, links)?;
+    let sc = program.scenario();
+    let source = OperatorSource::load(&sc.operator, &program.prepared().base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: operator: {e}", a.scenario.display())))?;
-    for w in source.warnings(p.scenario.samples, p.scenario.t_s()) {
+    for w in source.warnings(sc.samples, sc.t_s()) {
         tracing::warn!("{w}");
     }
-    let mut rec = Recorder::open(&a.out, Role::Master, a.append)?;
-    rec.start(start_record(Role::Master, a, &p))?;
-    let opts = MasterOptions {
-        scenario: p.scenario.clone(),
-        base_dir: p.base_dir.clone(),
-        startup_timeout: Duration::from_secs_f64(cli.startup_timeout_s.min(1e6)),
-        answer_timeout: Duration::from_millis(100),
-        wake_early_ns: p.wake_early.as_nanos() as u64,
-        run: new_run_token(),
-    };
-    let ended = master_link(a, p.spin, cli.direct).and_then(|link| {
-        let mut ros = crate::outside::RosParts::open(&opts.scenario)?;
-        run_with(&opts, link.as_ref(), &mut rec, ros.outside())
-            .map_err(|e| NodeError::Failed(e.to_string()))
-    });
-    match ended {
-        Ok(e) => Ok(e == Ending::Completed),
-        Err(e) => {
-            let _ = rec.event(0, format!("failed: {e}"));
-            Err(e)
-        }
-    }
+    let timeout = Duration::from_secs_f64(cli.startup_timeout_s.min(1e6));
+    program.lead(
+        timeout,
+        Box::new(move |p, outside| {
+            let master =
+                Master::new(&p.scenario, source).map_err(|e| NodeError::Failed(e.to_string()))?;
+            let timeout = p.scenario.faults.peer_timeout_samples;
+            Ok(MasterHandler::new(master, outside.haptic.take(), timeout))
+        }),
+    )
 }

@@ -63,10 +63,10 @@ impl Trajectory {
     /// Reads and checks the file at `full`.
     pub fn read(full: &Path, end: TrajectoryEnd) -> Result<Trajectory, OperatorError> {
         let shown = full.display().to_string();
-        let text = tactile_node::files::read_text(
+        let text = tactile_runtime::files::read_text(
             full,
             "trajectory",
-            tactile_node::files::MAX_TRAJECTORY_BYTES,
+            tactile_runtime::files::MAX_TRAJECTORY_BYTES,
         )
         .map_err(OperatorError::Read)?;
         Trajectory::parse(&text, shown, end)

@@ -11,44 +11,13 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::{Deserialize, Serialize};
 use tactile_messages::samples::{
     Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
 use tactile_netem::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
 use tactile_netem::{Loss, Replay};
+use tactile_records::emulator::{Direction, EmulatorCounters, Fate, Passage};
 use tactile_scenario::{ChannelConfig, Scenario};
-
-/// What the emulator counted over a run.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct EmulatorCounters {
-    /// Forward samples passed.
-    pub forward: u64,
-    /// Backward samples passed.
-    pub backward: u64,
-    /// Forward samples with no new packet: the last value (or, before the first
-    /// arrival, the first value sent) passed again, flagged.
-    pub forward_substituted: u64,
-    /// Backward samples with a value substituted.
-    pub backward_substituted: u64,
-    /// Forward samples dropped on purpose (loss model).
-    pub forward_dropped: u64,
-    /// Backward samples dropped on purpose.
-    pub backward_dropped: u64,
-    /// Forward samples corrupted to NaN on purpose (fault injection).
-    pub forward_corrupted: u64,
-    /// Backward samples corrupted to NaN on purpose.
-    pub backward_corrupted: u64,
-    /// Forward packets the network lost (a loss model or a replay): no packet
-    /// arrived for them, and the receiver filled the sample from what it had.
-    pub forward_packets_lost: u64,
-    /// Backward packets the network lost.
-    pub backward_packets_lost: u64,
-    /// Forward packets sent twice (netem's duplicate).
-    pub forward_duplicated: u64,
-    /// Backward packets sent twice.
-    pub backward_duplicated: u64,
-}
 
 /// The seeded drop and corruption decisions of one channel. A random stream of its
 /// own, so enabling loss does not change the noise a run sees.
@@ -60,48 +29,6 @@ struct Faults {
     model: Option<(Loss, ChaCha8Rng)>,
     corrupt: f64,
     rng: ChaCha8Rng,
-}
-
-/// What the fault model decided for one sample.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Fate {
-    /// Passed on.
-    Deliver,
-    /// Passed on with its values replaced by NaN (fault injection).
-    Corrupt,
-    /// Dropped on purpose (loss model).
-    Drop,
-}
-
-/// Which channel a sample crossed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Direction {
-    /// Master to slave: c(n) in, v(n) out.
-    Forward,
-    /// Slave to master: h(n) in, q(n) out.
-    Backward,
-}
-
-/// The emulator's record of one sample it passed.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Passage {
-    /// Which channel.
-    pub dir: Direction,
-    /// Sample number.
-    pub n: u64,
-    /// The values that arrived.
-    pub input: [f64; 3],
-    /// What left (values, provenance, injected delay, flags); values as sent even when
-    /// dropped.
-    pub out: Signal,
-    /// Noise added to each value.
-    pub noise: [f64; 3],
-    /// Jitter drawn for this packet, samples (zero without a jitter model).
-    pub jitter: f64,
-    /// True if the network lost this packet (a loss model or a replay).
-    pub lost: bool,
-    /// Delivered, corrupted or dropped.
-    pub fate: Fate,
 }
 
 impl Faults {

@@ -1,7 +1,10 @@
-//! The network emulator (the paper's NW subsystem), as a library so the same code runs
-//! in the `tactile-emulator` program and in the in-process simulation.
+//! The network emulator (the paper's NW subsystem): both channels as pure logic
+//! ([`emulator`]), the recorded networks it replays ([`replay`]), what it does with
+//! each sample the loop's driver hands it ([`handler`]), and its program ([`node`]).
+//! The same handler runs in the `tactile-emulator` program and in the in-process
+//! simulation.
 
 pub mod emulator;
+pub mod handler;
 pub mod node;
-pub mod process;
 pub mod replay;

@@ -1,14 +1,14 @@
 //! The `tactile-emulator` program (NW): its command line and its run.
 
-use crate::process::run_with;
+use crate::emulator::Emulator;
+use crate::handler::EmulatorHandler;
 use clap::Parser;
 use std::process::ExitCode;
 use tactile_messages::Role;
-use tactile_node::args::{exit, parse, LinkKind, NodeArgs, NodeError};
-use tactile_node::exit::EXIT_CODES_HELP;
-use tactile_node::open::{check_link_args, emulator_link};
-use tactile_node::recorder::Recorder;
-use tactile_node::runtime::{prepare, start_record};
+use tactile_runtime::args::{exit, parse, LinkKind, NodeArgs, NodeError};
+use tactile_runtime::exit::EXIT_CODES_HELP;
+use tactile_runtime::program::Program;
+use tactile_runtime::start::Links;
 
 /// tactile-emulator: the network between master and slave. Delays, perturbs, drops
 /// and corrupts c(n) and h(n) as the scenario says (seeded), and records every sample.
@@ -39,29 +39,18 @@ pub fn main() -> ExitCode {
 /// request (`Ok(false)`).
 pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let a = &cli.node;
-    let towards_master = cli.master_link.unwrap_or(a.link);
-    let towards_slave = cli.slave_link.unwrap_or(a.link);
-    let p = prepare(Role::Emulator, a)?;
-    check_link_args(a, &[towards_master, towards_slave])?;
-    let replays = crate::replay::load(&p.scenario, &p.base_dir)
+    let links = Links {
+        master_side: cli.master_link.unwrap_or(a.link.link),
+        slave_side: cli.slave_link.unwrap_or(a.link.link),
+        direct: false,
+    };
+    let program = Program::prepare(Role::Emulator, a, links)?;
+    let replays = crate::replay::load(program.scenario(), &program.prepared().base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: {e}", a.scenario.display())))?;
-    let mut rec = Recorder::open(&a.out, Role::Emulator, a.append)?;
-    let mut start = start_record(Role::Emulator, a, &p);
-    if towards_master != towards_slave {
-        start.link = format!(
-            "towards the master {}, towards the slave {}; {}",
-            towards_master.name(),
-            towards_slave.name(),
-            start.link
-        );
-    }
-    rec.start(start)?;
-    tracing::info!("waiting for the master");
-    let ended = emulator_link(a, p.spin, towards_master, towards_slave).and_then(|link| {
-        run_with(&p.scenario, replays, link.as_ref(), &mut rec, p.wake_early)
-            .map_err(|e| NodeError::Failed(e.to_string()))
-    });
-    ended.inspect_err(|e| {
-        let _ = rec.event(0, format!("failed: {e}"));
-    })
+    program.follow(Box::new(move |p, _| {
+        Ok(EmulatorHandler::new(Emulator::with_replays(
+            &p.scenario,
+            replays,
+        )))
+    }))
 }

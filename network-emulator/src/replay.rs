@@ -27,7 +27,7 @@ pub fn load(scenario: &Scenario, base_dir: &Path) -> Result<[Option<Replay>; 2],
 fn read(field: &str, cfg: &ReplayConfig, base_dir: &Path) -> Result<Replay, String> {
     let path = base_dir.join(&cfg.path);
     let shown = path.display().to_string();
-    let text = tactile_node::files::read_text(&path, "replay", MAX_REPLAY_BYTES)
+    let text = tactile_runtime::files::read_text(&path, "replay", MAX_REPLAY_BYTES)
         .map_err(|e| format!("{field}: {e}"))?;
     let parsed = match cfg.format {
         ReplayFormat::Csv => Replay::parse_csv(&text),

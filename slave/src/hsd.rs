@@ -1,8 +1,8 @@
 //! The slave side's per-sample logic (HSD + SD + ENV) as a pure state machine.
 //!
 //! [`Slave::step`] takes the forward sample v(n) and returns the backward sample h(n).
-//! The process edge (`process.rs`) only moves samples and stamps times, and the
-//! in-process simulation calls the same function, so both compute identical values.
+//! Its handler ([`crate::handler`]) is what the loop's driver calls, in the node
+//! program and in the in-process simulation alike, so both compute identical values.
 //!
 //! One step: the channel's control (the received position itself, or TDPA's or the
 //! wave's reference) -> CPD (pass-through) -> IK-HSD -> JPD (pass-through) -> FCS (PID)
@@ -12,9 +12,8 @@
 //! The HSD kernels (IK, FK, FBF) run in the scenario's arithmetic; the physical world
 //! (the device's true tool position and the contact force on it) is f64.
 
-use crate::device::{Controller, Dynamics, JointState};
+use crate::arm::{Controller, Dynamics, JointState};
 use crate::environment::deepest_contact;
-use crate::record::{HoldStep, SlaveCounters, Step};
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::SlaveSide;
 use tactile_math::arith::StdTrig;
@@ -25,6 +24,7 @@ use tactile_math::vec3::distance;
 use tactile_messages::samples::{
     Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
+use tactile_records::slave::{HoldStep, SlaveCounters, Step};
 use tactile_scenario::{Object, Scenario, ScenarioError};
 
 /// The slave: HSD kernels, controller, device and environment.

@@ -1,11 +1,11 @@
-//! The slave side of the loop (the paper's HSD, SD and ENV), as a library so the same
-//! code runs in the `tactile-slave` program and in the in-process simulation.
+//! The slave side of the loop (the paper's HSD, SD and ENV): the simulated arm's
+//! controller and joint dynamics ([`arm`]), its environment ([`environment`]), the HSD
+//! kernels as a pure state machine ([`hsd`]), what the slave does with each sample the
+//! loop's driver hands it ([`handler`]), and its program ([`node`]). The same handler
+//! runs in the `tactile-slave` program and in the in-process simulation.
 
-pub mod device;
+pub mod arm;
 pub mod environment;
+pub mod handler;
 pub mod hsd;
-pub mod live;
 pub mod node;
-pub mod outside;
-pub mod process;
-pub mod record;

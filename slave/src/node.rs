@@ -1,14 +1,14 @@
 //! The `tactile-slave` program (HSD): its command line and its run.
 
-use crate::process::run_with;
+use crate::handler::SlaveHandler;
+use crate::hsd::Slave;
 use clap::Parser;
 use std::process::ExitCode;
 use tactile_messages::Role;
-use tactile_node::args::{exit, parse, NodeArgs, NodeError};
-use tactile_node::exit::EXIT_CODES_HELP;
-use tactile_node::open::slave_link;
-use tactile_node::recorder::Recorder;
-use tactile_node::runtime::{prepare, start_record};
+use tactile_runtime::args::{exit, parse, NodeArgs, NodeError};
+use tactile_runtime::exit::EXIT_CODES_HELP;
+use tactile_runtime::program::Program;
+use tactile_runtime::start::Links;
 
 /// tactile-slave: the remote side (HSD, SD, ENV). Follows v(n) with the slave arm,
 /// senses contact, sends the force h(n) back, and records every step.
@@ -36,29 +36,13 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// Runs the emulator until the master's end-of-run sample (`Ok(true)`) or a stop
-/// request (`Ok(false)`).
+/// Runs the slave until the master's end-of-run sample (`Ok(true)`) or a stop request
+/// (`Ok(false)`).
 pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let a = &cli.node;
-    let p = prepare(Role::Slave, a)?;
-    if crate::outside::needs_ros(&p.scenario) && !cfg!(feature = "zenoh") {
-        return Err(NodeError::BadInput(tactile_node::args::NO_ROS.into()));
-    }
-    let mut rec = Recorder::open(&a.out, Role::Slave, a.append)?;
-    rec.start(start_record(Role::Slave, a, &p))?;
-    tracing::info!("waiting for the master");
-    let ended = slave_link(a, p.spin).and_then(|link| {
-        let mut ros = crate::outside::RosParts::open(&p.scenario)?;
-        run_with(
-            &p.scenario,
-            link.as_ref(),
-            &mut rec,
-            p.wake_early,
-            ros.outside(),
-        )
-        .map_err(|e| NodeError::Failed(e.to_string()))
-    });
-    ended.inspect_err(|e| {
-        let _ = rec.event(0, format!("failed: {e}"));
-    })
+    let program = Program::prepare(Role::Slave, a, Links::all(a.link.link))?;
+    program.follow(Box::new(|p, outside| {
+        let slave = Slave::new(&p.scenario).map_err(|e| NodeError::Failed(e.to_string()))?;
+        Ok(SlaveHandler::new(slave, &p.scenario, outside.robot.take()))
+    }))
 }

@@ -197,7 +197,7 @@ impl Sandbox {
 
 impl Drop for Sandbox {
     fn drop(&mut self) {
-        tactile_node::ipc::remove_run_files(&self.prefix);
+        tactile_transport::ipc::remove_run_files(&self.prefix);
     }
 }
 
@@ -331,7 +331,7 @@ pub fn cannot(what: &str) {
 /// True if this process may use SCHED_FIFO, decided by trying it on a thread of its
 /// own (root without CAP_SYS_NICE may not, a user with the limit raised may).
 pub fn fifo_permitted() -> bool {
-    std::thread::spawn(|| tactile_node::sched::set_thread_fifo(1).is_ok())
+    std::thread::spawn(|| tactile_runtime::sched::set_thread_fifo(1).is_ok())
         .join()
         .unwrap_or(false)
 }

@@ -228,14 +228,6 @@ impl Scenario {
         w
     }
 
-    /// True if any node reaches ROS 2: a ros2 backend on either side, or the live
-    /// view (such a run needs the node programs built with the `zenoh` feature).
-    pub fn uses_ros(&self) -> bool {
-        self.master.backend == Backend::Ros2
-            || self.slave.backend == Backend::Ros2
-            || self.ros.live.enabled
-    }
-
     /// Sampling period t_s in seconds.
     pub fn t_s(&self) -> f64 {
         1.0 / self.rate_hz

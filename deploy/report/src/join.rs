@@ -12,14 +12,12 @@ use crate::Error;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
-use tactile_master::record::{Answer, MasterSample, MasterTotals, Miss, Sent};
 use tactile_messages::samples::{stage, LATE_WINDOW};
 use tactile_messages::Role;
-use tactile_network_emulator::emulator::{Direction, Passage};
-use tactile_network_emulator::process::EmulatorTotals;
-use tactile_node::record::{Damage, Record, RecordReader, Start, Totals};
-use tactile_node::recorder::record_path;
-use tactile_slave::record::{SlaveSample, SlaveTotals, Step};
+use tactile_records::emulator::{Direction, EmulatorTotals, Passage};
+use tactile_records::master::{Answer, MasterSample, MasterTotals, Miss, Sent};
+use tactile_records::slave::{SlaveSample, SlaveTotals, Step};
+use tactile_records::{record_path, Damage, Record, RecordReader, Start, Totals};
 
 /// Events kept per node in the report; further ones are counted, not kept, so a node
 /// that broke a million times still gives a readable report.
@@ -357,24 +355,19 @@ fn row(
         r.q = a.q.value;
         r.delay_b = a.q.delay_samples;
         r.flags_b = a.q.flags;
-        r.tau = a.tau;
-        r.felt = a.felt;
-        r.flags_m = a.flags;
-        r.observer_m = a.observer;
-        r.dissipated_m = a.dissipated_j;
-        r.port_net_m = a.port_net_j;
         r.q_from = a.q.sent_seq;
         r.q_origin = a.q.origin_seq;
         r.round_trip_ns = a.round_trip_ns;
         r.overhead_ns = a.overhead_ns;
         r.stamps = Stamps(a.stamps);
-    } else if let Some(m) = miss {
-        r.tau = m.tau;
-        r.felt = m.felt;
-        r.flags_m = m.flags;
-        r.observer_m = m.observer;
-        r.dissipated_m = m.dissipated_j;
-        r.port_net_m = m.port_net_j;
+    }
+    if let Some(e) = answer.map(|a| &a.effect).or(miss.map(|m| &m.effect)) {
+        r.tau = e.tau;
+        r.felt = e.felt;
+        r.flags_m = e.flags;
+        r.observer_m = e.observer;
+        r.dissipated_m = e.dissipated_j;
+        r.port_net_m = e.port_net_j;
     }
     for p in passages {
         match p.dir {

@@ -4,8 +4,8 @@
 
 use super::*;
 use tactile_messages::samples::Signal;
-use tactile_network_emulator::emulator::Fate;
-use tactile_node::record::{RecordWriter, Start};
+use tactile_records::emulator::Fate;
+use tactile_records::{RecordWriter, Start};
 
 const N: u64 = 3000;
 const RUN: u64 = 7;
@@ -23,7 +23,7 @@ fn start(role: &str, clock: &str) -> Start {
         scenario_toml: "name = \"t\"\n".into(),
         samples: N,
         rate_hz: 1000.0,
-        sched: tactile_node::sched::Sched::default(),
+        sched: tactile_records::Sched::default(),
         unix_ms: 0,
         mono_ns: 0,
     }
@@ -43,7 +43,7 @@ fn writer<S: serde::Serialize, C: serde::Serialize>(
     run: u64,
 ) -> RecordWriter<Record<S, C>> {
     std::fs::create_dir_all(dir).expect("folder");
-    let path = tactile_node::recorder::record_path(dir, role);
+    let path = tactile_records::record_path(dir, role);
     let mut w = RecordWriter::create(&path, false).expect("record");
     w.write(&Record::Start(start(role.name(), clock)))
         .expect("write");

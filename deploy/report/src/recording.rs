@@ -13,10 +13,10 @@ use std::io::{self, Write};
 use tactile_math::geometry::Geometry;
 use tactile_messages::samples::stage;
 use tactile_ros::msg::{
-    Header, JointState, Marker, MarkerArray, PoseStamped, SampleTiming, StringMsg, TfMessage,
-    TransformStamped, WrenchStamped, IDENTITY,
+    Header, Marker, MarkerArray, SampleTiming, StringMsg, TfMessage, TransformStamped, IDENTITY,
 };
 use tactile_ros::topics::TOPICS;
+use tactile_ros::view::{self, At, MasterView, SampleView, SlaveView, Typed};
 use tactile_ros::{arm, schema, urdf, CdrWriter, Message};
 use tactile_scenario::Object;
 use tactile_scenario::{Mode, Scenario};
@@ -75,13 +75,18 @@ impl<W: Write> Recording<W> {
         })
     }
 
-    fn put<M: Message>(&mut self, topic: &str, m: &M, log: u64, publish: u64) -> io::Result<()> {
-        let k = TOPICS.iter().position(|t| t.name == topic).unwrap_or(0);
+    fn put<M: Message>(
+        &mut self,
+        topic: Typed<M>,
+        m: &M,
+        log: u64,
+        publish: u64,
+    ) -> io::Result<()> {
         self.cdr.reset();
         m.encode(&mut self.cdr);
         self.sequence = self.sequence.wrapping_add(1);
         self.mcap.message(
-            self.channels[k],
+            self.channels[topic.index()],
             self.sequence,
             log,
             publish,
@@ -91,18 +96,7 @@ impl<W: Write> Recording<W> {
 
     /// Adds one sample's messages.
     pub fn add(&mut self, row: &TraceRow) -> io::Result<()> {
-        let tick = row.stamps[stage::MASTER_TICK];
-        let nominal = (row.n as f64 * self.t_s_ns) as u64;
-        let log = match &mut self.nominal {
-            // The origin is the first sample's tick less its own nominal time.
-            Some(origin) => *origin.get_or_insert(tick.saturating_sub(nominal)) + nominal,
-            None if tick > 0 => tick,
-            None => nominal,
-        };
-        let at = |s: usize| match row.stamps[s] {
-            0 => log,
-            t => t,
-        };
+        let log = self.log_time(row);
         if self.prev.is_none() {
             self.first(log)?;
         }
@@ -110,10 +104,52 @@ impl<W: Write> Recording<W> {
             self.environment(log)?;
         }
         let (vm, vs) = self.velocities(row);
-        let g = self.geometry;
+        self.put(view::TF, &self.transforms(row, log), log, log)?;
+        let sample = SampleView {
+            master: Some(MasterView {
+                theta: row.theta_md,
+                velocity: Some(vm),
+                tau: row.tau,
+                target: row.target,
+                handle: row.handle,
+                q: row.q,
+                felt: row.felt,
+            }),
+            slave: Some(SlaveView {
+                theta: row.theta_sd,
+                velocity: Some(vs),
+                torque: row.u,
+                tool: row.tool,
+                force: row.h,
+            }),
+            timing: Some(timing(row)),
+        };
+        let mut sink = Stamped {
+            rec: self,
+            log,
+            stamps: row.stamps.0,
+        };
+        sample.emit(log, &mut sink)
+    }
+
+    /// The sample's log time: its tick on the master's clock, or in lockstep its
+    /// nominal time after the first tick.
+    fn log_time(&mut self, row: &TraceRow) -> u64 {
+        let tick = row.stamps[stage::MASTER_TICK];
+        let nominal = (row.n as f64 * self.t_s_ns) as u64;
+        match &mut self.nominal {
+            // The origin is the first sample's tick less its own nominal time.
+            Some(origin) => *origin.get_or_insert(tick.saturating_sub(nominal)) + nominal,
+            None if tick > 0 => tick,
+            None => nominal,
+        }
+    }
+
+    /// Both arms' link transforms at the row's angles.
+    fn transforms(&self, row: &TraceRow, log: u64) -> TfMessage {
         let mut tf = TfMessage::default();
         for (name, theta) in [("master", row.theta_md), ("slave", row.theta_sd)] {
-            for (parent, child, translation, rotation) in arm::links(&g, name, theta) {
+            for (parent, child, translation, rotation) in arm::links(&self.geometry, name, theta) {
                 tf.transforms.push(TransformStamped {
                     header: Header::at(log, &parent),
                     child_frame_id: child,
@@ -122,74 +158,7 @@ impl<W: Write> Recording<W> {
                 });
             }
         }
-        self.put("/tf", &tf, log, log)?;
-        let joints = |a: &str, p: [f64; 3], v: [f64; 3], e: [f64; 3]| JointState {
-            header: Header::at(log, ""),
-            name: arm::joint_names(a),
-            position: p.to_vec(),
-            velocity: v.to_vec(),
-            effort: e.to_vec(),
-        };
-        let master_at = at(stage::MASTER_TICK);
-        let slave_at = at(stage::SLAVE_SEND);
-        let back_at = at(stage::MASTER_RECV);
-        self.put(
-            "/master/joint_states",
-            &joints("master", row.theta_md, vm, row.tau),
-            log,
-            master_at,
-        )?;
-        self.put(
-            "/slave/joint_states",
-            &joints("slave", row.theta_sd, vs, row.u),
-            log,
-            slave_at,
-        )?;
-        let pose = |frame: &str, p: [f64; 3]| PoseStamped {
-            header: Header::at(log, frame),
-            position: p,
-            orientation: IDENTITY,
-        };
-        self.put(
-            "/master/target",
-            &pose("master_base", row.target),
-            log,
-            master_at,
-        )?;
-        self.put(
-            "/master/handle",
-            &pose("master_base", row.handle),
-            log,
-            master_at,
-        )?;
-        self.put("/slave/tool", &pose("slave_base", row.tool), log, slave_at)?;
-        let wrench = |frame: &str, f: [f64; 3]| WrenchStamped {
-            header: Header::at(log, frame),
-            force: f,
-            torque: [0.0; 3],
-        };
-        self.put("/slave/force", &wrench("slave_base", row.h), log, slave_at)?;
-        self.put("/master/force", &wrench("master_base", row.q), log, back_at)?;
-        self.put(
-            "/master/felt",
-            &wrench("master_base", row.felt),
-            log,
-            back_at,
-        )?;
-        let timing = SampleTiming {
-            sample: row.n,
-            answered: row.received,
-            round_trip_ns: i64::try_from(row.round_trip_ns).unwrap_or(i64::MAX),
-            overhead_ns: row.overhead_ns,
-            delay_forward: row.delay_f,
-            delay_backward: row.delay_b,
-            flags_forward: row.flags_f,
-            flags_backward: row.flags_b,
-            flags_master: row.flags_m,
-            observer_master: row.observer_m,
-            observer_slave: row.observer_s,
-        };
-        self.put("/tactile/timing", &timing, log, at(stage::MASTER_DONE))
+        tf
     }
 
     /// Backward differences of both arms' angles, rad/s (0 at the first sample).
@@ -213,7 +182,7 @@ impl<W: Write> Recording<W> {
         let description = StringMsg {
             data: urdf::urdf(&self.geometry),
         };
-        self.put("/robot_description", &description, log, log)?;
+        self.put(view::ROBOT_DESCRIPTION, &description, log, log)?;
         let transforms = arm::fixed(&self.geometry)
             .into_iter()
             .map(|(parent, child, translation, rotation)| TransformStamped {
@@ -223,7 +192,7 @@ impl<W: Write> Recording<W> {
                 rotation,
             })
             .collect();
-        self.put("/tf_static", &TfMessage { transforms }, log, log)
+        self.put(view::TF_STATIC, &TfMessage { transforms }, log, log)
     }
 
     fn environment(&mut self, log: u64) -> io::Result<()> {
@@ -233,12 +202,54 @@ impl<W: Write> Recording<W> {
             .enumerate()
             .map(|(k, o)| marker(o, k as i32, log))
             .collect();
-        self.put("/slave/environment", &MarkerArray { markers }, log, log)
+        self.put(view::SLAVE_ENVIRONMENT, &MarkerArray { markers }, log, log)
     }
 
     /// Writes the summary and the footer.
     pub fn finish(self) -> io::Result<W> {
         self.mcap.finish()
+    }
+}
+
+/// A row's timing as the recording shows it.
+fn timing(row: &TraceRow) -> SampleTiming {
+    SampleTiming {
+        sample: row.n,
+        answered: row.received,
+        round_trip_ns: i64::try_from(row.round_trip_ns).unwrap_or(i64::MAX),
+        overhead_ns: row.overhead_ns,
+        delay_forward: row.delay_f,
+        delay_backward: row.delay_b,
+        flags_forward: row.flags_f,
+        flags_backward: row.flags_b,
+        flags_master: row.flags_m,
+        observer_master: row.observer_m,
+        observer_slave: row.observer_s,
+    }
+}
+
+/// A sample's messages into the recording, each published at its stage's stamp (or
+/// the log time where that stage was not passed).
+struct Stamped<'a, W: Write> {
+    rec: &'a mut Recording<W>,
+    log: u64,
+    stamps: [u64; stage::COUNT],
+}
+
+impl<W: Write> view::Sink for Stamped<'_, W> {
+    type Error = io::Error;
+    fn put<M: Message>(&mut self, topic: Typed<M>, at: At, m: &M) -> io::Result<()> {
+        let s = match at {
+            At::MasterTick => stage::MASTER_TICK,
+            At::SlaveSend => stage::SLAVE_SEND,
+            At::MasterRecv => stage::MASTER_RECV,
+            At::MasterDone => stage::MASTER_DONE,
+        };
+        let publish = match self.stamps[s] {
+            0 => self.log,
+            t => t,
+        };
+        self.rec.put(topic, m, self.log, publish)
     }
 }
 

@@ -6,10 +6,10 @@ use crate::metrics::{Contact, Packets, Passivity, Tracking};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
-use tactile_master::record::MasterTotals;
-use tactile_network_emulator::process::EmulatorTotals;
+use tactile_records::emulator::EmulatorTotals;
+use tactile_records::master::MasterTotals;
+use tactile_records::slave::SlaveTotals;
 use tactile_scenario::Mode;
-use tactile_slave::record::SlaveTotals;
 
 /// Files a report writes into its folder.
 pub const REPORT_FILES: [&str; 11] = [
@@ -50,9 +50,9 @@ pub struct ChannelCount {
 impl ChannelCount {
     /// The accounting of a stream from its sender's and receiver's counts.
     pub fn new(
-        out: tactile_node::link::OutboxStats,
+        out: tactile_messages::stream::OutboxStats,
         dropped: u64,
-        inn: tactile_node::link::InboxStats,
+        inn: tactile_messages::stream::InboxStats,
     ) -> Self {
         let offered = out.published + dropped;
         let received = inn.received;
@@ -111,7 +111,7 @@ pub struct NodeSummary {
     pub damage: Vec<[u64; 2]>,
     /// Its scheduling (policy, priority, CPU, wake-up margin, poll budget) as its
     /// last start recorded it; `note` says what the kernel refused.
-    pub sched: tactile_node::sched::Sched,
+    pub sched: tactile_records::Sched,
 }
 
 /// The nodes' clocks.
@@ -327,8 +327,8 @@ pub fn render(s: &Summary, out: &Path) -> String {
             c.ik_clamped, c.rejected, c.torque_clamps, c.holds
         );
     }
-    let dev = |t: &mut String, who: &str, d: &tactile_node::device::DeviceCounters| {
-        if *d != tactile_node::device::DeviceCounters::default() {
+    let dev = |t: &mut String, who: &str, d: &tactile_records::device::DeviceCounters| {
+        if *d != tactile_records::device::DeviceCounters::default() {
             let _ = writeln!(
                 t,
                 "{who} over ROS 2: {} messages, {} dropped (malformed, missing joint, not finite, out of range); ticks fresh {}, stale {}, lost {} ({} losses); {} published, {} failed",
@@ -379,7 +379,7 @@ pub fn render(s: &Summary, out: &Path) -> String {
 }
 
 /// A node's scheduling in one line, with what the kernel refused.
-fn sched_line(s: &tactile_node::sched::Sched) -> String {
+fn sched_line(s: &tactile_records::Sched) -> String {
     let mut t = s.policy.clone();
     if s.priority > 0 {
         t += &format!(" {}", s.priority);

@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_messages::Role;
-use tactile_node::record::Start;
+use tactile_records::Start;
 use tactile_scenario::Scenario;
 
 /// The link name an in-process simulation records.

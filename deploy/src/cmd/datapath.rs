@@ -109,10 +109,10 @@ impl DatapathArgs {
             return Ok(g);
         }
         let path = PathBuf::from(&self.device);
-        let text = tactile_node::files::read_text(
+        let text = tactile_runtime::files::read_text(
             &path,
             "device file",
-            tactile_node::files::MAX_DEVICE_BYTES,
+            tactile_runtime::files::MAX_DEVICE_BYTES,
         )
         .map_err(|e| {
             Error::BadInput(format!(

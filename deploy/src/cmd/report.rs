@@ -46,7 +46,7 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
         return Ok(());
     }
     let stop =
-        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
+        tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let launch = Launch {
         no_trace: args.no_trace,
         stop: Some(stop),

@@ -6,8 +6,8 @@ use crate::launch::{self, load_scenario, parse_sets, Links, Supervision};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Duration;
-use tactile_node::args::LinkKind;
 use tactile_report::summary::render;
+use tactile_runtime::args::LinkKind;
 
 /// Arguments of `tactile run`.
 #[derive(Debug, Args)]
@@ -53,8 +53,8 @@ pub struct RunArgs {
     /// What carries the samples between the nodes on this host: iceoryx2 (shared
     /// memory), udp (loopback datagrams, the reference) or zenoh (loopback TCP; across
     /// hosts, start the nodes by hand, see docs/03-across-hosts.md).
-    #[arg(long, value_enum, default_value_t = tactile_node::args::LinkKind::Iceoryx2)]
-    pub link: tactile_node::args::LinkKind,
+    #[arg(long, value_enum, default_value_t = tactile_runtime::args::LinkKind::Iceoryx2)]
+    pub link: tactile_runtime::args::LinkKind,
     /// Shorthand for --link udp.
     #[arg(long, conflicts_with = "link")]
     pub udp: bool,
@@ -65,14 +65,14 @@ pub struct RunArgs {
     /// Scheduling the nodes set on themselves: fifo (SCHED_FIFO at priority 70 with
     /// memory locked, where permitted; otherwise SCHED_OTHER, said in the report) or
     /// other.
-    #[arg(long, value_enum, default_value_t = tactile_node::sched::Policy::Fifo)]
-    pub sched: tactile_node::sched::Policy,
+    #[arg(long, value_enum, default_value_t = tactile_runtime::sched::Policy::Fifo)]
+    pub sched: tactile_runtime::sched::Policy,
     /// What each node's CPU does while the node sleeps, under SCHED_FIFO: halt (the
     /// kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so a
     /// halted CPU is not woken late; on these virtual machines a CPU kept busy is
     /// taken away for about 7.5 ms every 10 s instead: docs/07-latency.md).
-    #[arg(long, value_enum, default_value_t = tactile_node::sched::IdleMode::Halt)]
-    pub idle: tactile_node::sched::IdleMode,
+    #[arg(long, value_enum, default_value_t = tactile_runtime::sched::IdleMode::Halt)]
+    pub idle: tactile_runtime::sched::IdleMode,
     /// Write no trace.csv and no run.mcap (a long run's trace is about 1 kB per
     /// sample, its recording about 0.75 kB); everything
     /// else is reported.

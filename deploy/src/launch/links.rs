@@ -5,7 +5,7 @@ use crate::error::Error;
 use std::path::Path;
 use std::process::Command;
 use tactile_messages::Role;
-use tactile_node::args::LinkKind;
+use tactile_runtime::args::LinkKind;
 
 /// The link of a run on one host, with the options each node needs for it.
 #[derive(Debug, Clone)]
@@ -21,13 +21,13 @@ impl Links {
     /// emulator listening on a free loopback TCP port and the others connecting to it.
     pub fn on_this_host(kind: LinkKind) -> Result<Links, Error> {
         if kind == LinkKind::Zenoh && !cfg!(feature = "zenoh") {
-            return Err(Error::BadInput(tactile_node::open::NO_ZENOH.into()));
+            return Err(Error::BadInput(tactile_transport::options::NO_ZENOH.into()));
         }
         let failed = |e: std::io::Error| Error::Failed(format!("picking a free port: {e}"));
         let args = match kind {
             LinkKind::Iceoryx2 => Default::default(),
             LinkKind::Udp => {
-                let p = tactile_node::udp::UdpPorts::free()
+                let p = tactile_transport::udp::UdpPorts::free()
                     .map_err(|e| Error::Failed(e.to_string()))?
                     .arg();
                 let a = vec!["--udp-ports".to_string(), p];

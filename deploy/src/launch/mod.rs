@@ -15,7 +15,7 @@ pub use scenario::{load_scenario, parse_sets, prepare_out, Loaded, PAPER_SCENARI
 pub use supervise::run_processes;
 
 use std::time::Duration;
-use tactile_node::args::LinkKind;
+use tactile_runtime::args::LinkKind;
 use tactile_scenario::Scenario;
 
 /// How `tactile run` supervises its processes.
@@ -39,9 +39,9 @@ pub struct Supervision {
     /// Pin master to CPU 0, emulator and slave to CPU 1.
     pub pin: bool,
     /// Scheduling of the three processes, which each node sets on itself.
-    pub sched: tactile_node::sched::Policy,
+    pub sched: tactile_runtime::sched::Policy,
     /// What each node's CPU does while the node sleeps (realtime, SCHED_FIFO).
-    pub idle: tactile_node::sched::IdleMode,
+    pub idle: tactile_runtime::sched::IdleMode,
     /// Write no trace.csv and no run.mcap.
     pub no_trace: bool,
 }
@@ -61,8 +61,8 @@ pub fn sweep_supervision(no_trace: bool) -> Supervision {
         },
         wrap: Default::default(),
         pin: true,
-        sched: tactile_node::sched::Policy::Fifo,
-        idle: tactile_node::sched::IdleMode::Halt,
+        sched: tactile_runtime::sched::Policy::Fifo,
+        idle: tactile_runtime::sched::IdleMode::Halt,
         no_trace,
     }
 }
@@ -77,20 +77,21 @@ pub fn two_cpus() -> bool {
 /// (a crashed or killed run leaves them; iceoryx2 would clean them only for the same
 /// prefix). A live run's are never touched: each of its processes holds its lock.
 pub fn clean_stale_runs() {
-    tactile_node::lock::clean_stale();
-    let Ok(dir) = std::fs::read_dir(tactile_node::ipc::ROOT) else {
+    tactile_runtime::lock::clean_stale();
+    let Ok(dir) = std::fs::read_dir(tactile_transport::ipc::ROOT) else {
         return;
     };
     for entry in dir.flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
-        let is_prefix = tactile_node::lock::check_prefix(&name).is_ok() && entry.path().is_dir();
+        let is_prefix = tactile_runtime::lock::check_prefix(&name).is_ok() && entry.path().is_dir();
         if !is_prefix {
             continue;
         }
         // Every lock of the prefix held while its files go, so no node of it starts
         // meanwhile (one that tries finds its prefix in use).
-        if let Some(_locks) = tactile_node::lock::take_all(&name, "tactile cleaning a dead run") {
-            tactile_node::ipc::remove_run_files(&name);
+        if let Some(_locks) = tactile_runtime::lock::take_all(&name, "tactile cleaning a dead run")
+        {
+            tactile_transport::ipc::remove_run_files(&name);
         }
     }
 }
@@ -98,5 +99,5 @@ pub fn clean_stale_runs() {
 /// How long the launcher lets the emulator and slave run on after the master died:
 /// long enough for the slave to notice and hold (its peer timeout) and to be seen.
 pub fn survivor_grace(scenario: &Scenario) -> Duration {
-    tactile_slave::process::hold_timeout(scenario) + Duration::from_millis(500)
+    tactile_slave::handler::hold_timeout(scenario) + Duration::from_millis(500)
 }

@@ -6,8 +6,8 @@ use crate::error::Error;
 use std::path::{Path, PathBuf};
 use tactile_master::operator::OperatorSource;
 use tactile_messages::Role;
-use tactile_node::files::{self, same_file};
 use tactile_report::write::REPORT_FILES;
+use tactile_runtime::files::{self, same_file};
 use tactile_scenario::overrides::Set;
 use tactile_scenario::{Operator, Scenario};
 
@@ -61,10 +61,10 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
         };
         Error::BadInput(format!("{name}{with}: {}", msg.trim_end()))
     })?;
-    if scenario.uses_ros() && !cfg!(feature = "zenoh") {
+    if tactile_runtime::outside::ros_in_run(&scenario) && !cfg!(feature = "zenoh") {
         return Err(Error::BadInput(format!(
             "{name}: {}",
-            tactile_node::args::NO_ROS
+            tactile_runtime::outside::NO_ROS
         )));
     }
     let source = OperatorSource::load(&scenario.operator, &base_dir)

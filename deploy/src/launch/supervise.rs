@@ -13,9 +13,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_messages::Role;
-use tactile_node::exit::{EXIT_BAD_INPUT, EXIT_INTERRUPTED};
 use tactile_report::summary::Summary;
 use tactile_report::write::{write_report, Launch};
+use tactile_runtime::exit::{EXIT_BAD_INPUT, EXIT_INTERRUPTED};
 use tactile_scenario::{Mode, Scenario};
 
 /// Wait before restarting a dead process: a process that dies at once again must not
@@ -387,13 +387,14 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     // Every check that can refuse the run comes before anything starts or is written:
     // a prefix held by any process (a launcher, a node started by hand), the output
     // folder, the node programs.
-    tactile_node::lock::in_use(&sup.prefix).map_err(Error::BadInput)?;
+    tactile_runtime::lock::in_use(&sup.prefix).map_err(Error::BadInput)?;
     let holder = format!(
         "tactile run (pid {}, writing to {})",
         std::process::id(),
         out.display()
     );
-    let _lock = tactile_node::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
+    let _lock =
+        tactile_runtime::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
     let dir = nodes::node_dir()?;
     let bundled = prepare_out(out, loaded)?;
     // The nodes run the scenario as written here, reading the copies of its inputs
@@ -423,11 +424,11 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
             .map_err(|e| Error::Failed(format!("cannot start {}: {e}", exe.display())))
     };
     let stop: Arc<AtomicBool> =
-        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
+        tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let mut run = Supervisor::start(&sup, &spawn, out, notes)?;
     run.watch(&loaded.scenario, &stop)?;
     let w = run.finish();
-    tactile_node::ipc::remove_run_files(&sup.prefix);
+    tactile_transport::ipc::remove_run_files(&sup.prefix);
     report(out, w, sup.no_trace)
 }
 
@@ -446,7 +447,7 @@ fn report(out: &Path, w: Watch, no_trace: bool) -> Result<Summary, Error> {
         events: w.events,
         failed: w.failed,
         no_trace,
-        stop: tactile_node::signals::stop_flag().ok(),
+        stop: tactile_runtime::signals::stop_flag().ok(),
         ..Launch::default()
     };
     let launch = if w.interrupted {

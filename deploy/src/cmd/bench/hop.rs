@@ -7,25 +7,41 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{Forward, FLAG_END, FLAG_PROBE};
-use tactile_node::ipc::{self, Inbox, Outbox, Waker};
-use tactile_node::link::{Idle, LinkError, WaitPolicy};
 use tactile_report::analysis::Latency;
+use tactile_runtime::driver::{Arrival, Failure, Idle, Link, OnTransports};
+use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber, IpcWake};
+use tactile_transport::{LinkError, Ports};
+
+/// One end of the hop: a stream in, one out, over iceoryx2, waited on as a node waits.
+fn hop_end(prefix: &str, me: &str, peer: &str, spin: Duration) -> Result<Link, LinkError> {
+    let node = std::rc::Rc::new(ipc::node(prefix, me)?);
+    let (out, inn) = if me == "echo" {
+        ("hop/pong", "hop/ping")
+    } else {
+        ("hop/ping", "hop/pong")
+    };
+    let ports = Ports {
+        forward_in: Some(Box::new(IpcSubscriber::<Forward>::open(&node, inn)?)),
+        forward_out: Some(Box::new(IpcPublisher::<Forward>::open(&node, out, peer)?)),
+        wakes: vec![Box::new(IpcWake::open(&node, me)?)],
+        ..Ports::default()
+    };
+    Ok(Link::new(ports, spin))
+}
 
 /// The echo side of the bare hop: sends back every sample it gets, until the end mark.
-pub fn echo(prefix: &str, wait: WaitPolicy) -> Result<(), LinkError> {
-    let node = ipc::node(prefix, "echo")?;
-    let inbox: Inbox<Forward> = Inbox::open(&node, "hop/ping")?;
-    let out: Outbox<Forward> = Outbox::open(&node, "hop/pong", "bench")?;
-    let waker = Waker::open(&node, "echo")?;
+pub fn echo(prefix: &str, spin: Duration) -> Result<(), Failure> {
+    tactile_runtime::signals::stop_flag().map_err(|e| Failure::Node(e.to_string()))?;
+    let mut link = hop_end(prefix, "echo", "bench", spin)?;
     loop {
         let deadline = Instant::now() + Duration::from_secs(3600);
-        match waker.wait(&node, wait.spin, deadline, || inbox.try_recv())? {
-            Ok(f) if f.signal.flags & FLAG_END != 0 => return Ok(()),
-            Ok(f) => {
-                out.publish(f, f.signal.flags & FLAG_PROBE != 0)?;
+        match link.wait(deadline, &mut OnTransports)? {
+            Ok(Arrival::Forward(f)) if f.signal.flags & FLAG_END != 0 => return Ok(()),
+            Ok(Arrival::Forward(f)) => {
+                link.send_forward(f, f.signal.flags & FLAG_PROBE != 0)?;
             }
-            Err(Idle::Terminate) => return Ok(()),
-            Err(Idle::Timeout) => {}
+            Ok(Arrival::Backward(_)) | Err(Idle::Timeout) => {}
+            Err(Idle::Stop) => return Ok(()),
         }
     }
 }
@@ -52,7 +68,7 @@ fn hop_spin(sup: &Supervision, rate: f64) -> Duration {
 pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
     let prefix = format!("{}h", sup.prefix);
     // Held while the hop runs, so no cleaner takes its shared memory for a dead run's.
-    let _lock = tactile_node::lock::take(&prefix, "run", "tactile bench's bare hop")
+    let _lock = tactile_runtime::lock::take(&prefix, "run", "tactile bench's bare hop")
         .map_err(Error::BadInput)?;
     let exe = std::env::current_exe().map_err(Error::io("locating the tactile executable"))?;
     let mut cmd = if sup.pin {
@@ -72,60 +88,49 @@ pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), 
         .map_err(|e| Error::Failed(format!("starting the echo process: {e}")))?;
     let saved_affinity = rustix::thread::sched_getaffinity(None).ok();
     let result = (|| -> Result<(Latency, u64), Error> {
-        let fail = |e: LinkError| Error::Failed(e.to_string());
+        let fail = |e: Failure| Error::Failed(e.to_string());
         if sup.pin {
-            let _ = tactile_node::sched::pin_thread(0);
+            let _ = tactile_runtime::sched::pin_thread(0);
         }
         let _restore = Restore(saved_affinity);
-        let node = ipc::node(&prefix, "bench").map_err(fail)?;
-        let out: Outbox<Forward> = Outbox::open(&node, "hop/ping", "echo").map_err(fail)?;
-        let inbox: Inbox<Forward> = Inbox::open(&node, "hop/pong").map_err(fail)?;
-        let waker = Waker::open(&node, "bench").map_err(fail)?;
+        let mut link =
+            hop_end(&prefix, "bench", "echo", Duration::ZERO).map_err(|e| fail(e.into()))?;
         // Probe until the echo answers.
         let start = Instant::now();
         loop {
             let mut p = Forward::default();
             p.signal.flags = FLAG_PROBE;
-            out.send_control(p).map_err(fail)?;
-            let got = waker
-                .wait(
-                    &node,
-                    Duration::ZERO,
-                    Instant::now() + Duration::from_millis(20),
-                    || inbox.try_recv(),
-                )
-                .map_err(fail)?;
-            if got.is_ok() {
+            link.send_forward(p, true).map_err(|e| fail(e.into()))?;
+            let until = Instant::now() + Duration::from_millis(20);
+            if link.wait(until, &mut OnTransports).map_err(fail)?.is_ok() {
                 break;
             }
             if start.elapsed() > Duration::from_secs(10) {
                 return Err(Error::Failed("the echo process did not answer".into()));
             }
         }
-        while inbox.try_recv().map_err(fail)?.is_some() {}
+        while link.poll().map_err(|e| fail(e.into()))?.is_some() {}
+        let mut link = Link::new(link.into_ports(), hop_spin(sup, rate));
         let t_s = (1e9 / rate) as u64;
         let t0 = now_ns() + 2_000_000;
         let mut lat = Latency::default();
         let mut misses = 0;
         for i in 0..n {
             let tick = t0 + i * t_s;
-            sleep_until_ns(tick.saturating_sub(tactile_node::pace::default_wake_early_ns(t_s)));
+            sleep_until_ns(tick.saturating_sub(tactile_runtime::pace::default_wake_early_ns(t_s)));
             while now_ns() < tick {
                 std::hint::spin_loop();
             }
             let sent = now_ns();
-            out.send(Forward {
+            let ping = Forward {
                 seq: i,
                 ..Forward::default()
-            })
-            .map_err(fail)?;
+            };
+            link.send_forward(ping, false).map_err(|e| fail(e.into()))?;
             let deadline = Instant::now() + Duration::from_nanos(t_s);
             loop {
-                match waker
-                    .wait(&node, hop_spin(sup, rate), deadline, || inbox.try_recv())
-                    .map_err(fail)?
-                {
-                    Ok(f) if f.seq == i => {
+                match link.wait(deadline, &mut OnTransports).map_err(fail)? {
+                    Ok(Arrival::Forward(f)) if f.seq == i => {
                         lat.record((now_ns() - sent) as i64);
                         break;
                     }
@@ -139,7 +144,7 @@ pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), 
         }
         let mut end = Forward::default();
         end.signal.flags = FLAG_END;
-        out.send_control(end).map_err(fail)?;
+        link.send_forward(end, true).map_err(|e| fail(e.into()))?;
         Ok((lat, misses))
     })();
     let _ = child.wait();

@@ -5,8 +5,8 @@
 use crate::error::Error;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
-use tactile_node::zlink::zenoh;
 use tactile_scenario::{RosConfig, Scenario};
+use tactile_transport::zenoh_link::zenoh;
 use zenoh::Wait as _;
 
 /// Messages a second each node's live view publishes in the bench.
@@ -36,7 +36,7 @@ impl Viewer {
             listen: vec![endpoint.clone()],
             ..RosConfig::default()
         };
-        let c = tactile_node::ros2::session_config(&cfg)
+        let c = tactile_devices::rmw_node::session_config(&cfg)
             .map_err(|e| Error::Failed(format!("the live view's viewer: {e}")))?;
         let session = zenoh::open(c).wait().map_err(failed)?;
         let received = Arc::new(AtomicU64::new(0));

@@ -24,10 +24,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
-use tactile_node::args::LinkKind;
 use tactile_report::analysis::{us_header, us_line, Percentiles};
 use tactile_report::summary::Summary;
 use tactile_report::write::write_json;
+use tactile_runtime::args::LinkKind;
 use tactile_scenario::{Mode, Scenario};
 
 /// Runs of this bench so far (their prefixes' suffix).
@@ -49,7 +49,7 @@ pub struct LoopResult {
     pub stages_ns: BTreeMap<String, Percentiles>,
     /// Each node's scheduling as its record says (the same for every loop of a rate,
     /// so the comparison is fair).
-    pub sched: BTreeMap<String, tactile_node::sched::Sched>,
+    pub sched: BTreeMap<String, tactile_runtime::sched::Sched>,
 }
 
 /// One rate's results.
@@ -135,14 +135,14 @@ pub struct BenchArgs {
     #[arg(long)]
     pub wake_early_us: Option<u64>,
     /// Scheduling of every loop's nodes (the same for every transport).
-    #[arg(long, value_enum, default_value_t = tactile_node::sched::Policy::Fifo)]
-    pub sched: tactile_node::sched::Policy,
+    #[arg(long, value_enum, default_value_t = tactile_runtime::sched::Policy::Fifo)]
+    pub sched: tactile_runtime::sched::Policy,
     /// What each node's CPU does while the node sleeps, under SCHED_FIFO: halt (the
     /// kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so a
     /// halted CPU is not woken late; on these virtual machines a CPU kept busy is
     /// taken away for about 7.5 ms every 10 s instead: docs/07-latency.md).
-    #[arg(long, value_enum, default_value_t = tactile_node::sched::IdleMode::Halt)]
-    pub idle: tactile_node::sched::IdleMode,
+    #[arg(long, value_enum, default_value_t = tactile_runtime::sched::IdleMode::Halt)]
+    pub idle: tactile_runtime::sched::IdleMode,
     /// Do not pin the iceoryx2 processes to CPUs.
     #[arg(long)]
     pub no_pin: bool,
@@ -221,7 +221,7 @@ fn trio_with(
         link: links,
         wrap,
         // A short suffix per run: iceoryx2's socket paths leave room for prefixes of
-        // 26 characters at most (see tactile_node::lock::MAX_PREFIX_LEN).
+        // 26 characters at most (see tactile_runtime::lock::MAX_PREFIX_LEN).
         prefix: format!(
             "{}{:x}",
             sup.prefix,
@@ -282,7 +282,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     // From here a stop request is a flag the runs look at, not the end of this
     // process: the bench stops between runs and removes what it made.
     let stop =
-        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
+        tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     if !cfg!(feature = "zenoh") {
         crate::noteln!(
             "tactile bench: no Zenoh loop: this build has no Zenoh link (build with --features zenoh)"
@@ -496,13 +496,13 @@ fn strategy(args: &BenchArgs) -> String {
     format!(
         "every loop: {}, each node sleeping until {} before its sample is due, then polling (yielding) for {} before it blocks{}",
         match (args.sched, args.idle) {
-            (tactile_node::sched::Policy::Fifo, tactile_node::sched::IdleMode::Poll) => {
+            (tactile_runtime::sched::Policy::Fifo, tactile_runtime::sched::IdleMode::Poll) => {
                 "SCHED_FIFO where permitted (memory locked, each CPU kept awake while its node sleeps)"
             }
-            (tactile_node::sched::Policy::Fifo, tactile_node::sched::IdleMode::Halt) => {
+            (tactile_runtime::sched::Policy::Fifo, tactile_runtime::sched::IdleMode::Halt) => {
                 "SCHED_FIFO where permitted (memory locked)"
             }
-            (tactile_node::sched::Policy::Other, _) => "SCHED_OTHER",
+            (tactile_runtime::sched::Policy::Other, _) => "SCHED_OTHER",
         },
         args.wake_early_us
             .map_or_else(|| "200 us (at most 40 % of a period)".to_string(), |u| format!("{u} us")),

@@ -77,7 +77,7 @@ pub struct StallReport {
 /// set. `fifo`: at SCHED_FIFO 99 (else at the caller's policy, which measures the
 /// scheduler too).
 pub fn probe(seconds: f64, fifo: bool, stop: &Arc<AtomicBool>) -> StallReport {
-    let cpus = match tactile_node::sched::allowed_cpus() {
+    let cpus = match tactile_runtime::sched::allowed_cpus() {
         Ok(c) => c,
         Err(e) => {
             return StallReport {
@@ -121,10 +121,10 @@ fn probe_cpu(
     fifo: bool,
     stop: &AtomicBool,
 ) -> Result<CpuStalls, String> {
-    tactile_node::sched::pin_thread(cpu)
+    tactile_runtime::sched::pin_thread(cpu)
         .map_err(|e| format!("pinning the probe to CPU {cpu}: {e}"))?;
     if fifo {
-        tactile_node::sched::set_thread_fifo(99)
+        tactile_runtime::sched::set_thread_fifo(99)
             .map_err(|e| format!("SCHED_FIFO not permitted ({e}): machine not probed"))?;
     }
     let mut s = CpuStalls {
@@ -222,7 +222,7 @@ mod tests {
         assert!(r.note.is_none(), "{r:?}");
         assert_eq!(
             r.cpus.len(),
-            tactile_node::sched::allowed_cpus().expect("cpus").len()
+            tactile_runtime::sched::allowed_cpus().expect("cpus").len()
         );
         for c in &r.cpus {
             assert!((0.2..0.5).contains(&c.spun_s), "{c:?}");

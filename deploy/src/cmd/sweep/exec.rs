@@ -74,7 +74,7 @@ pub fn run_all(
     args: &SweepArgs,
 ) -> Result<Vec<Option<Vec<Option<f64>>>>, Error> {
     let stop =
-        tactile_node::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
+        tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let results: Mutex<Vec<Option<Vec<Option<f64>>>>> = Mutex::new(vec![None; work.len()]);
     let mut todo = Vec::new();
     for (i, w) in work.iter().enumerate() {

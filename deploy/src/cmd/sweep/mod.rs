@@ -130,7 +130,7 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         }
         (Some(n), _) => n,
         (None, true) => 1,
-        (None, false) => tactile_node::sched::allowed_cpus().map_or(1, |c| c.len().max(1)),
+        (None, false) => tactile_runtime::sched::allowed_cpus().map_or(1, |c| c.len().max(1)),
     };
     let spec = Spec {
         scenario: scenario.display().to_string(),

@@ -1,0 +1,87 @@
+//! What lies outside a node's loop, and how the loop sees it: a haptic device under the
+//! operator's hand and a robot arm, with their joints mapped and checked ([`map`]),
+//! each tick's judgement of how fresh their newest sample is ([`watch`]) and what the
+//! loop holds through staleness and loss ([`held`]); over ROS 2 on rmw_zenoh (the
+//! node's session [`rmw_node`], the devices [`ros_devices`] and the live view
+//! [`live_view`], behind the `zenoh` feature). The judgements are pure and always
+//! built; the I/O only with Zenoh.
+
+pub mod held;
+#[cfg(feature = "zenoh")]
+pub mod live_view;
+pub mod map;
+#[cfg(feature = "zenoh")]
+pub mod rmw_node;
+#[cfg(feature = "zenoh")]
+pub mod ros_devices;
+pub mod watch;
+
+pub use map::{JointMap, Reject};
+pub use tactile_records::device::DeviceCounters;
+pub use watch::{Change, Reading};
+
+/// A device or robot as the loop's driver sees it, whatever it is: whether it has
+/// been heard from, what it delivered, and what it sent that was dropped.
+pub trait Peripheral {
+    /// `device` or `robot`, for messages.
+    fn kind(&self) -> &'static str;
+    /// True once a good message has come.
+    fn heard(&self) -> bool;
+    /// What it delivered and how it was judged.
+    fn counters(&self) -> DeviceCounters;
+    /// The first message dropped since the last call, for the log.
+    fn take_reject(&self) -> Option<Reject>;
+    /// Where it is read from, for messages.
+    fn describe(&self) -> String;
+}
+
+/// A real master device, as the master's loop uses it: encoders in, force out.
+pub trait HapticDevice: Peripheral {
+    /// The encoders' newest angles at this tick, judged.
+    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change);
+    /// Sends the force to render, N, in the device's base frame.
+    fn render(&mut self, force: [f64; 3], now_ns: u64);
+}
+
+/// A real slave robot, as the slave's loop uses it: joint references out, joint
+/// angles and (when it has a sensor) the contact force in.
+pub trait Robot: Peripheral {
+    /// The joints' newest angles at this tick, judged.
+    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change);
+    /// The contact force at this tick, N in the paper's frame, if the robot has a
+    /// force sensor (else the environment model gives it); zero when the sensor's
+    /// newest reading is older than the timeout.
+    fn force(&mut self, now_ns: u64) -> Option<[f64; 3]>;
+    /// Sends the joint references, rad in the paper's convention.
+    fn command(&mut self, theta_ref: [f64; 3], now_ns: u64);
+}
+
+/// Where a loop hands its state for the live view: takes it only every k-th sample,
+/// and never blocks.
+pub trait LiveSink<S> {
+    /// True if sample `n` is one the live view publishes.
+    fn due(&self, n: u64) -> bool;
+    /// Hands the state over (dropped and counted if the publisher is behind).
+    fn offer(&mut self, state: S);
+}
+
+/// A ROS 2 session, publisher or subscription that could not be made, with what was
+/// being done.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{context}: {detail}")]
+pub struct RosError {
+    /// What was being done.
+    pub context: String,
+    /// Zenoh's description.
+    pub detail: String,
+}
+
+impl RosError {
+    /// The error of `context`, from anything that says why.
+    pub fn new(context: &str, e: impl std::fmt::Display) -> RosError {
+        RosError {
+            context: context.to_string(),
+            detail: e.to_string(),
+        }
+    }
+}

@@ -1,0 +1,185 @@
+//! A device's or robot's joints as the loop takes them: three named joints of a
+//! `JointState` mapped to the paper's angles (sign, unit, offset) and checked (present,
+//! finite, in range), the inverse map for commands, and a force-torque reading checked.
+//! Pure: the messages come from [`crate::ros_devices`] (or a test).
+
+use tactile_ros::msg::{Decode, JointState, WrenchStamped};
+use tactile_scenario::JointMapConfig;
+
+/// Why a message was dropped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Reject {
+    /// Not a well-formed message of the topic's type.
+    #[error("not a well-formed message: {0}")]
+    Malformed(#[from] tactile_ros::CdrError),
+    /// A named joint is not in the message (or has no position).
+    #[error("joint {0:?} is missing")]
+    Missing(String),
+    /// A value is NaN or infinite.
+    #[error("joint {0:?} is not finite")]
+    NotFinite(String),
+    /// A value outside the configured range.
+    #[error("joint {joint:?} at {value} rad is outside {min}..={max}")]
+    OutOfRange {
+        /// The joint.
+        joint: String,
+        /// Its angle, rad (the paper's convention).
+        value: f64,
+        /// Smallest accepted.
+        min: f64,
+        /// Largest accepted.
+        max: f64,
+    },
+    /// A force that is NaN or infinite.
+    #[error("force is not finite")]
+    ForceNotFinite,
+}
+
+/// Three named joints of a `JointState`, in the paper's convention.
+#[derive(Debug, Clone)]
+pub struct JointMap {
+    names: [String; 3],
+    cfg: JointMapConfig,
+}
+
+impl JointMap {
+    /// The map for joints `names` under `cfg`.
+    pub fn new(names: [String; 3], cfg: JointMapConfig) -> JointMap {
+        JointMap { names, cfg }
+    }
+
+    /// The paper's angles from a CDR `JointState`.
+    pub fn angles_cdr(&self, cdr: &[u8]) -> Result<[f64; 3], Reject> {
+        self.angles(&JointState::from_cdr(cdr)?)
+    }
+
+    /// The paper's angles from a `JointState`: theta = sign raw unit + offset.
+    pub fn angles(&self, js: &JointState) -> Result<[f64; 3], Reject> {
+        let mut theta = [0.0; 3];
+        for (i, name) in self.names.iter().enumerate() {
+            let raw = js
+                .name
+                .iter()
+                .position(|n| n == name)
+                .and_then(|k| js.position.get(k))
+                .ok_or_else(|| Reject::Missing(name.clone()))?;
+            let t = self.cfg.sign[i] * raw * self.cfg.unit.radians() + self.cfg.offset[i];
+            if !t.is_finite() {
+                return Err(Reject::NotFinite(name.clone()));
+            }
+            let (min, max) = (self.cfg.min[i], self.cfg.max[i]);
+            if !(min..=max).contains(&t) {
+                return Err(Reject::OutOfRange {
+                    joint: name.clone(),
+                    value: t,
+                    min,
+                    max,
+                });
+            }
+            theta[i] = t;
+        }
+        Ok(theta)
+    }
+
+    /// The driver's values for the paper's angles (the inverse map), for commands;
+    /// each angle first clamped to the joint's `min..=max`, so a robot is never
+    /// commanded where its readings would be refused.
+    pub fn raw(&self, theta: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|i| {
+            let t = theta[i].clamp(self.cfg.min[i], self.cfg.max[i]);
+            (t - self.cfg.offset[i]) / (self.cfg.sign[i] * self.cfg.unit.radians())
+        })
+    }
+}
+
+/// A force from a CDR `WrenchStamped`, N; not finite is rejected.
+pub fn force_cdr(cdr: &[u8]) -> Result<[f64; 3], Reject> {
+    let w = WrenchStamped::from_cdr(cdr)?;
+    if w.force.iter().all(|f| f.is_finite()) {
+        Ok(w.force)
+    } else {
+        Err(Reject::ForceNotFinite)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tactile_ros::msg::{Header, Message};
+    use tactile_scenario::AngleUnit;
+
+    fn js(names: &[&str], pos: &[f64]) -> JointState {
+        JointState {
+            header: Header::at(1, "base"),
+            name: names.iter().map(|s| s.to_string()).collect(),
+            position: pos.to_vec(),
+            ..JointState::default()
+        }
+    }
+
+    fn map() -> JointMap {
+        let cfg = JointMapConfig {
+            sign: [1.0, -1.0, 1.0],
+            offset: [0.0, 0.0, 0.5],
+            unit: AngleUnit::Deg,
+            ..JointMapConfig::default()
+        };
+        JointMap::new(["a".into(), "b".into(), "c".into()], cfg)
+    }
+
+    #[test]
+    fn joints_are_found_by_name_and_mapped_both_ways() {
+        let m = map();
+        let got = m.angles(&js(&["x", "c", "b", "a"], &[9.0, 90.0, 45.0, 180.0]));
+        let pi = std::f64::consts::PI;
+        let want = [pi, -pi / 4.0, pi / 2.0 + 0.5];
+        let t = got.expect("mapped");
+        for i in 0..3 {
+            assert!((t[i] - want[i]).abs() < 1e-12, "{t:?}");
+        }
+        let raw = m.raw(t);
+        for (r, w) in raw.iter().zip([180.0, 45.0, 90.0]) {
+            assert!((r - w).abs() < 1e-9, "{raw:?}");
+        }
+    }
+
+    #[test]
+    fn missing_non_finite_and_out_of_range_values_are_rejected() {
+        let m = map();
+        assert_eq!(
+            m.angles(&js(&["a", "b"], &[0.0, 0.0])),
+            Err(Reject::Missing("c".into()))
+        );
+        assert_eq!(
+            m.angles(&js(&["a", "b", "c"], &[0.0, 0.0])),
+            Err(Reject::Missing("c".into())),
+            "a name without a position"
+        );
+        assert_eq!(
+            m.angles(&js(&["a", "b", "c"], &[0.0, f64::NAN, 0.0])),
+            Err(Reject::NotFinite("b".into()))
+        );
+        assert!(matches!(
+            m.angles(&js(&["a", "b", "c"], &[400.0, 0.0, 0.0])),
+            Err(Reject::OutOfRange { .. })
+        ));
+        assert!(matches!(
+            m.angles_cdr(&[1, 2, 3]),
+            Err(Reject::Malformed(_))
+        ));
+        let w = WrenchStamped {
+            force: [0.0, f64::INFINITY, 0.0],
+            ..WrenchStamped::default()
+        };
+        assert_eq!(force_cdr(&w.to_cdr()), Err(Reject::ForceNotFinite));
+    }
+
+    #[test]
+    fn commands_are_clamped_to_the_joints_range() {
+        let m = map();
+        assert!(
+            (m.raw([10.0, 0.0, 0.0])[0] - 180.0).abs() < 1e-9,
+            "clamped to pi"
+        );
+    }
+}

@@ -1,0 +1,219 @@
+//! A node as an rmw_zenoh node: its own Zenoh session (ROS 2's settings, apart from the
+//! loop's link), its liveliness tokens, and publishers and subscriptions whose key
+//! expressions and attachments are rmw_zenoh's (`tactile_ros::rmw`), so ROS 2 tools and
+//! drivers on rmw_zenoh and Tactile's nodes see each other.
+//!
+//! Subscriptions take any type hash (`<domain>/<topic>/<type>/*`): a Jazzy driver's
+//! RIHS01 hash and a Humble one's `TypeHashNotSupported` alike, the message layouts
+//! being the same. Publishers use the exact Jazzy key, as Jazzy subscribers expect.
+//! Publications do not wait: congestion control `Drop` with no wait before dropping,
+//! like ROS 2 sensor streams.
+
+use crate::RosError;
+use std::sync::atomic::{AtomicI64, AtomicU32, Ordering};
+use tactile_ros::rmw::{self, Attachment, EntityKind, NodeId};
+use tactile_scenario::RosConfig;
+use zenoh::liveliness::LivelinessToken;
+use zenoh::qos::CongestionControl;
+use zenoh::Wait as _;
+
+fn err(context: &str, e: impl std::fmt::Display) -> RosError {
+    RosError::new(context, e)
+}
+
+/// Nanoseconds since the Unix epoch (ROS time for stamps and attachments).
+pub fn wall_ns() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos() as u64)
+}
+
+/// The session's Zenoh configuration: peer mode, the `[ros]` endpoints, no multicast
+/// scouting, otherwise Zenoh's defaults, which rmw_zenoh's router and nodes use (the
+/// loop link's low-latency transport would not connect to them).
+pub fn session_config(cfg: &RosConfig) -> Result<zenoh::Config, RosError> {
+    let mut c = zenoh::Config::default();
+    let list = |v: &[String]| {
+        let quoted: Vec<String> = v.iter().map(|e| format!("{e:?}")).collect();
+        format!("[{}]", quoted.join(","))
+    };
+    for (key, value) in [
+        ("mode", "\"peer\"".to_string()),
+        ("connect/endpoints", list(&cfg.connect)),
+        ("listen/endpoints", list(&cfg.listen)),
+        ("scouting/multicast/enabled", "false".into()),
+        ("connect/timeout_ms", "-1".into()),
+        ("connect/exit_on_failure", "false".into()),
+        // A full queue drops a message at once instead of waiting up to 1 ms (Zenoh's
+        // default) for room: the loop publishes, and must not wait.
+        (
+            "transport/link/tx/queue/congestion_control/drop/wait_before_drop",
+            "0".into(),
+        ),
+    ] {
+        c.insert_json5(key, &value)
+            .map_err(|e| err(&format!("ROS 2 Zenoh setting {key} = {value}"), e))?;
+    }
+    Ok(c)
+}
+
+/// One node on ROS 2: a Zenoh session and its node token.
+pub struct RosNode {
+    session: zenoh::Session,
+    id: NodeId,
+    next_id: AtomicU32,
+    _token: LivelinessToken,
+}
+
+impl std::fmt::Debug for RosNode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RosNode")
+            .field("id", &self.id)
+            .finish_non_exhaustive()
+    }
+}
+
+impl RosNode {
+    /// Opens the session and declares node `name` in `[ros]`'s domain and namespace.
+    pub fn open(cfg: &RosConfig, name: &str) -> Result<RosNode, RosError> {
+        let session = zenoh::open(session_config(cfg)?)
+            .wait()
+            .map_err(|e| err("opening the ROS 2 Zenoh session", e))?;
+        let id = NodeId {
+            domain: cfg.domain_id,
+            zid: session.zid().to_string(),
+            nid: 0,
+            namespace: cfg.namespace.clone(),
+            name: name.to_string(),
+        };
+        let token = session
+            .liveliness()
+            .declare_token(id.node_token())
+            .wait()
+            .map_err(|e| err("declaring the ROS 2 node's liveliness token", e))?;
+        Ok(RosNode {
+            session,
+            id,
+            next_id: AtomicU32::new(1),
+            _token: token,
+        })
+    }
+
+    /// `name` under the node's namespace (the live view's topics).
+    pub fn in_namespace(&self, name: &str) -> String {
+        format!("{}{name}", self.id.namespace)
+    }
+
+    fn token(
+        &self,
+        kind: EntityKind,
+        topic: &str,
+        ty: &str,
+    ) -> Result<(String, LivelinessToken), RosError> {
+        let eid = self.next_id.fetch_add(1, Ordering::Relaxed);
+        let key = self
+            .id
+            .entity_token(eid, kind, topic, ty)
+            .ok_or_else(|| err(topic, format!("no type hash for {ty}")))?;
+        let token = self
+            .session
+            .liveliness()
+            .declare_token(key.clone())
+            .wait()
+            .map_err(|e| err(&format!("declaring the liveliness token of {topic}"), e))?;
+        Ok((key, token))
+    }
+
+    /// A publisher of `ty` on `topic`.
+    pub fn publisher(&self, topic: &str, ty: &str) -> Result<RosPublisher, RosError> {
+        let key = rmw::topic_key(self.id.domain, topic, ty)
+            .ok_or_else(|| err(topic, format!("no type hash for {ty}")))?;
+        let (token_key, token) = self.token(EntityKind::Publisher, topic, ty)?;
+        let publisher = self
+            .session
+            .declare_publisher(key)
+            .congestion_control(CongestionControl::Drop)
+            .express(true)
+            .wait()
+            .map_err(|e| err(&format!("declaring the publisher of {topic}"), e))?;
+        Ok(RosPublisher {
+            publisher,
+            gid: rmw::gid(&token_key),
+            seq: AtomicI64::new(0),
+            topic: topic.to_string(),
+            _token: token,
+        })
+    }
+
+    /// Calls `on(payload, arrival ns on CLOCK_MONOTONIC)` for every message of `ty` on
+    /// `topic`, from Zenoh's threads.
+    pub fn subscribe(
+        &self,
+        topic: &str,
+        ty: &str,
+        on: impl Fn(&[u8], u64) + Send + Sync + 'static,
+    ) -> Result<RosSubscription, RosError> {
+        let dds = rmw::dds_type(ty).ok_or_else(|| err(topic, format!("bad type {ty}")))?;
+        let name = topic.trim_matches('/');
+        let key = format!("{}/{name}/{dds}/*", self.id.domain);
+        let (_, token) = self.token(EntityKind::Subscription, topic, ty)?;
+        let sub = self
+            .session
+            .declare_subscriber(key)
+            .callback(move |sample| {
+                let at = tactile_messages::clock::now_ns();
+                on(&sample.payload().to_bytes(), at);
+            })
+            .wait()
+            .map_err(|e| err(&format!("subscribing to {topic}"), e))?;
+        Ok(RosSubscription {
+            _sub: sub,
+            _token: token,
+        })
+    }
+}
+
+/// A ROS 2 publisher: each put carries rmw_zenoh's attachment.
+pub struct RosPublisher {
+    publisher: zenoh::pubsub::Publisher<'static>,
+    gid: [u8; 16],
+    seq: AtomicI64,
+    topic: String,
+    _token: LivelinessToken,
+}
+
+impl std::fmt::Debug for RosPublisher {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RosPublisher")
+            .field("topic", &self.topic)
+            .finish_non_exhaustive()
+    }
+}
+
+impl RosPublisher {
+    /// Publishes one CDR message; false if Zenoh refused it.
+    pub fn put(&self, cdr: &[u8]) -> bool {
+        let a = Attachment {
+            seq: self.seq.fetch_add(1, Ordering::Relaxed) + 1,
+            stamp_ns: wall_ns() as i64,
+            gid: self.gid,
+        };
+        self.publisher
+            .put(cdr)
+            .attachment(a.to_bytes().to_vec())
+            .wait()
+            .is_ok()
+    }
+}
+
+/// A subscription, alive as long as this is.
+pub struct RosSubscription {
+    _sub: zenoh::pubsub::Subscriber<()>,
+    _token: LivelinessToken,
+}
+
+impl std::fmt::Debug for RosSubscription {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RosSubscription").finish_non_exhaustive()
+    }
+}

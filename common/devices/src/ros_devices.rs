@@ -1,0 +1,200 @@
+//! The master's haptic device and the slave's robot over ROS 2: subscriptions that
+//! fill an [`Inbox`] (decoded, mapped and checked on Zenoh's threads), a [`Watch`] the
+//! loop asks each tick, and the publisher of what the loop sends back.
+
+use crate::map::force_cdr;
+use crate::rmw_node::{wall_ns, RosNode, RosPublisher, RosSubscription};
+use crate::watch::{Inbox, Watch};
+use crate::RosError;
+use crate::{Change, DeviceCounters, HapticDevice, JointMap, Peripheral, Reading, Reject, Robot};
+use std::sync::Arc;
+use tactile_ros::msg::{Float64MultiArray, Header, JointState, Message, WrenchStamped};
+use tactile_scenario::{RosDeviceConfig, RosRobotConfig};
+
+/// Three joint angles or a force, as the loop takes them.
+type Inbox3 = Arc<Inbox<[f64; 3]>>;
+
+fn joints_in(
+    node: &Arc<RosNode>,
+    topic: &str,
+    map: JointMap,
+) -> Result<(Inbox3, RosSubscription), RosError> {
+    let inbox = Inbox::new();
+    let fill = Arc::clone(&inbox);
+    let sub = node.subscribe(topic, JointState::TYPE, move |cdr, at| {
+        fill.offer(map.angles_cdr(cdr), at);
+    })?;
+    Ok((inbox, sub))
+}
+
+/// A haptic device through its ROS 2 driver.
+#[derive(Debug)]
+pub struct RosHapticDevice {
+    /// The session everything below lives on, kept open while the device is.
+    _node: Arc<RosNode>,
+    joints: Arc<Inbox<[f64; 3]>>,
+    _sub: RosSubscription,
+    force: RosPublisher,
+    frame: String,
+    force_map: tactile_scenario::ForceMapConfig,
+    watch: Watch,
+    topic: String,
+}
+
+impl RosHapticDevice {
+    /// Subscribes to the encoders and declares the force publisher.
+    pub fn open(node: &Arc<RosNode>, cfg: &RosDeviceConfig, t_s_ns: u64) -> Result<Self, RosError> {
+        let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
+        let (joints, sub) = joints_in(node, &cfg.joint_states, map)?;
+        Ok(RosHapticDevice {
+            _node: Arc::clone(node),
+            joints,
+            _sub: sub,
+            force: node.publisher(&cfg.force_topic, WrenchStamped::TYPE)?,
+            frame: cfg.frame_id.clone(),
+            force_map: cfg.force_map.clone(),
+            watch: Watch::new(&cfg.watch, t_s_ns),
+            topic: cfg.joint_states.clone(),
+        })
+    }
+}
+
+impl Drop for RosHapticDevice {
+    /// A driver holds its last command: leave the device rendering nothing, however
+    /// the run ends.
+    fn drop(&mut self) {
+        self.render([0.0; 3], 0);
+    }
+}
+
+impl Peripheral for RosHapticDevice {
+    fn kind(&self) -> &'static str {
+        "device"
+    }
+
+    fn heard(&self) -> bool {
+        self.joints.latest().is_some()
+    }
+
+    fn counters(&self) -> DeviceCounters {
+        self.watch.counters(&[self.joints.counts()])
+    }
+
+    fn take_reject(&self) -> Option<Reject> {
+        self.joints.take_reject()
+    }
+
+    fn describe(&self) -> String {
+        format!("the device on {}", self.topic)
+    }
+}
+
+impl HapticDevice for RosHapticDevice {
+    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change) {
+        self.watch.judge(self.joints.latest(), now_ns)
+    }
+
+    fn render(&mut self, force: [f64; 3], _now_ns: u64) {
+        let w = WrenchStamped {
+            header: Header::at(wall_ns(), &self.frame),
+            force: self.force_map.to_device(force),
+            torque: [0.0; 3],
+        };
+        let ok = self.force.put(&w.to_cdr());
+        self.watch.published(ok);
+    }
+}
+
+/// A robot arm through ros2_control (and a force-torque sensor, if named).
+#[derive(Debug)]
+pub struct RosRobot {
+    /// The session everything below lives on, kept open while the robot is.
+    _node: Arc<RosNode>,
+    joints: Arc<Inbox<[f64; 3]>>,
+    wrench: Option<Arc<Inbox<[f64; 3]>>>,
+    _subs: Vec<RosSubscription>,
+    command: RosPublisher,
+    map: JointMap,
+    wrench_map: tactile_scenario::ForceMapConfig,
+    watch: Watch,
+    topic: String,
+}
+
+impl RosRobot {
+    /// Subscribes to the joint states (and the wrench) and declares the command
+    /// publisher.
+    pub fn open(node: &Arc<RosNode>, cfg: &RosRobotConfig, t_s_ns: u64) -> Result<Self, RosError> {
+        let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
+        let (joints, sub) = joints_in(node, &cfg.joint_states, map.clone())?;
+        let mut subs = vec![sub];
+        let wrench = if cfg.wrench_topic.is_empty() {
+            None
+        } else {
+            let inbox = Inbox::new();
+            let fill = Arc::clone(&inbox);
+            subs.push(
+                node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, move |cdr, at| {
+                    fill.offer(force_cdr(cdr), at);
+                })?,
+            );
+            Some(inbox)
+        };
+        Ok(RosRobot {
+            _node: Arc::clone(node),
+            joints,
+            wrench,
+            _subs: subs,
+            command: node.publisher(&cfg.command_topic, Float64MultiArray::TYPE)?,
+            map,
+            wrench_map: cfg.wrench_map.clone(),
+            watch: Watch::new(&cfg.watch, t_s_ns),
+            topic: cfg.joint_states.clone(),
+        })
+    }
+}
+
+impl Peripheral for RosRobot {
+    fn kind(&self) -> &'static str {
+        "robot"
+    }
+
+    fn heard(&self) -> bool {
+        self.joints.latest().is_some()
+    }
+
+    fn counters(&self) -> DeviceCounters {
+        let mut counts = vec![self.joints.counts()];
+        counts.extend(self.wrench.as_ref().map(|w| w.counts()));
+        self.watch.counters(&counts)
+    }
+
+    fn take_reject(&self) -> Option<Reject> {
+        self.joints
+            .take_reject()
+            .or_else(|| self.wrench.as_ref().and_then(|w| w.take_reject()))
+    }
+
+    fn describe(&self) -> String {
+        format!("the robot on {}", self.topic)
+    }
+}
+
+impl Robot for RosRobot {
+    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change) {
+        self.watch.judge(self.joints.latest(), now_ns)
+    }
+
+    fn force(&mut self, now_ns: u64) -> Option<[f64; 3]> {
+        let w = self.wrench.as_ref()?;
+        let f = self.watch.force(w.latest(), now_ns);
+        Some(self.wrench_map.to_paper(f))
+    }
+
+    fn command(&mut self, theta_ref: [f64; 3], _now_ns: u64) {
+        let m = Float64MultiArray {
+            data: self.map.raw(theta_ref).to_vec(),
+        };
+        let ok = self.command.put(&m.to_cdr());
+        self.watch.published(ok);
+    }
+}

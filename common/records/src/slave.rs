@@ -1,0 +1,110 @@
+//! The slave's record: one schema for what it received, computed and commanded. The
+//! report joins it with the master's and the emulator's records by sample number.
+
+use serde::{Deserialize, Serialize};
+use tactile_messages::samples::Signal;
+use tactile_messages::stream::{InboxStats, OutboxStats};
+
+/// What the slave counted over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SlaveCounters {
+    /// Steps taken.
+    pub steps: u64,
+    /// Targets outside the workspace: IK clamped.
+    pub ik_clamped: u64,
+    /// Samples not physically possible (not finite, too large, too fast, out of
+    /// order), rejected and filled by the predictor; or outside the workspace (IK).
+    pub rejected: u64,
+    /// Joint torque clamps (one per joint per step).
+    pub torque_clamps: u64,
+    /// Steps in contact with an object.
+    pub contact_steps: u64,
+    /// Steps taken holding position because the input went silent.
+    pub held_steps: u64,
+    /// Times the input went silent and the slave started holding.
+    pub holds: u64,
+    /// Largest distance the tool moved while holding, m.
+    pub hold_drift_max_m: f64,
+    /// Backward samples the codec put on the network (the others went as clock only).
+    pub packets_sent: u64,
+}
+
+/// One step on a received v(n).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Step {
+    /// Sample number of v(n).
+    pub n: u64,
+    /// v(n) as received (values, provenance, injected delay, flags).
+    pub received: Signal,
+    /// The control's Cartesian reference (the received position itself without
+    /// control), m.
+    pub reference: [f64; 3],
+    /// IK-HSD reference angles, rad.
+    pub theta_ref: [f64; 3],
+    /// Joint angles after the step, rad.
+    pub theta: [f64; 3],
+    /// Controller torques after clamping, N m.
+    pub torque: [f64; 3],
+    /// FK-HSD tool position l(n), m.
+    pub tool: [f64; 3],
+    /// Nearest surface point s^OBJ(n), m (zero without contact).
+    pub surface: [f64; 3],
+    /// h(n) before the backward channel, N.
+    pub force: [f64; 3],
+    /// The slave's passivity observer per axis after this step, J.
+    pub observer: [f64; 3],
+    /// Energy the slave's port has put into the channel minus what it took out, all
+    /// axes, J (its share of the channel's energy).
+    pub port_net_j: f64,
+    /// Energy the control dissipated this step, J.
+    pub dissipated_j: f64,
+    /// Torque clamps this step.
+    pub clamps: u32,
+    /// Object index in contact, or u32::MAX.
+    pub contact_object: u32,
+    /// `FLAG_*` bits of h(n).
+    pub flags: u32,
+}
+
+/// One step of holding position while the input is silent.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct HoldStep {
+    /// Held steps so far in the run.
+    pub step: u64,
+    /// Angles held, rad.
+    pub theta_ref: [f64; 3],
+    /// Joint angles after the step, rad.
+    pub theta: [f64; 3],
+    /// Controller torques, N m.
+    pub torque: [f64; 3],
+    /// Tool position (true device), m.
+    pub tool: [f64; 3],
+}
+
+/// One entry per step the slave took. A sample lives for one write or one read, and
+/// steps outnumber holds: boxing the step would allocate on every sample for nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum SlaveSample {
+    /// A step on v(n).
+    Step(Step),
+    /// A step holding position.
+    Hold(HoldStep),
+}
+
+/// The slave's counters.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SlaveTotals {
+    /// The state machine's counters.
+    pub counters: SlaveCounters,
+    /// v(n) as received.
+    pub v_in: InboxStats,
+    /// h(n) as published.
+    pub h_out: OutboxStats,
+    /// A real robot (`slave.backend = "ros2"`): what it delivered and how the loop
+    /// judged it; all zero with the simulated arm.
+    pub device: crate::device::DeviceCounters,
+}
+
+/// The slave's record type.
+pub type SlaveRecord = crate::Record<SlaveSample, SlaveTotals>;

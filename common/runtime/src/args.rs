@@ -1,0 +1,136 @@
+//! A node program's command line and outcome: the options every node takes
+//! ([`NodeArgs`], with its links' [`LinkArgs`]), why a node stops ([`NodeError`]), and
+//! the mapping of its outcome to an exit status and one line on stderr.
+
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use tactile_messages::Role;
+pub use tactile_transport::{LinkArgs, LinkKind};
+
+use crate::exit::{EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK};
+
+/// The command line every node takes.
+#[derive(Debug, Clone, Args)]
+pub struct NodeArgs {
+    /// Scenario file (TOML); its relative paths are resolved against its own folder.
+    #[arg(long)]
+    pub scenario: PathBuf,
+    /// Folder for this node's record (`ROLE.rec`) and log (`ROLE.log`).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The links: transport, ports, endpoints, TLS.
+    #[command(flatten)]
+    pub link: LinkArgs,
+    /// Microseconds to poll (yielding the CPU) before blocking on the wake-up event.
+    /// Default: twice --wake-early-us in realtime (the node wakes that long before a
+    /// sample is due), two sampling periods in lockstep; 0 blocks at once.
+    #[arg(long)]
+    pub spin_us: Option<u64>,
+    /// Realtime: stop sleeping this long before a sample is due, then poll. Default
+    /// 200 us, at most 40 % of a sampling period (measured, docs/07-latency.md, "Waiting").
+    #[arg(long)]
+    pub wake_early_us: Option<u64>,
+    /// Scheduling: fifo (SCHED_FIFO with memory locked, where permitted; otherwise
+    /// SCHED_OTHER, said in the log and the report) or other. Lockstep runs always
+    /// SCHED_OTHER: its loop never sleeps.
+    #[arg(long, value_enum, default_value_t = crate::sched::Policy::Fifo)]
+    pub sched: crate::sched::Policy,
+    /// What the node's CPU does while a realtime node under SCHED_FIFO sleeps: halt
+    /// (the kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so
+    /// a halted CPU is not woken late; on these virtual machines a CPU kept busy is
+    /// taken away for about 7.5 ms every 10 s instead: docs/07-latency.md, "What the CPUs do while the nodes
+    /// sleep").
+    #[arg(long, value_enum, default_value_t = crate::sched::IdleMode::Halt)]
+    pub idle: crate::sched::IdleMode,
+    /// SCHED_FIFO priority, 1 to 98.
+    #[arg(long, default_value_t = crate::sched::DEFAULT_PRIORITY, value_parser = clap::value_parser!(u8).range(1..=98))]
+    pub priority: u8,
+    /// Pin this node to one CPU.
+    #[arg(long)]
+    pub cpu: Option<usize>,
+    /// Continue this node's record in --out instead of starting it afresh (a node
+    /// restarted into a run that is still going).
+    #[arg(long)]
+    pub append: bool,
+    /// Started by `tactile run` (process id of the launcher): stop when it dies, log
+    /// to the file only.
+    #[arg(long, hide = true)]
+    pub supervised: Option<u32>,
+}
+
+/// Why a node stopped without completing.
+#[derive(Debug)]
+pub enum NodeError {
+    /// Bad input; nothing was started (exit 2).
+    BadInput(String),
+    /// A failure while running (exit 1).
+    Failed(String),
+}
+
+impl NodeError {
+    /// The exit status.
+    pub fn code(&self) -> u8 {
+        match self {
+            NodeError::BadInput(_) => EXIT_BAD_INPUT,
+            NodeError::Failed(_) => EXIT_FAILURE,
+        }
+    }
+}
+
+impl std::fmt::Display for NodeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NodeError::BadInput(m) | NodeError::Failed(m) => f.write_str(m),
+        }
+    }
+}
+
+/// Maps a node's outcome to its exit status and one line on stderr.
+pub fn exit(role: Role, outcome: Result<bool, NodeError>) -> ExitCode {
+    match outcome {
+        Ok(true) => ExitCode::from(EXIT_OK),
+        Ok(false) => ExitCode::from(EXIT_INTERRUPTED),
+        Err(e) => {
+            tracing::error!("{e}");
+            eprintln!("tactile-{role}: {e}");
+            ExitCode::from(e.code())
+        }
+    }
+}
+
+/// Parses a node's command line; on an error prints clap's message and returns the
+/// exit status (2 for bad arguments, 0 for --help and --version).
+pub fn parse<T: clap::Parser>() -> Result<T, ExitCode> {
+    // First thing, while the node has one thread.
+    #[cfg(feature = "zenoh")]
+    tactile_transport::zenoh_link::default_runtime();
+    T::try_parse().map_err(|e| {
+        let _ = e.print();
+        ExitCode::from(if e.use_stderr() {
+            EXIT_BAD_INPUT
+        } else {
+            EXIT_OK
+        })
+    })
+}
+
+/// Node arguments as the tests write them.
+#[cfg(test)]
+pub(crate) mod testing {
+    use super::NodeArgs;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Cli {
+        #[command(flatten)]
+        node: NodeArgs,
+    }
+
+    /// A node's arguments with `--scenario s.toml --out o` and `extra`.
+    pub fn args(extra: &[&str]) -> NodeArgs {
+        let mut v = vec!["node", "--scenario", "s.toml", "--out", "o"];
+        v.extend_from_slice(extra);
+        Cli::parse_from(v).node
+    }
+}

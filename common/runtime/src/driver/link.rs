@@ -1,0 +1,266 @@
+//! A node's ends as its driver uses them: the inputs polled (backward first: it
+//! completes a round trip someone waits for) and waited on, every wait bounded and
+//! broken by a stop request; the pacer's sleep before a sample is due; the outputs.
+
+use crate::pace::{deadline_ns, was_waiting, Pacer};
+use std::time::{Duration, Instant};
+use tactile_messages::samples::{Backward, Forward};
+use tactile_transport::{LinkError, PortStats, Ports};
+
+/// A sample arriving at a node.
+// Lives on the stack for one sample; boxing the larger variant would allocate per sample.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy)]
+pub enum Arrival {
+    /// c(n) or v(n).
+    Forward(Forward),
+    /// h(n) or q(n).
+    Backward(Backward),
+}
+
+impl Arrival {
+    /// The run token and sample number it carries.
+    pub fn run_and_seq(&self) -> (u64, u64) {
+        match self {
+            Arrival::Forward(f) => (f.run, f.seq),
+            Arrival::Backward(b) => (b.run, b.seq),
+        }
+    }
+}
+
+/// Why a wait returned without a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Idle {
+    /// The deadline passed (or, in one process, nothing more can come).
+    Timeout,
+    /// SIGINT or SIGTERM arrived.
+    Stop,
+}
+
+/// How a node blocks when nothing waits in its inputs.
+pub trait Block {
+    /// Blocks until a sample may have come, or `until`; false when nothing can come
+    /// before `until` (in one process: every other node is idle), so the wait ends now.
+    fn block(
+        &mut self,
+        wakes: &[Box<dyn tactile_transport::Wake>],
+        until: Instant,
+    ) -> Result<bool, super::Failure>;
+}
+
+/// Longest a blocking wait lasts before it looks at the stop flag again.
+pub const STOP_POLL: Duration = Duration::from_millis(50);
+
+/// How often a node that receives on two transports looks at the others while it
+/// blocks on the first (only once the loop has been idle for the poll budget).
+pub const MIXED_POLL: Duration = Duration::from_micros(200);
+
+/// Blocking on the transports themselves, as a node program does.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct OnTransports;
+
+impl Block for OnTransports {
+    fn block(
+        &mut self,
+        wakes: &[Box<dyn tactile_transport::Wake>],
+        until: Instant,
+    ) -> Result<bool, super::Failure> {
+        let cap = if wakes.len() > 1 {
+            MIXED_POLL
+        } else {
+            STOP_POLL
+        };
+        let until = until.min(Instant::now() + cap);
+        match wakes.first() {
+            Some(w) => w.block(until)?,
+            None => std::thread::sleep(until.saturating_duration_since(Instant::now())),
+        }
+        Ok(true)
+    }
+}
+
+/// A node's ends and how long it polls before it blocks.
+#[derive(Debug)]
+pub struct Link {
+    ports: Ports,
+    spin: Duration,
+}
+
+impl Link {
+    /// The ends `ports`, polled for `spin` before each block.
+    pub fn new(ports: Ports, spin: Duration) -> Link {
+        Link { ports, spin }
+    }
+
+    /// A sample if one waits, backward first.
+    pub fn poll(&mut self) -> Result<Option<Arrival>, LinkError> {
+        if let Some(b) = &mut self.ports.backward_in {
+            if let Some(h) = b.try_recv()? {
+                return Ok(Some(Arrival::Backward(h)));
+            }
+        }
+        match &mut self.ports.forward_in {
+            Some(f) => Ok(f.try_recv()?.map(Arrival::Forward)),
+            None => Ok(None),
+        }
+    }
+
+    /// Waits for a sample until `deadline`: polls (yielding the CPU) for the poll
+    /// budget, then blocks with `block`; a stop request ends it.
+    pub fn wait(
+        &mut self,
+        deadline: Instant,
+        block: &mut dyn Block,
+    ) -> Result<Result<Arrival, Idle>, super::Failure> {
+        let start = Instant::now();
+        loop {
+            if let Some(a) = self.poll()? {
+                return Ok(Ok(a));
+            }
+            if crate::signals::stop_requested() {
+                return Ok(Err(Idle::Stop));
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Ok(Err(Idle::Timeout));
+            }
+            if now.duration_since(start) < self.spin {
+                // Yield rather than burn: on two cores three polling processes would
+                // otherwise hold the core the next stage of the chain needs.
+                std::thread::yield_now();
+                continue;
+            }
+            if !block.block(&self.ports.wakes, deadline)? {
+                return Ok(self.poll()?.ok_or(Idle::Timeout));
+            }
+        }
+    }
+
+    /// Receives the next sample the tick-aware way: takes what is already there
+    /// (after a stall several samples may be queued, and each must go at once, not one
+    /// per period); else sleeps until the pacer's wake-up (never past `until`), then
+    /// waits until `until`. Without a pacer (lockstep) it just waits. Also says
+    /// whether a sample found at the first poll after the sleep was already waiting,
+    /// for [`Pacer::arrived`].
+    pub fn recv_paced(
+        &mut self,
+        pacer: Option<&Pacer>,
+        until: Instant,
+        block: &mut dyn Block,
+    ) -> Result<(Result<Arrival, Idle>, bool), super::Failure> {
+        let Some(p) = pacer else {
+            return Ok((self.wait(until, block)?, false));
+        };
+        if let Some(a) = self.poll()? {
+            return Ok((Ok(a), false));
+        }
+        let slept = p.sleep(deadline_ns(until));
+        let called = tactile_messages::clock::now_ns();
+        let got = self.wait(until, block)?;
+        let waiting =
+            slept && got.is_ok() && was_waiting(called, tactile_messages::clock::now_ns());
+        Ok((got, waiting))
+    }
+
+    /// Publishes a forward sample, if the node has a forward output.
+    pub fn send_forward(&mut self, v: Forward, control: bool) -> Result<bool, LinkError> {
+        match &mut self.ports.forward_out {
+            Some(o) => o.publish(v, control).map(|()| true),
+            None => Ok(false),
+        }
+    }
+
+    /// Publishes a backward sample, if the node has a backward output.
+    pub fn send_backward(&mut self, h: Backward, control: bool) -> Result<bool, LinkError> {
+        match &mut self.ports.backward_out {
+            Some(o) => o.publish(h, control).map(|()| true),
+            None => Ok(false),
+        }
+    }
+
+    /// True if the node passes forward samples on (it is not the end of the chain).
+    pub fn forwards(&self) -> bool {
+        self.ports.forward_out.is_some()
+    }
+
+    /// What the ends counted.
+    pub fn stats(&self) -> PortStats {
+        self.ports.stats()
+    }
+
+    /// The ends back, for another wait policy.
+    pub fn into_ports(self) -> Ports {
+        self.ports
+    }
+
+    /// The peers known to have died.
+    pub fn dead_peers(&self) -> Vec<String> {
+        self.ports.dead_peers()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pace::Pacer;
+    use tactile_messages::clock::now_ns;
+
+    /// Blocks as if nothing came, counting the calls.
+    struct Nothing(u32);
+
+    impl Block for Nothing {
+        fn block(
+            &mut self,
+            _: &[Box<dyn tactile_transport::Wake>],
+            until: Instant,
+        ) -> Result<bool, super::super::Failure> {
+            self.0 += 1;
+            std::thread::sleep(until.saturating_duration_since(Instant::now()));
+            Ok(true)
+        }
+    }
+
+    const T: u64 = 1_000_000;
+
+    #[test]
+    fn a_paced_receive_takes_what_is_waiting_before_it_sleeps() {
+        let [mut master, emulator, _] = tactile_transport::ports::in_memory();
+        let mut link = Link::new(emulator, Duration::ZERO);
+        // A pacer whose next wake-up is a second away: a queued sample must still be
+        // taken at once, without sleeping or blocking.
+        let mut p = Pacer::new(T, 200_000);
+        p.arrived(0, now_ns() + 1_000_000_000, false);
+        let c = Forward {
+            seq: 7,
+            ..Forward::default()
+        };
+        master
+            .forward_out
+            .as_mut()
+            .expect("c")
+            .publish(c, false)
+            .expect("c");
+        let start = Instant::now();
+        let mut block = Nothing(0);
+        let (got, waiting) = link
+            .recv_paced(Some(&p), start + Duration::from_secs(5), &mut block)
+            .expect("recv");
+        assert!(matches!(got, Ok(Arrival::Forward(f)) if f.seq == 7));
+        assert!(
+            !waiting,
+            "nothing slept, so nothing is known to have waited"
+        );
+        assert_eq!(block.0, 0);
+        assert!(start.elapsed() < Duration::from_millis(100));
+        // Nothing there: it sleeps (never more than two periods), then waits until
+        // the caller's deadline.
+        let start = Instant::now();
+        let until = start + Duration::from_millis(30);
+        let (got, _) = link.recv_paced(Some(&p), until, &mut block).expect("recv");
+        assert!(matches!(got, Err(Idle::Timeout)));
+        assert!(block.0 >= 1);
+        let waited = start.elapsed();
+        assert!(waited >= Duration::from_millis(30), "{waited:?}");
+        assert!(waited < Duration::from_millis(500), "{waited:?}");
+    }
+}

@@ -1,0 +1,123 @@
+//! A node's ROS 2 side, opened from the scenario: its session on rmw_zenoh, the real
+//! device (`master.backend = "ros2"`) or robot (`slave.backend = "ros2"`), and the live
+//! view (`ros.live`). Only in builds with the `zenoh` feature; without it a scenario
+//! that asks for any of them is refused before anything starts.
+
+use crate::args::NodeError;
+use tactile_devices::{HapticDevice, LiveSink, Robot};
+use tactile_messages::Role;
+use tactile_ros::view::SampleView;
+use tactile_scenario::{Backend, Scenario};
+
+/// What a node built without the `zenoh` feature says to a scenario that needs ROS 2.
+pub const NO_ROS: &str = "this scenario uses ROS 2 (a ros2 backend or the live view), which this build of Tactile does not include: build with `--features zenoh` (cargo build --release --features zenoh)";
+
+/// True if `role`'s node needs ROS 2 for the scenario.
+pub fn ros_on(sc: &Scenario, role: Role) -> bool {
+    match role {
+        Role::Master => sc.master.backend == Backend::Ros2 || sc.ros.live.enabled,
+        Role::Slave => sc.slave.backend == Backend::Ros2 || sc.ros.live.enabled,
+        Role::Emulator => false,
+    }
+}
+
+/// True if any node of the run needs ROS 2 (it needs the node programs: an in-process
+/// run simulates both devices and has no live view).
+pub fn ros_in_run(sc: &Scenario) -> bool {
+    Role::ALL.iter().any(|r| ros_on(sc, *r))
+}
+
+/// Refuses a scenario that needs ROS 2 in a build without it.
+pub fn check(sc: &Scenario, role: Role) -> Result<(), NodeError> {
+    if ros_on(sc, role) && !cfg!(feature = "zenoh") {
+        return Err(NodeError::BadInput(NO_ROS.into()));
+    }
+    Ok(())
+}
+
+/// What a node touches besides its link, opened for the run.
+#[derive(Default)]
+pub struct Outside {
+    /// The master's device.
+    pub haptic: Option<Box<dyn HapticDevice>>,
+    /// The slave's robot.
+    pub robot: Option<Box<dyn Robot>>,
+    /// The live view.
+    pub live: Option<Box<dyn LiveSink<SampleView>>>,
+}
+
+impl std::fmt::Debug for Outside {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Outside")
+            .field("haptic", &self.haptic.as_ref().map(|d| d.describe()))
+            .field("robot", &self.robot.as_ref().map(|d| d.describe()))
+            .field("live", &self.live.is_some())
+            .finish()
+    }
+}
+
+impl Outside {
+    /// Opens what the scenario asks of `role` (nothing for a simulated run without the
+    /// live view).
+    pub fn open(sc: &Scenario, role: Role) -> Result<Outside, NodeError> {
+        if !ros_on(sc, role) {
+            return Ok(Outside::default());
+        }
+        open_ros(sc, role)
+    }
+}
+
+#[cfg(feature = "zenoh")]
+fn open_ros(sc: &Scenario, role: Role) -> Result<Outside, NodeError> {
+    use std::sync::Arc;
+    use tactile_devices::live_view::{every, LiveView};
+    use tactile_devices::rmw_node::RosNode;
+    use tactile_devices::ros_devices::{RosHapticDevice, RosRobot};
+    let failed = |e: tactile_devices::RosError| NodeError::Failed(e.to_string());
+    let node = Arc::new(RosNode::open(&sc.ros, &format!("tactile_{role}")).map_err(failed)?);
+    let mut out = Outside::default();
+    if role == Role::Master && sc.master.backend == Backend::Ros2 {
+        let d = RosHapticDevice::open(&node, &sc.master.ros2, sc.t_s_ns()).map_err(failed)?;
+        out.haptic = Some(Box::new(d));
+    }
+    if role == Role::Slave && sc.slave.backend == Backend::Ros2 {
+        let r = RosRobot::open(&node, &sc.slave.ros2, sc.t_s_ns()).map_err(failed)?;
+        out.robot = Some(Box::new(r));
+    }
+    if sc.ros.live.enabled {
+        let topics: &[usize] = match role {
+            Role::Master => &tactile_ros::view::MASTER_LIVE,
+            _ => &tactile_ros::view::SLAVE_LIVE,
+        };
+        let every = every(sc.rate_hz, sc.ros.live.rate_hz);
+        let live =
+            LiveView::start(node, every, crate::sched::set_thread_other, topics).map_err(failed)?;
+        out.live = Some(Box::new(live));
+    }
+    Ok(out)
+}
+
+#[cfg(not(feature = "zenoh"))]
+fn open_ros(_: &Scenario, _: Role) -> Result<Outside, NodeError> {
+    Err(NodeError::BadInput(NO_ROS.into()))
+}
+
+#[cfg(all(test, not(feature = "zenoh")))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_build_without_zenoh_refuses_a_ros_scenario_and_runs_the_rest() {
+        let mut sc = Scenario::default();
+        assert!(
+            Outside::open(&sc, Role::Master).is_ok(),
+            "nothing asked, nothing opened"
+        );
+        sc.ros.live.enabled = true;
+        match Outside::open(&sc, Role::Slave) {
+            Err(NodeError::BadInput(m)) => assert!(m.contains("--features zenoh"), "{m}"),
+            other => panic!("{other:?}"),
+        }
+        assert!(check(&sc, Role::Emulator).is_ok());
+    }
+}

@@ -1,0 +1,132 @@
+//! A node program from its checks to its exit: the three node programs are each this,
+//! with their own handler. [`Program::prepare`] checks everything a user controls
+//! before anything starts (bad input: exit 2); [`Program::follow`] and
+//! [`Program::lead`] start the record, open the node's ends and its ROS 2 side, make
+//! the handler and run the driver; every failure after the record started is in it.
+
+use crate::args::{NodeArgs, NodeError};
+use crate::driver::follow::Follow;
+use crate::driver::lead::{Lead, LeadOptions};
+use crate::driver::{Failure, Follower, Handler, Leader, Link, OnTransports, Timing};
+use crate::outside::Outside;
+use crate::start::{new_run_token, prepare, start_record, Links, Prepared};
+use std::time::Duration;
+use tactile_messages::Role;
+use tactile_records::{Events, Recorder};
+use tactile_scenario::Scenario;
+
+/// A node program that passed its checks.
+#[derive(Debug)]
+pub struct Program {
+    role: Role,
+    args: NodeArgs,
+    links: Links,
+    prepared: Prepared,
+}
+
+/// What a node's handler is made from.
+pub type Make<'a, H> = Box<dyn FnOnce(&Prepared, &mut Outside) -> Result<H, NodeError> + 'a>;
+
+impl Program {
+    /// Checks the arguments, the scenario and the prefix, takes the role's lock,
+    /// installs the log, schedules the node (see [`prepare`]).
+    pub fn prepare(role: Role, args: &NodeArgs, links: Links) -> Result<Program, NodeError> {
+        let prepared = prepare(role, args, &links)?;
+        Ok(Program {
+            role,
+            args: args.clone(),
+            links,
+            prepared,
+        })
+    }
+
+    /// The scenario.
+    pub fn scenario(&self) -> &Scenario {
+        &self.prepared.scenario
+    }
+
+    /// What the checks found.
+    pub fn prepared(&self) -> &Prepared {
+        &self.prepared
+    }
+
+    /// The record, started.
+    fn record<H: Handler>(&self) -> Result<Recorder<H::Sample, H::Totals>, NodeError> {
+        let failed = |e: tactile_records::WriteError| NodeError::Failed(e.to_string());
+        let mut rec =
+            Recorder::open(&self.args.out, self.role, self.args.append).map_err(failed)?;
+        let start = start_record(self.role, &self.args, &self.links, &self.prepared);
+        rec.start(start).map_err(failed)?;
+        Ok(rec)
+    }
+
+    /// The node's ends, its ROS 2 side and its handler; a failure is recorded.
+    fn open<H: Handler>(
+        &self,
+        rec: &mut Recorder<H::Sample, H::Totals>,
+        make: Make<'_, H>,
+    ) -> Result<(Link, Outside, H), NodeError> {
+        let opened = (|| {
+            let links = self.links;
+            let ports = tactile_transport::ports::open(
+                self.role,
+                &self.args.link,
+                |s| links.of(s),
+                links.direct,
+            )
+            .map_err(|e| NodeError::Failed(e.to_string()))?;
+            let mut outside = Outside::open(&self.prepared.scenario, self.role)?;
+            let h = make(&self.prepared, &mut outside)?;
+            Ok((Link::new(ports, self.prepared.spin), outside, h))
+        })();
+        if let Err(e) = &opened {
+            let _ = rec.event(0, &format!("failed: {e}"));
+            let _ = rec.stop(
+                H::Totals::default(),
+                crate::sys::max_rss_kb(),
+                &format!("failed: {e}"),
+            );
+        }
+        opened
+    }
+
+    fn timing(&self) -> Timing {
+        Timing::of(&self.prepared.scenario, self.prepared.wake_early)
+    }
+
+    /// Runs a follower (the emulator, the slave) until the master's end of the run
+    /// (`Ok(true)`) or a stop request (`Ok(false)`).
+    pub fn follow<H: Follower>(self, make: Make<'_, H>) -> Result<bool, NodeError> {
+        let mut rec = self.record::<H>()?;
+        let (link, outside, h) = self.open(&mut rec, make)?;
+        Follow::new(h, link, rec, self.timing(), outside.live)
+            .run(&mut OnTransports)
+            .map_err(failed)
+    }
+
+    /// Runs the leader (the master) until every sample was sent (`Ok(true)`) or a
+    /// stop request (`Ok(false)`); `startup_timeout` bounds the waits for the device
+    /// and the peers.
+    pub fn lead<H: Leader>(
+        self,
+        startup_timeout: Duration,
+        make: Make<'_, H>,
+    ) -> Result<bool, NodeError> {
+        let mut rec = self.record::<H>()?;
+        let (link, outside, h) = self.open(&mut rec, make)?;
+        let opts = LeadOptions {
+            run: new_run_token(),
+            samples: self.prepared.scenario.samples,
+            startup_timeout,
+            answer_timeout: Duration::from_millis(100),
+            timing: self.timing(),
+        };
+        Lead::new(h, link, rec, opts, outside.live)
+            .run(&mut OnTransports)
+            .map_err(failed)
+    }
+}
+
+fn failed(e: Failure) -> NodeError {
+    NodeError::Failed(e.to_string())
+}

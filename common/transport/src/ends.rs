@@ -1,0 +1,52 @@
+//! What a node asks of a stream's two ends, whatever carries it: a publisher that
+//! stamps and counts what it sends, a subscriber that counts what it takes and what
+//! it refuses, and the wait on a transport until something may have come. The loop's
+//! driver (in `tactile-runtime`) composes a node's ends; the transports implement them.
+
+use std::time::Instant;
+use tactile_messages::stream::{InboxStats, OutboxStats};
+
+/// A link failure (iceoryx2, UDP, Zenoh), with what was being done.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{context}: {detail}")]
+pub struct LinkError {
+    /// What was being done.
+    pub context: String,
+    /// The transport's description.
+    pub detail: String,
+}
+
+impl LinkError {
+    /// The error of `context`, from anything that says why.
+    pub fn new(context: &str, e: impl std::fmt::Display) -> LinkError {
+        LinkError {
+            context: context.to_string(),
+            detail: e.to_string(),
+        }
+    }
+}
+
+/// The sending end of a stream.
+pub trait Publish<T> {
+    /// Publishes `value`, stamped with this hop's publish counter and counted, or, with
+    /// `control` (a start-up probe, the end of a run), marked so neither end counts it.
+    fn publish(&mut self, value: T, control: bool) -> Result<(), LinkError>;
+    /// What it counted.
+    fn stats(&self) -> OutboxStats;
+}
+
+/// The receiving end of a stream.
+pub trait Subscribe<T> {
+    /// A sample if one waits, counted (with any lost before it); what is not a whole
+    /// sample of this run's format is counted and passed over.
+    fn try_recv(&mut self) -> Result<Option<T>, LinkError>;
+    /// What it counted.
+    fn stats(&self) -> InboxStats;
+}
+
+/// How a node waits on one transport until a sample may have come for one of its
+/// subscribers there.
+pub trait Wake {
+    /// Blocks until something may have arrived, or `until`; it may return early.
+    fn block(&self, until: Instant) -> Result<(), LinkError>;
+}

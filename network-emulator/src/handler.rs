@@ -1,0 +1,59 @@
+//! What the emulator does with its samples, as the loop's driver hands them over
+//! (`tactile_runtime::driver`): each c(n) and h(n) through its channel of
+//! [`Emulator`], what comes out passed on. The driver owns the pacing (asleep until
+//! c(n) is due, but never while an h(n) is due back), the waits and the protocol.
+
+use crate::emulator::Emulator;
+use tactile_messages::samples::{Backward, Forward};
+use tactile_records::emulator::{EmulatorStats, EmulatorTotals, Passage};
+use tactile_runtime::driver::{Counts, Failure, Follower, Handler, Io, Reply};
+
+/// The emulator's handler: both channels.
+#[derive(Debug)]
+pub struct EmulatorHandler {
+    emulator: Emulator,
+}
+
+impl EmulatorHandler {
+    /// The handler of `emulator`.
+    pub fn new(emulator: Emulator) -> Self {
+        EmulatorHandler { emulator }
+    }
+}
+
+impl Handler for EmulatorHandler {
+    type Sample = Passage;
+    type Totals = EmulatorTotals;
+
+    fn totals(&self, c: &Counts) -> EmulatorTotals {
+        EmulatorTotals {
+            counters: self.emulator.counters(),
+            links: EmulatorStats {
+                c_in: c.ports.forward_in,
+                v_out: c.ports.forward_out,
+                h_in: c.ports.backward_in,
+                q_out: c.ports.backward_out,
+            },
+        }
+    }
+}
+
+impl Follower for EmulatorHandler {
+    fn forward(&mut self, c: &Forward, _: &mut Io) -> Result<Reply<Passage>, Failure> {
+        let (v, passage) = self.emulator.forward(c);
+        Ok(Reply {
+            forward: v,
+            backward: None,
+            record: Some(passage),
+        })
+    }
+
+    fn backward(&mut self, h: &Backward, _: &mut Io) -> Result<Reply<Passage>, Failure> {
+        let (q, passage) = self.emulator.backward(h);
+        Ok(Reply {
+            forward: None,
+            backward: q,
+            record: Some(passage),
+        })
+    }
+}
