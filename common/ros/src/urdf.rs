@@ -1,9 +1,10 @@
 //! The URDF of the two Omni-class arms in the paper's dimensions, published as
 //! `/robot_description` so viewers draw the arms on the frames of [`crate::arm`]:
-//! link and joint names, origins and axes are that chain's, so a URDF library's FK
-//! with the paper's joint angles puts the tool where the kernels' FK does.
+//! written from that chain ([`crate::arm::chain`]), so its link and joint names,
+//! origins and axes are the chain's, and a URDF library's FK with the paper's joint
+//! angles puts the tool where the kernels' FK does.
 
-use crate::arm::{name, ARMS, WORLD};
+use crate::arm::{axis_index, name, Joint, Motion, Shape, Visual, ARMS, WORLD};
 use std::fmt::Write as _;
 use tactile_math::geometry::Geometry;
 
@@ -23,142 +24,91 @@ pub fn urdf(g: &Geometry) -> String {
     s
 }
 
-fn link(s: &mut String, name: &str, visual: Option<(&str, [f64; 3], &str)>) {
-    match visual {
-        None => {
-            let _ = writeln!(s, "  <link name=\"{name}\"/>");
+/// The URDF element of a shape.
+fn geometry(shape: Shape) -> String {
+    match shape {
+        Shape::Box([x, y, z]) => format!("<box size=\"{x} {y} {z}\"/>"),
+        Shape::Cylinder(r, l) => format!("<cylinder radius=\"{r}\" length=\"{l}\"/>"),
+        Shape::Sphere(r) => format!("<sphere radius=\"{r}\"/>"),
+    }
+}
+
+fn link(s: &mut String, name: &str, visual: Option<Visual>, arm: &str) {
+    let Some(v) = visual else {
+        let _ = writeln!(s, "  <link name=\"{name}\"/>");
+        return;
+    };
+    let [x, y, z] = v.at;
+    let material = if v.tool { "tool" } else { arm };
+    let _ = writeln!(
+        s,
+        "  <link name=\"{name}\">\n    <visual>\n      <origin xyz=\"{x} {y} {z}\" rpy=\"0 0 0\"/>\n      \
+         <geometry>{}</geometry>\n      <material name=\"{material}\"/>\n    </visual>\n  </link>",
+        geometry(v.shape)
+    );
+}
+
+/// Every revolute joint's range and limits (the Omni turns no joint past half a turn).
+const LIMIT: &str = "\n    <limit lower=\"-3.1416\" upper=\"3.1416\" effort=\"10\" velocity=\"20\"/>";
+
+/// A joint's type, origin rpy and its axis, limit and mimic elements.
+fn motion(j: &Joint, chain: &[Joint], arm: &str) -> (&'static str, [f64; 3], String) {
+    match j.motion {
+        Motion::Fixed { about, angle } => {
+            let mut rpy = [0.0; 3];
+            rpy[about] = angle;
+            ("fixed", rpy, String::new())
         }
-        Some((geometry, [x, y, z], material)) => {
-            let _ = writeln!(
-                s,
-                "  <link name=\"{name}\">\n    <visual>\n      <origin xyz=\"{x} {y} {z}\" rpy=\"0 0 0\"/>\n      \
-                 <geometry>{geometry}</geometry>\n      <material name=\"{material}\"/>\n    </visual>\n  </link>"
-            );
+        Motion::Turns {
+            axis,
+            joint,
+            multiplier,
+            at_zero,
+        } => {
+            let mut rpy = [0.0; 3];
+            rpy[axis_index(axis).0] = at_zero;
+            let [x, y, z] = axis;
+            let mut extra = format!("\n    <axis xyz=\"{x} {y} {z}\"/>{LIMIT}");
+            if multiplier != 1.0 {
+                let driver = chain.iter().find(|d| {
+                    matches!(d.motion, Motion::Turns { joint: k, multiplier: m, .. } if k == joint && m == 1.0)
+                });
+                if let Some(d) = driver {
+                    let _ = write!(
+                        extra,
+                        "\n    <mimic joint=\"{}\" multiplier=\"{multiplier}\" offset=\"0\"/>",
+                        name(arm, d.name)
+                    );
+                }
+            }
+            ("revolute", rpy, extra)
         }
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn joint(
-    s: &mut String,
-    name: &str,
-    kind: &str,
-    parent: &str,
-    child: &str,
-    xyz: [f64; 3],
-    rpy: [f64; 3],
-    extra: &str,
-) {
-    let _ = writeln!(
-        s,
-        "  <joint name=\"{name}\" type=\"{kind}\">\n    <parent link=\"{parent}\"/>\n    \
-         <child link=\"{child}\"/>\n    <origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/>{extra}\n  </joint>",
-        xyz[0], xyz[1], xyz[2], rpy[0], rpy[1], rpy[2]
-    );
-}
-
+/// Each joint of `arm`'s chain and the link it carries.
 fn arm_urdf(s: &mut String, g: &Geometry, arm: &str) {
-    let n = |p: &str| name(arm, p);
-    let l4 = g.l1 + g.a;
-    let rod = |len: f64| format!("<cylinder radius=\"0.005\" length=\"{len}\"/>");
-    let limit = "\n    <limit lower=\"-3.1416\" upper=\"3.1416\" effort=\"10\" velocity=\"20\"/>";
-    let axis_x = format!("\n    <axis xyz=\"-1 0 0\"/>{limit}");
-    let base = crate::arm::base_in_world(arm);
-    let rpy = [std::f64::consts::FRAC_PI_2, 0.0, 0.0];
-    link(
-        s,
-        &n("base"),
-        Some(("<box size=\"0.06 0.01 0.06\"/>", [0.0, -0.005, 0.0], arm)),
-    );
-    joint(
-        s,
-        &n("base_joint"),
-        "fixed",
-        WORLD,
-        &n("base"),
-        base.2,
-        rpy,
-        "",
-    );
-    link(
-        s,
-        &n("link1"),
-        Some((
-            "<cylinder radius=\"0.012\" length=\"0.02\"/>",
-            [0.0; 3],
-            arm,
-        )),
-    );
-    joint(
-        s,
-        &n("joint1"),
-        "revolute",
-        &n("base"),
-        &n("link1"),
-        [0.0, g.l3, -l4],
-        [0.0; 3],
-        &format!("\n    <axis xyz=\"0 -1 0\"/>{limit}"),
-    );
-    link(
-        s,
-        &n("upper_arm"),
-        Some((&rod(g.l1), [0.0, 0.0, g.l1 / 2.0], arm)),
-    );
-    joint(
-        s,
-        &n("joint2"),
-        "revolute",
-        &n("link1"),
-        &n("upper_arm"),
-        [0.0; 3],
-        [0.0; 3],
-        &axis_x,
-    );
-    link(s, &n("elbow"), None);
-    let mimic = format!(
-        "{axis_x}\n    <mimic joint=\"{}\" multiplier=\"-1\" offset=\"0\"/>",
-        n("joint2")
-    );
-    joint(
-        s,
-        &n("elbow_joint"),
-        "revolute",
-        &n("upper_arm"),
-        &n("elbow"),
-        [0.0, 0.0, g.l1],
-        [0.0; 3],
-        &mimic,
-    );
-    link(
-        s,
-        &n("forearm"),
-        Some((&rod(g.l2), [0.0, 0.0, g.l2 / 2.0], arm)),
-    );
-    joint(
-        s,
-        &n("joint3"),
-        "revolute",
-        &n("elbow"),
-        &n("forearm"),
-        [0.0; 3],
-        rpy,
-        &axis_x,
-    );
-    link(
-        s,
-        &n("tool"),
-        Some(("<sphere radius=\"0.006\"/>", [0.0; 3], "tool")),
-    );
-    joint(
-        s,
-        &n("tool_joint"),
-        "fixed",
-        &n("forearm"),
-        &n("tool"),
-        [0.0, 0.0, g.l2],
-        [0.0; 3],
-        "",
-    );
+    let chain = crate::arm::chain(g, arm);
+    for j in &chain {
+        link(s, &name(arm, j.child), j.visual, arm);
+        let parent = if j.parent == WORLD {
+            WORLD.to_string()
+        } else {
+            name(arm, j.parent)
+        };
+        let (kind, rpy, extra) = motion(j, &chain, arm);
+        let [x, y, z] = j.origin;
+        let _ = writeln!(
+            s,
+            "  <joint name=\"{}\" type=\"{kind}\">\n    <parent link=\"{parent}\"/>\n    \
+             <child link=\"{}\"/>\n    <origin xyz=\"{x} {y} {z}\" rpy=\"{} {} {}\"/>{extra}\n  </joint>",
+            name(arm, j.name),
+            name(arm, j.child),
+            rpy[0],
+            rpy[1],
+            rpy[2]
+        );
+    }
 }
 
 #[cfg(test)]
