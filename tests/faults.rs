@@ -5,7 +5,7 @@
 use crate::util;
 
 use std::process::{Child, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
 use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber};
 use tactile_transport::{Publish, Subscribe};
@@ -32,18 +32,13 @@ fn kill(pid: i32, signal: rustix::process::Signal) {
     let _ = rustix::process::kill_process(pid, signal);
 }
 
-/// Waits until the run's master process is up.
-fn wait_for_master(sb: &Sandbox) {
-    let start = Instant::now();
-    while pid_of(sb, "master").is_none() && start.elapsed() < Duration::from_secs(10) {
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
-
-/// Waits until the run's master has got going, then kills `role` with SIGKILL.
-fn kill_mid_run(sb: &Sandbox, role: &str, after: Duration) {
-    wait_for_master(sb);
-    std::thread::sleep(after);
+/// Waits until the master of the run into `out` has recorded `bytes` (about 400 a sample at 1 kHz:
+/// 1,500 samples are 600 kB), then kills `role` with SIGKILL.
+fn kill_mid_run(sb: &Sandbox, out: &str, role: &str, bytes: u64) {
+    let rec = sb.path(out).join("master.rec");
+    util::wait_for("the run got going", Duration::from_secs(30), || {
+        std::fs::metadata(&rec).is_ok_and(|m| m.len() >= bytes)
+    });
     let pid = pid_of(sb, role).unwrap_or_else(|| panic!("no {role} running"));
     kill(pid, rustix::process::Signal::KILL);
 }
@@ -63,7 +58,7 @@ fn peer_dies_and_the_loop_resumes(role: &str) {
     let sb = Sandbox::new(role);
     let scenario = sb.write("s.toml", &util::paper_1khz(4000));
     let child = spawn_run(&sb, &scenario, "run");
-    kill_mid_run(&sb, role, Duration::from_millis(1500));
+    kill_mid_run(&sb, "run", role, 600_000);
     let (code, stdout, stderr) = finish(child);
     sb.assert_no_leftover_processes();
     assert_eq!(
@@ -148,7 +143,7 @@ fn master_killed_the_slave_holds_and_the_launcher_fails_cleanly() {
     let sb = Sandbox::new("master");
     let scenario = sb.write("s.toml", &util::paper_1khz(5000));
     let child = spawn_run(&sb, &scenario, "run");
-    kill_mid_run(&sb, "master", Duration::from_millis(1500));
+    kill_mid_run(&sb, "run", "master", 600_000);
     let (code, _stdout, stderr) = finish(child);
     sb.assert_no_leftover_processes();
     assert_eq!(code, Some(1), "{stderr}");
@@ -192,7 +187,7 @@ fn a_new_run_after_a_crash_starts_cleanly() {
     let sb = Sandbox::new("crash");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let child = spawn_run(&sb, &scenario, "first");
-    kill_mid_run(&sb, "master", Duration::from_millis(500));
+    kill_mid_run(&sb, "first", "master", 200_000);
     // Kill the launcher first, so nobody cleans up, then every process of the run.
     let launcher = child.id() as i32;
     let (m, e, s) = (

@@ -236,7 +236,11 @@ fn the_slave_host_node_killed_breaks_the_loop_and_it_resumes_after_restart() {
     }
     slave.kill().expect("SIGKILL the slave");
     let _ = slave.wait();
-    std::thread::sleep(Duration::from_millis(300));
+    // The master notices: the loop breaks before the slave is back.
+    let log = sb.path("m").join("master.log");
+    util::wait_for("the loop broke", Duration::from_secs(10), || {
+        std::fs::read_to_string(&log).is_ok_and(|l| l.contains("loop broken"))
+    });
     let mut again = slave_args.to_vec();
     again.push("--append");
     let slave = spawn(hosts.on(1, "tactile-slave", &again), &sb);
@@ -375,7 +379,19 @@ fn garbage_truncated_and_other_version_payloads_are_counted_and_dropped() {
             .expect("session")
         })
         .collect();
-    std::thread::sleep(Duration::from_millis(300));
+    // Each stranger's session has met its node before the junk goes out.
+    for (session, node) in sessions.iter().zip(["master", "emulator", "slave"]) {
+        util::wait_for(
+            &format!("a session met the {node}"),
+            Duration::from_secs(10),
+            || {
+                let info = session.info();
+                tactile_transport::zenoh_link::zenoh::Wait::wait(info.peers_zid())
+                    .next()
+                    .is_some()
+            },
+        );
+    }
     let bad = bad_payloads();
     for round in 0..40 {
         for stream in ["c", "v", "h", "q"] {
@@ -439,7 +455,11 @@ fn garbage_datagrams_at_a_udp_node_are_counted_and_dropped() {
     let slave = spawn(sb.node("tactile-slave", &args("s")), &sb);
     let master = spawn(sb.node("tactile-master", &args("m")), &sb);
     let socket = std::net::UdpSocket::bind("127.0.0.1:0").expect("bind");
-    std::thread::sleep(Duration::from_millis(500));
+    // The run is going (the slave answers) before the junk goes out.
+    let rec = sb.path("m").join("master.rec");
+    util::wait_for("the run got going", Duration::from_secs(30), || {
+        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 20_000)
+    });
     for _ in 0..50 {
         for b in bad_payloads() {
             let _ = socket.send_to(&b, ("127.0.0.1", ports.ports[2]));

@@ -34,10 +34,19 @@ fn hand_started_nodes_in_any_order_match_tactile_run_and_the_simulation() {
     let sb = Sandbox::new("byhand");
     let scenario = sb.write("s.toml", &lockstep(1200));
     // Slave first, then the master (which waits for its peers), then the emulator.
+    let waits = |role: &str, what: &str| {
+        let log = sb.path(&format!("h-{role}")).join(format!("{role}.log"));
+        let what = what.to_string();
+        util::wait_for(
+            &format!("the {role} waits"),
+            Duration::from_secs(20),
+            move || std::fs::read_to_string(&log).is_ok_and(|l| l.contains(&what)),
+        );
+    };
     let slave = start_node(&sb, "slave", &scenario, "h-slave", &[]);
-    std::thread::sleep(Duration::from_millis(300));
+    waits("slave", "waiting for the master");
     let master = start_node(&sb, "master", &scenario, "h-master", &[]);
-    std::thread::sleep(Duration::from_millis(500));
+    waits("master", "waiting for the emulator and slave");
     let emulator = start_node(&sb, "emulator", &scenario, "h-emulator", &[]);
     for (name, child) in [("master", master), ("emulator", emulator), ("slave", slave)] {
         let (code, err) = finish(child);

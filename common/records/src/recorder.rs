@@ -1,7 +1,7 @@
 //! A node's record as it runs: the writer with its bookkeeping (events into the log as
 //! well, counters every second).
 
-use crate::record::{Event, Record, Start, Stop, Totals};
+use crate::entry::{Event, Record, Start, Stop, Totals};
 use crate::RecordWriter;
 use serde::Serialize;
 use std::path::{Path, PathBuf};

@@ -224,7 +224,7 @@ impl Joint {
     /// angle is the paper's own expression, exactly: pi/2 - theta3 for joint 3).
     pub fn transform(&self, arm: &str, theta: [f64; 3]) -> Link {
         let rotation = match self.motion {
-            Motion::Fixed { angle, .. } if angle == 0.0 => [0.0, 0.0, 0.0, 1.0],
+            Motion::Fixed { angle: 0.0, .. } => [0.0, 0.0, 0.0, 1.0],
             Motion::Fixed { about: k, angle } => about(k, angle),
             Motion::Turns {
                 axis,

@@ -49,7 +49,8 @@ fn link(s: &mut String, name: &str, visual: Option<Visual>, arm: &str) {
 }
 
 /// Every revolute joint's range and limits (the Omni turns no joint past half a turn).
-const LIMIT: &str = "\n    <limit lower=\"-3.1416\" upper=\"3.1416\" effort=\"10\" velocity=\"20\"/>";
+const LIMIT: &str =
+    "\n    <limit lower=\"-3.1416\" upper=\"3.1416\" effort=\"10\" velocity=\"20\"/>";
 
 /// A joint's type, origin rpy and its axis, limit and mimic elements.
 fn motion(j: &Joint, chain: &[Joint], arm: &str) -> (&'static str, [f64; 3], String) {

@@ -11,7 +11,7 @@ pub use tactile_transport::{LinkArgs, LinkKind};
 use crate::exit::{EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK};
 
 /// The command line every node takes.
-#[derive(Debug, Clone, Args)]
+#[derive(Debug, Clone, PartialEq, Args)]
 pub struct NodeArgs {
     /// Scenario file (TOML); its relative paths are resolved against its own folder.
     #[arg(long)]
@@ -57,6 +57,45 @@ pub struct NodeArgs {
     /// to the file only.
     #[arg(long, hide = true)]
     pub supervised: Option<u32>,
+}
+
+/// `--flag value` for an option that is set.
+fn opt(v: &mut Vec<String>, flag: &str, value: Option<String>) {
+    if let Some(x) = value {
+        v.push(flag.to_string());
+        v.push(x);
+    }
+}
+
+impl NodeArgs {
+    /// The command line that parses back to these arguments: how a launcher starts a
+    /// node, written next to the options so a flag is named once.
+    pub fn argv(&self) -> Vec<String> {
+        let mut v = Vec::new();
+        let path = |p: &PathBuf| Some(p.display().to_string());
+        opt(&mut v, "--scenario", path(&self.scenario));
+        opt(&mut v, "--out", path(&self.out));
+        v.extend(self.link.argv());
+        opt(&mut v, "--spin-us", self.spin_us.map(|x| x.to_string()));
+        opt(
+            &mut v,
+            "--wake-early-us",
+            self.wake_early_us.map(|x| x.to_string()),
+        );
+        opt(&mut v, "--sched", Some(self.sched.name().into()));
+        opt(&mut v, "--idle", Some(self.idle.name().into()));
+        opt(&mut v, "--priority", Some(self.priority.to_string()));
+        opt(&mut v, "--cpu", self.cpu.map(|x| x.to_string()));
+        if self.append {
+            v.push("--append".into());
+        }
+        opt(
+            &mut v,
+            "--supervised",
+            self.supervised.map(|x| x.to_string()),
+        );
+        v
+    }
 }
 
 /// Why a node stopped without completing.
@@ -132,5 +171,49 @@ pub(crate) mod testing {
         let mut v = vec!["node", "--scenario", "s.toml", "--out", "o"];
         v.extend_from_slice(extra);
         Cli::parse_from(v).node
+    }
+
+    /// Arguments parsed from a whole command line, or clap's error.
+    pub fn parse(argv: &[String]) -> Result<NodeArgs, clap::Error> {
+        let mut v = vec!["node".to_string()];
+        v.extend_from_slice(argv);
+        Cli::try_parse_from(v).map(|c| c.node)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::testing::{args, parse};
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Whatever a launcher sets, the command line it writes parses back to it.
+        #[test]
+        fn a_command_line_parses_back_to_its_arguments(
+            spin in proptest::option::of(0u64..5000),
+            early in proptest::option::of(0u64..900),
+            cpu in proptest::option::of(0usize..4),
+            priority in 1u8..=98,
+            append: bool,
+            supervised in proptest::option::of(1u32..99999),
+            link in 0usize..3,
+            tls: bool,
+        ) {
+            let kind = ["iceoryx2", "udp", "zenoh"][link];
+            let mut extra = vec!["--link", kind, "--prefix", "p_1", "--udp-ports", "1,2,3"];
+            extra.extend(["--listen", "tcp/127.0.0.1:1", "--connect", "tcp/127.0.0.1:2"]);
+            if tls {
+                extra.extend(["--tls-ca", "ca.pem", "--tls-cert", "n.pem", "--tls-key", "n.key"]);
+            }
+            let mut a = args(&extra);
+            a.spin_us = spin;
+            a.wake_early_us = early;
+            a.cpu = cpu;
+            a.priority = priority;
+            a.append = append;
+            a.supervised = supervised;
+            let back = parse(&a.argv()).expect("parses");
+            prop_assert_eq!(back, a);
+        }
     }
 }

@@ -32,7 +32,7 @@ impl LinkKind {
 }
 
 /// The options of a node's links, on every node's command line.
-#[derive(Debug, Clone, Args)]
+#[derive(Debug, Clone, PartialEq, Eq, Args)]
 pub struct LinkArgs {
     /// Name of the run: nodes with the same prefix find each other (iceoryx2's shared
     /// memory, Zenoh's keys, the run's locks). 1 to 24 characters from A-Z a-z 0-9 _ -.
@@ -71,6 +71,18 @@ pub struct LinkArgs {
     pub tls_key: Option<PathBuf>,
 }
 
+impl Default for LinkArgs {
+    /// The options of a command line that gives none (clap's defaults).
+    fn default() -> Self {
+        #[derive(clap::Parser)]
+        struct Only {
+            #[command(flatten)]
+            link: LinkArgs,
+        }
+        <Only as clap::Parser>::parse_from(["node"]).link
+    }
+}
+
 /// An option that cannot work, in words that name it.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{0}")]
@@ -84,6 +96,38 @@ pub const NO_ZENOH: &str = "--link zenoh: this build has no Zenoh link; build wi
 const MAX_PEM: u64 = 1 << 20;
 
 impl LinkArgs {
+    /// The options as a command line that parses back to them.
+    pub fn argv(&self) -> Vec<String> {
+        let mut v = Vec::new();
+        let mut put = |flag: &str, value: String| {
+            v.push(flag.to_string());
+            v.push(value);
+        };
+        put("--prefix", self.prefix.clone());
+        put("--link", self.link.name().into());
+        put("--udp-ports", self.udp_ports.clone());
+        put("--udp-hosts", self.udp_hosts.clone());
+        for e in &self.listen {
+            put("--listen", e.clone());
+        }
+        for e in &self.connect {
+            put("--connect", e.clone());
+        }
+        for (flag, f) in [
+            ("--tls-ca", &self.tls_ca),
+            ("--tls-cert", &self.tls_cert),
+            ("--tls-key", &self.tls_key),
+        ] {
+            if let Some(f) = f {
+                put(flag, f.display().to_string());
+            }
+        }
+        if self.scout {
+            v.push("--scout".into());
+        }
+        v
+    }
+
     /// The UDP ports and hosts.
     pub fn udp(&self) -> Result<crate::udp::UdpPorts, BadOption> {
         let ports = crate::udp::UdpPorts::parse(&self.udp_ports).ok_or_else(|| {

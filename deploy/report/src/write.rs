@@ -8,7 +8,7 @@ use crate::plots::{self, Series};
 pub use crate::summary::REPORT_FILES;
 use crate::summary::{ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
 use crate::Error;
-use crate::{recording, trace};
+use crate::{run_mcap, trace};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -332,10 +332,10 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         Some(w)
     };
     let mut recording = if launch.no_trace {
-        let _ = std::fs::remove_file(out.join(recording::FILE));
+        let _ = std::fs::remove_file(out.join(run_mcap::FILE));
         None
     } else {
-        Some(recording::create(out, &scenario).map_err(Error::io("writing run.mcap"))?)
+        Some(run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?)
     };
     let mut line = String::with_capacity(2048);
     let mut t0 = None;
@@ -367,12 +367,12 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         }
         Ok(ControlFlow::Continue(()))
     })
-    .inspect_err(|_| recording::discard(out))?;
+    .inspect_err(|_| run_mcap::discard(out))?;
     if let Some(mut w) = trace {
         w.flush().map_err(Error::io("writing trace.csv"))?;
     }
     if let Some(r) = recording {
-        recording::commit(r, out).map_err(Error::io("writing run.mcap"))?;
+        run_mcap::commit(r, out).map_err(Error::io("writing run.mcap"))?;
     }
     analysis.finish();
     let round_trip = analysis.round_trip.hgrm();
@@ -419,17 +419,17 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
 
 /// Joins the records in `dirs` and writes only `out/run.mcap` (old records converted
 /// without redoing the report). Returns the number of samples recorded.
-pub fn write_recording(dirs: &[PathBuf], out: &Path) -> Result<u64, Error> {
+pub fn write_mcap(dirs: &[PathBuf], out: &Path) -> Result<u64, Error> {
     let (_, scenario) = recorded(dirs)?;
     make_out_dir(out)?;
-    let mut rec = recording::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
+    let mut rec = run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
     let mut samples = 0;
     join::join(dirs, |row| {
         samples += 1;
         rec.add(row).map_err(Error::io("writing run.mcap"))?;
         Ok(ControlFlow::Continue(()))
     })
-    .inspect_err(|_| recording::discard(out))?;
-    recording::commit(rec, out).map_err(Error::io("writing run.mcap"))?;
+    .inspect_err(|_| run_mcap::discard(out))?;
+    run_mcap::commit(rec, out).map_err(Error::io("writing run.mcap"))?;
     Ok(samples)
 }

@@ -19,7 +19,7 @@ pub struct CheckArgs {
 }
 
 /// Bytes per sample each file takes, measured on the million-sample lockstep run
-/// (`deploy/scenarios/lockstep-1e6.toml`, record format 5; docs/06 and docs/10).
+/// (`deploy/scenarios/lockstep-1e6.toml`, record format 6; docs/06 and docs/10).
 const PER_SAMPLE: [(&str, f64); 5] = [
     ("master.rec", 470.0),
     ("emulator.rec", 370.0),

@@ -6,7 +6,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use tactile_report::join;
 use tactile_report::summary::render;
-use tactile_report::write::{write_recording, write_report, Launch};
+use tactile_report::write::{write_mcap, write_report, Launch};
 
 /// Arguments of `tactile report`.
 #[derive(Debug, Args)]
@@ -38,10 +38,10 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
     };
     if args.mcap_only {
-        let samples = write_recording(&args.dirs, &out)?;
+        let samples = write_mcap(&args.dirs, &out)?;
         crate::outln!(
             "wrote {}: {samples} samples",
-            out.join(tactile_report::recording::FILE).display()
+            out.join(tactile_report::run_mcap::FILE).display()
         );
         return Ok(());
     }

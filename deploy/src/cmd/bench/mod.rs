@@ -23,7 +23,6 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::Duration;
 use tactile_report::analysis::{us_header, us_line, Percentiles};
 use tactile_report::summary::Summary;
 use tactile_report::write::write_json;
@@ -127,28 +126,9 @@ pub struct BenchArgs {
     /// Output folder (bench.json and each run's report).
     #[arg(long, default_value = "bench-out")]
     pub out: PathBuf,
-    /// Poll budget of every node, microseconds (default: the nodes' own).
-    #[arg(long)]
-    pub spin_us: Option<u64>,
-    /// Realtime: microseconds before a sample is due that each node stops sleeping
-    /// and polls (default 200, at most 40 % of a period).
-    #[arg(long)]
-    pub wake_early_us: Option<u64>,
-    /// Scheduling of every loop's nodes (the same for every transport).
-    #[arg(long, value_enum, default_value_t = tactile_runtime::sched::Policy::Fifo)]
-    pub sched: tactile_runtime::sched::Policy,
-    /// What each node's CPU does while the node sleeps, under SCHED_FIFO: halt (the
-    /// kernel's idle; the default) or poll (a SCHED_IDLE thread keeps it busy, so a
-    /// halted CPU is not woken late; on these virtual machines a CPU kept busy is
-    /// taken away for about 7.5 ms every 10 s instead: docs/07-latency.md).
-    #[arg(long, value_enum, default_value_t = tactile_runtime::sched::IdleMode::Halt)]
-    pub idle: tactile_runtime::sched::IdleMode,
-    /// Do not pin the iceoryx2 processes to CPUs.
-    #[arg(long)]
-    pub no_pin: bool,
-    /// iceoryx2 prefix of the bench's runs (default: one per invocation).
-    #[arg(long)]
-    pub prefix: Option<String>,
+    /// How the node programs wait and are scheduled (the same for every transport).
+    #[command(flatten)]
+    pub nodes: crate::launch::NodeOptions,
     /// Also run the loops across two hosts: Zenoh in clear, Zenoh over mutual TLS
     /// (certificates made with `openssl` for the run) and UDP, in two network
     /// namespaces joined by a veth pair (made and removed by the bench; needs root).
@@ -238,27 +218,6 @@ fn trio_with(
     run_processes(&loaded, out, &sup)
 }
 
-/// How the bench supervises its iceoryx2 runs: no restarts (a death fails the bench),
-/// no progress line, pinned unless `--no-pin`.
-fn supervision(args: &BenchArgs, prefix: &str) -> Supervision {
-    Supervision {
-        prefix: prefix.to_string(),
-        spin: args.spin_us.map(Duration::from_micros),
-        wake_early: args.wake_early_us.map(Duration::from_micros),
-        progress: false,
-        max_restarts: 0,
-        link: crate::launch::Links {
-            kind: LinkKind::Iceoryx2,
-            args: Default::default(),
-        },
-        pin: !args.no_pin,
-        sched: args.sched,
-        idle: args.idle,
-        no_trace: false,
-        wrap: Default::default(),
-    }
-}
-
 /// Whether this build can run a loop on `link`: the Zenoh loops need the `zenoh`
 /// feature, and a bench without it says once that it leaves them out.
 fn zenoh_built(link: LinkKind) -> bool {
@@ -275,10 +234,6 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     }
     tactile_report::write::make_out_dir(&args.out)?;
     crate::launch::clean_stale_runs();
-    let prefix = args
-        .prefix
-        .clone()
-        .unwrap_or_else(|| format!("tactile{}b", std::process::id()));
     // From here a stop request is a flag the runs look at, not the end of this
     // process: the bench stops between runs and removes what it made.
     let stop =
@@ -298,7 +253,10 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     };
     let bench = Bench {
         args,
-        sup: supervision(args, &prefix),
+        // No restarts (a death fails the bench), no progress line.
+        sup: args
+            .nodes
+            .supervision(crate::launch::Links::plain(LinkKind::Iceoryx2), "b"),
         stop: &stop,
     };
     let mut rates = Vec::new();
@@ -398,7 +356,7 @@ impl Bench<'_> {
                 self.stopped()?;
             }
             // Let the last messages land.
-            std::thread::sleep(Duration::from_millis(200));
+            std::thread::sleep(std::time::Duration::from_millis(200));
             Ok(Some(viewer.received()))
         }
         #[cfg(not(feature = "zenoh"))]
@@ -415,7 +373,7 @@ impl Bench<'_> {
         let mut loops = Vec::new();
         let tls = if zenoh_built(LinkKind::Zenoh) {
             match crate::launch::pki::make(&self.args.out.join("pki"), "bench", &pair.addrs) {
-                Ok(files) => Some(crate::launch::pki::args(&files)),
+                Ok(files) => Some(files),
                 Err(e) => {
                     crate::noteln!("tactile bench: no TLS loop: {e}");
                     None
@@ -495,7 +453,7 @@ impl Bench<'_> {
 fn strategy(args: &BenchArgs) -> String {
     format!(
         "every loop: {}, each node sleeping until {} before its sample is due, then polling (yielding) for {} before it blocks{}",
-        match (args.sched, args.idle) {
+        match (args.nodes.sched, args.nodes.idle) {
             (tactile_runtime::sched::Policy::Fifo, tactile_runtime::sched::IdleMode::Poll) => {
                 "SCHED_FIFO where permitted (memory locked, each CPU kept awake while its node sleeps)"
             }
@@ -504,11 +462,11 @@ fn strategy(args: &BenchArgs) -> String {
             }
             (tactile_runtime::sched::Policy::Other, _) => "SCHED_OTHER",
         },
-        args.wake_early_us
+        args.nodes.wake_early_us
             .map_or_else(|| "200 us (at most 40 % of a period)".to_string(), |u| format!("{u} us")),
-        args.spin_us
+        args.nodes.spin_us
             .map_or_else(|| "twice that".to_string(), |u| format!("{u} us")),
-        if args.no_pin {
+        if args.nodes.no_pin {
             ""
         } else {
             "; master on CPU 0, emulator and slave on CPU 1 (one host)"
