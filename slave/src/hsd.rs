@@ -189,13 +189,39 @@ impl Slave {
     pub fn step(&mut self, v: &Forward) -> (Backward, Step) {
         self.counters.steps += 1;
         self.hold_from = None;
+        let (mut flags, observer, dissipated_j) = self.follow(v);
+        let measured = self.measured.take();
+        let (theta, torque, clamps) = self.move_joints(measured);
+        let (tool, force, surface, contact_object) =
+            self.sense(theta, measured.and_then(|m| m.force), &mut flags);
+        let out = self.reply(v, force, tool, flags);
+        let step = Step {
+            n: v.seq,
+            received: v.signal,
+            reference: self.control.position(),
+            theta_ref: self.reference,
+            theta,
+            torque,
+            tool,
+            surface,
+            force,
+            observer,
+            port_net_j: self.control.ledger().net(),
+            dissipated_j,
+            clamps,
+            contact_object,
+            flags,
+        };
+        (out, step)
+    }
+
+    /// CPD-HSD, the channel's control and IK-HSD: the new reference angles from v(n).
+    /// A value not sent or not new (the channel held it) is filled by the predictor;
+    /// one that is not physically possible (not finite, too large, too fast) is
+    /// rejected and filled likewise, never reaching the control, IK or a torque.
+    /// Returns the flags so far, the observer and the energy dissipated.
+    fn follow(&mut self, v: &Forward) -> (u32, [f64; 3], f64) {
         let mut flags = 0;
-        // CPD-HSD: a value not sent or not new (the channel held it) is filled by the
-        // predictor; one that is not physically possible (not finite, too large, too
-        // fast) is rejected and filled likewise, never reaching the control, IK or a
-        // torque. Then the channel's control.
-        let mut observer = [0.0; 3];
-        let mut dissipated_j = 0.0;
         let new = v.signal.flags & (FLAG_UNSENT | FLAG_SUBSTITUTED) == 0;
         let fresh = (new || !self.predictor.has_value()).then(|| {
             let at = v.signal.sent_seq.iter().copied().min().unwrap_or(v.seq);
@@ -210,70 +236,79 @@ impl Slave {
             flags |= FLAG_REJECTED;
             self.counters.rejected += 1;
         }
-        if self.predictor.has_value() {
-            let r = self.control.receive(est.value(), energy, self.last_force);
-            (observer, dissipated_j) = (r.observer, r.dissipated);
-            let target = r.position;
-            // IK-HSD, then JPD-HSD: pass-through.
-            let ik = self.engine.ik(target);
-            match ik.status {
-                IkStatus::Reachable => {}
-                IkStatus::Clamped => {
-                    flags |= FLAG_IK_CLAMPED;
-                    self.counters.ik_clamped += 1;
-                }
-                IkStatus::Invalid => {
-                    flags |= FLAG_REJECTED;
-                    self.counters.rejected += 1;
-                }
+        if !self.predictor.has_value() {
+            return (flags, [0.0; 3], 0.0);
+        }
+        let r = self.control.receive(est.value(), energy, self.last_force);
+        // IK-HSD, then JPD-HSD: pass-through.
+        let ik = self.engine.ik(r.position);
+        match ik.status {
+            IkStatus::Reachable => {}
+            IkStatus::Clamped => {
+                flags |= FLAG_IK_CLAMPED;
+                self.counters.ik_clamped += 1;
             }
-            if ik.status != IkStatus::Invalid {
-                self.reference = ik.theta;
+            IkStatus::Invalid => {
+                flags |= FLAG_REJECTED;
+                self.counters.rejected += 1;
             }
         }
+        if ik.status != IkStatus::Invalid {
+            self.reference = ik.theta;
+        }
+        (flags, r.observer, r.dissipated)
+    }
 
-        // FCS and SD: the joint controller and the simulated joints, or the real robot
-        // (its own controller follows the reference; its encoders say where it is).
-        let measured = self.measured.take();
-        let (theta, torque, clamps) = match measured {
-            Some(m) => (m.theta, [0.0; 3], 0),
-            None => {
-                let state = self.dynamics.state;
-                let cmd =
-                    self.controller
-                        .update(self.reference, state.theta, state.velocity, self.t_s);
-                self.counters.torque_clamps += u64::from(cmd.clamped);
-                self.advance(cmd.torque);
-                (self.dynamics.state.theta, cmd.torque, cmd.clamped)
-            }
-        };
+    /// FCS and SD: the joint controller and the simulated joints, or the real robot
+    /// (its own controller follows the reference; its encoders say where it is).
+    /// Returns the angles, the torques and the torque clamps.
+    fn move_joints(&mut self, measured: Option<Measured>) -> ([f64; 3], [f64; 3], u32) {
+        if let Some(m) = measured {
+            return (m.theta, [0.0; 3], 0);
+        }
+        let state = self.dynamics.state;
+        let cmd = self
+            .controller
+            .update(self.reference, state.theta, state.velocity, self.t_s);
+        self.counters.torque_clamps += u64::from(cmd.clamped);
+        self.advance(cmd.torque);
+        (self.dynamics.state.theta, cmd.torque, cmd.clamped)
+    }
 
-        // FK-HSD in the HSD's arithmetic; ENV sensors report the surface point of the
-        // object the true tool is in.
+    /// FK-HSD in the HSD's arithmetic, then ENV and FBF-HSD: the tool, the contact
+    /// force (a force-torque sensor's if there is one), the surface point and the
+    /// object touched (u32::MAX for none).
+    fn sense(
+        &mut self,
+        theta: [f64; 3],
+        sensor: Option<[f64; 3]>,
+        flags: &mut u32,
+    ) -> ([f64; 3], [f64; 3], [f64; 3], u32) {
         let tool = self.engine.fk(theta);
         let contact = deepest_contact(&self.objects, kernels::fk(&self.truth, &StdTrig, theta));
-        let (force, surface, contact_object) = match (measured.and_then(|m| m.force), contact) {
+        let (force, surface, object) = match (sensor, contact) {
             (Some(f), _) => {
                 // A force-torque sensor: its force is h(n); no surface is known.
                 if f.iter().any(|x| *x != 0.0) {
-                    flags |= FLAG_CONTACT;
+                    *flags |= FLAG_CONTACT;
                     self.counters.contact_steps += 1;
                 }
                 (f, [0.0; 3], u32::MAX)
             }
             (None, Some(c)) => {
-                flags |= FLAG_CONTACT;
+                *flags |= FLAG_CONTACT;
                 self.counters.contact_steps += 1;
-                (
-                    self.engine.fbf(c.surface, tool, c.stiffness),
-                    c.surface,
-                    c.object as u32,
-                )
+                let f = self.engine.fbf(c.surface, tool, c.stiffness);
+                (f, c.surface, c.object as u32)
             }
             (None, None) => ([0.0; 3], [0.0; 3], u32::MAX),
         };
+        (tool, force, surface, object)
+    }
 
-        // h(n): the force takes the provenance of the oldest position value it used.
+    /// h(n): the control's value of the force, through the codec, with the provenance
+    /// of the oldest position value it used.
+    fn reply(&mut self, v: &Forward, force: [f64; 3], tool: [f64; 3], flags: u32) -> Backward {
         self.last_force = force;
         let oldest = (0..3).min_by_key(|&i| v.signal.origin_seq[i]).unwrap_or(0);
         let mut out = Backward {
@@ -295,23 +330,6 @@ impl Slave {
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
         out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
         out.signal.flags |= flags;
-        let step = Step {
-            n: v.seq,
-            received: v.signal,
-            reference: self.control.position(),
-            theta_ref: self.reference,
-            theta,
-            torque,
-            tool,
-            surface,
-            force,
-            observer,
-            port_net_j: self.control.ledger().net(),
-            dissipated_j,
-            clamps,
-            contact_object,
-            flags,
-        };
-        (out, step)
+        out
     }
 }

@@ -215,7 +215,40 @@ impl Channel {
     /// this sample (it still draws its jitter, so enabling a codec leaves the network
     /// the same): the receiver then gets whatever arrived, or the last value again.
     pub fn push_packet(&mut self, seq: u64, values: [Value; 3], sent: bool) -> Emitted {
-        let len = self.ring.len() as u64;
+        let (sent, replayed) = self.admit(seq, values, sent);
+        let lost = replayed.is_some_and(|(_, lost)| lost);
+        let jitter = self.jitter.as_mut().map_or(0.0, |(j, rng)| j.next(rng));
+        let (duplicated, copy_jitter) = self.duplicate_of(sent);
+        let packet = Packet {
+            seq,
+            sent,
+            delay: self.delay_at(seq),
+            replayed: replayed.map(|(d, _)| d),
+            jitter,
+            copy: duplicated.then_some(copy_jitter),
+        };
+        let mut out = [Value::default(); 3];
+        let mut noise = [0.0; 3];
+        let mut substituted = false;
+        for i in 0..3 {
+            let (v, r, held) = self.axis(i, &packet);
+            (out[i], noise[i]) = (v, r);
+            substituted |= held;
+        }
+        Emitted {
+            values: out,
+            noise,
+            jitter,
+            lost,
+            duplicated,
+            substituted,
+        }
+    }
+
+    /// Takes sample `seq` in: whether its packet goes on the network (it was sent, in
+    /// order, and a replayed network did not lose it; then it is kept for its
+    /// arrival), and the replay's delay and loss for it.
+    fn admit(&mut self, seq: u64, values: [Value; 3], sent: bool) -> (bool, Option<(u32, bool)>) {
         // Sample numbers must increase, and not by absurd steps.
         let in_order = self
             .last_seq
@@ -228,106 +261,112 @@ impl Channel {
             .replay
             .as_mut()
             .map(|(r, t_s)| r.packet(seq, *t_s, sent));
-        let lost = replayed.is_some_and(|(_, lost)| lost);
-        let sent = sent && !lost;
+        let sent = sent && !replayed.is_some_and(|(_, lost)| lost);
         if sent {
             let slot = Slot { seq, values };
+            let len = self.ring.len() as u64;
             self.ring[(seq % len) as usize] = Some(slot);
             self.first.get_or_insert(slot);
         }
-        let delay = self.delay_at(seq);
-        let jitter = self.jitter.as_mut().map_or(0.0, |(j, rng)| j.next(rng));
-        // A duplicate is a second copy of the packet with its own jitter: it may arrive
-        // before the original (which is then of no use) or after (no use itself). Its
-        // stream draws the same numbers every sample whatever else is on (a codec, a
-        // replay, jitter), so turning those on leaves the duplicates where they were;
-        // the copy's jitter continues the correlated process with the duplication's own
-        // draw, so the originals' jitter stays as it was.
-        let (dup_draw, dup_e) = match &mut self.duplicate {
+        (sent, replayed)
+    }
+
+    /// Whether this sample's packet goes twice, and the copy's jitter. A duplicate is
+    /// a second copy with its own jitter: it may arrive before the original (which is
+    /// then of no use) or after (no use itself). Its stream draws the same numbers
+    /// every sample whatever else is on (a codec, a replay, jitter), so turning those
+    /// on leaves the duplicates where they were; the copy's jitter continues the
+    /// correlated process with the duplication's own draw, so the originals' jitter
+    /// stays as it was.
+    fn duplicate_of(&mut self, sent: bool) -> (bool, f64) {
+        let (draw, e) = match &mut self.duplicate {
             Some((p, rng)) => (
                 rng.random::<f64>() < *p,
                 rand_distr::StandardNormal.sample(rng),
             ),
             None => (false, 0.0),
         };
-        let duplicated = sent && dup_draw;
-        let copy_jitter = match &self.jitter {
-            Some((j, _)) if duplicated => j.clone().next_with(dup_e),
+        let duplicated = sent && draw;
+        let copy = match &self.jitter {
+            Some((j, _)) if duplicated => j.clone().next_with(e),
             _ => 0.0,
         };
-        let mut out = [Value::default(); 3];
-        let mut noise = [0.0; 3];
-        let mut substituted = false;
-        for i in 0..3 {
-            // When a copy sent now with this jitter arrives: the replay's delay, or the
-            // configured one plus jitter; in sending order unless reordering is on.
-            let reorder = self.reorder;
-            let f = &mut self.flight[i];
-            let arrival = |f: &InFlight, jitter: f64| {
-                let d = match replayed {
-                    Some((d, _)) => u64::from(d),
-                    None => (f64::from(delay[i]) + jitter).round().max(0.0) as u64,
-                };
-                let at = seq.saturating_add(d);
-                if reorder {
-                    at
-                } else {
-                    at.max(f.last_arrival)
-                }
-            };
-            if sent {
-                let at = arrival(f, jitter);
-                f.send(seq, at);
-            }
-            if duplicated {
-                let at = arrival(f, copy_jitter);
-                f.send(seq, at);
-            }
-            let newest = f.receive(seq, &self.ring, i);
-            let fresh = newest.is_some() && newest.map(|n| n.0) != f.last_emitted;
-            f.last_emitted = newest.map(|n| n.0);
-            let (from, value) = match newest {
-                Some(n) => {
-                    // Held when no newer packet came: flagged so the receiver knows.
-                    substituted |= !fresh;
-                    n
-                }
-                None => {
-                    substituted = true;
-                    // Nothing has arrived yet: hold the first value sent.
-                    let s = self.first.unwrap_or(Slot {
-                        seq,
-                        values: [Value::default(); 3],
-                    });
-                    (s.seq, s.values[i])
-                }
-            };
-            // The delay injected is the value's age here: the packet's delay, and any
-            // time it was held.
-            let age = u32::try_from(seq.saturating_sub(from)).unwrap_or(u32::MAX);
-            let src = Value {
-                delay_samples: value.delay_samples.saturating_add(age),
-                ..value
-            };
-            let r = match &self.noise[i] {
-                Some(dist) => dist.sample(&mut self.rng),
-                None => 0.0,
-            };
-            noise[i] = r;
-            out[i] = Value {
-                v: src.v + r,
-                ..src
-            };
-        }
-        Emitted {
-            values: out,
-            noise,
-            jitter,
-            lost,
-            duplicated,
-            substituted,
-        }
+        (duplicated, copy)
     }
+
+    /// Axis `i` of the sample: its packet (and copy) in flight, the newest arrived
+    /// value out with its age added to its delay and its noise; true if it was held
+    /// (no newer packet came).
+    fn axis(&mut self, i: usize, p: &Packet) -> (Value, f64, bool) {
+        // When a copy sent now with this jitter arrives: the replay's delay, or the
+        // configured one plus jitter; in sending order unless reordering is on.
+        let reorder = self.reorder;
+        let f = &mut self.flight[i];
+        let arrival = |f: &InFlight, jitter: f64| {
+            let d = match p.replayed {
+                Some(d) => u64::from(d),
+                None => (f64::from(p.delay[i]) + jitter).round().max(0.0) as u64,
+            };
+            let at = p.seq.saturating_add(d);
+            if reorder {
+                at
+            } else {
+                at.max(f.last_arrival)
+            }
+        };
+        if p.sent {
+            let at = arrival(f, p.jitter);
+            f.send(p.seq, at);
+        }
+        if let Some(copy) = p.copy {
+            let at = arrival(f, copy);
+            f.send(p.seq, at);
+        }
+        let newest = f.receive(p.seq, &self.ring, i);
+        let fresh = newest.is_some() && newest.map(|n| n.0) != f.last_emitted;
+        f.last_emitted = newest.map(|n| n.0);
+        let (from, value, held) = match newest {
+            // Held when no newer packet came: flagged so the receiver knows.
+            Some((from, v)) => (from, v, !fresh),
+            None => {
+                // Nothing has arrived yet: hold the first value sent.
+                let s = self.first.unwrap_or(Slot {
+                    seq: p.seq,
+                    values: [Value::default(); 3],
+                });
+                (s.seq, s.values[i], true)
+            }
+        };
+        // The delay injected is the value's age here: the packet's delay, and any
+        // time it was held.
+        let age = u32::try_from(p.seq.saturating_sub(from)).unwrap_or(u32::MAX);
+        let r = match &self.noise[i] {
+            Some(dist) => dist.sample(&mut self.rng),
+            None => 0.0,
+        };
+        let v = Value {
+            v: value.v + r,
+            delay_samples: value.delay_samples.saturating_add(age),
+            ..value
+        };
+        (v, r, held)
+    }
+}
+
+/// One sample's packet as the three axes see it.
+#[derive(Debug, Clone, Copy)]
+struct Packet {
+    seq: u64,
+    /// It went on the network.
+    sent: bool,
+    /// The configured delays at this sample.
+    delay: [u32; 3],
+    /// A replayed network's delay for it.
+    replayed: Option<u32>,
+    /// Its jitter.
+    jitter: f64,
+    /// A duplicate's jitter, if it went twice.
+    copy: Option<f64>,
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! what `tactile report` does: [`join`] streams the nodes' records (one host's folder
 //! or several) and joins them by sequence number into [`trace::TraceRow`]s;
 //! [`analysis`] and [`metrics`] fold the rows into latency histograms and the loop's
-//! figures; [`summary`] says it in JSON and text; [`plots`] draws it; [`run_mcap`]
+//! figures; [`summary`] says it in JSON and [`text`] on the terminal; [`plots`] draws it; [`run_mcap`]
 //! writes it as ROS 2 messages in MCAP ([`mcap`]) for the robotics viewers; [`write`]
 //! puts the report's files in a folder; [`sweep`] tabulates many runs' summaries.
 
@@ -16,6 +16,7 @@ pub mod run_mcap;
 pub mod summary;
 pub mod sweep;
 pub mod sweep_plots;
+pub mod text;
 pub mod trace;
 pub mod write;
 

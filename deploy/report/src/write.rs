@@ -19,6 +19,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_messages::Role;
+use tactile_records::emulator::EmulatorTotals;
+use tactile_records::master::MasterTotals;
+use tactile_records::slave::SlaveTotals;
 use tactile_records::Start;
 use tactile_scenario::Scenario;
 
@@ -171,6 +174,54 @@ pub const LOCKSTEP_OVERHEAD: &str = "lockstep: each sample starts when the last 
      wall-clock time of a round trip holds the other samples computed meanwhile, not the \
      injected delay; the round trip is in samples";
 
+/// Each stream's count from the totals of its two ends.
+fn channels(
+    m: &MasterTotals,
+    emulator: Option<&EmulatorTotals>,
+    slave: Option<&SlaveTotals>,
+) -> BTreeMap<&'static str, ChannelCount> {
+    let mut channels = BTreeMap::new();
+    let Some(e) = emulator else {
+        return channels;
+    };
+    let k = &e.counters;
+    channels.insert("c", ChannelCount::new(m.c_out, 0, e.links.c_in));
+    let q = ChannelCount::new(e.links.q_out, k.backward_dropped, m.q_in);
+    channels.insert("q", q);
+    if let Some(s) = slave {
+        let v = ChannelCount::new(e.links.v_out, k.forward_dropped, s.v_in);
+        channels.insert("v", v);
+        channels.insert("h", ChannelCount::new(s.h_out, 0, e.links.h_in));
+    }
+    channels
+}
+
+/// Each node that left a record, summarised.
+fn nodes(logs: &Logs) -> BTreeMap<&'static str, NodeSummary> {
+    [
+        (Role::Master, node_summary(&logs.master)),
+        (Role::Emulator, node_summary(&logs.emulator)),
+        (Role::Slave, node_summary(&logs.slave)),
+    ]
+    .into_iter()
+    .filter_map(|(role, n)| Some((role.name(), n?)))
+    .collect()
+}
+
+/// Whether the nodes share a clock, their domains, and the offsets estimated.
+fn clocks(a: &Analysis, logs: &Logs) -> Clocks {
+    Clocks {
+        shared: (0..3).all(|k| a.same_clock(0, k) || logs_missing(logs, k)),
+        domains: Role::ALL
+            .iter()
+            .zip(a.domains())
+            .filter(|(_, d)| !d.is_empty())
+            .map(|(r, d)| (r.name(), d.clone()))
+            .collect(),
+        offsets: a.clock_offsets(),
+    }
+}
+
 /// The summary from the joined statistics and the nodes' logs.
 fn summarise(
     scenario: &Scenario,
@@ -182,39 +233,13 @@ fn summarise(
     let master_totals = summed(&logs.master).unwrap_or_default();
     let emulator = summed(&logs.emulator);
     let slave = summed(&logs.slave);
-    let mut channels = BTreeMap::new();
-    let (mo, mi) = (master_totals.c_out, master_totals.q_in);
-    if let Some(e) = &emulator {
-        let k = &e.counters;
-        channels.insert("c", ChannelCount::new(mo, 0, e.links.c_in));
-        channels.insert(
-            "q",
-            ChannelCount::new(e.links.q_out, k.backward_dropped, mi),
-        );
-        if let Some(s) = &slave {
-            channels.insert(
-                "v",
-                ChannelCount::new(e.links.v_out, k.forward_dropped, s.v_in),
-            );
-            channels.insert("h", ChannelCount::new(s.h_out, 0, e.links.h_in));
-        }
-    }
-    let mut nodes = BTreeMap::new();
-    for (role, n) in [
-        (Role::Master, node_summary(&logs.master)),
-        (Role::Emulator, node_summary(&logs.emulator)),
-        (Role::Slave, node_summary(&logs.slave)),
-    ] {
-        if let Some(n) = n {
-            nodes.insert(role.name(), n);
-        }
-    }
     let mut ev = launch.events.clone();
     let omitted = events(Role::Master, &logs.master, &mut ev)
         + events(Role::Emulator, &logs.emulator, &mut ev)
         + events(Role::Slave, &logs.slave, &mut ev);
     let elapsed = master_totals.elapsed_ns;
     let lockstep = scenario.mode == tactile_scenario::Mode::Lockstep;
+    let samples = a.round_trip_samples.percentiles();
     Summary {
         scenario: scenario.name.clone(),
         mode: scenario.mode,
@@ -223,24 +248,14 @@ fn summarise(
         runner,
         run: logs.master.runs.first().map(|t| format!("{t:016x}")),
         round_trip_ns: a.round_trip.percentiles(),
-        round_trip_samples: a.round_trip_samples.percentiles(),
-        round_trip_ms_nominal: lockstep
-            .then(|| a.round_trip_samples.percentiles())
-            .flatten()
+        round_trip_ms_nominal: samples
+            .filter(|_| lockstep)
             .map(|p| p.p50 as f64 * scenario.t_s() * 1e3),
+        round_trip_samples: samples,
         overhead_ns: a.overhead.percentiles().filter(|_| !lockstep),
         overhead_na: (lockstep && a.received > 0).then_some(LOCKSTEP_OVERHEAD),
         overhead_negative: a.overhead.negative,
-        clocks: Clocks {
-            shared: (0..3).all(|k| a.same_clock(0, k) || logs_missing(logs, k)),
-            domains: Role::ALL
-                .iter()
-                .zip(a.domains())
-                .filter(|(_, d)| !d.is_empty())
-                .map(|(r, d)| (r.name(), d.clone()))
-                .collect(),
-            offsets: a.clock_offsets(),
-        },
+        clocks: clocks(a, logs),
         stages_ns: STAGES
             .iter()
             .zip(&a.stages)
@@ -260,6 +275,7 @@ fn summarise(
             forward: master_totals.counters.packets_sent,
             backward: slave.as_ref().map_or(0, |s| s.counters.packets_sent),
         },
+        channels: channels(&master_totals, emulator.as_ref(), slave.as_ref()),
         master: MasterPart {
             totals: master_totals,
             motion: a.motion,
@@ -269,10 +285,9 @@ fn summarise(
                 0.0
             },
         },
-        channels,
         emulator,
         slave,
-        nodes,
+        nodes: nodes(logs),
         events: ev,
         events_omitted: omitted,
         failed: launch.failed,
@@ -300,81 +315,70 @@ fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
     Ok((starts, scenario))
 }
 
-/// Joins the records in `dirs` and writes the report into `out`: summary, trace,
-/// histograms, plots and the scenario as run. Returns the summary.
-pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Summary, Error> {
-    let (starts, scenario) = recorded(dirs)?;
-    let domains = starts
-        .clone()
-        .map(|s| s.map_or_else(String::new, |s| s.clock));
-    let start = starts[0]
-        .clone()
-        .ok_or_else(|| Error::BadInput("no master record".into()))?;
-    make_out_dir(out)?;
-    let t_s = scenario.t_s();
-    // The in-process simulation's stamps are synthetic: no stage times from them.
-    let runner = if start.link == IN_PROCESS {
-        IN_PROCESS
-    } else {
-        "processes"
-    };
-    let mut analysis = Analysis::new(runner != IN_PROCESS, domains);
-    let mut series = Series::default();
-    let trace_path = out.join("trace.csv");
-    let mut trace = if launch.no_trace {
-        let _ = std::fs::remove_file(&trace_path);
-        None
-    } else {
+/// What a report streams its rows into besides the statistics: `trace.csv` and
+/// `run.mcap` (neither with `--no-trace`).
+struct Streams {
+    trace: Option<std::io::BufWriter<std::fs::File>>,
+    recording: Option<run_mcap::FileRecording>,
+    line: String,
+    t0: Option<u64>,
+}
+
+impl Streams {
+    /// Starts both files in `out` (or removes old ones with `no_trace`).
+    fn create(out: &Path, scenario: &Scenario, no_trace: bool) -> Result<Streams, Error> {
+        let trace_path = out.join("trace.csv");
+        if no_trace {
+            let _ = std::fs::remove_file(&trace_path);
+            let _ = std::fs::remove_file(out.join(run_mcap::FILE));
+            return Ok(Streams {
+                trace: None,
+                recording: None,
+                line: String::new(),
+                t0: None,
+            });
+        }
         let f = std::fs::File::create(&trace_path)
             .map_err(Error::io(format!("writing {}", trace_path.display())))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
         writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
-        Some(w)
-    };
-    let mut recording = if launch.no_trace {
-        let _ = std::fs::remove_file(out.join(run_mcap::FILE));
-        None
-    } else {
-        Some(run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?)
-    };
-    let mut line = String::with_capacity(2048);
-    let mut t0 = None;
-    let stopped = || {
-        launch
-            .stop
-            .as_ref()
-            .is_some_and(|f| f.load(Ordering::SeqCst))
-            || launch.until.is_some_and(|u| Instant::now() >= u)
-    };
-    let mut cut_short = None;
-    let logs = join::join(dirs, |row| {
-        // Looked at every 1024 samples: a clock read per sample would cost.
-        if row.n % 1024 == 0 && stopped() {
-            cut_short = Some(row.n);
-            return Ok(ControlFlow::Break(()));
-        }
-        analysis.add(row);
-        series.add(row, t_s);
-        if let Some(w) = trace.as_mut() {
-            let t0 = *t0.get_or_insert(row.stamps[0]);
-            line.clear();
-            row.write_csv(&mut line, t0);
-            w.write_all(line.as_bytes())
+        let recording = run_mcap::create(out, scenario).map_err(Error::io("writing run.mcap"))?;
+        Ok(Streams {
+            trace: Some(w),
+            recording: Some(recording),
+            line: String::with_capacity(2048),
+            t0: None,
+        })
+    }
+
+    fn add(&mut self, row: &trace::TraceRow) -> Result<(), Error> {
+        if let Some(w) = self.trace.as_mut() {
+            let t0 = *self.t0.get_or_insert(row.stamps[0]);
+            self.line.clear();
+            row.write_csv(&mut self.line, t0);
+            w.write_all(self.line.as_bytes())
                 .map_err(Error::io("writing trace.csv"))?;
         }
-        if let Some(r) = recording.as_mut() {
+        if let Some(r) = self.recording.as_mut() {
             r.add(row).map_err(Error::io("writing run.mcap"))?;
         }
-        Ok(ControlFlow::Continue(()))
-    })
-    .inspect_err(|_| run_mcap::discard(out))?;
-    if let Some(mut w) = trace {
-        w.flush().map_err(Error::io("writing trace.csv"))?;
+        Ok(())
     }
-    if let Some(r) = recording {
-        run_mcap::commit(r, out).map_err(Error::io("writing run.mcap"))?;
+
+    /// Flushes the trace and gives the recording its name.
+    fn finish(self, out: &Path) -> Result<(), Error> {
+        if let Some(mut w) = self.trace {
+            w.flush().map_err(Error::io("writing trace.csv"))?;
+        }
+        if let Some(r) = self.recording {
+            run_mcap::commit(r, out).map_err(Error::io("writing run.mcap"))?;
+        }
+        Ok(())
     }
-    analysis.finish();
+}
+
+/// The histograms and the plots of a run.
+fn figures(out: &Path, analysis: &Analysis, series: &Series) -> Result<(), Error> {
     let round_trip = analysis.round_trip.hgrm();
     let overhead = analysis.overhead.hgrm();
     write_file(&out.join("round_trip.hgrm"), &round_trip)?;
@@ -397,7 +401,58 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
             ],
         ),
     )?;
-    plot("positions and forces", series.write(out))?;
+    plot("positions and forces", series.write(out))
+}
+
+/// The run's runner and the analysis that fits it: the in-process simulation's
+/// stamps are synthetic, so no stage times come from them.
+fn analysis_for(starts: &[Option<Start>; 3]) -> Result<(&'static str, Analysis), Error> {
+    let domains = starts
+        .clone()
+        .map(|s| s.map_or_else(String::new, |s| s.clock));
+    let start = starts[0]
+        .as_ref()
+        .ok_or_else(|| Error::BadInput("no master record".into()))?;
+    let runner = if start.link == IN_PROCESS {
+        IN_PROCESS
+    } else {
+        "processes"
+    };
+    Ok((runner, Analysis::new(runner != IN_PROCESS, domains)))
+}
+
+/// Joins the records in `dirs` and writes the report into `out`: summary, trace,
+/// histograms, plots and the scenario as run. Returns the summary.
+pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Summary, Error> {
+    let (starts, scenario) = recorded(dirs)?;
+    let (runner, mut analysis) = analysis_for(&starts)?;
+    make_out_dir(out)?;
+    let t_s = scenario.t_s();
+    let mut series = Series::default();
+    let mut streams = Streams::create(out, &scenario, launch.no_trace)?;
+    let stopped = || {
+        launch
+            .stop
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::SeqCst))
+            || launch.until.is_some_and(|u| Instant::now() >= u)
+    };
+    let mut cut_short = None;
+    let logs = join::join(dirs, |row| {
+        // Looked at every 1024 samples: a clock read per sample would cost.
+        if row.n % 1024 == 0 && stopped() {
+            cut_short = Some(row.n);
+            return Ok(ControlFlow::Break(()));
+        }
+        analysis.add(row);
+        series.add(row, t_s);
+        streams.add(row)?;
+        Ok(ControlFlow::Continue(()))
+    })
+    .inspect_err(|_| run_mcap::discard(out))?;
+    streams.finish(out)?;
+    analysis.finish();
+    figures(out, &analysis, &series)?;
     // Inputs copied into the folder are referred to relatively, so it reruns anywhere.
     let here = std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
     write_file(

@@ -5,7 +5,7 @@ use crate::error::Error;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use tactile_report::join;
-use tactile_report::summary::render;
+use tactile_report::text::render;
 use tactile_report::write::{write_mcap, write_report, Launch};
 
 /// Arguments of `tactile report`.

@@ -5,7 +5,7 @@ use crate::error::Error;
 use crate::launch::{self, load_scenario, parse_sets, Links, NodeOptions, Supervision};
 use clap::Args;
 use std::path::PathBuf;
-use tactile_report::summary::render;
+use tactile_report::text::render;
 use tactile_runtime::args::LinkKind;
 
 /// Arguments of `tactile run`.
