@@ -67,59 +67,27 @@ impl Default for ChannelConfig {
 /// Largest delay accepted, in samples: ten seconds at the highest rate.
 pub const MAX_DELAY_SAMPLES: i64 = 100_000;
 
+/// A delay a channel can apply: non-negative, at most [`MAX_DELAY_SAMPLES`].
+fn check_delay(d: i64, f: String) -> Result<(), ScenarioError> {
+    if d < 0 {
+        Err(invalid(
+            f,
+            format!("delay {d} is negative: a channel cannot deliver before sending"),
+        ))
+    } else if d > MAX_DELAY_SAMPLES {
+        Err(invalid(
+            f,
+            format!("delay {d} exceeds {MAX_DELAY_SAMPLES} samples"),
+        ))
+    } else {
+        Ok(())
+    }
+}
+
 impl ChannelConfig {
     pub(crate) fn validate(&self, field: &str) -> Result<(), ScenarioError> {
-        let check_delay = |d: i64, f: String| {
-            if d < 0 {
-                Err(invalid(
-                    f,
-                    format!("delay {d} is negative: a channel cannot deliver before sending"),
-                ))
-            } else if d > MAX_DELAY_SAMPLES {
-                Err(invalid(
-                    f,
-                    format!("delay {d} exceeds {MAX_DELAY_SAMPLES} samples"),
-                ))
-            } else {
-                Ok(())
-            }
-        };
-        for (i, d) in self.delay.iter().enumerate() {
-            check_delay(*d, format!("{field}.delay[{i}]"))?;
-        }
-        let mut last = -1;
-        for (k, e) in self.schedule.iter().enumerate() {
-            if e[0] < 0 || e[0] <= last {
-                return Err(invalid(
-                    format!("{field}.schedule[{k}]"),
-                    "from_sample must be non-negative and strictly increasing",
-                ));
-            }
-            last = e[0];
-            for i in 0..3 {
-                check_delay(e[i + 1], format!("{field}.schedule[{k}][{}]", i + 1))?;
-            }
-        }
-        for (name, p) in [
-            ("loss", self.loss),
-            ("corrupt", self.corrupt),
-            ("duplicate", self.duplicate),
-        ] {
-            if !p.is_finite() || !(0.0..=1.0).contains(&p) {
-                return Err(invalid(
-                    format!("{field}.{name}"),
-                    format!("{p} is not a probability in [0, 1]"),
-                ));
-            }
-        }
-        for (i, s) in self.noise_std.iter().enumerate() {
-            if !s.is_finite() || *s < 0.0 {
-                return Err(invalid(
-                    format!("{field}.noise_std[{i}]"),
-                    format!("{s} must be a finite, non-negative standard deviation"),
-                ));
-            }
-        }
+        self.validate_delays(field)?;
+        self.validate_faults(field)?;
         if let Some(j) = &self.jitter {
             j.validate(field)?;
         }
@@ -138,6 +106,53 @@ impl ChannelConfig {
                 return Err(invalid(
                     format!("{field}.loss_model"),
                     "and `loss` both set: choose one loss model",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The delays and the schedule's: each one a channel can apply, the schedule's
+    /// samples increasing.
+    fn validate_delays(&self, field: &str) -> Result<(), ScenarioError> {
+        for (i, d) in self.delay.iter().enumerate() {
+            check_delay(*d, format!("{field}.delay[{i}]"))?;
+        }
+        let mut last = -1;
+        for (k, e) in self.schedule.iter().enumerate() {
+            if e[0] < 0 || e[0] <= last {
+                return Err(invalid(
+                    format!("{field}.schedule[{k}]"),
+                    "from_sample must be non-negative and strictly increasing",
+                ));
+            }
+            last = e[0];
+            for i in 0..3 {
+                check_delay(e[i + 1], format!("{field}.schedule[{k}][{}]", i + 1))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The probabilities and the noise: each in its range.
+    fn validate_faults(&self, field: &str) -> Result<(), ScenarioError> {
+        for (name, p) in [
+            ("loss", self.loss),
+            ("corrupt", self.corrupt),
+            ("duplicate", self.duplicate),
+        ] {
+            if !p.is_finite() || !(0.0..=1.0).contains(&p) {
+                return Err(invalid(
+                    format!("{field}.{name}"),
+                    format!("{p} is not a probability in [0, 1]"),
+                ));
+            }
+        }
+        for (i, s) in self.noise_std.iter().enumerate() {
+            if !s.is_finite() || *s < 0.0 {
+                return Err(invalid(
+                    format!("{field}.noise_std[{i}]"),
+                    format!("{s} must be a finite, non-negative standard deviation"),
                 ));
             }
         }

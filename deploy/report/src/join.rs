@@ -330,45 +330,63 @@ fn slave_key(s: &SlaveSample) -> Option<u64> {
     }
 }
 
-/// Builds sample n's row from what each node recorded for it.
-fn row(
-    sent: &Sent,
-    answer: Option<&Answer>,
-    miss: Option<&Miss>,
-    passages: &[Passage],
-    step: Option<&Step>,
-) -> TraceRow {
-    let mut r = TraceRow {
-        n: sent.n,
-        target: sent.target,
-        theta_md: sent.theta_md,
-        c: sent.c,
-        handle: sent.handle,
-        hand_force: sent.hand_force,
-        contact_object: -1,
-        ..TraceRow::default()
-    };
-    r.stamps[stage::MASTER_TICK] = sent.tick_ns;
-    r.stamps[stage::MASTER_SEND] = sent.send_ns;
-    if let Some(a) = answer {
-        r.received = true;
-        r.q = a.q.value;
-        r.delay_b = a.q.delay_samples;
-        r.flags_b = a.q.flags;
-        r.q_from = a.q.sent_seq;
-        r.q_origin = a.q.origin_seq;
-        r.round_trip_ns = a.round_trip_ns;
-        r.overhead_ns = a.overhead_ns;
-        r.stamps = Stamps(a.stamps);
+/// What the master recorded for one sample: what went out, and what came back or
+/// what it did without.
+#[derive(Debug, Clone, Copy)]
+struct MasterPart {
+    sent: Sent,
+    answer: Option<Answer>,
+    miss: Option<Miss>,
+}
+
+impl MasterPart {
+    /// The master's entries of a sample, or None if its Sent was lost.
+    fn of(items: &[MasterSample]) -> Option<MasterPart> {
+        let mut part = MasterPart {
+            sent: items.iter().find_map(|x| match x {
+                MasterSample::Sent(s) => Some(*s),
+                _ => None,
+            })?,
+            answer: None,
+            miss: None,
+        };
+        for x in items {
+            match x {
+                MasterSample::Answer(a) if part.answer.is_none() => part.answer = Some(*a),
+                MasterSample::Miss(m) if part.miss.is_none() => part.miss = Some(*m),
+                _ => {}
+            }
+        }
+        Some(part)
     }
-    if let Some(e) = answer.map(|a| &a.effect).or(miss.map(|m| &m.effect)) {
-        r.tau = e.tau;
-        r.felt = e.felt;
-        r.flags_m = e.flags;
-        r.observer_m = e.observer;
-        r.dissipated_m = e.dissipated_j;
-        r.port_net_m = e.port_net_j;
+
+    /// The master's columns.
+    fn fill(&self, r: &mut TraceRow) {
+        let sent = &self.sent;
+        (r.n, r.target, r.theta_md, r.c) = (sent.n, sent.target, sent.theta_md, sent.c);
+        (r.handle, r.hand_force) = (sent.handle, sent.hand_force);
+        r.stamps[stage::MASTER_TICK] = sent.tick_ns;
+        r.stamps[stage::MASTER_SEND] = sent.send_ns;
+        if let Some(a) = &self.answer {
+            r.received = true;
+            (r.q, r.delay_b, r.flags_b) = (a.q.value, a.q.delay_samples, a.q.flags);
+            (r.q_from, r.q_origin) = (a.q.sent_seq, a.q.origin_seq);
+            (r.round_trip_ns, r.overhead_ns) = (a.round_trip_ns, a.overhead_ns);
+            r.stamps = Stamps(a.stamps);
+        }
+        let effect = self
+            .answer
+            .map(|a| a.effect)
+            .or(self.miss.map(|m| m.effect));
+        if let Some(e) = effect {
+            (r.tau, r.felt, r.flags_m, r.observer_m) = (e.tau, e.felt, e.flags, e.observer);
+            (r.dissipated_m, r.port_net_m) = (e.dissipated_j, e.port_net_j);
+        }
     }
+}
+
+/// The emulator's columns of a sample.
+fn fill_passages(r: &mut TraceRow, passages: &[Passage]) {
     for p in passages {
         match p.dir {
             Direction::Forward => {
@@ -378,28 +396,62 @@ fn row(
             Direction::Backward => r.noise_b = p.noise,
         }
     }
+}
+
+/// The slave's columns of a sample.
+fn fill_step(r: &mut TraceRow, s: &Step) {
+    r.stepped = true;
+    (r.v, r.delay_f, r.flags_f) = (s.received.value, s.received.delay_samples, s.received.flags);
+    (r.theta_ref, r.reference) = (s.theta_ref, s.reference);
+    (r.observer_s, r.port_net_s, r.dissipated_s) = (s.observer, s.port_net_j, s.dissipated_j);
+    (r.theta_sd, r.u, r.tool, r.surface, r.h) = (s.theta, s.torque, s.tool, s.surface, s.force);
+    r.contact_object = if s.contact_object == u32::MAX {
+        -1
+    } else {
+        i64::from(s.contact_object)
+    };
+}
+
+/// Builds sample n's row from what each node recorded for it.
+fn row(master: &MasterPart, passages: &[Passage], step: Option<&Step>) -> TraceRow {
+    let mut r = TraceRow {
+        contact_object: -1,
+        ..TraceRow::default()
+    };
+    master.fill(&mut r);
+    fill_passages(&mut r, passages);
     if let Some(s) = step {
-        r.stepped = true;
-        r.v = s.received.value;
-        r.delay_f = s.received.delay_samples;
-        r.flags_f = s.received.flags;
-        r.theta_ref = s.theta_ref;
-        r.reference = s.reference;
-        r.observer_s = s.observer;
-        r.port_net_s = s.port_net_j;
-        r.dissipated_s = s.dissipated_j;
-        r.theta_sd = s.theta;
-        r.u = s.torque;
-        r.tool = s.tool;
-        r.surface = s.surface;
-        r.h = s.force;
-        r.contact_object = if s.contact_object == u32::MAX {
-            -1
-        } else {
-            i64::from(s.contact_object)
-        };
+        fill_step(&mut r, s);
     }
     r
+}
+
+/// The three records, read sample by sample.
+struct Sources {
+    master: Source<MasterSample, MasterTotals>,
+    emulator: Source<Passage, EmulatorTotals>,
+    slave: Source<SlaveSample, SlaveTotals>,
+}
+
+impl Sources {
+    /// The logs so far (`whole`: read to the end, checking what remains).
+    fn logs(self, whole: bool) -> Result<Logs, Error> {
+        let logs = if whole {
+            Logs {
+                master: self.master.finish()?,
+                emulator: self.emulator.finish()?,
+                slave: self.slave.finish()?,
+            }
+        } else {
+            Logs {
+                master: self.master.into_log(),
+                emulator: self.emulator.into_log(),
+                slave: self.slave.into_log(),
+            }
+        };
+        check_one_run(&logs)?;
+        Ok(logs)
+    }
 }
 
 /// Joins the records found in `dirs`, handing each sample's row to `each` in order.
@@ -410,63 +462,32 @@ pub fn join(
     mut each: impl FnMut(&TraceRow) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
     let [m, e, s] = locate(dirs)?;
-    let mut master = Source::<MasterSample, MasterTotals>::open(m, master_key)?;
-    let mut emulator = Source::<Passage, EmulatorTotals>::open(e, passage_key)?;
-    let mut slave = Source::<SlaveSample, SlaveTotals>::open(s, slave_key)?;
+    let mut src = Sources {
+        master: Source::open(m, master_key)?,
+        emulator: Source::open(e, passage_key)?,
+        slave: Source::open(s, slave_key)?,
+    };
     let mut n = 0u64;
     loop {
-        let items = master.take(n)?;
-        let Some(sent) = items.iter().find_map(|x| match x {
-            MasterSample::Sent(s) => Some(*s),
-            _ => None,
-        }) else {
+        let Some(part) = MasterPart::of(&src.master.take(n)?) else {
             // A sample the master's record lost (a damaged stretch): skipped, the
             // rest joined; past the last one, the end.
-            if master.has_after(n) {
+            if src.master.has_after(n) {
                 n += 1;
                 continue;
             }
-            break;
+            return src.logs(true);
         };
-        let answer = items.iter().find_map(|x| match x {
-            MasterSample::Answer(a) => Some(*a),
-            _ => None,
-        });
-        let miss = items.iter().find_map(|x| match x {
-            MasterSample::Miss(m) => Some(*m),
-            _ => None,
-        });
-        let passages = emulator.take(n)?;
-        let steps = slave.take(n)?;
-        let step = steps.iter().find_map(|x| match x {
+        let passages = src.emulator.take(n)?;
+        let step = src.slave.take(n)?.iter().find_map(|x| match x {
             SlaveSample::Step(s) => Some(*s),
             SlaveSample::Hold(_) => None,
         });
-        let flow = each(&row(
-            &sent,
-            answer.as_ref(),
-            miss.as_ref(),
-            &passages,
-            step.as_ref(),
-        ))?;
-        if flow.is_break() {
-            let logs = Logs {
-                master: master.into_log(),
-                emulator: emulator.into_log(),
-                slave: slave.into_log(),
-            };
-            check_one_run(&logs)?;
-            return Ok(logs);
+        if each(&row(&part, &passages, step.as_ref()))?.is_break() {
+            return src.logs(false);
         }
         n += 1;
     }
-    let logs = Logs {
-        master: master.finish()?,
-        emulator: emulator.finish()?,
-        slave: slave.finish()?,
-    };
-    check_one_run(&logs)?;
-    Ok(logs)
 }
 
 /// Refuses records of different runs: the nodes of one run share the master's token.

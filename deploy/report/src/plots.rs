@@ -139,70 +139,49 @@ impl Series {
 
     /// Writes `positions.svg`, `forces.svg` and `passivity.svg` into `out`.
     pub fn write(&self, out: &Path) -> PlotResult {
-        let series = |a: &[Thinned; 3], b: &[Thinned; 3], la: &str, lb: &str, pre: &str| {
-            let mut v = Vec::new();
-            for i in 0..3 {
-                v.push((
-                    format!("{pre}{} {la}", AXES[i]),
-                    COLOURS[i],
-                    true,
-                    a[i].points(),
-                ));
-                v.push((
-                    format!("{pre}{} {lb}", AXES[i]),
-                    COLOURS[i],
-                    false,
-                    b[i].points(),
-                ));
-            }
-            v
-        };
         timeplot::time_series(
             &out.join("positions.svg"),
             "Master handle and slave tool position",
             "position (m)",
-            &series(&self.handle, &self.tool, "master handle", "slave tool", ""),
+            &pairs(&self.handle, &self.tool, "master handle", "slave tool", ""),
         )?;
         timeplot::time_series(
             &out.join("forces.svg"),
             "Contact force (slave) and feedback force (master)",
             "force (N)",
-            &series(&self.felt, &self.force, "felt", "slave h(n)", "F"),
+            &pairs(&self.felt, &self.force, "felt", "slave h(n)", "F"),
         )?;
-        let grey = RGBColor(90, 90, 90);
         // No line here is another's reference: all are drawn plain.
+        let grey = RGBColor(90, 90, 90);
+        let plain =
+            |label: &str, colour, t: &Thinned| (label.to_string(), colour, false, t.points());
         timeplot::time_series(
             &out.join("passivity.svg"),
             "Channel energy (below zero: the channel made energy), observers, dissipation",
             "energy (mJ)",
             &[
-                (
-                    "channel energy".into(),
-                    COLOURS[0],
-                    false,
-                    self.channel.points(),
-                ),
-                (
-                    "master observer (lowest axis)".into(),
+                plain("channel energy", COLOURS[0], &self.channel),
+                plain(
+                    "master observer (lowest axis)",
                     COLOURS[1],
-                    false,
-                    self.observer_m.points(),
+                    &self.observer_m,
                 ),
-                (
-                    "slave observer (lowest axis)".into(),
-                    COLOURS[2],
-                    false,
-                    self.observer_s.points(),
-                ),
-                (
-                    "dissipated by the control".into(),
-                    grey,
-                    false,
-                    self.dissipated.points(),
-                ),
+                plain("slave observer (lowest axis)", COLOURS[2], &self.observer_s),
+                plain("dissipated by the control", grey, &self.dissipated),
             ],
         )
     }
+}
+
+/// Per axis, a full-colour line of `a` (the reference) and a lighter one of `b`.
+fn pairs(a: &[Thinned; 3], b: &[Thinned; 3], la: &str, lb: &str, pre: &str) -> Vec<Line> {
+    let mut v = Vec::new();
+    for i in 0..3 {
+        let name = |l: &str| format!("{pre}{} {l}", AXES[i]);
+        v.push((name(la), COLOURS[i], true, a[i].points()));
+        v.push((name(lb), COLOURS[i], false, b[i].points()));
+    }
+    v
 }
 
 /// Histogram of the system overhead per round trip, in microseconds.
@@ -272,19 +251,10 @@ pub(crate) const LOOP_COLOURS: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-/// Latency against percentile as the field draws it (HdrHistogram's plotter): the
-/// percentile on a log axis of 1/(1 - p), so 90 %, 99 %, 99.9 % and 99.99 % are evenly
-/// spaced and the tail is as visible as the body; one line per distribution, each
-/// from its `.hgrm` text; latency on a log axis too, since body and tail lie decades
-/// apart.
-pub fn percentile_plot(
-    path: &Path,
-    title: &str,
-    series: &[(String, Vec<(f64, f64)>)],
-) -> PlotResult {
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    // The last point (p = 1) has no finite 1/(1-p): it is drawn at the largest x.
+/// The percentile plot's axes: the largest 1/(1-p), rounded up to a decade (the last
+/// point, p = 1, has no finite one: it is drawn there), and the latency range with
+/// headroom; None without a point.
+fn percentile_extent(series: &[(String, Vec<(f64, f64)>)]) -> Option<(f64, f64, f64)> {
     let mut x_max = 10.0f64;
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for (_, pts) in series {
@@ -297,10 +267,31 @@ pub fn percentile_plot(
         }
     }
     if !lo.is_finite() {
-        return root.present().map_err(err);
+        return None;
     }
     let x_max = 10f64.powf(x_max.log10().ceil());
-    let (lo, hi) = ((lo * 0.8).max(0.01), (hi * 1.25).max(lo * 10.0).max(0.1));
+    Some((
+        x_max,
+        (lo * 0.8).max(0.01),
+        (hi * 1.25).max(lo * 10.0).max(0.1),
+    ))
+}
+
+/// Latency against percentile as the field draws it (HdrHistogram's plotter): the
+/// percentile on a log axis of 1/(1 - p), so 90 %, 99 %, 99.9 % and 99.99 % are evenly
+/// spaced and the tail is as visible as the body; one line per distribution, each
+/// from its `.hgrm` text; latency on a log axis too, since body and tail lie decades
+/// apart.
+pub fn percentile_plot(
+    path: &Path,
+    title: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> PlotResult {
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let Some((x_max, lo, hi)) = percentile_extent(series) else {
+        return root.present().map_err(err);
+    };
     // The right margin holds the half of the last tick label ("99.99%") that lies
     // past the axis's end.
     let mut chart = ChartBuilder::on(&root)

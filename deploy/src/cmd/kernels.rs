@@ -101,6 +101,39 @@ impl<R: BufRead> Lines<R> {
     }
 }
 
+/// The first line that is not blank, checked as the module's header.
+fn header<R: BufRead>(lines: &mut Lines<R>, in_cols: &[&str]) -> Result<(), Error> {
+    while let Some((n, line)) = lines.next_line()? {
+        if !line.trim().is_empty() {
+            return csv::check_header(n, &line, in_cols)
+                .map_err(|e| Error::BadInput(e.to_string()));
+        }
+    }
+    Err(Error::BadInput(
+        csv::CsvError::Empty {
+            expected: in_cols.join(","),
+        }
+        .to_string(),
+    ))
+}
+
+/// One row through the module: its three values, and for IK whether the target was
+/// reachable.
+fn evaluate(engine: &Engine, module: Module, v: &[f64]) -> ([f64; 3], Option<bool>) {
+    match module {
+        Module::Fk => (engine.fk([v[0], v[1], v[2]]), None),
+        Module::Ik => {
+            let s = engine.ik([v[0], v[1], v[2]]);
+            (s.theta, Some(s.status == IkStatus::Reachable))
+        }
+        Module::Kff => (engine.kff([v[0], v[1], v[2]], [v[3], v[4], v[5]]), None),
+        Module::Fbf => (
+            engine.fbf([v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]),
+            None,
+        ),
+    }
+}
+
 /// Evaluates `args.module` over the CSV on `input`, writing CSV to `output`.
 pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> Result<(), Error> {
     let kind = ArithKind::from(args.arith);
@@ -108,29 +141,12 @@ pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> 
         .map_err(|e| Error::BadInput(format!("bad fixed-point format: {e}")))?;
     let module = args.module;
     let in_cols = module.input_columns();
-
     let mut lines = Lines {
         input,
         n: 0,
         buf: Vec::new(),
     };
-    let mut header = None;
-    while let Some((n, line)) = lines.next_line()? {
-        if !line.trim().is_empty() {
-            header = Some((n, line));
-            break;
-        }
-    }
-    let Some((hl, header)) = header else {
-        return Err(Error::BadInput(
-            csv::CsvError::Empty {
-                expected: in_cols.join(","),
-            }
-            .to_string(),
-        ));
-    };
-    csv::check_header(hl, &header, in_cols).map_err(|e| Error::BadInput(e.to_string()))?;
-
+    header(&mut lines, in_cols)?;
     let mut out = String::with_capacity(4096);
     out.push_str(&module.output_columns().join(","));
     out.push('\n');
@@ -141,18 +157,7 @@ pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> 
         }
         csv::parse_row(lineno, &line, in_cols, &mut v)
             .map_err(|e| Error::BadInput(e.to_string()))?;
-        let (values, reachable): ([f64; 3], Option<bool>) = match module {
-            Module::Fk => (engine.fk([v[0], v[1], v[2]]), None),
-            Module::Ik => {
-                let s = engine.ik([v[0], v[1], v[2]]);
-                (s.theta, Some(s.status == IkStatus::Reachable))
-            }
-            Module::Kff => (engine.kff([v[0], v[1], v[2]], [v[3], v[4], v[5]]), None),
-            Module::Fbf => (
-                engine.fbf([v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]),
-                None,
-            ),
-        };
+        let (values, reachable) = evaluate(&engine, module, &v);
         if let Some(k) = values.iter().position(|x| !x.is_finite()) {
             let name = module.output_columns()[k];
             return Err(Error::BadInput(format!(

@@ -64,12 +64,8 @@ fn hop_spin(sup: &Supervision, rate: f64) -> Duration {
         .unwrap_or_else(|| Duration::from_nanos((2e9 / rate) as u64))
 }
 
-/// Ping-pong with an echo process at `rate` for `n` round trips.
-pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
-    let prefix = format!("{}h", sup.prefix);
-    // Held while the hop runs, so no cleaner takes its shared memory for a dead run's.
-    let _lock = tactile_runtime::lock::take(&prefix, "run", "tactile bench's bare hop")
-        .map_err(Error::BadInput)?;
+/// Starts the echo process of the hop `prefix` (on CPU 1 when pinned).
+fn spawn_echo(prefix: &str, rate: f64, sup: &Supervision) -> Result<std::process::Child, Error> {
     let exe = std::env::current_exe().map_err(Error::io("locating the tactile executable"))?;
     let mut cmd = if sup.pin {
         let mut c = Command::new("taskset");
@@ -78,74 +74,95 @@ pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), 
     } else {
         Command::new(&exe)
     };
-    let mut child = cmd
-        .arg("bench-echo")
-        .args(["--prefix", &prefix, "--spin-us"])
+    cmd.arg("bench-echo")
+        .args(["--prefix", prefix, "--spin-us"])
         .arg(hop_spin(sup, rate).as_micros().to_string())
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .spawn()
-        .map_err(|e| Error::Failed(format!("starting the echo process: {e}")))?;
+        .map_err(|e| Error::Failed(format!("starting the echo process: {e}")))
+}
+
+fn fail(e: impl Into<Failure>) -> Error {
+    Error::Failed(e.into().to_string())
+}
+
+/// Probes until the echo answers (10 s at most), then lets the echoes pass.
+fn find_echo(link: &mut Link) -> Result<(), Error> {
+    let start = Instant::now();
+    loop {
+        let mut p = Forward::default();
+        p.signal.flags = FLAG_PROBE;
+        link.send_forward(p, true).map_err(fail)?;
+        let until = Instant::now() + Duration::from_millis(20);
+        if link.wait(until, &mut OnTransports).map_err(fail)?.is_ok() {
+            break;
+        }
+        if start.elapsed() > Duration::from_secs(10) {
+            return Err(Error::Failed("the echo process did not answer".into()));
+        }
+    }
+    while link.poll().map_err(fail)?.is_some() {}
+    Ok(())
+}
+
+/// `n` pings at `rate`, each at its tick; the round trips and the misses (no pong
+/// within a period).
+fn ping(link: &mut Link, rate: f64, n: u64) -> Result<(Latency, u64), Error> {
+    let t_s = (1e9 / rate) as u64;
+    let t0 = now_ns() + 2_000_000;
+    let mut lat = Latency::default();
+    let mut misses = 0;
+    for i in 0..n {
+        let tick = t0 + i * t_s;
+        sleep_until_ns(tick.saturating_sub(tactile_runtime::pace::default_wake_early_ns(t_s)));
+        while now_ns() < tick {
+            std::hint::spin_loop();
+        }
+        let sent = now_ns();
+        let ping = Forward {
+            seq: i,
+            ..Forward::default()
+        };
+        link.send_forward(ping, false).map_err(fail)?;
+        let deadline = Instant::now() + Duration::from_nanos(t_s);
+        loop {
+            match link.wait(deadline, &mut OnTransports).map_err(fail)? {
+                Ok(Arrival::Forward(f)) if f.seq == i => {
+                    lat.record((now_ns() - sent) as i64);
+                    break;
+                }
+                Ok(_) => {}
+                Err(_) => {
+                    misses += 1;
+                    break;
+                }
+            }
+        }
+    }
+    let mut end = Forward::default();
+    end.signal.flags = FLAG_END;
+    link.send_forward(end, true).map_err(fail)?;
+    Ok((lat, misses))
+}
+
+/// Ping-pong with an echo process at `rate` for `n` round trips.
+pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
+    let prefix = format!("{}h", sup.prefix);
+    // Held while the hop runs, so no cleaner takes its shared memory for a dead run's.
+    let _lock = tactile_runtime::lock::take(&prefix, "run", "tactile bench's bare hop")
+        .map_err(Error::BadInput)?;
+    let mut child = spawn_echo(&prefix, rate, sup)?;
     let saved_affinity = rustix::thread::sched_getaffinity(None).ok();
     let result = (|| -> Result<(Latency, u64), Error> {
-        let fail = |e: Failure| Error::Failed(e.to_string());
         if sup.pin {
             let _ = tactile_runtime::sched::pin_thread(0);
         }
         let _restore = Restore(saved_affinity);
-        let mut link =
-            hop_end(&prefix, "bench", "echo", Duration::ZERO).map_err(|e| fail(e.into()))?;
-        // Probe until the echo answers.
-        let start = Instant::now();
-        loop {
-            let mut p = Forward::default();
-            p.signal.flags = FLAG_PROBE;
-            link.send_forward(p, true).map_err(|e| fail(e.into()))?;
-            let until = Instant::now() + Duration::from_millis(20);
-            if link.wait(until, &mut OnTransports).map_err(fail)?.is_ok() {
-                break;
-            }
-            if start.elapsed() > Duration::from_secs(10) {
-                return Err(Error::Failed("the echo process did not answer".into()));
-            }
-        }
-        while link.poll().map_err(|e| fail(e.into()))?.is_some() {}
+        let mut link = hop_end(&prefix, "bench", "echo", Duration::ZERO).map_err(fail)?;
+        find_echo(&mut link)?;
         let mut link = Link::new(link.into_ports(), hop_spin(sup, rate));
-        let t_s = (1e9 / rate) as u64;
-        let t0 = now_ns() + 2_000_000;
-        let mut lat = Latency::default();
-        let mut misses = 0;
-        for i in 0..n {
-            let tick = t0 + i * t_s;
-            sleep_until_ns(tick.saturating_sub(tactile_runtime::pace::default_wake_early_ns(t_s)));
-            while now_ns() < tick {
-                std::hint::spin_loop();
-            }
-            let sent = now_ns();
-            let ping = Forward {
-                seq: i,
-                ..Forward::default()
-            };
-            link.send_forward(ping, false).map_err(|e| fail(e.into()))?;
-            let deadline = Instant::now() + Duration::from_nanos(t_s);
-            loop {
-                match link.wait(deadline, &mut OnTransports).map_err(fail)? {
-                    Ok(Arrival::Forward(f)) if f.seq == i => {
-                        lat.record((now_ns() - sent) as i64);
-                        break;
-                    }
-                    Ok(_) => {}
-                    Err(_) => {
-                        misses += 1;
-                        break;
-                    }
-                }
-            }
-        }
-        let mut end = Forward::default();
-        end.signal.flags = FLAG_END;
-        link.send_forward(end, true).map_err(|e| fail(e.into()))?;
-        Ok((lat, misses))
+        ping(&mut link, rate, n)
     })();
     let _ = child.wait();
     ipc::remove_run_files(&prefix);

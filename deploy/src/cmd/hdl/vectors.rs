@@ -16,6 +16,19 @@ use tactile_math::cordic::Cordic;
 /// f32 bits of the quiet NaN the model and the RTL return.
 const NAN_BITS: u32 = 0x7fc0_0000;
 
+/// A word of the TFB as the RTL's vector files write it: hexadecimal, as wide as the
+/// word.
+struct Code {
+    width: usize,
+    mask: u64,
+}
+
+impl Code {
+    fn of(&self, v: i64) -> String {
+        format!("{:0w$x}", v as u64 & self.mask, w = self.width)
+    }
+}
+
 /// The vector file's text for `function`: a comment header naming the fields, then
 /// one line per sample. Returns the text and the number of samples.
 pub fn vectors(
@@ -26,9 +39,10 @@ pub fn vectors(
     seed: u64,
 ) -> (String, usize) {
     let mut rng = SplitMix(seed);
-    let width = k.config.word.div_ceil(4) as usize;
-    let mask = (1u64 << k.config.word) - 1; // word <= 32
-    let code = |v: i64| format!("{:0width$x}", v as u64 & mask);
+    let code = Code {
+        width: k.config.word.div_ceil(4) as usize,
+        mask: (1u64 << k.config.word) - 1, // word <= 32
+    };
     let mut out = format!(
         "// tactile hdl vectors: {} for [s{}.{}], {} iterations, {:?}; seed {seed}\n// fields: {}\n",
         function.name(),
@@ -38,82 +52,87 @@ pub fn vectors(
         k.config.rounding,
         function.fields()
     );
-    let mut n = 0;
-    match function {
-        Function::Sincos => {
-            for a in sincos_inputs(k, count, &mut rng) {
-                let a = f32::from_bits(a);
-                let line = match cordic.sin_cos_stages(a) {
-                    Some(s) => format!(
-                        "{:08x} 0 {} {} {} {} {} {:08x} {:08x}",
-                        a.to_bits(),
-                        code(s.code),
-                        code(s.folded),
-                        u8::from(s.flip),
-                        code(s.sin_code),
-                        code(s.cos_code),
-                        s.sin.to_bits(),
-                        s.cos.to_bits()
-                    ),
-                    None => format!(
-                        "{:08x} 1 {z} {z} 0 {z} {z} {NAN_BITS:08x} {NAN_BITS:08x}",
-                        a.to_bits(),
-                        z = code(0)
-                    ),
-                };
-                let _ = writeln!(out, "{line}");
-                n += 1;
-            }
-        }
-        Function::Atan2 => {
-            for (y, x) in atan2_inputs(count, &mut rng) {
-                let (y, x) = (f32::from_bits(y), f32::from_bits(x));
-                let line = match cordic.atan2_stages(y, x) {
-                    Some(s) => format!(
-                        "{:08x} {:08x} 1 {} {} {} {:08x}",
-                        y.to_bits(),
-                        x.to_bits(),
-                        code(s.x_code),
-                        code(s.y_code),
-                        code(s.z_code),
-                        s.out.to_bits()
-                    ),
-                    None => format!(
-                        "{:08x} {:08x} 0 {z} {z} {z} {NAN_BITS:08x}",
-                        y.to_bits(),
-                        x.to_bits(),
-                        z = code(0)
-                    ),
-                };
-                let _ = writeln!(out, "{line}");
-                n += 1;
-            }
-        }
-        Function::Acos => {
-            for a in acos_inputs(count, &mut rng) {
-                let a = f32::from_bits(a);
-                let line = match cordic.acos_stages(a) {
-                    Some(s) => format!(
-                        "{:08x} 1 {:08x} {} {} {} {:08x}",
-                        a.to_bits(),
-                        s.root.to_bits(),
-                        code(s.vector.x_code),
-                        code(s.vector.y_code),
-                        code(s.vector.z_code),
-                        s.vector.out.to_bits()
-                    ),
-                    None => format!(
-                        "{:08x} 0 00000000 {z} {z} {z} {NAN_BITS:08x}",
-                        a.to_bits(),
-                        z = code(0)
-                    ),
-                };
-                let _ = writeln!(out, "{line}");
-                n += 1;
-            }
-        }
+    let lines = match function {
+        Function::Sincos => sincos_inputs(k, count, &mut rng)
+            .into_iter()
+            .map(|a| sincos_line(cordic, &code, f32::from_bits(a)))
+            .collect::<Vec<_>>(),
+        Function::Atan2 => atan2_inputs(count, &mut rng)
+            .into_iter()
+            .map(|(y, x)| atan2_line(cordic, &code, f32::from_bits(y), f32::from_bits(x)))
+            .collect(),
+        Function::Acos => acos_inputs(count, &mut rng)
+            .into_iter()
+            .map(|a| acos_line(cordic, &code, f32::from_bits(a)))
+            .collect(),
+    };
+    for line in &lines {
+        let _ = writeln!(out, "{line}");
     }
-    (out, n)
+    (out, lines.len())
+}
+
+/// One sin/cos vector: input, invalid flag, the stages' codes and the outputs.
+fn sincos_line(cordic: &Cordic, code: &Code, a: f32) -> String {
+    match cordic.sin_cos_stages(a) {
+        Some(s) => format!(
+            "{:08x} 0 {} {} {} {} {} {:08x} {:08x}",
+            a.to_bits(),
+            code.of(s.code),
+            code.of(s.folded),
+            u8::from(s.flip),
+            code.of(s.sin_code),
+            code.of(s.cos_code),
+            s.sin.to_bits(),
+            s.cos.to_bits()
+        ),
+        None => format!(
+            "{:08x} 1 {z} {z} 0 {z} {z} {NAN_BITS:08x} {NAN_BITS:08x}",
+            a.to_bits(),
+            z = code.of(0)
+        ),
+    }
+}
+
+/// One atan2 vector: inputs, valid flag, the vectoring's codes and the output.
+fn atan2_line(cordic: &Cordic, code: &Code, y: f32, x: f32) -> String {
+    match cordic.atan2_stages(y, x) {
+        Some(s) => format!(
+            "{:08x} {:08x} 1 {} {} {} {:08x}",
+            y.to_bits(),
+            x.to_bits(),
+            code.of(s.x_code),
+            code.of(s.y_code),
+            code.of(s.z_code),
+            s.out.to_bits()
+        ),
+        None => format!(
+            "{:08x} {:08x} 0 {z} {z} {z} {NAN_BITS:08x}",
+            y.to_bits(),
+            x.to_bits(),
+            z = code.of(0)
+        ),
+    }
+}
+
+/// One acos vector: input, valid flag, the root, the vectoring's codes and the output.
+fn acos_line(cordic: &Cordic, code: &Code, a: f32) -> String {
+    match cordic.acos_stages(a) {
+        Some(s) => format!(
+            "{:08x} 1 {:08x} {} {} {} {:08x}",
+            a.to_bits(),
+            s.root.to_bits(),
+            code.of(s.vector.x_code),
+            code.of(s.vector.y_code),
+            code.of(s.vector.z_code),
+            s.vector.out.to_bits()
+        ),
+        None => format!(
+            "{:08x} 0 00000000 {z} {z} {z} {NAN_BITS:08x}",
+            a.to_bits(),
+            z = code.of(0)
+        ),
+    }
 }
 
 /// Both signs of each value.

@@ -91,16 +91,9 @@ pub struct Spec {
     pub shard: Option<[usize; 2]>,
 }
 
-/// `tactile sweep`.
-pub fn main(args: &SweepArgs) -> Result<(), Error> {
-    if !args.merge.is_empty() {
-        return table::merge(&args.merge, &args.out);
-    }
-    let scenario = args
-        .scenario
-        .as_deref()
-        .ok_or_else(|| Error::BadInput("a scenario file is needed".into()))?;
-    let axes = parse_axes(&args.set)?;
+/// `--seeds` within its range and not beside a seed axis; the grid within
+/// [`MAX_RUNS`].
+fn check_size(args: &SweepArgs, axes: &[Axis], combinations: usize) -> Result<(), Error> {
     if args.seeds == 0 || args.seeds > 1000 {
         return Err(Error::BadInput(format!(
             "--seeds {}: give 1 to 1000",
@@ -112,26 +105,53 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
             "--set seed=... and --seeds: sweep the seed one way or the other".into(),
         ));
     }
-    let combos = combinations(&axes);
-    if combos.len().saturating_mul(args.seeds) > MAX_RUNS {
+    if combinations.saturating_mul(args.seeds) > MAX_RUNS {
         return Err(Error::BadInput(format!(
-            "{} combinations x {} seeds: more than the {MAX_RUNS} runs a sweep may run",
-            combos.len(),
+            "{combinations} combinations x {} seeds: more than the {MAX_RUNS} runs a sweep may run",
             args.seeds
         )));
     }
-    let shard = args.shard.as_deref().map(parse_shard).transpose()?;
-    let jobs = match (args.jobs, args.processes) {
-        (Some(0), _) => return Err(Error::BadInput("--jobs 0: give at least 1".into())),
-        (Some(n), true) if n > 1 => {
-            return Err(Error::BadInput(
-                "--processes runs take the machine's CPUs one run at a time: --jobs 1".into(),
-            ))
+    Ok(())
+}
+
+/// Runs at a time: as given, one with `--processes` (they take the machine's CPUs),
+/// else the CPUs this process may use.
+fn jobs(args: &SweepArgs) -> Result<usize, Error> {
+    match (args.jobs, args.processes) {
+        (Some(0), _) => Err(Error::BadInput("--jobs 0: give at least 1".into())),
+        (Some(n), true) if n > 1 => Err(Error::BadInput(
+            "--processes runs take the machine's CPUs one run at a time: --jobs 1".into(),
+        )),
+        (Some(n), _) => Ok(n),
+        (None, true) => Ok(1),
+        (None, false) => Ok(tactile_runtime::sched::allowed_cpus().map_or(1, |c| c.len().max(1))),
+    }
+}
+
+/// Says each warning of the runs' scenarios once, however many runs share it.
+fn warn_once(work: &[exec::Work]) {
+    let mut said = std::collections::BTreeSet::new();
+    for w in work.iter().flat_map(|w| &w.loaded.warnings) {
+        if said.insert(w) {
+            crate::noteln!("tactile: warning: {w}");
         }
-        (Some(n), _) => n,
-        (None, true) => 1,
-        (None, false) => tactile_runtime::sched::allowed_cpus().map_or(1, |c| c.len().max(1)),
-    };
+    }
+}
+
+/// `tactile sweep`.
+pub fn main(args: &SweepArgs) -> Result<(), Error> {
+    if !args.merge.is_empty() {
+        return table::merge(&args.merge, &args.out);
+    }
+    let scenario = args
+        .scenario
+        .as_deref()
+        .ok_or_else(|| Error::BadInput("a scenario file is needed".into()))?;
+    let axes = parse_axes(&args.set)?;
+    let combos = combinations(&axes);
+    check_size(args, &axes, combos.len())?;
+    let shard = args.shard.as_deref().map(parse_shard).transpose()?;
+    let jobs = jobs(args)?;
     let spec = Spec {
         scenario: scenario.display().to_string(),
         scenario_hash: file_hash(scenario)?,
@@ -146,13 +166,7 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
     // Every run's scenario is checked before the first starts, so a bad value is bad
     // input (exit 2) with nothing run.
     let work = exec::plan(scenario, &axes, &combos, &mine, args)?;
-    // What deserves a word, once however many runs share it.
-    let mut said = std::collections::BTreeSet::new();
-    for w in work.iter().flat_map(|w| &w.loaded.warnings) {
-        if said.insert(w) {
-            crate::noteln!("tactile: warning: {w}");
-        }
-    }
+    warn_once(&work);
     tactile_report::write::make_out_dir(&args.out)?;
     table::check_resume(&args.out, &spec, args.resume)?;
     table::write_spec(&args.out, &spec)?;

@@ -93,8 +93,8 @@ pub fn write_tables(
     sweep_plots(out, axes, &points).map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))
 }
 
-/// `tactile sweep --merge DIR... --out OUT`.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
+/// The slices' specs, all of one sweep (scenario, `--set`s and seeds).
+fn slices_of_one_sweep(dirs: &[PathBuf]) -> Result<Spec, Error> {
     let specs = dirs
         .iter()
         .map(|d| read_spec(d))
@@ -112,18 +112,25 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
             )));
         }
     }
-    let axes = parse_axes(&first.sets)?;
-    let mut results = Vec::new();
-    let mut missing = Vec::new();
-    for k in 0..first.combinations {
-        for s in 0..first.seeds {
+    Ok(first.clone())
+}
+
+/// Every run of the grid found (combination, seed, its metrics), and the runs in
+/// none of the folders.
+type Found = (Vec<(usize, usize, Vec<Option<f64>>)>, Vec<String>);
+
+/// Each run of the grid from the one folder that holds it.
+fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
+    let (mut results, mut missing) = (Vec::new(), Vec::new());
+    for k in 0..spec.combinations {
+        for s in 0..spec.seeds {
             let found: Vec<_> = dirs
                 .iter()
-                .filter_map(|d| super::exec::finished(&run_dir(d, k, s, first.seeds)))
+                .filter_map(|d| super::exec::finished(&run_dir(d, k, s, spec.seeds)))
                 .collect();
             match found.len() {
                 0 => missing.push(
-                    run_dir(Path::new(""), k, s, first.seeds)
+                    run_dir(Path::new(""), k, s, spec.seeds)
                         .display()
                         .to_string(),
                 ),
@@ -136,6 +143,14 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
             }
         }
     }
+    Ok((results, missing))
+}
+
+/// `tactile sweep --merge DIR... --out OUT`.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
+    let first = slices_of_one_sweep(dirs)?;
+    let axes = parse_axes(&first.sets)?;
+    let (results, missing) = gather(dirs, &first)?;
     tactile_report::write::make_out_dir(out)?;
     write_spec(
         out,
