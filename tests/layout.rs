@@ -262,8 +262,50 @@ fn the_crates_depend_as_the_architecture_says() {
     );
     for pure in ["tactile-scenario", "tactile-control", "tactile-netem"] {
         let t = tree(pure);
-        for other in ["zenoh", "tactile-node"] {
+        for other in ["zenoh", "tactile-runtime", "tactile-transport"] {
             assert!(!has(&t, other), "{pure} depends on {other}");
+        }
+    }
+    // The report reads records: it needs none of the nodes, their runtime or links.
+    let report = tree("tactile-report");
+    for node in [
+        "tactile-master",
+        "tactile-slave",
+        "tactile-network-emulator",
+        "tactile-runtime",
+        "tactile-transport",
+        "tactile-devices",
+    ] {
+        assert!(!has(&report, node), "tactile-report depends on {node}");
+    }
+    assert!(has(&report, "tactile-records"));
+    // The records and the links stand below the runtime, not beside it.
+    for low in ["tactile-records", "tactile-transport", "tactile-devices"] {
+        let t = tree(low);
+        assert!(!has(&t, "tactile-runtime"), "{low} depends on the runtime");
+    }
+}
+
+/// The per-sample protocol is the driver's alone: no node crate names the pacer, the
+/// run filter, the probe or end-of-run flags, or the record's once-a-second counters.
+#[test]
+fn only_the_driver_speaks_the_protocol() {
+    let words = [
+        "Pacer",
+        "RunFilter",
+        "FLAG_END",
+        "FLAG_PROBE",
+        "recv_paced",
+        "counters_due",
+    ];
+    for krate in ["master", "network-emulator", "slave"] {
+        let mut files = Vec::new();
+        rust_files(&root().join(krate).join("src"), &mut files);
+        for f in files {
+            let text = code(&std::fs::read_to_string(&f).expect("source"));
+            for w in words {
+                assert!(!text.contains(w), "{} names {w}", f.display());
+            }
         }
     }
 }
