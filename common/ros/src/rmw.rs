@@ -1,7 +1,7 @@
 //! What ROS 2's Zenoh middleware (rmw_zenoh, `docs/design.md`) puts on the wire besides
 //! the CDR payload, so that `ros2 topic list/echo` on a host running rmw_zenoh sees a
 //! Tactile node and ROS 2 publishers reach it. Pure: strings and bytes only; the Zenoh
-//! session that uses them is in `tactile-node`.
+//! session that uses them is in `tactile-devices`.
 //!
 //! - Data key expression: `<domain>/<topic without its leading and trailing
 //!   slash>/<pkg>::msg::dds_::<Type>_/RIHS01_<sha256 hex>`.
