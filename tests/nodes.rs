@@ -603,3 +603,45 @@ fn a_run_leaves_nothing_behind_and_cleans_only_dead_runs() {
     drop(held);
     tactile_transport::ipc::remove_run_files(&live);
 }
+
+/// TLS options on a node whose link cannot carry them: refused (exit 2, nothing
+/// written), never a run in clear that looks encrypted.
+#[test]
+fn tls_on_a_link_without_tls_is_refused() {
+    let sb = Sandbox::new("tlsclear");
+    let scenario = sb.write("s.toml", &util::paper_1khz(100));
+    for f in ["ca.pem", "n.pem", "n.key"] {
+        sb.write(
+            f,
+            "-----BEGIN CERTIFICATE-----\n-----END CERTIFICATE-----\n",
+        );
+    }
+    for link in ["udp", "iceoryx2"] {
+        let o = util::output_within(
+            sb.node(
+                "tactile-slave",
+                &[
+                    "--scenario",
+                    scenario.to_str().expect("utf-8"),
+                    "--out",
+                    "out",
+                    "--prefix",
+                    &sb.prefix,
+                    "--link",
+                    link,
+                    "--tls-ca",
+                    "ca.pem",
+                    "--tls-cert",
+                    "n.pem",
+                    "--tls-key",
+                    "n.key",
+                ],
+            ),
+            util::LIMIT,
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{link}: {err}");
+        assert!(err.contains("would run in clear"), "{link}: {err}");
+        assert!(!sb.path("out").join("slave.rec").exists(), "{link}");
+    }
+}

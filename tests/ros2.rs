@@ -135,6 +135,46 @@ fn paper_move(sb: &Sandbox) -> (Vec<[f64; 4]>, Vec<[f64; 4]>) {
     (joints, handle)
 }
 
+/// The device's trajectory file: the paper's joint angles `joints` (rows `t, theta`)
+/// in its driver's units.
+fn device_csv(sb: &Sandbox, joints: &[[f64; 4]]) {
+    let mut dev = String::from("t,waist,shoulder,elbow\n");
+    for r in joints {
+        let raw =
+            [0, 1, 2].map(|i| (r[i + 1] - OFFSET[i]) / SIGN[i] / (std::f64::consts::PI / 180.0));
+        dev.push_str(&format!("{},{},{},{}\n", r[0], raw[0], raw[1], raw[2]));
+    }
+    sb.write("device.csv", &dev);
+}
+
+/// The stand-in robot on `/arm/...` in ROS domain `domain`, listening on `port`, until
+/// two seconds after the last command.
+fn robot_standin(sb: &Sandbox, domain: u32, port: u16) -> Child {
+    let (domain, listen) = (domain.to_string(), format!("tcp/127.0.0.1:{port}"));
+    standin(
+        sb,
+        &[
+            "robot",
+            "--domain",
+            &domain,
+            "--listen",
+            &listen,
+            "--names",
+            "j1,j2,j3",
+            "--joint-topic",
+            "/arm/joint_states",
+            "--command-topic",
+            "/arm/commands",
+            "--duration",
+            "60",
+            "--idle-exit",
+            "2",
+            "--report",
+            "robot.json",
+        ],
+    )
+}
+
 fn mean(v: impl Iterator<Item = f64>) -> f64 {
     let (s, n) = v.fold((0.0, 0), |(s, n), x| (s + x, n + 1));
     s / f64::from(n)
@@ -166,37 +206,10 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
     let held_sim = [1, 2, 3].map(|i| util::column(&st, &format!("felt_{i}"))[650]);
 
     // The device plays the same angles in its driver's units, then holds.
-    let mut dev = String::from("t,waist,shoulder,elbow\n");
-    for r in &joints {
-        let raw =
-            [0, 1, 2].map(|i| (r[i + 1] - OFFSET[i]) / SIGN[i] / (std::f64::consts::PI / 180.0));
-        dev.push_str(&format!("{},{},{},{}\n", r[0], raw[0], raw[1], raw[2]));
-    }
-    sb.write("device.csv", &dev);
+    device_csv(&sb, &joints);
     let ports = [free_port(), free_port()];
     let ep = |p: u16| format!("tcp/127.0.0.1:{p}");
-    let robot = standin(
-        &sb,
-        &[
-            "robot",
-            "--domain",
-            "11",
-            "--listen",
-            &ep(ports[1]),
-            "--names",
-            "j1,j2,j3",
-            "--joint-topic",
-            "/arm/joint_states",
-            "--command-topic",
-            "/arm/commands",
-            "--duration",
-            "60",
-            "--idle-exit",
-            "2",
-            "--report",
-            "robot.json",
-        ],
-    );
+    let robot = robot_standin(&sb, 11, ports[1]);
     let device = standin(
         &sb,
         &[
@@ -266,17 +279,24 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
     let felt = [1, 2, 3].map(|i| util::column(&rt, &format!("felt_{i}")));
     assert_eq!(
         forces.len(),
-        801,
-        "one force per sample, and a zero force when the master stops"
+        803,
+        "one force per sample, and three zero forces when the master stops"
     );
-    assert!(forces[800][1..].iter().all(|x| *x == 0.0));
+    assert!(forces[800..]
+        .iter()
+        .all(|f| f[1..].iter().all(|x| *x == 0.0)));
+    // Each sample's felt force, rising from zero over the ramp's 0.5 s (50 samples)
+    // at the start, then exactly.
     let silent = num(&d["silent_from"]);
     for (k, f) in forces.iter().enumerate().take_while(|(_, f)| f[0] < silent) {
-        assert_eq!(
-            [f[1], f[2], f[3]],
-            [felt[0][k], felt[1][k], felt[2][k]],
-            "force of sample {k}"
-        );
+        let ramp = (k as f64 / 50.0).min(1.0);
+        for i in 0..3 {
+            assert!(
+                (f[i + 1] - felt[i][k] * ramp).abs() <= 1e-12,
+                "force of sample {k}: {f:?} against {} x {ramp}",
+                felt[i][k]
+            );
+        }
     }
 
     // Held against the wall, the force matches the simulated devices'. The stand-in
@@ -321,10 +341,33 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
     assert_eq!(s["nodes"]["master"]["ended"], "completed, after sample 799");
     // Junk, NaN, a missing joint, out of range: 3 of each, every one counted, none used.
     assert_eq!(num(&md["rejected"]), 12.0, "{md}");
-    assert_eq!(num(&md["published"]), 800.0, "{md}");
+    assert_eq!(num(&md["published"]), 803.0, "{md}");
+    assert_eq!((num(&md["ramps"]), num(&md["gated"])), (1.0, 0.0), "{md}");
+    assert_eq!(md["released"], true, "{md}");
+    let again = sb.path("again");
+    let o = sb.tactile(&[
+        "report",
+        sb.path("ros").to_str().expect("utf-8"),
+        "--out",
+        again.to_str().expect("utf-8"),
+        "--no-trace",
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("master device over ROS 2"))
+        .unwrap_or_default();
+    eprintln!("{line}");
+    assert!(
+        line.ends_with(
+            "803 published, 0 failed; gate: 0 held back, 0 limited, 1 ramps; released at the end"
+        ),
+        "{text}"
+    );
 
-    // The robot: one command a step, all well formed; the slave's counters.
-    assert_eq!(num(&r["commands"]), 800.0, "{r}");
+    // The robot: one command a step and the hold at the end, all well formed; the
+    // slave's counters.
+    assert_eq!(num(&r["commands"]), 801.0, "{r}");
     assert_eq!(num(&r["bad_commands"]), 0.0);
     let sd = &s["slave"]["device"];
     assert_eq!(
@@ -449,6 +492,9 @@ fn a_robot_that_goes_silent_is_held_and_its_sensor_gives_the_force() {
     let sd = &s["slave"]["device"];
     assert_eq!(num(&sd["losses"]), 1.0, "{sd}");
     assert_eq!(s["nodes"]["slave"]["ended"], "completed, after sample 399");
+    // Silent at the end: no hold from stale angles (the robot may have moved since);
+    // its controller keeps the held reference.
+    assert_eq!(sd["released"], false, "{sd}");
     // After the loss (300 ms past the silence, plus a sample or two) every command is
     // the reference held from before it.
     let after: Vec<Vec<f64>> = r["after_silence"]
@@ -500,5 +546,156 @@ fn ros_settings_are_checked_and_need_the_node_programs() {
         "master.ros2.joints=[\"a\",\"a\",\"b\"]",
         "master.ros2.joints[1]",
     );
+    // A map that would overflow on its way to the driver, a gate that lets nothing
+    // through, a joint name too many.
+    sb.assert_bad_set(
+        paper,
+        "slave.ros2.map.offset=[0,1e300,0]",
+        "slave.ros2.map.offset[1]",
+    );
+    sb.assert_bad_set(
+        paper,
+        "slave.ros2.max_velocity=[2,0,2]",
+        "slave.ros2.max_velocity[1]",
+    );
+    sb.assert_bad_set(paper, "master.ros2.ramp_s=-1", "master.ros2.ramp_s");
+    sb.assert_bad_set(
+        paper,
+        "master.ros2.max_force_rate=0",
+        "master.ros2.max_force_rate",
+    );
+    sb.assert_bad_set(
+        paper,
+        "slave.ros2.joints=[\"a\",\"b\",\"c\",\"d\"]",
+        "slave.ros2.joints",
+    );
+    sb.assert_bad_set(paper, "network.forward.delay=[1,2,3,4,5]", "has 5 elements");
     sb.assert_bad_set(paper, "master.backend=\"ros2\"", "needs the node programs");
+}
+
+/// SIGINT to the launcher in the middle of the move, no live view (which kept the
+/// session open a little longer): the device's last forces are zero, the robot's last
+/// command is where it stood, and the summary says both were released.
+#[test]
+fn a_run_stopped_by_sigint_leaves_no_force_and_the_robot_holding() {
+    if !python_ready() {
+        return cannot("python3 lacks eclipse-zenoh or rosbags");
+    }
+    let sb = Sandbox::new("ros2-stop");
+    let (joints, _) = paper_move(&sb);
+    device_csv(&sb, &joints);
+    let ports = [free_port(), free_port()];
+    let ep = |p: u16| format!("tcp/127.0.0.1:{p}");
+    let robot = robot_standin(&sb, 13, ports[1]);
+    let device = standin(
+        &sb,
+        &[
+            "device",
+            "--domain",
+            "13",
+            "--listen",
+            &ep(ports[0]),
+            "--names",
+            "waist,shoulder,elbow",
+            "--joint-topic",
+            "/phantom/joint_states",
+            "--force-topic",
+            "/phantom/force_feedback",
+            "--trajectory",
+            "device.csv",
+            "--end-after",
+            "8.0",
+            "--report",
+            "device.json",
+        ],
+    );
+    let scenario = sb.write(
+        "ros.toml",
+        &format!(
+            "{}{}",
+            looped("realtime", 3000),
+            ros_tables(13, ports, false, true)
+        ),
+    );
+    listening(ports[0]);
+    listening(ports[1]);
+    let out = sb.path("out");
+    let child = sb
+        .command(&[
+            "run",
+            scenario.to_str().expect("utf-8"),
+            "--out",
+            out.to_str().expect("utf-8"),
+            "--prefix",
+            &sb.prefix,
+            "-q",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("tactile run");
+    let rec = out.join("master.rec");
+    util::wait_for(
+        "the master's record",
+        std::time::Duration::from_secs(60),
+        || std::fs::metadata(&rec).is_ok_and(|m| m.len() > 0),
+    );
+    // Into the hold against the wall, at the end of the 4 s move.
+    std::thread::sleep(std::time::Duration::from_secs(6));
+    let pid = rustix::process::Pid::from_raw(child.id() as i32).expect("pid");
+    let _ = rustix::process::kill_process(pid, rustix::process::Signal::INT);
+    let (code, err) = util::finish(child);
+    assert_eq!(code, Some(130), "{err}");
+    sb.assert_no_leftover_processes();
+    let d = report(&sb, device, "device.json");
+    let r = report(&sb, robot, "robot.json");
+    let forces: Vec<[f64; 3]> = d["forces"]
+        .as_array()
+        .expect("forces")
+        .iter()
+        .map(|f| [1, 2, 3].map(|i| num(&f[i])))
+        .collect();
+    assert!(forces.len() > 200, "{} forces", forces.len());
+    assert!(
+        forces[..forces.len() - 3]
+            .iter()
+            .any(|f| f.iter().any(|x| x.abs() > 0.1)),
+        "a force was rendered before the stop"
+    );
+    assert_eq!(
+        forces[forces.len() - 3..],
+        [[0.0; 3]; 3],
+        "the zeros at the end"
+    );
+    // The hold: the robot's measured angles (at most a few ms old when the slave read
+    // them), not the reference it was chasing.
+    let last: Vec<f64> = r["last_command"]
+        .as_array()
+        .expect("cmd")
+        .iter()
+        .map(num)
+        .collect();
+    let at: Vec<f64> = r["theta_at_last"]
+        .as_array()
+        .expect("theta")
+        .iter()
+        .map(num)
+        .collect();
+    for i in 0..3 {
+        assert!(
+            (last[i] - at[i]).abs() < 5e-3,
+            "joint {i}: hold {last:?}, robot at {at:?}"
+        );
+    }
+    let s = sb.json("out", "summary.json");
+    assert_eq!(
+        s["master"]["device"]["released"], true,
+        "{}",
+        s["master"]["device"]
+    );
+    assert_eq!(
+        s["slave"]["device"]["released"], true,
+        "{}",
+        s["slave"]["device"]
+    );
 }

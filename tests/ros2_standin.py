@@ -313,6 +313,7 @@ def robot(a):
             cmd["bad"] += 1
             return
         cmd["value"] = data
+        cmd["theta_at_last"] = list(theta)
         cmd["count"] += 1
         cmd["t0"] = cmd["t0"] or time.monotonic()
         cmd["last"] = time.monotonic()
@@ -352,6 +353,7 @@ def robot(a):
     with open(a.report, "w") as f:
         json.dump({"commands": cmd["count"], "bad_commands": cmd["bad"], "theta": theta,
                    "after_silence": cmd["after_silence"], "last_before": state["last_before"],
+                   "last_command": cmd["value"], "theta_at_last": cmd.get("theta_at_last"),
                    "bad_attachments": node.bad_attachments}, f)
     node.s.close()
 

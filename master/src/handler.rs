@@ -6,7 +6,7 @@
 
 use crate::hmd::Master;
 use tactile_devices::held::Held;
-use tactile_devices::{HapticDevice, Peripheral};
+use tactile_devices::{Change, HapticDevice, Peripheral};
 use tactile_messages::samples::{stage, Backward, Forward};
 use tactile_records::master::{Answer, MasterCounters, MasterSample, MasterTotals, Sent};
 use tactile_ros::msg::SampleTiming;
@@ -97,6 +97,20 @@ impl Handler for MasterHandler {
         self.device.as_deref().map(|d| d as &dyn Peripheral)
     }
 
+    fn release(&mut self) -> Option<String> {
+        let d = self.device.as_deref_mut()?;
+        let heard = d.release();
+        Some(format!(
+            "zero force sent to {}{}",
+            d.describe(),
+            if heard {
+                ""
+            } else {
+                " (no driver was listening: it may hold its last force)"
+            }
+        ))
+    }
+
     fn live(&self) -> Option<SampleView> {
         let s = &self.sent;
         let a = self.last_answer.filter(|a| a.n == s.n);
@@ -137,6 +151,10 @@ impl Leader for MasterHandler {
             Some(d) => {
                 let who = d.describe();
                 let judged = d.read(io.now());
+                if judged.1 == Change::Back {
+                    // Back from a loss: the force rises from zero again, no jolt.
+                    d.restart_ramp();
+                }
                 if let Some(what) = self
                     .held
                     .take(judged, ("device", &who), "rendering zero force")
@@ -159,6 +177,9 @@ impl Leader for MasterHandler {
     fn answer(&mut self, q: &Backward, late: bool, io: &mut Io) -> Result<MasterSample, Failure> {
         if self.master.peer_lost() {
             io.event(q.seq, "loop resumed: answers are back")?;
+            if let Some(d) = self.device.as_deref_mut() {
+                d.restart_ramp();
+            }
         }
         let mut a = self.master.backward(q);
         a.stamps[stage::MASTER_DONE] = io.now();

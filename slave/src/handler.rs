@@ -135,6 +135,20 @@ impl Handler for SlaveHandler {
         self.robot.as_deref().map(|r| r as &dyn Peripheral)
     }
 
+    fn release(&mut self) -> Option<String> {
+        let r = self.robot.as_deref_mut()?;
+        let heard = r.release();
+        Some(format!(
+            "{} commanded to hold where it is{}",
+            r.describe(),
+            if heard {
+                ""
+            } else {
+                " (not heard from, or no controller listening: it holds its last command)"
+            }
+        ))
+    }
+
     fn live(&self) -> Option<SampleView> {
         let s = self.last_step?;
         Some(SampleView {

@@ -6,6 +6,7 @@
 //! [`live_view`], behind the `zenoh` feature). The judgements are pure and always
 //! built; the I/O only with Zenoh.
 
+pub mod gate;
 pub mod held;
 #[cfg(feature = "zenoh")]
 pub mod live_view;
@@ -39,8 +40,13 @@ pub trait Peripheral {
 pub trait HapticDevice: Peripheral {
     /// The encoders' newest angles at this tick, judged.
     fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change);
-    /// Sends the force to render, N, in the device's base frame.
+    /// Sends the force to render, N, in the paper's base frame, through the gate.
     fn render(&mut self, force: [f64; 3], now_ns: u64);
+    /// The force rises from zero again (the device or the loop back from a loss).
+    fn restart_ramp(&mut self);
+    /// Leaves the device rendering nothing: the zero force, sent so it arrives (the
+    /// driver holds its last command). True if it was sent to a listening driver.
+    fn release(&mut self) -> bool;
 }
 
 /// A real slave robot, as the slave's loop uses it: joint references out, joint
@@ -52,8 +58,11 @@ pub trait Robot: Peripheral {
     /// force sensor (else the environment model gives it); zero when the sensor's
     /// newest reading is older than the timeout.
     fn force(&mut self, now_ns: u64) -> Option<[f64; 3]>;
-    /// Sends the joint references, rad in the paper's convention.
+    /// Sends the joint references, rad in the paper's convention, through the gate.
     fn command(&mut self, theta_ref: [f64; 3], now_ns: u64);
+    /// Leaves the robot holding: its own last angles commanded, sent so they arrive.
+    /// True if it was sent to a listening controller.
+    fn release(&mut self) -> bool;
 }
 
 /// Where a loop hands its state for the live view: takes it only every k-th sample,

@@ -85,10 +85,27 @@ impl JointMap {
     /// each angle first clamped to the joint's `min..=max`, so a robot is never
     /// commanded where its readings would be refused.
     pub fn raw(&self, theta: [f64; 3]) -> [f64; 3] {
-        [0, 1, 2].map(|i| {
-            let t = theta[i].clamp(self.cfg.min[i], self.cfg.max[i]);
-            (t - self.cfg.offset[i]) / (self.cfg.sign[i] * self.cfg.unit.radians())
-        })
+        let t = [0, 1, 2].map(|i| theta[i].clamp(self.cfg.min[i], self.cfg.max[i]));
+        self.unclamped_raw(t)
+    }
+
+    /// The driver's values of the joints' range, `(at min, at max)` per joint (either
+    /// may be the larger: the sign can flip them), for the gate.
+    pub fn raw_range(&self) -> ([f64; 3], [f64; 3]) {
+        (
+            self.unclamped_raw(self.cfg.min),
+            self.unclamped_raw(self.cfg.max),
+        )
+    }
+
+    /// The driver's step for a step of `rad` of the paper's angle, per joint.
+    pub fn raw_step(&self, rad: [f64; 3]) -> [f64; 3] {
+        rad.map(|r| (r / self.cfg.unit.radians()).abs())
+    }
+
+    fn unclamped_raw(&self, theta: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2]
+            .map(|i| (theta[i] - self.cfg.offset[i]) / (self.cfg.sign[i] * self.cfg.unit.radians()))
     }
 }
 

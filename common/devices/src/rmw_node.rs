@@ -138,6 +138,7 @@ impl RosNode {
             .map_err(|e| err(&format!("declaring the publisher of {topic}"), e))?;
         Ok(RosPublisher {
             publisher,
+            session: self.session.clone(),
             gid: rmw::gid(&token_key),
             seq: AtomicI64::new(0),
             topic: topic.to_string(),
@@ -176,6 +177,8 @@ impl RosNode {
 /// A ROS 2 publisher: each put carries rmw_zenoh's attachment.
 pub struct RosPublisher {
     publisher: zenoh::pubsub::Publisher<'static>,
+    /// For the last message, put reliably (congestion control `Block`).
+    session: zenoh::Session,
     gid: [u8; 16],
     seq: AtomicI64,
     topic: String,
@@ -191,18 +194,43 @@ impl std::fmt::Debug for RosPublisher {
 }
 
 impl RosPublisher {
-    /// Publishes one CDR message; false if Zenoh refused it.
-    pub fn put(&self, cdr: &[u8]) -> bool {
+    fn attachment(&self) -> Vec<u8> {
         let a = Attachment {
             seq: self.seq.fetch_add(1, Ordering::Relaxed) + 1,
             stamp_ns: wall_ns() as i64,
             gid: self.gid,
         };
+        a.to_bytes().to_vec()
+    }
+
+    /// Publishes one CDR message, dropped rather than waited for if the network is
+    /// behind; false if Zenoh refused it.
+    pub fn put(&self, cdr: &[u8]) -> bool {
         self.publisher
             .put(cdr)
-            .attachment(a.to_bytes().to_vec())
+            .attachment(self.attachment())
             .wait()
             .is_ok()
+    }
+
+    /// Publishes one CDR message that must arrive (the zero force at the end, a
+    /// robot's hold): congestion control `Block`, so Zenoh waits for room rather than
+    /// dropping it. Returns whether it was put, and whether a subscriber was matched.
+    pub fn put_reliably(&self, cdr: &[u8]) -> (bool, bool) {
+        let matched = self
+            .publisher
+            .matching_status()
+            .wait()
+            .is_ok_and(|m| m.matching());
+        let put = self
+            .session
+            .put(self.publisher.key_expr().clone(), cdr)
+            .congestion_control(CongestionControl::Block)
+            .express(true)
+            .attachment(self.attachment())
+            .wait()
+            .is_ok();
+        (put, matched)
     }
 }
 

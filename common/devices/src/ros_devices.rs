@@ -2,6 +2,7 @@
 //! fill an [`Inbox`] (decoded, mapped and checked on Zenoh's threads), a [`Watch`] the
 //! loop asks each tick, and the publisher of what the loop sends back.
 
+use crate::gate::{ForceGate, JointGate};
 use crate::map::force_cdr;
 use crate::rmw_node::{wall_ns, RosNode, RosPublisher, RosSubscription};
 use crate::watch::{Inbox, Watch};
@@ -37,13 +38,22 @@ pub struct RosHapticDevice {
     force: RosPublisher,
     frame: String,
     force_map: tactile_scenario::ForceMapConfig,
+    gate: ForceGate,
     watch: Watch,
     topic: String,
+    released: bool,
 }
 
 impl RosHapticDevice {
-    /// Subscribes to the encoders and declares the force publisher.
-    pub fn open(node: &Arc<RosNode>, cfg: &RosDeviceConfig, t_s_ns: u64) -> Result<Self, RosError> {
+    /// Subscribes to the encoders and declares the force publisher; forces stay
+    /// within `force_limit` N per axis.
+    pub fn open(
+        node: &Arc<RosNode>,
+        cfg: &RosDeviceConfig,
+        t_s_ns: u64,
+        force_limit: f64,
+    ) -> Result<Self, RosError> {
+        let t_s = t_s_ns as f64 * 1e-9;
         let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
         let (joints, sub) = joints_in(node, &cfg.joint_states, map)?;
         Ok(RosHapticDevice {
@@ -53,17 +63,35 @@ impl RosHapticDevice {
             force: node.publisher(&cfg.force_topic, WrenchStamped::TYPE)?,
             frame: cfg.frame_id.clone(),
             force_map: cfg.force_map.clone(),
+            gate: ForceGate::new(force_limit, cfg.max_force_rate, cfg.ramp_s, t_s),
             watch: Watch::new(&cfg.watch, t_s_ns),
             topic: cfg.joint_states.clone(),
+            released: false,
         })
+    }
+
+    fn wrench(&self, force: [f64; 3]) -> Vec<u8> {
+        WrenchStamped {
+            header: Header::at(wall_ns(), &self.frame),
+            force,
+            torque: [0.0; 3],
+        }
+        .to_cdr()
     }
 }
 
+/// How many times the zero at the end is put, and how far apart: a driver that misses
+/// one (a subscriber's queue full) takes the next.
+const RELEASE_PUTS: u32 = 3;
+const RELEASE_GAP: std::time::Duration = std::time::Duration::from_millis(5);
+
 impl Drop for RosHapticDevice {
     /// A driver holds its last command: leave the device rendering nothing, however
-    /// the run ends.
+    /// the run ends (the loop's driver releases it first; this is the last resort).
     fn drop(&mut self) {
-        self.render([0.0; 3], 0);
+        if !self.released {
+            self.release();
+        }
     }
 }
 
@@ -95,13 +123,34 @@ impl HapticDevice for RosHapticDevice {
     }
 
     fn render(&mut self, force: [f64; 3], _now_ns: u64) {
-        let w = WrenchStamped {
-            header: Header::at(wall_ns(), &self.frame),
-            force: self.force_map.to_device(force),
-            torque: [0.0; 3],
-        };
-        let ok = self.force.put(&w.to_cdr());
-        self.watch.published(ok);
+        let passed = self.gate.pass(self.force_map.to_device(force));
+        self.watch.gated(&passed);
+        self.watch.ramps(self.gate.ramps());
+        if let Some(f) = passed.value() {
+            let ok = self.force.put(&self.wrench(f));
+            self.watch.published(ok);
+        }
+    }
+
+    fn restart_ramp(&mut self) {
+        self.gate.restart();
+        self.watch.ramps(self.gate.ramps());
+    }
+
+    fn release(&mut self) -> bool {
+        let zero = self.wrench([0.0; 3]);
+        let (mut sent, mut matched) = (false, false);
+        for k in 0..RELEASE_PUTS {
+            if k > 0 {
+                std::thread::sleep(RELEASE_GAP);
+            }
+            let (s, m) = self.force.put_reliably(&zero);
+            self.watch.published(s);
+            (sent, matched) = (sent || s, matched || m);
+        }
+        self.released = true;
+        self.watch.released(sent && matched);
+        sent && matched
     }
 }
 
@@ -116,8 +165,11 @@ pub struct RosRobot {
     command: RosPublisher,
     map: JointMap,
     wrench_map: tactile_scenario::ForceMapConfig,
+    gate: JointGate,
     watch: Watch,
     topic: String,
+    /// The loop's last tick, CLOCK_MONOTONIC ns: the end's hold is judged at it.
+    last_tick_ns: u64,
 }
 
 impl RosRobot {
@@ -145,10 +197,16 @@ impl RosRobot {
             wrench,
             _subs: subs,
             command: node.publisher(&cfg.command_topic, Float64MultiArray::TYPE)?,
+            gate: {
+                let (lo, hi) = map.raw_range();
+                let t_s = t_s_ns as f64 * 1e-9;
+                JointGate::new(lo, hi, map.raw_step(cfg.max_velocity.map(|v| v * t_s)))
+            },
             map,
             wrench_map: cfg.wrench_map.clone(),
             watch: Watch::new(&cfg.watch, t_s_ns),
             topic: cfg.joint_states.clone(),
+            last_tick_ns: 0,
         })
     }
 }
@@ -190,11 +248,39 @@ impl Robot for RosRobot {
         Some(self.wrench_map.to_paper(f))
     }
 
-    fn command(&mut self, theta_ref: [f64; 3], _now_ns: u64) {
-        let m = Float64MultiArray {
-            data: self.map.raw(theta_ref).to_vec(),
+    fn command(&mut self, theta_ref: [f64; 3], now_ns: u64) {
+        self.last_tick_ns = now_ns;
+        if let Some(l) = self.joints.latest() {
+            self.gate.start_at(self.map.raw(l.value));
+        }
+        let passed = self.gate.pass(self.map.raw(theta_ref));
+        self.watch.gated(&passed);
+        if let Some(raw) = passed.value() {
+            let m = Float64MultiArray { data: raw.to_vec() };
+            let ok = self.command.put(&m.to_cdr());
+            self.watch.published(ok);
+        }
+    }
+
+    fn release(&mut self) -> bool {
+        // Where the robot is, checked like every command; never heard from, or silent
+        // past the timeout (it may have moved since), nothing: the controller holds
+        // the last command it took.
+        let Some(l) = self.joints.latest() else {
+            return false;
         };
-        let ok = self.command.put(&m.to_cdr());
-        self.watch.published(ok);
+        if !self.watch.fresh(l.at_ns, self.last_tick_ns) {
+            return false;
+        }
+        let passed = self.gate.hold(self.map.raw(l.value));
+        self.watch.gated(&passed);
+        let Some(raw) = passed.value() else {
+            return false;
+        };
+        let m = Float64MultiArray { data: raw.to_vec() };
+        let (sent, matched) = self.command.put_reliably(&m.to_cdr());
+        self.watch.published(sent);
+        self.watch.released(sent && matched);
+        sent && matched
     }
 }

@@ -167,6 +167,30 @@ impl Watch {
         }
     }
 
+    /// True if a value that arrived at `at_ns` is within the timeout at `now_ns`.
+    pub fn fresh(&self, at_ns: u64, now_ns: u64) -> bool {
+        now_ns.saturating_sub(at_ns) <= self.timeout_ns
+    }
+
+    /// Counts what the gate did with a command.
+    pub fn gated(&mut self, p: &crate::gate::Passed) {
+        match p {
+            crate::gate::Passed::As(_) => {}
+            crate::gate::Passed::Cut(_) => self.counters.limited += 1,
+            crate::gate::Passed::Held(_) => self.counters.gated += 1,
+        }
+    }
+
+    /// The force gate's ramps so far.
+    pub fn ramps(&mut self, ramps: u64) {
+        self.counters.ramps = ramps;
+    }
+
+    /// Notes the end's zero or hold: sent, and heard by a subscriber.
+    pub fn released(&mut self, heard: bool) {
+        self.counters.released = heard;
+    }
+
     /// Counts one publication and its outcome.
     pub fn published(&mut self, ok: bool) {
         if ok {

@@ -27,4 +27,16 @@ pub struct DeviceCounters {
     /// Ticks whose force-torque reading was older than the timeout, or not there yet:
     /// zero force used, never a stale contact.
     pub force_lost: u64,
+    /// Commands the gate did not let through (not finite, or outside the joints' range
+    /// in the driver's unit): the last good one was sent again instead, or nothing.
+    pub gated: u64,
+    /// Commands the gate cut: a force to its limit or by its rate, a joint step to the
+    /// velocity limit.
+    pub limited: u64,
+    /// Times the force on the device was ramped up from zero (at the start, when the
+    /// device or the loop came back, after a non-finite force).
+    pub ramps: u64,
+    /// Whether the zero (the device) or the hold (the robot) at the end was sent, and
+    /// a subscriber was matched to receive it.
+    pub released: bool,
 }

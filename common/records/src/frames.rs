@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// First bytes of every record file; the last byte is the format version.
-pub const MAGIC: [u8; 8] = *b"TACTREC\x06";
+pub const MAGIC: [u8; 8] = *b"TACTREC\x07";
 /// The first bytes of every frame: where a reader picks up again after damage.
 pub const SYNC: [u8; 4] = [0xA5, b'T', b'F', 0x5A];
 /// Bytes before a frame's body: sync, length, checksum.
@@ -27,8 +27,11 @@ pub const MAX_FRAME: u32 = 1 << 20;
 /// Damaged stretches a reader keeps the place of (the rest are counted).
 pub const MAX_KEPT_DAMAGE: usize = 32;
 
+/// bincode's standard encoding, with a limit: a length inside a whole frame (its
+/// checksum right) can claim no more than a frame holds, so decoding damage never
+/// tries to allocate gigabytes (the limit changes no byte written).
 fn config() -> impl bincode::config::Config {
-    bincode::config::standard()
+    bincode::config::standard().with_limit::<{ MAX_FRAME as usize }>()
 }
 
 /// Failures of opening or reading a record.
@@ -435,6 +438,25 @@ mod tests {
             .expect_err("version 4");
         let want = format!("format version 4; this build reads version {}", MAGIC[7]);
         assert!(e.to_string().contains(&want), "{e}");
+    }
+
+    #[test]
+    fn a_whole_frame_claiming_a_huge_string_is_damage_not_a_crash() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("x.rec");
+        write(&path, 3);
+        // (7, a string of 2^62 bytes) in bincode's varints, in a frame whose checksum
+        // holds: a writer of another build, or an attacker.
+        let mut body = vec![7u8, 0xFD];
+        body.extend_from_slice(&(1u64 << 62).to_le_bytes());
+        body.extend_from_slice(b"abc");
+        let mut bytes = std::fs::read(&path).expect("read");
+        bytes.extend_from_slice(&frame(&body));
+        std::fs::write(&path, &bytes).expect("write");
+        let mut w = RecordWriter::<R>::create(&path, true).expect("append");
+        w.write(&(9, String::new())).expect("write");
+        drop(w);
+        assert_eq!(read(&path), (vec![0, 1, 2, 9], 1));
     }
 
     proptest! {

@@ -77,7 +77,9 @@ fn open_ros(sc: &Scenario, role: Role) -> Result<Outside, NodeError> {
     let node = Arc::new(RosNode::open(&sc.ros, &format!("tactile_{role}")).map_err(failed)?);
     let mut out = Outside::default();
     if role == Role::Master && sc.master.backend == Backend::Ros2 {
-        let d = RosHapticDevice::open(&node, &sc.master.ros2, sc.t_s_ns()).map_err(failed)?;
+        let limit = sc.master.force_limit;
+        let d =
+            RosHapticDevice::open(&node, &sc.master.ros2, sc.t_s_ns(), limit).map_err(failed)?;
         out.haptic = Some(Box::new(d));
     }
     if role == Role::Slave && sc.slave.backend == Backend::Ros2 {

@@ -11,6 +11,7 @@ mod control;
 pub mod csv;
 mod device;
 mod error;
+mod lengths;
 mod master;
 mod network;
 mod operator;
@@ -141,6 +142,10 @@ impl Scenario {
     pub fn from_toml_str(text: &str) -> Result<Scenario, ScenarioError> {
         let s: Scenario =
             toml::from_str(text).map_err(|e| ScenarioError::Parse(one_line(text, &e)))?;
+        if let (Ok(written), Ok(parsed)) = (text.parse::<toml::Value>(), toml::Value::try_from(&s))
+        {
+            lengths::check(&written, &parsed)?;
+        }
         s.validate()?;
         Ok(s)
     }

@@ -93,6 +93,10 @@ impl AngleUnit {
     }
 }
 
+/// The largest angle (an offset, a joint's limit) a map may name, rad: a hundred
+/// turns, far beyond any joint, and small enough that no conversion overflows.
+pub const MAX_ANGLE_RAD: f64 = 200.0 * std::f64::consts::PI;
+
 /// How a driver's joint values become the paper's angles: `theta = sign * raw * unit
 /// + offset`, checked against `min..=max`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -132,9 +136,21 @@ impl JointMapConfig {
                 ));
             }
         }
-        finite3(&self.offset, &format!("{field}.offset"))?;
-        finite3(&self.min, &format!("{field}.min"))?;
-        finite3(&self.max, &format!("{field}.max"))?;
+        for (name, v) in [
+            ("offset", &self.offset),
+            ("min", &self.min),
+            ("max", &self.max),
+        ] {
+            finite3(v, &format!("{field}.{name}"))?;
+            for (i, x) in v.iter().enumerate() {
+                if x.abs() > MAX_ANGLE_RAD {
+                    return Err(invalid(
+                        format!("{field}.{name}[{i}]"),
+                        format!("{x} rad is beyond +-{MAX_ANGLE_RAD} rad: no joint turns that far"),
+                    ));
+                }
+            }
+        }
         for i in 0..3 {
             if self.min[i] >= self.max[i] {
                 return Err(invalid(
@@ -286,6 +302,12 @@ pub struct RosDeviceConfig {
     pub force_map: ForceMapConfig,
     /// Staleness and loss.
     pub watch: WatchConfig,
+    /// Seconds the force rendered takes to rise from zero at the start and after each
+    /// discontinuity (the device or the loop back from a loss), as OpenHaptics' force
+    /// ramping does; 0: no ramp.
+    pub ramp_s: f64,
+    /// The fastest the force rendered may change, N/s per axis.
+    pub max_force_rate: f64,
 }
 
 impl Default for RosDeviceConfig {
@@ -298,6 +320,8 @@ impl Default for RosDeviceConfig {
             frame_id: "base".into(),
             force_map: ForceMapConfig::default(),
             watch: WatchConfig::default(),
+            ramp_s: 0.5,
+            max_force_rate: 1000.0,
         }
     }
 }
@@ -323,6 +347,9 @@ pub struct RosRobotConfig {
     pub wrench_map: ForceMapConfig,
     /// Staleness and loss.
     pub watch: WatchConfig,
+    /// The fastest each joint may be commanded to move, rad/s (the paper's angles): a
+    /// command's step per period is cut to it.
+    pub max_velocity: [f64; 3],
 }
 
 impl Default for RosRobotConfig {
@@ -335,6 +362,7 @@ impl Default for RosRobotConfig {
             wrench_topic: String::new(),
             wrench_map: ForceMapConfig::default(),
             watch: WatchConfig::default(),
+            max_velocity: [2.0; 3],
         }
     }
 }
@@ -401,6 +429,13 @@ impl RosDeviceConfig {
         self.map.validate("master.ros2.map")?;
         topic_name(&self.force_topic, "master.ros2.force_topic")?;
         self.force_map.validate("master.ros2.force_map")?;
+        if !self.ramp_s.is_finite() || !(0.0..=10.0).contains(&self.ramp_s) {
+            return Err(invalid(
+                "master.ros2.ramp_s",
+                format!("{} s is outside 0 to 10 s", self.ramp_s),
+            ));
+        }
+        positive(self.max_force_rate, "master.ros2.max_force_rate", false)?;
         self.watch.validate("master.ros2.watch")
     }
 }
@@ -416,6 +451,9 @@ impl RosRobotConfig {
             topic_name(&self.wrench_topic, "slave.ros2.wrench_topic")?;
         }
         self.wrench_map.validate("slave.ros2.wrench_map")?;
+        for (i, v) in self.max_velocity.iter().enumerate() {
+            positive(*v, &format!("slave.ros2.max_velocity[{i}]"), false)?;
+        }
         self.watch.validate("slave.ros2.watch")
     }
 }

@@ -162,6 +162,14 @@ impl LinkArgs {
         }
         if links.contains(&LinkKind::Zenoh) {
             self.check_zenoh()?;
+        } else if self.tls_ca.is_some() || self.tls_cert.is_some() || self.tls_key.is_some() {
+            // Asked for encryption on a link that cannot carry it: refused, never a
+            // run in clear that looks encrypted.
+            let names: Vec<&str> = links.iter().map(|l| l.name()).collect();
+            return Err(BadOption(format!(
+                "--tls-ca, --tls-cert and --tls-key encrypt the Zenoh link only; this node's link is {}: it would run in clear (use --link zenoh with tls/ endpoints)",
+                names.join(" and ")
+            )));
         }
         Ok(())
     }
@@ -326,5 +334,21 @@ mod tests {
         let a = testing::args(&["--udp-hosts", "1.2.3.4,x,y"]);
         let e = a.check(&[LinkKind::Udp]).expect_err("bad hosts");
         assert!(e.0.contains("--udp-hosts"), "{e}");
+    }
+
+    #[test]
+    fn tls_on_a_link_that_cannot_carry_it_is_refused() {
+        let a = testing::args(&[
+            "--tls-ca",
+            "ca.pem",
+            "--tls-cert",
+            "n.pem",
+            "--tls-key",
+            "n.key",
+        ]);
+        for kind in [LinkKind::Udp, LinkKind::Iceoryx2] {
+            let e = a.check(&[kind]).expect_err("tls in clear");
+            assert!(e.0.contains("would run in clear"), "{e}");
+        }
     }
 }

@@ -172,8 +172,10 @@ fn devices(t: &mut String, s: &Summary) {
         if *d != tactile_records::device::DeviceCounters::default() {
             let _ = writeln!(
                 t,
-                "{who} over ROS 2: {} messages, {} dropped (malformed, missing joint, not finite, out of range); ticks fresh {}, stale {}, lost {} ({} losses); {} published, {} failed",
-                d.messages, d.rejected, d.fresh, d.stale, d.lost, d.losses, d.published, d.publish_errors
+                "{who} over ROS 2: {} messages, {} dropped (malformed, missing joint, not finite, out of range); ticks fresh {}, stale {}, lost {} ({} losses); {} published, {} failed; gate: {} held back, {} limited, {} ramps; {}",
+                d.messages, d.rejected, d.fresh, d.stale, d.lost, d.losses, d.published, d.publish_errors,
+                d.gated, d.limited, d.ramps,
+                if d.released { "released at the end" } else { "NOT released at the end (no subscriber matched)" }
             );
         }
     };

@@ -149,7 +149,13 @@ impl<H: Follower> Follow<H> {
     pub fn run(mut self, block: &mut dyn Block) -> Result<bool, Failure> {
         let ended = self.run_loop(block);
         let counts = self.counts();
-        super::close(&mut self.rec, &self.handler, &counts, self.last_seq, &ended)?;
+        super::close(
+            &mut self.rec,
+            &mut self.handler,
+            &counts,
+            self.last_seq,
+            &ended,
+        )?;
         ended
     }
 
@@ -374,7 +380,13 @@ impl<H: Follower> Follow<H> {
     /// Ends the record as the master's loop ended (the in-process runner's end).
     pub fn close(mut self, ended: &Result<bool, Failure>) -> Result<(), Failure> {
         let counts = self.counts();
-        super::close(&mut self.rec, &self.handler, &counts, self.last_seq, ended)
+        super::close(
+            &mut self.rec,
+            &mut self.handler,
+            &counts,
+            self.last_seq,
+            ended,
+        )
     }
 }
 

@@ -126,7 +126,7 @@ impl<H: Leader> Lead<H> {
         let ended = self.run_loop(block);
         let at = self.window.sent;
         let counts = self.counts();
-        super::close(&mut self.rec, &self.handler, &counts, at, &ended)?;
+        super::close(&mut self.rec, &mut self.handler, &counts, at, &ended)?;
         ended
     }
 

@@ -162,7 +162,7 @@ pub struct Counts {
 /// its event and its stop reason, after the final counters.
 pub(crate) fn close<H: Handler>(
     rec: &mut Recorder<H::Sample, H::Totals>,
-    handler: &H,
+    handler: &mut H,
     counts: &Counts,
     at: u64,
     ended: &Result<bool, Failure>,
@@ -174,6 +174,10 @@ pub(crate) fn close<H: Handler>(
     };
     if ended.is_err() {
         let _ = rec.event(at, &reason);
+    }
+    // The device or robot left safe before anything else, however the loop ended.
+    if let Some(what) = handler.release() {
+        let _ = rec.event(at, &what);
     }
     rec.stop(handler.totals(counts), crate::sys::max_rss_kb(), &reason)?;
     Ok(())
@@ -230,6 +234,11 @@ pub trait Handler {
     }
     /// The live view's state after the sample just handled.
     fn live(&self) -> Option<tactile_ros::view::SampleView> {
+        None
+    }
+    /// At the end, however the loop ended: leaves the device rendering nothing and
+    /// the robot holding; what was done, for the record.
+    fn release(&mut self) -> Option<String> {
         None
     }
 }
