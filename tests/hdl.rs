@@ -82,6 +82,27 @@ fn a_wrong_rtl_is_caught_by_the_same_test() {
     }
 }
 
+/// A count past the bound (or none at all) is refused before anything is allocated:
+/// `u64::MAX` panicked and `1e10` asked for 20 GB.
+#[test]
+fn vector_counts_are_bounded() {
+    let sb = Sandbox::new("hdl-count");
+    for count in ["18446744073709551615", "10000000000", "0", "-1", "1e10"] {
+        for cmd in [
+            &["hdl", "vectors", "--function", "atan2"][..],
+            &["hdl", "cosim"],
+        ] {
+            let arg = format!("--count={count}");
+            let o = sb.tactile(&[cmd, &[arg.as_str()]].concat());
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{cmd:?} {count}: {err}");
+            assert!(err.contains("--count"), "{count}: {err}");
+        }
+    }
+    let o = sb.tactile(&["hdl", "vectors", "--function", "atan2", "--count", "4"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 #[test]
 fn a_format_the_model_refuses_the_generator_refuses_alike() {
     let sb = Sandbox::new("hdl-refuse");

@@ -192,6 +192,24 @@ fn parallel_sharded_and_resumed_sweeps_give_the_same_table() {
     let o = sweep(&sb, "one", &["--resume"]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("5 runs kept from before"));
     assert_eq!(read(&sb, "one", "sweep.csv"), table);
+    // Another combination's run left in a run's folder, and a run that failed: both
+    // are run again, never put in the table.
+    let one = sb.path("one");
+    for f in ["scenario.toml", "summary.json"] {
+        std::fs::copy(one.join("run-0005").join(f), one.join("run-0002").join(f)).expect("cp");
+    }
+    let path = one.join("run-0001").join("summary.json");
+    let mut s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).expect("read")).expect("json");
+    s["failed"] = serde_json::Value::Bool(true);
+    std::fs::write(&path, s.to_string()).expect("write");
+    let o = sweep(&sb, "one", &["--resume"]);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("4 runs kept from before"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(read(&sb, "one", "sweep.csv"), table);
     // A slice of another sweep is refused.
     std::fs::create_dir(sb.path("other")).expect("mkdir");
     let spec = read(&sb, "shard4", "sweep.json")

@@ -42,8 +42,8 @@ pub enum HdlCommand {
         #[arg(long, value_enum)]
         function: Function,
         /// Samples beyond the edge cases: half an even sweep of the input range, half
-        /// random from the seed.
-        #[arg(long, default_value_t = 20_000)]
+        /// random from the seed (1 to 10^7).
+        #[arg(long, default_value_t = 20_000, value_parser = sim::count_parser())]
         count: usize,
         /// Seed of the random inputs.
         #[arg(long, default_value_t = 1)]

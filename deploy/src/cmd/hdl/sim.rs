@@ -9,14 +9,24 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The most vectors a function may be asked for: every input class is covered far
+/// below it, and the vectors, held in memory before they are written, stay in tens of
+/// megabytes (a count past it is refused, exit 2, before anything is allocated).
+pub const MAX_COUNT: u64 = 10_000_000;
+
+/// `--count`: 1 to [`MAX_COUNT`].
+pub fn count_parser() -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::<usize>::new().range(1..=MAX_COUNT)
+}
+
 /// Arguments of `tactile hdl cosim`.
 #[derive(Debug, Args)]
 pub struct CosimArgs {
     /// Functions to run (default: all three).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub function: Vec<Function>,
-    /// Samples beyond the edge cases, per function.
-    #[arg(long, default_value_t = 20_000)]
+    /// Samples beyond the edge cases, per function (1 to 10^7).
+    #[arg(long, default_value_t = 20_000, value_parser = count_parser())]
     pub count: usize,
     /// Seed of the random inputs.
     #[arg(long, default_value_t = 1)]

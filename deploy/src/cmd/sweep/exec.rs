@@ -60,10 +60,36 @@ pub fn plan(
 /// run ended (a stop request did not cut it short; a run whose node died did end, and
 /// its summary says so).
 pub fn finished(dir: &Path) -> Option<Vec<Option<f64>>> {
-    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
-    let json: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let json = summary(dir)?;
     let whole = json["interrupted"] == false;
     whole.then(|| values(&json))
+}
+
+fn summary(dir: &Path) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
+/// True if the run in `dir` failed (a node died or a wait ran out).
+pub fn failed(dir: &Path) -> bool {
+    summary(dir).is_some_and(|j| j["failed"] == true)
+}
+
+/// What `--resume` keeps of a folder: a run that ended, did not fail, and ran this
+/// very combination (its `scenario.toml`, input paths aside, is `w`'s scenario), never
+/// another scenario's summary left in the folder.
+fn kept(w: &Work) -> Option<Vec<Option<f64>>> {
+    let text = std::fs::read_to_string(w.dir.join("scenario.toml")).ok()?;
+    let mut theirs = tactile_scenario::Scenario::from_toml_str(&text).ok()?;
+    let mut ours = w.loaded.scenario.clone();
+    for s in [&mut theirs, &mut ours] {
+        for p in s.input_paths_mut() {
+            p.clear();
+        }
+    }
+    (theirs == ours && !failed(&w.dir))
+        .then(|| finished(&w.dir))
+        .flatten()
 }
 
 /// Runs `work` on `jobs` threads; each entry of the result is the run's metrics, or
@@ -78,7 +104,7 @@ pub fn run_all(
     let results: Mutex<Vec<Option<Vec<Option<f64>>>>> = Mutex::new(vec![None; work.len()]);
     let mut todo = Vec::new();
     for (i, w) in work.iter().enumerate() {
-        match finished(&w.dir).filter(|_| args.resume) {
+        match args.resume.then(|| kept(w)).flatten() {
             Some(v) => lock(&results)[i] = Some(v),
             None => todo.push(i),
         }

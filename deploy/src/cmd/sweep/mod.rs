@@ -186,6 +186,21 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         );
         return Err(Error::Interrupted);
     }
+    let failed: Vec<String> = work
+        .iter()
+        .filter(|w| exec::failed(&w.dir))
+        .map(|w| format!("{} ({})", w.dir.display(), w.what))
+        .collect();
+    if !failed.is_empty() {
+        // A run whose node died still has its row (its summary says what ran), but
+        // the sweep is not a success: --resume runs the failed ones again.
+        return Err(Error::Failed(format!(
+            "{} of {} runs failed: {}; their rows in sweep.csv are from what ran; --resume runs them again",
+            failed.len(),
+            work.len(),
+            failed.join(", ")
+        )));
+    }
     crate::outln!(
         "tactile sweep: {} runs{}; sweep.csv and one plot per metric in {}",
         work.len(),
