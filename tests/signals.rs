@@ -161,3 +161,37 @@ fn a_closed_stdout_ends_quietly() {
     assert_eq!(code, Some(0), "{err}");
     assert!(err.is_empty(), "{err}");
 }
+
+/// SIGTERM to any one node, master included, is a stop from outside, the same for
+/// each: the launcher ends with 130, the run `interrupted`, not `failed` (the master's
+/// was "failed", exit 1, the others' 130).
+#[test]
+fn sigterm_to_any_node_is_the_same_stop() {
+    for role in ["master", "emulator", "slave"] {
+        let sb = Sandbox::new(&format!("sigterm{role}"));
+        let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
+        let child = sb
+            .command(&["run", scenario.to_str().expect("utf-8"), "--out", "run"])
+            .args(["--prefix", &sb.prefix, "-q"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("start");
+        let rec = sb.path("run").join("slave.rec");
+        wait_for("the loop runs", Duration::from_secs(20), || {
+            std::fs::metadata(&rec).is_ok_and(|m| m.len() > 100_000)
+        });
+        let pid = util::pid_of(&sb.prefix, role).unwrap_or_else(|| panic!("no {role}"));
+        signal(pid, rustix::process::Signal::TERM);
+        let (code, err) = finish(child);
+        assert_eq!(code, Some(130), "{role}: {err}");
+        sb.assert_no_leftover_processes();
+        let s = sb.json("run", "summary.json");
+        assert_eq!(
+            (&s["interrupted"], &s["failed"]),
+            (&serde_json::json!(true), &serde_json::json!(false)),
+            "{role}: {}",
+            s["events"]
+        );
+    }
+}

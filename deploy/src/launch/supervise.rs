@@ -236,6 +236,11 @@ impl<'a> Supervisor<'a> {
         }
         if role == Role::Master {
             self.watch.master = Some(status);
+            if !status.success() && !self.watch.interrupted && stopped_by_signal(status) {
+                // Stopped by someone, like any other node: the run was interrupted,
+                // it did not fail.
+                self.stopped_from_outside(role, status);
+            }
             return false;
         }
         if status.success() || self.watch.interrupted {
@@ -247,16 +252,22 @@ impl<'a> Supervisor<'a> {
             // Asked to stop (the terminal's Ctrl-C reaches every process of the group,
             // maybe before the launcher looks): not a death, not restarted.
             self.procs[k].status = Some(status);
-            let at = self.elapsed_s();
-            let how = describe(status);
-            self.watch.events.push(format!(
-                "{role} {how} after {at:.2} s: a stop request, not restarted"
-            ));
-            // Someone stopped this node (or the whole group): the run stops with it.
-            self.on_stop_request();
+            self.stopped_from_outside(role, status);
             return false;
         }
         self.on_death(k, status)
+    }
+
+    /// Someone stopped this node (or the whole group: the terminal's Ctrl-C reaches
+    /// every process, maybe before the launcher looks): the run stops with it, as
+    /// interrupted, whichever node it was.
+    fn stopped_from_outside(&mut self, role: Role, status: ExitStatus) {
+        let at = self.elapsed_s();
+        let how = describe(status);
+        self.watch.events.push(format!(
+            "{role} {how} after {at:.2} s: a stop request, not restarted"
+        ));
+        self.on_stop_request();
     }
 
     /// The emulator or the slave died while the master runs: restart it if allowed.
