@@ -52,6 +52,17 @@ fn hand_started_nodes_in_any_order_match_tactile_run_and_the_simulation() {
         let (code, err) = finish(child);
         assert_eq!(code, Some(0), "{name}: {err}");
     }
+    // The last node to end removed the run's shared memory and iceoryx2 files.
+    let shm = format!("{}.", sb.prefix);
+    let left: Vec<String> = std::fs::read_dir("/dev/shm")
+        .expect("/dev/shm")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(&shm))
+        .collect();
+    assert!(left.is_empty(), "left in /dev/shm: {left:?}");
+    let iox = std::path::Path::new(tactile_transport::ipc::ROOT).join(&sb.prefix);
+    assert!(!iox.exists(), "{} left", iox.display());
     // Each node wrote its own record and log into its own folder.
     for role in ["master", "emulator", "slave"] {
         let dir = sb.path(&format!("h-{role}"));

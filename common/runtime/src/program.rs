@@ -97,11 +97,27 @@ impl Program {
     /// Runs a follower (the emulator, the slave) until the master's end of the run
     /// (`Ok(true)`) or a stop request (`Ok(false)`).
     pub fn follow<H: Follower>(self, make: Make<'_, H>) -> Result<bool, NodeError> {
-        let mut rec = self.record::<H>()?;
-        let (link, outside, h) = self.open(&mut rec, make)?;
-        Follow::new(h, link, rec, self.timing(), outside.live)
-            .run(&mut OnTransports)
-            .map_err(failed)
+        let ended = (|| {
+            let mut rec = self.record::<H>()?;
+            let (link, outside, h) = self.open(&mut rec, make)?;
+            Follow::new(h, link, rec, self.timing(), outside.live)
+                .run(&mut OnTransports)
+                .map_err(failed)
+        })();
+        self.leave();
+        ended
+    }
+
+    /// The node's lock given back and, if it was the last process of its run (a node
+    /// started by hand; a launcher cleans up its own run), the run's shared memory and
+    /// iceoryx2 files removed, however the node ended.
+    fn leave(self) {
+        let prefix = self.args.link.prefix.clone();
+        drop(self.prepared);
+        if let Some(locks) = crate::lock::take_all(&prefix, "a node cleaning up after its run") {
+            tactile_transport::ipc::remove_run_files(&prefix);
+            drop(locks);
+        }
     }
 
     /// Runs the leader (the master) until every sample was sent (`Ok(true)`) or a
@@ -112,18 +128,22 @@ impl Program {
         startup_timeout: Duration,
         make: Make<'_, H>,
     ) -> Result<bool, NodeError> {
-        let mut rec = self.record::<H>()?;
-        let (link, outside, h) = self.open(&mut rec, make)?;
-        let opts = LeadOptions {
-            run: new_run_token(),
-            samples: self.prepared.scenario.samples,
-            startup_timeout,
-            answer_timeout: Duration::from_millis(100),
-            timing: self.timing(),
-        };
-        Lead::new(h, link, rec, opts, outside.live)
-            .run(&mut OnTransports)
-            .map_err(failed)
+        let ended = (|| {
+            let mut rec = self.record::<H>()?;
+            let (link, outside, h) = self.open(&mut rec, make)?;
+            let opts = LeadOptions {
+                run: new_run_token(),
+                samples: self.prepared.scenario.samples,
+                startup_timeout,
+                answer_timeout: Duration::from_millis(100),
+                timing: self.timing(),
+            };
+            Lead::new(h, link, rec, opts, outside.live)
+                .run(&mut OnTransports)
+                .map_err(failed)
+        })();
+        self.leave();
+        ended
     }
 }
 
