@@ -699,3 +699,48 @@ fn a_run_stopped_by_sigint_leaves_no_force_and_the_robot_holding() {
         s["slave"]["device"]
     );
 }
+
+/// A slave whose robot never speaks (its joint states on another topic): the master
+/// gives up after its start-up timeout saying the slave waits for its robot, never
+/// blaming the prefix or the link, and the run ends failed with every process gone.
+#[test]
+fn a_slave_waiting_for_its_robot_is_named_by_the_master() {
+    if !python_ready() {
+        return cannot("python3 lacks eclipse-zenoh or rosbags");
+    }
+    let sb = Sandbox::new("ros2-wait");
+    let ports = [free_port(), free_port()];
+    let robot = robot_standin(&sb, 14, ports[1]);
+    let tables = ros_tables(14, ports, false, false)
+        .replace("\"/arm/joint_states\"", "\"/arm/elsewhere\"")
+        .replace(&format!("\"tcp/127.0.0.1:{}\", ", ports[0]), "");
+    let scenario = sb.write("w.toml", &format!("{}{tables}", looped("realtime", 200)));
+    listening(ports[1]);
+    let o = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        sb.path("out").to_str().expect("utf-8"),
+        "--prefix",
+        &sb.prefix,
+        "-q",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let log = std::fs::read_to_string(sb.path("out").join("master.log")).unwrap_or_default();
+    assert!(
+        err.contains("the slave still waits for its robot"),
+        "{err}\n{log}"
+    );
+    assert!(!err.contains("same prefix and link"), "{err}");
+    sb.assert_no_leftover_processes();
+    // The stand-in never had a command, so it would wait out its duration: stopped.
+    let pid = rustix::process::Pid::from_raw(robot.id() as i32).expect("pid");
+    let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
+    let r = report(&sb, robot, "robot.json");
+    assert_eq!(
+        num(&r["commands"]),
+        0.0,
+        "no command before the robot spoke"
+    );
+}

@@ -74,6 +74,9 @@ pub const FLAG_CLAMPED: u32 = 512;
 /// processes as the loop's clock only, no packet crosses the network for it, and the
 /// receiver fills it with its predictor.
 pub const FLAG_UNSENT: u32 = 1024;
+/// Flag: on a probe's echo, the node at the end of the chain is there but still
+/// waits for its robot, so the master can say what it waits for.
+pub const FLAG_WAITING: u32 = 2048;
 
 /// A sample that carries a per-hop publish counter.
 pub trait Sequenced {

@@ -81,10 +81,9 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
     if summary.failed {
         return Err(Error::Failed(format!(
             "the run failed: {}",
-            summary
-                .events
-                .first()
-                .map_or("", |e| e.lines().next().unwrap_or(""))
+            // The launcher's first event: what died, and its last words (at most the
+            // five last lines of its log), so the reason is on stderr.
+            summary.events.first().map_or("", String::as_str)
         )));
     }
     Ok(())

@@ -10,7 +10,7 @@ use super::{Counts, Failure, Follower, Io, Timing};
 use crate::pace::Pacer;
 use std::time::{Duration, Instant};
 use tactile_devices::{DeviceCounters, LiveSink};
-use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE};
+use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, FLAG_WAITING};
 use tactile_records::{Events, Recorder};
 
 /// The run this node serves: learned from the master's first sample (probe or data);
@@ -201,7 +201,16 @@ impl<H: Follower> Follow<H> {
             return Ok(true);
         };
         let (kind, who) = (p.kind(), p.describe());
-        match super::waits::until(&who, None, &|| p.heard())? {
+        // Meanwhile the master's probes are answered "waiting", so it says what the
+        // run waits for rather than blaming the prefix or the link.
+        let (link, filter, place) = (&mut self.link, &mut self.filter, self.place);
+        let mut joined = None;
+        let mut answer = || answer_waiting(link, filter, place, &mut joined);
+        let waited = super::waits::until_doing(&who, None, &|| p.heard(), &mut answer)?;
+        if let Some(t) = joined {
+            self.rec.run(t)?;
+        }
+        match waited {
             super::waits::Waited::Ready => {
                 let what = format!("{kind} found: {who}");
                 Events::event(&mut self.rec, 0, &what)?;
@@ -388,6 +397,34 @@ impl<H: Follower> Follow<H> {
             ended,
         )
     }
+}
+
+/// While the end of the chain waits for its robot: each probe of a run it may join
+/// is echoed with [`FLAG_WAITING`]; anything else is left (no data comes before the
+/// master has its answer).
+fn answer_waiting(
+    link: &mut Link,
+    filter: &mut RunFilter,
+    place: Place,
+    joined: &mut Option<u64>,
+) -> Result<(), Failure> {
+    while let Some(a) = link.poll()? {
+        if let Arrival::Forward(c) = a {
+            if place == Place::End
+                && c.signal.flags & FLAG_PROBE != 0
+                && filter.admit(c.run, joined)
+            {
+                let mut echo = Backward {
+                    seq: c.seq,
+                    run: c.run,
+                    ..Backward::default()
+                };
+                echo.signal.flags = FLAG_PROBE | FLAG_WAITING;
+                link.send_backward(echo, true)?;
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

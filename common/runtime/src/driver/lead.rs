@@ -11,7 +11,9 @@ use super::{Counts, Failure, Io, Leader, Timing};
 use std::time::{Duration, Instant};
 use tactile_devices::{DeviceCounters, LiveSink};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
-use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, LATE_WINDOW};
+use tactile_messages::samples::{
+    stage, Backward, Forward, FLAG_END, FLAG_PROBE, FLAG_WAITING, LATE_WINDOW,
+};
 use tactile_records::{Events, Recorder};
 
 /// Samples waiting for their answer: the last [`LATE_WINDOW`] sent, each answered or
@@ -179,12 +181,20 @@ impl<H: Leader> Lead<H> {
         let limit = self.opts.startup_timeout;
         let mut notes = Notes::new("the emulator and slave", Some(limit));
         let mut k = 0u64;
+        let mut robot_wait = false;
         loop {
             if notes.timed_out() {
-                return Err(Failure::NoAnswer(format!(
-                    "no answer from the emulator and slave within {:.1} s: are both running with the same prefix and link?",
-                    limit.as_secs_f64()
-                )));
+                return Err(Failure::NoAnswer(if robot_wait {
+                    format!(
+                        "the emulator and slave answer, but the slave still waits for its robot after {:.1} s: see the slave's log for the robot's topic and what it received",
+                        limit.as_secs_f64()
+                    )
+                } else {
+                    format!(
+                        "no answer from the emulator and slave within {:.1} s: are both running with the same prefix and link?",
+                        limit.as_secs_f64()
+                    )
+                }));
             }
             let mut p = Forward {
                 seq: k,
@@ -197,6 +207,18 @@ impl<H: Leader> Lead<H> {
             let deadline = Instant::now() + Duration::from_millis(20);
             loop {
                 match self.link.wait(deadline, block)? {
+                    Ok(super::Arrival::Backward(b))
+                        if b.signal.flags & FLAG_WAITING != 0 && b.run == self.opts.run =>
+                    {
+                        if !robot_wait {
+                            robot_wait = true;
+                            tracing::info!(
+                                "the emulator and slave answer; the slave waits for its robot"
+                            );
+                            self.rec
+                                .event(0, "peers answer: the slave waits for its robot")?;
+                        }
+                    }
                     Ok(super::Arrival::Backward(b))
                         if b.signal.flags & FLAG_PROBE != 0 && b.run == self.opts.run =>
                     {

@@ -74,8 +74,20 @@ pub fn until(
     limit: Option<Duration>,
     ready: &dyn Fn() -> bool,
 ) -> Result<Waited, Failure> {
+    until_doing(who, limit, ready, &mut || Ok(()))
+}
+
+/// [`until`], calling `meanwhile` at each look (a node answering its peers' probes
+/// while it waits for its robot).
+pub fn until_doing(
+    who: &str,
+    limit: Option<Duration>,
+    ready: &dyn Fn() -> bool,
+    meanwhile: &mut dyn FnMut() -> Result<(), Failure>,
+) -> Result<Waited, Failure> {
     let mut notes = Notes::new(who, limit);
     loop {
+        meanwhile()?;
         if ready() {
             return Ok(Waited::Ready);
         }
