@@ -744,3 +744,72 @@ fn a_slave_waiting_for_its_robot_is_named_by_the_master() {
         "no command before the robot spoke"
     );
 }
+
+/// A device whose every message is dropped (the scenario names joints the driver does
+/// not publish): the master's wait says so once a second and its error gives the
+/// reason, not "is its driver running".
+#[test]
+fn a_device_whose_messages_are_all_dropped_says_why() {
+    if !python_ready() {
+        return cannot("python3 lacks eclipse-zenoh or rosbags");
+    }
+    let sb = Sandbox::new("ros2-drop");
+    sb.write("device.csv", "t,waist,shoulder,elbow\n0,0,0,0\n1,0,0,0\n");
+    let ports = [free_port(), free_port()];
+    let device = standin(
+        &sb,
+        &[
+            "device",
+            "--domain",
+            "15",
+            "--listen",
+            &format!("tcp/127.0.0.1:{}", ports[0]),
+            "--names",
+            "waist,shoulder,elbow",
+            "--joint-topic",
+            "/phantom/joint_states",
+            "--force-topic",
+            "/phantom/force_feedback",
+            "--trajectory",
+            "device.csv",
+            "--end-after",
+            "0",
+            "--report",
+            "device.json",
+        ],
+    );
+    let robot = robot_standin(&sb, 15, ports[1]);
+    let tables = ros_tables(15, ports, false, true).replace(
+        "joints = [\"waist\", \"shoulder\", \"elbow\"]",
+        "joints = [\"waist\", \"shoulder\", \"wrist\"]",
+    );
+    let scenario = sb.write("d.toml", &format!("{}{tables}", looped("realtime", 200)));
+    listening(ports[0]);
+    listening(ports[1]);
+    let o = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        sb.path("out").to_str().expect("utf-8"),
+        "--prefix",
+        &sb.prefix,
+        "-q",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the last dropped: joint \"wrist\" is missing"),
+        "{err}"
+    );
+    let log = std::fs::read_to_string(sb.path("out").join("master.log")).expect("log");
+    assert!(
+        log.contains("while waiting:") && log.contains("dropped"),
+        "{log}"
+    );
+    sb.assert_no_leftover_processes();
+    for child in [device, robot] {
+        let pid = rustix::process::Pid::from_raw(child.id() as i32).expect("pid");
+        let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
+        let _ = util::wait_within(child, util::LIMIT);
+    }
+}

@@ -205,7 +205,11 @@ impl<H: Follower> Follow<H> {
         // run waits for rather than blaming the prefix or the link.
         let (link, filter, place) = (&mut self.link, &mut self.filter, self.place);
         let mut joined = None;
-        let mut answer = || answer_waiting(link, filter, place, &mut joined);
+        let mut delivered = super::waits::Delivered::default();
+        let mut answer = || {
+            delivered.tick(p);
+            answer_waiting(link, filter, place, &mut joined)
+        };
         let waited = super::waits::until_doing(&who, None, &|| p.heard(), &mut answer)?;
         if let Some(t) = joined {
             self.rec.run(t)?;

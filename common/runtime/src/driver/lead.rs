@@ -6,7 +6,7 @@
 //! run.
 
 use super::link::{Block, Idle, Link};
-use super::waits::{until, Notes, Waited};
+use super::waits::{Notes, Waited};
 use super::{Counts, Failure, Io, Leader, Timing};
 use std::time::{Duration, Instant};
 use tactile_devices::{DeviceCounters, LiveSink};
@@ -157,7 +157,13 @@ impl<H: Leader> Lead<H> {
             return Ok(true);
         };
         let (kind, who) = (p.kind(), p.describe());
-        match until(&who, Some(self.opts.startup_timeout), &|| p.heard())? {
+        let mut delivered = super::waits::Delivered::default();
+        let limit = Some(self.opts.startup_timeout);
+        let mut note = || {
+            delivered.tick(p);
+            Ok(())
+        };
+        match super::waits::until_doing(&who, limit, &|| p.heard(), &mut note)? {
             Waited::Ready => {
                 self.rec.event(0, &format!("{kind} found: {who}"))?;
                 Ok(true)
@@ -165,8 +171,13 @@ impl<H: Leader> Lead<H> {
             Waited::Stopped => Ok(false),
             Waited::TimedOut => {
                 let c = p.counters();
+                let hint = if c.messages == 0 {
+                    ": is its driver running, with the same ROS_DOMAIN_ID, reaching the same Zenoh router?".to_string()
+                } else {
+                    delivered.why()
+                };
                 Err(Failure::NoAnswer(format!(
-                    "no usable message from {who} within {:.1} s ({} received, {} rejected): is its driver running, with the same ROS_DOMAIN_ID, reaching the same Zenoh router?",
+                    "no usable message from {who} within {:.1} s ({} received, {} rejected){hint}",
                     self.opts.startup_timeout.as_secs_f64(),
                     c.messages,
                     c.rejected

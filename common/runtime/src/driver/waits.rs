@@ -101,3 +101,57 @@ pub fn until_doing(
         std::thread::sleep(Duration::from_millis(10));
     }
 }
+
+/// While a node waits for its device or robot: once a second, if messages came, what
+/// came and why the last were dropped, so a wait that never ends says why (a wrong
+/// joint name, a unit that maps out of range) rather than only that it waits.
+#[derive(Debug)]
+pub struct Delivered {
+    next: Instant,
+    seen: (u64, u64),
+    /// The newest reason a message was dropped.
+    pub reason: Option<String>,
+}
+
+impl Default for Delivered {
+    fn default() -> Self {
+        Delivered {
+            next: Instant::now() + Duration::from_secs(1),
+            seen: (0, 0),
+            reason: None,
+        }
+    }
+}
+
+impl Delivered {
+    /// Looks at `p`'s counters if a second passed, and logs what changed.
+    pub fn tick(&mut self, p: &dyn tactile_devices::Peripheral) {
+        if Instant::now() < self.next {
+            return;
+        }
+        self.next += Duration::from_secs(1);
+        if let Some(r) = p.take_reject() {
+            self.reason = Some(r.to_string());
+        }
+        let c = p.counters();
+        if (c.messages, c.rejected) != self.seen {
+            tracing::warn!(
+                "{} while waiting: {} messages, {} dropped{}",
+                p.describe(),
+                c.messages,
+                c.rejected,
+                self.reason
+                    .as_ref()
+                    .map_or(String::new(), |r| format!(" (last: {r})"))
+            );
+            self.seen = (c.messages, c.rejected);
+        }
+    }
+
+    /// `, the last dropped because: ...` for a message, or nothing.
+    pub fn why(&self) -> String {
+        self.reason
+            .as_ref()
+            .map_or(String::new(), |r| format!("; the last dropped: {r}"))
+    }
+}
