@@ -173,7 +173,10 @@ impl<H: Follower> Follow<H> {
             match got {
                 Ok(a) => {
                     if self.handle(a, waiting)? == Flow::End {
-                        return Ok(true);
+                        // The master's end came, but if this node was asked to stop
+                        // too (SIGTERM to the whole run, its launcher gone), it was
+                        // interrupted like the master: one ending for one cause.
+                        return Ok(!crate::signals::stop_requested());
                     }
                 }
                 Err(Idle::Timeout) => self.idle()?,
