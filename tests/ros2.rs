@@ -147,6 +147,31 @@ fn device_csv(sb: &Sandbox, joints: &[[f64; 4]]) {
     sb.write("device.csv", &dev);
 }
 
+/// The stand-in device on `/phantom/...` in ROS domain `domain`, listening on `port`,
+/// playing `device.csv`, with `extra` arguments (junk, silence, its end).
+fn device_standin(sb: &Sandbox, domain: u32, port: u16, extra: &[&str]) -> Child {
+    let (domain, listen) = (domain.to_string(), format!("tcp/127.0.0.1:{port}"));
+    let mut args = vec![
+        "device",
+        "--domain",
+        &domain,
+        "--listen",
+        &listen,
+        "--names",
+        "waist,shoulder,elbow",
+        "--joint-topic",
+        "/phantom/joint_states",
+        "--force-topic",
+        "/phantom/force_feedback",
+        "--trajectory",
+        "device.csv",
+        "--report",
+        "device.json",
+    ];
+    args.extend_from_slice(extra);
+    standin(sb, &args)
+}
+
 /// The stand-in robot on `/arm/...` in ROS domain `domain`, listening on `port`, until
 /// two seconds after the last command.
 fn robot_standin(sb: &Sandbox, domain: u32, port: u16) -> Child {
@@ -208,24 +233,12 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
     // The device plays the same angles in its driver's units, then holds.
     device_csv(&sb, &joints);
     let ports = [free_port(), free_port()];
-    let ep = |p: u16| format!("tcp/127.0.0.1:{p}");
     let robot = robot_standin(&sb, 11, ports[1]);
-    let device = standin(
+    let device = device_standin(
         &sb,
+        11,
+        ports[0],
         &[
-            "device",
-            "--domain",
-            "11",
-            "--listen",
-            &ep(ports[0]),
-            "--names",
-            "waist,shoulder,elbow",
-            "--joint-topic",
-            "/phantom/joint_states",
-            "--force-topic",
-            "/phantom/force_feedback",
-            "--trajectory",
-            "device.csv",
             "--junk-at",
             "6.0",
             "--junk-each",
@@ -235,8 +248,6 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
             "--end-after",
             "9.0",
             "--live",
-            "--report",
-            "device.json",
         ],
     );
     let scenario = sb.write(
@@ -585,30 +596,8 @@ fn a_run_stopped_by_sigint_leaves_no_force_and_the_robot_holding() {
     let (joints, _) = paper_move(&sb);
     device_csv(&sb, &joints);
     let ports = [free_port(), free_port()];
-    let ep = |p: u16| format!("tcp/127.0.0.1:{p}");
     let robot = robot_standin(&sb, 13, ports[1]);
-    let device = standin(
-        &sb,
-        &[
-            "device",
-            "--domain",
-            "13",
-            "--listen",
-            &ep(ports[0]),
-            "--names",
-            "waist,shoulder,elbow",
-            "--joint-topic",
-            "/phantom/joint_states",
-            "--force-topic",
-            "/phantom/force_feedback",
-            "--trajectory",
-            "device.csv",
-            "--end-after",
-            "8.0",
-            "--report",
-            "device.json",
-        ],
-    );
+    let device = device_standin(&sb, 13, ports[0], &["--end-after", "8.0"]);
     let scenario = sb.write(
         "ros.toml",
         &format!(
@@ -756,28 +745,7 @@ fn a_device_whose_messages_are_all_dropped_says_why() {
     let sb = Sandbox::new("ros2-drop");
     sb.write("device.csv", "t,waist,shoulder,elbow\n0,0,0,0\n1,0,0,0\n");
     let ports = [free_port(), free_port()];
-    let device = standin(
-        &sb,
-        &[
-            "device",
-            "--domain",
-            "15",
-            "--listen",
-            &format!("tcp/127.0.0.1:{}", ports[0]),
-            "--names",
-            "waist,shoulder,elbow",
-            "--joint-topic",
-            "/phantom/joint_states",
-            "--force-topic",
-            "/phantom/force_feedback",
-            "--trajectory",
-            "device.csv",
-            "--end-after",
-            "0",
-            "--report",
-            "device.json",
-        ],
-    );
+    let device = device_standin(&sb, 15, ports[0], &["--end-after", "0"]);
     let robot = robot_standin(&sb, 15, ports[1]);
     let tables = ros_tables(15, ports, false, true).replace(
         "joints = [\"waist\", \"shoulder\", \"elbow\"]",
