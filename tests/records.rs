@@ -161,3 +161,72 @@ fn corrupted_bytes_mid_record_cost_only_their_frames() {
         "{rows} rows of {all}, {gone} samples lost"
     );
 }
+
+/// Copies the three records of `from` into a new folder `to`, under `names` (a
+/// record's file name by role: master, emulator, slave).
+fn copy_records(sb: &Sandbox, from: &str, to: &str, names: [&str; 3]) {
+    std::fs::create_dir(sb.path(to)).expect("folder");
+    for (role, name) in ["master", "emulator", "slave"].iter().zip(names) {
+        if name.is_empty() {
+            continue;
+        }
+        let src = sb.path(from).join(format!("{role}.rec"));
+        std::fs::copy(src, sb.path(to).join(format!("{name}.rec"))).expect("copy");
+    }
+}
+
+/// One bit flipped in the master's first frame (its start, which holds the scenario)
+/// costs that frame: the scenario is read from another node's start, every sample is
+/// reported, and the summary says a start was lost.
+#[test]
+fn a_damaged_first_frame_costs_only_that_frame() {
+    let sb = Sandbox::new("firstframe");
+    let scenario = sb.write("s.toml", &util::wall_delay());
+    sb.simulate(&scenario, "clean");
+    copy_records(&sb, "clean", "bad", ["master", "emulator", "slave"]);
+    let rec = sb.path("bad").join("master.rec");
+    let mut bytes = std::fs::read(&rec).expect("record");
+    // Past the magic (8) and the frame's header (12): inside the start's body.
+    bytes[8 + 12 + 40] ^= 0x10;
+    std::fs::write(&rec, &bytes).expect("write");
+    let o = sb.tactile(&["report", "bad"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        sb.trace("bad"),
+        sb.trace("clean"),
+        "every sample reported alike"
+    );
+    let s = sb.json("bad", "summary.json");
+    assert_eq!(s["nodes"]["master"]["damaged_stretches"], 1);
+    let events = s["events"].to_string();
+    assert!(
+        events.contains("master: 1 segment start(s) lost to damage"),
+        "{events}"
+    );
+    assert_eq!(s["master"], sb.json("clean", "summary.json")["master"]);
+}
+
+/// Records under each other's names are refused, naming the file and what it holds;
+/// a missing record is named in the summary.
+#[test]
+fn records_are_checked_by_their_content_and_a_missing_one_is_named() {
+    let sb = Sandbox::new("swapped");
+    let scenario = sb.write("s.toml", &util::wall_delay());
+    sb.simulate(&scenario, "clean");
+    copy_records(&sb, "clean", "swapped", ["master", "slave", "emulator"]);
+    let o = sb.tactile(&["report", "swapped"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("emulator.rec holds the slave's record, not the emulator's"),
+        "{err}"
+    );
+    copy_records(&sb, "clean", "noslave", ["master", "emulator", ""]);
+    let o = sb.tactile(&["report", "noslave"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let events = sb.json("noslave", "summary.json")["events"].to_string();
+    assert!(
+        events.contains("slave: no slave.rec among the records reported"),
+        "{events}"
+    );
+}

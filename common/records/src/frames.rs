@@ -138,6 +138,11 @@ impl<T: Serialize> RecordWriter<T> {
         self.file.write_all(&frame(&self.buf))
     }
 
+    /// Cuts the file back to `len` bytes (a segment taken back out).
+    pub fn truncate(&mut self, len: u64) -> std::io::Result<()> {
+        self.file.set_len(len)
+    }
+
     /// The file written.
     pub fn path(&self) -> &Path {
         &self.path
@@ -152,6 +157,24 @@ fn whole_end(path: &Path) -> std::io::Result<u64> {
         end = r.offset;
     }
     Ok(end)
+}
+
+/// The run tokens a record holds (`Record::Run`), in order, each once; none if the
+/// file cannot be read. Every other frame is skipped undecoded.
+pub fn runs_in(path: &Path) -> Vec<u64> {
+    type Any = crate::Record<serde::de::IgnoredAny, serde::de::IgnoredAny>;
+    let mut runs = Vec::new();
+    let Ok(mut r) = RecordReader::<Any>::open(path) else {
+        return runs;
+    };
+    while let Ok(Some(rec)) = r.next_record() {
+        if let crate::Record::Run(t) = rec {
+            if !runs.contains(&t) {
+                runs.push(t);
+            }
+        }
+    }
+    runs
 }
 
 /// The frames of a record file, checked and resynchronised, in bounded memory.

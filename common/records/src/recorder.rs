@@ -38,6 +38,9 @@ pub trait Events {
 pub struct Recorder<S, C> {
     writer: RecordWriter<Record<S, C>>,
     next_counters_ns: u64,
+    /// With `--append`: where the existing record ended and the runs it holds, so a
+    /// node that turns out to have joined another run takes its segment back out.
+    appended: Option<(u64, Vec<u64>)>,
 }
 
 /// Counters are written this often, ns.
@@ -47,14 +50,22 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
     /// Opens `ROLE.rec` in `dir` (afresh, or appended to with `append`).
     pub fn open(dir: &Path, role: Role, append: bool) -> Result<Self, WriteError> {
         let path = record_path(dir, role);
-        let writer = RecordWriter::create(&path, append).map_err(|source| WriteError {
+        let opening = |source| WriteError {
             action: "opening",
             path: path.display().to_string(),
             source,
-        })?;
+        };
+        let writer = RecordWriter::create(&path, append).map_err(opening)?;
+        let appended = if append {
+            let end = std::fs::metadata(&path).map_err(opening)?.len();
+            Some((end, crate::frames::runs_in(&path)))
+        } else {
+            None
+        };
         Ok(Recorder {
             writer,
             next_counters_ns: now_ns() + COUNTERS_EVERY_NS,
+            appended,
         })
     }
 
@@ -87,7 +98,31 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
     }
 
     /// The run token this node joined.
+    /// Appended to a record of another run, the segment is taken back out (the other
+    /// run's record left as it was) and the node fails: one record holds one run.
     pub fn run(&mut self, token: u64) -> Result<(), WriteError> {
+        if let Some((end, runs)) = &self.appended {
+            if !runs.is_empty() && !runs.contains(&token) {
+                let shown: Vec<String> = runs.iter().map(|t| format!("{t:016x}")).collect();
+                let path = self.writer.path().display().to_string();
+                let undo = self.writer.truncate(*end);
+                return Err(WriteError {
+                    action: "appending to",
+                    path,
+                    source: std::io::Error::new(
+                        std::io::ErrorKind::InvalidInput,
+                        format!(
+                            "it is the record of run {}, and this node joined run {token:016x}: \
+                             --append continues a record of the same run only (give another --out){}",
+                            shown.join(", "),
+                            undo.err().map_or(String::new(), |e| format!(
+                                "; taking this segment back out failed: {e}"
+                            ))
+                        ),
+                    ),
+                });
+            }
+        }
         tracing::info!("joined run {token:016x}");
         self.put(&Record::Run(token))
     }
@@ -135,5 +170,38 @@ impl<S: Serialize, C: Serialize> Events for Recorder<S, C> {
             mono_ns: now_ns(),
             what: what.to_string(),
         }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    type Rec = Recorder<u64, u64>;
+
+    fn segment(dir: &Path, append: bool, run: u64) -> Result<(), WriteError> {
+        let mut r = Rec::open(dir, Role::Slave, append)?;
+        r.run(run)?;
+        r.sample(run)?;
+        r.stop(0, 0, "completed")
+    }
+
+    #[test]
+    fn an_append_into_another_runs_record_is_refused_and_leaves_it_as_it_was() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        segment(dir.path(), false, 1).expect("first run");
+        let path = record_path(dir.path(), Role::Slave);
+        let before = std::fs::read(&path).expect("record");
+        let e = segment(dir.path(), true, 2).expect_err("another run");
+        let said = e.to_string();
+        assert!(
+            said.contains("it is the record of run 0000000000000001, and this node joined run 0000000000000002"),
+            "{said}"
+        );
+        assert_eq!(std::fs::read(&path).expect("record"), before);
+        // The same run continues.
+        segment(dir.path(), true, 1).expect("same run");
+        assert_eq!(crate::frames::runs_in(&path), vec![1]);
+        assert!(std::fs::read(&path).expect("record").len() > before.len());
     }
 }

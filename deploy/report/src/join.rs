@@ -28,8 +28,12 @@ pub const MAX_EVENTS: usize = 200;
 pub struct NodeLog<C> {
     /// The record file.
     pub path: PathBuf,
-    /// One `Start` per segment (a restarted node appends a segment).
+    /// One `Start` per segment (a restarted node appends a segment) whose start frame
+    /// was read.
     pub starts: Vec<Start>,
+    /// Segments whose `Start` frame was lost to damage: their records are kept (they
+    /// follow the last whole start, or open the file).
+    pub starts_lost: u64,
     /// Run tokens the node joined.
     pub runs: Vec<u64>,
     /// Events, as `(sample, what)`, at most [`MAX_EVENTS`].
@@ -57,6 +61,7 @@ impl<C> Default for NodeLog<C> {
         NodeLog {
             path: PathBuf::new(),
             starts: Vec::new(),
+            starts_lost: 0,
             runs: Vec::new(),
             events: Vec::new(),
             events_omitted: 0,
@@ -72,6 +77,11 @@ impl<C> Default for NodeLog<C> {
 
 impl<C: Clone> NodeLog<C> {
     fn take<S>(&mut self, r: Record<S, C>) -> Option<S> {
+        if self.stops.is_empty() && !matches!(r, Record::Start(_)) {
+            // The file's first frame was damaged: its records still form a segment.
+            self.starts_lost += 1;
+            self.stops.push(None);
+        }
         match r {
             Record::Start(s) => {
                 self.starts.push(s);
@@ -92,7 +102,7 @@ impl<C: Clone> NodeLog<C> {
             }
             Record::Counters(c) => {
                 // The last counters of the current segment replace the earlier ones.
-                if self.counters.len() < self.starts.len() {
+                if self.counters.len() < self.segments() {
                     self.counters.push(c);
                 } else if let Some(last) = self.counters.last_mut() {
                     *last = c;
@@ -105,6 +115,11 @@ impl<C: Clone> NodeLog<C> {
             }
         }
         None
+    }
+
+    /// Segments in the record: one per start, read or lost.
+    pub fn segments(&self) -> usize {
+        self.stops.len()
     }
 
     /// Peak RSS over the segments, kB.
@@ -274,41 +289,45 @@ pub fn locate(dirs: &[PathBuf]) -> Result<[Option<PathBuf>; 3], Error> {
     Ok(found)
 }
 
-/// The `Start` (first segment) of a record, read without joining.
-fn first_start<S, C>(path: &Path) -> Result<Start, Error>
-where
-    S: serde::de::DeserializeOwned,
-    C: serde::de::DeserializeOwned,
-{
-    let mut r =
-        RecordReader::<Record<S, C>>::open(path).map_err(|e| Error::BadInput(e.to_string()))?;
-    match r.next_record() {
-        Ok(Some(Record::Start(s))) => Ok(s),
-        _ => Err(Error::BadInput(format!(
-            "{}: the record does not begin with its node's start",
-            path.display()
-        ))),
+/// The first whole `Start` of a record, read without joining (a frame of any role's
+/// record decodes as a `Start` alike: the variant does not depend on the samples'
+/// type). A damaged first frame costs only itself: the next segment's start is taken,
+/// or none if the record holds no other.
+fn first_start(path: &Path) -> Result<Option<Start>, Error> {
+    type Any = Record<serde::de::IgnoredAny, serde::de::IgnoredAny>;
+    let mut r = RecordReader::<Any>::open(path).map_err(|e| Error::BadInput(e.to_string()))?;
+    loop {
+        match r.next_record() {
+            Ok(Some(Record::Start(s))) => return Ok(Some(s)),
+            Ok(Some(_)) => {}
+            Ok(None) => return Ok(None),
+            Err(e) => return Err(Error::BadInput(e.to_string())),
+        }
     }
 }
 
-/// The first `Start` of each node's record (None where a node left no record), read
-/// without joining: the master's holds the scenario, each one its clock domain.
+/// The first `Start` of each node's record (None where a node left no record or its
+/// starts were all lost), read without joining: the master's holds the scenario, each
+/// one its clock domain. A record whose start names another role than its file is
+/// refused: renamed or copied files would otherwise join as nothing.
 pub fn starts(found: &[Option<PathBuf>; 3]) -> Result<[Option<Start>; 3], Error> {
-    let read = |p: &Option<PathBuf>, k: usize| -> Result<Option<Start>, Error> {
-        let Some(p) = p else {
-            return Ok(None);
+    let mut out: [Option<Start>; 3] = [None, None, None];
+    for ((slot, path), role) in out.iter_mut().zip(found).zip(Role::ALL) {
+        let Some(path) = path else { continue };
+        let Some(start) = first_start(path)? else {
+            continue;
         };
-        Ok(Some(match k {
-            0 => first_start::<MasterSample, MasterTotals>(p)?,
-            1 => first_start::<Passage, EmulatorTotals>(p)?,
-            _ => first_start::<SlaveSample, SlaveTotals>(p)?,
-        }))
-    };
-    Ok([
-        read(&found[0], 0)?,
-        read(&found[1], 1)?,
-        read(&found[2], 2)?,
-    ])
+        if start.role != role.name() {
+            return Err(Error::BadInput(format!(
+                "{} holds the {}'s record, not the {role}'s: a renamed or misplaced file? \
+                 (each record is read under its role's name, {role}.rec)",
+                path.display(),
+                start.role
+            )));
+        }
+        *slot = Some(start);
+    }
+    Ok(out)
 }
 
 fn master_key(s: &MasterSample) -> Option<u64> {
@@ -490,18 +509,25 @@ pub fn join(
     }
 }
 
-/// Refuses records of different runs: the nodes of one run share the master's token.
+/// Refuses records of different runs: the nodes of one run share the master's token,
+/// and each record holds one run (a node appended into another run's record).
 fn check_one_run(logs: &Logs) -> Result<(), Error> {
     let Some(&token) = logs.master.runs.first() else {
         return Ok(());
     };
     for (role, runs, path) in [
+        (Role::Master, &logs.master.runs, &logs.master.path),
         (Role::Emulator, &logs.emulator.runs, &logs.emulator.path),
         (Role::Slave, &logs.slave.runs, &logs.slave.path),
     ] {
         if let Some(other) = runs.iter().find(|&&t| t != token) {
+            let whose = if role == Role::Master {
+                "a later segment of the same record".to_string()
+            } else {
+                format!("the master's record {}", logs.master.path.display())
+            };
             return Err(Error::BadInput(format!(
-                "the {role}'s record {} belongs to run {other:016x}, the master's to run {token:016x}: not one run",
+                "the {role}'s record {} holds run {other:016x}, {whose} run {token:016x}: not one run (a node started with --append into another run's record?)",
                 path.display()
             )));
         }

@@ -130,12 +130,17 @@ fn node_summary<C>(log: &NodeLog<C>) -> Option<NodeSummary>
 where
     C: Clone,
 {
-    let first = log.starts.first()?;
+    if log.segments() == 0 {
+        return None;
+    }
     Some(NodeSummary {
         record: log.path.display().to_string(),
         hosts: log.starts.iter().map(|s| s.host.clone()).collect(),
         pids: log.starts.iter().map(|s| s.pid).collect(),
-        link: first.link.clone(),
+        link: log
+            .starts
+            .first()
+            .map_or_else(|| "unknown (start lost)".into(), |s| s.link.clone()),
         peak_rss_kb: log.peak_rss_kb(),
         last_sample: log.last_sample,
         ended: log.ending(),
@@ -151,7 +156,20 @@ where
     })
 }
 
+/// The node's events, after what the report itself saw of its record: none at all, or
+/// a start lost to damage.
 fn events<C: Clone>(role: Role, log: &NodeLog<C>, out: &mut Vec<String>) -> u64 {
+    if log.path.as_os_str().is_empty() {
+        out.push(format!(
+            "{role}: no {role}.rec among the records reported: its columns are empty"
+        ));
+    } else if log.starts_lost > 0 {
+        out.push(format!(
+            "{role}: {} segment start(s) lost to damage in {}; the segment's records are kept",
+            log.starts_lost,
+            log.path.display()
+        ));
+    }
     out.extend(
         log.events
             .iter()
@@ -163,9 +181,9 @@ fn events<C: Clone>(role: Role, log: &NodeLog<C>, out: &mut Vec<String>) -> u64 
 /// True if node `k` (0 master, 1 emulator, 2 slave) left no record.
 fn logs_missing(logs: &Logs, k: usize) -> bool {
     match k {
-        0 => logs.master.starts.is_empty(),
-        1 => logs.emulator.starts.is_empty(),
-        _ => logs.slave.starts.is_empty(),
+        0 => logs.master.segments() == 0,
+        1 => logs.emulator.segments() == 0,
+        _ => logs.slave.segments() == 0,
     }
 }
 
@@ -295,21 +313,32 @@ fn summarise(
     }
 }
 
-/// The nodes' start records and the scenario the master recorded.
+/// The nodes' start records and the scenario the master recorded (or, where the
+/// master's start frame was damaged, the one another node recorded: every node records
+/// the scenario it runs).
 fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
     let found = join::locate(dirs)?;
-    let master = found[0]
-        .clone()
-        .ok_or_else(|| Error::BadInput("no master record".into()))?;
     let starts = join::starts(&found)?;
-    let text = starts[0]
-        .as_ref()
-        .map(|s| s.scenario_toml.clone())
-        .ok_or_else(|| Error::BadInput("no master record".into()))?;
-    let scenario = Scenario::from_toml_str(&text).map_err(|e| {
+    let Some((k, start)) = starts
+        .iter()
+        .enumerate()
+        .find_map(|(k, s)| s.as_ref().map(|s| (k, s)))
+    else {
+        let shown: Vec<String> = found
+            .iter()
+            .flatten()
+            .map(|p| p.display().to_string())
+            .collect();
+        return Err(Error::BadInput(format!(
+            "no whole start frame in {}: the scenario run is not known",
+            shown.join(", ")
+        )));
+    };
+    let from = found[k].clone().unwrap_or_default();
+    let scenario = Scenario::from_toml_str(&start.scenario_toml).map_err(|e| {
         Error::BadInput(format!(
             "{}: the scenario recorded is not valid: {e}",
-            master.display()
+            from.display()
         ))
     })?;
     Ok((starts, scenario))
@@ -410,9 +439,11 @@ fn analysis_for(starts: &[Option<Start>; 3]) -> Result<(&'static str, Analysis),
     let domains = starts
         .clone()
         .map(|s| s.map_or_else(String::new, |s| s.clock));
-    let start = starts[0]
-        .as_ref()
-        .ok_or_else(|| Error::BadInput("no master record".into()))?;
+    let start = starts
+        .iter()
+        .flatten()
+        .next()
+        .ok_or_else(|| Error::BadInput("no whole start frame in the records".into()))?;
     let runner = if start.link == IN_PROCESS {
         IN_PROCESS
     } else {
