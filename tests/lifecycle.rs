@@ -153,3 +153,105 @@ fn a_sweep_of_process_runs_tabulates_each() {
         assert_eq!(util::num(&s["samples_received"]), 300.0);
     }
 }
+
+/// Two runs into one --out: the second is refused (exit 2, naming the first) with
+/// nothing of the first touched, so does a report into it meanwhile; the first ends
+/// whole.
+#[test]
+fn an_output_folder_holds_one_run_at_a_time() {
+    let sb = Sandbox::new("oneout");
+    let scenario = sb.write("s.toml", &util::paper_1khz(3000));
+    let out = sb.path("out");
+    let mut first = sb.command(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--prefix",
+        &sb.prefix,
+        "-q",
+    ]);
+    let first = first
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("first run");
+    let rec = out.join("slave.rec");
+    util::wait_for(
+        "the first run's slave records",
+        Duration::from_secs(30),
+        || std::fs::metadata(&rec).is_ok_and(|m| m.len() > 10_000),
+    );
+    let before = std::fs::metadata(&rec).expect("record").len();
+    let second = sb.tactile(&[
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(second.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert!(
+        err.contains("tactile run (pid") && err.contains("is writing into it"),
+        "{err}"
+    );
+    let report = sb.tactile(&["report", out.to_str().expect("utf-8")]);
+    assert_eq!(report.status.code(), Some(2), "{report:?}");
+    assert!(std::fs::metadata(&rec).expect("record kept").len() >= before);
+    let done = util::wait_within(first, Duration::from_secs(60));
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let s = sb.json("out", "summary.json");
+    assert_eq!(s["samples_sent"], 3000, "{s}");
+    assert!(!out.join(".tactile.lock").exists());
+    let names: Vec<String> = std::fs::read_dir(&out)
+        .expect("folder")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".partial"))
+        .collect();
+    assert!(names.is_empty(), "{names:?}");
+}
+
+/// A slave frozen by SIGSTOP: its record stands still, the launcher names it frozen
+/// after the stall limit, kills it, and the run is failed (exit 1), not a completed
+/// run with most samples lost.
+#[test]
+fn a_frozen_node_fails_the_run_after_the_stall_limit() {
+    let sb = Sandbox::new("frozen");
+    let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
+    let out = sb.path("run");
+    let child = sb
+        .command(&["run", scenario.to_str().expect("utf-8"), "--out"])
+        .arg(&out)
+        .args(["--prefix", &sb.prefix, "-q", "--max-restarts", "0"])
+        .args(["--stall-s", "1.5"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start");
+    wait_for("the slave records", Duration::from_secs(20), || {
+        std::fs::metadata(out.join("slave.rec")).is_ok_and(|m| m.len() > 50_000)
+    });
+    let slave = util::pid_of(&sb.prefix, "slave").expect("slave");
+    let pid = rustix::process::Pid::from_raw(slave).expect("pid");
+    rustix::process::kill_process(pid, rustix::process::Signal::STOP).expect("SIGSTOP");
+    let o = util::wait_within(child, util::LIMIT);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["failed"], true);
+    let events = s["events"].to_string();
+    assert!(
+        events.contains("slave made no progress for 1.5 s (its record stopped growing; the process is stopped (SIGSTOP"),
+        "{events}"
+    );
+    assert!(
+        util::num(&s["samples_sent"]) < 20_000.0,
+        "stopped early: {s}"
+    );
+    sb.assert_no_leftover_processes();
+}

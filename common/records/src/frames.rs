@@ -11,7 +11,7 @@
 
 use serde::de::DeserializeOwned;
 use serde::Serialize;
-use std::io::{BufReader, Read, Write};
+use std::io::{BufReader, Read, Seek, Write};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -98,20 +98,38 @@ impl<T: Serialize> RecordWriter<T> {
     /// restarted node of the same run) after trimming a torn tail; a file that is not
     /// a record of this format is never touched.
     pub fn create(path: &Path, append: bool) -> std::io::Result<Self> {
+        // Locked before anything is cut: a second writer of this record (two nodes
+        // of one role given one --out) is refused with the first's record intact.
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(path)?;
+        rustix::fs::flock(&file, rustix::fs::FlockOperation::NonBlockingLockExclusive).map_err(
+            |_| {
+                std::io::Error::new(
+                    std::io::ErrorKind::WouldBlock,
+                    "another process is writing this record (a node of the same role with the same --out)",
+                )
+            },
+        )?;
         // A file killed before its magic was whole holds nothing: started afresh.
-        let started = std::fs::read(path)
-            .map(|b| b.len() >= MAGIC.len() || !MAGIC.starts_with(&b))
-            .unwrap_or(false);
-        let file = if append && path.exists() && started {
-            let end = whole_end(path)?;
-            let f = std::fs::OpenOptions::new().append(true).open(path)?;
-            f.set_len(end)?;
-            f
-        } else {
-            let mut f = std::fs::File::create(path)?;
-            f.write_all(&MAGIC)?;
-            f
+        let len = file.metadata()?.len();
+        let started = len >= MAGIC.len() as u64 || {
+            let mut head = Vec::new();
+            (&file).read_to_end(&mut head)?;
+            !MAGIC.starts_with(&head)
         };
+        if append && len > 0 && started {
+            let end = whole_end(path)?;
+            file.set_len(end)?;
+            file.seek(std::io::SeekFrom::End(0))?;
+        } else {
+            file.set_len(0)?;
+            file.rewind()?;
+            file.write_all(&MAGIC)?;
+        }
         Ok(RecordWriter {
             file,
             buf: Vec::with_capacity(512),

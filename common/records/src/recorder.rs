@@ -41,6 +41,8 @@ pub struct Recorder<S, C> {
     /// With `--append`: where the existing record ended and the runs it holds, so a
     /// node that turns out to have joined another run takes its segment back out.
     appended: Option<(u64, Vec<u64>)>,
+    /// Set once the segment was taken back out: nothing more is written to the file.
+    withdrawn: bool,
 }
 
 /// Counters are written this often, ns.
@@ -66,10 +68,14 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
             writer,
             next_counters_ns: now_ns() + COUNTERS_EVERY_NS,
             appended,
+            withdrawn: false,
         })
     }
 
     fn put(&mut self, r: &Record<S, C>) -> Result<(), WriteError> {
+        if self.withdrawn {
+            return Ok(());
+        }
         self.writer.write(r).map_err(|source| WriteError {
             action: "writing",
             path: self.writer.path().display().to_string(),
@@ -106,6 +112,7 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
                 let shown: Vec<String> = runs.iter().map(|t| format!("{t:016x}")).collect();
                 let path = self.writer.path().display().to_string();
                 let undo = self.writer.truncate(*end);
+                self.withdrawn = true;
                 return Err(WriteError {
                     action: "appending to",
                     path,
@@ -181,9 +188,29 @@ mod tests {
 
     fn segment(dir: &Path, append: bool, run: u64) -> Result<(), WriteError> {
         let mut r = Rec::open(dir, Role::Slave, append)?;
-        r.run(run)?;
+        let joined = r.run(run);
+        // A node that failed still ends its segment: nothing of it may reach the file.
         r.sample(run)?;
-        r.stop(0, 0, "completed")
+        r.stop(0, 0, "failed")?;
+        joined
+    }
+
+    #[test]
+    fn a_second_writer_of_a_record_is_refused_and_cuts_nothing() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut first = Rec::open(dir.path(), Role::Master, false).expect("first");
+        first.run(3).expect("run");
+        let path = record_path(dir.path(), Role::Master);
+        let before = std::fs::read(&path).expect("record");
+        let e = Rec::open(dir.path(), Role::Master, false).expect_err("second");
+        assert!(
+            e.to_string()
+                .contains("another process is writing this record"),
+            "{e}"
+        );
+        assert_eq!(std::fs::read(&path).expect("record"), before);
+        drop(first);
+        Rec::open(dir.path(), Role::Master, false).expect("free again");
     }
 
     #[test]

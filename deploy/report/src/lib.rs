@@ -4,13 +4,14 @@
 //! [`analysis`] and [`metrics`] fold the rows into latency histograms and the loop's
 //! figures; [`summary`] says it in JSON and [`text`] on the terminal; [`plots`] draws it; [`run_mcap`]
 //! writes it as ROS 2 messages in MCAP ([`mcap`]) for the robotics viewers; [`write`]
-//! puts the report's files in a folder; [`sweep`] tabulates many runs' summaries.
+//! puts the report's files in a folder ([`out`]: one process at a time, each file whole); [`sweep`] tabulates many runs' summaries.
 
 pub mod analysis;
 pub mod error;
 pub mod join;
 pub mod mcap;
 pub mod metrics;
+pub mod out;
 pub mod plots;
 pub mod run_mcap;
 pub mod summary;

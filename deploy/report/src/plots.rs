@@ -139,37 +139,44 @@ impl Series {
 
     /// Writes `positions.svg`, `forces.svg` and `passivity.svg` into `out`.
     pub fn write(&self, out: &Path) -> PlotResult {
-        timeplot::time_series(
-            &out.join("positions.svg"),
-            "Master handle and slave tool position",
-            "position (m)",
-            &pairs(&self.handle, &self.tool, "master handle", "slave tool", ""),
-        )?;
-        timeplot::time_series(
-            &out.join("forces.svg"),
-            "Contact force (slave) and feedback force (master)",
-            "force (N)",
-            &pairs(&self.felt, &self.force, "felt", "slave h(n)", "F"),
-        )?;
+        whole_svg(&out.join("positions.svg"), |p| {
+            timeplot::time_series(
+                p,
+                "Master handle and slave tool position",
+                "position (m)",
+                &pairs(&self.handle, &self.tool, "master handle", "slave tool", ""),
+            )
+        })?;
+        whole_svg(&out.join("forces.svg"), |p| {
+            timeplot::time_series(
+                p,
+                "Contact force (slave) and feedback force (master)",
+                "force (N)",
+                &pairs(&self.felt, &self.force, "felt", "slave h(n)", "F"),
+            )
+        })?;
         // No line here is another's reference: all are drawn plain.
         let grey = RGBColor(90, 90, 90);
         let plain =
             |label: &str, colour, t: &Thinned| (label.to_string(), colour, false, t.points());
-        timeplot::time_series(
-            &out.join("passivity.svg"),
-            "Channel energy (below zero: the channel made energy), observers, dissipation",
-            "energy (mJ)",
-            &[
-                plain("channel energy", COLOURS[0], &self.channel),
-                plain(
-                    "master observer (lowest axis)",
-                    COLOURS[1],
-                    &self.observer_m,
-                ),
-                plain("slave observer (lowest axis)", COLOURS[2], &self.observer_s),
-                plain("dissipated by the control", grey, &self.dissipated),
-            ],
-        )
+        let lines = [
+            plain("channel energy", COLOURS[0], &self.channel),
+            plain(
+                "master observer (lowest axis)",
+                COLOURS[1],
+                &self.observer_m,
+            ),
+            plain("slave observer (lowest axis)", COLOURS[2], &self.observer_s),
+            plain("dissipated by the control", grey, &self.dissipated),
+        ];
+        whole_svg(&out.join("passivity.svg"), |p| {
+            timeplot::time_series(
+                p,
+                "Channel energy (below zero: the channel made energy), observers, dissipation",
+                "energy (mJ)",
+                &lines,
+            )
+        })
     }
 }
 
@@ -182,6 +189,13 @@ fn pairs(a: &[Thinned; 3], b: &[Thinned; 3], la: &str, lb: &str, pre: &str) -> V
         v.push((name(lb), COLOURS[i], false, b[i].points()));
     }
     v
+}
+
+/// Draws `path` by `draw` under its temporary name, renamed when whole (a report cut
+/// short leaves the old plot or none, never half of one).
+pub fn whole_svg(path: &Path, draw: impl FnOnce(&Path) -> PlotResult) -> PlotResult {
+    crate::out::whole(path, |tmp| draw(tmp).map_err(std::io::Error::other))
+        .map_err(|e| e.to_string())
 }
 
 /// Histogram of the system overhead per round trip, in microseconds.

@@ -47,13 +47,9 @@ pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<(), St
             );
             series.push((label, LOOP_COLOURS[line % LOOP_COLOURS.len()], pts));
         }
-        plot(
-            &out.join(format!("sweep-{name}.svg")),
-            name,
-            &first.key,
-            &x_desc,
-            &series,
-        )?;
+        crate::plots::whole_svg(&out.join(format!("sweep-{name}.svg")), |p| {
+            plot(p, name, &first.key, &x_desc, &series)
+        })?;
     }
     Ok(())
 }

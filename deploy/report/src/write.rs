@@ -62,20 +62,26 @@ impl Launch {
 }
 
 pub fn write_file(path: &Path, text: &str) -> Result<(), Error> {
-    std::fs::write(path, text).map_err(Error::io(format!("writing {}", path.display())))
+    crate::out::write_file(path, text)
 }
 
-/// Makes the output folder `out`; a path that exists and is not a folder is bad input
-/// (a typo naming a file must not become a confusing I/O failure).
-pub fn make_out_dir(out: &Path) -> Result<(), Error> {
-    if out.exists() && !out.is_dir() {
-        return Err(Error::BadInput(format!(
-            "--out {}: is a file, not a folder",
-            out.display()
-        )));
+/// Removes `path` if it is there.
+fn remove_if_there(path: &Path) -> Result<(), Error> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(Error::io(format!("removing {}", path.display()))(e))
+        }
+        _ => Ok(()),
     }
-    std::fs::create_dir_all(out).map_err(Error::io(format!("creating {}", out.display())))
 }
+
+/// Removes what a failed report had started (its temporary files).
+fn discard(out: &Path) {
+    run_mcap::discard(out);
+    let _ = std::fs::remove_file(crate::out::partial(&out.join("trace.csv")));
+}
+
+pub use crate::out::make_out_dir;
 
 /// Writes `value` as pretty JSON to `path`.
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), Error> {
@@ -367,7 +373,7 @@ impl Streams {
                 t0: None,
             });
         }
-        let f = std::fs::File::create(&trace_path)
+        let f = std::fs::File::create(crate::out::partial(&trace_path))
             .map_err(Error::io(format!("writing {}", trace_path.display())))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
         writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
@@ -398,6 +404,9 @@ impl Streams {
     fn finish(self, out: &Path) -> Result<(), Error> {
         if let Some(mut w) = self.trace {
             w.flush().map_err(Error::io("writing trace.csv"))?;
+            let path = out.join("trace.csv");
+            std::fs::rename(crate::out::partial(&path), &path)
+                .map_err(Error::io("writing trace.csv"))?;
         }
         if let Some(r) = self.recording {
             run_mcap::commit(r, out).map_err(Error::io("writing run.mcap"))?;
@@ -417,18 +426,22 @@ fn figures(out: &Path, analysis: &Analysis, series: &Series) -> Result<(), Error
     };
     plot(
         "latency",
-        plots::overhead_histogram(&analysis.overhead, &out.join("latency.svg")),
+        plots::whole_svg(&out.join("latency.svg"), |p| {
+            plots::overhead_histogram(&analysis.overhead, p)
+        }),
     )?;
     plot(
         "percentiles",
-        plots::percentile_plot(
-            &out.join("percentiles.svg"),
-            "Latency by percentile",
-            &[
-                ("round trip".into(), plots::read_hgrm(&round_trip)),
-                ("system overhead".into(), plots::read_hgrm(&overhead)),
-            ],
-        ),
+        plots::whole_svg(&out.join("percentiles.svg"), |p| {
+            plots::percentile_plot(
+                p,
+                "Latency by percentile",
+                &[
+                    ("round trip".into(), plots::read_hgrm(&round_trip)),
+                    ("system overhead".into(), plots::read_hgrm(&overhead)),
+                ],
+            )
+        }),
     )?;
     plot("positions and forces", series.write(out))
 }
@@ -458,6 +471,9 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     let (starts, scenario) = recorded(dirs)?;
     let (runner, mut analysis) = analysis_for(&starts)?;
     make_out_dir(out)?;
+    // Written last: until then the folder holds no summary, so no older one sits beside
+    // this report's files if it is cut short.
+    remove_if_there(&out.join("summary.json"))?;
     let t_s = scenario.t_s();
     let mut series = Series::default();
     let mut streams = Streams::create(out, &scenario, launch.no_trace)?;
@@ -480,7 +496,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         streams.add(row)?;
         Ok(ControlFlow::Continue(()))
     })
-    .inspect_err(|_| run_mcap::discard(out))?;
+    .inspect_err(|_| discard(out))?;
     streams.finish(out)?;
     analysis.finish();
     figures(out, &analysis, &series)?;

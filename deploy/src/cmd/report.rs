@@ -37,6 +37,8 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
             .and_then(Path::parent)
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
     };
+    let holder = format!("tactile report (pid {})", std::process::id());
+    let _held = tactile_report::out::take(&out, &holder)?;
     if args.mcap_only {
         let samples = write_mcap(&args.dirs, &out)?;
         crate::outln!(

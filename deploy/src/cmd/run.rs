@@ -30,7 +30,7 @@ pub struct RunArgs {
     /// refused with it).
     #[arg(long, conflicts_with_all = [
         "prefix", "spin_us", "wake_early_us", "max_restarts", "link", "udp", "no_pin",
-        "sched", "idle",
+        "sched", "idle", "stall_s",
     ])]
     pub in_process: bool,
     /// No progress line.
@@ -39,6 +39,12 @@ pub struct RunArgs {
     /// Times the emulator or the slave is restarted if it dies mid-run.
     #[arg(long, default_value_t = 3)]
     pub max_restarts: u32,
+    /// Seconds a node's record may stand still mid-run before the node counts as
+    /// frozen (SIGSTOP, a debugger, a hang): it is killed, restarted if allowed, and
+    /// the run is failed. 0: never. A running loop writes its record at least once a
+    /// second.
+    #[arg(long, default_value_t = 5.0, value_parser = stall_parser)]
+    pub stall_s: f64,
     /// What carries the samples between the nodes on this host: iceoryx2 (shared
     /// memory), udp (loopback datagrams, the reference) or zenoh (loopback TCP; across
     /// hosts, start the nodes by hand, see docs/03-across-hosts.md).
@@ -52,6 +58,17 @@ pub struct RunArgs {
     /// else is reported.
     #[arg(long)]
     pub no_trace: bool,
+}
+
+/// A stall limit: 0 (never) or 1.5 to 3600 seconds (a running loop may go a second
+/// without writing its record).
+fn stall_parser(text: &str) -> Result<f64, String> {
+    let s: f64 = text.parse().map_err(|e| format!("{e}"))?;
+    if s == 0.0 || (1.5..=3600.0).contains(&s) {
+        Ok(s)
+    } else {
+        Err("takes 0 (never) or 1.5 to 3600 seconds".into())
+    }
 }
 
 /// `tactile run`.
@@ -70,6 +87,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
             progress: !args.quiet,
             max_restarts: args.max_restarts,
             no_trace: args.no_trace,
+            stall: (args.stall_s > 0.0).then(|| std::time::Duration::from_secs_f64(args.stall_s)),
             ..args.nodes.supervision(link, "")
         };
         launch::run_processes(&loaded, &args.out, &sup)?

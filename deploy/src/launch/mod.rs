@@ -8,6 +8,7 @@ pub mod nodes;
 pub mod pki;
 pub mod scenario;
 pub mod sim;
+pub mod stall;
 pub mod supervise;
 
 pub use links::Links;
@@ -72,6 +73,7 @@ impl NodeOptions {
             sched: self.sched,
             idle: self.idle,
             no_trace: false,
+            stall: Some(stall::DEFAULT_STALL),
         }
     }
 }
@@ -102,6 +104,9 @@ pub struct Supervision {
     pub idle: tactile_runtime::sched::IdleMode,
     /// Write no trace.csv and no run.mcap.
     pub no_trace: bool,
+    /// How long a node's record may stand still before the node counts as frozen
+    /// (None: never).
+    pub stall: Option<Duration>,
 }
 
 /// How `tactile sweep --processes` runs each combination: as `tactile run` does by
@@ -119,6 +124,7 @@ pub fn sweep_supervision(no_trace: bool) -> Supervision {
         sched: tactile_runtime::sched::Policy::Fifo,
         idle: tactile_runtime::sched::IdleMode::Halt,
         no_trace,
+        stall: Some(stall::DEFAULT_STALL),
     }
 }
 

@@ -110,9 +110,18 @@ pub fn output_files(out: &Path) -> Vec<PathBuf> {
 /// Makes `out` ready for a new run: refuses if a file the run would write is one of
 /// its inputs, then removes the files of an earlier run, so the folder never mixes
 /// two runs' files, and copies the inputs in (see [`bundle`]). Returns the scenario to
-/// run: the one that reads the copies.
-pub fn prepare_out(out: &Path, loaded: &Loaded) -> Result<Loaded, Error> {
-    tactile_report::write::make_out_dir(out)?;
+/// run (the one that reads the copies) and the folder's lock, held for the run and its
+/// report: a second run or report into the folder is refused meanwhile, nothing touched.
+pub fn prepare_out(
+    out: &Path,
+    loaded: &Loaded,
+) -> Result<(Loaded, tactile_report::out::OutLock), Error> {
+    let holder = format!(
+        "tactile run (pid {}, scenario {:?})",
+        std::process::id(),
+        loaded.scenario.name
+    );
+    let held = tactile_report::out::take(out, &holder)?;
     let outputs = output_files(out);
     let copies = out.join(INPUTS);
     for i in &loaded.inputs {
@@ -144,7 +153,7 @@ pub fn prepare_out(out: &Path, loaded: &Loaded) -> Result<Loaded, Error> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
         Err(e) => return Err(Error::io(format!("removing {}", copies.display()))(e)),
     }
-    bundle(out, loaded)
+    Ok((bundle(out, loaded)?, held))
 }
 
 /// The folder of a run's output that holds copies of its input files.

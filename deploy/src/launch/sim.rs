@@ -130,7 +130,7 @@ pub fn run_in_process(
             "an in-process run simulates both devices and has no live view: a ros2 backend or ros.live needs the node programs (tactile run without --in-process)".into(),
         ));
     }
-    let bundled = super::prepare_out(out, loaded)?;
+    let (bundled, _held) = super::prepare_out(out, loaded)?;
     let completed = simulate(&bundled.scenario, &bundled.base_dir, out)?;
     let launch = tactile_report::write::Launch {
         no_trace,

@@ -3,6 +3,7 @@
 //! writes the report from their records.
 
 use super::links::node_command;
+use super::stall::{self, Progress};
 use super::{nodes, prepare_out, survivor_grace, two_cpus, Loaded, Supervision};
 use crate::error::Error;
 use signal_hook::consts::{SIGINT, SIGTERM};
@@ -13,6 +14,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_messages::Role;
+use tactile_records::record_path;
 use tactile_report::summary::Summary;
 use tactile_report::write::{write_report, Launch};
 use tactile_runtime::exit::{EXIT_BAD_INPUT, EXIT_INTERRUPTED};
@@ -55,6 +57,8 @@ struct Proc {
     restarts: u32,
     /// Set while a dead process waits out the restart backoff.
     restart_at: Option<Instant>,
+    /// How its record grows: a node whose record stands still is frozen.
+    progress: Progress,
 }
 
 impl Proc {
@@ -149,6 +153,7 @@ impl<'a> Supervisor<'a> {
                     status: None,
                     restarts: 0,
                     restart_at: None,
+                    progress: Progress::new(record_path(out, role)),
                 }),
                 Err(e) => {
                     procs
@@ -212,6 +217,7 @@ impl<'a> Supervisor<'a> {
                 let role = self.procs[k].role;
                 self.procs[k].restart_at = None;
                 self.procs[k].child = (self.spawn)(role, true)?;
+                self.procs[k].progress = Progress::new(record_path(self.out, role));
                 let at = self.elapsed_s();
                 self.watch
                     .events
@@ -294,8 +300,35 @@ impl<'a> Supervisor<'a> {
         true
     }
 
+    /// A node whose record stood still past the stall limit is frozen (SIGSTOP, a
+    /// debugger, a hang): killed, its death then handled like any other (restarted if
+    /// allowed, else the run stops), and the run counts as failed.
+    fn kill_frozen(&mut self) {
+        let Some(limit) = self.sup.stall else { return };
+        let now = Instant::now();
+        let at = self.elapsed_s();
+        for p in &mut self.procs {
+            if p.status.is_some() || p.restart_at.is_some() {
+                continue;
+            }
+            if p.progress.still_for(now).is_none_or(|still| still < limit) {
+                continue;
+            }
+            let state = stall::state_of(p.child.id());
+            self.watch.events.push(format!(
+                "{} made no progress for {:.1} s (its record stopped growing; the process is {state}): frozen, killed after {at:.2} s",
+                p.role,
+                limit.as_secs_f64()
+            ));
+            self.watch.failed = true;
+            let _ = p.child.kill();
+            p.progress = Progress::new(record_path(self.out, p.role));
+        }
+    }
+
     /// One look at every process.
     fn poll(&mut self) -> Result<(), Error> {
+        self.kill_frozen();
         self.restart_due()?;
         let mut stop_master = false;
         for k in 0..self.procs.len() {
@@ -407,7 +440,7 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     let _lock =
         tactile_runtime::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
     let dir = nodes::node_dir()?;
-    let bundled = prepare_out(out, loaded)?;
+    let (bundled, _held) = prepare_out(out, loaded)?;
     // The nodes run the scenario as written here, reading the copies of its inputs
     // (absolute paths); the report's scenario.toml refers to them relatively.
     let scenario_file = out.join("scenario.toml");

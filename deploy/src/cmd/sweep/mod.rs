@@ -167,7 +167,8 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
     // input (exit 2) with nothing run.
     let work = exec::plan(scenario, &axes, &combos, &mine, args)?;
     warn_once(&work);
-    tactile_report::write::make_out_dir(&args.out)?;
+    let holder = format!("tactile sweep (pid {})", std::process::id());
+    let _held = tactile_report::out::take(&args.out, &holder)?;
     table::check_resume(&args.out, &spec, args.resume)?;
     table::write_spec(&args.out, &spec)?;
     let done = exec::run_all(&work, jobs, args)?;

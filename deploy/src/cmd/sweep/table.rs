@@ -13,7 +13,7 @@ use tactile_report::sweep_plots::{sweep_plots, Point};
 pub type Result3 = (usize, usize, Vec<Option<f64>>);
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
-    std::fs::write(path, text).map_err(Error::io(format!("writing {}", path.display())))
+    Ok(tactile_report::out::write_file(path, text)?)
 }
 
 /// Records the sweep in `out/sweep.json`.
@@ -151,7 +151,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
     let first = slices_of_one_sweep(dirs)?;
     let axes = parse_axes(&first.sets)?;
     let (results, missing) = gather(dirs, &first)?;
-    tactile_report::write::make_out_dir(out)?;
+    let holder = format!("tactile sweep --merge (pid {})", std::process::id());
+    let _held = tactile_report::out::take(out, &holder)?;
     write_spec(
         out,
         &Spec {
