@@ -159,6 +159,9 @@ fn parallel_sharded_and_resumed_sweeps_give_the_same_table() {
     sweep(&sb, "one", &["--jobs", "1"]);
     let table = read(&sb, "one", "sweep.csv");
     assert_eq!(table.lines().count(), 1 + 6);
+    // The last column says whether each run failed: none did.
+    assert!(table.lines().next().is_some_and(|h| h.ends_with(",failed")));
+    assert!(table.lines().skip(1).all(|r| r.ends_with(",0")), "{table}");
     sweep(&sb, "two", &["--jobs", "2"]);
     assert_eq!(
         read(&sb, "two", "sweep.csv"),

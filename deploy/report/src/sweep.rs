@@ -6,8 +6,11 @@
 use tactile_scenario::overrides::{split_values, Set};
 
 /// The columns of `sweep.csv` after the swept keys: a name, and where the value is in
-/// a run's `summary.json` (a JSON pointer).
-pub const METRICS: [(&str, &str); 22] = [
+/// a run's `summary.json` (a JSON pointer). `failed` is 1 for a run that failed (a
+/// node died or froze, a wait ran out) and 0 otherwise: a failed run's other values
+/// are what it ran before it failed, so a table never passes one off as whole (with
+/// `--seeds`, `failed_mean` is the share of the seeds' runs that failed).
+pub const METRICS: [(&str, &str); 23] = [
     ("samples_sent", "/samples_sent"),
     ("samples_lost", "/samples_lost"),
     ("deadline_misses", "/deadline_misses"),
@@ -30,7 +33,11 @@ pub const METRICS: [(&str, &str); 22] = [
     ("drift_max_m", "/passivity/drift_max_m"),
     ("packets_forward", "/packets/forward"),
     ("packets_backward", "/packets/backward"),
+    ("failed", "/failed"),
 ];
+
+/// The metric that says whether a run failed, not how it ran: never plotted.
+pub const FAILED: &str = "failed";
 
 /// One swept key and its values, each already a `--set`.
 #[derive(Debug, Clone)]
@@ -93,7 +100,11 @@ pub fn describe(axes: &[Axis], combo: &[usize]) -> String {
 pub fn values(summary: &serde_json::Value) -> Vec<Option<f64>> {
     METRICS
         .iter()
-        .map(|(_, p)| summary.pointer(p).and_then(serde_json::Value::as_f64))
+        .map(|(_, p)| {
+            let v = summary.pointer(p)?;
+            v.as_f64()
+                .or_else(|| v.as_bool().map(|b| f64::from(u8::from(b))))
+        })
         .collect()
 }
 
@@ -232,6 +243,27 @@ fn csv_field(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_failed_run_is_one_in_its_column_and_a_whole_run_zero() {
+        let col = METRICS
+            .iter()
+            .position(|(n, _)| *n == FAILED)
+            .expect("column");
+        let failed = serde_json::json!({"failed": true, "samples_sent": 5});
+        let whole = serde_json::json!({"failed": false, "samples_sent": 5});
+        assert_eq!(values(&failed)[col], Some(1.0));
+        assert_eq!(values(&whole)[col], Some(0.0));
+        assert_eq!(values(&failed)[0], Some(5.0));
+        // Over seeds, the share that failed.
+        let runs = [
+            values(&failed),
+            values(&whole),
+            values(&whole),
+            values(&whole),
+        ];
+        assert_eq!(stats(&runs)[col].0, Some(0.25));
+    }
 
     #[test]
     fn combinations_cover_every_pair_once() {

@@ -4,7 +4,7 @@
 //! elements' mean on a numeric axis; words at their positions 0, 1, 2, ...
 
 use crate::plots::{tick, LOOP_COLOURS};
-use crate::sweep::{numeric, Axis, METRICS};
+use crate::sweep::{numeric, Axis, FAILED, METRICS};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -30,6 +30,9 @@ pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<(), St
     };
     let lines = axes.get(1).map_or(1, |a| a.values.len());
     for (m, (name, _)) in METRICS.iter().enumerate() {
+        if *name == FAILED {
+            continue;
+        }
         let mut series = Vec::new();
         for line in 0..lines {
             let mut pts: Vec<(f64, f64, f64)> = points
