@@ -216,8 +216,7 @@ fn an_output_folder_holds_one_run_at_a_time() {
     assert!(names.is_empty(), "{names:?}");
 }
 
-/// A slave frozen by SIGSTOP: its record stands still, the launcher names it frozen
-/// after the stall limit, kills it, and the run is failed (exit 1), not a completed
+/// A slave frozen by SIGSTOP: the launcher names it frozen after the stall limit, kills it, and the run is failed (exit 1), not a completed
 /// run with most samples lost.
 #[test]
 fn a_frozen_node_fails_the_run_after_the_stall_limit() {
@@ -246,7 +245,7 @@ fn a_frozen_node_fails_the_run_after_the_stall_limit() {
     assert_eq!(s["failed"], true);
     let events = s["events"].to_string();
     assert!(
-        events.contains("slave made no progress for 1.5 s (its record stopped growing; the process is stopped (SIGSTOP"),
+        events.contains("slave made no progress for 1.5 s (the process is stopped (SIGSTOP"),
         "{events}"
     );
     assert!(

@@ -551,6 +551,17 @@ fn ros_settings_are_checked_and_need_the_node_programs() {
         "slave.ros2.map.sign[1]",
     );
     sb.assert_bad_set(paper, "ros.domain_id=300", "ros.domain_id");
+    // Endpoints that cannot connect anywhere are refused before anything starts.
+    sb.assert_bad_set(
+        paper,
+        "ros.connect=[\"tcp/127.0.0.1:99999\"]",
+        "field `ros.connect[0]`: \"tcp/127.0.0.1:99999\": port 99999 is outside 1..=65535",
+    );
+    sb.assert_bad_set(
+        paper,
+        "ros.connect=[\"tcp/999.1.1.1:7447\"]",
+        "999.1.1.1 is not an IP address",
+    );
     sb.assert_bad_set(paper, "ros.live.rate_hz=500", "ros.live.rate_hz");
     sb.assert_bad_set(
         paper,
@@ -780,4 +791,39 @@ fn a_device_whose_messages_are_all_dropped_says_why() {
         let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
         let _ = util::wait_within(child, util::LIMIT);
     }
+}
+
+/// A master whose ROS 2 session reaches nothing (no router at the endpoint): its wait
+/// and its error say no connection was made, not that the driver is missing.
+#[test]
+fn a_session_that_reaches_no_endpoint_says_so() {
+    let sb = Sandbox::new("ros2-noreach");
+    let ports = [free_port(), free_port()];
+    let scenario = sb.write(
+        "n.toml",
+        &format!(
+            "{}{}",
+            looped("realtime", 200),
+            ros_tables(16, ports, false, true)
+        ),
+    );
+    let master = util::start_node(
+        &sb,
+        "master",
+        &scenario,
+        "m",
+        &["--startup-timeout-s", "2.5"],
+    );
+    let (code, err) = util::finish(master);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("the ROS 2 session reached none of ros.connect")
+            && err.contains(&format!("tcp/127.0.0.1:{}", ports[0])),
+        "{err}"
+    );
+    let log = std::fs::read_to_string(sb.path("m").join("master.log")).expect("log");
+    assert!(
+        log.contains("cannot come yet: the ROS 2 session reached none"),
+        "{log}"
+    );
 }

@@ -34,6 +34,11 @@ pub trait Peripheral {
     fn take_reject(&self) -> Option<Reject>;
     /// Where it is read from, for messages.
     fn describe(&self) -> String;
+    /// Why nothing can come yet, if the way to it is not even open (the ROS 2 session
+    /// reached no router or peer); None once it is, or where there is no such way.
+    fn unreached(&self) -> Option<String> {
+        None
+    }
 }
 
 /// A real master device, as the master's loop uses it: encoders in, force out.

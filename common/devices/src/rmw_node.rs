@@ -60,6 +60,8 @@ pub fn session_config(cfg: &RosConfig) -> Result<zenoh::Config, RosError> {
 /// One node on ROS 2: a Zenoh session and its node token.
 pub struct RosNode {
     session: zenoh::Session,
+    /// The `[ros]` endpoints it connects to, for messages.
+    connect: Vec<String>,
     id: NodeId,
     next_id: AtomicU32,
     _token: LivelinessToken,
@@ -93,9 +95,28 @@ impl RosNode {
             .map_err(|e| err("declaring the ROS 2 node's liveliness token", e))?;
         Ok(RosNode {
             session,
+            connect: cfg.connect.clone(),
             id,
             next_id: AtomicU32::new(1),
             _token: token,
+        })
+    }
+
+    /// Whether the session reached anyone (a router or a peer); if not, what to check:
+    /// a wait for a device that never began to connect says so instead of blaming the
+    /// driver.
+    pub fn unreached(&self) -> Option<String> {
+        let info = self.session.info();
+        if info.routers_zid().wait().next().is_some() || info.peers_zid().wait().next().is_some() {
+            return None;
+        }
+        Some(if self.connect.is_empty() {
+            "the ROS 2 session connects to no endpoint (ros.connect is empty) and no peer reached it".into()
+        } else {
+            format!(
+                "the ROS 2 session reached none of ros.connect {:?}: is the router running there (ros2 run rmw_zenoh_cpp rmw_zenohd), are the address and port right, does a firewall let it through?",
+                self.connect
+            )
         })
     }
 

@@ -32,7 +32,7 @@ fn joints_in(
 #[derive(Debug)]
 pub struct RosHapticDevice {
     /// The session everything below lives on, kept open while the device is.
-    _node: Arc<RosNode>,
+    node: Arc<RosNode>,
     joints: Arc<Inbox<[f64; 3]>>,
     _sub: RosSubscription,
     force: RosPublisher,
@@ -57,7 +57,7 @@ impl RosHapticDevice {
         let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
         let (joints, sub) = joints_in(node, &cfg.joint_states, map)?;
         Ok(RosHapticDevice {
-            _node: Arc::clone(node),
+            node: Arc::clone(node),
             joints,
             _sub: sub,
             force: node.publisher(&cfg.force_topic, WrenchStamped::TYPE)?,
@@ -115,6 +115,10 @@ impl Peripheral for RosHapticDevice {
     fn describe(&self) -> String {
         format!("the device on {}", self.topic)
     }
+
+    fn unreached(&self) -> Option<String> {
+        self.node.unreached()
+    }
 }
 
 impl HapticDevice for RosHapticDevice {
@@ -158,7 +162,7 @@ impl HapticDevice for RosHapticDevice {
 #[derive(Debug)]
 pub struct RosRobot {
     /// The session everything below lives on, kept open while the robot is.
-    _node: Arc<RosNode>,
+    node: Arc<RosNode>,
     joints: Arc<Inbox<[f64; 3]>>,
     wrench: Option<Arc<Inbox<[f64; 3]>>>,
     _subs: Vec<RosSubscription>,
@@ -192,7 +196,7 @@ impl RosRobot {
             Some(inbox)
         };
         Ok(RosRobot {
-            _node: Arc::clone(node),
+            node: Arc::clone(node),
             joints,
             wrench,
             _subs: subs,
@@ -234,6 +238,10 @@ impl Peripheral for RosRobot {
 
     fn describe(&self) -> String {
         format!("the robot on {}", self.topic)
+    }
+
+    fn unreached(&self) -> Option<String> {
+        self.node.unreached()
     }
 }
 

@@ -39,10 +39,9 @@ pub struct RunArgs {
     /// Times the emulator or the slave is restarted if it dies mid-run.
     #[arg(long, default_value_t = 3)]
     pub max_restarts: u32,
-    /// Seconds a node's record may stand still mid-run before the node counts as
-    /// frozen (SIGSTOP, a debugger, a hang): it is killed, restarted if allowed, and
-    /// the run is failed. 0: never. A running loop writes its record at least once a
-    /// second.
+    /// Seconds a node's process may stay stopped (SIGSTOP, a debugger) before the node
+    /// counts as frozen: it is killed, restarted if allowed, and the run is failed.
+    /// 0: never.
     #[arg(long, default_value_t = 5.0, value_parser = stall_parser)]
     pub stall_s: f64,
     /// What carries the samples between the nodes on this host: iceoryx2 (shared
@@ -60,8 +59,8 @@ pub struct RunArgs {
     pub no_trace: bool,
 }
 
-/// A stall limit: 0 (never) or 1.5 to 3600 seconds (a running loop may go a second
-/// without writing its record).
+/// A stall limit: 0 (never) or 1.5 to 3600 seconds (a job-control stop and continue
+/// at a terminal takes a moment).
 fn stall_parser(text: &str) -> Result<f64, String> {
     let s: f64 = text.parse().map_err(|e| format!("{e}"))?;
     if s == 0.0 || (1.5..=3600.0).contains(&s) {

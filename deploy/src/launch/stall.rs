@@ -1,66 +1,59 @@
-//! A node that makes no progress: its record stops growing while its process lives.
+//! A node that makes no progress: its process stopped (SIGSTOP, a job-control stop, a
+//! debugger) while the run goes on.
 //!
-//! Every node's loop writes its record at least once a second (a sample, or the
-//! counters when no sample came), so a record that stands still for longer than the
-//! run's stall limit belongs to a node that no longer runs its loop: stopped by SIGSTOP
-//! or a debugger, or hung. Before its loop starts a node may wait (for its peers, its
-//! device) without writing: a record is watched only once it has grown since the
-//! process started.
+//! The kernel says it (`/proc/PID/stat`, state `T` or `t`). A node's record is no
+//! sign: a node waits without writing for as long as its peers or its device take
+//! (before the master's first sample the emulator and the slave write nothing), so
+//! a record standing still is a wait as often as a freeze. A node that hangs while
+//! it runs is the peers' to notice: the master's peer timeout breaks the loop.
 
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-/// How long a node may make no progress, by default, before the run counts it as
-/// frozen: five times the longest a running loop goes without writing its record.
+/// How long a node may stay stopped, by default, before the run counts it as frozen.
 pub const DEFAULT_STALL: Duration = Duration::from_secs(5);
 
-/// The growth of one node's record.
-#[derive(Debug)]
+/// Since when a process has been seen stopped.
+#[derive(Debug, Default)]
 pub struct Progress {
-    record: PathBuf,
-    len: u64,
-    since: Instant,
-    moving: bool,
-}
-
-fn len_of(path: &std::path::Path) -> u64 {
-    std::fs::metadata(path).map_or(0, |m| m.len())
+    stopped_since: Option<Instant>,
 }
 
 impl Progress {
-    /// Watches `record` from now (a node just started or restarted).
-    pub fn new(record: PathBuf) -> Progress {
-        Progress {
-            len: len_of(&record),
-            record,
-            since: Instant::now(),
-            moving: false,
-        }
+    /// Watches a process from now (just started or restarted).
+    pub fn new() -> Progress {
+        Progress::default()
     }
 
-    /// How long the record has stood still, once it has moved at all; None while it
-    /// grows or has not started to.
-    pub fn still_for(&mut self, now: Instant) -> Option<Duration> {
-        let len = len_of(&self.record);
-        if len != self.len {
-            (self.len, self.since, self.moving) = (len, now, true);
+    /// How long process `pid` has been stopped, as of `now` (None while it runs).
+    pub fn stopped_for(&mut self, pid: u32, now: Instant) -> Option<Duration> {
+        if !is_stopped(pid) {
+            self.stopped_since = None;
             return None;
         }
-        self.moving
-            .then(|| now.saturating_duration_since(self.since))
+        let since = *self.stopped_since.get_or_insert(now);
+        Some(now.saturating_duration_since(since))
     }
 }
 
-/// A process's state as the kernel says it (`/proc/PID/stat`), in words.
-pub fn state_of(pid: u32) -> String {
+/// The state letter of process `pid` (`R`, `S`, `T`, ...), `?` if unknown.
+fn state_letter(pid: u32) -> String {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
     // The state follows the command's name, which is in parentheses and may hold any
     // character: read after the last `)`.
-    let state = stat
-        .rfind(')')
+    stat.rfind(')')
         .and_then(|i| stat[i + 1..].split_whitespace().next())
-        .unwrap_or("?");
-    match state {
+        .unwrap_or("?")
+        .to_string()
+}
+
+/// True if process `pid` is stopped (by a signal or a debugger).
+pub fn is_stopped(pid: u32) -> bool {
+    matches!(state_letter(pid).as_str(), "T" | "t")
+}
+
+/// A process's state as the kernel says it, in words.
+pub fn state_of(pid: u32) -> String {
+    match state_letter(pid).as_str() {
         "T" => "stopped (SIGSTOP or a job-control stop)".into(),
         "t" => "stopped by a debugger".into(),
         "D" => "in uninterruptible sleep (waiting for a disk or a device)".into(),
@@ -76,33 +69,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_record_is_watched_once_it_moves_and_stands_still_from_its_last_growth() {
-        let dir = tempfile::tempdir().expect("tempdir");
-        let rec = dir.path().join("slave.rec");
-        std::fs::write(&rec, b"start").expect("write");
-        let mut p = Progress::new(rec.clone());
-        let t0 = Instant::now();
-        assert_eq!(
-            p.still_for(t0 + Duration::from_secs(60)),
-            None,
-            "not moved yet"
-        );
-        std::fs::write(&rec, b"start, then a sample").expect("write");
-        assert_eq!(p.still_for(t0 + Duration::from_secs(61)), None);
-        assert_eq!(
-            p.still_for(t0 + Duration::from_secs(64)),
-            Some(Duration::from_secs(3))
-        );
-    }
-
-    #[test]
     fn a_stopped_process_is_named_stopped() {
         let mut child = std::process::Command::new("sleep")
             .arg("30")
             .spawn()
             .expect("sleep");
         let pid = rustix::process::Pid::from_child(&child);
-        assert_eq!(state_of(child.id()), "sleeping");
+        assert!(!is_stopped(child.id()), "{}", state_of(child.id()));
         rustix::process::kill_process(pid, rustix::process::Signal::STOP).expect("SIGSTOP");
         let mut seen = String::new();
         for _ in 0..100 {
@@ -112,8 +85,17 @@ mod tests {
             }
             std::thread::sleep(Duration::from_millis(10));
         }
+        let mut p = Progress::new();
+        let t0 = Instant::now();
+        assert_eq!(p.stopped_for(child.id(), t0), Some(Duration::ZERO));
+        let later = p.stopped_for(child.id(), t0 + Duration::from_secs(3));
+        rustix::process::kill_process(pid, rustix::process::Signal::CONT).expect("SIGCONT");
+        std::thread::sleep(Duration::from_millis(50));
+        let resumed = p.stopped_for(child.id(), t0 + Duration::from_secs(4));
         let _ = child.kill();
         let _ = child.wait();
         assert_eq!(seen, "stopped (SIGSTOP or a job-control stop)");
+        assert_eq!(later, Some(Duration::from_secs(3)));
+        assert_eq!(resumed, None, "running again");
     }
 }

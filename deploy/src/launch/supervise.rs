@@ -14,7 +14,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use tactile_messages::Role;
-use tactile_records::record_path;
 use tactile_report::summary::Summary;
 use tactile_report::write::{write_report, Launch};
 use tactile_runtime::exit::{EXIT_BAD_INPUT, EXIT_INTERRUPTED};
@@ -57,7 +56,7 @@ struct Proc {
     restarts: u32,
     /// Set while a dead process waits out the restart backoff.
     restart_at: Option<Instant>,
-    /// How its record grows: a node whose record stands still is frozen.
+    /// Since when its process is stopped: a node stopped too long is frozen.
     progress: Progress,
 }
 
@@ -153,7 +152,7 @@ impl<'a> Supervisor<'a> {
                     status: None,
                     restarts: 0,
                     restart_at: None,
-                    progress: Progress::new(record_path(out, role)),
+                    progress: Progress::new(),
                 }),
                 Err(e) => {
                     procs
@@ -217,7 +216,7 @@ impl<'a> Supervisor<'a> {
                 let role = self.procs[k].role;
                 self.procs[k].restart_at = None;
                 self.procs[k].child = (self.spawn)(role, true)?;
-                self.procs[k].progress = Progress::new(record_path(self.out, role));
+                self.procs[k].progress = Progress::new();
                 let at = self.elapsed_s();
                 self.watch
                     .events
@@ -300,8 +299,8 @@ impl<'a> Supervisor<'a> {
         true
     }
 
-    /// A node whose record stood still past the stall limit is frozen (SIGSTOP, a
-    /// debugger, a hang): killed, its death then handled like any other (restarted if
+    /// A node stopped for longer than the stall limit is frozen (SIGSTOP, a debugger):
+    /// killed, its death then handled like any other (restarted if
     /// allowed, else the run stops), and the run counts as failed.
     fn kill_frozen(&mut self) {
         let Some(limit) = self.sup.stall else { return };
@@ -311,18 +310,21 @@ impl<'a> Supervisor<'a> {
             if p.status.is_some() || p.restart_at.is_some() {
                 continue;
             }
-            if p.progress.still_for(now).is_none_or(|still| still < limit) {
+            if p.progress
+                .stopped_for(p.child.id(), now)
+                .is_none_or(|s| s < limit)
+            {
                 continue;
             }
             let state = stall::state_of(p.child.id());
             self.watch.events.push(format!(
-                "{} made no progress for {:.1} s (its record stopped growing; the process is {state}): frozen, killed after {at:.2} s",
+                "{} made no progress for {:.1} s (the process is {state}): frozen, killed after {at:.2} s",
                 p.role,
                 limit.as_secs_f64()
             ));
             self.watch.failed = true;
             let _ = p.child.kill();
-            p.progress = Progress::new(record_path(self.out, p.role));
+            p.progress = Progress::new();
         }
     }
 

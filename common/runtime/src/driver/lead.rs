@@ -172,7 +172,7 @@ impl<H: Leader> Lead<H> {
             Waited::TimedOut => {
                 let c = p.counters();
                 let hint = if c.messages == 0 {
-                    ": is its driver running, with the same ROS_DOMAIN_ID, reaching the same Zenoh router?".to_string()
+                    delivered.nothing_came(p)
                 } else {
                     delivered.why()
                 };

@@ -111,6 +111,8 @@ pub struct Delivered {
     seen: (u64, u64),
     /// The newest reason a message was dropped.
     pub reason: Option<String>,
+    /// Why nothing can come (the session reached nobody), as last said in the log.
+    pub unreached: Option<String>,
 }
 
 impl Default for Delivered {
@@ -119,6 +121,7 @@ impl Default for Delivered {
             next: Instant::now() + Duration::from_secs(1),
             seen: (0, 0),
             reason: None,
+            unreached: None,
         }
     }
 }
@@ -130,6 +133,14 @@ impl Delivered {
             return;
         }
         self.next += Duration::from_secs(1);
+        let unreached = p.unreached();
+        if unreached != self.unreached {
+            match &unreached {
+                Some(why) => tracing::warn!("{} cannot come yet: {why}", p.describe()),
+                None => tracing::info!("the ROS 2 session reached a router or a peer"),
+            }
+            self.unreached = unreached;
+        }
         if let Some(r) = p.take_reject() {
             self.reason = Some(r.to_string());
         }
@@ -148,10 +159,19 @@ impl Delivered {
         }
     }
 
-    /// `, the last dropped because: ...` for a message, or nothing.
+    /// `; the last dropped: ...` for a message, or nothing.
     pub fn why(&self) -> String {
         self.reason
             .as_ref()
             .map_or(String::new(), |r| format!("; the last dropped: {r}"))
+    }
+
+    /// What to say when nothing came from `p`: the session reached nobody, or (it did)
+    /// the driver's side to check.
+    pub fn nothing_came(&self, p: &dyn tactile_devices::Peripheral) -> String {
+        match p.unreached() {
+            Some(why) => format!(": {why}"),
+            None => ": the session reached a router or a peer; is the driver running, with the same ROS_DOMAIN_ID, publishing on that topic?".into(),
+        }
     }
 }
