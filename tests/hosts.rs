@@ -592,6 +592,11 @@ fn mutual_tls_admits_the_run_and_refuses_strangers() {
         let (log, _) = (sb.path(r).join("slave.log"), ());
         let text = std::fs::read_to_string(log).unwrap_or_default();
         assert!(!text.contains("joined run"), "{r} joined:\n{text}");
+        // The connecting side says its attempt failed, and to where.
+        assert!(
+            text.contains("Unable to connect to configured peer") && text.contains(&a[4..]),
+            "{r} says nothing of its failed attempts:\n{text}"
+        );
     }
 }
 

@@ -656,3 +656,66 @@ fn tls_on_a_link_without_tls_is_refused() {
         assert!(!sb.path("out").join("slave.rec").exists(), "{link}");
     }
 }
+
+/// A node's own TLS files, each wrong in its own way: refused before anything starts
+/// (exit 2), the message naming the file and the fault, never a wait with nothing said.
+#[test]
+fn a_nodes_own_bad_tls_files_are_named_and_refused() {
+    let sb = Sandbox::new("tlsown");
+    let ips = vec!["127.0.0.1".to_string()];
+    let (run, other) = match (
+        tactile::launch::pki::make(&sb.path("run"), "run", &ips),
+        tactile::launch::pki::make(&sb.path("other"), "other", &ips),
+    ) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => return util::cannot(&e),
+    };
+    let garbled = sb.write(
+        "garbled.pem",
+        "-----BEGIN CERTIFICATE-----\nAAAA\n-----END CERTIFICATE-----\n",
+    );
+    let scenario = sb.write("s.toml", &util::paper_1khz(100));
+    let path = |p: &std::path::Path| p.to_str().expect("utf-8").to_string();
+    let cases = [
+        ([path(&run[0]), path(&garbled), path(&run[2])], "--tls-cert"),
+        (
+            [path(&run[0]), path(&run[1]), path(&other[2])],
+            "is not the key of --tls-cert",
+        ),
+        (
+            [path(&run[0]), path(&other[1]), path(&other[2])],
+            "is not valid under --tls-ca",
+        ),
+        ([path(&run[0]), path(&run[1]), path(&run[0])], "--tls-key"),
+    ];
+    for ([ca, cert, key], needle) in &cases {
+        let o = util::output_within(
+            sb.node(
+                "tactile-master",
+                &[
+                    "--scenario",
+                    scenario.to_str().expect("utf-8"),
+                    "--out",
+                    "out",
+                    "--prefix",
+                    &sb.prefix,
+                    "--link",
+                    "zenoh",
+                    "--listen",
+                    "tls/127.0.0.1:0",
+                    "--tls-ca",
+                    ca,
+                    "--tls-cert",
+                    cert,
+                    "--tls-key",
+                    key,
+                ],
+            ),
+            util::LIMIT,
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{needle}: {err}");
+        assert!(err.contains(needle), "{needle}: {err}");
+        assert!(!sb.path("out").join("master.rec").exists(), "{needle}");
+    }
+}

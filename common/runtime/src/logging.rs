@@ -1,13 +1,19 @@
 //! A node's log: `tracing` events into `<role>.log` in the node's output folder, and,
 //! when the node runs by hand, also to stderr (in colour only on a terminal). Neither
 //! file nor redirected stderr gets colour codes. `RUST_LOG` sets the level (default
-//! `info`).
+//! [`DEFAULT_FILTER`]).
 
 use std::io::IsTerminal;
 use std::path::Path;
 use tracing_subscriber::layer::SubscriberExt;
 use tracing_subscriber::util::SubscriberInitExt;
 use tracing_subscriber::{fmt, EnvFilter, Layer};
+
+/// The log's level without `RUST_LOG`: info, and the attempts of Zenoh's connecting
+/// side, which it says only at debug: a connection refused, a failed TLS handshake (the
+/// listener says its side at warn), a retry, so a node that cannot reach its peer or
+/// its router says why on its own side too.
+pub const DEFAULT_FILTER: &str = "info,zenoh::net::runtime::orchestrator=debug";
 
 /// Installs the node's logger; `to_stderr` adds a copy on stderr. Returns an error line
 /// if the log file cannot be opened.
@@ -18,7 +24,8 @@ pub fn init(dir: &Path, role: tactile_messages::Role, to_stderr: bool) -> Result
         .append(true)
         .open(&path)
         .map_err(|e| format!("opening {}: {e}", path.display()))?;
-    let filter = || EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info"));
+    let filter =
+        || EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new(DEFAULT_FILTER));
     let file_layer = fmt::layer()
         .with_writer(std::sync::Mutex::new(file))
         .with_ansi(false)

@@ -13,6 +13,8 @@ pub mod memory;
 pub mod options;
 pub mod ports;
 pub mod streams;
+#[cfg(feature = "zenoh")]
+pub mod tls_files;
 pub mod udp;
 pub mod wire;
 #[cfg(feature = "zenoh")]

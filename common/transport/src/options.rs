@@ -215,6 +215,10 @@ impl LinkArgs {
                 readable(f, what)?;
             }
         }
+        #[cfg(feature = "zenoh")]
+        if let (Some(ca), Some(cert), Some(key)) = (&self.tls_ca, &self.tls_cert, &self.tls_key) {
+            crate::tls_files::check(ca, cert, key).map_err(BadOption)?;
+        }
         for e in self.listen.iter().chain(&self.connect) {
             let is_tls = e.starts_with("tls/");
             if tls && !is_tls {
