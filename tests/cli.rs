@@ -286,3 +286,36 @@ fn help_texts_name_only_their_own_options_and_no_rustdoc_links() {
         }
     }
 }
+
+/// The short fuzz campaign CI runs: every decoder of outside bytes, no panic.
+#[test]
+fn a_short_fuzz_campaign_finds_no_panic() {
+    let sb = Sandbox::new("fuzz");
+    let o = sb.tactile(&["fuzz", "--seconds", "0.4", "--out", "crashes"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for t in [
+        "records",
+        "cdr",
+        "wire",
+        "attachment",
+        "scenario",
+        "trajectory",
+        "kernels",
+    ] {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(t))
+            .unwrap_or_else(|| panic!("{t} not fuzzed:\n{text}"));
+        let cells: Vec<&str> = line.split_whitespace().collect();
+        assert!(cells[1].parse::<u64>().is_ok_and(|n| n > 10), "{line}");
+        assert_eq!(cells.last(), Some(&"0"), "{line}");
+    }
+    assert!(!sb.path("crashes").exists());
+    let bad = sb.tactile(&["fuzz", "--target", "nothing"]);
+    assert_eq!(bad.status.code(), Some(2));
+}

@@ -47,6 +47,10 @@ pub enum Command {
     /// The paper's trigonometric block as RTL: Verilog, test vectors from the model,
     /// co-simulation (Icarus Verilog) and synthesis (Yosys, Virtex-6).
     Hdl(HdlArgs),
+    /// Drive every decoder of outside bytes (records, CDR, wire samples, attachments,
+    /// scenario TOML, trajectory CSV, kernels input) with mutated inputs; exit 1 on a
+    /// panic, the input kept.
+    Fuzz(crate::cmd::fuzz::FuzzArgs),
     /// The echo side of `tactile bench`'s bare iceoryx2 hop (started by the bench).
     #[command(hide = true)]
     BenchEcho(EchoArgs),
@@ -91,6 +95,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Bench(args) => crate::cmd::bench::main(&args),
         Command::Report(args) => crate::cmd::report::main(&args),
         Command::Sweep(args) => crate::cmd::sweep::main(&args),
+        Command::Fuzz(args) => crate::cmd::fuzz::main(&args),
         Command::BenchEcho(args) => {
             crate::cmd::bench::echo(&args.prefix, std::time::Duration::from_micros(args.spin_us))
                 .map_err(|e| Error::Failed(e.to_string()))

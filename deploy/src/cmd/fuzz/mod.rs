@@ -1,0 +1,212 @@
+//! `tactile fuzz`: every decoder of outside bytes (records, ROS 2 CDR, the loop's wire
+//! samples, rmw_zenoh attachments, scenario TOML, trajectory CSV, `tactile kernels`
+//! input) driven with mutated inputs on stable Rust, each input under `catch_unwind`.
+//!
+//! Guidance without compiler instrumentation: an input is kept in the target's corpus
+//! when its outcome has a shape not seen before (the decoder's answer with its numbers
+//! blanked, per decoder): the errors a decoder gives are the paths it can take through
+//! its checks, and mutating an input that reached a new one explores from there. The
+//! count of shapes is what the report calls paths. A panic is written to `--out` as
+//! the input that caused it, and the command exits 1.
+
+mod mutate;
+mod targets;
+
+use crate::error::Error;
+use clap::Args;
+use std::collections::HashSet;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// Arguments of `tactile fuzz`.
+#[derive(Debug, Args)]
+pub struct FuzzArgs {
+    /// Targets to fuzz (default: all): records, cdr, wire, attachment, scenario,
+    /// trajectory, kernels.
+    #[arg(long = "target", value_name = "NAME")]
+    pub targets: Vec<String>,
+    /// Seconds per target.
+    #[arg(long, default_value_t = 5.0, value_parser = seconds)]
+    pub seconds: f64,
+    /// Seed of the mutations (the same seed and time make the same first inputs).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Folder for the inputs that made a decoder panic.
+    #[arg(long, default_value = "fuzz-crashes")]
+    pub out: PathBuf,
+}
+
+fn seconds(text: &str) -> Result<f64, String> {
+    let s: f64 = text.parse().map_err(|e| format!("{e}"))?;
+    if (0.01..=86_400.0).contains(&s) {
+        Ok(s)
+    } else {
+        Err("takes 0.01 to 86400 seconds".into())
+    }
+}
+
+/// What a target's campaign did.
+struct Campaign {
+    inputs: u64,
+    paths: usize,
+    corpus: usize,
+    panics: u64,
+}
+
+/// An outcome's shape: numbers blanked and quoted or bracketed text left out (an error quoting the
+/// input would otherwise make every input a path of its own), bounded, so `at byte 17`
+/// and `at byte 18`, or `"abc"` and `"abd"`, are one path.
+fn shape(outcome: &str) -> String {
+    let mut out = String::new();
+    let mut quote = None;
+    let mut escaped = false;
+    for c in outcome.chars() {
+        match quote {
+            // Inside quotes a backslash escapes the next character (Debug's `\"`).
+            Some(_) if escaped => escaped = false,
+            Some(_) if c == '\\' => escaped = true,
+            Some(q) if c == q => quote = None,
+            Some(_) => {}
+            None if matches!(c, '"' | '`' | '\'' | '[') => {
+                quote = Some(if c == '[' { ']' } else { c });
+                out.push('_');
+            }
+            None if c.is_ascii_digit() => {
+                if !out.ends_with('#') {
+                    out.push('#');
+                }
+            }
+            None if c.is_ascii() => out.push(c),
+            None => {}
+        }
+        if out.len() >= 120 {
+            break;
+        }
+    }
+    out
+}
+
+/// Paths told apart per target (memory stays bounded however long a campaign runs; a
+/// target that reaches this many says so as `>=`).
+const MAX_PATHS: usize = 1 << 16;
+
+/// Inputs kept per target: past it, a new path's input replaces a random one.
+const MAX_CORPUS: usize = 4096;
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shapes_leave_out_numbers_and_quoted_text() {
+        assert_eq!(
+            super::shape("line 17: \"abc\" is not a number"),
+            super::shape("line 18: \"abd\" is not a number")
+        );
+        assert_eq!(
+            super::shape("header is \"a\\\"b\", expected x"),
+            super::shape("header is \"c\", expected x")
+        );
+        assert_ne!(super::shape("no rows"), super::shape("no header"));
+    }
+}
+
+fn campaign(t: &targets::Target, args: &FuzzArgs, k: u64) -> Result<Campaign, Error> {
+    let mut rng = mutate::Rng::new(args.seed ^ (k + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    let mut corpus = t.seeds.clone();
+    let mut seen = HashSet::new();
+    let mut c = Campaign {
+        inputs: 0,
+        paths: 0,
+        corpus: 0,
+        panics: 0,
+    };
+    let until = Instant::now() + Duration::from_secs_f64(args.seconds);
+    let mut queue: Vec<Vec<u8>> = t.seeds.clone();
+    while Instant::now() < until {
+        let input = queue
+            .pop()
+            .unwrap_or_else(|| mutate::mutate(&mut rng, &corpus));
+        c.inputs += 1;
+        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (t.run)(&input))) {
+            Ok(outcome) => {
+                let new = seen.len() < MAX_PATHS && seen.insert(shape(&outcome));
+                if new && input.len() <= mutate::MAX_LEN {
+                    if corpus.len() < MAX_CORPUS {
+                        corpus.push(input);
+                    } else {
+                        let k = rng.below(corpus.len());
+                        corpus[k] = input;
+                    }
+                }
+            }
+            Err(_) => {
+                c.panics += 1;
+                std::fs::create_dir_all(&args.out)
+                    .map_err(Error::io(format!("creating {}", args.out.display())))?;
+                let path = args.out.join(format!("{}-{}.bin", t.name, c.panics));
+                std::fs::write(&path, &input)
+                    .map_err(Error::io(format!("writing {}", path.display())))?;
+            }
+        }
+    }
+    c.paths = seen.len();
+    c.corpus = corpus.len();
+    Ok(c)
+}
+
+/// `tactile fuzz`.
+pub fn main(args: &FuzzArgs) -> Result<(), Error> {
+    let scratch = tempfile::tempdir().map_err(Error::io("making a scratch folder"))?;
+    let all = targets::all(scratch.path()).map_err(Error::Failed)?;
+    for name in &args.targets {
+        if !all.iter().any(|t| t.name == name) {
+            let names: Vec<&str> = all.iter().map(|t| t.name).collect();
+            return Err(Error::BadInput(format!(
+                "--target {name:?}: not one of {}",
+                names.join(", ")
+            )));
+        }
+    }
+    // Panics are counted and their inputs kept; the default hook would print each.
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    crate::outln!("target       inputs    inputs/s  paths  corpus  panics");
+    let mut panics = 0;
+    let mut result = Ok(());
+    for (k, t) in all.iter().enumerate() {
+        if !args.targets.is_empty() && !args.targets.iter().any(|n| n == t.name) {
+            continue;
+        }
+        match campaign(t, args, k as u64) {
+            Ok(c) => {
+                panics += c.panics;
+                let paths = if c.paths >= MAX_PATHS {
+                    format!(">={}", c.paths)
+                } else {
+                    c.paths.to_string()
+                };
+                crate::outln!(
+                    "{:<10} {:>8} {:>11.0} {:>6} {:>7} {:>7}",
+                    t.name,
+                    c.inputs,
+                    c.inputs as f64 / args.seconds,
+                    paths,
+                    c.corpus,
+                    c.panics
+                );
+            }
+            Err(e) => {
+                result = Err(e);
+                break;
+            }
+        }
+    }
+    std::panic::set_hook(hook);
+    result?;
+    if panics > 0 {
+        return Err(Error::Failed(format!(
+            "{panics} inputs made a decoder panic; each is in {}",
+            args.out.display()
+        )));
+    }
+    Ok(())
+}
