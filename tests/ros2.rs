@@ -562,6 +562,25 @@ fn ros_settings_are_checked_and_need_the_node_programs() {
         "ros.connect=[\"tcp/999.1.1.1:7447\"]",
         "999.1.1.1 is not an IP address",
     );
+    // A session in clear to another host is said, not silent.
+    let o = sb.tactile(&[
+        "check",
+        paper,
+        "--set",
+        "master.backend=\"ros2\"",
+        "--set",
+        "ros.connect=[\"tcp/198.18.0.1:7447\"]",
+    ]);
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        o.status.success()
+            && said.contains("ros endpoint tcp/198.18.0.1:7447 leaves this host in clear"),
+        "{said}"
+    );
     sb.assert_bad_set(paper, "ros.live.rate_hz=500", "ros.live.rate_hz");
     sb.assert_bad_set(
         paper,

@@ -10,6 +10,7 @@ mod bounds;
 mod control;
 pub mod csv;
 mod device;
+pub mod endpoint;
 mod error;
 mod lengths;
 mod master;
@@ -199,6 +200,16 @@ impl Scenario {
     /// maximum, a delay or a schedule entry beyond the run's length.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
+        let ros_used = self.master.backend == Backend::Ros2
+            || self.slave.backend == Backend::Ros2
+            || self.ros.live.enabled;
+        if ros_used {
+            w.extend(self.ros.in_clear_to_other_hosts().into_iter().map(|e| {
+                format!(
+                    "ros endpoint {e} leaves this host in clear: joint states, forces and robot commands can be read and forged on that network (Tactile's ROS 2 session has no TLS yet; keep the router on this host, or the network trusted)"
+                )
+            }));
+        }
         for (k, o) in self.environment.objects.iter().enumerate() {
             for (i, h) in o.stiffness().iter().enumerate() {
                 if *h > NOMINAL_MAX_STIFFNESS {

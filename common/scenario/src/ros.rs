@@ -388,56 +388,18 @@ pub fn topic_name(name: &str, field: &str) -> Result<(), ScenarioError> {
     Ok(())
 }
 
-/// Checks a Zenoh endpoint `PROTOCOL/HOST:PORT` as far as it can be without the
-/// network: a known protocol, a port in 1..=65535, an IP address that parses (a dotted
-/// quad like 999.1.1.1 does not) or a host name of letters, digits, `-` and `.`.
-/// Anything after `#` (Zenoh's endpoint options) is left to Zenoh. Port 0 listens on
-/// any free port, and connects nowhere.
-pub fn endpoint(e: &str, connect: bool) -> Result<(), String> {
-    let locator = e.split('#').next().unwrap_or(e);
-    let (proto, addr) = locator
-        .split_once('/')
-        .ok_or("no protocol (tcp/, udp/, tls/, quic/)")?;
-    if !matches!(proto, "tcp" | "udp" | "tls" | "quic") {
-        return Err(format!("protocol {proto:?} is not tcp, udp, tls or quic"));
-    }
-    if let Ok(a) = addr.parse::<std::net::SocketAddr>() {
-        if connect && a.port() == 0 {
-            return Err("port 0 is outside 1..=65535 (it connects nowhere)".into());
-        }
-        return Ok(());
-    }
-    let (host, port) = addr.rsplit_once(':').ok_or("no :PORT")?;
-    let port: u32 = port
-        .parse()
-        .map_err(|_| format!("port {port:?} is not a number"))?;
-    if !(1..=65535).contains(&port) {
-        return Err(format!("port {port} is outside 1..=65535"));
-    }
-    if host.starts_with('[') || host.parse::<std::net::IpAddr>().is_ok() {
-        return Err(format!("{host} is not an IP address with a port"));
-    }
-    if host
-        .split('.')
-        .all(|p| p.chars().all(|c| c.is_ascii_digit()))
-    {
-        return Err(format!("{host} is not an IP address"));
-    }
-    let name_ok = !host.is_empty()
-        && host.len() <= 253
-        && host.split('.').all(|l| {
-            !l.is_empty()
-                && l.len() <= 63
-                && l.chars().all(|c| c.is_ascii_alphanumeric() || c == '-')
-                && !l.starts_with('-')
-        });
-    if !name_ok {
-        return Err(format!("{host:?} is neither an IP address nor a host name"));
-    }
-    Ok(())
-}
-
 impl RosConfig {
+    /// The endpoints (`ros.connect`, `ros.listen`) that reach beyond this host without
+    /// TLS.
+    pub fn in_clear_to_other_hosts(&self) -> Vec<String> {
+        self.connect
+            .iter()
+            .chain(&self.listen)
+            .filter(|e| crate::endpoint::in_clear_to_another_host(e))
+            .cloned()
+            .collect()
+    }
+
     /// Checks the ranges; errors name `ros.*`. `rate_hz` is the loop's.
     pub fn validate(&self, rate_hz: f64) -> Result<(), ScenarioError> {
         if self.domain_id > 232 {
@@ -451,7 +413,7 @@ impl RosConfig {
         }
         for (list, name) in [(&self.connect, "connect"), (&self.listen, "listen")] {
             for (i, e) in list.iter().enumerate() {
-                endpoint(e, name == "connect").map_err(|why| {
+                crate::endpoint::check(e, name == "connect").map_err(|why| {
                     invalid(
                         format!("ros.{name}[{i}]"),
                         format!("{e:?}: {why} (a Zenoh endpoint is like tcp/127.0.0.1:7447)"),
@@ -510,43 +472,6 @@ impl RosRobotConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn endpoints_are_checked_before_anything_connects() {
-        for good in [
-            "tcp/127.0.0.1:7447",
-            "tls/198.18.0.1:7447",
-            "udp/[::1]:7447",
-            "tcp/router.lab-1.example:7447",
-            "tcp/localhost:7447#iface=lo",
-        ] {
-            assert_eq!(endpoint(good, true), Ok(()), "{good}");
-        }
-        for (bad, why) in [
-            ("tcp/127.0.0.1:99999", "port 99999 is outside 1..=65535"),
-            ("tcp/999.1.1.1:7447", "999.1.1.1 is not an IP address"),
-            ("tcp/127.0.0.1:0", "port 0 is outside"),
-            ("tcp/127.0.0.1", "no :PORT"),
-            ("ws/127.0.0.1:7447", "protocol \"ws\""),
-            ("127.0.0.1:7447", "no protocol"),
-            ("tcp/a b:7447", "neither an IP address nor a host name"),
-            ("tcp/host:port", "port \"port\" is not a number"),
-        ] {
-            let e = endpoint(bad, true).expect_err(bad);
-            assert!(e.contains(why), "{bad}: {e}");
-        }
-        assert_eq!(
-            endpoint("tcp/0.0.0.0:0", false),
-            Ok(()),
-            "listen on any port"
-        );
-        let cfg = RosConfig {
-            connect: vec!["tcp/127.0.0.1:99999".into()],
-            ..RosConfig::default()
-        };
-        let e = cfg.validate(1000.0).expect_err("bad port").to_string();
-        assert!(e.contains("ros.connect[0]") && e.contains("99999"), "{e}");
-    }
 
     #[test]
     fn topic_names_follow_ros_rules() {

@@ -57,33 +57,35 @@ struct Campaign {
 /// input would otherwise make every input a path of its own), bounded, so `at byte 17`
 /// and `at byte 18`, or `"abc"` and `"abd"`, are one path.
 fn shape(outcome: &str) -> String {
-    let mut out = String::new();
-    let mut quote = None;
-    let mut escaped = false;
-    for c in outcome.chars() {
-        match quote {
-            // Inside quotes a backslash escapes the next character (Debug's `\"`).
-            Some(_) if escaped => escaped = false,
-            Some(_) if c == '\\' => escaped = true,
-            Some(q) if c == q => quote = None,
-            Some(_) => {}
-            None if matches!(c, '"' | '`' | '\'' | '[') => {
-                quote = Some(if c == '[' { ']' } else { c });
-                out.push('_');
+    // A parser's excerpt of the input (TOML's `3 | foo = bar` and its caret line) is
+    // the input again, not a path.
+    let excerpt = |l: &&str| {
+        l.trim_start()
+            .trim_start_matches(|c: char| c.is_ascii_digit())
+            .trim_start()
+            .starts_with('|')
+    };
+    let text: Vec<&str> = outcome.lines().filter(|l| !excerpt(l)).collect();
+    let outcome = text.join(" ");
+    // What a decoder quotes is the input: only the text before the first quote and
+    // after the last is the message's own (a quoted value may hold quotes itself).
+    let quote = |c: char| matches!(c, '"' | '`' | '\'' | '[' | ']');
+    let (head, tail) = match (outcome.find(quote), outcome.rfind(quote)) {
+        (Some(a), Some(b)) => (&outcome[..a], &outcome[b + 1..]),
+        _ => (outcome.as_str(), ""),
+    };
+    let blank = |t: &str| -> String {
+        let mut out = String::new();
+        for c in t.chars().filter(char::is_ascii).take(80) {
+            if !c.is_ascii_digit() {
+                out.push(c);
+            } else if !out.ends_with('#') {
+                out.push('#');
             }
-            None if c.is_ascii_digit() => {
-                if !out.ends_with('#') {
-                    out.push('#');
-                }
-            }
-            None if c.is_ascii() => out.push(c),
-            None => {}
         }
-        if out.len() >= 120 {
-            break;
-        }
-    }
-    out
+        out
+    };
+    format!("{}_{}", blank(head), blank(tail))
 }
 
 /// Paths told apart per target (memory stays bounded however long a campaign runs; a
@@ -92,22 +94,6 @@ const MAX_PATHS: usize = 1 << 16;
 
 /// Inputs kept per target: past it, a new path's input replaces a random one.
 const MAX_CORPUS: usize = 4096;
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn shapes_leave_out_numbers_and_quoted_text() {
-        assert_eq!(
-            super::shape("line 17: \"abc\" is not a number"),
-            super::shape("line 18: \"abd\" is not a number")
-        );
-        assert_eq!(
-            super::shape("header is \"a\\\"b\", expected x"),
-            super::shape("header is \"c\", expected x")
-        );
-        assert_ne!(super::shape("no rows"), super::shape("no header"));
-    }
-}
 
 fn campaign(t: &targets::Target, args: &FuzzArgs, k: u64) -> Result<Campaign, Error> {
     let mut rng = mutate::Rng::new(args.seed ^ (k + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
@@ -209,4 +195,30 @@ pub fn main(args: &FuzzArgs) -> Result<(), Error> {
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shapes_leave_out_numbers_and_quoted_text() {
+        assert_eq!(
+            super::shape("line 17: \"abc\" is not a number"),
+            super::shape("line 18: \"abd\" is not a number")
+        );
+        assert_eq!(
+            super::shape("header is \"a\\\"b\", expected x"),
+            super::shape("header is \"c\", expected x")
+        );
+        assert_eq!(
+            super::shape("unknown variant `a`b`, expected `x` or `y`"),
+            super::shape("unknown variant `q`, expected `x` or `y`")
+        );
+        assert_ne!(super::shape("no rows"), super::shape("no header"));
+        assert_eq!(
+            super::shape(
+                "TOML parse error at line 3\n  |\n3 | foo = bar\n  |     ^\ninvalid string"
+            ),
+            super::shape("TOML parse error at line 9\n  |\n9 | x = \n  |   ^\ninvalid string")
+        );
+    }
 }

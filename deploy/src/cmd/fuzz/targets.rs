@@ -11,6 +11,9 @@ use tactile_records::slave::{SlaveSample, SlaveTotals};
 use tactile_records::{Record, RecordReader};
 use tactile_ros::msg::{Decode, Float64MultiArray, JointState, Message, WrenchStamped};
 
+/// A decoder over one input, its outcome in words.
+pub type Run = Box<dyn Fn(&[u8]) -> String>;
+
 /// One decoder: its name, its seeds, and a run over one input.
 pub struct Target {
     /// As `--target` names it.
@@ -18,7 +21,7 @@ pub struct Target {
     /// Valid inputs to start from.
     pub seeds: Vec<Vec<u8>>,
     /// Decodes one input; the outcome in words.
-    pub run: Box<dyn Fn(&[u8]) -> String>,
+    pub run: Run,
 }
 
 /// Every target, seeded; `scratch` is a folder for the record files.
@@ -100,7 +103,6 @@ fn cdr() -> Target {
     let wrench = WrenchStamped::default();
     let array = Float64MultiArray {
         data: vec![1.0, 2.0, 3.0],
-        ..Float64MultiArray::default()
     };
     Target {
         name: "cdr",
