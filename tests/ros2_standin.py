@@ -65,6 +65,9 @@ class Node:
         c.insert_json5("mode", '"peer"')
         c.insert_json5("scouting/multicast/enabled", "false")
         c.insert_json5("listen/endpoints", json.dumps(listen))
+        # No shared memory: Tactile's sessions have none, and a stand-in killed at the
+        # end of a test would leave its segment in /dev/shm.
+        c.insert_json5("transport/shared_memory/enabled", "false")
         self.s = zenoh.open(c)
         self.domain = domain
         self.name = name
