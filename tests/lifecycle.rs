@@ -39,19 +39,30 @@ fn a_master_whose_peers_never_come_exits_1_naming_them() {
     );
 }
 
+/// `tactile run SCENARIO --out OUT --max-restarts 0` (and `extra`) under the sandbox's
+/// prefix, its output captured.
+fn run_without_restarts(
+    sb: &Sandbox,
+    scenario: &Path,
+    out: &Path,
+    extra: &[&str],
+) -> std::process::Child {
+    sb.command(&["run", scenario.to_str().expect("utf-8"), "--out"])
+        .arg(out)
+        .args(["--prefix", &sb.prefix, "-q", "--max-restarts", "0"])
+        .args(extra)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start")
+}
+
 #[test]
 fn a_node_that_dies_past_its_restarts_ends_the_run_as_failed() {
     let sb = Sandbox::new("norestart");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let out = sb.path("run");
-    let child = sb
-        .command(&["run", scenario.to_str().expect("utf-8"), "--out"])
-        .arg(&out)
-        .args(["--prefix", &sb.prefix, "-q", "--max-restarts", "0"])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("start");
+    let child = run_without_restarts(&sb, &scenario, &out, &[]);
     wait_for("the slave runs", Duration::from_secs(20), || {
         util::pid_of(&sb.prefix, "slave").is_some()
     });
@@ -223,15 +234,7 @@ fn a_frozen_node_fails_the_run_after_the_stall_limit() {
     let sb = Sandbox::new("frozen");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let out = sb.path("run");
-    let child = sb
-        .command(&["run", scenario.to_str().expect("utf-8"), "--out"])
-        .arg(&out)
-        .args(["--prefix", &sb.prefix, "-q", "--max-restarts", "0"])
-        .args(["--stall-s", "1.5"])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("start");
+    let child = run_without_restarts(&sb, &scenario, &out, &["--stall-s", "1.5"]);
     wait_for("the slave records", Duration::from_secs(20), || {
         std::fs::metadata(out.join("slave.rec")).is_ok_and(|m| m.len() > 50_000)
     });

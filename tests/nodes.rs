@@ -615,6 +615,21 @@ fn a_run_leaves_nothing_behind_and_cleans_only_dead_runs() {
     tactile_transport::ipc::remove_run_files(&live);
 }
 
+/// `program` by hand into `out` with `link` options and the TLS files `[ca, cert, key]`.
+fn with_tls(
+    sb: &Sandbox,
+    program: &str,
+    scenario: &std::path::Path,
+    link: &[&str],
+    [ca, cert, key]: [&str; 3],
+) -> std::process::Output {
+    let mut args = vec!["--scenario", scenario.to_str().expect("utf-8")];
+    args.extend(["--out", "out", "--prefix", &sb.prefix]);
+    args.extend_from_slice(link);
+    args.extend(["--tls-ca", ca, "--tls-cert", cert, "--tls-key", key]);
+    util::output_within(sb.node(program, &args), util::LIMIT)
+}
+
 /// TLS options on a node whose link cannot carry them: refused (exit 2, nothing
 /// written), never a run in clear that looks encrypted.
 #[test]
@@ -628,27 +643,12 @@ fn tls_on_a_link_without_tls_is_refused() {
         );
     }
     for link in ["udp", "iceoryx2"] {
-        let o = util::output_within(
-            sb.node(
-                "tactile-slave",
-                &[
-                    "--scenario",
-                    scenario.to_str().expect("utf-8"),
-                    "--out",
-                    "out",
-                    "--prefix",
-                    &sb.prefix,
-                    "--link",
-                    link,
-                    "--tls-ca",
-                    "ca.pem",
-                    "--tls-cert",
-                    "n.pem",
-                    "--tls-key",
-                    "n.key",
-                ],
-            ),
-            util::LIMIT,
+        let o = with_tls(
+            &sb,
+            "tactile-slave",
+            &scenario,
+            &["--link", link],
+            ["ca.pem", "n.pem", "n.key"],
         );
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{link}: {err}");
@@ -689,30 +689,9 @@ fn a_nodes_own_bad_tls_files_are_named_and_refused() {
         ([path(&run[0]), path(&run[1]), path(&run[0])], "--tls-key"),
     ];
     for ([ca, cert, key], needle) in &cases {
-        let o = util::output_within(
-            sb.node(
-                "tactile-master",
-                &[
-                    "--scenario",
-                    scenario.to_str().expect("utf-8"),
-                    "--out",
-                    "out",
-                    "--prefix",
-                    &sb.prefix,
-                    "--link",
-                    "zenoh",
-                    "--listen",
-                    "tls/127.0.0.1:0",
-                    "--tls-ca",
-                    ca,
-                    "--tls-cert",
-                    cert,
-                    "--tls-key",
-                    key,
-                ],
-            ),
-            util::LIMIT,
-        );
+        let zenoh = ["--link", "zenoh", "--listen", "tls/127.0.0.1:0"];
+        let files = [ca.as_str(), cert.as_str(), key.as_str()];
+        let o = with_tls(&sb, "tactile-master", &scenario, &zenoh, files);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{needle}: {err}");
         assert!(err.contains(needle), "{needle}: {err}");

@@ -27,6 +27,10 @@ pub enum Record<S, C> {
     Stop(Stop),
 }
 
+/// A record of any role read for its role-independent entries (`Start`, `Run`): the
+/// samples' and counters' bodies are not decoded, so such a frame counts as damage.
+pub type AnyRecord = Record<serde::de::IgnoredAny, serde::de::IgnoredAny>;
+
 /// How a node started.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Start {

@@ -180,9 +180,8 @@ fn whole_end(path: &Path) -> std::io::Result<u64> {
 /// The run tokens a record holds (`Record::Run`), in order, each once; none if the
 /// file cannot be read. Every other frame is skipped undecoded.
 pub fn runs_in(path: &Path) -> Vec<u64> {
-    type Any = crate::Record<serde::de::IgnoredAny, serde::de::IgnoredAny>;
     let mut runs = Vec::new();
-    let Ok(mut r) = RecordReader::<Any>::open(path) else {
+    let Ok(mut r) = RecordReader::<crate::AnyRecord>::open(path) else {
         return runs;
     };
     while let Ok(Some(rec)) = r.next_record() {

@@ -13,6 +13,6 @@ pub mod master;
 pub mod recorder;
 pub mod slave;
 
-pub use entry::{Event, Record, Sched, Start, Stop, Totals};
+pub use entry::{AnyRecord, Event, Record, Sched, Start, Stop, Totals};
 pub use frames::{Damage, RecordError, RecordReader, RecordWriter, MAGIC};
 pub use recorder::{record_path, Events, Recorder, WriteError};

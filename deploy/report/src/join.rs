@@ -294,8 +294,8 @@ pub fn locate(dirs: &[PathBuf]) -> Result<[Option<PathBuf>; 3], Error> {
 /// type). A damaged first frame costs only itself: the next segment's start is taken,
 /// or none if the record holds no other.
 fn first_start(path: &Path) -> Result<Option<Start>, Error> {
-    type Any = Record<serde::de::IgnoredAny, serde::de::IgnoredAny>;
-    let mut r = RecordReader::<Any>::open(path).map_err(|e| Error::BadInput(e.to_string()))?;
+    let mut r = RecordReader::<tactile_records::AnyRecord>::open(path)
+        .map_err(|e| Error::BadInput(e.to_string()))?;
     loop {
         match r.next_record() {
             Ok(Some(Record::Start(s))) => return Ok(Some(s)),
