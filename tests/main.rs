@@ -9,6 +9,7 @@ mod util;
 mod bad_input;
 mod bench;
 mod bilateral;
+mod chain;
 mod channels;
 mod cli;
 mod faults;

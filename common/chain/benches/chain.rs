@@ -1,0 +1,66 @@
+//! Time per call of the chain's kernels on a 7-joint arm (the Panda) and a 6-joint
+//! one (the UR5): FK, the Jacobian, RNEA, ABA, and the IK following a moving target
+//! as a slave does every period (the paper gives each side 37.5 us).
+//!
+//! Run with `cargo bench -p tactile-chain --bench chain`.
+
+use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
+use nalgebra::{Matrix6xX, Vector3};
+use tactile_chain::dynamics::EARTH;
+use tactile_chain::{Chain, Dynamics, Ik, IkConfig};
+
+const PANDA: &str = include_str!("../../../deploy/robots/panda.urdf");
+const UR5: &str = include_str!("../../../deploy/robots/ur5_robot.urdf");
+
+fn arms() -> Vec<(&'static str, Chain, Vec<f64>)> {
+    let panda = Chain::from_urdf(PANDA, "panda_link0", "panda_hand").expect("panda");
+    let ur5 = Chain::from_urdf(UR5, "base_link", "tool0").expect("ur5");
+    vec![
+        (
+            "panda",
+            panda,
+            vec![0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785],
+        ),
+        ("ur5", ur5, vec![0.0, -1.2, 1.4, -1.8, -1.2, 0.0]),
+    ]
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("chain");
+    for (name, arm, q) in arms() {
+        let dynamics = Dynamics::new(&arm, EARTH).expect("dynamics");
+        let zero = vec![0.0; q.len()];
+        let mut jac = Matrix6xX::zeros(arm.dof());
+        g.bench_function(BenchmarkId::new("fk", name), |b| {
+            b.iter(|| arm.fk(black_box(&q)))
+        });
+        g.bench_function(BenchmarkId::new("jacobian", name), |b| {
+            b.iter(|| arm.jacobian(black_box(&q), &mut jac))
+        });
+        g.bench_function(BenchmarkId::new("rnea", name), |b| {
+            b.iter(|| dynamics.rnea(black_box(&q), &zero, &zero))
+        });
+        g.bench_function(BenchmarkId::new("aba", name), |b| {
+            b.iter(|| dynamics.aba(black_box(&q), &zero, &zero))
+        });
+        // The target circles 5 cm around the start at 1 Hz, sampled at 1 kHz: each
+        // call starts from the last one's answer, as the slave's does.
+        let home = arm.fk(&q);
+        let mut ik = Ik::new(&arm, IkConfig::default()).expect("ik");
+        let (mut now, mut k) = (q.clone(), 0u64);
+        g.bench_function(BenchmarkId::new("ik_step", name), |b| {
+            b.iter(|| {
+                k += 1;
+                let t = (k % 1000) as f64 * 1e-3 * std::f64::consts::TAU;
+                let mut target = home;
+                target.p += Vector3::new(0.05 * t.cos() - 0.05, 0.05 * t.sin(), 0.0);
+                now = ik.step(&now, black_box(&target), 1e-3).expect("step").q;
+            })
+        });
+        eprintln!("{name}: {:?}", ik.stats);
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,168 @@
+//! Rigid-body dynamics of a chain: inverse dynamics by the recursive Newton-Euler
+//! algorithm, forward dynamics by the articulated-body algorithm (Featherstone,
+//! *Rigid Body Dynamics Algorithms*, 2008, tables 5.1 and 7.1), in the base frame with
+//! gravity given there. O(n) each, no mass matrix inverted.
+
+use crate::chain::{Chain, Kind};
+use crate::error::Error;
+use crate::spatial::{force_cross, motion_cross};
+use nalgebra::{Matrix6, Vector3, Vector6};
+
+/// A chain's dynamics.
+#[derive(Debug, Clone)]
+pub struct Dynamics {
+    chain: Chain,
+    /// Gravity in the base frame, m/s^2.
+    pub gravity: Vector3<f64>,
+    /// Each joint's motion subspace in its own frame.
+    s: Vec<Vector6<f64>>,
+}
+
+/// Gravity on Earth in a base whose z points up.
+pub const EARTH: Vector3<f64> = Vector3::new(0.0, 0.0, -9.81);
+
+impl Dynamics {
+    /// The dynamics of `chain` under `gravity` (base frame). Refused for a chain with
+    /// mimic joints (a closed linkage in disguise) and for a joint that carries no
+    /// inertia about its own axis (its acceleration would be unbounded).
+    pub fn new(chain: &Chain, gravity: Vector3<f64>) -> Result<Dynamics, Error> {
+        if chain.has_mimic() {
+            return Err(Error::Dynamics(
+                "the chain has mimic joints: its dynamics are a closed linkage's".into(),
+            ));
+        }
+        let s: Vec<Vector6<f64>> = chain.joints.iter().map(subspace).collect();
+        // A joint with nothing of mass from it to the tip has no articulated inertia
+        // about its axis: its acceleration would be unbounded.
+        let mut massless = true;
+        for j in chain.joints.iter().rev() {
+            massless &= j.body.norm() == 0.0;
+            if massless {
+                return Err(Error::Dynamics(format!(
+                    "joint `{}` moves nothing with mass: the links from it to the tip need <inertial>",
+                    j.name
+                )));
+            }
+        }
+        Ok(Dynamics {
+            chain: chain.clone(),
+            gravity,
+            s,
+        })
+    }
+
+    /// The chain.
+    pub fn chain(&self) -> &Chain {
+        &self.chain
+    }
+
+    fn check(&self, what: &'static str, v: &[f64]) -> Result<(), Error> {
+        self.chain.check_len(what, v)
+    }
+
+    /// Each body's transform from its parent's coordinates, at `q`.
+    fn transforms(&self, q: &[f64]) -> Vec<Matrix6<f64>> {
+        self.chain
+            .joints
+            .iter()
+            .map(|j| j.frame(q[j.dof]).motion_to_child())
+            .collect()
+    }
+
+    /// The base's acceleration that stands for gravity.
+    fn a0(&self) -> Vector6<f64> {
+        let g = -self.gravity;
+        Vector6::new(g.x, g.y, g.z, 0.0, 0.0, 0.0)
+    }
+
+    /// Joint efforts that give accelerations `qdd` at `q`, `qd`: `M qdd + C qd + g`.
+    pub fn rnea(&self, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<Vec<f64>, Error> {
+        self.check("q", q)?;
+        self.check("qd", qd)?;
+        self.check("qdd", qdd)?;
+        let x = self.transforms(q);
+        let n = x.len();
+        let (mut v, mut a) = (Vector6::zeros(), self.a0());
+        let mut f = Vec::with_capacity(n);
+        for i in 0..n {
+            let s = &self.s[i];
+            let vj = s * qd[i];
+            v = x[i] * v + vj;
+            a = x[i] * a + s * qdd[i] + motion_cross(&v) * vj;
+            let body = &self.chain.joints[i].body;
+            f.push(body * a + force_cross(&v, &(body * v)));
+        }
+        let mut tau = vec![0.0; n];
+        for i in (0..n).rev() {
+            tau[i] = self.s[i].dot(&f[i]);
+            if i > 0 {
+                let up = x[i].transpose() * f[i];
+                f[i - 1] += up;
+            }
+        }
+        Ok(tau)
+    }
+
+    /// The efforts that hold the arm still at `q` against gravity.
+    pub fn gravity_torques(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
+        let z = vec![0.0; q.len()];
+        self.rnea(q, &z, &z)
+    }
+
+    /// Joint accelerations under efforts `tau` at `q`, `qd`.
+    pub fn aba(&self, q: &[f64], qd: &[f64], tau: &[f64]) -> Result<Vec<f64>, Error> {
+        self.check("q", q)?;
+        self.check("qd", qd)?;
+        self.check("tau", tau)?;
+        let x = self.transforms(q);
+        let n = x.len();
+        let mut c = Vec::with_capacity(n);
+        let mut ia: Vec<Matrix6<f64>> = Vec::with_capacity(n);
+        let mut pa: Vec<Vector6<f64>> = Vec::with_capacity(n);
+        let mut v = Vector6::zeros();
+        for i in 0..n {
+            let vj = self.s[i] * qd[i];
+            v = x[i] * v + vj;
+            c.push(motion_cross(&v) * vj);
+            let body = self.chain.joints[i].body;
+            ia.push(body);
+            pa.push(force_cross(&v, &(body * v)));
+        }
+        let (mut u, mut d, mut uu) = (vec![Vector6::zeros(); n], vec![0.0; n], vec![0.0; n]);
+        for i in (0..n).rev() {
+            let s = &self.s[i];
+            u[i] = ia[i] * s;
+            d[i] = s.dot(&u[i]);
+            if d[i].is_nan() || d[i] <= 1e-12 {
+                let name = &self.chain.joints[i].name;
+                return Err(Error::Dynamics(format!(
+                    "joint `{name}` has no inertia about its axis at this configuration"
+                )));
+            }
+            uu[i] = tau[i] - s.dot(&pa[i]);
+            if i > 0 {
+                let iai = ia[i] - u[i] * u[i].transpose() / d[i];
+                let pai = pa[i] + iai * c[i] + u[i] * (uu[i] / d[i]);
+                ia[i - 1] += x[i].transpose() * iai * x[i];
+                pa[i - 1] += x[i].transpose() * pai;
+            }
+        }
+        let mut a = self.a0();
+        let mut qdd = vec![0.0; n];
+        for i in 0..n {
+            let ap = x[i] * a + c[i];
+            qdd[i] = (uu[i] - u[i].dot(&ap)) / d[i];
+            a = ap + self.s[i] * qdd[i];
+        }
+        Ok(qdd)
+    }
+}
+
+/// A joint's motion subspace `[linear; angular]` in its own frame.
+fn subspace(j: &crate::chain::Joint) -> Vector6<f64> {
+    let a = j.axis.into_inner();
+    match j.kind {
+        Kind::Revolute => Vector6::new(0.0, 0.0, 0.0, a.x, a.y, a.z),
+        Kind::Prismatic => Vector6::new(a.x, a.y, a.z, 0.0, 0.0, 0.0),
+    }
+}

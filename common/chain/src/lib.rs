@@ -1,0 +1,28 @@
+//! Any serial arm from its URDF: a chain from a base link to a tip link (revolute and
+//! prismatic joints, fixed joints folded, mimic joints followed), its forward
+//! kinematics and geometric Jacobian, a damped least-squares IK with joint and
+//! velocity limits and a null-space posture term, and its rigid-body dynamics (the
+//! recursive Newton-Euler and articulated-body algorithms). Pure math, no I/O: the
+//! nodes read the file, this crate reads the text.
+//!
+//! Vectors follow Pinocchio's order (`[linear; angular]`), so every figure compares
+//! with it entry by entry; the tests do (tests/chain.rs of the workspace, against
+//! `pin` on the Panda, the UR5 and the xArm7).
+//!
+//! The README follows; its examples run as doctests.
+#![doc = include_str!("../README.md")]
+
+pub mod chain;
+pub mod dynamics;
+mod error;
+pub mod ik;
+pub mod kinematics;
+pub mod spatial;
+pub mod urdf;
+
+pub use chain::{Chain, Dof};
+pub use dynamics::Dynamics;
+pub use error::Error;
+pub use ik::{Ik, IkConfig, IkStats, IkStep, Pose};
+pub use spatial::Frame;
+pub use urdf::Robot;
