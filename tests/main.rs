@@ -6,6 +6,7 @@
 
 mod util;
 
+mod arm;
 mod bad_input;
 mod bench;
 mod bilateral;

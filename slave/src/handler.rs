@@ -5,11 +5,12 @@
 //! the protocol.
 
 use crate::hsd::{Measured, Slave};
+use crate::urdf_arm::ArmState;
 use std::time::Duration;
 use tactile_devices::held::Held;
 use tactile_devices::{Peripheral, Robot};
 use tactile_messages::samples::{Backward, Forward};
-use tactile_records::slave::{SlaveCounters, SlaveSample, SlaveTotals, Step};
+use tactile_records::slave::{ArmJoints, SlaveCounters, SlaveSample, SlaveTotals, Step};
 use tactile_ros::view::{SampleView, SlaveView};
 use tactile_runtime::driver::{changed, Counts, Failure, Follower, Handler, Io, Reply};
 use tactile_scenario::Scenario;
@@ -176,10 +177,14 @@ impl Follower for SlaveHandler {
         let (h, step) = self.slave.step(v);
         self.due = Some(step.theta_ref);
         self.last_step = Some(step);
+        let record = match self.slave.arm_state() {
+            Some(a) => SlaveSample::ArmStep(step, joints(a)),
+            None => SlaveSample::Step(step),
+        };
         Ok(Reply {
             forward: None,
             backward: Some(h),
-            record: Some(SlaveSample::Step(step)),
+            record: Some(record),
         })
     }
 
@@ -217,6 +222,18 @@ impl Follower for SlaveHandler {
                 held
             }
         };
-        Ok(Some(SlaveSample::Hold(held)))
+        Ok(Some(match self.slave.arm_state() {
+            Some(a) => SlaveSample::ArmHold(held, joints(a)),
+            None => SlaveSample::Hold(held),
+        }))
+    }
+}
+
+/// A URDF arm's joints as its record holds them.
+fn joints(a: &ArmState) -> ArmJoints {
+    ArmJoints {
+        q_ref: a.q_ref.clone(),
+        q: a.q.clone(),
+        tau: a.tau.clone(),
     }
 }

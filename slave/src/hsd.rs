@@ -14,6 +14,7 @@
 
 use crate::arm::{Controller, Dynamics, JointState};
 use crate::environment::deepest_contact;
+use crate::urdf_arm::{ArmState, UrdfArm};
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::SlaveSide;
 use tactile_math::arith::StdTrig;
@@ -46,6 +47,10 @@ pub struct Slave {
     predictor: Predictor,
     /// A real robot's joints (and force sensor) for the next step, in place of SD.
     measured: Option<Measured>,
+    /// Any arm from its URDF in place of the paper's (`[slave.arm]`).
+    arm: Option<UrdfArm>,
+    /// The URDF arm's joints held since input went silent.
+    arm_hold: Option<Vec<f64>>,
 }
 
 /// What a real robot measured for one step.
@@ -58,8 +63,15 @@ pub struct Measured {
 }
 
 impl Slave {
-    /// A slave at rest (zero joint angles) for the scenario.
-    pub fn new(scenario: &Scenario) -> Result<Slave, ScenarioError> {
+    /// A slave at rest (zero joint angles, or a URDF arm at its home) for the
+    /// scenario; `arm` is the scenario's `[slave.arm]` loaded (`UrdfArm::of_scenario`).
+    pub fn new(scenario: &Scenario, arm: Option<UrdfArm>) -> Result<Slave, ScenarioError> {
+        if scenario.slave.arm.is_some() != arm.is_some() {
+            return Err(ScenarioError::Invalid {
+                field: "slave.arm".into(),
+                problem: "the arm's URDF must be loaded with the scenario that names it".into(),
+            });
+        }
         let geometry = scenario.device.geometry()?;
         let engine = Engine::new(scenario.arithmetic, geometry, scenario.cordic.config()?)
             .map_err(|e| ScenarioError::Invalid {
@@ -95,6 +107,8 @@ impl Slave {
             counters: SlaveCounters::default(),
             hold_from: None,
             measured: None,
+            arm,
+            arm_hold: None,
         })
     }
 
@@ -108,9 +122,17 @@ impl Slave {
         self.dynamics.state
     }
 
+    /// A URDF arm's joints, if the slave is one.
+    pub fn arm_state(&self) -> Option<&ArmState> {
+        self.arm.as_ref().map(UrdfArm::state)
+    }
+
     /// One sample of t_s with no input: hold the joints where they were when the input
     /// went silent (the master or the network is gone; the device must not wander).
     pub fn hold(&mut self) -> HoldStep {
+        if self.arm.is_some() {
+            return self.hold_arm();
+        }
         let theta_now = self.dynamics.state.theta;
         let from = *self.hold_from.get_or_insert_with(|| {
             self.counters.holds += 1;
@@ -136,6 +158,31 @@ impl Slave {
             theta: self.dynamics.state.theta,
             torque: cmd.torque,
             tool: p,
+        }
+    }
+
+    /// [`Slave::hold`] for a URDF arm: its servo holds the joints where they were.
+    fn hold_arm(&mut self) -> HoldStep {
+        let Some(arm) = self.arm.as_mut() else {
+            return HoldStep::default();
+        };
+        if self.arm_hold.is_none() {
+            self.counters.holds += 1;
+            let now = arm.state().q.clone();
+            self.arm_hold = Some(now);
+        }
+        let from = self.arm_hold.as_deref().unwrap_or_default();
+        arm.hold_at(from);
+        let p0 = arm.tool_at(from);
+        self.counters.held_steps += 1;
+        let clamps = arm.advance(self.t_s, &self.objects);
+        self.counters.torque_clamps += u64::from(clamps);
+        let p = arm.tool();
+        self.counters.hold_drift_max_m = self.counters.hold_drift_max_m.max(distance(p, p0));
+        HoldStep {
+            step: self.counters.held_steps,
+            tool: p,
+            ..HoldStep::default()
         }
     }
 
@@ -189,6 +236,7 @@ impl Slave {
     pub fn step(&mut self, v: &Forward) -> (Backward, Step) {
         self.counters.steps += 1;
         self.hold_from = None;
+        self.arm_hold = None;
         let (mut flags, observer, dissipated_j) = self.follow(v);
         let measured = self.measured.take();
         let (theta, torque, clamps) = self.move_joints(measured);
@@ -240,6 +288,10 @@ impl Slave {
             return (flags, [0.0; 3], 0.0);
         }
         let r = self.control.receive(est.value(), energy, self.last_force);
+        if self.arm.is_some() {
+            flags |= self.follow_arm(r.position);
+            return (flags, r.observer, r.dissipated);
+        }
         // IK-HSD, then JPD-HSD: pass-through.
         let ik = self.engine.ik(r.position);
         match ik.status {
@@ -259,12 +311,40 @@ impl Slave {
         (flags, r.observer, r.dissipated)
     }
 
+    /// IK for a URDF arm: its reference joints toward the position; the flags.
+    fn follow_arm(&mut self, position: [f64; 3]) -> u32 {
+        let Some(arm) = self.arm.as_mut() else {
+            return 0;
+        };
+        let f = arm.follow(position, self.t_s);
+        let c = &mut self.counters;
+        c.ik_joint_limited += u64::from(f.joint_limited);
+        c.ik_velocity_limited += u64::from(f.velocity_limited);
+        c.ik_damped += u64::from(f.damped);
+        let mut flags = 0;
+        if f.unreachable {
+            flags |= FLAG_IK_CLAMPED;
+            c.ik_clamped += 1;
+        }
+        if f.refused {
+            flags |= FLAG_REJECTED;
+            c.rejected += 1;
+        }
+        flags
+    }
+
     /// FCS and SD: the joint controller and the simulated joints, or the real robot
     /// (its own controller follows the reference; its encoders say where it is).
     /// Returns the angles, the torques and the torque clamps.
     fn move_joints(&mut self, measured: Option<Measured>) -> ([f64; 3], [f64; 3], u32) {
         if let Some(m) = measured {
             return (m.theta, [0.0; 3], 0);
+        }
+        if let Some(arm) = self.arm.as_mut() {
+            // The arm's joints are in its own record entry: not three angles.
+            let clamps = arm.advance(self.t_s, &self.objects);
+            self.counters.torque_clamps += u64::from(clamps);
+            return ([0.0; 3], [0.0; 3], clamps);
         }
         let state = self.dynamics.state;
         let cmd = self
@@ -284,8 +364,15 @@ impl Slave {
         sensor: Option<[f64; 3]>,
         flags: &mut u32,
     ) -> ([f64; 3], [f64; 3], [f64; 3], u32) {
-        let tool = self.engine.fk(theta);
-        let contact = deepest_contact(&self.objects, kernels::fk(&self.truth, &StdTrig, theta));
+        let (tool, truth) = match &self.arm {
+            // A URDF arm's kernels are f64 (tactile-chain): its FK is the truth.
+            Some(arm) => (arm.tool(), arm.tool()),
+            None => (
+                self.engine.fk(theta),
+                kernels::fk(&self.truth, &StdTrig, theta),
+            ),
+        };
+        let contact = deepest_contact(&self.objects, truth);
         let (force, surface, object) = match (sensor, contact) {
             (Some(f), _) => {
                 // A force-torque sensor: its force is h(n); no surface is known.
@@ -298,7 +385,10 @@ impl Slave {
             (None, Some(c)) => {
                 *flags |= FLAG_CONTACT;
                 self.counters.contact_steps += 1;
-                let f = self.engine.fbf(c.surface, tool, c.stiffness);
+                let f = match self.arm {
+                    Some(_) => kernels::fbf(c.surface, tool, c.stiffness),
+                    None => self.engine.fbf(c.surface, tool, c.stiffness),
+                };
                 (f, c.surface, c.object as u32)
             }
             (None, None) => ([0.0; 3], [0.0; 3], u32::MAX),

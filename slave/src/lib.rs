@@ -1,6 +1,7 @@
 //! The slave side of the loop (the paper's HSD, SD and ENV): the simulated arm's
 //! controller and joint dynamics ([`arm`]), its environment ([`environment`]), the HSD
-//! kernels as a pure state machine ([`hsd`]), what the slave does with each sample the
+//! kernels as a pure state machine ([`hsd`]), any arm from its URDF in place of the
+//! paper's ([`urdf_arm`]), what the slave does with each sample the
 //! loop's driver hands it ([`handler`]), and its program ([`node`]). The same handler
 //! runs in the `tactile-slave` program and in the in-process simulation.
 
@@ -9,3 +10,4 @@ pub mod environment;
 pub mod handler;
 pub mod hsd;
 pub mod node;
+pub mod urdf_arm;

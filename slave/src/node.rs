@@ -2,6 +2,7 @@
 
 use crate::handler::SlaveHandler;
 use crate::hsd::Slave;
+use crate::urdf_arm::UrdfArm;
 use clap::Parser;
 use std::process::ExitCode;
 use tactile_messages::Role;
@@ -41,8 +42,11 @@ pub fn main() -> ExitCode {
 pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let a = &cli.node;
     let program = Program::prepare(Role::Slave, a, Links::all(a.link.link))?;
-    program.follow(Box::new(|p, outside| {
-        let slave = Slave::new(&p.scenario).map_err(|e| NodeError::Failed(e.to_string()))?;
+    // Read and checked before anything starts: a bad URDF is bad input (exit 2).
+    let arm = UrdfArm::of_scenario(program.scenario(), &program.prepared().base_dir)
+        .map_err(NodeError::BadInput)?;
+    program.follow(Box::new(move |p, outside| {
+        let slave = Slave::new(&p.scenario, arm).map_err(|e| NodeError::Failed(e.to_string()))?;
         Ok(SlaveHandler::new(slave, &p.scenario, outside.robot.take()))
     }))
 }

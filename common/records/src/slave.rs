@@ -27,6 +27,12 @@ pub struct SlaveCounters {
     pub hold_drift_max_m: f64,
     /// Backward samples the codec put on the network (the others went as clock only).
     pub packets_sent: u64,
+    /// A URDF arm (`[slave.arm]`): IK calls a joint limit clamped.
+    pub ik_joint_limited: u64,
+    /// A URDF arm: IK calls the joints' velocity limits shortened.
+    pub ik_velocity_limited: u64,
+    /// A URDF arm: IK calls that damped near a singularity.
+    pub ik_damped: u64,
 }
 
 /// One step on a received v(n).
@@ -81,15 +87,41 @@ pub struct HoldStep {
     pub tool: [f64; 3],
 }
 
+/// A URDF arm's joints after a step (`[slave.arm]`), in the chain's order; the
+/// step's three-angle fields are the paper arm's and stay zero.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ArmJoints {
+    /// The IK's joint references, rad or m.
+    pub q_ref: Vec<f64>,
+    /// Joint values, rad or m.
+    pub q: Vec<f64>,
+    /// Efforts the servo applied, N m or N.
+    pub tau: Vec<f64>,
+}
+
 /// One entry per step the slave took. A sample lives for one write or one read, and
 /// steps outnumber holds: boxing the step would allocate on every sample for nothing.
 #[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum SlaveSample {
     /// A step on v(n).
     Step(Step),
     /// A step holding position.
     Hold(HoldStep),
+    /// A step on v(n) of a URDF arm, with its joints.
+    ArmStep(Step, ArmJoints),
+    /// A step holding position of a URDF arm, with its joints.
+    ArmHold(HoldStep, ArmJoints),
+}
+
+impl SlaveSample {
+    /// The step on v(n), if this is one (of any arm).
+    pub fn step(&self) -> Option<&Step> {
+        match self {
+            SlaveSample::Step(s) | SlaveSample::ArmStep(s, _) => Some(s),
+            SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
+        }
+    }
 }
 
 /// The slave's counters.

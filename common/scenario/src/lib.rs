@@ -6,6 +6,7 @@
 //! delay, a zero rate, negative noise) is refused with the field's dotted path before
 //! anything starts. The defaults reproduce the paper's setup.
 
+mod arm;
 mod bounds;
 mod control;
 pub mod csv;
@@ -21,6 +22,7 @@ mod ros;
 mod slave;
 mod validate;
 
+pub use arm::{ArmConfig, ArmIkConfig, MAX_ARM_DOF};
 pub use control::{
     CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, PredictorConfig, PredictorKind,
 };
@@ -170,6 +172,9 @@ impl Scenario {
         let mut v = Vec::new();
         if let Operator::Csv { path, .. } = &mut self.operator {
             v.push(path);
+        }
+        if let Some(arm) = &mut self.slave.arm {
+            v.push(&mut arm.urdf);
         }
         for c in [&mut self.network.forward, &mut self.network.backward] {
             if let Some(r) = &mut c.replay {

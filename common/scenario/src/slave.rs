@@ -2,7 +2,7 @@
 //! objects the tool can touch.
 
 use crate::{finite3, invalid, positive3, ScenarioError};
-use crate::{Backend, PredictorConfig, RosRobotConfig};
+use crate::{ArmConfig, Backend, PredictorConfig, RosRobotConfig};
 use serde::{Deserialize, Serialize};
 
 /// The slave side.
@@ -20,6 +20,9 @@ pub struct SlaveConfig {
     pub backend: Backend,
     /// The ROS 2 robot, with `backend = "ros2"`.
     pub ros2: RosRobotConfig,
+    /// Any serial arm from its URDF, simulated, in place of the paper's arm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub arm: Option<ArmConfig>,
 }
 
 /// PD or PID per joint: u = kp e + ki integral(e) + kd de/dt, clamped to the limit.
@@ -148,6 +151,15 @@ impl SlaveConfig {
             ));
         }
         self.predictor.validate("slave.predictor")?;
+        if let Some(arm) = &self.arm {
+            arm.validate()?;
+            if self.backend == Backend::Ros2 {
+                return Err(invalid(
+                    "slave.arm",
+                    "a URDF arm is simulated only for now: a robot over ROS 2 (slave.backend = \"ros2\") must have the paper arm's three joints; drop [slave.arm] or set slave.backend = \"simulated\"",
+                ));
+            }
+        }
         self.ros2.validate()
     }
 }

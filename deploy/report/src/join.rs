@@ -16,7 +16,7 @@ use tactile_messages::samples::{stage, LATE_WINDOW};
 use tactile_messages::Role;
 use tactile_records::emulator::{Direction, EmulatorTotals, Passage};
 use tactile_records::master::{Answer, MasterSample, MasterTotals, Miss, Sent};
-use tactile_records::slave::{SlaveSample, SlaveTotals, Step};
+use tactile_records::slave::{ArmJoints, SlaveSample, SlaveTotals, Step};
 use tactile_records::{record_path, Damage, Record, RecordReader, Start, Totals};
 
 /// Events kept per node in the report; further ones are counted, not kept, so a node
@@ -343,10 +343,7 @@ fn passage_key(p: &Passage) -> Option<u64> {
 }
 
 fn slave_key(s: &SlaveSample) -> Option<u64> {
-    match s {
-        SlaveSample::Step(x) => Some(x.n),
-        SlaveSample::Hold(_) => None,
-    }
+    s.step().map(|x| x.n)
 }
 
 /// What the master recorded for one sample: what went out, and what came back or
@@ -473,12 +470,12 @@ impl Sources {
     }
 }
 
-/// Joins the records found in `dirs`, handing each sample's row to `each` in order.
-/// `each` may stop the join early (a stop request): the logs then hold what was read
-/// so far.
+/// Joins the records found in `dirs`, handing each sample's row to `each` in order,
+/// with a URDF arm's joints where the slave is one. `each` may stop the join early (a
+/// stop request): the logs then hold what was read so far.
 pub fn join(
     dirs: &[PathBuf],
-    mut each: impl FnMut(&TraceRow) -> Result<ControlFlow<()>, Error>,
+    mut each: impl FnMut(&TraceRow, Option<&ArmJoints>) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
     let [m, e, s] = locate(dirs)?;
     let mut src = Sources {
@@ -498,11 +495,16 @@ pub fn join(
             return src.logs(true);
         };
         let passages = src.emulator.take(n)?;
-        let step = src.slave.take(n)?.iter().find_map(|x| match x {
-            SlaveSample::Step(s) => Some(*s),
-            SlaveSample::Hold(_) => None,
-        });
-        if each(&row(&part, &passages, step.as_ref()))?.is_break() {
+        let steps = src.slave.take(n)?;
+        let (step, joints) = steps
+            .iter()
+            .find_map(|x| match x {
+                SlaveSample::Step(s) => Some((Some(*s), None)),
+                SlaveSample::ArmStep(s, j) => Some((Some(*s), Some(j))),
+                SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
+            })
+            .unwrap_or((None, None));
+        if each(&row(&part, &passages, step.as_ref()), joints)?.is_break() {
             return src.logs(false);
         }
         n += 1;

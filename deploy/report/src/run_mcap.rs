@@ -31,6 +31,8 @@ pub struct Recording<W: Write> {
     channels: Vec<u16>,
     geometry: Geometry,
     objects: Vec<Object>,
+    /// Whether the slave is the paper's arm (drawn in /tf), not a URDF arm.
+    paper_slave: bool,
     rate_hz: u64,
     t_s_ns: f64,
     /// Lockstep: log times are nominal, `n t_s` after the first sample's tick.
@@ -66,6 +68,7 @@ impl<W: Write> Recording<W> {
             channels,
             geometry,
             objects: scenario.environment.objects.clone(),
+            paper_slave: scenario.slave.arm.is_none(),
             rate_hz: (scenario.rate_hz.round() as u64).max(1),
             t_s_ns: scenario.t_s() * 1e9,
             nominal: (scenario.mode == Mode::Lockstep).then_some(None),
@@ -148,7 +151,15 @@ impl<W: Write> Recording<W> {
     /// Both arms' link transforms at the row's angles.
     fn transforms(&self, row: &TraceRow, log: u64) -> TfMessage {
         let mut tf = TfMessage::default();
-        for (name, theta) in [("master", row.theta_md), ("slave", row.theta_sd)] {
+        let arms = [("master", row.theta_md), ("slave", row.theta_sd)];
+        // A URDF arm's links are not the paper arm's: it is left out of /tf, not drawn
+        // as the paper's arm at rest.
+        let drawn = if self.paper_slave {
+            &arms[..]
+        } else {
+            &arms[..1]
+        };
+        for &(name, theta) in drawn {
             for (parent, child, translation, rotation) in arm::links(&self.geometry, name, theta) {
                 tf.transforms.push(TransformStamped {
                     header: Header::at(log, &parent),

@@ -10,10 +10,16 @@ use tactile_records::master::MasterTotals;
 use tactile_records::slave::SlaveTotals;
 use tactile_scenario::Mode;
 
+/// A URDF arm's joints, one row a sample: `n`, then the IK's references, the joint
+/// values and the servo's efforts, each `_1` to `_<dof>` in the chain's order
+/// (written only when the slave is a URDF arm, `[slave.arm]`).
+pub const JOINTS_FILE: &str = "joints.csv";
+
 /// Files a report writes into its folder.
-pub const REPORT_FILES: [&str; 11] = [
+pub const REPORT_FILES: [&str; 12] = [
     "summary.json",
     "trace.csv",
+    JOINTS_FILE,
     "run.mcap",
     "round_trip.hgrm",
     "overhead.hgrm",

@@ -5,13 +5,14 @@ use crate::analysis::{Analysis, STAGES};
 use crate::join::{self, Logs, NodeLog};
 use crate::metrics::Packets;
 use crate::plots::{self, Series};
-pub use crate::summary::REPORT_FILES;
 use crate::summary::{ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
+pub use crate::summary::{JOINTS_FILE, REPORT_FILES};
 use crate::Error;
 use crate::{run_mcap, trace};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::io::Write as _;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -21,7 +22,7 @@ use std::time::{Duration, Instant};
 use tactile_messages::Role;
 use tactile_records::emulator::EmulatorTotals;
 use tactile_records::master::MasterTotals;
-use tactile_records::slave::SlaveTotals;
+use tactile_records::slave::{ArmJoints, SlaveTotals};
 use tactile_records::Start;
 use tactile_scenario::Scenario;
 
@@ -79,6 +80,7 @@ fn remove_if_there(path: &Path) -> Result<(), Error> {
 fn discard(out: &Path) {
     run_mcap::discard(out);
     let _ = std::fs::remove_file(crate::out::partial(&out.join("trace.csv")));
+    let _ = std::fs::remove_file(crate::out::partial(&out.join(JOINTS_FILE)));
 }
 
 pub use crate::out::make_out_dir;
@@ -354,6 +356,8 @@ fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
 /// `run.mcap` (neither with `--no-trace`).
 struct Streams {
     trace: Option<std::io::BufWriter<std::fs::File>>,
+    /// A URDF arm's joints, one row a sample (`[slave.arm]`).
+    joints: Option<std::io::BufWriter<std::fs::File>>,
     recording: Option<run_mcap::FileRecording>,
     line: String,
     t0: Option<u64>,
@@ -366,8 +370,10 @@ impl Streams {
         if no_trace {
             let _ = std::fs::remove_file(&trace_path);
             let _ = std::fs::remove_file(out.join(run_mcap::FILE));
+            let _ = std::fs::remove_file(out.join(JOINTS_FILE));
             return Ok(Streams {
                 trace: None,
+                joints: None,
                 recording: None,
                 line: String::new(),
                 t0: None,
@@ -378,15 +384,33 @@ impl Streams {
         let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
         writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
         let recording = run_mcap::create(out, scenario).map_err(Error::io("writing run.mcap"))?;
+        let joints = match &scenario.slave.arm {
+            Some(arm) => Some(joints_csv(out, arm.home.len())?),
+            None => {
+                let _ = std::fs::remove_file(out.join(JOINTS_FILE));
+                None
+            }
+        };
         Ok(Streams {
             trace: Some(w),
+            joints,
             recording: Some(recording),
             line: String::with_capacity(2048),
             t0: None,
         })
     }
 
-    fn add(&mut self, row: &trace::TraceRow) -> Result<(), Error> {
+    fn add(&mut self, row: &trace::TraceRow, joints: Option<&ArmJoints>) -> Result<(), Error> {
+        if let (Some(w), Some(j)) = (self.joints.as_mut(), joints) {
+            self.line.clear();
+            let _ = write!(self.line, "{}", row.n);
+            for x in j.q_ref.iter().chain(&j.q).chain(&j.tau) {
+                let _ = write!(self.line, ",{x:?}");
+            }
+            self.line.push('\n');
+            w.write_all(self.line.as_bytes())
+                .map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
+        }
         if let Some(w) = self.trace.as_mut() {
             let t0 = *self.t0.get_or_insert(row.stamps[0]);
             self.line.clear();
@@ -402,6 +426,12 @@ impl Streams {
 
     /// Flushes the trace and gives the recording its name.
     fn finish(self, out: &Path) -> Result<(), Error> {
+        if let Some(mut w) = self.joints {
+            let path = out.join(JOINTS_FILE);
+            w.flush()
+                .and_then(|()| std::fs::rename(crate::out::partial(&path), &path))
+                .map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
+        }
         if let Some(mut w) = self.trace {
             w.flush().map_err(Error::io("writing trace.csv"))?;
             let path = out.join("trace.csv");
@@ -413,6 +443,22 @@ impl Streams {
         }
         Ok(())
     }
+}
+
+/// Starts `joints.csv` (as its partial file) with its header, for `dof` joints.
+fn joints_csv(out: &Path, dof: usize) -> Result<std::io::BufWriter<std::fs::File>, Error> {
+    let path = out.join(JOINTS_FILE);
+    let f = std::fs::File::create(crate::out::partial(&path))
+        .map_err(Error::io(format!("writing {}", path.display())))?;
+    let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
+    let mut header = String::from("n");
+    for field in ["q_ref", "q", "tau"] {
+        for i in 1..=dof {
+            let _ = write!(header, ",{field}_{i}");
+        }
+    }
+    writeln!(w, "{header}").map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
+    Ok(w)
 }
 
 /// The histograms and the plots of a run.
@@ -485,7 +531,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
             || launch.until.is_some_and(|u| Instant::now() >= u)
     };
     let mut cut_short = None;
-    let logs = join::join(dirs, |row| {
+    let logs = join::join(dirs, |row, joints| {
         // Looked at every 1024 samples: a clock read per sample would cost.
         if row.n % 1024 == 0 && stopped() {
             cut_short = Some(row.n);
@@ -493,7 +539,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         }
         analysis.add(row);
         series.add(row, t_s);
-        streams.add(row)?;
+        streams.add(row, joints)?;
         Ok(ControlFlow::Continue(()))
     })
     .inspect_err(|_| discard(out))?;
@@ -526,7 +572,7 @@ pub fn write_mcap(dirs: &[PathBuf], out: &Path) -> Result<u64, Error> {
     make_out_dir(out)?;
     let mut rec = run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
     let mut samples = 0;
-    join::join(dirs, |row| {
+    join::join(dirs, |row, _| {
         samples += 1;
         rec.add(row).map_err(Error::io("writing run.mcap"))?;
         Ok(ControlFlow::Continue(()))

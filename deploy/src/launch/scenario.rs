@@ -73,6 +73,8 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
     warnings.extend(source.warnings(scenario.samples, scenario.t_s()));
     tactile_network_emulator::replay::load(&scenario, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    tactile_slave::urdf_arm::UrdfArm::of_scenario(&scenario, &base_dir)
+        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
     for c in [&scenario.network.forward, &scenario.network.backward] {
         if let Some(r) = &c.replay {
@@ -81,6 +83,9 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
     }
     if let Operator::Csv { path, .. } = &scenario.operator {
         inputs.push(base_dir.join(path));
+    }
+    if let Some(arm) = &scenario.slave.arm {
+        inputs.push(base_dir.join(&arm.urdf));
     }
     Ok(Loaded {
         scenario,

@@ -1,0 +1,183 @@
+//! `[slave.arm]`: the slave as any serial arm from its URDF, simulated (its rigid-body
+//! dynamics from the URDF's inertias, a joint-space PD with gravity compensation, the
+//! IK of `tactile-chain`). Without this table the slave is the paper's 3-DoF arm with
+//! its closed-form kernels.
+//!
+//! The loop still carries positions in the master's frame: the arm's tool target is its
+//! home pose moved by `scale` times the master's displacement from the paper arm's
+//! home, the orientation held at home; the environment is evaluated at the arm's tool
+//! mapped back into the master's frame, so a scenario's objects and stiffnesses keep
+//! their meaning whatever the arm.
+
+use crate::{invalid, positive, ScenarioError};
+use serde::{Deserialize, Serialize};
+
+/// The slave arm from a URDF.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArmConfig {
+    /// The URDF file (relative to the scenario's folder).
+    pub urdf: String,
+    /// The link poses are given in (the arm's base).
+    pub base: String,
+    /// The link the IK moves (the tool).
+    pub tip: String,
+    /// Joint values at the start, one per degree of freedom in chain order, rad or m.
+    pub home: Vec<f64>,
+    /// Proportional gains of the joint PD, one per degree of freedom, N m/rad.
+    pub kp: Vec<f64>,
+    /// Derivative gains, one per degree of freedom, N m s/rad.
+    pub kd: Vec<f64>,
+    /// Metres the arm's tool moves per metre of the master's.
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Integration step of the arm's dynamics, s (at most 10 ms).
+    #[serde(default = "step")]
+    pub step_s: f64,
+    /// Gravity in the base frame, m/s^2.
+    #[serde(default = "gravity")]
+    pub gravity: [f64; 3],
+    /// The IK's settings.
+    #[serde(default)]
+    pub ik: ArmIkConfig,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn step() -> f64 {
+    2.5e-4
+}
+fn gravity() -> [f64; 3] {
+    [0.0, 0.0, -9.81]
+}
+
+/// The IK's settings (`tactile_chain::IkConfig`), each with its default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ArmIkConfig {
+    /// Newton steps per sample at most.
+    pub max_iterations: u32,
+    /// Metres an orientation error of one radian weighs against a position error.
+    pub orientation_weight: f64,
+    /// The largest damping, reached at a singularity (weighted units, m).
+    pub damping_max: f64,
+    /// Smallest singular value below which the damping starts (weighted units, m).
+    pub singular_threshold: f64,
+    /// Fraction of the gap to the home posture closed per sample in the null space
+    /// (redundant arms).
+    pub posture_gain: f64,
+    /// Fraction of each URDF velocity limit the reference may use.
+    pub velocity_scale: f64,
+}
+
+impl Default for ArmIkConfig {
+    fn default() -> Self {
+        ArmIkConfig {
+            max_iterations: 4,
+            orientation_weight: 0.1,
+            damping_max: 0.04,
+            singular_threshold: 0.02,
+            posture_gain: 0.02,
+            velocity_scale: 1.0,
+        }
+    }
+}
+
+impl ArmConfig {
+    /// Checks what can be checked without the URDF; the lengths of `home`, `kp` and
+    /// `kd` against the chain's degrees of freedom are checked where the URDF is read.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        for (field, v) in [
+            ("urdf", &self.urdf),
+            ("base", &self.base),
+            ("tip", &self.tip),
+        ] {
+            if v.trim().is_empty() {
+                return Err(invalid(format!("slave.arm.{field}"), "must not be empty"));
+            }
+        }
+        for (field, v, zero_ok) in [
+            ("home", &self.home, None),
+            ("kp", &self.kp, Some(false)),
+            ("kd", &self.kd, Some(true)),
+        ] {
+            if v.is_empty() || v.len() > MAX_ARM_DOF {
+                return Err(invalid(
+                    format!("slave.arm.{field}"),
+                    format!(
+                        "has {} values; it takes one per joint (1 to {MAX_ARM_DOF})",
+                        v.len()
+                    ),
+                ));
+            }
+            for (i, x) in v.iter().enumerate() {
+                let f = format!("slave.arm.{field}[{i}]");
+                match zero_ok {
+                    None if !x.is_finite() => {
+                        return Err(invalid(f, format!("{x} is not a finite number")))
+                    }
+                    None => {}
+                    Some(z) => positive(*x, &f, z)?,
+                }
+            }
+        }
+        if !(self.scale.is_finite() && self.scale > 0.0 && self.scale <= 100.0) {
+            return Err(invalid(
+                "slave.arm.scale",
+                format!("{} is outside (0, 100]", self.scale),
+            ));
+        }
+        if !self.step_s.is_finite() || self.step_s < 1e-6 || self.step_s > 0.01 {
+            return Err(invalid(
+                "slave.arm.step_s",
+                format!("{} s is outside 1 us to 10 ms", self.step_s),
+            ));
+        }
+        for (i, g) in self.gravity.iter().enumerate() {
+            if !g.is_finite() || g.abs() > 100.0 {
+                return Err(invalid(
+                    format!("slave.arm.gravity[{i}]"),
+                    format!("{g} m/s^2 is not a finite number within 100"),
+                ));
+            }
+        }
+        self.ik.validate()
+    }
+}
+
+/// The most degrees of freedom an arm may have (a record holds its joints whole).
+pub const MAX_ARM_DOF: usize = 16;
+
+impl ArmIkConfig {
+    fn validate(&self) -> Result<(), ScenarioError> {
+        if !(1..=50).contains(&self.max_iterations) {
+            return Err(invalid(
+                "slave.arm.ik.max_iterations",
+                format!("{} is outside 1..=50", self.max_iterations),
+            ));
+        }
+        positive(
+            self.orientation_weight,
+            "slave.arm.ik.orientation_weight",
+            false,
+        )?;
+        positive(self.damping_max, "slave.arm.ik.damping_max", false)?;
+        positive(
+            self.singular_threshold,
+            "slave.arm.ik.singular_threshold",
+            false,
+        )?;
+        positive(self.posture_gain, "slave.arm.ik.posture_gain", true)?;
+        if self.posture_gain > 1.0 {
+            return Err(invalid("slave.arm.ik.posture_gain", "must be at most 1"));
+        }
+        if !(self.velocity_scale > 0.0 && self.velocity_scale <= 1.0) {
+            return Err(invalid(
+                "slave.arm.ik.velocity_scale",
+                format!("{} is outside (0, 1]", self.velocity_scale),
+            ));
+        }
+        Ok(())
+    }
+}

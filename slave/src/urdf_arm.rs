@@ -1,0 +1,412 @@
+//! The slave as any serial arm from its URDF, simulated: the IK of `tactile-chain`
+//! turns the received position into joint references once a sample, a joint-space PD
+//! on the references and their velocity (as a joint trajectory controller's) with
+//! gravity compensation (the robot's own servo, evaluated at every integration
+//! step as a real arm's inner loop runs far faster than the network's samples) drives
+//! the joints, and the articulated-body algorithm integrates the URDF's inertias under
+//! gravity, the joints' damping and the environment's contact force at the tool.
+//!
+//! The loop carries positions in the master's frame (see `tactile_scenario::ArmConfig`):
+//! the tool's target is its home pose moved by `scale` times the master's displacement
+//! from `master_home`, its orientation held at home; the environment sees the tool
+//! mapped back into the master's frame, and the contact force it returns acts on the
+//! arm's tool as it is (the objects are the master frame's, so a wall keeps its place
+//! and stiffness for the operator whatever the arm).
+
+use nalgebra::{Matrix6xX, Vector3};
+use std::path::Path;
+use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
+use tactile_math::arith::StdTrig;
+use tactile_scenario::{ArmConfig, Object, Scenario};
+
+use crate::environment::deepest_contact;
+use tactile_math::kernels;
+
+/// Largest URDF file read, bytes (the Panda's is 15 kB; meshes are separate files).
+pub const MAX_URDF_BYTES: u64 = 16 << 20;
+
+/// The simulated arm and its references.
+#[derive(Debug, Clone)]
+pub struct UrdfArm {
+    chain: Chain,
+    ik: Ik,
+    dynamics: Dynamics,
+    cfg: ArmConfig,
+    home_tool: Frame,
+    master_home: [f64; 3],
+    state: ArmState,
+    jac: Matrix6xX<f64>,
+}
+
+/// The arm's joints after a step: references, angles, velocities, efforts.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ArmState {
+    /// The IK's joint references, rad or m.
+    pub q_ref: Vec<f64>,
+    /// The references' velocity over the last period (the servo's feedforward), rad/s
+    /// or m/s.
+    pub qd_ref: Vec<f64>,
+    /// Joint values, rad or m.
+    pub q: Vec<f64>,
+    /// Joint velocities, rad/s or m/s.
+    pub qd: Vec<f64>,
+    /// The PD's efforts (with gravity compensation) at the step's last integration
+    /// step, after the effort limits, N m or N.
+    pub tau: Vec<f64>,
+}
+
+/// What one IK call did, for the slave's flags and counters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Followed {
+    /// The target is out of reach (error left that speed does not explain).
+    pub unreachable: bool,
+    /// A joint limit clamped the reference.
+    pub joint_limited: bool,
+    /// The velocity limit shortened the reference's step.
+    pub velocity_limited: bool,
+    /// The IK damped (near a singularity).
+    pub damped: bool,
+    /// The IK refused the call (a non-finite input): the reference held.
+    pub refused: bool,
+}
+
+impl UrdfArm {
+    /// The scenario's `[slave.arm]`, its URDF read (relative to `base_dir`) and
+    /// checked; `None` without one (the paper's arm).
+    pub fn of_scenario(scenario: &Scenario, base_dir: &Path) -> Result<Option<Self>, String> {
+        let Some(cfg) = &scenario.slave.arm else {
+            return Ok(None);
+        };
+        let geometry = scenario.device.geometry().map_err(|e| e.to_string())?;
+        // The paper arm's tool at zero angles: where the master starts.
+        let home = kernels::fk(&geometry.lengths(), &StdTrig, [0.0; 3]);
+        UrdfArm::load(cfg, base_dir, home).map(Some)
+    }
+
+    /// Reads the URDF named by `cfg` (relative to `base_dir`) and makes the arm.
+    pub fn load(cfg: &ArmConfig, base_dir: &Path, master_home: [f64; 3]) -> Result<Self, String> {
+        let path = base_dir.join(&cfg.urdf);
+        let xml = tactile_runtime::files::read_text(&path, "URDF", MAX_URDF_BYTES)?;
+        UrdfArm::new(cfg, &xml, master_home)
+            .map_err(|e| format!("slave.arm: {}: {e}", path.display()))
+    }
+
+    /// The arm of `cfg` from the URDF text `xml`, at rest at its home posture;
+    /// `master_home` is the master's position that maps onto the tool's home pose.
+    pub fn new(cfg: &ArmConfig, xml: &str, master_home: [f64; 3]) -> Result<Self, String> {
+        let chain = Chain::from_urdf(xml, &cfg.base, &cfg.tip).map_err(|e| e.to_string())?;
+        let dof = chain.dof();
+        for (field, v) in [("home", &cfg.home), ("kp", &cfg.kp), ("kd", &cfg.kd)] {
+            if v.len() != dof {
+                return Err(format!(
+                    "field `slave.arm.{field}`: has {} values; the chain from `{}` to `{}` has {dof} joints ({})",
+                    v.len(),
+                    cfg.base,
+                    cfg.tip,
+                    chain.dofs.iter().map(|d| d.name.as_str()).collect::<Vec<_>>().join(", ")
+                ));
+            }
+        }
+        for (d, q) in chain.dofs.iter().zip(&cfg.home) {
+            if *q < d.lower || *q > d.upper {
+                return Err(format!(
+                    "field `slave.arm.home`: {q} for joint `{}` is outside its limits [{}, {}]",
+                    d.name, d.lower, d.upper
+                ));
+            }
+        }
+        let dynamics =
+            Dynamics::new(&chain, Vector3::from(cfg.gravity)).map_err(|e| e.to_string())?;
+        let ik_cfg = IkConfig {
+            max_iterations: cfg.ik.max_iterations as usize,
+            orientation_weight: cfg.ik.orientation_weight,
+            damping_max: cfg.ik.damping_max,
+            singular_threshold: cfg.ik.singular_threshold,
+            posture: Some(cfg.home.clone()),
+            posture_gain: cfg.ik.posture_gain,
+            velocity_scale: cfg.ik.velocity_scale,
+            ..IkConfig::default()
+        };
+        let ik = Ik::new(&chain, ik_cfg).map_err(|e| e.to_string())?;
+        let home_tool = chain.fk(&cfg.home);
+        let state = ArmState {
+            q_ref: cfg.home.clone(),
+            qd_ref: vec![0.0; dof],
+            q: cfg.home.clone(),
+            qd: vec![0.0; dof],
+            tau: vec![0.0; dof],
+        };
+        Ok(UrdfArm {
+            jac: Matrix6xX::zeros(dof),
+            chain,
+            ik,
+            dynamics,
+            cfg: cfg.clone(),
+            home_tool,
+            master_home,
+            state,
+        })
+    }
+
+    /// The joints now.
+    pub fn state(&self) -> &ArmState {
+        &self.state
+    }
+
+    /// The chain.
+    pub fn chain(&self) -> &Chain {
+        &self.chain
+    }
+
+    /// The tool's target in the arm's base frame for the master's `position`.
+    pub fn target(&self, position: [f64; 3]) -> Frame {
+        let d = Vector3::from(position) - Vector3::from(self.master_home);
+        Frame {
+            r: self.home_tool.r,
+            p: self.home_tool.p + self.cfg.scale * d,
+        }
+    }
+
+    /// The tool (FK of the joints) mapped into the master's frame, m.
+    pub fn tool(&self) -> [f64; 3] {
+        self.to_master(&self.chain.fk(&self.state.q).p)
+    }
+
+    /// The tool at joints `q`, in the master's frame, m.
+    pub fn tool_at(&self, q: &[f64]) -> [f64; 3] {
+        self.to_master(&self.chain.fk(q).p)
+    }
+
+    fn to_master(&self, p: &Vector3<f64>) -> [f64; 3] {
+        let m = Vector3::from(self.master_home) + (p - self.home_tool.p) / self.cfg.scale;
+        [m.x, m.y, m.z]
+    }
+
+    /// IK toward the master's `position`, one period of `dt` from the last reference
+    /// (the reference is a smooth path the servo follows, as a trajectory generator's).
+    pub fn follow(&mut self, position: [f64; 3], dt: f64) -> Followed {
+        let target = self.target(position);
+        match self.ik.step(&self.state.q_ref, &target, dt) {
+            Ok(s) => {
+                for ((v, new), old) in self
+                    .state
+                    .qd_ref
+                    .iter_mut()
+                    .zip(&s.q)
+                    .zip(&self.state.q_ref)
+                {
+                    *v = (new - old) / dt;
+                }
+                self.state.q_ref = s.q;
+                Followed {
+                    unreachable: s.unreachable,
+                    joint_limited: s.clamped,
+                    velocity_limited: s.velocity_limited,
+                    damped: s.damping > 0.0,
+                    refused: false,
+                }
+            }
+            Err(_) => Followed {
+                refused: true,
+                ..Followed::default()
+            },
+        }
+    }
+
+    /// Holds the joints at `q_ref` (the angles where input went silent).
+    pub fn hold_at(&mut self, q_ref: &[f64]) {
+        self.state.q_ref.copy_from_slice(q_ref);
+        self.state.qd_ref.iter_mut().for_each(|v| *v = 0.0);
+    }
+
+    /// Integrates the arm over `dt` under its servo, pushed by whatever the tool
+    /// touches among `objects`. Returns how many joints hit their effort limit.
+    pub fn advance(&mut self, dt: f64, objects: &[Object]) -> u32 {
+        let steps = (dt / self.cfg.step_s).ceil().max(1.0) as u32;
+        let h = dt / f64::from(steps);
+        let mut clamped = vec![false; self.chain.dof()];
+        for _ in 0..steps {
+            let tau = self.servo(&mut clamped);
+            let ext = self.contact_torques(objects);
+            let drive: Vec<f64> = (0..tau.len())
+                .map(|i| tau[i] + ext[i] - self.chain.dofs[i].damping * self.state.qd[i])
+                .collect();
+            let Ok(acc) = self.dynamics.aba(&self.state.q, &self.state.qd, &drive) else {
+                break;
+            };
+            if acc.iter().any(|a| !a.is_finite()) {
+                // Never integrate a non-finite state: the joints stop where they are.
+                self.state.qd.iter_mut().for_each(|v| *v = 0.0);
+                break;
+            }
+            self.integrate(&acc, h);
+            self.state.tau = tau;
+        }
+        clamped.iter().filter(|c| **c).count() as u32
+    }
+
+    /// The PD with gravity compensation, clamped to each joint's effort limit.
+    fn servo(&self, clamped: &mut [bool]) -> Vec<f64> {
+        let g = self
+            .dynamics
+            .gravity_torques(&self.state.q)
+            .unwrap_or_else(|_| vec![0.0; self.chain.dof()]);
+        let s = &self.state;
+        (0..g.len())
+            .map(|i| {
+                let u = self.cfg.kp[i] * (s.q_ref[i] - s.q[i])
+                    + self.cfg.kd[i] * (s.qd_ref[i] - s.qd[i])
+                    + g[i];
+                let limit = self.chain.dofs[i].effort;
+                let t = u.clamp(-limit, limit);
+                clamped[i] |= t != u;
+                t
+            })
+            .collect()
+    }
+
+    /// The contact force at the tool (the environment's, evaluated in the master's
+    /// frame) as joint efforts: J_v^T f.
+    fn contact_torques(&mut self, objects: &[Object]) -> Vec<f64> {
+        let tip = self.chain.jacobian(&self.state.q, &mut self.jac);
+        let tool = self.to_master(&tip.p);
+        let Some(c) = deepest_contact(objects, tool) else {
+            return vec![0.0; self.chain.dof()];
+        };
+        let f = Vector3::from(kernels::fbf(c.surface, tool, c.stiffness));
+        (0..self.chain.dof())
+            .map(|i| self.jac.fixed_view::<3, 1>(0, i).dot(&f))
+            .collect()
+    }
+
+    /// Semi-implicit Euler; a joint that reaches its limit stops there.
+    fn integrate(&mut self, acc: &[f64], h: f64) {
+        let s = &mut self.state;
+        for (i, d) in self.chain.dofs.iter().enumerate() {
+            s.qd[i] += h * acc[i];
+            s.q[i] += h * s.qd[i];
+            if s.q[i] < d.lower || s.q[i] > d.upper {
+                s.q[i] = s.q[i].clamp(d.lower, d.upper);
+                s.qd[i] = 0.0;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tactile_scenario::ArmIkConfig;
+
+    fn panda_xml() -> String {
+        let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../deploy/robots/panda.urdf");
+        std::fs::read_to_string(p).expect("panda.urdf")
+    }
+
+    fn panda_cfg() -> ArmConfig {
+        ArmConfig {
+            urdf: "panda.urdf".into(),
+            base: "panda_link0".into(),
+            tip: "panda_hand".into(),
+            home: vec![0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796, 0.785398],
+            kp: vec![600.0, 600.0, 600.0, 600.0, 250.0, 150.0, 50.0],
+            kd: vec![50.0, 50.0, 50.0, 50.0, 30.0, 25.0, 15.0],
+            scale: 1.0,
+            step_s: 2.5e-4,
+            gravity: [0.0, 0.0, -9.81],
+            ik: ArmIkConfig::default(),
+        }
+    }
+
+    const HOME: [f64; 3] = [0.0, -0.107, -0.035];
+
+    #[test]
+    fn gravity_compensation_holds_the_arm_at_home() {
+        let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+        for _ in 0..1000 {
+            arm.follow(HOME, 1e-3);
+            assert_eq!(arm.advance(1e-3, &[]), 0);
+        }
+        let s = arm.state();
+        for (q, h) in s.q.iter().zip(&panda_cfg().home) {
+            assert!((q - h).abs() < 1e-6, "{q} against {h}");
+        }
+        let tool = arm.tool();
+        for k in 0..3 {
+            assert!((tool[k] - HOME[k]).abs() < 1e-6, "{tool:?}");
+        }
+    }
+
+    #[test]
+    fn at_rest_the_servo_gives_the_gravity_torques() {
+        // At home with no error the servo's effort is the gravity torque itself (RNEA),
+        // far from zero: without it the arm would sag.
+        let arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+        let g = arm.dynamics.gravity_torques(&panda_cfg().home).expect("g");
+        let mut clamped = vec![false; 7];
+        let tau = arm.servo(&mut clamped);
+        assert_eq!(tau, g);
+        assert!(g[1].abs() > 1.0, "{g:?}");
+    }
+
+    #[test]
+    fn the_tool_follows_a_scaled_displacement_and_maps_back() {
+        let cfg = ArmConfig {
+            scale: 2.0,
+            ..panda_cfg()
+        };
+        let mut arm = UrdfArm::new(&cfg, &panda_xml(), HOME).expect("arm");
+        let home_tool = arm.chain().fk(&cfg.home);
+        let goal = [HOME[0] + 0.01, HOME[1] - 0.02, HOME[2] + 0.015];
+        for _ in 0..2000 {
+            arm.follow(goal, 1e-3);
+            arm.advance(1e-3, &[]);
+        }
+        // In the robot's frame the tool moved twice the master's displacement...
+        let p = arm.chain().fk(&arm.state().q).p - home_tool.p;
+        for (k, d) in [0.02, -0.04, 0.03].iter().enumerate() {
+            assert!((p[k] - d).abs() < 1e-5, "{p:?}");
+        }
+        // ...and mapped back it is where the master is.
+        let t = arm.tool();
+        for k in 0..3 {
+            assert!((t[k] - goal[k]).abs() < 1e-5, "{t:?}");
+        }
+    }
+
+    #[test]
+    fn a_wall_pushes_the_tool_back_and_efforts_stay_in_limits() {
+        let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+        let wall = Object::Plane {
+            point: [0.0, 0.0, HOME[2] - 0.01],
+            normal: [0.0, 0.0, 1.0],
+            stiffness: [600.0; 3],
+        };
+        let goal = [HOME[0], HOME[1], HOME[2] - 0.03];
+        for _ in 0..3000 {
+            arm.follow(goal, 1e-3);
+            arm.advance(1e-3, std::slice::from_ref(&wall));
+        }
+        let t = arm.tool();
+        // Held between the wall and the target: inside the wall, short of the target.
+        assert!(t[2] < HOME[2] - 0.01 && t[2] > goal[2] + 1e-3, "{t:?}");
+        for (tau, d) in arm.state().tau.iter().zip(&arm.chain().dofs) {
+            assert!(tau.abs() <= d.effort);
+        }
+    }
+
+    #[test]
+    fn a_chain_that_does_not_fit_the_table_is_named() {
+        let cfg = ArmConfig {
+            kp: vec![1.0; 6],
+            ..panda_cfg()
+        };
+        let e = UrdfArm::new(&cfg, &panda_xml(), HOME).expect_err("six gains");
+        assert!(
+            e.contains("slave.arm.kp") && e.contains("has 7 joints"),
+            "{e}"
+        );
+        let e = UrdfArm::new(&panda_cfg(), "<robot name=\"x\"/>", HOME).expect_err("empty");
+        assert!(e.contains("panda_link0"), "{e}");
+    }
+}

@@ -1,0 +1,185 @@
+//! Any arm from its URDF as the slave (`[slave.arm]`): the shipped Panda scenario
+//! follows the master in free space within a millimetre and presses the wall, its
+//! joints stay inside the URDF's limits, two runs give the same bytes, the node
+//! programs load the arm as the in-process run does, and a bad arm is refused before
+//! anything starts, naming the field.
+
+use crate::util;
+
+use std::path::{Path, PathBuf};
+use util::{column, Sandbox};
+
+/// The shipped Panda scenario.
+fn panda() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/panda.toml")
+}
+
+/// The Panda's URDF, as the shipped scenario names it.
+fn panda_urdf() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("robots/panda.urdf")
+}
+
+/// The shipped Panda scenario's text, its URDF named by an absolute path (so a copy
+/// runs from a sandbox).
+fn panda_text() -> String {
+    let text = std::fs::read_to_string(panda()).expect("scenario");
+    text.replace(
+        "../robots/panda.urdf",
+        panda_urdf().to_str().expect("utf-8"),
+    )
+}
+
+/// Rows of a CSV file, header first.
+fn rows(path: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .expect("csv")
+        .lines()
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+#[test]
+fn a_panda_follows_in_free_space_presses_the_wall_and_stays_in_its_limits() {
+    let sb = Sandbox::new("armpanda");
+    sb.simulate(&panda(), "a");
+    let trace = sb.trace("a");
+    let (tool, v, h3) = (
+        (1..=3)
+            .map(|i| column(&trace, &format!("tool_{i}")))
+            .collect::<Vec<_>>(),
+        (1..=3)
+            .map(|i| column(&trace, &format!("v_{i}")))
+            .collect::<Vec<_>>(),
+        column(&trace, "h_3"),
+    );
+    assert_eq!(h3.len(), 4000);
+    // In free space (no force) the hand is where the master's position puts it.
+    let mut free = 0;
+    for n in 0..h3.len() {
+        if h3[n] == 0.0 {
+            free += 1;
+            let e = (0..3)
+                .map(|k| (tool[k][n] - v[k][n]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            assert!(e < 1e-3, "sample {n}: tool {e} m from its target");
+        }
+    }
+    assert!(free > 1000, "{free} samples in free space");
+    // The wall at z = -0.08 pushes back up, as its stiffness says.
+    let h_max = h3.iter().copied().fold(0.0, f64::max);
+    assert!(h_max > 5.0, "largest wall force {h_max} N");
+
+    // joints.csv: a row a sample, 7 references, 7 angles, 7 efforts, all in limits.
+    let j = rows(&sb.path("a").join("joints.csv"));
+    assert_eq!(j.len(), 4001);
+    assert_eq!(j[0].len(), 1 + 3 * 7);
+    assert_eq!(j[0][1], "q_ref_1");
+    assert_eq!(j[0][15], "tau_1");
+    let chain = tactile_chain::Chain::from_urdf(
+        &std::fs::read_to_string(panda_urdf()).expect("urdf"),
+        "panda_link0",
+        "panda_hand",
+    )
+    .expect("chain");
+    for row in &j[1..] {
+        let x: Vec<f64> = row[1..].iter().map(|c| c.parse().expect("float")).collect();
+        for (i, d) in chain.dofs.iter().enumerate() {
+            for q in [x[i], x[7 + i]] {
+                assert!(q >= d.lower && q <= d.upper, "{}: {q}", d.name);
+            }
+            assert!(
+                x[14 + i].abs() <= d.effort,
+                "{}: effort {}",
+                d.name,
+                x[14 + i]
+            );
+        }
+    }
+    let s = sb.json("a", "summary.json");
+    let c = &s["slave"]["counters"];
+    assert_eq!(c["ik_clamped"], 0, "{c}");
+    assert_eq!(c["rejected"], 0, "{c}");
+
+    // The same scenario and seed give the same bytes.
+    sb.simulate(&panda(), "b");
+    for f in ["trace.csv", "joints.csv"] {
+        let (a, b) = (sb.path("a").join(f), sb.path("b").join(f));
+        let strip = |p: &Path| {
+            let text = std::fs::read_to_string(p).expect("read");
+            if f == "trace.csv" {
+                tactile_report::trace::signal_columns(&text)
+            } else {
+                text
+            }
+        };
+        assert!(strip(&a) == strip(&b), "{f} differs between two runs");
+    }
+}
+
+#[test]
+fn the_node_programs_load_the_arm_as_the_in_process_run_does() {
+    let sb = Sandbox::new("armnodes");
+    let scenario = sb.write(
+        "panda.toml",
+        &panda_text()
+            .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+            .replace("samples = 4000", "samples = 300"),
+    );
+    sb.simulate(&scenario, "sim");
+    sb.run(&scenario, "nodes");
+    let out = sb.path("nodes");
+    // The URDF travels with the run: bundled into the output folder's inputs.
+    let bundled = out.join("inputs").join("panda.urdf");
+    assert_eq!(
+        std::fs::read(&bundled).expect("bundled urdf"),
+        std::fs::read(panda_urdf()).expect("urdf")
+    );
+    let joints = rows(&out.join("joints.csv"));
+    assert_eq!(joints.len(), 301);
+    // The slave program's arm starts where the in-process one does.
+    assert_eq!(joints[1], rows(&sb.path("sim").join("joints.csv"))[1]);
+}
+
+#[test]
+fn a_bad_arm_is_named_and_nothing_starts() {
+    let sb = Sandbox::new("armbad");
+    let base = panda_text();
+    let cases: [(&str, &str, &str); 6] = [
+        (
+            "home = [0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796, 0.785398]",
+            "home = [0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796]",
+            "field `slave.arm.home`: has 6 values; the chain from `panda_link0` to `panda_hand` has 7 joints",
+        ),
+        (
+            "home = [0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796, 0.785398]",
+            "home = [0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796, 9.0]",
+            "field `slave.arm.home`: 9 for joint `panda_joint7` is outside its limits",
+        ),
+        ("tip = \"panda_hand\"", "tip = \"panda_nose\"", "chain from `panda_link0` to `panda_nose`"),
+        (
+            "kd = [50.0,",
+            "kd = [-50.0,",
+            "field `slave.arm.kd[0]`: -50 must be finite and non-negative",
+        ),
+        ("panda.urdf\"", "missing.urdf\"", "missing.urdf"),
+        (
+            "[slave.arm]",
+            "[slave]\nbackend = \"ros2\"\n[slave.arm]",
+            "field `slave.arm`: a URDF arm is simulated only for now",
+        ),
+    ];
+    for (k, (from, to, want)) in cases.iter().enumerate() {
+        assert!(base.contains(from), "case {k}: {from}");
+        let s = sb.write(&format!("bad{k}.toml"), &base.replacen(from, to, 1));
+        let out = format!("out{k}");
+        let o = sb.tactile(&["run", s.to_str().expect("utf-8"), "--out", &out, "-q"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "case {k}: {err}");
+        assert!(err.contains(want), "case {k}: want {want:?} in {err}");
+        assert!(
+            !sb.path(&out).join("slave.rec").exists(),
+            "case {k}: started"
+        );
+    }
+}
