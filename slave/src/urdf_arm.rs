@@ -296,6 +296,7 @@ impl UrdfArm {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
     use tactile_scenario::ArmIkConfig;
 
     fn panda_xml() -> String {
@@ -308,7 +309,15 @@ mod tests {
             urdf: "panda.urdf".into(),
             base: "panda_link0".into(),
             tip: "panda_hand".into(),
-            home: vec![0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796, 0.785398],
+            home: vec![
+                0.0,
+                -FRAC_PI_4,
+                0.0,
+                -3.0 * FRAC_PI_4,
+                0.0,
+                FRAC_PI_2,
+                FRAC_PI_4,
+            ],
             kp: vec![600.0, 600.0, 600.0, 600.0, 250.0, 150.0, 50.0],
             kd: vec![50.0, 50.0, 50.0, 50.0, 30.0, 25.0, 15.0],
             scale: 1.0,
