@@ -14,7 +14,7 @@
 
 use crate::arm::{Controller, Dynamics, JointState};
 use crate::environment::deepest_contact;
-use crate::urdf_arm::{ArmState, UrdfArm};
+use crate::urdf_arm::{ArmState, Followed, UrdfArm};
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::SlaveSide;
 use tactile_math::arith::StdTrig;
@@ -49,8 +49,6 @@ pub struct Slave {
     measured: Option<Measured>,
     /// Any arm from its URDF in place of the paper's (`[slave.arm]`).
     arm: Option<UrdfArm>,
-    /// The URDF arm's joints held since input went silent.
-    arm_hold: Option<Vec<f64>>,
 }
 
 /// What a real robot measured for one step.
@@ -108,7 +106,6 @@ impl Slave {
             hold_from: None,
             measured: None,
             arm,
-            arm_hold: None,
         })
     }
 
@@ -130,8 +127,19 @@ impl Slave {
     /// One sample of t_s with no input: hold the joints where they were when the input
     /// went silent (the master or the network is gone; the device must not wander).
     pub fn hold(&mut self) -> HoldStep {
-        if self.arm.is_some() {
-            return self.hold_arm();
+        if let Some(arm) = self.arm.as_mut() {
+            let h = arm.hold(self.t_s, &self.objects);
+            let c = &mut self.counters;
+            c.holds += u64::from(h.started);
+            c.held_steps += 1;
+            c.torque_clamps += u64::from(h.clamps);
+            c.hold_drift_max_m = c.hold_drift_max_m.max(h.drift_m);
+            // The arm's joints are in its own record entry: not three angles.
+            return HoldStep {
+                step: c.held_steps,
+                tool: h.tool,
+                ..HoldStep::default()
+            };
         }
         let theta_now = self.dynamics.state.theta;
         let from = *self.hold_from.get_or_insert_with(|| {
@@ -158,31 +166,6 @@ impl Slave {
             theta: self.dynamics.state.theta,
             torque: cmd.torque,
             tool: p,
-        }
-    }
-
-    /// [`Slave::hold`] for a URDF arm: its servo holds the joints where they were.
-    fn hold_arm(&mut self) -> HoldStep {
-        let Some(arm) = self.arm.as_mut() else {
-            return HoldStep::default();
-        };
-        if self.arm_hold.is_none() {
-            self.counters.holds += 1;
-            let now = arm.state().q.clone();
-            self.arm_hold = Some(now);
-        }
-        let from = self.arm_hold.as_deref().unwrap_or_default();
-        arm.hold_at(from);
-        let p0 = arm.tool_at(from);
-        self.counters.held_steps += 1;
-        let clamps = arm.advance(self.t_s, &self.objects);
-        self.counters.torque_clamps += u64::from(clamps);
-        let p = arm.tool();
-        self.counters.hold_drift_max_m = self.counters.hold_drift_max_m.max(distance(p, p0));
-        HoldStep {
-            step: self.counters.held_steps,
-            tool: p,
-            ..HoldStep::default()
         }
     }
 
@@ -236,7 +219,9 @@ impl Slave {
     pub fn step(&mut self, v: &Forward) -> (Backward, Step) {
         self.counters.steps += 1;
         self.hold_from = None;
-        self.arm_hold = None;
+        if let Some(arm) = self.arm.as_mut() {
+            arm.end_hold();
+        }
         let (mut flags, observer, dissipated_j) = self.follow(v);
         let measured = self.measured.take();
         let (theta, torque, clamps) = self.move_joints(measured);
@@ -288,8 +273,8 @@ impl Slave {
             return (flags, [0.0; 3], 0.0);
         }
         let r = self.control.receive(est.value(), energy, self.last_force);
-        if self.arm.is_some() {
-            flags |= self.follow_arm(r.position);
+        if let Some(arm) = self.arm.as_mut() {
+            flags |= count_followed(&mut self.counters, arm.follow(r.position, self.t_s));
             return (flags, r.observer, r.dissipated);
         }
         // IK-HSD, then JPD-HSD: pass-through.
@@ -309,28 +294,6 @@ impl Slave {
             self.reference = ik.theta;
         }
         (flags, r.observer, r.dissipated)
-    }
-
-    /// IK for a URDF arm: its reference joints toward the position; the flags.
-    fn follow_arm(&mut self, position: [f64; 3]) -> u32 {
-        let Some(arm) = self.arm.as_mut() else {
-            return 0;
-        };
-        let f = arm.follow(position, self.t_s);
-        let c = &mut self.counters;
-        c.ik_joint_limited += u64::from(f.joint_limited);
-        c.ik_velocity_limited += u64::from(f.velocity_limited);
-        c.ik_damped += u64::from(f.damped);
-        let mut flags = 0;
-        if f.unreachable {
-            flags |= FLAG_IK_CLAMPED;
-            c.ik_clamped += 1;
-        }
-        if f.refused {
-            flags |= FLAG_REJECTED;
-            c.rejected += 1;
-        }
-        flags
     }
 
     /// FCS and SD: the joint controller and the simulated joints, or the real robot
@@ -366,7 +329,10 @@ impl Slave {
     ) -> ([f64; 3], [f64; 3], [f64; 3], u32) {
         let (tool, truth) = match &self.arm {
             // A URDF arm's kernels are f64 (tactile-chain): its FK is the truth.
-            Some(arm) => (arm.tool(), arm.tool()),
+            Some(arm) => {
+                let tool = arm.tool();
+                (tool, tool)
+            }
             None => (
                 self.engine.fk(theta),
                 kernels::fk(&self.truth, &StdTrig, theta),
@@ -422,4 +388,21 @@ impl Slave {
         out.signal.flags |= flags;
         out
     }
+}
+
+/// Counts what a URDF arm's IK call did; the flags it sets on h(n).
+fn count_followed(c: &mut SlaveCounters, f: Followed) -> u32 {
+    c.ik_joint_limited += u64::from(f.joint_limited);
+    c.ik_velocity_limited += u64::from(f.velocity_limited);
+    c.ik_damped += u64::from(f.damped);
+    let mut flags = 0;
+    if f.unreachable {
+        flags |= FLAG_IK_CLAMPED;
+        c.ik_clamped += 1;
+    }
+    if f.refused {
+        flags |= FLAG_REJECTED;
+        c.rejected += 1;
+    }
+    flags
 }

@@ -36,6 +36,8 @@ pub struct UrdfArm {
     master_home: [f64; 3],
     state: ArmState,
     jac: Matrix6xX<f64>,
+    /// The joints held since input went silent, if it is.
+    held: Option<Vec<f64>>,
 }
 
 /// The arm's joints after a step: references, angles, velocities, efforts.
@@ -68,6 +70,19 @@ pub struct Followed {
     pub damped: bool,
     /// The IK refused the call (a non-finite input): the reference held.
     pub refused: bool,
+}
+
+/// What one period of holding did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Holding {
+    /// This period started the hold (the input just went silent).
+    pub started: bool,
+    /// Joints that hit their effort limit.
+    pub clamps: u32,
+    /// How far the tool is from where it was held, m (master's frame).
+    pub drift_m: f64,
+    /// The tool in the master's frame, m.
+    pub tool: [f64; 3],
 }
 
 impl UrdfArm {
@@ -145,6 +160,7 @@ impl UrdfArm {
             home_tool,
             master_home,
             state,
+            held: None,
         })
     }
 
@@ -170,11 +186,6 @@ impl UrdfArm {
     /// The tool (FK of the joints) mapped into the master's frame, m.
     pub fn tool(&self) -> [f64; 3] {
         self.to_master(&self.chain.fk(&self.state.q).p)
-    }
-
-    /// The tool at joints `q`, in the master's frame, m.
-    pub fn tool_at(&self, q: &[f64]) -> [f64; 3] {
-        self.to_master(&self.chain.fk(q).p)
     }
 
     fn to_master(&self, p: &Vector3<f64>) -> [f64; 3] {
@@ -213,10 +224,28 @@ impl UrdfArm {
         }
     }
 
-    /// Holds the joints at `q_ref` (the angles where input went silent).
-    pub fn hold_at(&mut self, q_ref: &[f64]) {
-        self.state.q_ref.copy_from_slice(q_ref);
+    /// One period of `dt` with no input: the servo holds the joints where they were
+    /// when the input went silent, the arm integrated as in [`UrdfArm::advance`].
+    pub fn hold(&mut self, dt: f64, objects: &[Object]) -> Holding {
+        let started = self.held.is_none();
+        let from = self.held.get_or_insert_with(|| self.state.q.clone());
+        self.state.q_ref.copy_from_slice(from);
         self.state.qd_ref.iter_mut().for_each(|v| *v = 0.0);
+        let p0 = self.chain.fk(&self.state.q_ref).p;
+        let clamps = self.advance(dt, objects);
+        let p = self.chain.fk(&self.state.q).p;
+        Holding {
+            started,
+            clamps,
+            // Measured in the master's frame, as the paper arm's drift is.
+            drift_m: (p - p0).norm() / self.cfg.scale,
+            tool: self.to_master(&p),
+        }
+    }
+
+    /// Input is back: the next silence holds where the joints are then.
+    pub fn end_hold(&mut self) {
+        self.held = None;
     }
 
     /// Integrates the arm over `dt` under its servo, pushed by whatever the tool
@@ -402,6 +431,33 @@ mod tests {
         for (tau, d) in arm.state().tau.iter().zip(&arm.chain().dofs) {
             assert!(tau.abs() <= d.effort);
         }
+    }
+
+    #[test]
+    fn a_hold_keeps_the_joints_where_the_input_went_silent() {
+        let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+        let goal = [HOME[0] + 0.02, HOME[1], HOME[2]];
+        for _ in 0..100 {
+            arm.follow(goal, 1e-3);
+            arm.advance(1e-3, &[]);
+        }
+        // Still moving when the input stops: the servo brings it back to where it was.
+        let at_silence = arm.state().q.clone();
+        let first = arm.hold(1e-3, &[]);
+        assert!(first.started);
+        let mut last = first;
+        for _ in 0..1000 {
+            last = arm.hold(1e-3, &[]);
+            assert!(!last.started);
+            // Braking from the velocity limit overshoots by about 2 mm, no more.
+            assert!(last.drift_m < 5e-3, "{last:?}");
+        }
+        assert!(last.drift_m < 1e-6, "{last:?}");
+        for (q, h) in arm.state().q.iter().zip(&at_silence) {
+            assert!((q - h).abs() < 1e-5);
+        }
+        arm.end_hold();
+        assert!(arm.hold(1e-3, &[]).started);
     }
 
     #[test]

@@ -97,11 +97,7 @@ impl ArmConfig {
                 return Err(invalid(format!("slave.arm.{field}"), "must not be empty"));
             }
         }
-        for (field, v, zero_ok) in [
-            ("home", &self.home, None),
-            ("kp", &self.kp, Some(false)),
-            ("kd", &self.kd, Some(true)),
-        ] {
+        for (field, v) in [("home", &self.home), ("kp", &self.kp), ("kd", &self.kd)] {
             if v.is_empty() || v.len() > MAX_ARM_DOF {
                 return Err(invalid(
                     format!("slave.arm.{field}"),
@@ -111,15 +107,18 @@ impl ArmConfig {
                     ),
                 ));
             }
+        }
+        for (i, x) in self.home.iter().enumerate() {
+            if !x.is_finite() {
+                return Err(invalid(
+                    format!("slave.arm.home[{i}]"),
+                    format!("{x} is not a finite number"),
+                ));
+            }
+        }
+        for (field, v, zero_ok) in [("kp", &self.kp, false), ("kd", &self.kd, true)] {
             for (i, x) in v.iter().enumerate() {
-                let f = format!("slave.arm.{field}[{i}]");
-                match zero_ok {
-                    None if !x.is_finite() => {
-                        return Err(invalid(f, format!("{x} is not a finite number")))
-                    }
-                    None => {}
-                    Some(z) => positive(*x, &f, z)?,
-                }
+                positive(*x, &format!("slave.arm.{field}[{i}]"), zero_ok)?;
             }
         }
         if !(self.scale.is_finite() && self.scale > 0.0 && self.scale <= 100.0) {
