@@ -7,6 +7,7 @@ use crate::util;
 use std::process::{Child, Stdio};
 use std::time::Duration;
 use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
+use tactile_report::trace::signal_columns;
 use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber};
 use tactile_transport::{Publish, Subscribe};
 use util::{column, Sandbox};
@@ -125,6 +126,45 @@ fn peer_dies_and_the_loop_resumes(role: &str) {
             .filter(|r| **r == 1.0)
             .count()
             > 100
+    );
+}
+
+/// Lockstep has no clock, so neither a drop nor a stall may change what it computes:
+/// with 5 % of the samples dropped each way and the emulator, then the master,
+/// stopped for 300 ms mid-run (a loaded machine's worst), the three processes give the
+/// in-process run's signals exactly. Before the emulator's drop notice, each drop cost
+/// the master a 100 ms timeout, and a stall past it held a sample the in-process run
+/// did not.
+#[test]
+fn lockstep_drops_and_stalls_change_nothing() {
+    let sb = Sandbox::new("lockstall");
+    let text = util::paper_1khz(20_000)
+        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        .replace("[network.forward]\n", "[network.forward]\nloss = 0.05\n")
+        .replace("[network.backward]\n", "[network.backward]\nloss = 0.05\n");
+    let scenario = sb.write("s.toml", &text);
+    let child = spawn_run(&sb, &scenario, "run");
+    let rec = sb.path("run").join("master.rec");
+    for (role, bytes) in [("emulator", 400_000), ("master", 1_600_000)] {
+        util::wait_for("the run got going", Duration::from_secs(30), || {
+            std::fs::metadata(&rec).is_ok_and(|m| m.len() >= bytes)
+        });
+        let pid = pid_of(&sb, role).unwrap_or_else(|| panic!("no {role} running"));
+        kill(pid, rustix::process::Signal::STOP);
+        std::thread::sleep(Duration::from_millis(300));
+        kill(pid, rustix::process::Signal::CONT);
+    }
+    let (code, _, stderr) = finish(child);
+    assert_eq!(code, Some(0), "{stderr}");
+    sb.assert_no_leftover_processes();
+    sb.simulate(&scenario, "sim");
+    let (run, sim) = (sb.trace("run"), sb.trace("sim"));
+    assert_eq!(signal_columns(&run), signal_columns(&sim));
+    let s = sb.json("run", "summary.json");
+    let held = util::num(&s["master"]["counters"]["held_samples"]);
+    assert!(
+        held > 1000.0,
+        "{held} samples dropped of 20,000 at 5 % each way"
     );
 }
 

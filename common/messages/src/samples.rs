@@ -77,6 +77,11 @@ pub const FLAG_UNSENT: u32 = 1024;
 /// Flag: on a probe's echo, the node at the end of the chain is there but still
 /// waits for its robot, so the master can say what it waits for.
 pub const FLAG_WAITING: u32 = 2048;
+/// Flag: lockstep only, a notice from the emulator to the master that sample `seq`
+/// was dropped on purpose (the loss model): no answer to it comes, so the master
+/// counts the miss at once, as the in-process run does, instead of waiting out a
+/// timeout whose firing would depend on the machine's load.
+pub const FLAG_DROPPED: u32 = 4096;
 
 /// A sample that carries a per-hop publish counter.
 pub trait Sequenced {

@@ -135,7 +135,11 @@ impl Program {
                 run: new_run_token(),
                 samples: self.prepared.scenario.samples,
                 startup_timeout,
-                answer_timeout: Duration::from_millis(100),
+                // Lockstep only (realtime waits for the next tick): drops come as
+                // the emulator's notice, so this waits out only a peer that is gone
+                // or stalled; at 100 ms a loaded machine's stall counted as a miss
+                // and lockstep traces differed from run to run.
+                answer_timeout: Duration::from_secs(1),
                 timing: self.timing(),
             };
             Lead::new(h, link, rec, opts, outside.live)

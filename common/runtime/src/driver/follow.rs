@@ -10,7 +10,9 @@ use super::{Counts, Failure, Follower, Io, Timing};
 use crate::pace::Pacer;
 use std::time::{Duration, Instant};
 use tactile_devices::{DeviceCounters, LiveSink};
-use tactile_messages::samples::{stage, Backward, Forward, FLAG_END, FLAG_PROBE, FLAG_WAITING};
+use tactile_messages::samples::{
+    stage, Backward, Forward, FLAG_DROPPED, FLAG_END, FLAG_PROBE, FLAG_WAITING,
+};
 use tactile_records::{Events, Recorder};
 
 /// The run this node serves: learned from the master's first sample (probe or data);
@@ -295,6 +297,8 @@ impl<H: Follower> Follow<H> {
             self.awaiting = Some(v.seq);
             v.stamps[fwd_send] = self.timing.stamp();
             sent |= self.link.send_forward(v, false)?;
+        } else if self.place == Place::Middle {
+            self.dropped(c.seq, c.run)?;
         }
         if let Some(mut h) = reply.backward {
             h.run = c.run;
@@ -316,10 +320,30 @@ impl<H: Follower> Follow<H> {
         );
         self.handler.after(&mut io);
         self.finish(c.seq, reply.record)?;
+        // Lockstep has no clock: silence is slowness, not a lost master, and a held
+        // step would change the signals with the machine's load.
         self.idle_at = self
             .handler
             .idle_timing()
+            .filter(|_| self.timing != Timing::Lockstep)
             .map(|(after, _)| Instant::now() + after);
+        Ok(())
+    }
+
+    /// Lockstep: tells the master that sample `seq` was dropped here, so it counts the
+    /// miss at once (in realtime the tick's deadline does; in one process, the
+    /// runner sees nothing more can come).
+    fn dropped(&mut self, seq: u64, run: u64) -> Result<(), Failure> {
+        if self.timing != Timing::Lockstep {
+            return Ok(());
+        }
+        let mut notice = Backward {
+            seq,
+            run,
+            ..Backward::default()
+        };
+        notice.signal.flags = FLAG_DROPPED;
+        self.link.send_backward(notice, true)?;
         Ok(())
     }
 
@@ -336,6 +360,8 @@ impl<H: Follower> Follow<H> {
         if let Some(mut q) = reply.backward {
             q.stamps[stage::EMU_BWD_SEND] = self.timing.stamp();
             self.link.send_backward(q, false)?;
+        } else {
+            self.dropped(h.seq, h.run)?;
         }
         self.finish(h.seq, reply.record)
     }

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use tactile_devices::{DeviceCounters, LiveSink};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{
-    stage, Backward, Forward, FLAG_END, FLAG_PROBE, FLAG_WAITING, LATE_WINDOW,
+    stage, Backward, Forward, FLAG_DROPPED, FLAG_END, FLAG_PROBE, FLAG_WAITING, LATE_WINDOW,
 };
 use tactile_records::{Events, Recorder};
 
@@ -294,6 +294,14 @@ impl<H: Leader> Lead<H> {
         loop {
             match self.link.wait(deadline, block)? {
                 Ok(super::Arrival::Backward(q)) => {
+                    if q.signal.flags & FLAG_DROPPED != 0 {
+                        // The emulator dropped sample n: no answer comes.
+                        if q.run == self.opts.run && q.seq == n {
+                            self.miss(n, origin)?;
+                            break;
+                        }
+                        continue;
+                    }
                     if self.absorb(q, n, origin)? == Some(n) {
                         break;
                     }
@@ -327,7 +335,7 @@ impl<H: Leader> Lead<H> {
         origin: u64,
     ) -> Result<Option<u64>, Failure> {
         q.stamps[stage::MASTER_RECV] = self.opts.timing.stamp();
-        if q.signal.flags & FLAG_PROBE != 0 {
+        if q.signal.flags & (FLAG_PROBE | FLAG_DROPPED) != 0 {
             return Ok(None);
         }
         if q.run != self.opts.run {
