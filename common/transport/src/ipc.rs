@@ -59,6 +59,11 @@ pub fn config(prefix: &str) -> Result<Config, LinkError> {
         FileName::new(format!("{prefix}.").as_bytes()),
         format!("prefix {prefix:?}"),
     )?;
+    // How long opening a service waits for another process to finish creating it.
+    // iceoryx2's 1 s was too short on a loaded 2-core machine: a slave restarted after
+    // SIGKILL, while CI's tests ran beside it, failed with HangsInCreation opening its
+    // own wake-up event (faults::slave_killed_..., once in a fresh-clone CI run).
+    cfg.global.creation_timeout = std::time::Duration::from_secs(5);
     Ok(cfg)
 }
 
