@@ -36,6 +36,10 @@ pub type IpcNode = Node<ipc::Service>;
 /// lost sample shows as a gap in the sequence numbers and is counted.
 pub const SUBSCRIBER_BUFFER: usize = 64;
 
+/// The shortest wait handed to iceoryx2: its socket timeout counts whole microseconds
+/// and reads zero as "for ever".
+const MIN_WAIT: std::time::Duration = std::time::Duration::from_micros(1);
+
 /// Root folder of the node and service files of all runs.
 pub const ROOT: &str = "/tmp/tactile-iox2";
 
@@ -264,6 +268,14 @@ impl IpcWake {
 impl Wake for IpcWake {
     fn block(&self, until: Instant) -> Result<(), LinkError> {
         let left = until.saturating_duration_since(Instant::now());
+        // iceoryx2 0.10 waits with SO_RCVTIMEO set from the timeout cut to whole
+        // microseconds, and a zero timeval there means "no timeout": a wait with less
+        // than 1 us left blocked until the next notification, which never comes when
+        // the peer is gone (a master hung for ever after its slave was killed). So
+        // under 1 us there is no wait: the caller polls again and sees its deadline.
+        if left < MIN_WAIT {
+            return Ok(());
+        }
         match self.listener.timed_wait(|_| {}, left) {
             Ok(_) | Err(ListenerWaitError::InterruptSignal) => Ok(()),
             Err(e) => map(
@@ -310,4 +322,35 @@ pub fn remove_run_files(prefix: &str) {
         }
     }
     let _ = std::fs::remove_dir_all(format!("{ROOT}/{prefix}"));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    /// Waits of every length under and around a microsecond end by their deadline with
+    /// nobody notifying (each ran for ever before: iceoryx2 read them as no timeout).
+    #[test]
+    fn a_wait_shorter_than_a_microsecond_returns() {
+        let prefix = format!("ttwake{}", std::process::id());
+        let (tx, rx) = std::sync::mpsc::channel();
+        let p = prefix.clone();
+        std::thread::spawn(move || {
+            let node = Rc::new(node(&p, "waiter").expect("node"));
+            let wake = IpcWake::open(&node, "waiter").expect("wake");
+            for ns in [0, 1, 500, 999, 1_000, 1_500, 20_000] {
+                let start = Instant::now();
+                wake.block(start + Duration::from_nanos(ns)).expect("block");
+                tx.send((ns, start.elapsed())).expect("send");
+            }
+        });
+        for _ in 0..7 {
+            let (ns, took) = rx
+                .recv_timeout(Duration::from_secs(10))
+                .expect("a wait with a deadline of at most 20 us did not return in 10 s");
+            assert!(took < Duration::from_secs(1), "{ns} ns: {took:?}");
+        }
+        remove_run_files(&prefix);
+    }
 }
