@@ -183,3 +183,32 @@ fn a_bad_arm_is_named_and_nothing_starts() {
         );
     }
 }
+
+/// The recording draws the Panda where its joints put it: run.mcap read by independent
+/// readers (mcap_ros2, yourdfpy's URDF parser and FK; tests/mcap_arm_check.py).
+#[test]
+fn the_recording_draws_the_arm_where_its_joints_put_it() {
+    let probe = "import mcap, mcap_ros2, yourdfpy, numpy";
+    let ready = std::process::Command::new("python3")
+        .args(["-c", probe])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ready {
+        return util::cannot("python3 lacks mcap, mcap-ros2-support, yourdfpy or numpy");
+    }
+    let sb = Sandbox::new("armmcap");
+    sb.simulate(&panda(), "a");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/mcap_arm_check.py");
+    let mut c = std::process::Command::new("python3");
+    c.arg(script)
+        .arg(sb.path("a"))
+        .args(["--base", "panda_link0", "--tip", "panda_hand"]);
+    let o = util::output_within(c, util::LIMIT);
+    let text =
+        String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{text}");
+    assert!(
+        text.contains("4000 samples, 41 drawn and compared"),
+        "{text}"
+    );
+}

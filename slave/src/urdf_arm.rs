@@ -176,10 +176,10 @@ impl UrdfArm {
 
     /// The tool's target in the arm's base frame for the master's `position`.
     pub fn target(&self, position: [f64; 3]) -> Frame {
-        let d = Vector3::from(position) - Vector3::from(self.master_home);
+        let home = self.home_tool.p.into();
         Frame {
             r: self.home_tool.r,
-            p: self.home_tool.p + self.cfg.scale * d,
+            p: self.cfg.to_robot(home, self.master_home, position).into(),
         }
     }
 
@@ -189,8 +189,8 @@ impl UrdfArm {
     }
 
     fn to_master(&self, p: &Vector3<f64>) -> [f64; 3] {
-        let m = Vector3::from(self.master_home) + (p - self.home_tool.p) / self.cfg.scale;
-        [m.x, m.y, m.z]
+        let home = self.home_tool.p.into();
+        self.cfg.to_master(home, self.master_home, (*p).into())
     }
 
     /// IK toward the master's `position`, one period of `dt` from the last reference

@@ -18,6 +18,7 @@ mod error;
 pub mod ik;
 pub mod kinematics;
 pub mod spatial;
+pub mod tree;
 pub mod urdf;
 
 pub use chain::{Chain, Dof};
@@ -25,4 +26,5 @@ pub use dynamics::Dynamics;
 pub use error::Error;
 pub use ik::{Ik, IkConfig, IkStats, IkStep, Pose};
 pub use spatial::Frame;
+pub use tree::Tree;
 pub use urdf::Robot;

@@ -152,6 +152,18 @@ impl Robot {
     }
 }
 
+/// The text of every top-level element of `xml` whose tag is one of `tags`, in file
+/// order, exactly as written: to put a robot's links and joints into another URDF.
+pub fn elements<'a>(xml: &'a str, tags: &[&str]) -> Result<Vec<&'a str>, Error> {
+    let doc = Document::parse(xml).map_err(|e| Error::Xml(e.to_string()))?;
+    Ok(doc
+        .root_element()
+        .children()
+        .filter(|n| n.is_element() && tags.contains(&n.tag_name().name()))
+        .map(|n| &xml[n.range()])
+        .collect())
+}
+
 /// What an element is, for errors: `joint `panda_joint1``.
 fn what(n: Node) -> String {
     format!(

@@ -254,8 +254,13 @@ pub fn base_in_world(g: &Geometry, arm: &str) -> Link {
 /// The transforms that never move: the bases in the world and each tool on its
 /// forearm.
 pub fn fixed(g: &Geometry) -> Vec<Link> {
-    let mut v: Vec<Link> = ARMS.iter().map(|a| base_in_world(g, a)).collect();
-    for a in ARMS {
+    fixed_of(g, &ARMS)
+}
+
+/// The transforms that never move of the arms `arms` (of [`ARMS`]).
+pub fn fixed_of(g: &Geometry, arms: &[&str]) -> Vec<Link> {
+    let mut v: Vec<Link> = arms.iter().map(|a| base_in_world(g, a)).collect();
+    for a in arms {
         v.push(chain(g, a)[5].transform(a, [0.0; 3]));
     }
     v

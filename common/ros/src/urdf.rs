@@ -10,6 +10,14 @@ use tactile_math::geometry::Geometry;
 
 /// The URDF (XML) of robot `tactile`: the world, the master and the slave arm.
 pub fn urdf(g: &Geometry) -> String {
+    let mut s = urdf_open(g, &ARMS);
+    s.push_str("</robot>\n");
+    s
+}
+
+/// The URDF of the world and the Omni-class arms `arms` (of [`ARMS`]), without its
+/// closing `</robot>`: another robot's links and joints can follow.
+pub fn urdf_open(g: &Geometry, arms: &[&str]) -> String {
     let mut s = String::from(
         "<?xml version=\"1.0\"?>\n<robot name=\"tactile\">\n\
          \x20 <material name=\"master\"><color rgba=\"0.2 0.45 0.85 1\"/></material>\n\
@@ -17,10 +25,9 @@ pub fn urdf(g: &Geometry) -> String {
          \x20 <material name=\"tool\"><color rgba=\"0.1 0.1 0.1 1\"/></material>\n",
     );
     let _ = writeln!(s, "  <link name=\"{WORLD}\"/>");
-    for arm in ARMS {
+    for arm in arms {
         arm_urdf(&mut s, g, arm);
     }
-    s.push_str("</robot>\n");
     s
 }
 

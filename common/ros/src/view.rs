@@ -159,6 +159,50 @@ pub struct SlaveView {
     pub force: [f64; 3],
 }
 
+/// A URDF arm's part of a sample (the slave as any robot): its joints by their own
+/// names, the tool and the force in its base frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArmView<'a> {
+    /// The base link: the frame of the tool and the force.
+    pub base: &'a str,
+    /// The joints' names, as the URDF and the robot's controllers call them.
+    pub names: &'a [String],
+    /// Joint values, rad or m.
+    pub q: &'a [f64],
+    /// Joint velocities (the recording's; none in the live view).
+    pub velocity: Option<&'a [f64]>,
+    /// Efforts the servo applied, N m or N.
+    pub effort: &'a [f64],
+    /// The tool, m, in `base`.
+    pub tool: [f64; 3],
+    /// The contact force on the tool, N, in `base`'s axes.
+    pub force: [f64; 3],
+}
+
+impl ArmView<'_> {
+    /// Puts the arm's messages, as [`SampleView::emit`] puts the paper slave's.
+    pub fn emit<S: Sink>(&self, stamp: u64, sink: &mut S) -> Result<(), S::Error> {
+        let js = JointState {
+            header: Header::at(stamp, ""),
+            name: self.names.to_vec(),
+            position: self.q.to_vec(),
+            velocity: self.velocity.map_or_else(Vec::new, <[f64]>::to_vec),
+            effort: self.effort.to_vec(),
+        };
+        sink.put(SLAVE_JOINTS, At::SlaveSend, &js)?;
+        sink.put(
+            SLAVE_TOOL,
+            At::SlaveSend,
+            &pose(stamp, self.base, self.tool),
+        )?;
+        sink.put(
+            SLAVE_FORCE,
+            At::SlaveSend,
+            &wrench(stamp, self.base, self.force),
+        )
+    }
+}
+
 /// What a sample shows, from whichever nodes saw it.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SampleView {

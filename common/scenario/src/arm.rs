@@ -85,6 +85,24 @@ impl Default for ArmIkConfig {
 }
 
 impl ArmConfig {
+    /// Where the tool goes in the arm's base frame for the master's `position`: the
+    /// master's displacement from `master_home`, scaled, from the tool's home
+    /// `home_tool` (the frames' axes are the same). The loop's one map from the
+    /// master's workspace to the arm's; [`ArmConfig::to_master`] undoes it.
+    pub fn to_robot(
+        &self,
+        home_tool: [f64; 3],
+        master_home: [f64; 3],
+        position: [f64; 3],
+    ) -> [f64; 3] {
+        [0, 1, 2].map(|k| home_tool[k] + self.scale * (position[k] - master_home[k]))
+    }
+
+    /// The master's position for the tool at `p` in the arm's base frame.
+    pub fn to_master(&self, home_tool: [f64; 3], master_home: [f64; 3], p: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|k| master_home[k] + (p[k] - home_tool[k]) / self.scale)
+    }
+
     /// Checks what can be checked without the URDF; the lengths of `home`, `kp` and
     /// `kd` against the chain's degrees of freedom are checked where the URDF is read.
     pub fn validate(&self) -> Result<(), ScenarioError> {

@@ -3,10 +3,11 @@
 //! or several) and joins them by sequence number into [`trace::TraceRow`]s;
 //! [`analysis`] and [`metrics`] fold the rows into latency histograms and the loop's
 //! figures; [`summary`] says it in JSON and [`text`] on the terminal; [`plots`] draws it; [`run_mcap`]
-//! writes it as ROS 2 messages in MCAP ([`mcap`]) for the robotics viewers; [`write`]
+//! writes it as ROS 2 messages in MCAP ([`mcap`]) for the robotics viewers, a URDF slave drawn as [`arm_scene`] says; [`write`]
 //! puts the report's files in a folder ([`out`]: one process at a time, each file whole); [`sweep`] tabulates many runs' summaries.
 
 pub mod analysis;
+pub mod arm_scene;
 pub mod error;
 pub mod join;
 pub mod mcap;

@@ -7,19 +7,24 @@
 //! send for its messages, the master's receive for q(n)), or the log time where that
 //! stage was not passed. Header stamps are the log time.
 
+use crate::arm_scene::ArmScene;
 use crate::mcap::McapWriter;
 use crate::trace::TraceRow;
 use std::io::{self, Write};
 use tactile_math::geometry::Geometry;
 use tactile_messages::samples::stage;
+use tactile_records::slave::ArmJoints;
 use tactile_ros::msg::{
     Header, Marker, MarkerArray, SampleTiming, StringMsg, TfMessage, TransformStamped, IDENTITY,
 };
 use tactile_ros::topics::TOPICS;
-use tactile_ros::view::{self, At, MasterView, SampleView, SlaveView, Typed};
+use tactile_ros::view::{self, ArmView, At, MasterView, SampleView, SlaveView, Typed};
 use tactile_ros::{arm, schema, urdf, CdrWriter, Message};
 use tactile_scenario::Object;
 use tactile_scenario::{Mode, Scenario};
+
+/// A URDF arm's joint values at a sample.
+type Joints = (u64, Vec<f64>);
 
 /// The recording's file name in a report folder.
 pub const FILE: &str = "run.mcap";
@@ -31,8 +36,9 @@ pub struct Recording<W: Write> {
     channels: Vec<u16>,
     geometry: Geometry,
     objects: Vec<Object>,
-    /// Whether the slave is the paper's arm (drawn in /tf), not a URDF arm.
-    paper_slave: bool,
+    /// The slave as a URDF arm, with its joints' last values and the sample they
+    /// came from (the velocities' previous values); None for the paper's arm.
+    arm: Option<(ArmScene, Vec<f64>, Option<Joints>)>,
     rate_hz: u64,
     t_s_ns: f64,
     /// Lockstep: log times are nominal, `n t_s` after the first sample's tick.
@@ -44,8 +50,8 @@ pub struct Recording<W: Write> {
 }
 
 impl<W: Write> Recording<W> {
-    /// Starts the file with a channel per topic.
-    pub fn new(out: W, scenario: &Scenario) -> io::Result<Self> {
+    /// Starts the file with a channel per topic; `arm` draws a URDF slave.
+    pub fn new(out: W, scenario: &Scenario, arm: Option<ArmScene>) -> io::Result<Self> {
         let geometry = scenario.device.geometry().map_err(io::Error::other)?;
         let library = concat!("tactile ", env!("CARGO_PKG_VERSION"));
         let mut mcap = McapWriter::new(out, "ros2", library)?;
@@ -68,7 +74,14 @@ impl<W: Write> Recording<W> {
             channels,
             geometry,
             objects: scenario.environment.objects.clone(),
-            paper_slave: scenario.slave.arm.is_none(),
+            arm: arm.map(|a| {
+                let home = scenario
+                    .slave
+                    .arm
+                    .as_ref()
+                    .map_or_else(Vec::new, |c| c.home.clone());
+                (a, home, None)
+            }),
             rate_hz: (scenario.rate_hz.round() as u64).max(1),
             t_s_ns: scenario.t_s() * 1e9,
             nominal: (scenario.mode == Mode::Lockstep).then_some(None),
@@ -97,8 +110,9 @@ impl<W: Write> Recording<W> {
         )
     }
 
-    /// Adds one sample's messages.
-    pub fn add(&mut self, row: &TraceRow) -> io::Result<()> {
+    /// Adds one sample's messages; `joints` are a URDF arm's (a row without them
+    /// draws the arm where it last was).
+    pub fn add(&mut self, row: &TraceRow, joints: Option<&ArmJoints>) -> io::Result<()> {
         let log = self.log_time(row);
         if self.prev.is_none() {
             self.first(log)?;
@@ -107,6 +121,7 @@ impl<W: Write> Recording<W> {
             self.environment(log)?;
         }
         let (vm, vs) = self.velocities(row);
+        let arm_velocity = self.arm_velocity(row.n, joints);
         self.put(view::TF, &self.transforms(row, log), log, log)?;
         let sample = SampleView {
             master: Some(MasterView {
@@ -118,7 +133,7 @@ impl<W: Write> Recording<W> {
                 q: row.q,
                 felt: row.felt,
             }),
-            slave: Some(SlaveView {
+            slave: self.arm.is_none().then_some(SlaveView {
                 theta: row.theta_sd,
                 velocity: Some(vs),
                 torque: row.u,
@@ -127,12 +142,49 @@ impl<W: Write> Recording<W> {
             }),
             timing: Some(timing(row)),
         };
+        let arm = self.arm.take();
         let mut sink = Stamped {
             rec: self,
             log,
             stamps: row.stamps.0,
         };
-        sample.emit(log, &mut sink)
+        let done = sample.emit(log, &mut sink).and_then(|()| match &arm {
+            Some((scene, q, _)) => ArmView {
+                base: &scene.base,
+                names: &scene.names,
+                q,
+                velocity: Some(&arm_velocity),
+                effort: joints.map_or(&[][..], |j| &j.tau),
+                tool: scene.to_robot(row.tool),
+                force: row.h,
+            }
+            .emit(log, &mut sink),
+            None => Ok(()),
+        });
+        self.arm = arm;
+        done
+    }
+
+    /// A URDF arm's joints taken from the row (kept where it has none) and their
+    /// backward differences, rad/s (0 at the first sample and after a gap of joints).
+    fn arm_velocity(&mut self, n: u64, joints: Option<&ArmJoints>) -> Vec<f64> {
+        let t_s = self.t_s_ns * 1e-9;
+        let Some((_, q, prev)) = &mut self.arm else {
+            return Vec::new();
+        };
+        let Some(j) = joints.filter(|j| j.q.len() == q.len()) else {
+            return vec![0.0; q.len()];
+        };
+        q.clone_from(&j.q);
+        let v = match prev.as_ref() {
+            Some((m, before)) if n > *m => {
+                let dt = (n - m) as f64 * t_s;
+                q.iter().zip(before).map(|(a, b)| (a - b) / dt).collect()
+            }
+            _ => vec![0.0; q.len()],
+        };
+        *prev = Some((n, q.clone()));
+        v
     }
 
     /// The sample's log time: its tick on the master's clock, or in lockstep its
@@ -148,28 +200,16 @@ impl<W: Write> Recording<W> {
         }
     }
 
-    /// Both arms' link transforms at the row's angles.
+    /// Both arms' link transforms at the row's angles (a URDF arm's at its joints).
     fn transforms(&self, row: &TraceRow, log: u64) -> TfMessage {
-        let mut tf = TfMessage::default();
-        let arms = [("master", row.theta_md), ("slave", row.theta_sd)];
-        // A URDF arm's links are not the paper arm's: it is left out of /tf, not drawn
-        // as the paper's arm at rest.
-        let drawn = if self.paper_slave {
-            &arms[..]
-        } else {
-            &arms[..1]
-        };
-        for &(name, theta) in drawn {
-            for (parent, child, translation, rotation) in arm::links(&self.geometry, name, theta) {
-                tf.transforms.push(TransformStamped {
-                    header: Header::at(log, &parent),
-                    child_frame_id: child,
-                    translation,
-                    rotation,
-                });
-            }
+        let mut links = arm::links(&self.geometry, "master", row.theta_md).to_vec();
+        match &self.arm {
+            Some((scene, q, _)) => links.extend(scene.links(q)),
+            None => links.extend(arm::links(&self.geometry, "slave", row.theta_sd)),
         }
-        tf
+        TfMessage {
+            transforms: links.into_iter().map(|l| stamped(l, log)).collect(),
+        }
     }
 
     /// Backward differences of both arms' angles, rad/s (0 at the first sample).
@@ -190,28 +230,30 @@ impl<W: Write> Recording<W> {
 
     /// The messages sent once: the URDF and the transforms that never move.
     fn first(&mut self, log: u64) -> io::Result<()> {
-        let description = StringMsg {
-            data: urdf::urdf(&self.geometry),
+        let (data, fixed) = match &self.arm {
+            Some((scene, _, _)) => {
+                let mut fixed = arm::fixed_of(&self.geometry, &["master"]);
+                fixed.extend(scene.fixed());
+                (scene.description().to_string(), fixed)
+            }
+            None => (urdf::urdf(&self.geometry), arm::fixed(&self.geometry)),
         };
-        self.put(view::ROBOT_DESCRIPTION, &description, log, log)?;
-        let transforms = arm::fixed(&self.geometry)
-            .into_iter()
-            .map(|(parent, child, translation, rotation)| TransformStamped {
-                header: Header::at(log, &parent),
-                child_frame_id: child,
-                translation,
-                rotation,
-            })
-            .collect();
+        self.put(view::ROBOT_DESCRIPTION, &StringMsg { data }, log, log)?;
+        let transforms = fixed.into_iter().map(|l| stamped(l, log)).collect();
         self.put(view::TF_STATIC, &TfMessage { transforms }, log, log)
     }
 
+    /// The objects, in the paper slave's base frame or a URDF arm's (where the map
+    /// from the loop puts them).
     fn environment(&mut self, log: u64) -> io::Result<()> {
         let markers = self
             .objects
             .iter()
             .enumerate()
-            .map(|(k, o)| marker(o, k as i32, log))
+            .map(|(k, o)| match &self.arm {
+                Some((scene, _, _)) => marker(&scene.object(o), &scene.base, k as i32, log),
+                None => marker(o, view::SLAVE_BASE, k as i32, log),
+            })
             .collect();
         self.put(view::SLAVE_ENVIRONMENT, &MarkerArray { markers }, log, log)
     }
@@ -268,10 +310,21 @@ impl<W: Write> view::Sink for Stamped<'_, W> {
 /// it is whole, so a report that fails half-way leaves no truncated recording.
 pub type FileRecording = Recording<std::io::BufWriter<std::fs::File>>;
 
-/// Starts `dir/run.mcap.partial`.
+/// Starts `dir/run.mcap.partial`; a URDF slave's file is read and checked.
 pub fn create(dir: &std::path::Path, scenario: &Scenario) -> io::Result<FileRecording> {
+    let arm = ArmScene::of_scenario(scenario).map_err(io::Error::other)?;
     let f = std::fs::File::create(dir.join(format!("{FILE}.partial")))?;
-    Recording::new(std::io::BufWriter::with_capacity(1 << 16, f), scenario)
+    Recording::new(std::io::BufWriter::with_capacity(1 << 16, f), scenario, arm)
+}
+
+/// A transform as `/tf` carries it.
+fn stamped((parent, child, translation, rotation): arm::Link, log: u64) -> TransformStamped {
+    TransformStamped {
+        header: Header::at(log, &parent),
+        child_frame_id: child,
+        translation,
+        rotation,
+    }
 }
 
 /// Finishes a recording from [`create`] and gives it its name.
@@ -286,8 +339,9 @@ pub fn discard(dir: &std::path::Path) {
     let _ = std::fs::remove_file(dir.join(format!("{FILE}.partial")));
 }
 
-/// An object as a marker: a sphere, a box, or a plane as a thin 0.3 m square.
-fn marker(o: &Object, id: i32, log: u64) -> Marker {
+/// An object as a marker in `frame`: a sphere, a box, or a plane as a thin 0.3 m
+/// square.
+fn marker(o: &Object, frame: &str, id: i32, log: u64) -> Marker {
     let (kind, position, orientation, scale) = match o {
         Object::Sphere { center, radius, .. } => {
             (Marker::SPHERE, *center, IDENTITY, [2.0 * radius; 3])
@@ -307,7 +361,7 @@ fn marker(o: &Object, id: i32, log: u64) -> Marker {
         }
     };
     Marker {
-        header: Header::at(log, "slave_base"),
+        header: Header::at(log, frame),
         ns: "environment".into(),
         id,
         kind,

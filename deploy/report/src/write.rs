@@ -419,7 +419,7 @@ impl Streams {
                 .map_err(Error::io("writing trace.csv"))?;
         }
         if let Some(r) = self.recording.as_mut() {
-            r.add(row).map_err(Error::io("writing run.mcap"))?;
+            r.add(row, joints).map_err(Error::io("writing run.mcap"))?;
         }
         Ok(())
     }
@@ -572,9 +572,10 @@ pub fn write_mcap(dirs: &[PathBuf], out: &Path) -> Result<u64, Error> {
     make_out_dir(out)?;
     let mut rec = run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
     let mut samples = 0;
-    join::join(dirs, |row, _| {
+    join::join(dirs, |row, joints| {
         samples += 1;
-        rec.add(row).map_err(Error::io("writing run.mcap"))?;
+        rec.add(row, joints)
+            .map_err(Error::io("writing run.mcap"))?;
         Ok(ControlFlow::Continue(()))
     })
     .inspect_err(|_| run_mcap::discard(out))?;
