@@ -145,7 +145,7 @@ fn the_node_programs_load_the_arm_as_the_in_process_run_does() {
 fn a_bad_arm_is_named_and_nothing_starts() {
     let sb = Sandbox::new("armbad");
     let base = panda_text();
-    let cases: [(&str, &str, &str); 6] = [
+    let cases: [(&str, &str, &str); 7] = [
         (
             "home = [0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796, 0.785398]",
             "home = [0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796]",
@@ -165,8 +165,13 @@ fn a_bad_arm_is_named_and_nothing_starts() {
         ("panda.urdf\"", "missing.urdf\"", "missing.urdf"),
         (
             "[slave.arm]",
-            "[slave]\nbackend = \"ros2\"\n[slave.arm]",
-            "field `slave.arm`: a URDF arm is simulated only for now",
+            "[slave]\nbackend = \"ros2\"\n[slave.ros2]\njoints = [\"a\", \"b\", \"c\"]\n[slave.arm]",
+            "field `slave.ros2.joints`: with [slave.arm] the arm's URDF gives the joints",
+        ),
+        (
+            "[slave.arm]",
+            "[slave.ros2]\ntrajectory_time_s = 2.0\n[slave.arm]",
+            "field `slave.ros2.trajectory_time_s`: 2 s is outside (0, 1] s",
         ),
     ];
     for (k, (from, to, want)) in cases.iter().enumerate() {

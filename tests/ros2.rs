@@ -846,3 +846,201 @@ fn a_session_that_reaches_no_endpoint_says_so() {
         "{log}"
     );
 }
+
+/// The shipped Panda scenario (its URDF by absolute path) driving a real arm over
+/// ROS 2: `samples` at 1 kHz, its commands as `command`, the robot's stand-in on
+/// `port` in `domain`; `extra` goes into `[slave.ros2]`.
+fn panda_over_ros(domain: u32, port: u16, samples: u64, command: &str, extra: &str) -> String {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let text = std::fs::read_to_string(format!("{root}/scenarios/panda.toml")).expect("panda");
+    format!(
+        "{}\n[ros]\ndomain_id = {domain}\nconnect = [\"tcp/127.0.0.1:{port}\"]\n\n\
+         [slave]\nbackend = \"ros2\"\n\n[slave.ros2]\njoint_states = \"/fr3/joint_states\"\n\
+         command_topic = \"/fr3_arm_controller/CMD\"\ncommand = \"{command}\"\n{extra}\n\
+         [slave.ros2.watch]\ntimeout_ms = 300.0\n",
+        text.replace("../robots/panda.urdf", &format!("{root}/robots/panda.urdf"))
+            .replace("samples = 4000", &format!("samples = {samples}"))
+    )
+}
+
+const PANDA_JOINTS: &str =
+    "panda_joint1,panda_joint2,panda_joint3,panda_joint4,panda_joint5,panda_joint6,panda_joint7";
+const PANDA_READY: &str = "0.0,-0.785398,0.0,-2.356194,0.0,1.570796,0.785398";
+
+fn arm_standin(
+    sb: &Sandbox,
+    domain: u32,
+    port: u16,
+    command: &str,
+    topic: &str,
+    extra: &[&str],
+) -> Child {
+    let (domain, listen) = (domain.to_string(), format!("tcp/127.0.0.1:{port}"));
+    let mut args = vec![
+        "arm",
+        "--domain",
+        &domain,
+        "--listen",
+        &listen,
+        "--names",
+        PANDA_JOINTS,
+        "--initial",
+        PANDA_READY,
+        "--joint-topic",
+        "/fr3/joint_states",
+        "--command-topic",
+        topic,
+        "--command-type",
+        command,
+        "--duration",
+        "60",
+        "--idle-exit",
+        "2",
+        "--report",
+        "arm.json",
+    ];
+    args.extend_from_slice(extra);
+    standin(sb, &args)
+}
+
+fn floats(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array().expect("array").iter().map(num).collect()
+}
+
+/// A 7-joint arm over ROS 2 through a forward position controller: its joint states
+/// read by name (the stand-in sends them reversed, with a gripper joint among them),
+/// every command inside the URDF's limits and steps, the tool following the master.
+#[test]
+fn a_panda_over_ros2_follows_through_a_position_controller() {
+    if !python_ready() {
+        return cannot("python3 lacks eclipse-zenoh or rosbags");
+    }
+    let sb = Sandbox::new("ros2-panda");
+    let port = free_port();
+    let topic = "/fr3_arm_controller/commands";
+    let arm = arm_standin(&sb, 16, port, "positions", topic, &[]);
+    let scenario = sb.write(
+        "panda.toml",
+        &panda_over_ros(16, port, 4000, "positions", "").replace("/fr3_arm_controller/CMD", topic),
+    );
+    listening(port);
+    sb.run(&scenario, "out");
+    let r = report(&sb, arm, "arm.json");
+    let s = sb.json("out", "summary.json");
+    assert_eq!(s["nodes"]["slave"]["ended"], "completed, after sample 3999");
+    let sd = &s["slave"]["device"];
+    assert_eq!(num(&sd["rejected"]), 0.0, "{sd}");
+    assert_eq!(sd["released"], true, "{sd}");
+    assert!(num(&r["commands"]) > 3500.0, "{r}");
+    assert_eq!(r["bad_commands"], serde_json::json!([]), "{r}");
+    // The URDF's limits (panda_joint4 in [-3.0718, -0.0698]) and velocity limits
+    // (2.175 rad/s and up: 2.175 mrad a period at 1 kHz) hold for every command.
+    let (lo, hi, step) = (
+        floats(&r["lowest"]),
+        floats(&r["highest"]),
+        floats(&r["max_step"]),
+    );
+    assert!(lo[3] >= -3.0718 && hi[3] <= -0.0698, "{lo:?} {hi:?}");
+    assert!(step.iter().all(|s| *s <= 2.175e-3 + 1e-12), "{step:?}");
+    // The loop read the joints by name: at the end (the stand-in settled on the last
+    // command, the release's hold) its last reading is the stand-in's joints.
+    let joints = std::fs::read_to_string(sb.path("out").join("joints.csv")).expect("joints");
+    let last: Vec<f64> = joints
+        .lines()
+        .last()
+        .expect("rows")
+        .split(',')
+        .map(|x| x.parse().expect("number"))
+        .collect();
+    let dof = 7;
+    let q_read = &last[1 + dof..1 + 2 * dof];
+    let q_robot = floats(&r["q"]);
+    assert!(
+        q_read
+            .iter()
+            .zip(&q_robot)
+            .all(|(a, b)| (a - b).abs() < 2e-3),
+        "{q_read:?} {q_robot:?}"
+    );
+    // In free space the measured tool follows the master within 2 mm (the stand-in's
+    // 20 ms lag at the press's 30 mm/s is 0.6 mm).
+    let trace = sb.trace("out");
+    let col = |c: &str| util::column(&trace, c);
+    let (t, v, h) = (
+        [1, 2, 3].map(|i| col(&format!("tool_{i}"))),
+        [1, 2, 3].map(|i| col(&format!("v_{i}"))),
+        col("h_3"),
+    );
+    let worst = (500..h.len())
+        .filter(|&k| h[k] == 0.0)
+        .map(|k| {
+            (0..3)
+                .map(|i| (t[i][k] - v[i][k]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 2e-3, "free-space error {worst} m");
+    assert!(h.iter().any(|f| *f > 1.0), "the wall pushed back");
+}
+
+/// The same arm through a joint_trajectory_controller (one point a period, joints by
+/// name) with a force-torque sensor in the hand's frame, turned into the base's.
+#[test]
+fn a_panda_over_ros2_takes_trajectories_and_its_wrench_turns_into_the_base() {
+    if !python_ready() {
+        return cannot("python3 lacks eclipse-zenoh or rosbags");
+    }
+    let sb = Sandbox::new("ros2-panda-jtc");
+    let port = free_port();
+    let topic = "/fr3_arm_controller/joint_trajectory";
+    let arm = arm_standin(
+        &sb,
+        17,
+        port,
+        "trajectory",
+        topic,
+        &[
+            "--wrench-topic",
+            "/fts/wrench",
+            "--wrench-frame",
+            "panda_hand",
+            "--wrench",
+            "0",
+            "0",
+            "5",
+        ],
+    );
+    let scenario = sb.write(
+        "panda.toml",
+        &panda_over_ros(
+            17,
+            port,
+            1500,
+            "trajectory",
+            "wrench_topic = \"/fts/wrench\"\n",
+        )
+        .replace("/fr3_arm_controller/CMD", topic),
+    );
+    listening(port);
+    sb.run(&scenario, "out");
+    let r = report(&sb, arm, "arm.json");
+    let s = sb.json("out", "summary.json");
+    assert_eq!(s["nodes"]["slave"]["ended"], "completed, after sample 1499");
+    assert_eq!(r["bad_commands"], serde_json::json!([]), "{r}");
+    assert!(num(&r["commands"]) > 1200.0, "{r}");
+    // One period from start, by default.
+    assert_eq!(r["point_times"], serde_json::json!([1_000_000]), "{r}");
+    // The hand's z points down at the ready pose (held by the IK): the sensor's +5 N
+    // along it is -5 N along the base's z.
+    let trace = sb.trace("out");
+    let h = [1, 2, 3].map(|i| util::column(&trace, &format!("h_{i}")));
+    let k = 1000;
+    assert!(
+        (h[2][k] + 5.0).abs() < 0.05 && h[0][k].abs() < 0.05 && h[1][k].abs() < 0.05,
+        "{} {} {}",
+        h[0][k],
+        h[1][k],
+        h[2][k]
+    );
+}

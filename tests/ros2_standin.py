@@ -9,6 +9,12 @@ independent of Tactile's, for tests/ros2.rs.
           times publishes junk, then goes silent. Its clock starts at the first force.
   robot:  follows Float64MultiArray joint commands with first-order dynamics and
           publishes its JointState at 1 kHz.
+  arm:    an arm of any number of joints under ros2_control: follows a forward
+          position controller's Float64MultiArray (the joints in order) or a
+          joint_trajectory_controller's JointTrajectory (joints by name; the point
+          reached over its time_from_start), first-order, and publishes its
+          JointState at 1 kHz with its joints in reverse order and a gripper joint
+          among them; optionally a WrenchStamped in a named frame.
 
 Both declare rmw_zenoh's liveliness tokens, check every attachment they receive
 (33 bytes: seq, timestamp, 16-byte gid), and write a JSON report on exit.
@@ -39,6 +45,7 @@ TS.register(get_types_from_msg(TIMING, "tactile_msgs/msg/SampleTiming"))
 JOINT_STATE = "sensor_msgs/msg/JointState"
 WRENCH = "geometry_msgs/msg/WrenchStamped"
 ARRAY = "std_msgs/msg/Float64MultiArray"
+TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
 
 
 def dds(ty):
@@ -186,6 +193,16 @@ def joint_state(names, values):
         velocity=np.array([], dtype=np.float64),
         effort=np.array([], dtype=np.float64),
     )
+
+
+def wrench_stamped(frame, force):
+    """A WrenchStamped now in `frame`: `force`, no torque."""
+    Header = TS.types["std_msgs/msg/Header"]
+    V = TS.types["geometry_msgs/msg/Vector3"]
+    return TS.types[WRENCH](
+        header=Header(stamp=stamp(time.time_ns()), frame_id=frame),
+        wrench=TS.types["geometry_msgs/msg/Wrench"](
+            force=V(x=force[0], y=force[1], z=force[2]), torque=V(x=0.0, y=0.0, z=0.0)))
 
 
 def stopping():
@@ -342,13 +359,7 @@ def robot(a):
         state["last_before"] = cmd["value"]
         put(joint_state(["gripper"] + names, [0.0] + theta))
         if put_wrench:
-            Header = TS.types["std_msgs/msg/Header"]
-            V = TS.types["geometry_msgs/msg/Vector3"]
-            put_wrench(TS.types[WRENCH](
-                header=Header(stamp=stamp(time.time_ns()), frame_id="base"),
-                wrench=TS.types["geometry_msgs/msg/Wrench"](
-                    force=V(x=a.wrench[0], y=a.wrench[1], z=a.wrench[2]),
-                    torque=V(x=0.0, y=0.0, z=0.0))))
+            put_wrench(wrench_stamped("base", a.wrench))
         return True
 
     at_rate(1000.0, stop, a.duration, step)
@@ -361,10 +372,83 @@ def robot(a):
     node.s.close()
 
 
+def arm(a):
+    node = Node("arm_standin", a.listen, a.domain)
+    names = a.names.split(",")
+    n = len(names)
+    q = [float(x) for x in a.initial.split(",")]
+    if len(q) != n:
+        sys.exit(f"--initial has {len(q)} values for {n} joints")
+    put = node.publisher(a.joint_topic, JOINT_STATE)
+    rep = {"commands": 0, "bad_commands": [], "first": None, "last": None,
+           "max_step": [0.0] * n, "lowest": [math.inf] * n, "highest": [-math.inf] * n,
+           "point_times": set(), "q_at_last": None, "t_last": None}
+    target = {"q": None}
+
+    def take(values):
+        if len(values) != n or not all(math.isfinite(x) for x in values):
+            rep["bad_commands"].append(list(values))
+            return
+        if rep["last"] is not None:
+            rep["max_step"] = [max(m, abs(v - w)) for m, v, w in zip(rep["max_step"], values, rep["last"])]
+        rep["lowest"] = [min(m, v) for m, v in zip(rep["lowest"], values)]
+        rep["highest"] = [max(m, v) for m, v in zip(rep["highest"], values)]
+        rep["first"] = rep["first"] or list(values)
+        rep["last"] = list(values)
+        rep["q_at_last"] = list(q)
+        rep["commands"] += 1
+        rep["t_last"] = time.monotonic()
+        target["q"] = list(values)
+
+    def on_array(msg, _t):
+        take(list(msg.data))
+
+    def on_trajectory(msg, _t):
+        if len(msg.points) != 1:
+            rep["bad_commands"].append(f"{len(msg.points)} points")
+            return
+        pt = msg.points[0]
+        by_name = dict(zip(msg.joint_names, pt.positions))
+        if sorted(by_name) != sorted(names) or len(pt.positions) != len(msg.joint_names):
+            rep["bad_commands"].append(f"joints {list(msg.joint_names)}")
+            return
+        rep["point_times"].add(pt.time_from_start.sec * 10**9 + pt.time_from_start.nanosec)
+        take([by_name[j] for j in names])
+
+    if a.command_type == "trajectory":
+        sub = node.subscribe(a.command_topic, TRAJECTORY, on_trajectory)
+    else:
+        sub = node.subscribe(a.command_topic, ARRAY, on_array)
+    put_wrench = node.publisher(a.wrench_topic, WRENCH) if a.wrench_topic else None
+    stop = stopping()
+    alpha = 1.0 - math.exp(-1e-3 / a.tau)
+
+    def step():
+        if a.idle_exit and rep["t_last"] is not None and time.monotonic() - rep["t_last"] > a.idle_exit:
+            return False
+        if target["q"] is not None:
+            for i in range(n):
+                q[i] += alpha * (target["q"][i] - q[i])
+        put(joint_state(["gripper"] + names[::-1], [0.0] + q[::-1]))
+        if put_wrench:
+            put_wrench(wrench_stamped(a.wrench_frame, a.wrench))
+        return True
+
+    at_rate(1000.0, stop, a.duration, step)
+    del sub
+    rep["q"] = q
+    rep["point_times"] = sorted(rep["point_times"])
+    rep["bad_attachments"] = node.bad_attachments
+    rep.pop("t_last")
+    with open(a.report, "w") as f:
+        json.dump(rep, f)
+    node.s.close()
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = p.add_subparsers(dest="role", required=True)
-    for role in ("device", "robot"):
+    for role in ("device", "robot", "arm"):
         q = sub.add_parser(role)
         q.add_argument("--listen", action="append", required=True)
         q.add_argument("--domain", type=int, default=0)
@@ -389,8 +473,18 @@ def main():
                    help="exit this many seconds after the last command (0: never)")
     r.add_argument("--wrench-topic", default="")
     r.add_argument("--wrench", type=float, nargs=3, default=[0.0, 0.0, 0.0])
+    m = sub.choices["arm"]
+    m.add_argument("--command-topic", required=True)
+    m.add_argument("--command-type", choices=["positions", "trajectory"], default="positions")
+    m.add_argument("--initial", required=True, help="the joints' start, comma-separated")
+    m.add_argument("--tau", type=float, default=0.02)
+    m.add_argument("--duration", type=float, required=True)
+    m.add_argument("--idle-exit", type=float, default=0.0)
+    m.add_argument("--wrench-topic", default="")
+    m.add_argument("--wrench-frame", default="")
+    m.add_argument("--wrench", type=float, nargs=3, default=[0.0, 0.0, 0.0])
     a = p.parse_args()
-    (device if a.role == "device" else robot)(a)
+    {"device": device, "robot": robot, "arm": arm}[a.role](a)
 
 
 if __name__ == "__main__":

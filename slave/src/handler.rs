@@ -23,17 +23,92 @@ pub fn hold_timeout(scenario: &Scenario) -> Duration {
     t.max(Duration::from_millis(50))
 }
 
+/// A real robot: the paper's three joints, or an arm from its URDF.
+pub enum RealRobot {
+    /// Three joints shaped like the paper's arm.
+    Paper(Box<dyn Robot>),
+    /// An arm of `[slave.arm]`, its joints by the URDF's names.
+    Arm(Box<dyn Robot<Vec<f64>>>),
+}
+
+impl std::fmt::Debug for RealRobot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RealRobot::Paper(r) => write!(f, "Paper({})", r.describe()),
+            RealRobot::Arm(r) => write!(f, "Arm({})", r.describe()),
+        }
+    }
+}
+
+/// A real robot as the loop holds it.
+struct Hardware<V> {
+    robot: Box<dyn Robot<V>>,
+    /// Its joints as the loop holds them.
+    held: Held<V>,
+    /// What it was last commanded (held while it is lost).
+    commanded: Option<V>,
+    /// The reference of the step just taken, commanded once h(n) is on its way.
+    due: Option<V>,
+}
+
+impl<V: Clone + Default> Hardware<V> {
+    fn new(robot: Box<dyn Robot<V>>) -> Self {
+        Hardware {
+            robot,
+            held: Held::default(),
+            commanded: None,
+            due: None,
+        }
+    }
+
+    /// Reads the robot for this tick (its joints, its force sensor's force); says so
+    /// in the record when it is lost or back.
+    fn read(&mut self, n: u64, io: &mut Io) -> Result<(V, Option<[f64; 3]>), Failure> {
+        let who = self.robot.describe();
+        let judged = self.robot.read(io.now());
+        let meanwhile = "holding its last safe reference";
+        if let Some(what) = self.held.take(judged, ("robot", &who), meanwhile) {
+            io.event(n, &what)?;
+        }
+        Ok((self.held.theta.clone(), self.robot.force(io.now())))
+    }
+
+    /// Commands `reference`, or, while the robot is lost, the last reference it had.
+    fn command(&mut self, reference: V) {
+        if !self.held.lost {
+            self.commanded = Some(reference);
+        }
+        if let Some(c) = self.commanded.clone() {
+            self.robot.command(c, tactile_messages::clock::now_ns());
+        }
+    }
+
+    fn release(&mut self) -> String {
+        let heard = self.robot.release();
+        format!(
+            "{} commanded to hold where it is{}",
+            self.robot.describe(),
+            if heard {
+                ""
+            } else {
+                " (not heard from, or no controller listening: it holds its last command)"
+            }
+        )
+    }
+}
+
+/// The real robot the handler drives, if any.
+enum Robots {
+    None,
+    Paper(Hardware<[f64; 3]>),
+    Arm(Hardware<Vec<f64>>),
+}
+
 /// The slave's handler: its state machine, the real robot if there is one, and what
 /// it keeps between the driver's calls.
 pub struct SlaveHandler {
     slave: Slave,
-    robot: Option<Box<dyn Robot>>,
-    /// The robot's angles as the loop holds them.
-    held: Held,
-    /// What the robot was last commanded (held while it is lost).
-    commanded: Option<[f64; 3]>,
-    /// The reference of the step just taken, commanded once h(n) is on its way.
-    due: Option<[f64; 3]>,
+    robot: Robots,
     holding: bool,
     idle: (Duration, Duration),
     last_step: Option<Step>,
@@ -43,7 +118,7 @@ pub struct SlaveHandler {
 impl std::fmt::Debug for SlaveHandler {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SlaveHandler")
-            .field("robot", &self.robot.as_ref().map(|r| r.describe()))
+            .field("robot", &self.peripheral().map(|r| r.describe()))
             .field("holding", &self.holding)
             .finish_non_exhaustive()
     }
@@ -52,13 +127,14 @@ impl std::fmt::Debug for SlaveHandler {
 impl SlaveHandler {
     /// The handler of `slave` for `scenario`, with a real robot (`None`: the
     /// simulated arm).
-    pub fn new(slave: Slave, scenario: &Scenario, robot: Option<Box<dyn Robot>>) -> Self {
+    pub fn new(slave: Slave, scenario: &Scenario, robot: Option<RealRobot>) -> Self {
         SlaveHandler {
             slave,
-            robot,
-            held: Held::default(),
-            commanded: None,
-            due: None,
+            robot: match robot {
+                None => Robots::None,
+                Some(RealRobot::Paper(r)) => Robots::Paper(Hardware::new(r)),
+                Some(RealRobot::Arm(r)) => Robots::Arm(Hardware::new(r)),
+            },
             holding: false,
             idle: (
                 hold_timeout(scenario),
@@ -73,36 +149,6 @@ impl SlaveHandler {
     pub fn counters(&self) -> SlaveCounters {
         self.slave.counters()
     }
-
-    /// Reads the robot for this tick; says so in the record when it is lost or back.
-    fn read(&mut self, n: u64, io: &mut Io) -> Result<Option<Measured>, Failure> {
-        let Some(r) = self.robot.as_deref_mut() else {
-            return Ok(None);
-        };
-        let who = r.describe();
-        let judged = r.read(io.now());
-        let meanwhile = "holding its last safe reference";
-        if let Some(what) = self.held.take(judged, ("robot", &who), meanwhile) {
-            io.event(n, &what)?;
-        }
-        Ok(Some(Measured {
-            theta: self.held.theta,
-            force: r.force(io.now()),
-        }))
-    }
-
-    /// Commands `theta_ref`, or, while the robot is lost, the last reference it had.
-    fn command(&mut self, theta_ref: [f64; 3]) {
-        let Some(r) = self.robot.as_deref_mut() else {
-            return;
-        };
-        if !self.held.lost {
-            self.commanded = Some(theta_ref);
-        }
-        if let Some(c) = self.commanded {
-            r.command(c, tactile_messages::clock::now_ns());
-        }
-    }
 }
 
 impl Handler for SlaveHandler {
@@ -114,11 +160,7 @@ impl Handler for SlaveHandler {
             counters: self.slave.counters(),
             v_in: c.ports.forward_in,
             h_out: c.ports.backward_out,
-            device: self
-                .robot
-                .as_ref()
-                .map(|r| r.counters())
-                .unwrap_or_default(),
+            device: self.peripheral().map(|r| r.counters()).unwrap_or_default(),
         }
     }
 
@@ -133,21 +175,19 @@ impl Handler for SlaveHandler {
     }
 
     fn peripheral(&self) -> Option<&dyn Peripheral> {
-        self.robot.as_deref().map(|r| r as &dyn Peripheral)
+        match &self.robot {
+            Robots::None => None,
+            Robots::Paper(h) => Some(h.robot.as_ref() as &dyn Peripheral),
+            Robots::Arm(h) => Some(h.robot.as_ref() as &dyn Peripheral),
+        }
     }
 
     fn release(&mut self) -> Option<String> {
-        let r = self.robot.as_deref_mut()?;
-        let heard = r.release();
-        Some(format!(
-            "{} commanded to hold where it is{}",
-            r.describe(),
-            if heard {
-                ""
-            } else {
-                " (not heard from, or no controller listening: it holds its last command)"
-            }
-        ))
+        match &mut self.robot {
+            Robots::None => None,
+            Robots::Paper(h) => Some(h.release()),
+            Robots::Arm(h) => Some(h.release()),
+        }
     }
 
     fn live(&self) -> Option<SampleView> {
@@ -171,11 +211,23 @@ impl Follower for SlaveHandler {
             self.holding = false;
             io.event(v.seq, "input back: following the master again")?;
         }
-        if let Some(m) = self.read(v.seq, io)? {
-            self.slave.measure(m);
+        match &mut self.robot {
+            Robots::None => {}
+            Robots::Paper(hw) => {
+                let (theta, force) = hw.read(v.seq, io)?;
+                self.slave.measure(Measured { theta, force });
+            }
+            Robots::Arm(hw) => {
+                let (q, force) = hw.read(v.seq, io)?;
+                self.slave.measure_arm(q, force);
+            }
         }
         let (h, step) = self.slave.step(v);
-        self.due = Some(step.theta_ref);
+        match &mut self.robot {
+            Robots::None => {}
+            Robots::Paper(hw) => hw.due = Some(step.theta_ref),
+            Robots::Arm(hw) => hw.due = self.slave.arm_state().map(|a| a.q_ref.clone()),
+        }
         self.last_step = Some(step);
         let record = match self.slave.arm_state() {
             Some(a) => SlaveSample::ArmStep(step, joints(a)),
@@ -198,8 +250,18 @@ impl Follower for SlaveHandler {
     }
 
     fn after(&mut self, _: &mut Io) {
-        if let Some(r) = self.due.take() {
-            self.command(r);
+        match &mut self.robot {
+            Robots::None => {}
+            Robots::Paper(hw) => {
+                if let Some(r) = hw.due.take() {
+                    hw.command(r);
+                }
+            }
+            Robots::Arm(hw) => {
+                if let Some(r) = hw.due.take() {
+                    hw.command(r);
+                }
+            }
         }
     }
 
@@ -214,11 +276,20 @@ impl Follower for SlaveHandler {
             tracing::warn!("input silent for {:?}: holding position", self.idle.0);
             io.event(last, "input silent: holding position")?;
         }
-        let held = match self.read(last, io)? {
-            None => self.slave.hold(),
-            Some(m) => {
-                let held = self.slave.hold_measured(m.theta);
-                self.command(held.theta_ref);
+        let held = match &mut self.robot {
+            Robots::None => self.slave.hold(),
+            Robots::Paper(hw) => {
+                let (theta, _) = hw.read(last, io)?;
+                let held = self.slave.hold_measured(theta);
+                hw.command(held.theta_ref);
+                held
+            }
+            Robots::Arm(hw) => {
+                let (q, _) = hw.read(last, io)?;
+                let held = self.slave.hold_measured_arm(&q);
+                if let Some(a) = self.slave.arm_state() {
+                    hw.command(a.q_ref.clone());
+                }
                 held
             }
         };

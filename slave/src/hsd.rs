@@ -47,6 +47,8 @@ pub struct Slave {
     predictor: Predictor,
     /// A real robot's joints (and force sensor) for the next step, in place of SD.
     measured: Option<Measured>,
+    /// A real arm's joints (`[slave.arm]` over ROS 2) for the next step.
+    measured_arm: Option<Vec<f64>>,
     /// Any arm from its URDF in place of the paper's (`[slave.arm]`).
     arm: Option<UrdfArm>,
 }
@@ -105,6 +107,7 @@ impl Slave {
             counters: SlaveCounters::default(),
             hold_from: None,
             measured: None,
+            measured_arm: None,
             arm,
         })
     }
@@ -191,6 +194,34 @@ impl Slave {
     /// controller (the step's `theta_ref` is what it is commanded).
     pub fn measure(&mut self, m: Measured) {
         self.measured = Some(m);
+    }
+
+    /// A real arm's state for the next step: its joints `q` (the URDF's order and
+    /// units) and its force sensor's force in the base's axes, if it has one.
+    pub fn measure_arm(&mut self, q: Vec<f64>, force: Option<[f64; 3]>) {
+        self.measured_arm = Some(q);
+        self.measured = Some(Measured {
+            theta: [0.0; 3],
+            force,
+        });
+    }
+
+    /// One sample of holding with a real arm measured at `q`: it is commanded the
+    /// reference it had when the input went silent.
+    pub fn hold_measured_arm(&mut self, q: &[f64]) -> HoldStep {
+        let Some(arm) = self.arm.as_mut() else {
+            return self.hold();
+        };
+        let h = arm.hold_measured(q, self.t_s);
+        let c = &mut self.counters;
+        c.holds += u64::from(h.started);
+        c.held_steps += 1;
+        c.hold_drift_max_m = c.hold_drift_max_m.max(h.drift_m);
+        HoldStep {
+            step: c.held_steps,
+            tool: h.tool,
+            ..HoldStep::default()
+        }
     }
 
     /// One sample of holding with a real robot: it is commanded the reference held
@@ -301,6 +332,9 @@ impl Slave {
     /// Returns the angles, the torques and the torque clamps.
     fn move_joints(&mut self, measured: Option<Measured>) -> ([f64; 3], [f64; 3], u32) {
         if let Some(m) = measured {
+            if let (Some(arm), Some(q)) = (self.arm.as_mut(), self.measured_arm.take()) {
+                arm.set_measured(&q, self.t_s);
+            }
             return (m.theta, [0.0; 3], 0);
         }
         if let Some(arm) = self.arm.as_mut() {

@@ -1,6 +1,6 @@
 //! The `tactile-slave` program (HSD): its command line and its run.
 
-use crate::handler::SlaveHandler;
+use crate::handler::{RealRobot, SlaveHandler};
 use crate::hsd::Slave;
 use crate::urdf_arm::UrdfArm;
 use clap::Parser;
@@ -16,9 +16,9 @@ use tactile_runtime::start::Links;
 ///
 /// The arm and its environment are simulated, or a real robot under ros2_control over
 /// rmw_zenoh (`slave.backend = "ros2"` and `[slave.ros2]` in the scenario: joint
-/// references out as Float64MultiArray, JointState and an optional force-torque
-/// WrenchStamped in); it waits for the robot's first message before it answers the
-/// master. `[ros.live]` publishes the slave's state as ROS 2 topics while it runs.
+/// references out as Float64MultiArray, or JointTrajectory for an arm from its URDF,
+/// JointState and an optional force-torque WrenchStamped in); it waits for the robot's
+/// first message before it answers the master. `[ros.live]` publishes the slave's state as ROS 2 topics while it runs.
 /// Both need a build with the `zenoh` feature; every option is in
 /// docs/11-real-devices-and-ros2.md.
 #[derive(Debug, Parser)]
@@ -47,6 +47,11 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
         .map_err(NodeError::BadInput)?;
     program.follow(Box::new(move |p, outside| {
         let slave = Slave::new(&p.scenario, arm).map_err(|e| NodeError::Failed(e.to_string()))?;
-        Ok(SlaveHandler::new(slave, &p.scenario, outside.robot.take()))
+        let robot = match (outside.robot.take(), outside.arm_robot.take()) {
+            (Some(r), _) => Some(RealRobot::Paper(r)),
+            (None, Some(r)) => Some(RealRobot::Arm(r)),
+            (None, None) => None,
+        };
+        Ok(SlaveHandler::new(slave, &p.scenario, robot))
     }))
 }

@@ -243,6 +243,39 @@ impl UrdfArm {
         }
     }
 
+    /// A real arm's joints, measured (`[slave.arm]` over ROS 2): they are the state,
+    /// their velocity the difference over `dt`; the robot's own controller follows
+    /// the reference, so no effort is known.
+    pub fn set_measured(&mut self, q: &[f64], dt: f64) {
+        let s = &mut self.state;
+        if q.len() != s.q.len() {
+            return;
+        }
+        for ((v, new), old) in s.qd.iter_mut().zip(q).zip(&s.q) {
+            *v = (new - old) / dt;
+        }
+        s.q.copy_from_slice(q);
+        s.tau.iter_mut().for_each(|t| *t = 0.0);
+    }
+
+    /// One period with no input for a real arm measured at `q`: it is commanded the
+    /// reference it had when the input went silent.
+    pub fn hold_measured(&mut self, q: &[f64], dt: f64) -> Holding {
+        let started = self.held.is_none();
+        let from = self.held.get_or_insert_with(|| self.state.q_ref.clone());
+        self.state.q_ref.copy_from_slice(from);
+        self.state.qd_ref.iter_mut().for_each(|v| *v = 0.0);
+        self.set_measured(q, dt);
+        let p0 = self.chain.fk(&self.state.q_ref).p;
+        let p = self.chain.fk(&self.state.q).p;
+        Holding {
+            started,
+            clamps: 0,
+            drift_m: (p - p0).norm() / self.cfg.scale,
+            tool: self.to_master(&p),
+        }
+    }
+
     /// Input is back: the next silence holds where the joints are then.
     pub fn end_hold(&mut self) {
         self.held = None;

@@ -12,20 +12,21 @@
 //! operator's quick move) is then reached at the robot's velocity limit, where holding
 //! would leave the robot stuck until the target came back near it.
 
-/// What the gate did with one value.
+/// What the gate did with one value: three joints or a force (`[f64; 3]`), or an
+/// arm's joints (`Vec<f64>`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Passed {
+pub enum Passed<V = [f64; 3]> {
     /// Let through as it was.
-    As([f64; 3]),
+    As(V),
     /// Cut to the range, limit or step: this is what goes out.
-    Cut([f64; 3]),
+    Cut(V),
     /// Not let through: this (the last good value) goes out instead, or nothing.
-    Held(Option<[f64; 3]>),
+    Held(Option<V>),
 }
 
-impl Passed {
+impl<V> Passed<V> {
     /// What goes out, if anything.
-    pub fn value(self) -> Option<[f64; 3]> {
+    pub fn value(self) -> Option<V> {
         match self {
             Passed::As(v) | Passed::Cut(v) => Some(v),
             Passed::Held(v) => v,
@@ -33,60 +34,74 @@ impl Passed {
     }
 }
 
-/// A robot's joint commands, in the driver's unit.
+/// A robot's joint commands, in the driver's unit: three joints (`[f64; 3]`, the
+/// paper's arm) or any number (`Vec<f64>`, an arm from its URDF).
 #[derive(Debug, Clone, PartialEq)]
-pub struct JointGate {
-    lo: [f64; 3],
-    hi: [f64; 3],
+pub struct JointGate<V = [f64; 3]> {
+    lo: V,
+    hi: V,
     /// The largest step per period, driver units.
-    step: [f64; 3],
-    last: Option<[f64; 3]>,
+    step: V,
+    last: Option<V>,
 }
 
-impl JointGate {
+impl<V: Clone + PartialEq + AsRef<[f64]> + AsMut<[f64]>> JointGate<V> {
     /// A gate for commands between `lo` and `hi` (per joint, either order) moving no
-    /// more than `step` a period, all in the driver's unit.
-    pub fn new(lo: [f64; 3], hi: [f64; 3], step: [f64; 3]) -> JointGate {
+    /// more than `step` a period, all in the driver's unit (all three of one length).
+    pub fn new(lo: V, hi: V, step: V) -> JointGate<V> {
+        let (mut low, mut high, mut step) = (lo.clone(), hi, step);
+        for (i, l) in low.as_mut().iter_mut().enumerate() {
+            let h = &mut high.as_mut()[i];
+            (*l, *h) = (l.min(*h), l.max(*h));
+        }
+        step.as_mut().iter_mut().for_each(|s| *s = s.abs());
         JointGate {
-            lo: [0, 1, 2].map(|i| lo[i].min(hi[i])),
-            hi: [0, 1, 2].map(|i| lo[i].max(hi[i])),
-            step: step.map(f64::abs),
+            lo: low,
+            hi: high,
+            step,
             last: None,
         }
     }
 
     /// Where the robot is, so the first command steps from there.
-    pub fn start_at(&mut self, raw: [f64; 3]) {
-        if self.last.is_none() && self.inside(raw) {
+    pub fn start_at(&mut self, raw: V) {
+        if self.last.is_none() && self.inside(&raw) {
             self.last = Some(raw);
         }
     }
 
-    fn inside(&self, v: [f64; 3]) -> bool {
-        (0..3).all(|i| v[i].is_finite() && self.lo[i] <= v[i] && v[i] <= self.hi[i])
+    /// Finite, of the gate's length and in range.
+    fn inside(&self, v: &V) -> bool {
+        let (v, lo, hi) = (v.as_ref(), self.lo.as_ref(), self.hi.as_ref());
+        v.len() == lo.len()
+            && (0..v.len()).all(|i| v[i].is_finite() && lo[i] <= v[i] && v[i] <= hi[i])
     }
 
     /// The hold at the end: where the robot is (`raw`, measured), checked for finite
     /// and in range but not stepped, since commanding the measured angles moves nothing.
-    pub fn hold(&mut self, raw: [f64; 3]) -> Passed {
-        if !self.inside(raw) {
-            return Passed::Held(self.last);
+    pub fn hold(&mut self, raw: V) -> Passed<V> {
+        if !self.inside(&raw) {
+            return Passed::Held(self.last.clone());
         }
-        self.last = Some(raw);
+        self.last = Some(raw.clone());
         Passed::As(raw)
     }
 
     /// The command to send for `raw`.
-    pub fn pass(&mut self, raw: [f64; 3]) -> Passed {
-        if !self.inside(raw) {
-            return Passed::Held(self.last);
+    pub fn pass(&mut self, raw: V) -> Passed<V> {
+        if !self.inside(&raw) {
+            return Passed::Held(self.last.clone());
         }
-        let Some(last) = self.last else {
-            self.last = Some(raw);
+        let Some(last) = self.last.as_ref() else {
+            self.last = Some(raw.clone());
             return Passed::As(raw);
         };
-        let cut = [0, 1, 2].map(|i| raw[i].clamp(last[i] - self.step[i], last[i] + self.step[i]));
-        self.last = Some(cut);
+        let mut cut = raw.clone();
+        for (i, c) in cut.as_mut().iter_mut().enumerate() {
+            let (l, s) = (last.as_ref()[i], self.step.as_ref()[i]);
+            *c = c.clamp(l - s, l + s);
+        }
+        self.last = Some(cut.clone());
         if cut == raw {
             Passed::As(raw)
         } else {
@@ -231,6 +246,18 @@ mod tests {
                 last = v;
             }
         }
+    }
+
+    #[test]
+    fn an_arms_command_of_another_length_is_held() {
+        let mut g = JointGate::new(vec![-1.0; 7], vec![1.0; 7], vec![0.1; 7]);
+        assert_eq!(g.pass(vec![0.0; 7]), Passed::As(vec![0.0; 7]));
+        assert_eq!(g.pass(vec![0.0; 6]), Passed::Held(Some(vec![0.0; 7])));
+        let mut v = vec![0.05; 7];
+        v[6] = 0.5;
+        let mut cut = vec![0.05; 7];
+        cut[6] = 0.1;
+        assert_eq!(g.pass(v), Passed::Cut(cut));
     }
 
     #[test]

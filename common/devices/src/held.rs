@@ -5,30 +5,31 @@
 use crate::{Change, DeviceCounters, Reading, Reject};
 
 /// A device's angles as a loop holds them: the last good ones (held while the device
-/// is stale or lost) and whether it is lost now.
+/// is stale or lost) and whether it is lost now. `V`: three angles, or an arm's
+/// joints.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Held {
+pub struct Held<V = [f64; 3]> {
     /// The last fresh or stale angles, rad.
-    pub theta: [f64; 3],
+    pub theta: V,
     /// True while the device is lost.
     pub lost: bool,
 }
 
-impl Held {
+impl<V> Held<V> {
     /// Takes a tick's judgement of `who` (a `kind`: device, robot). Returns the
     /// record's event when it was just lost (also logged as a warning; `meanwhile`
     /// says what the loop does then) or is back.
     pub fn take(
         &mut self,
-        (reading, change): (Reading<[f64; 3]>, Change),
+        (reading, change): (Reading<V>, Change),
         (kind, who): (&str, &str),
         meanwhile: &str,
     ) -> Option<String> {
+        self.lost = matches!(reading, Reading::Lost);
         match reading {
             Reading::Fresh(t) | Reading::Stale(t) => self.theta = t,
             Reading::Lost => {}
         }
-        self.lost = matches!(reading, Reading::Lost);
         match change {
             Change::Lost => {
                 let what = format!("{kind} lost: {who} silent past its timeout; {meanwhile}");

@@ -6,6 +6,7 @@
 //! [`live_view`], behind the `zenoh` feature). The judgements are pure and always
 //! built; the I/O only with Zenoh.
 
+pub mod arm_map;
 pub mod gate;
 pub mod held;
 #[cfg(feature = "zenoh")]
@@ -13,6 +14,8 @@ pub mod live_view;
 pub mod map;
 #[cfg(feature = "zenoh")]
 pub mod rmw_node;
+#[cfg(feature = "zenoh")]
+pub mod ros_arm;
 #[cfg(feature = "zenoh")]
 pub mod ros_devices;
 pub mod watch;
@@ -55,16 +58,18 @@ pub trait HapticDevice: Peripheral {
 }
 
 /// A real slave robot, as the slave's loop uses it: joint references out, joint
-/// angles and (when it has a sensor) the contact force in.
-pub trait Robot: Peripheral {
+/// angles and (when it has a sensor) the contact force in. `V` is the joints' values:
+/// the paper arm's three angles, or an arm's joints from its URDF (`Vec<f64>`).
+pub trait Robot<V = [f64; 3]>: Peripheral {
     /// The joints' newest angles at this tick, judged.
-    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change);
-    /// The contact force at this tick, N in the paper's frame, if the robot has a
-    /// force sensor (else the environment model gives it); zero when the sensor's
-    /// newest reading is older than the timeout.
+    fn read(&mut self, now_ns: u64) -> (Reading<V>, Change);
+    /// The contact force at this tick, N in the paper's frame (an arm's: its base's
+    /// axes), if the robot has a force sensor (else the environment model gives it);
+    /// zero when the sensor's newest reading is older than the timeout.
     fn force(&mut self, now_ns: u64) -> Option<[f64; 3]>;
-    /// Sends the joint references, rad in the paper's convention, through the gate.
-    fn command(&mut self, theta_ref: [f64; 3], now_ns: u64);
+    /// Sends the joint references (rad in the paper's convention; an arm's in its
+    /// URDF's), through the gate.
+    fn command(&mut self, reference: V, now_ns: u64);
     /// Leaves the robot holding: its own last angles commanded, sent so they arrive.
     /// True if it was sent to a listening controller.
     fn release(&mut self) -> bool;

@@ -33,6 +33,10 @@ pub enum Reject {
     /// A force that is NaN or infinite.
     #[error("force is not finite")]
     ForceNotFinite,
+    /// A force in a frame the arm's URDF does not have (it cannot be turned into the
+    /// base's).
+    #[error("force in frame {0:?}, which is not a link of the arm's URDF")]
+    UnknownFrame(String),
 }
 
 /// Three named joints of a `JointState`, in the paper's convention.

@@ -5,7 +5,7 @@
 use crate::gate::{ForceGate, JointGate};
 use crate::map::force_cdr;
 use crate::rmw_node::{wall_ns, RosNode, RosPublisher, RosSubscription};
-use crate::watch::{Inbox, Watch};
+use crate::watch::{Inbox, Latest, Watch};
 use crate::RosError;
 use crate::{Change, DeviceCounters, HapticDevice, JointMap, Peripheral, Reading, Reject, Robot};
 use std::sync::Arc;
@@ -215,35 +215,45 @@ impl RosRobot {
     }
 }
 
-impl Peripheral for RosRobot {
-    fn kind(&self) -> &'static str {
-        "robot"
-    }
+/// `Peripheral` for a robot of fields `node`, `joints` (its JointState inbox), `wrench`
+/// (its sensor's, if any), `watch` and `topic`: the paper's arm and an arm from its
+/// URDF are judged and counted alike.
+macro_rules! robot_peripheral {
+    ($t:ty) => {
+        impl $crate::Peripheral for $t {
+            fn kind(&self) -> &'static str {
+                "robot"
+            }
 
-    fn heard(&self) -> bool {
-        self.joints.latest().is_some()
-    }
+            fn heard(&self) -> bool {
+                self.joints.latest().is_some()
+            }
 
-    fn counters(&self) -> DeviceCounters {
-        let mut counts = vec![self.joints.counts()];
-        counts.extend(self.wrench.as_ref().map(|w| w.counts()));
-        self.watch.counters(&counts)
-    }
+            fn counters(&self) -> $crate::DeviceCounters {
+                let mut counts = vec![self.joints.counts()];
+                counts.extend(self.wrench.as_ref().map(|w| w.counts()));
+                self.watch.counters(&counts)
+            }
 
-    fn take_reject(&self) -> Option<Reject> {
-        self.joints
-            .take_reject()
-            .or_else(|| self.wrench.as_ref().and_then(|w| w.take_reject()))
-    }
+            fn take_reject(&self) -> Option<$crate::Reject> {
+                self.joints
+                    .take_reject()
+                    .or_else(|| self.wrench.as_ref().and_then(|w| w.take_reject()))
+            }
 
-    fn describe(&self) -> String {
-        format!("the robot on {}", self.topic)
-    }
+            fn describe(&self) -> String {
+                format!("the robot on {}", self.topic)
+            }
 
-    fn unreached(&self) -> Option<String> {
-        self.node.unreached()
-    }
+            fn unreached(&self) -> Option<String> {
+                self.node.unreached()
+            }
+        }
+    };
 }
+pub(crate) use robot_peripheral;
+
+robot_peripheral!(RosRobot);
 
 impl Robot for RosRobot {
     fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change) {
@@ -271,24 +281,42 @@ impl Robot for RosRobot {
     }
 
     fn release(&mut self) -> bool {
-        // Where the robot is, checked like every command; never heard from, or silent
-        // past the timeout (it may have moved since), nothing: the controller holds
-        // the last command it took.
-        let Some(l) = self.joints.latest() else {
-            return false;
-        };
-        if !self.watch.fresh(l.at_ns, self.last_tick_ns) {
-            return false;
-        }
-        let passed = self.gate.hold(self.map.raw(l.value));
-        self.watch.gated(&passed);
-        let Some(raw) = passed.value() else {
+        let map = &self.map;
+        let raw = self.joints.latest().map(|l| Latest {
+            value: map.raw(l.value),
+            at_ns: l.at_ns,
+        });
+        let Some(raw) = hold_at(raw, self.last_tick_ns, &mut self.gate, &mut self.watch) else {
             return false;
         };
         let m = Float64MultiArray { data: raw.to_vec() };
-        let (sent, matched) = self.command.put_reliably(&m.to_cdr());
-        self.watch.published(sent);
-        self.watch.released(sent && matched);
-        sent && matched
+        released(&self.command, &m.to_cdr(), &mut self.watch)
     }
+}
+
+/// The hold at a run's end: where the robot is (`latest`, in the driver's unit),
+/// checked like every command; never heard from, or silent past the timeout at the
+/// last tick (it may have moved since), nothing: the controller holds the last command
+/// it took.
+pub(crate) fn hold_at<V: Clone + PartialEq + AsRef<[f64]> + AsMut<[f64]>>(
+    latest: Option<Latest<V>>,
+    last_tick_ns: u64,
+    gate: &mut JointGate<V>,
+    watch: &mut Watch,
+) -> Option<V> {
+    let l = latest?;
+    if !watch.fresh(l.at_ns, last_tick_ns) {
+        return None;
+    }
+    let passed = gate.hold(l.value);
+    watch.gated(&passed);
+    passed.value()
+}
+
+/// Sends the hold `cdr` so it arrives; true if a controller took it.
+pub(crate) fn released(command: &RosPublisher, cdr: &[u8], watch: &mut Watch) -> bool {
+    let (sent, matched) = command.put_reliably(cdr);
+    watch.published(sent);
+    watch.released(sent && matched);
+    sent && matched
 }

@@ -35,7 +35,7 @@ pub struct Inbox<T> {
     last_reject: Mutex<Option<Reject>>,
 }
 
-impl<T: Copy> Inbox<T> {
+impl<T: Clone> Inbox<T> {
     /// An empty inbox.
     pub fn new() -> Arc<Inbox<T>> {
         Arc::new(Inbox {
@@ -66,7 +66,7 @@ impl<T: Copy> Inbox<T> {
 
     /// The newest accepted value.
     pub fn latest(&self) -> Option<Latest<T>> {
-        self.latest.lock().ok().and_then(|l| *l)
+        self.latest.lock().ok().and_then(|l| l.clone())
     }
 
     /// Messages received and rejected so far.
@@ -126,12 +126,13 @@ impl Watch {
     }
 
     /// Judges `latest` at `now_ns`.
-    pub fn judge<T: Copy>(
+    pub fn judge<T: Clone>(
         &mut self,
         latest: Option<Latest<T>>,
         now_ns: u64,
     ) -> (Reading<T>, Change) {
-        let age = latest.map(|l| now_ns.saturating_sub(l.at_ns));
+        let heard = latest.is_some();
+        let age = latest.as_ref().map(|l| now_ns.saturating_sub(l.at_ns));
         let reading = match (latest, age) {
             (Some(l), Some(a)) if a <= self.stale_ns => Reading::Fresh(l.value),
             (Some(l), Some(a)) if a <= self.timeout_ns => Reading::Stale(l.value),
@@ -145,7 +146,7 @@ impl Watch {
             Reading::Lost => self.counters.lost += 1,
         }
         let change = match (was_lost, self.lost) {
-            (false, true) if latest.is_some() => {
+            (false, true) if heard => {
                 self.counters.losses += 1;
                 Change::Lost
             }
@@ -173,7 +174,7 @@ impl Watch {
     }
 
     /// Counts what the gate did with a command.
-    pub fn gated(&mut self, p: &crate::gate::Passed) {
+    pub fn gated<V>(&mut self, p: &crate::gate::Passed<V>) {
         match p {
             crate::gate::Passed::As(_) => {}
             crate::gate::Passed::Cut(_) => self.counters.limited += 1,

@@ -264,6 +264,62 @@ impl Decode for Float64MultiArray {
     }
 }
 
+/// `trajectory_msgs/msg/JointTrajectory` of one point, as a joint_trajectory_controller
+/// takes a streamed reference: the joints by name, where they should be and how fast
+/// they should move `time_from_start` after the header's stamp (zero: on receipt).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointTrajectory {
+    /// Stamp (zero: start at once) and frame (empty).
+    pub header: Header,
+    /// The joints the point's values belong to, in their order.
+    pub joint_names: Vec<String>,
+    /// Positions, rad or m.
+    pub positions: Vec<f64>,
+    /// Velocities, rad/s or m/s (empty: none given).
+    pub velocities: Vec<f64>,
+    /// When the point is to be reached, after the stamp.
+    pub time_from_start: Time,
+}
+
+impl Message for JointTrajectory {
+    const TYPE: &'static str = "trajectory_msgs/msg/JointTrajectory";
+    fn encode(&self, w: &mut CdrWriter) {
+        self.header.encode(w);
+        w.seq_len(self.joint_names.len());
+        self.joint_names.iter().for_each(|n| w.string(n));
+        w.seq_len(1); // points
+        f64s(w, &self.positions);
+        f64s(w, &self.velocities);
+        f64s(w, &[]); // accelerations
+        f64s(w, &[]); // effort
+        self.time_from_start.encode(w);
+    }
+}
+
+impl Decode for JointTrajectory {
+    /// The first point (a trajectory of none reads as no positions).
+    fn decode(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        let header = Header::decode(r)?;
+        let n = r.seq_len()?;
+        let joint_names = (0..n).map(|_| r.string()).collect::<Result<_, _>>()?;
+        let mut t = JointTrajectory {
+            header,
+            joint_names,
+            ..JointTrajectory::default()
+        };
+        for k in 0..r.seq_len()? {
+            let (p, v) = (read_f64s(r)?, read_f64s(r)?);
+            read_f64s(r)?;
+            read_f64s(r)?;
+            let at = Time::decode(r)?;
+            if k == 0 {
+                (t.positions, t.velocities, t.time_from_start) = (p, v, at);
+            }
+        }
+        Ok(t)
+    }
+}
+
 /// `geometry_msgs/TransformStamped`: `child_frame_id` in `header.frame_id`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TransformStamped {
@@ -457,6 +513,14 @@ mod tests {
             data: vec![0.1, 0.2, 0.3],
         };
         assert_eq!(Float64MultiArray::from_cdr(&a.to_cdr()), Ok(a));
+        let t = JointTrajectory {
+            header: Header::at(0, ""),
+            joint_names: vec!["a".into(), "b".into()],
+            positions: vec![0.5, -1.0],
+            velocities: vec![0.1, 0.2],
+            time_from_start: Time::from_ns(1_000_000),
+        };
+        assert_eq!(JointTrajectory::from_cdr(&t.to_cdr()), Ok(t));
         for cut in 0..b.len() {
             assert!(JointState::from_cdr(&b[..cut]).is_err(), "cut at {cut}");
         }

@@ -37,6 +37,10 @@ pub const TYPE_HASHES: &[(&str, &str)] = &[
         "RIHS01_1025ddc6b9552d191f89ef1a8d2f60f3d373e28b283d8891ddcc974e8c55397f",
     ),
     (
+        "trajectory_msgs/msg/JointTrajectory",
+        "RIHS01_179b33eba59d676f6d967ac71fe35e7ca2f64b2f3928f4a018cec115e213796e",
+    ),
+    (
         "tf2_msgs/msg/TFMessage",
         "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087",
     ),

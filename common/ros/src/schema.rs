@@ -78,6 +78,15 @@ pub const DEFINITIONS: &[(&str, &str)] = &[
         "std_msgs/MultiArrayLayout layout\nfloat64[] data\n",
     ),
     (
+        "trajectory_msgs/JointTrajectoryPoint",
+        "float64[] positions\nfloat64[] velocities\nfloat64[] accelerations\nfloat64[] effort\n\
+         builtin_interfaces/Duration time_from_start\n",
+    ),
+    (
+        "trajectory_msgs/JointTrajectory",
+        "std_msgs/Header header\nstring[] joint_names\ntrajectory_msgs/JointTrajectoryPoint[] points\n",
+    ),
+    (
         "tactile_msgs/SampleTiming",
         "uint64 sample\nbool answered\nint64 round_trip_ns\nint64 overhead_ns\n\
          uint32[3] delay_forward\nuint32[3] delay_backward\nuint32 flags_forward\n\

@@ -42,6 +42,8 @@ pub struct Outside {
     pub haptic: Option<Box<dyn HapticDevice>>,
     /// The slave's robot.
     pub robot: Option<Box<dyn Robot>>,
+    /// The slave's robot when it is an arm from its URDF (`[slave.arm]`).
+    pub arm_robot: Option<Box<dyn Robot<Vec<f64>>>>,
     /// The live view.
     pub live: Option<Box<dyn LiveSink<SampleView>>>,
 }
@@ -51,6 +53,7 @@ impl std::fmt::Debug for Outside {
         f.debug_struct("Outside")
             .field("haptic", &self.haptic.as_ref().map(|d| d.describe()))
             .field("robot", &self.robot.as_ref().map(|d| d.describe()))
+            .field("arm_robot", &self.arm_robot.as_ref().map(|d| d.describe()))
             .field("live", &self.live.is_some())
             .finish()
     }
@@ -58,17 +61,21 @@ impl std::fmt::Debug for Outside {
 
 impl Outside {
     /// Opens what the scenario asks of `role` (nothing for a simulated run without the
-    /// live view).
-    pub fn open(sc: &Scenario, role: Role) -> Result<Outside, NodeError> {
+    /// live view); the scenario's files (an arm's URDF) are relative to `base_dir`.
+    pub fn open(
+        sc: &Scenario,
+        role: Role,
+        base_dir: &std::path::Path,
+    ) -> Result<Outside, NodeError> {
         if !ros_on(sc, role) {
             return Ok(Outside::default());
         }
-        open_ros(sc, role)
+        open_ros(sc, role, base_dir)
     }
 }
 
 #[cfg(feature = "zenoh")]
-fn open_ros(sc: &Scenario, role: Role) -> Result<Outside, NodeError> {
+fn open_ros(sc: &Scenario, role: Role, base_dir: &std::path::Path) -> Result<Outside, NodeError> {
     use std::sync::Arc;
     use tactile_devices::live_view::{every, LiveView};
     use tactile_devices::rmw_node::RosNode;
@@ -83,8 +90,13 @@ fn open_ros(sc: &Scenario, role: Role) -> Result<Outside, NodeError> {
         out.haptic = Some(Box::new(d));
     }
     if role == Role::Slave && sc.slave.backend == Backend::Ros2 {
-        let r = RosRobot::open(&node, &sc.slave.ros2, sc.t_s_ns()).map_err(failed)?;
-        out.robot = Some(Box::new(r));
+        match &sc.slave.arm {
+            Some(arm) => out.arm_robot = Some(open_arm(&node, sc, arm, base_dir)?),
+            None => {
+                let r = RosRobot::open(&node, &sc.slave.ros2, sc.t_s_ns()).map_err(failed)?;
+                out.robot = Some(Box::new(r));
+            }
+        }
     }
     if sc.ros.live.enabled {
         let topics: &[usize] = match role {
@@ -99,8 +111,29 @@ fn open_ros(sc: &Scenario, role: Role) -> Result<Outside, NodeError> {
     Ok(out)
 }
 
+/// The arm of `[slave.arm]` over ROS 2: its URDF read for the joints' names, limits and
+/// speeds, and the frames a wrench may come in.
+#[cfg(feature = "zenoh")]
+fn open_arm(
+    node: &std::sync::Arc<tactile_devices::rmw_node::RosNode>,
+    sc: &Scenario,
+    arm: &tactile_scenario::ArmConfig,
+    base_dir: &std::path::Path,
+) -> Result<Box<dyn Robot<Vec<f64>>>, NodeError> {
+    use tactile_chain::{Chain, Robot as Urdf, Tree};
+    let path = base_dir.join(&arm.urdf);
+    let bad = |e: String| NodeError::BadInput(format!("slave.arm: {}: {e}", path.display()));
+    let xml = crate::files::read_text(&path, "URDF", 16 << 20).map_err(NodeError::BadInput)?;
+    let robot = Urdf::parse(&xml).map_err(|e| bad(e.to_string()))?;
+    let chain = Chain::new(&robot, &arm.base, &arm.tip).map_err(|e| bad(e.to_string()))?;
+    let tree = Tree::new(&robot).map_err(|e| bad(e.to_string()))?;
+    let r = tactile_devices::ros_arm::RosArm::open(node, &sc.slave.ros2, &chain, tree, sc.t_s_ns())
+        .map_err(|e| NodeError::Failed(e.to_string()))?;
+    Ok(Box::new(r))
+}
+
 #[cfg(not(feature = "zenoh"))]
-fn open_ros(_: &Scenario, _: Role) -> Result<Outside, NodeError> {
+fn open_ros(_: &Scenario, _: Role, _: &std::path::Path) -> Result<Outside, NodeError> {
     Err(NodeError::BadInput(NO_ROS.into()))
 }
 
@@ -112,11 +145,11 @@ mod tests {
     fn a_build_without_zenoh_refuses_a_ros_scenario_and_runs_the_rest() {
         let mut sc = Scenario::default();
         assert!(
-            Outside::open(&sc, Role::Master).is_ok(),
+            Outside::open(&sc, Role::Master, std::path::Path::new(".")).is_ok(),
             "nothing asked, nothing opened"
         );
         sc.ros.live.enabled = true;
-        match Outside::open(&sc, Role::Slave) {
+        match Outside::open(&sc, Role::Slave, std::path::Path::new(".")) {
             Err(NodeError::BadInput(m)) => assert!(m.contains("--features zenoh"), "{m}"),
             other => panic!("{other:?}"),
         }

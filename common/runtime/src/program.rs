@@ -75,7 +75,8 @@ impl Program {
                 links.direct,
             )
             .map_err(|e| NodeError::Failed(e.to_string()))?;
-            let mut outside = Outside::open(&self.prepared.scenario, self.role)?;
+            let mut outside =
+                Outside::open(&self.prepared.scenario, self.role, &self.prepared.base_dir)?;
             let h = make(&self.prepared, &mut outside)?;
             Ok((Link::new(ports, self.prepared.spin), outside, h))
         })();

@@ -36,8 +36,8 @@ pub use network::{
 };
 pub use operator::{Operator, TrajectoryEnd};
 pub use ros::{
-    topic_name, AngleUnit, Backend, ForceMapConfig, JointMapConfig, LiveConfig, RosConfig,
-    RosDeviceConfig, RosRobotConfig, WatchConfig,
+    topic_name, AngleUnit, Backend, ForceMapConfig, JointMapConfig, LiveConfig, RobotCommand,
+    RosConfig, RosDeviceConfig, RosRobotConfig, WatchConfig,
 };
 use serde::{Deserialize, Serialize};
 pub use slave::{

@@ -326,6 +326,21 @@ impl Default for RosDeviceConfig {
     }
 }
 
+/// The message a robot's controller takes its references in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum RobotCommand {
+    /// `std_msgs/msg/Float64MultiArray`, the joints in order: a forward position
+    /// controller's `commands` (`/<controller>/commands`).
+    #[default]
+    Positions,
+    /// `trajectory_msgs/msg/JointTrajectory` of one point, the joints by name: a
+    /// joint_trajectory_controller's `/<controller>/joint_trajectory` (UR's
+    /// scaled_joint_trajectory_controller, Franka's fr3_arm_controller, Kinova's,
+    /// xArm's). Only with `[slave.arm]`.
+    Trajectory,
+}
+
 /// `[slave.ros2]`: a robot arm through ros2_control.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -350,6 +365,10 @@ pub struct RosRobotConfig {
     /// The fastest each joint may be commanded to move, rad/s (the paper's angles): a
     /// command's step per period is cut to it.
     pub max_velocity: [f64; 3],
+    /// The message the controller takes (`positions` or `trajectory`).
+    pub command: RobotCommand,
+    /// A trajectory point's `time_from_start`, s (default: one period).
+    pub trajectory_time_s: Option<f64>,
 }
 
 impl Default for RosRobotConfig {
@@ -363,6 +382,8 @@ impl Default for RosRobotConfig {
             wrench_map: ForceMapConfig::default(),
             watch: WatchConfig::default(),
             max_velocity: [2.0; 3],
+            command: RobotCommand::Positions,
+            trajectory_time_s: None,
         }
     }
 }
@@ -465,13 +486,72 @@ impl RosRobotConfig {
         for (i, v) in self.max_velocity.iter().enumerate() {
             positive(*v, &format!("slave.ros2.max_velocity[{i}]"), false)?;
         }
+        if let Some(t) = self.trajectory_time_s {
+            if !t.is_finite() || !(0.0..=1.0).contains(&t) || t == 0.0 {
+                return Err(invalid(
+                    "slave.ros2.trajectory_time_s",
+                    format!("{t} s is outside (0, 1] s"),
+                ));
+            }
+        }
         self.watch.validate("slave.ros2.watch")
+    }
+
+    /// With `[slave.arm]` the arm's URDF names its joints, their limits and speeds:
+    /// the paper arm's three-joint fields must be left as they are.
+    pub fn validate_for_arm(&self) -> Result<(), ScenarioError> {
+        let d = RosRobotConfig::default();
+        let unused = [
+            ("joints", self.joints != d.joints),
+            ("map", self.map != d.map),
+            ("max_velocity", self.max_velocity != d.max_velocity),
+            ("wrench_map", self.wrench_map != d.wrench_map),
+        ];
+        for (field, set) in unused {
+            if set {
+                return Err(invalid(
+                    format!("slave.ros2.{field}"),
+                    "with [slave.arm] the arm's URDF gives the joints (by name), their limits and speeds, and a wrench is turned through its chain: leave it out",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl RobotCommand {
+    /// Checks the command fits the arm: a trajectory names joints, which only an arm
+    /// from its URDF has.
+    pub fn validate(self, arm: bool) -> Result<(), ScenarioError> {
+        if self == RobotCommand::Trajectory && !arm {
+            return Err(invalid(
+                "slave.ros2.command",
+                "\"trajectory\" needs [slave.arm] (its URDF names the joints); the paper's three joints take \"positions\"",
+            ));
+        }
+        Ok(())
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_trajectory_command_needs_an_arm_from_its_urdf() {
+        let e = RobotCommand::Trajectory
+            .validate(false)
+            .expect_err("no arm");
+        assert!(e.to_string().contains("slave.ros2.command"), "{e}");
+        assert!(RobotCommand::Trajectory.validate(true).is_ok());
+        assert!(RobotCommand::Positions.validate(false).is_ok());
+        let cfg: RosRobotConfig =
+            toml::from_str("command = \"trajectory\"\ntrajectory_time_s = 0.004").expect("toml");
+        assert_eq!(
+            (cfg.command, cfg.trajectory_time_s),
+            (RobotCommand::Trajectory, Some(0.004))
+        );
+    }
 
     #[test]
     fn topic_names_follow_ros_rules() {

@@ -154,12 +154,10 @@ impl SlaveConfig {
         if let Some(arm) = &self.arm {
             arm.validate()?;
             if self.backend == Backend::Ros2 {
-                return Err(invalid(
-                    "slave.arm",
-                    "a URDF arm is simulated only for now: a robot over ROS 2 (slave.backend = \"ros2\") must have the paper arm's three joints; drop [slave.arm] or set slave.backend = \"simulated\"",
-                ));
+                self.ros2.validate_for_arm()?;
             }
         }
+        self.ros2.command.validate(self.arm.is_some())?;
         self.ros2.validate()
     }
 }

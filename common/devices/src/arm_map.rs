@@ -1,0 +1,219 @@
+//! A robot arm from its URDF as the loop takes it over ROS 2: its chain's joints read
+//! by name from a `JointState` (any order, other joints ignored) and checked (present,
+//! finite, within the URDF's limits), the gate's range and step from the same limits,
+//! and a measured wrench turned from the frame it is in (a flange, a sensor: any link
+//! of the URDF) into the base's. Pure: the messages come from [`crate::ros_arm`] (or a
+//! test).
+
+use crate::map::Reject;
+use tactile_chain::{Chain, Frame, Tree};
+use tactile_ros::msg::{Decode, JointState, WrenchStamped};
+
+/// How far past a URDF limit a reading may be and still be taken, rad or m: encoders
+/// report a little beyond the limit a controller stops at.
+pub const LIMIT_MARGIN: f64 = 0.01;
+
+/// The fastest a joint is commanded where the URDF gives no velocity limit, rad/s or
+/// m/s.
+pub const DEFAULT_VELOCITY: f64 = 2.0;
+
+/// A chain's joints, by name.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmJointMap {
+    /// The chain's joint names, in its order (the commands' order).
+    pub names: Vec<String>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    velocity: Vec<f64>,
+}
+
+impl ArmJointMap {
+    /// The joints of `chain`.
+    pub fn of(chain: &Chain) -> ArmJointMap {
+        ArmJointMap {
+            names: chain.dofs.iter().map(|d| d.name.clone()).collect(),
+            lower: chain.dofs.iter().map(|d| d.lower).collect(),
+            upper: chain.dofs.iter().map(|d| d.upper).collect(),
+            velocity: chain
+                .dofs
+                .iter()
+                .map(|d| {
+                    if d.velocity.is_finite() {
+                        d.velocity
+                    } else {
+                        DEFAULT_VELOCITY
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    /// The chain's joint values from a CDR `JointState`.
+    pub fn positions_cdr(&self, cdr: &[u8]) -> Result<Vec<f64>, Reject> {
+        self.positions(&JointState::from_cdr(cdr)?)
+    }
+
+    /// The chain's joint values from a `JointState`, in the chain's order.
+    pub fn positions(&self, js: &JointState) -> Result<Vec<f64>, Reject> {
+        let mut q = Vec::with_capacity(self.names.len());
+        for (i, name) in self.names.iter().enumerate() {
+            let v = *js
+                .name
+                .iter()
+                .position(|n| n == name)
+                .and_then(|k| js.position.get(k))
+                .ok_or_else(|| Reject::Missing(name.clone()))?;
+            if !v.is_finite() {
+                return Err(Reject::NotFinite(name.clone()));
+            }
+            let (min, max) = (self.lower[i] - LIMIT_MARGIN, self.upper[i] + LIMIT_MARGIN);
+            if !(min..=max).contains(&v) {
+                return Err(Reject::OutOfRange {
+                    joint: name.clone(),
+                    value: v,
+                    min,
+                    max,
+                });
+            }
+            q.push(v);
+        }
+        Ok(q)
+    }
+
+    /// The gate's range (the URDF's limits) and largest step in `t_s` seconds (its
+    /// velocity limits).
+    pub fn gate(&self, t_s: f64) -> crate::gate::JointGate<Vec<f64>> {
+        let step = self.velocity.iter().map(|v| v * t_s).collect();
+        crate::gate::JointGate::new(self.lower.clone(), self.upper.clone(), step)
+    }
+}
+
+/// A measured force and the frame it is in.
+pub type FramedForce = ([f64; 3], String);
+
+/// The force of a CDR `WrenchStamped` and its frame, if `tree` has it (an empty frame
+/// is taken as the base's); not finite, or in a frame the URDF lacks, is rejected.
+pub fn framed_force_cdr(cdr: &[u8], tree: &Tree, base: &str) -> Result<FramedForce, Reject> {
+    let w = WrenchStamped::from_cdr(cdr)?;
+    if !w.force.iter().all(|f| f.is_finite()) {
+        return Err(Reject::ForceNotFinite);
+    }
+    let frame = match w.header.frame_id.as_str() {
+        "" => base.to_string(),
+        f => f.to_string(),
+    };
+    let none = |_: &str| None;
+    if tree.pose(&frame, &none).is_none() {
+        return Err(Reject::UnknownFrame(frame));
+    }
+    Ok((w.force, frame))
+}
+
+/// The force `f` in frame `frame` turned into `base`'s axes, the arm's joints at `q`
+/// (named by `names`).
+pub fn in_base(
+    tree: &Tree,
+    base: &str,
+    names: &[String],
+    q: &[f64],
+    (f, frame): &FramedForce,
+) -> [f64; 3] {
+    if frame == base {
+        return *f;
+    }
+    let value = |n: &str| {
+        names
+            .iter()
+            .position(|m| m == n)
+            .and_then(|k| q.get(k).copied())
+    };
+    let (Some(b), Some(s)) = (tree.pose(base, &value), tree.pose(frame, &value)) else {
+        return *f;
+    };
+    let r: Frame = b.inverse().then(&s);
+    let v = r.r * nalgebra::Vector3::from(*f);
+    [v.x, v.y, v.z]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tactile_chain::Robot;
+    use tactile_ros::msg::{Header, Message};
+
+    const PANDA: &str = include_str!("../../../deploy/robots/panda.urdf");
+
+    fn panda() -> (Chain, Tree) {
+        let r = Robot::parse(PANDA).expect("urdf");
+        (
+            Chain::new(&r, "panda_link0", "panda_hand").expect("chain"),
+            Tree::new(&r).expect("tree"),
+        )
+    }
+
+    #[test]
+    fn joints_are_read_by_name_in_any_order_and_checked() {
+        let (chain, _) = panda();
+        let m = ArmJointMap::of(&chain);
+        let mut names: Vec<String> = m.names.iter().rev().cloned().collect();
+        names.push("panda_finger_joint1".into());
+        let mut js = JointState {
+            header: Header::at(1, ""),
+            name: names,
+            position: vec![0.1, 1.0, 0.0, -1.5, 0.0, -0.5, 0.2, 0.04],
+            ..JointState::default()
+        };
+        assert_eq!(
+            m.positions_cdr(&js.to_cdr()),
+            Ok(vec![0.2, -0.5, 0.0, -1.5, 0.0, 1.0, 0.1])
+        );
+        js.position[3] = 0.5; // panda_joint4 is in [-3.0718, -0.0698]
+        assert!(
+            matches!(m.positions(&js), Err(Reject::OutOfRange { joint, .. }) if joint == "panda_joint4")
+        );
+        js.position[3] = f64::NAN;
+        assert_eq!(
+            m.positions(&js),
+            Err(Reject::NotFinite("panda_joint4".into()))
+        );
+        js.position[3] = -1.5;
+        js.name.remove(0);
+        js.position.remove(0);
+        assert_eq!(
+            m.positions(&js),
+            Err(Reject::Missing("panda_joint7".into()))
+        );
+    }
+
+    #[test]
+    fn a_wrench_in_the_hand_turns_into_the_base() {
+        let (chain, tree) = panda();
+        let names = ArmJointMap::of(&chain).names;
+        // The shipped Panda scenario's home: franka_ros' ready pose.
+        let sc = include_str!("../../../deploy/scenarios/panda.toml");
+        let sc = tactile_scenario::Scenario::from_toml_str(sc).expect("scenario");
+        let q = sc.slave.arm.expect("arm").home;
+        let w = WrenchStamped {
+            header: Header::at(1, "panda_hand"),
+            force: [0.0, 0.0, 5.0],
+            torque: [0.0; 3],
+        };
+        let framed = framed_force_cdr(&w.to_cdr(), &tree, "panda_link0").expect("framed");
+        let f = in_base(&tree, "panda_link0", &names, &q, &framed);
+        // At the ready pose the hand's z points down.
+        let hand = chain.fk(&q).r * nalgebra::Vector3::new(0.0, 0.0, 5.0);
+        assert!((f[2] - hand.z).abs() < 1e-12 && f[2] < -4.99, "{f:?}");
+        let mut bad = w.clone();
+        bad.header.frame_id = "tool0_controller".into();
+        assert_eq!(
+            framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0"),
+            Err(Reject::UnknownFrame("tool0_controller".into()))
+        );
+        bad.header.frame_id = String::new();
+        bad.force[0] = f64::INFINITY;
+        assert_eq!(
+            framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0"),
+            Err(Reject::ForceNotFinite)
+        );
+    }
+}
