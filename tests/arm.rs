@@ -189,31 +189,75 @@ fn a_bad_arm_is_named_and_nothing_starts() {
     }
 }
 
-/// The recording draws the Panda where its joints put it: run.mcap read by independent
-/// readers (mcap_ros2, yourdfpy's URDF parser and FK; tests/mcap_arm_check.py).
-#[test]
-fn the_recording_draws_the_arm_where_its_joints_put_it() {
+/// True if python3 has the readers tests/mcap_arm_check.py needs.
+fn mcap_readers() -> bool {
     let probe = "import mcap, mcap_ros2, yourdfpy, numpy";
-    let ready = std::process::Command::new("python3")
+    std::process::Command::new("python3")
         .args(["-c", probe])
         .output()
-        .is_ok_and(|o| o.status.success());
-    if !ready {
-        return util::cannot("python3 lacks mcap, mcap-ros2-support, yourdfpy or numpy");
-    }
-    let sb = Sandbox::new("armmcap");
-    sb.simulate(&panda(), "a");
+        .is_ok_and(|o| o.status.success())
+}
+
+/// tests/mcap_arm_check.py on the report in `out`: its output.
+fn mcap_arm_check(sb: &Sandbox, out: &str, base: &str, tip: &str) -> String {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/mcap_arm_check.py");
     let mut c = std::process::Command::new("python3");
     c.arg(script)
-        .arg(sb.path("a"))
-        .args(["--base", "panda_link0", "--tip", "panda_hand"]);
+        .arg(sb.path(out))
+        .args(["--base", base, "--tip", tip]);
     let o = util::output_within(c, util::LIMIT);
     let text =
         String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{text}");
+    text
+}
+
+/// The recording draws the Panda where its joints put it: run.mcap read by independent
+/// readers (mcap_ros2, yourdfpy's URDF parser and FK; tests/mcap_arm_check.py).
+#[test]
+fn the_recording_draws_the_arm_where_its_joints_put_it() {
+    if !mcap_readers() {
+        return util::cannot("python3 lacks mcap, mcap-ros2-support, yourdfpy or numpy");
+    }
+    let sb = Sandbox::new("armmcap");
+    sb.simulate(&panda(), "a");
+    let text = mcap_arm_check(&sb, "a", "panda_link0", "panda_hand");
     assert!(
         text.contains("4000 samples, 41 drawn and compared"),
         "{text}"
     );
+}
+
+/// The shipped UR5 scenario: six joints, a URDF rooted in `world` (drawn where its
+/// URDF puts it), the tool within a millimetre of its target in free space.
+#[test]
+fn a_ur5_follows_in_free_space_and_is_drawn_from_its_own_world() {
+    let sb = Sandbox::new("armur5");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/ur5.toml");
+    sb.simulate(&scenario, "a");
+    let trace = sb.trace("a");
+    let col = |c: &str| column(&trace, c);
+    let (t, v, h) = (
+        [1, 2, 3].map(|i| col(&format!("tool_{i}"))),
+        [1, 2, 3].map(|i| col(&format!("v_{i}"))),
+        col("h_3"),
+    );
+    let free: Vec<f64> = (0..h.len())
+        .filter(|&k| h[k] == 0.0)
+        .map(|k| {
+            (0..3)
+                .map(|i| (t[i][k] - v[i][k]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .collect();
+    assert!(free.len() > 1000, "{}", free.len());
+    let worst = free.iter().copied().fold(0.0, f64::max);
+    assert!(worst < 1e-3, "free-space error {worst} m");
+    assert!(h.iter().any(|f| *f > 5.0), "the wall pushed back");
+    if !mcap_readers() {
+        return util::cannot("python3 lacks mcap, mcap-ros2-support, yourdfpy or numpy");
+    }
+    let text = mcap_arm_check(&sb, "a", "base_link", "tool0");
+    assert!(text.contains("4000 samples"), "{text}");
 }
