@@ -5,6 +5,9 @@
 //! step as a real arm's inner loop runs far faster than the network's samples) drives
 //! the joints, and the articulated-body algorithm integrates the URDF's inertias under
 //! gravity, the joints' damping and the environment's contact force at the tool.
+//! With `servo = "cartesian"` an impedance at the tool replaces the joint PD (the
+//! IK's references then only steer the null space), as a torque-controlled arm's
+//! Cartesian impedance controller does.
 //!
 //! The loop carries positions in the master's frame (see `tactile_scenario::ArmConfig`):
 //! the tool's target is its home pose moved by `scale` times the master's displacement
@@ -13,11 +16,11 @@
 //! arm's tool as it is (the objects are the master frame's, so a wall keeps its place
 //! and stiffness for the operator whatever the arm).
 
-use nalgebra::{Matrix6xX, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix6, Matrix6xX, Vector3, Vector6};
 use std::path::Path;
 use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
 use tactile_math::arith::StdTrig;
-use tactile_scenario::{ArmConfig, Object, Scenario};
+use tactile_scenario::{ArmConfig, ArmServo, Object, Scenario};
 
 use crate::environment::deepest_contact;
 use tactile_math::kernels;
@@ -38,6 +41,9 @@ pub struct UrdfArm {
     jac: Matrix6xX<f64>,
     /// The joints held since input went silent, if it is.
     held: Option<Vec<f64>>,
+    /// The tool's pose reference and its velocity `[linear; angular]` in the base
+    /// frame (the Cartesian servo's).
+    reference: (Frame, Vector6<f64>),
 }
 
 /// The arm's joints after a step: references, angles, velocities, efforts.
@@ -159,6 +165,7 @@ impl UrdfArm {
             cfg: cfg.clone(),
             home_tool,
             master_home,
+            reference: (home_tool, Vector6::zeros()),
             state,
             held: None,
         })
@@ -197,6 +204,8 @@ impl UrdfArm {
     /// (the reference is a smooth path the servo follows, as a trajectory generator's).
     pub fn follow(&mut self, position: [f64; 3], dt: f64) -> Followed {
         let target = self.target(position);
+        let v = (target.p - self.reference.0.p) / dt;
+        self.reference = (target, Vector6::new(v.x, v.y, v.z, 0.0, 0.0, 0.0));
         match self.ik.step(&self.state.q_ref, &target, dt) {
             Ok(s) => {
                 for ((v, new), old) in self
@@ -231,7 +240,9 @@ impl UrdfArm {
         let from = self.held.get_or_insert_with(|| self.state.q.clone());
         self.state.q_ref.copy_from_slice(from);
         self.state.qd_ref.iter_mut().for_each(|v| *v = 0.0);
-        let p0 = self.chain.fk(&self.state.q_ref).p;
+        let held = self.chain.fk(&self.state.q_ref);
+        self.reference = (held, Vector6::zeros());
+        let p0 = held.p;
         let clamps = self.advance(dt, objects);
         let p = self.chain.fk(&self.state.q).p;
         Holding {
@@ -307,24 +318,63 @@ impl UrdfArm {
         clamped.iter().filter(|c| **c).count() as u32
     }
 
-    /// The PD with gravity compensation, clamped to each joint's effort limit.
-    fn servo(&self, clamped: &mut [bool]) -> Vec<f64> {
+    /// The servo's efforts with gravity compensation, clamped to each joint's effort
+    /// limit: the joint PD, or the Cartesian impedance.
+    fn servo(&mut self, clamped: &mut [bool]) -> Vec<f64> {
         let g = self
             .dynamics
             .gravity_torques(&self.state.q)
             .unwrap_or_else(|_| vec![0.0; self.chain.dof()]);
+        let drive = match self.cfg.servo {
+            ArmServo::Joint => None,
+            ArmServo::Cartesian => Some(self.impedance()),
+        };
         let s = &self.state;
         (0..g.len())
             .map(|i| {
-                let u = self.cfg.kp[i] * (s.q_ref[i] - s.q[i])
-                    + self.cfg.kd[i] * (s.qd_ref[i] - s.qd[i])
-                    + g[i];
+                let u = match &drive {
+                    None => {
+                        self.cfg.kp[i] * (s.q_ref[i] - s.q[i])
+                            + self.cfg.kd[i] * (s.qd_ref[i] - s.qd[i])
+                            + g[i]
+                    }
+                    Some(d) => d[i] + g[i],
+                };
                 let limit = self.chain.dofs[i].effort;
                 let t = u.clamp(-limit, limit);
                 clamped[i] |= t != u;
                 t
             })
             .collect()
+    }
+
+    /// The Cartesian impedance without gravity: `J^T (K e - D (v - v_ref))` toward the
+    /// pose reference, and in the null space of the task (`I - J^T J^+T`, `J^+` damped)
+    /// a PD toward the IK's references, so a redundant arm keeps its posture.
+    fn impedance(&mut self) -> Vec<f64> {
+        let n = self.chain.dof();
+        let tip = self.chain.jacobian(&self.state.q, &mut self.jac);
+        let (r, v_ref) = &self.reference;
+        let e_p = r.p - tip.p;
+        let e_r = tactile_chain::spatial::log_rotation(&(r.r * tip.r.transpose()));
+        let qd = DVector::from_column_slice(&self.state.qd);
+        let v = &self.jac * &qd;
+        let c = &self.cfg.cartesian;
+        let (k, d) = (c.stiffness, c.damping());
+        let e = [e_p.x, e_p.y, e_p.z, e_r.x, e_r.y, e_r.z];
+        let w = Vector6::from_fn(|i, _| k[i] * e[i] - d[i] * (v[i] - v_ref[i]));
+        let task = self.jac.transpose() * w;
+        // J^+ = J^T (J J^T + lambda^2 I)^-1: damped, so a singular pose stays finite.
+        let jjt: Matrix6<f64> = &self.jac * self.jac.transpose() + Matrix6::identity() * 1e-6;
+        let inv = jjt.try_inverse().unwrap_or_else(Matrix6::zeros);
+        let pinv = self.jac.transpose() * inv;
+        let null = DMatrix::identity(n, n) - self.jac.transpose() * pinv.transpose();
+        let kn = c.nullspace_stiffness;
+        let dn = 2.0 * kn.sqrt();
+        let s = &self.state;
+        let posture = DVector::from_fn(n, |i, _| kn * (s.q_ref[i] - s.q[i]) - dn * s.qd[i]);
+        let tau = task + null * posture;
+        tau.iter().copied().collect()
     }
 
     /// The contact force at the tool (the environment's, evaluated in the master's
@@ -359,7 +409,7 @@ impl UrdfArm {
 mod tests {
     use super::*;
     use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
-    use tactile_scenario::ArmIkConfig;
+    use tactile_scenario::{ArmIkConfig, CartesianConfig};
 
     fn panda_xml() -> String {
         let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../deploy/robots/panda.urdf");
@@ -386,6 +436,8 @@ mod tests {
             step_s: 2.5e-4,
             gravity: [0.0, 0.0, -9.81],
             ik: ArmIkConfig::default(),
+            servo: ArmServo::Joint,
+            cartesian: CartesianConfig::default(),
         }
     }
 
@@ -412,7 +464,7 @@ mod tests {
     fn at_rest_the_servo_gives_the_gravity_torques() {
         // At home with no error the servo's effort is the gravity torque itself (RNEA),
         // far from zero: without it the arm would sag.
-        let arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+        let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
         let g = arm.dynamics.gravity_torques(&panda_cfg().home).expect("g");
         let mut clamped = vec![false; 7];
         let tau = arm.servo(&mut clamped);
@@ -443,6 +495,43 @@ mod tests {
         for k in 0..3 {
             assert!((t[k] - goal[k]).abs() < 1e-5, "{t:?}");
         }
+    }
+
+    /// The Cartesian impedance is a spring at the tool: held 2 cm into a 1000 N/m wall
+    /// with a 1000 N/m stiffness along z, the tool settles half way (two equal springs
+    /// in series: 1 cm, 10 N).
+    #[test]
+    fn a_cartesian_impedance_yields_as_its_stiffness_says() {
+        let wall_z = HOME[2] - 0.01;
+        let wall = Object::Plane {
+            point: [0.0, 0.0, wall_z],
+            normal: [0.0, 0.0, 1.0],
+            stiffness: [1000.0; 3],
+        };
+        let goal = [HOME[0], HOME[1], wall_z - 0.02];
+        let settle = |cfg: &ArmConfig| {
+            let mut arm = UrdfArm::new(cfg, &panda_xml(), HOME).expect("arm");
+            for _ in 0..4000 {
+                arm.follow(goal, 1e-3);
+                arm.advance(1e-3, std::slice::from_ref(&wall));
+            }
+            wall_z - arm.tool()[2]
+        };
+        let cfg = ArmConfig {
+            servo: ArmServo::Cartesian,
+            cartesian: CartesianConfig {
+                stiffness: [1000.0, 1000.0, 1000.0, 100.0, 100.0, 100.0],
+                ..CartesianConfig::default()
+            },
+            ..panda_cfg()
+        };
+        let pen = settle(&cfg);
+        assert!((pen - 0.01).abs() < 5e-4, "penetration {pen} m");
+        // Three times stiffer: three quarters of the way (15 mm, 15 N).
+        let mut stiffer = cfg.clone();
+        stiffer.cartesian.stiffness[2] = 3000.0;
+        let pen = settle(&stiffer);
+        assert!((pen - 0.015).abs() < 5e-4, "penetration {pen} m");
     }
 
     #[test]

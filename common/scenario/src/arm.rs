@@ -40,6 +40,73 @@ pub struct ArmConfig {
     /// The IK's settings.
     #[serde(default)]
     pub ik: ArmIkConfig,
+    /// How the simulated arm's joints are driven: `joint` (a PD on the IK's joint
+    /// references with gravity compensation) or `cartesian` (an impedance at the tool).
+    #[serde(default)]
+    pub servo: ArmServo,
+    /// The Cartesian impedance's settings (`servo = "cartesian"`).
+    #[serde(default)]
+    pub cartesian: CartesianConfig,
+}
+
+/// The simulated arm's servo.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ArmServo {
+    /// A joint-space PD on the IK's references (`kp`, `kd`), gravity compensated:
+    /// what a position-controlled arm (UR, a joint_trajectory_controller) does.
+    #[default]
+    Joint,
+    /// A Cartesian impedance at the tool, `tau = J^T (K e - D v) + g` and a
+    /// null-space PD toward the IK's references: what franka_ros'
+    /// cartesian_impedance_example_controller does.
+    Cartesian,
+}
+
+/// A Cartesian impedance at the tool, in the base frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CartesianConfig {
+    /// Translational stiffness, N/m, then rotational, N m/rad (x, y, z each).
+    pub stiffness: [f64; 6],
+    /// Damping, N s/m and N m s/rad; default `2 sqrt(stiffness)` (critical for a unit
+    /// mass, as franka_ros' example).
+    pub damping: Option<[f64; 6]>,
+    /// The null space's stiffness toward the IK's references, N m/rad (damped
+    /// critically for a unit inertia).
+    pub nullspace_stiffness: f64,
+}
+
+impl Default for CartesianConfig {
+    fn default() -> Self {
+        CartesianConfig {
+            stiffness: [3000.0, 3000.0, 3000.0, 300.0, 300.0, 300.0],
+            damping: None,
+            nullspace_stiffness: 10.0,
+        }
+    }
+}
+
+impl CartesianConfig {
+    /// The damping in use.
+    pub fn damping(&self) -> [f64; 6] {
+        self.damping
+            .unwrap_or_else(|| self.stiffness.map(|k| 2.0 * k.sqrt()))
+    }
+
+    fn validate(&self) -> Result<(), ScenarioError> {
+        for (i, k) in self.stiffness.iter().enumerate() {
+            positive(*k, &format!("slave.arm.cartesian.stiffness[{i}]"), false)?;
+        }
+        for (i, d) in self.damping.iter().flatten().enumerate() {
+            positive(*d, &format!("slave.arm.cartesian.damping[{i}]"), true)?;
+        }
+        positive(
+            self.nullspace_stiffness,
+            "slave.arm.cartesian.nullspace_stiffness",
+            true,
+        )
+    }
 }
 
 fn one() -> f64 {
@@ -159,6 +226,7 @@ impl ArmConfig {
                 ));
             }
         }
+        self.cartesian.validate()?;
         self.ik.validate()
     }
 }

@@ -22,7 +22,7 @@ mod ros;
 mod slave;
 mod validate;
 
-pub use arm::{ArmConfig, ArmIkConfig, MAX_ARM_DOF};
+pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
 pub use control::{
     CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, PredictorConfig, PredictorKind,
 };
