@@ -918,10 +918,15 @@ fn a_panda_over_ros2_follows_through_a_position_controller() {
     let sb = Sandbox::new("ros2-panda");
     let port = free_port();
     let topic = "/fr3_arm_controller/commands";
-    let arm = arm_standin(&sb, 16, port, "positions", topic, &[]);
+    let arm = arm_standin(&sb, 16, port, "positions", topic, &["--live"]);
     let scenario = sb.write(
         "panda.toml",
-        &panda_over_ros(16, port, 4000, "positions", "").replace("/fr3_arm_controller/CMD", topic),
+        &panda_over_ros(16, port, 4000, "positions", "")
+            .replace("/fr3_arm_controller/CMD", topic)
+            .replace(
+                "[slave]\n",
+                "[ros.live]\nenabled = true\nrate_hz = 50.0\n\n[slave]\n",
+            ),
     );
     listening(port);
     sb.run(&scenario, "out");
@@ -982,6 +987,14 @@ fn a_panda_over_ros2_follows_through_a_position_controller() {
         .fold(0.0, f64::max);
     assert!(worst < 2e-3, "free-space error {worst} m");
     assert!(h.iter().any(|f| *f > 1.0), "the wall pushed back");
+    // The live view names the arm's joints, in chain order, and puts its tool in the
+    // base's frame (4 s at 50 Hz: 200 states, some lost to a busy machine).
+    let live = &r["live"];
+    assert!(num(&live["count"]) > 100.0, "{live}");
+    let names: Vec<&str> = PANDA_JOINTS.split(',').collect();
+    assert_eq!(live["names"], serde_json::json!(names), "{live}");
+    assert_eq!(live["frames"], serde_json::json!(["panda_link0"]), "{live}");
+    assert_eq!(live["errors"], serde_json::json!([]), "{live}");
 }
 
 /// The same arm through a joint_trajectory_controller (one point a period, joints by

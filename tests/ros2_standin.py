@@ -420,6 +420,23 @@ def arm(a):
     else:
         sub = node.subscribe(a.command_topic, ARRAY, on_array)
     put_wrench = node.publisher(a.wrench_topic, WRENCH) if a.wrench_topic else None
+    live = {"count": 0, "names": None, "q": None, "frames": set(), "errors": []}
+
+    def on_live(sample):
+        """The slave's live view: its joint states and the frames of its tool."""
+        try:
+            ty, topic = ty_of_key(str(sample.key_expr))
+            msg = TS.deserialize_cdr(sample.payload.to_bytes(), ty)
+        except Exception as e:  # noqa: BLE001 - reported, never fatal
+            live["errors"].append(f"{sample.key_expr}: {e}")
+            return
+        if topic == "/slave/joint_states":
+            live["count"] += 1
+            live["names"], live["q"] = list(msg.name), list(msg.position)
+        elif topic == "/slave/tool":
+            live["frames"].add(msg.header.frame_id)
+
+    live_sub = node.s.declare_subscriber(f"{a.domain}/slave/**", on_live) if a.live else None
     stop = stopping()
     alpha = 1.0 - math.exp(-1e-3 / a.tau)
 
@@ -435,7 +452,9 @@ def arm(a):
         return True
 
     at_rate(1000.0, stop, a.duration, step)
-    del sub
+    del sub, live_sub
+    live["frames"] = sorted(live["frames"])
+    rep["live"] = live
     rep["q"] = q
     rep["point_times"] = sorted(rep["point_times"])
     rep["bad_attachments"] = node.bad_attachments
@@ -483,6 +502,7 @@ def main():
     m.add_argument("--wrench-topic", default="")
     m.add_argument("--wrench-frame", default="")
     m.add_argument("--wrench", type=float, nargs=3, default=[0.0, 0.0, 0.0])
+    m.add_argument("--live", action="store_true", help="take the slave's live view")
     a = p.parse_args()
     {"device": device, "robot": robot, "arm": arm}[a.role](a)
 

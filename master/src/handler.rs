@@ -136,8 +136,8 @@ impl Handler for MasterHandler {
         };
         Some(SampleView {
             master: Some(master),
-            slave: None,
             timing: Some(timing),
+            ..SampleView::default()
         })
     }
 }

@@ -6,12 +6,13 @@
 
 use crate::hsd::{Measured, Slave};
 use crate::urdf_arm::ArmState;
+use std::sync::Arc;
 use std::time::Duration;
 use tactile_devices::held::Held;
 use tactile_devices::{Peripheral, Robot};
 use tactile_messages::samples::{Backward, Forward};
 use tactile_records::slave::{ArmJoints, SlaveCounters, SlaveSample, SlaveTotals, Step};
-use tactile_ros::view::{SampleView, SlaveView};
+use tactile_ros::view::{ArmSample, SampleView, SlaveView};
 use tactile_runtime::driver::{changed, Counts, Failure, Follower, Handler, Io, Reply};
 use tactile_scenario::Scenario;
 
@@ -109,6 +110,8 @@ enum Robots {
 pub struct SlaveHandler {
     slave: Slave,
     robot: Robots,
+    /// A URDF arm's base link and joint names, for the live view.
+    arm_names: Option<(Arc<str>, Arc<[String]>)>,
     holding: bool,
     idle: (Duration, Duration),
     last_step: Option<Step>,
@@ -128,8 +131,14 @@ impl SlaveHandler {
     /// The handler of `slave` for `scenario`, with a real robot (`None`: the
     /// simulated arm).
     pub fn new(slave: Slave, scenario: &Scenario, robot: Option<RealRobot>) -> Self {
+        let arm_names = slave.arm().map(|a| {
+            let c = a.chain();
+            let names: Vec<String> = c.dofs.iter().map(|d| d.name.clone()).collect();
+            (Arc::from(c.base.as_str()), Arc::from(names))
+        });
         SlaveHandler {
             slave,
+            arm_names,
             robot: match robot {
                 None => Robots::None,
                 Some(RealRobot::Paper(r)) => Robots::Paper(Hardware::new(r)),
@@ -192,6 +201,20 @@ impl Handler for SlaveHandler {
 
     fn live(&self) -> Option<SampleView> {
         let s = self.last_step?;
+        if let (Some(arm), Some((base, names))) = (self.slave.arm(), &self.arm_names) {
+            let a = arm.state();
+            return Some(SampleView {
+                arm: Some(ArmSample {
+                    base: Arc::clone(base),
+                    names: Arc::clone(names),
+                    q: a.q.clone(),
+                    effort: a.tau.clone(),
+                    tool: arm.tool_in_base(),
+                    force: s.force,
+                }),
+                ..SampleView::default()
+            });
+        }
         Some(SampleView {
             slave: Some(SlaveView {
                 theta: s.theta,

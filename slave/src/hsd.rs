@@ -122,6 +122,11 @@ impl Slave {
         self.dynamics.state
     }
 
+    /// The URDF arm, if the slave is one.
+    pub fn arm(&self) -> Option<&UrdfArm> {
+        self.arm.as_ref()
+    }
+
     /// A URDF arm's joints, if the slave is one.
     pub fn arm_state(&self) -> Option<&ArmState> {
         self.arm.as_ref().map(UrdfArm::state)

@@ -195,6 +195,11 @@ impl UrdfArm {
         self.to_master(&self.chain.fk(&self.state.q).p)
     }
 
+    /// The tool (FK of the joints) in the arm's base frame, m.
+    pub fn tool_in_base(&self) -> [f64; 3] {
+        self.chain.fk(&self.state.q).p.into()
+    }
+
     fn to_master(&self, p: &Vector3<f64>) -> [f64; 3] {
         let home = self.home_tool.p.into();
         self.cfg.to_master(home, self.master_home, (*p).into())

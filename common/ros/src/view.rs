@@ -203,13 +203,48 @@ impl ArmView<'_> {
     }
 }
 
+/// A URDF arm's part of a sample, owned (the live view hands it to its thread): what
+/// [`ArmView`] borrows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmSample {
+    /// The base link.
+    pub base: std::sync::Arc<str>,
+    /// The joints' names.
+    pub names: std::sync::Arc<[String]>,
+    /// Joint values, rad or m.
+    pub q: Vec<f64>,
+    /// Efforts, N m or N.
+    pub effort: Vec<f64>,
+    /// The tool in the base frame, m.
+    pub tool: [f64; 3],
+    /// The contact force, N, in the base's axes.
+    pub force: [f64; 3],
+}
+
+impl ArmSample {
+    /// The sample as an [`ArmView`] (no velocities: the live view has none).
+    pub fn view(&self) -> ArmView<'_> {
+        ArmView {
+            base: &self.base,
+            names: &self.names,
+            q: &self.q,
+            velocity: None,
+            effort: &self.effort,
+            tool: self.tool,
+            force: self.force,
+        }
+    }
+}
+
 /// What a sample shows, from whichever nodes saw it.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct SampleView {
     /// The master's part.
     pub master: Option<MasterView>,
-    /// The slave's part.
+    /// The slave's part (the paper's arm).
     pub slave: Option<SlaveView>,
+    /// The slave's part when it is an arm from its URDF.
+    pub arm: Option<ArmSample>,
     /// Round trip, delays, flags, observers.
     pub timing: Option<SampleTiming>,
 }
@@ -275,6 +310,9 @@ impl SampleView {
             sink.put(SLAVE_TOOL, SlaveSend, &pose(stamp, SLAVE_BASE, s.tool))?;
             sink.put(SLAVE_FORCE, SlaveSend, &wrench(stamp, SLAVE_BASE, s.force))?;
         }
+        if let Some(a) = &self.arm {
+            a.view().emit(stamp, sink)?;
+        }
         if let Some(m) = &self.master {
             sink.put(MASTER_FORCE, MasterRecv, &wrench(stamp, MASTER_BASE, m.q))?;
             sink.put(MASTER_FELT, MasterRecv, &wrench(stamp, MASTER_BASE, m.felt))?;
@@ -320,5 +358,17 @@ mod tests {
             ..SampleView::default()
         };
         assert_eq!(names(slave), live(&SLAVE_LIVE));
+        let arm = SampleView {
+            arm: Some(ArmSample {
+                base: "panda_link0".into(),
+                names: vec!["a".to_string()].into(),
+                q: vec![0.5],
+                effort: vec![1.0],
+                tool: [0.0; 3],
+                force: [0.0; 3],
+            }),
+            ..SampleView::default()
+        };
+        assert_eq!(names(arm), live(&SLAVE_LIVE));
     }
 }

@@ -140,6 +140,8 @@ impl<W: Write> Recording<W> {
                 tool: row.tool,
                 force: row.h,
             }),
+            // A URDF arm's part is emitted below, borrowed (no copy of its joints).
+            arm: None,
             timing: Some(timing(row)),
         };
         let arm = self.arm.take();
