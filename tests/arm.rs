@@ -261,3 +261,34 @@ fn a_ur5_follows_in_free_space_and_is_drawn_from_its_own_world() {
     let text = mcap_arm_check(&sb, "a", "base_link", "tool0");
     assert!(text.contains("4000 samples"), "{text}");
 }
+
+/// Records whose URDF is gone (moved without their inputs) still make a whole report:
+/// the recording leaves the arm undrawn and the summary says why.
+#[test]
+fn a_report_whose_urdf_is_gone_says_so_and_loses_nothing_else() {
+    let sb = Sandbox::new("armgone");
+    sb.simulate(&panda(), "a");
+    std::fs::remove_file(sb.path("a").join("inputs").join("panda.urdf")).expect("bundled urdf");
+    let a = sb.path("a");
+    let b = sb.path("b");
+    let o = sb.tactile(&[
+        "report",
+        a.to_str().expect("utf-8"),
+        "--out",
+        b.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = sb.json("b", "summary.json");
+    let events = s["events"].to_string();
+    assert!(
+        events.contains("the slave arm is not drawn") && events.contains("panda.urdf"),
+        "{events}"
+    );
+    for f in ["trace.csv", "joints.csv", "run.mcap"] {
+        assert!(sb.path("b").join(f).exists(), "{f}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(sb.path("a").join("joints.csv")).expect("a"),
+        std::fs::read_to_string(sb.path("b").join("joints.csv")).expect("b")
+    );
+}

@@ -903,6 +903,39 @@ fn arm_standin(
     standin(sb, &args)
 }
 
+/// Runs the shipped Panda scenario (`samples`, `command` on `topic`, `extra` in
+/// `[slave.ros2]`, `live` view or not) against the stand-in `arm` listening on `port`
+/// in `domain`: the stand-in's report and the run's summary, the run completed and
+/// every command well formed.
+fn run_panda(
+    sb: &Sandbox,
+    arm: Child,
+    (domain, port): (u32, u16),
+    samples: u64,
+    (command, topic): (&str, &str),
+    extra: &str,
+    live: bool,
+) -> (serde_json::Value, serde_json::Value) {
+    let mut text = panda_over_ros(domain, port, samples, command, extra)
+        .replace("/fr3_arm_controller/CMD", topic);
+    if live {
+        text = text.replace(
+            "[slave]\n",
+            "[ros.live]\nenabled = true\nrate_hz = 50.0\n\n[slave]\n",
+        );
+    }
+    let scenario = sb.write("panda.toml", &text);
+    listening(port);
+    sb.run(&scenario, "out");
+    let r = report(sb, arm, "arm.json");
+    let s = sb.json("out", "summary.json");
+    let ended = format!("completed, after sample {}", samples - 1);
+    assert_eq!(s["nodes"]["slave"]["ended"], ended.as_str());
+    assert_eq!(num(&s["slave"]["device"]["rejected"]), 0.0, "{s}");
+    assert_eq!(r["bad_commands"], serde_json::json!([]), "{r}");
+    (r, s)
+}
+
 fn floats(v: &serde_json::Value) -> Vec<f64> {
     v.as_array().expect("array").iter().map(num).collect()
 }
@@ -919,25 +952,11 @@ fn a_panda_over_ros2_follows_through_a_position_controller() {
     let port = free_port();
     let topic = "/fr3_arm_controller/commands";
     let arm = arm_standin(&sb, 16, port, "positions", topic, &["--live"]);
-    let scenario = sb.write(
-        "panda.toml",
-        &panda_over_ros(16, port, 4000, "positions", "")
-            .replace("/fr3_arm_controller/CMD", topic)
-            .replace(
-                "[slave]\n",
-                "[ros.live]\nenabled = true\nrate_hz = 50.0\n\n[slave]\n",
-            ),
-    );
-    listening(port);
-    sb.run(&scenario, "out");
-    let r = report(&sb, arm, "arm.json");
-    let s = sb.json("out", "summary.json");
-    assert_eq!(s["nodes"]["slave"]["ended"], "completed, after sample 3999");
+    let cmd = ("positions", topic);
+    let (r, s) = run_panda(&sb, arm, (16, port), 4000, cmd, "", true);
     let sd = &s["slave"]["device"];
-    assert_eq!(num(&sd["rejected"]), 0.0, "{sd}");
     assert_eq!(sd["released"], true, "{sd}");
     assert!(num(&r["commands"]) > 3500.0, "{r}");
-    assert_eq!(r["bad_commands"], serde_json::json!([]), "{r}");
     // The URDF's limits (panda_joint4 in [-3.0718, -0.0698]) and velocity limits
     // (2.175 rad/s and up: 2.175 mrad a period at 1 kHz) hold for every command.
     let (lo, hi, step) = (
@@ -1024,23 +1043,16 @@ fn a_panda_over_ros2_takes_trajectories_and_its_wrench_turns_into_the_base() {
             "5",
         ],
     );
-    let scenario = sb.write(
-        "panda.toml",
-        &panda_over_ros(
-            17,
-            port,
-            1500,
-            "trajectory",
-            "wrench_topic = \"/fts/wrench\"\n",
-        )
-        .replace("/fr3_arm_controller/CMD", topic),
+    let wrench = "wrench_topic = \"/fts/wrench\"\n";
+    let (r, _) = run_panda(
+        &sb,
+        arm,
+        (17, port),
+        1500,
+        ("trajectory", topic),
+        wrench,
+        false,
     );
-    listening(port);
-    sb.run(&scenario, "out");
-    let r = report(&sb, arm, "arm.json");
-    let s = sb.json("out", "summary.json");
-    assert_eq!(s["nodes"]["slave"]["ended"], "completed, after sample 1499");
-    assert_eq!(r["bad_commands"], serde_json::json!([]), "{r}");
     assert!(num(&r["commands"]) > 1200.0, "{r}");
     // One period from start, by default.
     assert_eq!(r["point_times"], serde_json::json!([1_000_000]), "{r}");
@@ -1056,4 +1068,97 @@ fn a_panda_over_ros2_takes_trajectories_and_its_wrench_turns_into_the_base() {
         h[1][k],
         h[2][k]
     );
+}
+
+/// True if python3 also has MuJoCo (tests/mujoco_arm.py).
+fn mujoco_ready() -> bool {
+    python_ready()
+        && Command::new("python3")
+            .args(["-c", "import mujoco"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+}
+
+/// A Panda simulated by MuJoCo (its own URDF import, dynamics and soft contact) under a
+/// stiff position servo, driven over a JointTrajectory controller, its contact force
+/// on the hand as a force-torque sensor in the hand's frame: the loop's tool is where
+/// MuJoCo's hand is, and the wall MuJoCo's arm presses on is the force h(n) the master
+/// gets.
+#[test]
+fn a_mujoco_panda_presses_a_wall_and_its_force_comes_back() {
+    if !mujoco_ready() {
+        return cannot("python3 lacks eclipse-zenoh, rosbags or mujoco");
+    }
+    let sb = Sandbox::new("ros2-mujoco");
+    let port = free_port();
+    let topic = "/fr3_arm_controller/joint_trajectory";
+    let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/panda.urdf");
+    let arm = arm_standin(
+        &sb,
+        18,
+        port,
+        "trajectory",
+        topic,
+        &[
+            "--mujoco",
+            urdf,
+            "--tool",
+            "panda_hand",
+            "--wall-below",
+            "0.045",
+            "--wrench-topic",
+            "/fts/wrench",
+            "--wrench-frame",
+            "panda_hand",
+        ],
+    );
+    let wrench = "wrench_topic = \"/fts/wrench\"\n";
+    let (r, _) = run_panda(
+        &sb,
+        arm,
+        (18, port),
+        3000,
+        ("trajectory", topic),
+        wrench,
+        false,
+    );
+    let trace = sb.trace("out");
+    let col = |c: &str| util::column(&trace, c);
+    let (t, v, h) = (
+        [1, 2, 3].map(|i| col(&format!("tool_{i}"))),
+        [1, 2, 3].map(|i| col(&format!("v_{i}"))),
+        col("h_3"),
+    );
+    // Free space (the first second: the hand 1.5 cm or more above the wall): no force,
+    // and the tool follows within 6 mm (MuJoCo's servo lags the moving reference by
+    // about 3 mm at the press's 30 mm/s).
+    assert!(h[..1000].iter().all(|f| *f == 0.0));
+    let worst = (300..1000)
+        .map(|k| {
+            (0..3)
+                .map(|i| (t[i][k] - v[i][k]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 6e-3, "free-space error {worst} m");
+    // Pressed 1.5 cm past the wall by a stiff servo: MuJoCo's contact pushes back up
+    // (the base's z, the master's too), through the hand's frame and the chain.
+    let end = h.len() - 1;
+    assert!(h[end] > 20.0, "h_3 at the end {}", h[end]);
+    assert!(num(&r["max_force"]) > 20.0, "{r}");
+    // The loop's tool (its FK of the joints it read) is MuJoCo's hand (its FK): the
+    // master's frame maps onto the base's by a shift, MuJoCo's start against the
+    // master's home.
+    let tool0 = floats(&r["tool0"]);
+    let hand = floats(&r["tool"]);
+    let home = [0.0, -0.107, -0.035];
+    let ours: Vec<f64> = (0..3).map(|i| tool0[i] + t[i][end] - home[i]).collect();
+    let d = (0..3)
+        .map(|i| (ours[i] - hand[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(d < 2e-3, "the loop's tool {ours:?}, MuJoCo's hand {hand:?}");
+    // The hand stands on the wall, not through it.
+    assert!((t[2][end] - (-0.08)).abs() < 2e-3, "tool z {}", t[2][end]);
 }

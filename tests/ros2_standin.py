@@ -12,9 +12,11 @@ independent of Tactile's, for tests/ros2.rs.
   arm:    an arm of any number of joints under ros2_control: follows a forward
           position controller's Float64MultiArray (the joints in order) or a
           joint_trajectory_controller's JointTrajectory (joints by name; the point
-          reached over its time_from_start), first-order, and publishes its
+          reached over its time_from_start), first-order or simulated by MuJoCo
+          (tests/mujoco_arm.py: its dynamics and a wall's contact), and publishes its
           JointState at 1 kHz with its joints in reverse order and a gripper joint
-          among them; optionally a WrenchStamped in a named frame.
+          among them; optionally a WrenchStamped in a named frame (MuJoCo's contact
+          force on the tool, or a constant).
 
 Both declare rmw_zenoh's liveliness tokens, check every attachment they receive
 (33 bytes: seq, timestamp, 16-byte gid), and write a JSON report on exit.
@@ -439,16 +441,30 @@ def arm(a):
     live_sub = node.s.declare_subscriber(f"{a.domain}/slave/**", on_live) if a.live else None
     stop = stopping()
     alpha = 1.0 - math.exp(-1e-3 / a.tau)
+    sim = None
+    if a.mujoco:
+        from mujoco_arm import MujocoArm  # beside this script
+        sim = MujocoArm(a.mujoco, names, q, a.tool, a.wall_below)
+        start = list(q)  # held until the first command, as a controller holds at start
+        rep["tool0"] = sim.tool_position()
+        rep["max_force"] = 0.0
 
     def step():
         if a.idle_exit and rep["t_last"] is not None and time.monotonic() - rep["t_last"] > a.idle_exit:
             return False
-        if target["q"] is not None:
+        if sim:
+            sim.step(target["q"] if target["q"] is not None else start)
+            q[:] = sim.q()
+        elif target["q"] is not None:
             for i in range(n):
                 q[i] += alpha * (target["q"][i] - q[i])
         put(joint_state(["gripper"] + names[::-1], [0.0] + q[::-1]))
         if put_wrench:
-            put_wrench(wrench_stamped(a.wrench_frame, a.wrench))
+            force = a.wrench
+            if sim:
+                force = sim.force_in(a.wrench_frame)
+                rep["max_force"] = max(rep["max_force"], math.hypot(*force))
+            put_wrench(wrench_stamped(a.wrench_frame, force))
         return True
 
     at_rate(1000.0, stop, a.duration, step)
@@ -456,6 +472,8 @@ def arm(a):
     live["frames"] = sorted(live["frames"])
     rep["live"] = live
     rep["q"] = q
+    if sim:
+        rep["tool"] = sim.tool_position()
     rep["point_times"] = sorted(rep["point_times"])
     rep["bad_attachments"] = node.bad_attachments
     rep.pop("t_last")
@@ -503,6 +521,10 @@ def main():
     m.add_argument("--wrench-frame", default="")
     m.add_argument("--wrench", type=float, nargs=3, default=[0.0, 0.0, 0.0])
     m.add_argument("--live", action="store_true", help="take the slave's live view")
+    m.add_argument("--mujoco", default="", help="simulate the arm of this URDF in MuJoCo")
+    m.add_argument("--tool", default="", help="the link whose contact force is measured")
+    m.add_argument("--wall-below", type=float, default=1.0,
+                   help="the wall's surface this far under the tool's start, m (MuJoCo)")
     a = p.parse_args()
     {"device": device, "robot": robot, "arm": arm}[a.role](a)
 

@@ -312,11 +312,23 @@ impl<W: Write> view::Sink for Stamped<'_, W> {
 /// it is whole, so a report that fails half-way leaves no truncated recording.
 pub type FileRecording = Recording<std::io::BufWriter<std::fs::File>>;
 
-/// Starts `dir/run.mcap.partial`; a URDF slave's file is read and checked.
-pub fn create(dir: &std::path::Path, scenario: &Scenario) -> io::Result<FileRecording> {
-    let arm = ArmScene::of_scenario(scenario).map_err(io::Error::other)?;
+/// Starts `dir/run.mcap.partial`; a URDF slave is drawn from its file. A URDF that
+/// cannot be read (the records moved without their inputs) leaves the arm undrawn
+/// rather than the run unreported: the second value says why, for the summary.
+pub fn create(
+    dir: &std::path::Path,
+    scenario: &Scenario,
+) -> io::Result<(FileRecording, Option<String>)> {
+    let (arm, warning) = match ArmScene::of_scenario(scenario) {
+        Ok(arm) => (arm, None),
+        Err(e) => (
+            None,
+            Some(format!("run.mcap: the slave arm is not drawn: {e}")),
+        ),
+    };
     let f = std::fs::File::create(dir.join(format!("{FILE}.partial")))?;
-    Recording::new(std::io::BufWriter::with_capacity(1 << 16, f), scenario, arm)
+    let rec = Recording::new(std::io::BufWriter::with_capacity(1 << 16, f), scenario, arm)?;
+    Ok((rec, warning))
 }
 
 /// A transform as `/tf` carries it.

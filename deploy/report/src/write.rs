@@ -359,6 +359,8 @@ struct Streams {
     /// A URDF arm's joints, one row a sample (`[slave.arm]`).
     joints: Option<std::io::BufWriter<std::fs::File>>,
     recording: Option<run_mcap::FileRecording>,
+    /// Why the recording leaves something out, for the summary's events.
+    warning: Option<String>,
     line: String,
     t0: Option<u64>,
 }
@@ -375,6 +377,7 @@ impl Streams {
                 trace: None,
                 joints: None,
                 recording: None,
+                warning: None,
                 line: String::new(),
                 t0: None,
             });
@@ -383,7 +386,8 @@ impl Streams {
             .map_err(Error::io(format!("writing {}", trace_path.display())))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
         writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
-        let recording = run_mcap::create(out, scenario).map_err(Error::io("writing run.mcap"))?;
+        let (recording, warning) =
+            run_mcap::create(out, scenario).map_err(Error::io("writing run.mcap"))?;
         let joints = match &scenario.slave.arm {
             Some(arm) => Some(joints_csv(out, arm.home.len())?),
             None => {
@@ -395,6 +399,7 @@ impl Streams {
             trace: Some(w),
             joints,
             recording: Some(recording),
+            warning,
             line: String::with_capacity(2048),
             t0: None,
         })
@@ -523,6 +528,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     let t_s = scenario.t_s();
     let mut series = Series::default();
     let mut streams = Streams::create(out, &scenario, launch.no_trace)?;
+    let warning = streams.warning.clone();
     let stopped = || {
         launch
             .stop
@@ -553,6 +559,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         &scenario.relative_to(&here).to_toml(),
     )?;
     let mut summary = summarise(&scenario, runner, &analysis, &logs, launch);
+    summary.events.extend(warning);
     if let Some(n) = cut_short {
         summary.interrupted = true;
         let dirs: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
@@ -566,11 +573,14 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
 }
 
 /// Joins the records in `dirs` and writes only `out/run.mcap` (old records converted
-/// without redoing the report). Returns the number of samples recorded.
-pub fn write_mcap(dirs: &[PathBuf], out: &Path) -> Result<u64, Error> {
+/// without redoing the report). Returns the number of samples recorded, and what the
+/// recording leaves out, if anything (an arm whose URDF cannot be read).
+pub fn write_mcap(dirs: &[PathBuf], out: &Path) -> Result<(u64, Option<String>), Error> {
     let (_, scenario) = recorded(dirs)?;
     make_out_dir(out)?;
-    let mut rec = run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
+    let (mut rec, warning) =
+        run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
+
     let mut samples = 0;
     join::join(dirs, |row, joints| {
         samples += 1;
@@ -580,5 +590,5 @@ pub fn write_mcap(dirs: &[PathBuf], out: &Path) -> Result<u64, Error> {
     })
     .inspect_err(|_| run_mcap::discard(out))?;
     run_mcap::commit(rec, out).map_err(Error::io("writing run.mcap"))?;
-    Ok(samples)
+    Ok((samples, warning))
 }

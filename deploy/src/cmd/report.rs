@@ -40,7 +40,10 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
     let holder = format!("tactile report (pid {})", std::process::id());
     let _held = tactile_report::out::take(&out, &holder)?;
     if args.mcap_only {
-        let samples = write_mcap(&args.dirs, &out)?;
+        let (samples, warning) = write_mcap(&args.dirs, &out)?;
+        if let Some(w) = warning {
+            crate::noteln!("warning: {w}");
+        }
         crate::outln!(
             "wrote {}: {samples} samples",
             out.join(tactile_report::run_mcap::FILE).display()

@@ -1,0 +1,190 @@
+//! The URDF arm's unit tests (beside the module, which they would double).
+use super::*;
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+use tactile_scenario::{ArmIkConfig, CartesianConfig};
+
+fn panda_xml() -> String {
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../deploy/robots/panda.urdf");
+    std::fs::read_to_string(p).expect("panda.urdf")
+}
+
+fn panda_cfg() -> ArmConfig {
+    ArmConfig {
+        urdf: "panda.urdf".into(),
+        base: "panda_link0".into(),
+        tip: "panda_hand".into(),
+        home: vec![
+            0.0,
+            -FRAC_PI_4,
+            0.0,
+            -3.0 * FRAC_PI_4,
+            0.0,
+            FRAC_PI_2,
+            FRAC_PI_4,
+        ],
+        kp: vec![600.0, 600.0, 600.0, 600.0, 250.0, 150.0, 50.0],
+        kd: vec![50.0, 50.0, 50.0, 50.0, 30.0, 25.0, 15.0],
+        scale: 1.0,
+        step_s: 2.5e-4,
+        gravity: [0.0, 0.0, -9.81],
+        ik: ArmIkConfig::default(),
+        servo: ArmServo::Joint,
+        cartesian: CartesianConfig::default(),
+    }
+}
+
+const HOME: [f64; 3] = [0.0, -0.107, -0.035];
+
+#[test]
+fn gravity_compensation_holds_the_arm_at_home() {
+    let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    for _ in 0..1000 {
+        arm.follow(HOME, 1e-3);
+        assert_eq!(arm.advance(1e-3, &[]), 0);
+    }
+    let s = arm.state();
+    for (q, h) in s.q.iter().zip(&panda_cfg().home) {
+        assert!((q - h).abs() < 1e-6, "{q} against {h}");
+    }
+    let tool = arm.tool();
+    for k in 0..3 {
+        assert!((tool[k] - HOME[k]).abs() < 1e-6, "{tool:?}");
+    }
+}
+
+#[test]
+fn at_rest_the_servo_gives_the_gravity_torques() {
+    // At home with no error the servo's effort is the gravity torque itself (RNEA),
+    // far from zero: without it the arm would sag.
+    let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    let g = arm.dynamics.gravity_torques(&panda_cfg().home).expect("g");
+    let mut clamped = vec![false; 7];
+    let tau = arm.servo(&mut clamped);
+    assert_eq!(tau, g);
+    assert!(g[1].abs() > 1.0, "{g:?}");
+}
+
+#[test]
+fn the_tool_follows_a_scaled_displacement_and_maps_back() {
+    let cfg = ArmConfig {
+        scale: 2.0,
+        ..panda_cfg()
+    };
+    let mut arm = UrdfArm::new(&cfg, &panda_xml(), HOME).expect("arm");
+    let home_tool = arm.chain().fk(&cfg.home);
+    let goal = [HOME[0] + 0.01, HOME[1] - 0.02, HOME[2] + 0.015];
+    for _ in 0..2000 {
+        arm.follow(goal, 1e-3);
+        arm.advance(1e-3, &[]);
+    }
+    // In the robot's frame the tool moved twice the master's displacement...
+    let p = arm.chain().fk(&arm.state().q).p - home_tool.p;
+    for (k, d) in [0.02, -0.04, 0.03].iter().enumerate() {
+        assert!((p[k] - d).abs() < 1e-5, "{p:?}");
+    }
+    // ...and mapped back it is where the master is.
+    let t = arm.tool();
+    for k in 0..3 {
+        assert!((t[k] - goal[k]).abs() < 1e-5, "{t:?}");
+    }
+}
+
+/// The Cartesian impedance is a spring at the tool: held 2 cm into a 1000 N/m wall
+/// with a 1000 N/m stiffness along z, the tool settles half way (two equal springs
+/// in series: 1 cm, 10 N).
+#[test]
+fn a_cartesian_impedance_yields_as_its_stiffness_says() {
+    let wall_z = HOME[2] - 0.01;
+    let wall = Object::Plane {
+        point: [0.0, 0.0, wall_z],
+        normal: [0.0, 0.0, 1.0],
+        stiffness: [1000.0; 3],
+    };
+    let goal = [HOME[0], HOME[1], wall_z - 0.02];
+    let settle = |cfg: &ArmConfig| {
+        let mut arm = UrdfArm::new(cfg, &panda_xml(), HOME).expect("arm");
+        for _ in 0..4000 {
+            arm.follow(goal, 1e-3);
+            arm.advance(1e-3, std::slice::from_ref(&wall));
+        }
+        wall_z - arm.tool()[2]
+    };
+    let cfg = ArmConfig {
+        servo: ArmServo::Cartesian,
+        cartesian: CartesianConfig {
+            stiffness: [1000.0, 1000.0, 1000.0, 100.0, 100.0, 100.0],
+            ..CartesianConfig::default()
+        },
+        ..panda_cfg()
+    };
+    let pen = settle(&cfg);
+    assert!((pen - 0.01).abs() < 5e-4, "penetration {pen} m");
+    // Three times stiffer: three quarters of the way (15 mm, 15 N).
+    let mut stiffer = cfg.clone();
+    stiffer.cartesian.stiffness[2] = 3000.0;
+    let pen = settle(&stiffer);
+    assert!((pen - 0.015).abs() < 5e-4, "penetration {pen} m");
+}
+
+#[test]
+fn a_wall_pushes_the_tool_back_and_efforts_stay_in_limits() {
+    let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    let wall = Object::Plane {
+        point: [0.0, 0.0, HOME[2] - 0.01],
+        normal: [0.0, 0.0, 1.0],
+        stiffness: [600.0; 3],
+    };
+    let goal = [HOME[0], HOME[1], HOME[2] - 0.03];
+    for _ in 0..3000 {
+        arm.follow(goal, 1e-3);
+        arm.advance(1e-3, std::slice::from_ref(&wall));
+    }
+    let t = arm.tool();
+    // Held between the wall and the target: inside the wall, short of the target.
+    assert!(t[2] < HOME[2] - 0.01 && t[2] > goal[2] + 1e-3, "{t:?}");
+    for (tau, d) in arm.state().tau.iter().zip(&arm.chain().dofs) {
+        assert!(tau.abs() <= d.effort);
+    }
+}
+
+#[test]
+fn a_hold_keeps_the_joints_where_the_input_went_silent() {
+    let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    let goal = [HOME[0] + 0.02, HOME[1], HOME[2]];
+    for _ in 0..100 {
+        arm.follow(goal, 1e-3);
+        arm.advance(1e-3, &[]);
+    }
+    // Still moving when the input stops: the servo brings it back to where it was.
+    let at_silence = arm.state().q.clone();
+    let first = arm.hold(1e-3, &[]);
+    assert!(first.started);
+    let mut last = first;
+    for _ in 0..1000 {
+        last = arm.hold(1e-3, &[]);
+        assert!(!last.started);
+        // Braking from the velocity limit overshoots by about 2 mm, no more.
+        assert!(last.drift_m < 5e-3, "{last:?}");
+    }
+    assert!(last.drift_m < 1e-6, "{last:?}");
+    for (q, h) in arm.state().q.iter().zip(&at_silence) {
+        assert!((q - h).abs() < 1e-5);
+    }
+    arm.end_hold();
+    assert!(arm.hold(1e-3, &[]).started);
+}
+
+#[test]
+fn a_chain_that_does_not_fit_the_table_is_named() {
+    let cfg = ArmConfig {
+        kp: vec![1.0; 6],
+        ..panda_cfg()
+    };
+    let e = UrdfArm::new(&cfg, &panda_xml(), HOME).expect_err("six gains");
+    assert!(
+        e.contains("slave.arm.kp") && e.contains("has 7 joints"),
+        "{e}"
+    );
+    let e = UrdfArm::new(&panda_cfg(), "<robot name=\"x\"/>", HOME).expect_err("empty");
+    assert!(e.contains("panda_link0"), "{e}");
+}
