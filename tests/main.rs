@@ -21,6 +21,7 @@ mod lifecycle;
 mod logs;
 mod loop_processes;
 mod nodes;
+mod pose;
 mod recordings;
 mod records;
 mod ros2;

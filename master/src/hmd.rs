@@ -12,15 +12,15 @@
 //! ([`MasterSide`]) decides what is sent for c(n) and which force comes of q(n).
 //! Either hand reaches the trajectory from the devices' home along [`Approach`].
 
-use crate::operator::{Approach, OperatorSource, Target};
+use crate::operator::{Approach, OperatorSource, Target, IDENTITY};
 use crate::simulated::HeldDevice;
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::{MasterForce, MasterSide};
 use tactile_math::engine::Engine;
 use tactile_math::kernels::IkStatus;
 use tactile_messages::samples::{
-    stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_REJECTED,
-    FLAG_SUBSTITUTED, FLAG_UNSENT,
+    stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_POSE, FLAG_REJECTED,
+    FLAG_RELEASED, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
 use tactile_records::master::{Answer, Effect, MasterCounters, Miss, Sent};
 use tactile_scenario::ControlKind;
@@ -55,6 +55,7 @@ pub struct Master {
 impl Master {
     /// A master for the scenario with a loaded operator source.
     pub fn new(scenario: &Scenario, source: OperatorSource) -> Result<Master, ScenarioError> {
+        source.check_six_dof(scenario)?;
         let geometry = scenario.device.geometry()?;
         let cordic = scenario.cordic.config()?;
         let bad = |e: tactile_math::cordic::CordicError| ScenarioError::Invalid {
@@ -124,7 +125,28 @@ impl Master {
             false => (self.ideal_hand(n), [0.0; 3]),
             true => self.impedance_hand(n),
         };
-        self.encode(n, now_ns, target, hand_force)
+        let (mut f, mut sent) = self.encode(n, now_ns, target, hand_force);
+        self.turn(n, &mut f, &mut sent);
+        (f, sent)
+    }
+
+    /// A 6-DoF operator's orientation and clutch onto c(n) and its record.
+    fn turn(&self, n: u64, f: &mut Forward, sent: &mut Sent) {
+        if !self.source.six_dof() {
+            return;
+        }
+        let t = n as f64 * self.t_s;
+        let r = self.source.rotation(n, self.t_s).unwrap_or(IDENTITY);
+        f.rotation = match &self.approach {
+            Some(a) => a.apply_rotation(r, t),
+            None => r,
+        };
+        f.signal.flags |= FLAG_POSE;
+        sent.rotation = Some(f.rotation);
+        if !self.source.engaged(n, self.t_s) {
+            f.signal.flags |= FLAG_RELEASED;
+            sent.released = true;
+        }
     }
 
     /// Sample n forward from a real device's encoders: b(n) = `theta` as measured (the
@@ -182,6 +204,8 @@ impl Master {
             hand_force,
             tick_ns: now_ns,
             send_ns: 0,
+            rotation: None,
+            released: false,
         };
         (f, sent)
     }

@@ -7,9 +7,17 @@
 
 pub use crate::trajectory::OperatorError;
 use crate::trajectory::Trajectory;
+use nalgebra::{Quaternion, UnitQuaternion};
 use std::path::Path;
 use tactile_math::validation::{paper_joint_path, MOVE_S};
-use tactile_scenario::Operator;
+use tactile_scenario::{CodecKind, Operator, Scenario, ScenarioError};
+
+/// No turn, `[x, y, z, w]`.
+pub const IDENTITY: [f64; 4] = [0.0, 0.0, 0.0, 1.0];
+
+fn unit(r: [f64; 4]) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_quaternion(Quaternion::new(r[3], r[0], r[1], r[2]))
+}
 
 /// What the operator commands at one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,7 +93,7 @@ impl Approach {
         let at_home = match source.target(0, t_s) {
             Target::Joints(theta) => theta == [0.0; 3],
             Target::Position(p) => p == home,
-        };
+        } && source.rotation(0, t_s).is_none_or(|r| r == IDENTITY);
         (seconds > 0.0 && !at_home).then_some(Approach { home, seconds })
     }
 
@@ -93,6 +101,15 @@ impl Approach {
     /// progress, joints from zero and positions from the home position. Computed so
     /// even once s is 1 (a rounding's difference from `a`), as the impedance hand's
     /// runs in deploy/results/ were.
+    /// A 6-DoF operator's orientation at time `t`: from none (the identity) to the
+    /// trajectory's own along the same blend.
+    pub fn apply_rotation(&self, r: [f64; 4], t: f64) -> [f64; 4] {
+        let s = min_jerk(t / self.seconds);
+        let q = UnitQuaternion::identity().slerp(&unit(r), s);
+        [q.i, q.j, q.k, q.w]
+    }
+
+    /// See [`Approach::apply_rotation`]; positions and joints.
     pub fn apply(&self, a: Target, t: f64) -> Target {
         let s = min_jerk(t / self.seconds);
         match a {
@@ -159,6 +176,56 @@ impl OperatorSource {
             OperatorSource::File(f) => f.shortfall(samples, t_s).into_iter().collect(),
             _ => Vec::new(),
         }
+    }
+
+    /// A 6-DoF operator's orientation at sample `n` (`[x, y, z, w]`, relative to
+    /// the operator's home); `None` for a 3-DoF source.
+    pub fn rotation(&self, n: u64, t_s: f64) -> Option<[f64; 4]> {
+        match self {
+            OperatorSource::File(f) => f.rotation_at(n, t_s),
+            _ => None,
+        }
+    }
+
+    /// Whether the operator holds the clutch at sample `n` (always, without one).
+    pub fn engaged(&self, n: u64, t_s: f64) -> bool {
+        match self {
+            OperatorSource::File(f) => f.engaged_at(n, t_s),
+            _ => true,
+        }
+    }
+
+    /// True if this source makes 6-DoF samples (an orientation or a clutch).
+    pub fn six_dof(&self) -> bool {
+        matches!(self, OperatorSource::File(f) if f.oriented() || f.clutched())
+    }
+
+    /// What a 6-DoF source needs of the rest of the scenario, or the first thing
+    /// missing, naming the field: an arm that can turn its tool, a forward channel
+    /// that carries the whole pose in one packet (equal delays), a codec that sends
+    /// every sample (the deadband weighs positions only).
+    pub fn check_six_dof(&self, sc: &Scenario) -> Result<(), ScenarioError> {
+        if !self.six_dof() {
+            return Ok(());
+        }
+        let bad = |field: &str, problem: &str| {
+            Err(ScenarioError::Invalid {
+                field: field.into(),
+                problem: format!("the operator's trajectory has an orientation or a clutch (a 6-DoF run): {problem}"),
+            })
+        };
+        let f = &sc.network.forward;
+        let equal = |d: [i64; 3]| d[0] == d[1] && d[1] == d[2];
+        if sc.slave.arm.is_none() {
+            return bad("slave.arm", "the paper's arm has three joints and cannot turn its tool; a 6-DoF run needs [slave.arm]");
+        }
+        if !equal(f.delay) || f.schedule.iter().any(|e| !equal([e[1], e[2], e[3]])) {
+            return bad("network.forward.delay", "the pose crosses in one packet, so the three forward delays (and every schedule row's) must be equal");
+        }
+        if sc.codec.forward.kind != CodecKind::None {
+            return bad("codec.forward.kind", "the deadband codecs weigh positions only and would leave turns unsent; use \"none\"");
+        }
+        Ok(())
     }
 
     /// The target at sample `n` with sampling period `t_s`.

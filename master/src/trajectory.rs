@@ -5,14 +5,33 @@
 //! run takes the straight line between the rows around each sample's time, so a file
 //! recorded at 100 Hz plays at its own speed in a 1 kHz run instead of ten times too
 //! fast. What happens after the last row is the scenario's `end`: held or looped.
+//! A 6-DoF operator's file adds the tool's orientation, `qx,qy,qz,qw` (a unit
+//! quaternion relative to the operator's home, slerped between timed rows), and may
+//! add `engaged` (1 while the operator holds the clutch, 0 while released; between
+//! timed rows the earlier row's).
 //! Reading is at the edge ([`Trajectory::read`]); [`Trajectory::at`] is pure.
 
+use nalgebra::{Quaternion, UnitQuaternion};
 use std::path::Path;
 use tactile_scenario::{csv, TrajectoryEnd};
 use thiserror::Error;
 
-/// The two headers a trajectory file may have.
-const HEADERS: [&[&str]; 2] = [&["x", "y", "z"], &["t", "x", "y", "z"]];
+/// The headers a trajectory file may have: with or without a time column, an
+/// orientation, a clutch (index bits: 1 timed, 2 oriented, 4 clutched).
+const HEADERS: [&[&str]; 8] = [
+    &["x", "y", "z"],
+    &["t", "x", "y", "z"],
+    &["x", "y", "z", "qx", "qy", "qz", "qw"],
+    &["t", "x", "y", "z", "qx", "qy", "qz", "qw"],
+    &["x", "y", "z", "engaged"],
+    &["t", "x", "y", "z", "engaged"],
+    &["x", "y", "z", "qx", "qy", "qz", "qw", "engaged"],
+    &["t", "x", "y", "z", "qx", "qy", "qz", "qw", "engaged"],
+];
+
+/// How far a file's quaternion's norm may be from one (rounding in a recorder's
+/// output); it is normalized when read.
+pub const UNIT_TOLERANCE: f64 = 1e-3;
 
 /// A trajectory file that cannot be used.
 #[derive(Debug, Error)]
@@ -34,9 +53,10 @@ pub enum OperatorError {
         /// The file.
         path: String,
     },
-    /// A time in the `t` column that cannot be (before 0, not after the row before).
+    /// A value that cannot be: a time before 0 or not after the row before, a
+    /// quaternion that is not a rotation, an `engaged` other than 0 or 1.
     #[error("{path}: line {line}: {problem}")]
-    Time {
+    Row {
         /// The file.
         path: String,
         /// 1-based line number.
@@ -55,6 +75,10 @@ pub struct Trajectory {
     times: Option<Vec<f64>>,
     /// Each row's position, m (never empty).
     points: Vec<[f64; 3]>,
+    /// Each row's orientation, for a file with one.
+    rotations: Option<Vec<UnitQuaternion<f64>>>,
+    /// Each row's clutch, for a file with one (true: engaged).
+    engaged: Option<Vec<bool>>,
     /// After the last row.
     end: TrajectoryEnd,
 }
@@ -86,43 +110,78 @@ impl Trajectory {
         if rows.is_empty() {
             return Err(OperatorError::NoRows { path: shown });
         }
-        let timed = which == 1;
-        let point = |r: &[f64]| -> [f64; 3] {
-            let k = usize::from(timed);
-            [r[k], r[k + 1], r[k + 2]]
-        };
-        let points = rows.iter().map(|(_, r)| point(r)).collect();
+        let (timed, oriented, clutched) = (which & 1 != 0, which & 2 != 0, which & 4 != 0);
+        let k = usize::from(timed);
+        let points = rows
+            .iter()
+            .map(|(_, r)| [r[k], r[k + 1], r[k + 2]])
+            .collect();
         let times = if timed {
             Some(check_times(&rows, &shown)?)
         } else {
             None
         };
+        let rotations = match oriented {
+            true => Some(check_rotations(&rows, k + 3, &shown)?),
+            false => None,
+        };
+        let last = if oriented { k + 7 } else { k + 3 };
+        let engaged = match clutched {
+            true => Some(check_engaged(&rows, last, &shown)?),
+            false => None,
+        };
         Ok(Trajectory {
             shown,
             times,
             points,
+            rotations,
+            engaged,
             end,
         })
     }
 
-    /// The position at sample `n` of a run with sampling period `t_s`.
-    pub fn at(&self, n: u64, t_s: f64) -> [f64; 3] {
-        let rows = self.points.len();
-        match &self.times {
-            None => {
-                let k = match self.end {
-                    TrajectoryEnd::Hold => n.min(rows as u64 - 1),
-                    TrajectoryEnd::Loop => n % rows as u64,
-                };
-                self.points[k as usize]
-            }
-            Some(times) => self.at_time(times, n as f64 * t_s),
-        }
+    /// True if the file gives an orientation (a 6-DoF operator).
+    pub fn oriented(&self) -> bool {
+        self.rotations.is_some()
     }
 
-    /// A timed file at `t` seconds: the straight line between the rows around it.
-    fn at_time(&self, times: &[f64], t: f64) -> [f64; 3] {
+    /// True if the file gives the clutch.
+    pub fn clutched(&self) -> bool {
+        self.engaged.is_some()
+    }
+
+    /// The orientation at sample `n` (`None` for a file without one) as `[x, y, z, w]`.
+    pub fn rotation_at(&self, n: u64, t_s: f64) -> Option<[f64; 4]> {
+        let r = self.rotations.as_ref()?;
+        let q = match self.locate(n, t_s) {
+            Row::At(k) => r[k],
+            Row::Between(k, w) => r[k].slerp(&r[k + 1], w),
+        };
+        Some([q.i, q.j, q.k, q.w])
+    }
+
+    /// Whether the operator holds the clutch at sample `n` (always, for a file
+    /// without the column).
+    pub fn engaged_at(&self, n: u64, t_s: f64) -> bool {
+        self.engaged
+            .as_ref()
+            .is_none_or(|e| match self.locate(n, t_s) {
+                Row::At(k) | Row::Between(k, _) => e[k],
+            })
+    }
+
+    /// Where sample `n` falls among the rows.
+    fn locate(&self, n: u64, t_s: f64) -> Row {
+        let rows = self.points.len();
+        let Some(times) = &self.times else {
+            let k = match self.end {
+                TrajectoryEnd::Hold => n.min(rows as u64 - 1),
+                TrajectoryEnd::Loop => n % rows as u64,
+            };
+            return Row::At(k as usize);
+        };
         let last = times[times.len() - 1];
+        let t = n as f64 * t_s;
         let t = match self.end {
             TrajectoryEnd::Loop if last > 0.0 => t % last,
             _ => t,
@@ -131,15 +190,25 @@ impl Trajectory {
         let k = times.partition_point(|&tk| tk < t);
         if k == 0 || (k < times.len() && times[k] == t) {
             // On a row's time, its point exactly (before the first, the first).
-            return self.points[k];
+            return Row::At(k);
         }
         if k == times.len() {
-            return self.points[k - 1];
+            return Row::At(k - 1);
         }
         let (t0, t1) = (times[k - 1], times[k]);
-        let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-        let (a, b) = (self.points[k - 1], self.points[k]);
-        [0, 1, 2].map(|i| a[i] + w * (b[i] - a[i]))
+        Row::Between(k - 1, ((t - t0) / (t1 - t0)).clamp(0.0, 1.0))
+    }
+
+    /// The position at sample `n` of a run with sampling period `t_s`: a timed
+    /// file's straight line between the rows around the sample's time.
+    pub fn at(&self, n: u64, t_s: f64) -> [f64; 3] {
+        match self.locate(n, t_s) {
+            Row::At(k) => self.points[k],
+            Row::Between(k, w) => {
+                let (a, b) = (self.points[k], self.points[k + 1]);
+                [0, 1, 2].map(|i| a[i] + w * (b[i] - a[i]))
+            }
+        }
     }
 
     /// What the run will do once the file has run out, when that is before the run
@@ -188,6 +257,66 @@ impl Trajectory {
     }
 }
 
+/// Where a sample falls among a file's rows.
+#[derive(Debug, Clone, Copy)]
+enum Row {
+    /// On row k (or held at it).
+    At(usize),
+    /// Between row k and the next, at this fraction of the way.
+    Between(usize, f64),
+}
+
+/// The orientation columns from `col`: unit quaternions (within [`UNIT_TOLERANCE`]),
+/// normalized, each on the same side as the row before so a slerp takes the short way.
+fn check_rotations(
+    rows: &[(usize, Vec<f64>)],
+    col: usize,
+    shown: &str,
+) -> Result<Vec<UnitQuaternion<f64>>, OperatorError> {
+    let mut out: Vec<UnitQuaternion<f64>> = Vec::with_capacity(rows.len());
+    for (line, r) in rows {
+        let q = Quaternion::new(r[col + 3], r[col], r[col + 1], r[col + 2]);
+        let norm = q.norm();
+        if (norm - 1.0).abs() > UNIT_TOLERANCE {
+            return Err(OperatorError::Row {
+                path: shown.to_string(),
+                line: *line,
+                problem: format!(
+                    "the quaternion (qx, qy, qz, qw) = ({}, {}, {}, {}) has norm {norm}; an orientation is a unit quaternion (within {UNIT_TOLERANCE})",
+                    r[col], r[col + 1], r[col + 2], r[col + 3]
+                ),
+            });
+        }
+        let mut u = UnitQuaternion::new_normalize(q);
+        if out.last().is_some_and(|p| p.coords.dot(&u.coords) < 0.0) {
+            u = UnitQuaternion::new_unchecked(-u.into_inner());
+        }
+        out.push(u);
+    }
+    Ok(out)
+}
+
+/// The `engaged` column (column `col`): 0 or 1.
+fn check_engaged(
+    rows: &[(usize, Vec<f64>)],
+    col: usize,
+    shown: &str,
+) -> Result<Vec<bool>, OperatorError> {
+    rows.iter()
+        .map(|(line, r)| {
+            let v = r[col];
+            if v == 1.0 || v == 0.0 {
+                return Ok(v == 1.0);
+            }
+            Err(OperatorError::Row {
+                path: shown.to_string(),
+                line: *line,
+                problem: format!("engaged = {v}: it is 1 (clutch held) or 0 (released)"),
+            })
+        })
+        .collect()
+}
+
 /// The first sample whose time, computed as the run computes it, is at or after `t`.
 fn first_sample_at(t: f64, t_s: f64) -> u64 {
     let mut n = (t / t_s).floor().max(0.0) as u64;
@@ -214,7 +343,7 @@ fn first_sample_after(t: f64, t_s: f64) -> u64 {
 /// CSV parser refuses anything else). An error names the file, the line and what is
 /// wrong with its time.
 fn check_times(rows: &[(usize, Vec<f64>)], shown: &str) -> Result<Vec<f64>, OperatorError> {
-    let bad = |line: usize, problem: String| OperatorError::Time {
+    let bad = |line: usize, problem: String| OperatorError::Row {
         path: shown.to_string(),
         line,
         problem,
@@ -338,6 +467,52 @@ mod tests {
         );
         let e = bad("t,x,y\n0,0,0\n");
         assert!(e.contains("expected x,y,z or t,x,y,z"), "{e}");
+    }
+
+    #[test]
+    fn orientations_slerp_the_short_way_and_the_clutch_steps() {
+        // 90 degrees about z at t = 1 s, given with the opposite sign (the same
+        // orientation): the slerp takes the short way, 45 degrees at 0.5 s.
+        let h = std::f64::consts::FRAC_PI_4;
+        let text = format!(
+            "t,x,y,z,qx,qy,qz,qw,engaged\n0,0,0,0,0,0,0,1,1\n1,0,0,0,0,0,{},{},0\n",
+            -h.sin(),
+            -h.cos()
+        );
+        let f = file(&text, TrajectoryEnd::Hold);
+        assert!(f.oriented() && f.clutched());
+        let q = f.rotation_at(500, 1e-3).expect("oriented");
+        let want = [0.0, 0.0, (h / 2.0).sin(), (h / 2.0).cos()];
+        for k in 0..4 {
+            assert!((q[k] - want[k]).abs() < 1e-12, "{q:?} vs {want:?}");
+        }
+        // The clutch between rows is the earlier row's.
+        assert!(f.engaged_at(999, 1e-3) && !f.engaged_at(1000, 1e-3));
+        // A quaternion a little off unit is normalized; an untimed file steps.
+        let f = file(
+            "x,y,z,qx,qy,qz,qw\n0,0,0,0,0,0,1.0004\n",
+            TrajectoryEnd::Hold,
+        );
+        assert_eq!(f.rotation_at(7, 1e-3), Some([0.0, 0.0, 0.0, 1.0]));
+        assert!(f.engaged_at(7, 1e-3) && !f.clutched());
+        assert_eq!(
+            file("x,y,z\n0,0,0\n", TrajectoryEnd::Hold).rotation_at(0, 1e-3),
+            None
+        );
+    }
+
+    #[test]
+    fn a_quaternion_that_is_no_rotation_or_a_clutch_not_0_or_1_names_its_line() {
+        let bad = |text: &str| {
+            Trajectory::parse(text, "traj.csv".into(), TrajectoryEnd::Hold)
+                .expect_err("invalid")
+                .to_string()
+        };
+        let e = bad("x,y,z,qx,qy,qz,qw\n0,0,0,0,0,0,1\n0,0,0,0,0,0,0\n");
+        assert!(e.starts_with("traj.csv: line 3: the quaternion"), "{e}");
+        assert!(e.contains("has norm 0"), "{e}");
+        let e = bad("x,y,z,engaged\n0,0,0,0.5\n");
+        assert!(e.starts_with("traj.csv: line 2: engaged = 0.5"), "{e}");
     }
 
     #[test]

@@ -12,7 +12,7 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tactile_messages::samples::{
-    Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
+    Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_POSE, FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
 use tactile_netem::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
 use tactile_netem::{Loss, Replay};
@@ -140,6 +140,7 @@ impl Emulator {
             &mut self.forward_faults,
             c.seq,
             &mut v.signal,
+            &mut v.rotation,
         );
         let k = &mut self.counters;
         k.forward += 1;
@@ -153,6 +154,7 @@ impl Emulator {
             n: c.seq,
             input: c.signal.value,
             out: v.signal,
+            rotational: (c.signal.flags & FLAG_POSE != 0).then_some(v.rotation),
             noise,
             jitter,
             lost,
@@ -164,12 +166,15 @@ impl Emulator {
     /// h(n) in, q(n) out (`None` when the loss model drops it), and the record of it.
     pub fn backward(&mut self, h: &Backward) -> (Option<Backward>, Passage) {
         let mut q = *h;
+        let mut torque = [q.torque[0], q.torque[1], q.torque[2], 0.0];
         let (fate, noise, jitter, lost, duplicated) = pass(
             &mut self.backward,
             &mut self.backward_faults,
             h.seq,
             &mut q.signal,
+            &mut torque,
         );
+        q.torque = [torque[0], torque[1], torque[2]];
         let k = &mut self.counters;
         k.backward += 1;
         k.backward_substituted += u64::from(q.signal.flags & FLAG_SUBSTITUTED != 0);
@@ -182,6 +187,7 @@ impl Emulator {
             n: h.seq,
             input: h.signal.value,
             out: q.signal,
+            rotational: (h.signal.flags & FLAG_POSE != 0).then_some(torque),
             noise,
             jitter,
             lost,
@@ -192,7 +198,8 @@ impl Emulator {
 }
 
 /// One sample through one channel: delay and noise into `signal`, then the fault
-/// model's decision (a corrupted signal is already NaN when this returns). Returns the
+/// model's decision (a corrupted signal is already NaN when this returns); `extra` is
+/// the sample's rotational half, carried in the same packet. Returns the
 /// decision, the noise added, the jitter drawn, whether a replayed network lost the
 /// packet and whether it was duplicated.
 fn pass(
@@ -200,6 +207,7 @@ fn pass(
     faults: &mut Faults,
     seq: u64,
     signal: &mut Signal,
+    extra: &mut [f64; 4],
 ) -> (Fate, [f64; 3], f64, bool, bool) {
     // A sample its sender's codec did not send carries no packet, nor one the loss
     // model loses (netem's loss is of packets: the receiver still ticks and fills the
@@ -207,12 +215,16 @@ fn pass(
     // gets nothing). What leaves is what the network delivers at this sample.
     let unsent = signal.flags & FLAG_UNSENT != 0;
     let model_lost = faults.packet_lost() && !unsent;
-    let e = channel.push_packet(seq, values(signal), !unsent && !model_lost);
+    let e = channel.push_packet(seq, values(signal), *extra, !unsent && !model_lost);
     signal.flags &= !FLAG_UNSENT;
     apply(signal, &e);
+    *extra = e.extra;
     let fate = faults.fate();
     if fate == Fate::Corrupt {
         signal.value = [f64::NAN; 3];
+        if signal.flags & FLAG_POSE != 0 {
+            *extra = [f64::NAN; 4];
+        }
         signal.flags |= FLAG_CORRUPTED;
     }
     (fate, e.noise, e.jitter, e.lost || model_lost, e.duplicated)

@@ -5,7 +5,7 @@
 //! the protocol.
 
 use crate::hsd::{Measured, Slave};
-use crate::urdf_arm::ArmState;
+use crate::urdf_arm::UrdfArm;
 use std::sync::Arc;
 use std::time::Duration;
 use tactile_devices::held::Held;
@@ -252,7 +252,7 @@ impl Follower for SlaveHandler {
             Robots::Arm(hw) => hw.due = self.slave.arm_state().map(|a| a.q_ref.clone()),
         }
         self.last_step = Some(step);
-        let record = match self.slave.arm_state() {
+        let record = match self.slave.arm() {
             Some(a) => SlaveSample::ArmStep(step, joints(a)),
             None => SlaveSample::Step(step),
         };
@@ -316,18 +316,22 @@ impl Follower for SlaveHandler {
                 held
             }
         };
-        Ok(Some(match self.slave.arm_state() {
+        Ok(Some(match self.slave.arm() {
             Some(a) => SlaveSample::ArmHold(held, joints(a)),
             None => SlaveSample::Hold(held),
         }))
     }
 }
 
-/// A URDF arm's joints as its record holds them.
-fn joints(a: &ArmState) -> ArmJoints {
+/// A URDF arm's joints and tool orientation as its record holds them.
+fn joints(arm: &UrdfArm) -> ArmJoints {
+    let a = arm.state();
     ArmJoints {
         q_ref: a.q_ref.clone(),
         q: a.q.clone(),
         tau: a.tau.clone(),
+        target_rotation: arm.target_rotation(),
+        tool_rotation: arm.tool_rotation(),
+        released: arm.released(),
     }
 }

@@ -23,7 +23,8 @@ use tactile_math::geometry::Lengths;
 use tactile_math::kernels::{self, IkStatus};
 use tactile_math::vec3::distance;
 use tactile_messages::samples::{
-    Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_REJECTED, FLAG_SUBSTITUTED, FLAG_UNSENT,
+    Backward, Forward, FLAG_CONTACT, FLAG_IK_CLAMPED, FLAG_POSE, FLAG_REJECTED, FLAG_RELEASED,
+    FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
 use tactile_records::slave::{HoldStep, SlaveCounters, Step};
 use tactile_scenario::{Object, Scenario, ScenarioError};
@@ -51,6 +52,8 @@ pub struct Slave {
     measured_arm: Option<Vec<f64>>,
     /// Any arm from its URDF in place of the paper's (`[slave.arm]`).
     arm: Option<UrdfArm>,
+    /// A 6-DoF master's last accepted orientation (held while none valid comes).
+    rotation: Option<[f64; 4]>,
 }
 
 /// What a real robot measured for one step.
@@ -109,6 +112,7 @@ impl Slave {
             measured: None,
             measured_arm: None,
             arm,
+            rotation: None,
         })
     }
 
@@ -309,8 +313,14 @@ impl Slave {
             return (flags, [0.0; 3], 0.0);
         }
         let r = self.control.receive(est.value(), energy, self.last_force);
+        self.accept_rotation(v, &mut flags);
         if let Some(arm) = self.arm.as_mut() {
-            flags |= count_followed(&mut self.counters, arm.follow(r.position, self.t_s));
+            if v.signal.flags & FLAG_RELEASED != 0 {
+                arm.release();
+            } else {
+                let f = arm.follow(r.position, self.rotation, self.t_s);
+                flags |= count_followed(&mut self.counters, f);
+            }
             return (flags, r.observer, r.dissipated);
         }
         // IK-HSD, then JPD-HSD: pass-through.
@@ -330,6 +340,28 @@ impl Slave {
             self.reference = ik.theta;
         }
         (flags, r.observer, r.dissipated)
+    }
+
+    /// A 6-DoF sample's orientation, if it is a rotation (finite, of norm one within
+    /// [`ROTATION_TOLERANCE`]): taken, normalized; otherwise rejected and counted,
+    /// and the last one held.
+    fn accept_rotation(&mut self, v: &Forward, flags: &mut u32) {
+        if v.signal.flags & FLAG_POSE == 0 {
+            return;
+        }
+        let q = v.rotation;
+        let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm.is_finite() && (norm - 1.0).abs() <= ROTATION_TOLERANCE {
+            self.rotation = Some(q.map(|x| x / norm));
+        } else if *flags & FLAG_REJECTED == 0 {
+            *flags |= FLAG_REJECTED;
+            self.counters.rejected += 1;
+        }
+    }
+
+    /// The orientation the arm follows (a 6-DoF master's, as last accepted).
+    pub fn rotation(&self) -> Option<[f64; 4]> {
+        self.rotation
     }
 
     /// FCS and SD: the joint controller and the simulated joints, or the real robot
@@ -425,9 +457,16 @@ impl Slave {
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
         out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
         out.signal.flags |= flags;
+        // A 6-DoF sample is answered with a wrench: the torque of a point contact at
+        // the tool is zero.
+        out.signal.flags |= v.signal.flags & FLAG_POSE;
         out
     }
 }
+
+/// How far from one a received quaternion's norm may be (the sender normalized it;
+/// a wire carries it exactly): anything further is not a rotation and is rejected.
+pub const ROTATION_TOLERANCE: f64 = 1e-6;
 
 /// Counts what a URDF arm's IK call did; the flags it sets on h(n).
 fn count_followed(c: &mut SlaveCounters, f: Followed) -> u32 {

@@ -11,12 +11,18 @@
 //!
 //! The loop carries positions in the master's frame (see `tactile_scenario::ArmConfig`):
 //! the tool's target is its home pose moved by `scale` times the master's displacement
-//! from `master_home`, its orientation held at home; the environment sees the tool
+//! from `master_home`, its orientation the master's rotation (a 6-DoF sample's, about
+//! the base's axes) applied to its home orientation, or held at home for a 3-DoF
+//! master. While the operator's clutch is released the references stay where they
+//! are (the robot holds); at the next engaged sample the offset between the master's
+//! mapped pose and the held reference is captured, so the robot continues from where
+//! it held instead of jumping (clutch indexing). The environment sees the tool
 //! mapped back into the master's frame, and the contact force it returns acts on the
 //! arm's tool as it is (the objects are the master frame's, so a wall keeps its place
 //! and stiffness for the operator whatever the arm).
 
-use nalgebra::{DMatrix, DVector, Matrix6, Matrix6xX, Vector3, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Matrix6xX, Quaternion, UnitQuaternion};
+use nalgebra::{Vector3, Vector6};
 use std::path::Path;
 use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
 use tactile_math::arith::StdTrig;
@@ -44,6 +50,20 @@ pub struct UrdfArm {
     /// The tool's pose reference and its velocity `[linear; angular]` in the base
     /// frame (the Cartesian servo's).
     reference: (Frame, Vector6<f64>),
+    /// The clutch is released: the references hold.
+    released: bool,
+    /// The offsets captured at the last re-engage: the master's mapped pose moved by
+    /// these is the target (`None` until the clutch was first released).
+    indexing: Option<Indexing>,
+}
+
+/// Where the master's mapped pose met the robot's reference at a re-engage: the
+/// target is `p + dp` and `r dr`, so the master's rotations since then turn the tool
+/// about the base's axes from where it held.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Indexing {
+    dp: Vector3<f64>,
+    dr: Matrix3<f64>,
 }
 
 /// The arm's joints after a step: references, angles, velocities, efforts.
@@ -168,6 +188,8 @@ impl UrdfArm {
             reference: (home_tool, Vector6::zeros()),
             state,
             held: None,
+            released: false,
+            indexing: None,
         })
     }
 
@@ -181,13 +203,62 @@ impl UrdfArm {
         &self.chain
     }
 
-    /// The tool's target in the arm's base frame for the master's `position`.
-    pub fn target(&self, position: [f64; 3]) -> Frame {
+    /// The tool's target in the arm's base frame for the master's `position` and,
+    /// from a 6-DoF master, `rotation` (a unit quaternion `[x, y, z, w]` relative to
+    /// the operator's home), moved by the clutch's offsets.
+    pub fn target(&self, position: [f64; 3], rotation: Option<[f64; 4]>) -> Frame {
         let home = self.home_tool.p.into();
-        Frame {
-            r: self.home_tool.r,
-            p: self.cfg.to_robot(home, self.master_home, position).into(),
+        let r = match rotation {
+            Some(q) => rotation_matrix(q) * self.home_tool.r,
+            None => self.home_tool.r,
+        };
+        let p = Vector3::from(self.cfg.to_robot(home, self.master_home, position));
+        match self.indexing {
+            Some(ix) => Frame {
+                r: r * ix.dr,
+                p: p + ix.dp,
+            },
+            None => Frame { r, p },
         }
+    }
+
+    /// The tool's orientation relative to its home, about the base's axes, as `[x, y,
+    /// z, w]`: what a 6-DoF master's rotation is compared with.
+    pub fn tool_rotation(&self) -> [f64; 4] {
+        let r = self.chain.fk(&self.state.q).r * self.home_tool.r.transpose();
+        quaternion(&r)
+    }
+
+    /// The orientation reference relative to the tool's home, `[x, y, z, w]`.
+    pub fn target_rotation(&self) -> [f64; 4] {
+        quaternion(&(self.reference.0.r * self.home_tool.r.transpose()))
+    }
+
+    /// True while the operator's clutch is released.
+    pub fn released(&self) -> bool {
+        self.released
+    }
+
+    /// The clutch is released this sample: the references stay (the robot holds).
+    pub fn release(&mut self) {
+        self.released = true;
+        self.state.qd_ref.iter_mut().for_each(|v| *v = 0.0);
+        self.reference.1 = Vector6::zeros();
+    }
+
+    /// At the first engaged sample after a release, the offsets that put the master's
+    /// mapped pose where the robot's reference held.
+    fn engage(&mut self, position: [f64; 3], rotation: Option<[f64; 4]>) {
+        if !std::mem::take(&mut self.released) {
+            return;
+        }
+        self.indexing = None;
+        let raw = self.target(position, rotation);
+        let held = self.reference.0;
+        self.indexing = Some(Indexing {
+            dp: held.p - raw.p,
+            dr: raw.r.transpose() * held.r,
+        });
     }
 
     /// The tool (FK of the joints) mapped into the master's frame, m.
@@ -205,12 +276,21 @@ impl UrdfArm {
         self.cfg.to_master(home, self.master_home, (*p).into())
     }
 
-    /// IK toward the master's `position`, one period of `dt` from the last reference
-    /// (the reference is a smooth path the servo follows, as a trajectory generator's).
-    pub fn follow(&mut self, position: [f64; 3], dt: f64) -> Followed {
-        let target = self.target(position);
+    /// IK toward the master's `position` (and `rotation`, from a 6-DoF master), one
+    /// period of `dt` from the last reference (the reference is a smooth path the
+    /// servo follows, as a trajectory generator's).
+    pub fn follow(&mut self, position: [f64; 3], rotation: Option<[f64; 4]>, dt: f64) -> Followed {
+        self.engage(position, rotation);
+        let target = self.target(position, rotation);
         let v = (target.p - self.reference.0.p) / dt;
-        self.reference = (target, Vector6::new(v.x, v.y, v.z, 0.0, 0.0, 0.0));
+        let w = match rotation.is_some() || self.indexing.is_some() {
+            true => {
+                tactile_chain::spatial::log_rotation(&(target.r * self.reference.0.r.transpose()))
+                    / dt
+            }
+            false => Vector3::zeros(),
+        };
+        self.reference = (target, Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z));
         match self.ik.step(&self.state.q_ref, &target, dt) {
             Ok(s) => {
                 for ((v, new), old) in self
@@ -413,3 +493,17 @@ impl UrdfArm {
 #[cfg(test)]
 #[path = "urdf_arm_tests.rs"]
 mod tests;
+
+/// The rotation of a unit quaternion `[x, y, z, w]` (normalized here).
+pub fn rotation_matrix(q: [f64; 4]) -> Matrix3<f64> {
+    UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
+        .to_rotation_matrix()
+        .into_inner()
+}
+
+/// A rotation matrix as a unit quaternion `[x, y, z, w]` with `w >= 0`.
+pub fn quaternion(r: &Matrix3<f64>) -> [f64; 4] {
+    let q = UnitQuaternion::from_matrix(r);
+    let s = if q.w < 0.0 { -1.0 } else { 1.0 };
+    [s * q.i, s * q.j, s * q.k, s * q.w]
+}

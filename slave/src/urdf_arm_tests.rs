@@ -39,7 +39,7 @@ const HOME: [f64; 3] = [0.0, -0.107, -0.035];
 fn gravity_compensation_holds_the_arm_at_home() {
     let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
     for _ in 0..1000 {
-        arm.follow(HOME, 1e-3);
+        arm.follow(HOME, None, 1e-3);
         assert_eq!(arm.advance(1e-3, &[]), 0);
     }
     let s = arm.state();
@@ -74,7 +74,7 @@ fn the_tool_follows_a_scaled_displacement_and_maps_back() {
     let home_tool = arm.chain().fk(&cfg.home);
     let goal = [HOME[0] + 0.01, HOME[1] - 0.02, HOME[2] + 0.015];
     for _ in 0..2000 {
-        arm.follow(goal, 1e-3);
+        arm.follow(goal, None, 1e-3);
         arm.advance(1e-3, &[]);
     }
     // In the robot's frame the tool moved twice the master's displacement...
@@ -104,7 +104,7 @@ fn a_cartesian_impedance_yields_as_its_stiffness_says() {
     let settle = |cfg: &ArmConfig| {
         let mut arm = UrdfArm::new(cfg, &panda_xml(), HOME).expect("arm");
         for _ in 0..4000 {
-            arm.follow(goal, 1e-3);
+            arm.follow(goal, None, 1e-3);
             arm.advance(1e-3, std::slice::from_ref(&wall));
         }
         wall_z - arm.tool()[2]
@@ -136,7 +136,7 @@ fn a_wall_pushes_the_tool_back_and_efforts_stay_in_limits() {
     };
     let goal = [HOME[0], HOME[1], HOME[2] - 0.03];
     for _ in 0..3000 {
-        arm.follow(goal, 1e-3);
+        arm.follow(goal, None, 1e-3);
         arm.advance(1e-3, std::slice::from_ref(&wall));
     }
     let t = arm.tool();
@@ -152,7 +152,7 @@ fn a_hold_keeps_the_joints_where_the_input_went_silent() {
     let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
     let goal = [HOME[0] + 0.02, HOME[1], HOME[2]];
     for _ in 0..100 {
-        arm.follow(goal, 1e-3);
+        arm.follow(goal, None, 1e-3);
         arm.advance(1e-3, &[]);
     }
     // Still moving when the input stops: the servo brings it back to where it was.
@@ -187,4 +187,90 @@ fn a_chain_that_does_not_fit_the_table_is_named() {
     );
     let e = UrdfArm::new(&panda_cfg(), "<robot name=\"x\"/>", HOME).expect_err("empty");
     assert!(e.contains("panda_link0"), "{e}");
+}
+
+/// A 6-DoF master's turn, under either servo: the hand turns to it about the base's
+/// axes (its orientation relative to home is the master's rotation).
+#[test]
+fn both_servos_turn_the_hand_to_the_masters_rotation() {
+    let h = 15f64.to_radians();
+    // 30 degrees about z, then 20 about x, composed about the base's axes.
+    let turn = quaternion(
+        &(rotation_matrix([h.sin(), 0.0, 0.0, h.cos()])
+            * rotation_matrix([0.0, 0.0, (2.0 * h).sin(), (2.0 * h).cos()])),
+    );
+    // Round trip of the two conversions.
+    let back = quaternion(&rotation_matrix(turn));
+    assert!(turn.iter().zip(&back).all(|(a, b)| (a - b).abs() < 1e-15));
+    for servo in [ArmServo::Joint, ArmServo::Cartesian] {
+        let mut arm = UrdfArm::new(
+            &ArmConfig {
+                servo,
+                ..panda_cfg()
+            },
+            &panda_xml(),
+            HOME,
+        )
+        .expect("arm");
+        for n in 0..=2000 {
+            // Along a slerp from home over the first second.
+            let s = (n as f64 / 1000.0).min(1.0);
+            let r = UnitQuaternion::identity().slerp(
+                &UnitQuaternion::from_quaternion(Quaternion::new(
+                    turn[3], turn[0], turn[1], turn[2],
+                )),
+                s,
+            );
+            arm.follow(HOME, Some([r.i, r.j, r.k, r.w]), 1e-3);
+            arm.advance(1e-3, &[]);
+        }
+        let got = arm.tool_rotation();
+        let err = (0..4).map(|k| (got[k] - turn[k]).abs()).fold(0.0, f64::max);
+        assert!(err < 1e-3, "{servo:?}: {got:?} vs {turn:?}");
+        let p = arm.tool();
+        assert!(
+            (0..3).all(|k| (p[k] - HOME[k]).abs() < 1e-3),
+            "{servo:?}: {p:?}"
+        );
+    }
+}
+
+/// Released, the references hold whatever the master does; engaged again, the
+/// target continues from the held reference (no step), then follows the master's
+/// moves from there.
+#[test]
+fn the_clutch_holds_the_references_and_reengages_without_a_step() {
+    let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    let away = [HOME[0] + 0.02, HOME[1], HOME[2]];
+    for _ in 0..500 {
+        arm.follow(away, None, 1e-3);
+        arm.advance(1e-3, &[]);
+    }
+    let held = arm.state().q_ref.clone();
+    for _ in 0..200 {
+        arm.release();
+        arm.advance(1e-3, &[]);
+    }
+    assert_eq!(arm.state().q_ref, held);
+    assert!(arm.released());
+    // Engaged with the master back home: the reference does not move.
+    arm.follow(HOME, None, 1e-3);
+    let step = arm
+        .state()
+        .q_ref
+        .iter()
+        .zip(&held)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(step < 1e-9, "re-engage stepped {step} rad");
+    let at_engage = arm.tool();
+    for _ in 0..1000 {
+        arm.follow([HOME[0], HOME[1] + 0.01, HOME[2]], None, 1e-3);
+        arm.advance(1e-3, &[]);
+    }
+    let p = arm.tool();
+    assert!(
+        (p[1] - at_engage[1] - 0.01).abs() < 1e-3,
+        "{p:?} from {at_engage:?}"
+    );
 }

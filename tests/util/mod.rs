@@ -151,6 +151,21 @@ impl Sandbox {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
 
+    /// `tactile run` of the scenario `text` (written as `bad{k}.toml`) must exit 2
+    /// with `want` in its error, and start nothing (no record written).
+    pub fn assert_refused(&self, k: usize, text: &str, want: &str) {
+        let s = self.write(&format!("bad{k}.toml"), text);
+        let out = format!("out{k}");
+        let o = self.tactile(&["run", s.to_str().expect("utf-8"), "--out", &out, "-q"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "case {k}: {err}");
+        assert!(err.contains(want), "case {k}: want {want:?} in {err}");
+        assert!(
+            !self.path(&out).join("slave.rec").exists(),
+            "case {k}: started"
+        );
+    }
+
     /// Fails if any process started with this sandbox's prefix is still alive.
     pub fn assert_no_leftover_processes(&self) {
         // Bench runs use the prefix as a stem (prefix + run name).

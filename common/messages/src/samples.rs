@@ -82,6 +82,14 @@ pub const FLAG_WAITING: u32 = 2048;
 /// counts the miss at once, as the in-process run does, instead of waiting out a
 /// timeout whose firing would depend on the machine's load.
 pub const FLAG_DROPPED: u32 = 4096;
+/// Flag: a 6-DoF sample. Forward, c(n) carries an orientation in
+/// [`Forward::rotation`]; backward, h(n) carries a torque in [`Backward::torque`].
+/// Never set in the paper's 3-DoF runs, whose samples carry positions and forces only.
+pub const FLAG_POSE: u32 = 8192;
+/// Flag (forward): the operator has released the clutch; the robot holds where it is
+/// and, at the next engaged sample, takes the master's pose from there (its offsets
+/// captured again), so it never jumps.
+pub const FLAG_RELEASED: u32 = 16384;
 
 /// A sample that carries a per-hop publish counter.
 pub trait Sequenced {
@@ -112,7 +120,7 @@ impl Sequenced for Backward {
 /// Three signal values with their provenance.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Signal/3")]
+#[type_name("tactile::Signal/4")]
 pub struct Signal {
     /// Values: what crosses the network. Position in metres (forward) and force in
     /// newtons (backward); with `control.kind = "wave"`, the wave variables.
@@ -138,7 +146,7 @@ pub struct Signal {
 /// loop needs; what each node did with it is in that node's own record.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Forward/3")]
+#[type_name("tactile::Forward/4")]
 pub struct Forward {
     /// Sample number n on this stream.
     pub seq: u64,
@@ -150,6 +158,10 @@ pub struct Forward {
     pub run: u64,
     /// Tool position.
     pub signal: Signal,
+    /// With `FLAG_POSE`: the tool's orientation relative to the operator's home, in the
+    /// master's frame, as a unit quaternion `[x, y, z, w]` (ROS order). It crosses the
+    /// network in the position's packet (delayed with it, never noised).
+    pub rotation: [f64; 4],
     /// Timestamps per stage (`stage::*`), ns; zero where not passed yet.
     pub stamps: [u64; stage::COUNT],
 }
@@ -157,7 +169,7 @@ pub struct Forward {
 /// Backward stream: h(n) from the slave, q(n) from the emulator.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Backward/3")]
+#[type_name("tactile::Backward/4")]
 pub struct Backward {
     /// Sample number n on this stream (the forward sample that triggered it).
     pub seq: u64,
@@ -167,6 +179,10 @@ pub struct Backward {
     pub run: u64,
     /// Contact force.
     pub signal: Signal,
+    /// With `FLAG_POSE`: the contact torque about the tool, in the master's frame, N m
+    /// (zero for a point contact; what a real robot's wrench sensor measured). It
+    /// crosses the network in the force's packet.
+    pub torque: [f64; 3],
     /// Stamps of the triggering forward sample, then the backward stages.
     pub stamps: [u64; stage::COUNT],
 }

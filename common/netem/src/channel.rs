@@ -10,7 +10,10 @@
 //! With a constant delay this is exactly c(n - d). Every output value carries the
 //! origin (sequence and timestamp) of the input value it came from and the delay that
 //! was injected, so the master can tell injected delay from system overhead; the noise
-//! actually added is returned too.
+//! actually added is returned too. A 6-DoF sample's rotational half (an orientation
+//! forward, a torque backward) rides in the packet of the first signal: it arrives
+//! with it, is held with it, and is never noised (the scenario makes a 6-DoF run's
+//! three delays equal, so the whole pose arrives together).
 
 use crate::{Jitter, Replay};
 use rand::{Rng, SeedableRng};
@@ -45,6 +48,8 @@ pub struct Emitted {
     pub values: [Value; 3],
     /// The noise added to each value.
     pub noise: [f64; 3],
+    /// The rotational half that came with the first value's packet.
+    pub extra: [f64; 4],
     /// The jitter drawn for the input packet, samples (before rounding).
     pub jitter: f64,
     /// True if a replayed network lost the input packet.
@@ -60,6 +65,7 @@ pub struct Emitted {
 struct Slot {
     seq: u64,
     values: [Value; 3],
+    extra: [f64; 4],
 }
 
 /// One signal's packets in flight: arrival sample -> newest sequence arriving then;
@@ -68,7 +74,7 @@ struct Slot {
 #[derive(Debug, Clone, Default)]
 struct InFlight {
     arriving: BTreeMap<u64, u64>,
-    newest: Option<(u64, Value)>,
+    newest: Option<(u64, Value, [f64; 4])>,
     last_arrival: u64,
     last_emitted: Option<u64>,
 }
@@ -84,16 +90,21 @@ impl InFlight {
     /// The newest packet arrived by sample `now`, its value read from `ring` as it
     /// arrives (every packet arrives within the ring's length of being sent, so its
     /// slot still holds it then).
-    fn receive(&mut self, now: u64, ring: &[Option<Slot>], i: usize) -> Option<(u64, Value)> {
+    fn receive(
+        &mut self,
+        now: u64,
+        ring: &[Option<Slot>],
+        i: usize,
+    ) -> Option<(u64, Value, [f64; 4])> {
         let len = ring.len() as u64;
         while let Some((&at, &seq)) = self.arriving.first_key_value() {
             if at > now {
                 break;
             }
             self.arriving.remove(&at);
-            if self.newest.is_none_or(|(n, _)| seq > n) {
+            if self.newest.is_none_or(|(n, ..)| seq > n) {
                 if let Some(s) = ring[(seq % len) as usize].filter(|s| s.seq == seq) {
-                    self.newest = Some((seq, s.values[i]));
+                    self.newest = Some((seq, s.values[i], s.extra));
                 }
             }
         }
@@ -208,14 +219,21 @@ impl Channel {
 
     /// Takes input sample `seq` and returns the output for the same sample index.
     pub fn push(&mut self, seq: u64, values: [Value; 3]) -> Emitted {
-        self.push_packet(seq, values, true)
+        self.push_packet(seq, values, [0.0; 4], true)
     }
 
     /// As [`Channel::push`]; `sent` false when the sender's codec sent no packet for
     /// this sample (it still draws its jitter, so enabling a codec leaves the network
     /// the same): the receiver then gets whatever arrived, or the last value again.
-    pub fn push_packet(&mut self, seq: u64, values: [Value; 3], sent: bool) -> Emitted {
-        let (sent, replayed) = self.admit(seq, values, sent);
+    /// `extra` is the sample's rotational half (zero in a 3-DoF run).
+    pub fn push_packet(
+        &mut self,
+        seq: u64,
+        values: [Value; 3],
+        extra: [f64; 4],
+        sent: bool,
+    ) -> Emitted {
+        let (sent, replayed) = self.admit(Slot { seq, values, extra }, sent);
         let lost = replayed.is_some_and(|(_, lost)| lost);
         let jitter = self.jitter.as_mut().map_or(0.0, |(j, rng)| j.next(rng));
         let (duplicated, copy_jitter) = self.duplicate_of(sent);
@@ -229,15 +247,20 @@ impl Channel {
         };
         let mut out = [Value::default(); 3];
         let mut noise = [0.0; 3];
+        let mut extra = [0.0; 4];
         let mut substituted = false;
         for i in 0..3 {
-            let (v, r, held) = self.axis(i, &packet);
+            let (v, r, held, x) = self.axis(i, &packet);
             (out[i], noise[i]) = (v, r);
+            if i == 0 {
+                extra = x;
+            }
             substituted |= held;
         }
         Emitted {
             values: out,
             noise,
+            extra,
             jitter,
             lost,
             duplicated,
@@ -248,7 +271,8 @@ impl Channel {
     /// Takes sample `seq` in: whether its packet goes on the network (it was sent, in
     /// order, and a replayed network did not lose it; then it is kept for its
     /// arrival), and the replay's delay and loss for it.
-    fn admit(&mut self, seq: u64, values: [Value; 3], sent: bool) -> (bool, Option<(u32, bool)>) {
+    fn admit(&mut self, slot: Slot, sent: bool) -> (bool, Option<(u32, bool)>) {
+        let seq = slot.seq;
         // Sample numbers must increase, and not by absurd steps.
         let in_order = self
             .last_seq
@@ -263,7 +287,6 @@ impl Channel {
             .map(|(r, t_s)| r.packet(seq, *t_s, sent));
         let sent = sent && !replayed.is_some_and(|(_, lost)| lost);
         if sent {
-            let slot = Slot { seq, values };
             let len = self.ring.len() as u64;
             self.ring[(seq % len) as usize] = Some(slot);
             self.first.get_or_insert(slot);
@@ -296,8 +319,8 @@ impl Channel {
 
     /// Axis `i` of the sample: its packet (and copy) in flight, the newest arrived
     /// value out with its age added to its delay and its noise; true if it was held
-    /// (no newer packet came).
-    fn axis(&mut self, i: usize, p: &Packet) -> (Value, f64, bool) {
+    /// (no newer packet came); and the rotational half of the packet it came in.
+    fn axis(&mut self, i: usize, p: &Packet) -> (Value, f64, bool, [f64; 4]) {
         // When a copy sent now with this jitter arrives: the replay's delay, or the
         // configured one plus jitter; in sending order unless reordering is on.
         let reorder = self.reorder;
@@ -325,16 +348,17 @@ impl Channel {
         let newest = f.receive(p.seq, &self.ring, i);
         let fresh = newest.is_some() && newest.map(|n| n.0) != f.last_emitted;
         f.last_emitted = newest.map(|n| n.0);
-        let (from, value, held) = match newest {
+        let (from, value, held, extra) = match newest {
             // Held when no newer packet came: flagged so the receiver knows.
-            Some((from, v)) => (from, v, !fresh),
+            Some((from, v, x)) => (from, v, !fresh, x),
             None => {
                 // Nothing has arrived yet: hold the first value sent.
                 let s = self.first.unwrap_or(Slot {
                     seq: p.seq,
                     values: [Value::default(); 3],
+                    extra: [0.0; 4],
                 });
-                (s.seq, s.values[i], true)
+                (s.seq, s.values[i], true, s.extra)
             }
         };
         // The delay injected is the value's age here: the packet's delay, and any
@@ -349,7 +373,7 @@ impl Channel {
             delay_samples: value.delay_samples.saturating_add(age),
             ..value
         };
-        (v, r, held)
+        (v, r, held, extra)
     }
 }
 

@@ -317,3 +317,42 @@ fn phi_is_the_normal_cdf() {
         assert!((phi(z) - want).abs() < 2e-7, "{z}: {}", phi(z));
     }
 }
+
+/// A 6-DoF sample's rotational half arrives in its position's packet: delayed and
+/// held exactly as the first value, never noised, and the values unchanged by it.
+#[test]
+fn the_rotational_half_rides_the_first_values_packet() {
+    use crate::channel::{Channel, Value, FORWARD_STREAM};
+    use tactile_scenario::{ChannelConfig, JitterConfig};
+    let cfg = ChannelConfig {
+        delay: [4, 4, 4],
+        noise_std: [1e-3; 3],
+        jitter: Some(JitterConfig {
+            jitter: 2.0,
+            correlation: 0.0,
+            distribution: Default::default(),
+        }),
+        reorder: true,
+        ..Default::default()
+    };
+    let vals = |n: u64| {
+        [0, 1, 2].map(|i| Value {
+            v: n as f64 + i as f64,
+            origin_seq: n,
+            ..Default::default()
+        })
+    };
+    let extra = |n: u64| [n as f64, -(n as f64), 0.5, 1.0];
+    let (mut with, mut without) = (
+        Channel::new(&cfg, 3, FORWARD_STREAM),
+        Channel::new(&cfg, 3, FORWARD_STREAM),
+    );
+    for n in 0..2_000u64 {
+        // Every fifth sample unsent: the receiver holds the last packet, rotation too.
+        let sent = n % 5 != 1;
+        let e = with.push_packet(n, vals(n), extra(n), sent);
+        let plain = without.push_packet(n, vals(n), [0.0; 4], sent);
+        assert_eq!(e.values, plain.values, "sample {n}");
+        assert_eq!(e.extra, extra(e.values[0].origin_seq), "sample {n}");
+    }
+}

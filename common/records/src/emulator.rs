@@ -69,6 +69,9 @@ pub struct Passage {
     /// What left (values, provenance, injected delay, flags); values as sent even when
     /// dropped.
     pub out: Signal,
+    /// A 6-DoF sample's rotational half as it left (the orientation forward, the torque
+    /// and a zero backward); `None` in a 3-DoF run.
+    pub rotational: Option<[f64; 4]>,
     /// Noise added to each value.
     pub noise: [f64; 3],
     /// Jitter drawn for this packet, samples (zero without a jitter model).

@@ -53,6 +53,10 @@ pub struct Sent {
     pub tick_ns: u64,
     /// When c(n) was published, ns.
     pub send_ns: u64,
+    /// A 6-DoF operator's orientation c(n) carried, `[x, y, z, w]` (`None`: 3-DoF).
+    pub rotation: Option<[f64; 4]>,
+    /// The operator's clutch was released at this sample.
+    pub released: bool,
 }
 
 /// What the master commanded for a sample, answered or not, and its passivity books

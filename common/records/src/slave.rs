@@ -97,6 +97,14 @@ pub struct ArmJoints {
     pub q: Vec<f64>,
     /// Efforts the servo applied, N m or N.
     pub tau: Vec<f64>,
+    /// The tool's orientation reference relative to its home, about the base's axes,
+    /// `[x, y, z, w]` (a 6-DoF master's rotation, moved by the clutch's offsets; the
+    /// identity for a 3-DoF master).
+    pub target_rotation: [f64; 4],
+    /// The tool's orientation (FK of the joints) relative to its home, `[x, y, z, w]`.
+    pub tool_rotation: [f64; 4],
+    /// The operator's clutch was released: the references held.
+    pub released: bool,
 }
 
 /// One entry per step the slave took. A sample lives for one write or one read, and

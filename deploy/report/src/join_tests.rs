@@ -75,6 +75,7 @@ fn write_run(root: &Path, slave_run: u64) -> [PathBuf; 3] {
             delay_samples: [1, 2, 3],
             ..signal(n as f64)
         },
+        rotational: None,
         noise: [n as f64 * 1e-3; 3],
         jitter: 0.0,
         lost: false,

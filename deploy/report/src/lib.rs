@@ -10,6 +10,7 @@ pub mod analysis;
 pub mod arm_scene;
 pub mod error;
 pub mod join;
+pub mod joints;
 pub mod mcap;
 pub mod metrics;
 pub mod out;

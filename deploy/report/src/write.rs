@@ -12,7 +12,6 @@ use crate::{run_mcap, trace};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 use std::io::Write as _;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -408,11 +407,7 @@ impl Streams {
     fn add(&mut self, row: &trace::TraceRow, joints: Option<&ArmJoints>) -> Result<(), Error> {
         if let (Some(w), Some(j)) = (self.joints.as_mut(), joints) {
             self.line.clear();
-            let _ = write!(self.line, "{}", row.n);
-            for x in j.q_ref.iter().chain(&j.q).chain(&j.tau) {
-                let _ = write!(self.line, ",{x:?}");
-            }
-            self.line.push('\n');
+            crate::joints::row(&mut self.line, row.n, j);
             w.write_all(self.line.as_bytes())
                 .map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
         }
@@ -456,13 +451,8 @@ fn joints_csv(out: &Path, dof: usize) -> Result<std::io::BufWriter<std::fs::File
     let f = std::fs::File::create(crate::out::partial(&path))
         .map_err(Error::io(format!("writing {}", path.display())))?;
     let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
-    let mut header = String::from("n");
-    for field in ["q_ref", "q", "tau"] {
-        for i in 1..=dof {
-            let _ = write!(header, ",{field}_{i}");
-        }
-    }
-    writeln!(w, "{header}").map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
+    writeln!(w, "{}", crate::joints::header(dof))
+        .map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
     Ok(w)
 }
 

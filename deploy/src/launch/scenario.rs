@@ -69,6 +69,9 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
     }
     let source = OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
+    source
+        .check_six_dof(&scenario)
+        .map_err(|e| Error::BadInput(format!("{name}{with}: {e}")))?;
     let mut warnings = scenario.warnings();
     warnings.extend(source.warnings(scenario.samples, scenario.t_s()));
     tactile_network_emulator::replay::load(&scenario, &base_dir)

@@ -1,0 +1,258 @@
+//! The 6-DoF sample: an operator whose trajectory gives the hand's orientation and
+//! a clutch (`deploy/scenarios/panda-pose.toml`). The Panda's hand turns as the
+//! operator's does within a degree, holds while the clutch is released, continues
+//! from where it held when engaged again (no jump), two runs and the node programs
+//! give the same bytes as the in-process run, and a 6-DoF run the rest of the
+//! scenario cannot carry is refused before anything starts, naming the field.
+
+use crate::util;
+
+use std::path::{Path, PathBuf};
+use util::{column, Sandbox};
+
+fn scenarios() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
+}
+
+/// The shipped scenario's text with its files named by absolute paths.
+fn pose_text() -> String {
+    let dir = scenarios();
+    let text = std::fs::read_to_string(dir.join("panda-pose.toml")).expect("scenario");
+    text.replace(
+        "\"../robots/panda.urdf\"",
+        &format!("{:?}", dir.join("../robots/panda.urdf")),
+    )
+    .replace(
+        "\"panda-pose.csv\"",
+        &format!("{:?}", dir.join("panda-pose.csv")),
+    )
+}
+
+/// A column of joints.csv.
+fn joint_col(text: &str, name: &str) -> Vec<f64> {
+    column(text, name)
+}
+
+/// Hamilton product of quaternions `[x, y, z, w]`.
+fn mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    let ([ax, ay, az, aw], [bx, by, bz, bw]) = (a, b);
+    [
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ]
+}
+
+/// Largest difference between two orientations as quaternions (either sign).
+fn apart(a: [f64; 4], b: [f64; 4]) -> f64 {
+    let d = |s: f64| (0..4).map(|i| (a[i] - s * b[i]).abs()).fold(0.0, f64::max);
+    d(1.0).min(d(-1.0))
+}
+
+#[test]
+fn the_panda_turns_with_the_operator_holds_when_released_and_continues_without_a_jump() {
+    let sb = Sandbox::new("pose");
+    let scenario = scenarios().join("panda-pose.toml");
+    sb.simulate(&scenario, "a");
+    let joints = std::fs::read_to_string(sb.path("a").join("joints.csv")).expect("joints");
+    let trace = sb.trace("a");
+    let err = joint_col(&joints, "rot_error_deg");
+    let released = joint_col(&joints, "released");
+    let rot = |which: &str, n: usize| {
+        ["x", "y", "z", "w"].map(|c| joint_col(&joints, &format!("{which}_rot_{c}"))[n])
+    };
+    assert_eq!(err.len(), 6000);
+    // The file releases the clutch from t = 3 s to 4 s.
+    let (r0, r1) = (
+        released.iter().position(|r| *r == 1.0).expect("a release"),
+        released.iter().rposition(|r| *r == 1.0).expect("a release"),
+    );
+    assert_eq!((r0, r1), (3000, 3999));
+
+    // Engaged, the hand's orientation is the target's within a degree (free space),
+    // and before the release the target is the operator's own (the file's row at
+    // t = 2 s is sample 2000, no delay).
+    for (n, e) in err.iter().enumerate() {
+        assert!(*e < 1.0, "sample {n}: tool {e} degrees from its target");
+    }
+    let row_2s = [0.0, 0.0, 0.258819045103, 0.965925826289];
+    assert!(
+        apart(rot("target", 2000), row_2s) < 1e-9,
+        "{:?}",
+        rot("target", 2000)
+    );
+
+    // Released, the references hold: the hand stays within a millimetre.
+    let tool = [1, 2, 3].map(|i| column(&trace, &format!("tool_{i}")));
+    let v = [1, 2, 3].map(|i| column(&trace, &format!("v_{i}")));
+    let dist = |a: usize, b: usize| {
+        (0..3)
+            .map(|k| (tool[k][a] - tool[k][b]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    for n in r0..=r1 {
+        assert!(
+            dist(n, r0) < 1e-3,
+            "sample {n}: moved {} m while released",
+            dist(n, r0)
+        );
+        assert_eq!(rot("target", n), rot("target", r0 - 1), "sample {n}");
+    }
+
+    // Engaged again at 4 s with the hand back home: the Panda continues from where it
+    // held. Its hand moves as the master's since then (the map's scale is 1), and the
+    // operator's turn since then (20 degrees about z) turns it about the base's z.
+    let engage = r1 + 1;
+    for n in engage..6000 {
+        let e = (0..3)
+            .map(|k| ((tool[k][n] - tool[k][engage]) - (v[k][n] - v[k][engage])).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(
+            e < 1e-3,
+            "sample {n}: {e} m off the master's move since the engage"
+        );
+    }
+    let h = 10f64.to_radians();
+    let want = mul([0.0, 0.0, h.sin(), h.cos()], rot("target", r0 - 1));
+    assert!(
+        apart(rot("target", 5999), want) < 1e-6,
+        "{:?} vs {want:?}",
+        rot("target", 5999)
+    );
+
+    // No jump anywhere, the re-engage included: every reference step is inside the
+    // joints' velocity limits over one period.
+    let chain = tactile_chain::Chain::from_urdf(
+        &std::fs::read_to_string(scenarios().join("../robots/panda.urdf")).expect("urdf"),
+        "panda_link0",
+        "panda_hand",
+    )
+    .expect("chain");
+    for (i, d) in chain.dofs.iter().enumerate() {
+        let q = joint_col(&joints, &format!("q_ref_{}", i + 1));
+        let step = q
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        assert!(step <= d.velocity * 1e-3, "{}: step {step} rad", d.name);
+    }
+
+    // The same scenario and seed give the same bytes.
+    sb.simulate(&scenario, "b");
+    let again = std::fs::read_to_string(sb.path("b").join("joints.csv")).expect("joints");
+    assert!(joints == again, "joints.csv differs between two runs");
+    let s = sb.json("a", "summary.json");
+    let c = &s["slave"]["counters"];
+    assert_eq!(c["rejected"], 0, "{c}");
+    assert_eq!(c["ik_clamped"], 0, "{c}");
+}
+
+/// Lockstep through the node programs (iceoryx2 between real processes): the pose
+/// crosses master, emulator and slave and the arm does what the in-process run's does.
+#[test]
+fn the_node_programs_carry_the_pose_as_the_in_process_run_does() {
+    let sb = Sandbox::new("posenodes");
+    let text = pose_text()
+        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        .replace("samples = 6000", "samples = 800")
+        .replace(
+            "[slave.arm]",
+            "[network.forward]\ndelay = [3, 3, 3]\n\n[slave.arm]",
+        );
+    let scenario = sb.write("pose.toml", &text);
+    sb.simulate(&scenario, "sim");
+    sb.run(&scenario, "nodes");
+    let read =
+        |out: &str| std::fs::read_to_string(sb.path(out).join("joints.csv")).expect("joints");
+    let (sim, nodes) = (read("sim"), read("nodes"));
+    assert_eq!(sim.lines().count(), 801);
+    assert!(
+        sim == nodes,
+        "joints.csv of the node programs differs from the in-process run's"
+    );
+    // The turn arrived three samples late, as the delay says.
+    let z = joint_col(&nodes, "target_rot_z");
+    assert!(z[3..].iter().any(|v| *v > 0.0) && z[..3].iter().all(|v| *v == 0.0));
+}
+
+#[test]
+fn a_six_dof_run_the_scenario_cannot_carry_is_refused_naming_the_field() {
+    let sb = Sandbox::new("posebad");
+    let base = pose_text();
+    let bad_row = "0.05,0.000003009,-0.107000000,-0.035000000,0.000000000000,0.000000000000,0.5,0.999999999224,1";
+    let csv = std::fs::read_to_string(scenarios().join("panda-pose.csv")).expect("csv");
+    let mut lines: Vec<&str> = csv.lines().collect();
+    lines[2] = bad_row;
+    let not_unit = sb.write("not-unit.csv", &(lines.join("\n") + "\n"));
+    lines[2] = "0.05,0,-0.107,-0.035,0,0,0,1,2";
+    let bad_clutch = sb.write("bad-clutch.csv", &(lines.join("\n") + "\n"));
+    let arm_block = base.find("[slave.arm]").expect("arm");
+    let cases: Vec<(String, &str)> = vec![
+        (base[..arm_block].to_string(), "field `slave.arm`"),
+        (
+            base.replace(
+                "[slave.arm]",
+                "[network.forward]\ndelay = [0, 5, 0]\n\n[slave.arm]",
+            ),
+            "field `network.forward.delay`",
+        ),
+        (
+            base.replace(
+                "[slave.arm]",
+                "[codec.forward]\nkind = \"deadband\"\n\n[slave.arm]",
+            ),
+            "field `codec.forward.kind`",
+        ),
+        (
+            base.replace(
+                &format!("{:?}", scenarios().join("panda-pose.csv")),
+                &format!("{not_unit:?}"),
+            ),
+            "line 3: the quaternion",
+        ),
+        (
+            base.replace(
+                &format!("{:?}", scenarios().join("panda-pose.csv")),
+                &format!("{bad_clutch:?}"),
+            ),
+            "line 3: engaged = 2",
+        ),
+    ];
+    for (k, (text, want)) in cases.iter().enumerate() {
+        sb.assert_refused(k, text, want);
+    }
+}
+
+/// Corrupted poses (the emulator's fault injection turns position and orientation to
+/// NaN) are rejected and counted, never reach the IK: the hand keeps turning with
+/// the operator as before.
+#[test]
+fn a_corrupted_pose_is_rejected_and_counted_and_the_hand_keeps_its_course() {
+    let sb = Sandbox::new("posecorrupt");
+    let text = pose_text()
+        .replace("samples = 6000", "samples = 3000")
+        .replace(
+            "[slave.arm]",
+            "[network.forward]\ncorrupt = 0.02\n\n[slave.arm]",
+        );
+    let scenario = sb.write("corrupt.toml", &text);
+    sb.simulate(&scenario, "a");
+    let s = sb.json("a", "summary.json");
+    let corrupted = s["emulator"]["counters"]["forward_corrupted"]
+        .as_u64()
+        .expect("count");
+    assert!(corrupted > 20, "{corrupted} corrupted");
+    let c = &s["slave"]["counters"];
+    assert_eq!(c["rejected"].as_u64(), Some(corrupted), "{c}");
+    assert_eq!(c["ik_clamped"], 0, "{c}");
+    let joints = std::fs::read_to_string(sb.path("a").join("joints.csv")).expect("joints");
+    let err = joint_col(&joints, "rot_error_deg");
+    assert!(
+        err.iter().all(|e| *e < 1.0),
+        "{:?}",
+        err.iter().copied().fold(0.0, f64::max)
+    );
+}
