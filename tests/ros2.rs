@@ -1085,6 +1085,86 @@ fn a_panda_over_ros2_takes_trajectories_and_its_wrench_turns_into_the_base() {
     );
 }
 
+/// True if python3 also has Pinocchio (tests/servo_ik.py).
+fn pinocchio_ready() -> bool {
+    python_ready()
+        && Command::new("python3")
+            .args(["-c", "import pinocchio"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+}
+
+/// The same arm through a stack that does its own IK and safety (MoveIt Servo's pose
+/// target, FZI cartesian_controllers' target_frame): each PoseStamped is checked by a
+/// Servo-like stand-in (tests/servo_ik.py: the frame_id must be the base link, the
+/// stamp within 0.1 s of the robot's clock, a finite pose and a rotation) and followed
+/// through Pinocchio's IK. Every pose is the tool's pose at joints the loop commanded
+/// (joints.csv's references, in order), and the robot follows.
+#[test]
+fn a_panda_over_ros2_takes_poses_as_moveit_servo_does() {
+    if !pinocchio_ready() {
+        return cannot("python3 lacks eclipse-zenoh, rosbags or pinocchio");
+    }
+    let _serial = one_at_a_time();
+    let sb = Sandbox::new("ros2-panda-pose");
+    let port = free_port();
+    let topic = "/servo_node/pose_target_cmds";
+    let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/panda.urdf");
+    let extra = [
+        "--ik-urdf",
+        urdf,
+        "--tool",
+        "panda_hand",
+        "--pose-frame",
+        "panda_link0",
+    ];
+    let arm = arm_standin(&sb, 18, port, "pose", topic, &extra);
+    let (r, _) = run_panda(&sb, arm, (18, port), 1500, ("pose", topic), "", false);
+    assert!(num(&r["commands"]) > 1200.0, "{r}");
+    assert!(num(&r["ik_residual_max"]) < 1e-9, "{r}");
+    let chain = tactile_chain::Chain::from_urdf(
+        &std::fs::read_to_string(urdf).expect("urdf"),
+        "panda_link0",
+        "panda_hand",
+    )
+    .expect("chain");
+    let joints = std::fs::read_to_string(sb.path("out").join("joints.csv")).expect("joints");
+    let q_ref: Vec<Vec<f64>> = (1..=7)
+        .map(|i| util::column(&joints, &format!("q_ref_{i}")))
+        .collect();
+    let pose_at = |k: usize| {
+        let q: Vec<f64> = (0..7).map(|i| q_ref[i][k]).collect();
+        let f = chain.fk(&q);
+        let o = tactile_chain::spatial::quaternion(&f.r);
+        [f.p.x, f.p.y, f.p.z, o[0], o[1], o[2], o[3]]
+    };
+    let poses: Vec<Vec<f64>> = r["poses"]
+        .as_array()
+        .expect("poses")
+        .iter()
+        .map(floats)
+        .collect();
+    // The last pose is the end's hold (where the robot was measured), not a reference.
+    let mut k = 0;
+    for (i, p) in poses[..poses.len() - 1].iter().enumerate() {
+        let same = |k: usize| pose_at(k).iter().zip(p).all(|(a, b)| (a - b).abs() < 1e-12);
+        while k < q_ref[0].len() && !same(k) {
+            k += 1;
+        }
+        assert!(
+            k < q_ref[0].len(),
+            "pose {i} {p:?} is no commanded joints' pose"
+        );
+    }
+    // The stand-in's robot (first-order, 20 ms) ended where the last pose put it.
+    let (tool, last) = (floats(&r["tool"]), &poses[poses.len() - 1]);
+    let off = (0..3)
+        .map(|i| (tool[i] - last[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(off < 1e-3, "the robot's tool {off} m from the last pose");
+}
+
 /// True if python3 also has MuJoCo (tests/mujoco_arm.py).
 fn mujoco_ready() -> bool {
     python_ready()

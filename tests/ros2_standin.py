@@ -16,7 +16,9 @@ independent of Tactile's, for tests/ros2.rs.
           (tests/mujoco_arm.py: its dynamics and a wall's contact), and publishes its
           JointState at 1 kHz with its joints in reverse order and a gripper joint
           among them; optionally a WrenchStamped in a named frame (MuJoCo's contact
-          force on the tool, or a constant).
+          force on the tool, or a constant). Or, as MoveIt Servo or
+          cartesian_controllers, takes PoseStamped targets and does its own IK
+          (Pinocchio, tests/servo_ik.py).
 
 Both declare rmw_zenoh's liveliness tokens, check every attachment they receive
 (33 bytes: seq, timestamp, 16-byte gid), and write a JSON report on exit.
@@ -48,6 +50,7 @@ JOINT_STATE = "sensor_msgs/msg/JointState"
 WRENCH = "geometry_msgs/msg/WrenchStamped"
 ARRAY = "std_msgs/msg/Float64MultiArray"
 TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
+POSE = "geometry_msgs/msg/PoseStamped"
 
 
 def dds(ty):
@@ -417,7 +420,21 @@ def arm(a):
         rep["point_times"].add(pt.time_from_start.sec * 10**9 + pt.time_from_start.nanosec)
         take([by_name[j] for j in names])
 
-    if a.command_type == "trajectory":
+    def on_pose(msg, _t):
+        why = servo.check(msg, time.time_ns())
+        if why:
+            rep["bad_commands"].append(why)
+            return
+        p, o = msg.pose.position, msg.pose.orientation
+        rep["poses"].append([p.x, p.y, p.z, o.x, o.y, o.z, o.w])
+        take(servo.solve(target["q"] or q, msg))
+
+    if a.command_type == "pose":
+        from servo_ik import ServoIk  # beside this script
+        servo = ServoIk(a.ik_urdf, names, a.tool, a.pose_frame)
+        rep["poses"] = []
+        sub = node.subscribe(a.command_topic, POSE, on_pose)
+    elif a.command_type == "trajectory":
         sub = node.subscribe(a.command_topic, TRAJECTORY, on_trajectory)
     else:
         sub = node.subscribe(a.command_topic, ARRAY, on_array)
@@ -474,7 +491,13 @@ def arm(a):
     rep["q"] = q
     if sim:
         rep["tool"] = sim.tool_position()
+    if a.command_type == "pose":
+        rep["tool"] = servo.tool(q)
+        rep["ik_residual_max"] = servo.residual_max
     rep["point_times"] = sorted(rep["point_times"])
+    if not rep["commands"]:
+        rep["lowest"] = rep["highest"] = None  # no command: JSON has no infinity
+    rep["bad_commands"] = rep["bad_commands"][:20]
     rep["bad_attachments"] = node.bad_attachments
     rep.pop("t_last")
     with open(a.report, "w") as f:
@@ -512,7 +535,9 @@ def main():
     r.add_argument("--wrench", type=float, nargs=3, default=[0.0, 0.0, 0.0])
     m = sub.choices["arm"]
     m.add_argument("--command-topic", required=True)
-    m.add_argument("--command-type", choices=["positions", "trajectory"], default="positions")
+    m.add_argument("--command-type", choices=["positions", "trajectory", "pose"], default="positions")
+    m.add_argument("--ik-urdf", default="", help="pose: the arm's URDF for the IK")
+    m.add_argument("--pose-frame", default="", help="pose: the frame_id poses must have")
     m.add_argument("--initial", required=True, help="the joints' start, comma-separated")
     m.add_argument("--tau", type=float, default=0.02)
     m.add_argument("--duration", type=float, required=True)

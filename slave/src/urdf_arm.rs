@@ -21,9 +21,9 @@
 //! arm's tool as it is (the objects are the master frame's, so a wall keeps its place
 //! and stiffness for the operator whatever the arm).
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Matrix6xX, Quaternion, UnitQuaternion};
-use nalgebra::{Vector3, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Matrix6xX, Vector3, Vector6};
 use std::path::Path;
+pub use tactile_chain::spatial::{quaternion, rotation_matrix};
 use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
 use tactile_math::arith::StdTrig;
 use tactile_scenario::{ArmConfig, ArmServo, Object, Scenario};
@@ -493,17 +493,3 @@ impl UrdfArm {
 #[cfg(test)]
 #[path = "urdf_arm_tests.rs"]
 mod tests;
-
-/// The rotation of a unit quaternion `[x, y, z, w]` (normalized here).
-pub fn rotation_matrix(q: [f64; 4]) -> Matrix3<f64> {
-    UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
-        .to_rotation_matrix()
-        .into_inner()
-}
-
-/// A rotation matrix as a unit quaternion `[x, y, z, w]` with `w >= 0`.
-pub fn quaternion(r: &Matrix3<f64>) -> [f64; 4] {
-    let q = UnitQuaternion::from_matrix(r);
-    let s = if q.w < 0.0 { -1.0 } else { 1.0 };
-    [s * q.i, s * q.j, s * q.k, s * q.w]
-}

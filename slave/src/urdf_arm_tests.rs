@@ -1,5 +1,6 @@
 //! The URDF arm's unit tests (beside the module, which they would double).
 use super::*;
+use nalgebra::{Quaternion, UnitQuaternion};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 use tactile_scenario::{ArmIkConfig, CartesianConfig};
 

@@ -2,7 +2,7 @@
 //! a motion is `[linear; angular]`, a force `[force; moment]`, so vectors and
 //! Jacobians compare with Pinocchio's entry by entry.
 
-use nalgebra::{Matrix3, Matrix6, Rotation3, Unit, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Quaternion, Rotation3, Unit, UnitQuaternion, Vector3, Vector6};
 
 /// A frame's pose in another: `x_parent = r * x_child + p`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -115,6 +115,21 @@ pub fn inertia(mass: f64, com: &Vector3<f64>, i_com: &Matrix3<f64>) -> Matrix6<f
 pub fn inertia_to_parent(f: &Frame, i: &Matrix6<f64>) -> Matrix6<f64> {
     let x = f.motion_to_child();
     x.transpose() * i * x
+}
+
+/// The rotation of a unit quaternion `[x, y, z, w]` (ROS order; normalized here).
+pub fn rotation_matrix(q: [f64; 4]) -> Matrix3<f64> {
+    UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]))
+        .to_rotation_matrix()
+        .into_inner()
+}
+
+/// A rotation matrix as a unit quaternion `[x, y, z, w]` with `w >= 0` (one of the
+/// two that are the same rotation, so equal rotations give equal numbers).
+pub fn quaternion(r: &Matrix3<f64>) -> [f64; 4] {
+    let q = UnitQuaternion::from_matrix(r);
+    let s = if q.w < 0.0 { -1.0 } else { 1.0 };
+    [s * q.i, s * q.j, s * q.k, s * q.w]
 }
 
 /// The rotation vector (axis times angle, rad) of `r`, its logarithm: finite for any

@@ -2,19 +2,22 @@
 //! the chain's joints read by name from the robot's `JointState`, each reference sent
 //! as the controller takes it (a forward position controller's `Float64MultiArray`, in
 //! the chain's order, or a joint_trajectory_controller's `JointTrajectory` of one
-//! point), through the gate of the URDF's limits, and a force-torque sensor's wrench
-//! turned into the base's axes through the chain.
+//! point), or, for a stack that does its own IK (MoveIt Servo, cartesian_controllers),
+//! the tool's pose those joints put it at (`PoseStamped` in the base link, stamped with
+//! the wall clock), always through the gate of the URDF's limits; and a force-torque
+//! sensor's wrench turned into the base's axes through the chain.
 
 use crate::arm_map::{framed_force_cdr, in_base, ArmJointMap, FramedForce};
 use crate::gate::JointGate;
-use crate::rmw_node::{RosNode, RosPublisher, RosSubscription};
+use crate::rmw_node::{wall_ns, RosNode, RosPublisher, RosSubscription};
 use crate::ros_devices::{hold_at, released};
 use crate::watch::{Inbox, Watch};
 use crate::{Change, Reading, Robot, RosError};
 use std::sync::Arc;
 use tactile_chain::{Chain, Tree};
 use tactile_ros::msg::{
-    Float64MultiArray, Header, JointState, JointTrajectory, Message, Time, WrenchStamped,
+    Float64MultiArray, Header, JointState, JointTrajectory, Message, PoseStamped, Time,
+    WrenchStamped,
 };
 use tactile_scenario::{RobotCommand, RosRobotConfig};
 
@@ -31,6 +34,8 @@ pub struct RosArm {
     point_time: Time,
     map: ArmJointMap,
     tree: Arc<Tree>,
+    /// The chain, for a pose command's FK.
+    chain: Chain,
     base: String,
     gate: JointGate<Vec<f64>>,
     watch: Watch,
@@ -76,6 +81,7 @@ impl RosArm {
         let ty = match cfg.command {
             RobotCommand::Positions => Float64MultiArray::TYPE,
             RobotCommand::Trajectory => JointTrajectory::TYPE,
+            RobotCommand::Pose => PoseStamped::TYPE,
         };
         let point_s = cfg.trajectory_time_s.unwrap_or(t_s);
         Ok(RosArm {
@@ -89,6 +95,7 @@ impl RosArm {
             gate: map.gate(t_s),
             map,
             tree,
+            chain: chain.clone(),
             base: chain.base.clone(),
             watch: Watch::new(&cfg.watch, t_s_ns),
             topic: cfg.joint_states.clone(),
@@ -96,7 +103,9 @@ impl RosArm {
         })
     }
 
-    /// The command message for joint values `q`.
+    /// The command message for joint values `q` (which passed the gate): a pose
+    /// command's is the tool's pose at `q`, so it is reachable and moves no joint
+    /// faster than the gate lets it.
     fn message(&self, q: Vec<f64>) -> Vec<u8> {
         match self.kind {
             RobotCommand::Positions => Float64MultiArray { data: q }.to_cdr(),
@@ -109,6 +118,15 @@ impl RosArm {
                 time_from_start: self.point_time,
             }
             .to_cdr(),
+            RobotCommand::Pose => {
+                let tool = self.chain.fk(&q);
+                PoseStamped {
+                    header: Header::at(wall_ns(), &self.base),
+                    position: tool.p.into(),
+                    orientation: tactile_chain::spatial::quaternion(&tool.r),
+                }
+                .to_cdr()
+            }
         }
     }
 }

@@ -339,6 +339,12 @@ pub enum RobotCommand {
     /// scaled_joint_trajectory_controller, Franka's fr3_arm_controller, Kinova's,
     /// xArm's). Only with `[slave.arm]`.
     Trajectory,
+    /// `geometry_msgs/msg/PoseStamped` of the tool in the arm's base link (its
+    /// `frame_id`), stamped with the wall clock: for stacks that do their own IK and
+    /// safety, MoveIt Servo's `/servo_node/pose_target_cmds` and FZI
+    /// cartesian_controllers' `<controller>/target_frame`. The pose is the FK of the
+    /// joints the gate passed. Only with `[slave.arm]`.
+    Pose,
 }
 
 /// `[slave.ros2]`: a robot arm through ros2_control.
@@ -520,13 +526,18 @@ impl RosRobotConfig {
 }
 
 impl RobotCommand {
-    /// Checks the command fits the arm: a trajectory names joints, which only an arm
-    /// from its URDF has.
+    /// Checks the command fits the arm: a trajectory names joints and a pose needs
+    /// the chain's FK, which only an arm from its URDF has.
     pub fn validate(self, arm: bool) -> Result<(), ScenarioError> {
-        if self == RobotCommand::Trajectory && !arm {
+        let name = match self {
+            RobotCommand::Positions => return Ok(()),
+            RobotCommand::Trajectory => "trajectory",
+            RobotCommand::Pose => "pose",
+        };
+        if !arm {
             return Err(invalid(
                 "slave.ros2.command",
-                "\"trajectory\" needs [slave.arm] (its URDF names the joints); the paper's three joints take \"positions\"",
+                format!("\"{name}\" needs [slave.arm] (its URDF names the joints and the tool); the paper's three joints take \"positions\""),
             ));
         }
         Ok(())
@@ -534,64 +545,5 @@ impl RobotCommand {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_trajectory_command_needs_an_arm_from_its_urdf() {
-        let e = RobotCommand::Trajectory
-            .validate(false)
-            .expect_err("no arm");
-        assert!(e.to_string().contains("slave.ros2.command"), "{e}");
-        assert!(RobotCommand::Trajectory.validate(true).is_ok());
-        assert!(RobotCommand::Positions.validate(false).is_ok());
-        let cfg: RosRobotConfig =
-            toml::from_str("command = \"trajectory\"\ntrajectory_time_s = 0.004").expect("toml");
-        assert_eq!(
-            (cfg.command, cfg.trajectory_time_s),
-            (RobotCommand::Trajectory, Some(0.004))
-        );
-    }
-
-    #[test]
-    fn topic_names_follow_ros_rules() {
-        assert!(topic_name("/phantom/joint_states", "f").is_ok());
-        for bad in ["joint_states", "/", "/a//b", "/1abc", "/a-b", "/a/"] {
-            assert!(topic_name(bad, "f").is_err(), "{bad}");
-        }
-    }
-
-    #[test]
-    fn a_force_goes_to_the_device_frame_and_back() {
-        let m = ForceMapConfig {
-            axes: [1, 2, 0],
-            sign: [1.0, -1.0, 1.0],
-        };
-        let f = [1.0, 2.0, 3.0];
-        assert_eq!(m.to_device(f), [2.0, -3.0, 1.0]);
-        assert_eq!(m.to_paper(m.to_device(f)), f);
-        let bad = ForceMapConfig {
-            axes: [0, 0, 2],
-            ..ForceMapConfig::default()
-        };
-        assert!(bad.validate("m").is_err());
-    }
-
-    #[test]
-    fn a_ros2_device_runs_in_real_time_only() {
-        let mut sc = crate::Scenario::default();
-        sc.slave.backend = Backend::Ros2;
-        assert!(sc.validate().is_ok());
-        sc.mode = crate::Mode::Lockstep;
-        let e = sc.validate().expect_err("lockstep");
-        assert!(e.to_string().contains("field `mode`"), "{e}");
-    }
-
-    #[test]
-    fn joint_names_must_differ() {
-        let mut d = RosDeviceConfig::default();
-        d.joints[2] = "waist".into();
-        let e = d.validate().expect_err("duplicate");
-        assert!(e.to_string().contains("master.ros2.joints[2]"), "{e}");
-    }
-}
+#[path = "ros_tests.rs"]
+mod tests;
