@@ -43,28 +43,11 @@ fn a_panda_follows_in_free_space_presses_the_wall_and_stays_in_its_limits() {
     let sb = Sandbox::new("armpanda");
     sb.simulate(&panda(), "a");
     let trace = sb.trace("a");
-    let (tool, v, h3) = (
-        (1..=3)
-            .map(|i| column(&trace, &format!("tool_{i}")))
-            .collect::<Vec<_>>(),
-        (1..=3)
-            .map(|i| column(&trace, &format!("v_{i}")))
-            .collect::<Vec<_>>(),
-        column(&trace, "h_3"),
-    );
+    let h3 = column(&trace, "h_3");
     assert_eq!(h3.len(), 4000);
     // In free space (no force) the hand is where the master's position puts it.
-    let mut free = 0;
-    for n in 0..h3.len() {
-        if h3[n] == 0.0 {
-            free += 1;
-            let e = (0..3)
-                .map(|k| (tool[k][n] - v[k][n]).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            assert!(e < 1e-3, "sample {n}: tool {e} m from its target");
-        }
-    }
+    let (worst, free) = util::free_space_error(&trace, 0);
+    assert!(worst < 1e-3, "tool {worst} m from its target");
     assert!(free > 1000, "{free} samples in free space");
     // The wall at z = -0.08 pushes back up, as its stiffness says.
     let h_max = h3.iter().copied().fold(0.0, f64::max);
@@ -228,24 +211,10 @@ fn a_ur5_follows_in_free_space_and_is_drawn_from_its_own_world() {
     let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/ur5.toml");
     sb.simulate(&scenario, "a");
     let trace = sb.trace("a");
-    let col = |c: &str| column(&trace, c);
-    let (t, v, h) = (
-        [1, 2, 3].map(|i| col(&format!("tool_{i}"))),
-        [1, 2, 3].map(|i| col(&format!("v_{i}"))),
-        col("h_3"),
-    );
-    let free: Vec<f64> = (0..h.len())
-        .filter(|&k| h[k] == 0.0)
-        .map(|k| {
-            (0..3)
-                .map(|i| (t[i][k] - v[i][k]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
-        .collect();
-    assert!(free.len() > 1000, "{}", free.len());
-    let worst = free.iter().copied().fold(0.0, f64::max);
+    let (worst, free) = util::free_space_error(&trace, 0);
+    assert!(free > 1000, "{free}");
     assert!(worst < 1e-3, "free-space error {worst} m");
+    let h = column(&trace, "h_3");
     assert!(h.iter().any(|f| *f > 5.0), "the wall pushed back");
     if !mcap_readers() {
         return util::cannot("python3 lacks mcap, mcap-ros2-support, yourdfpy or numpy");

@@ -36,6 +36,9 @@ class MujocoArm:
                      r'fusestatic="false" balanceinertia="true"/></mujoco>', xml, count=1)
         spec = mujoco.MjSpec.from_string(xml)
         spec.option.timestep = STEP
+        # The servo's damping integrated implicitly: explicit, kv would make a light
+        # link (a UR wrist's) unstable at 1 ms steps.
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
         for b in spec.bodies:
             b.gravcomp = 1.0
         for n in names:

@@ -863,15 +863,37 @@ fn a_session_that_reaches_no_endpoint_says_so() {
 /// ROS 2: `samples` at 1 kHz, its commands as `command`, the robot's stand-in on
 /// `port` in `domain`; `extra` goes into `[slave.ros2]`.
 fn panda_over_ros(domain: u32, port: u16, samples: u64, command: &str, extra: &str) -> String {
+    over_ros(
+        ("panda", "panda.urdf"),
+        domain,
+        port,
+        samples,
+        command,
+        extra,
+    )
+}
+
+/// As [`panda_over_ros`] for the shipped scenario `name` whose arm is `urdf`.
+fn over_ros(
+    (name, urdf): (&str, &str),
+    domain: u32,
+    port: u16,
+    samples: u64,
+    command: &str,
+    extra: &str,
+) -> String {
     let root = env!("CARGO_MANIFEST_DIR");
-    let text = std::fs::read_to_string(format!("{root}/scenarios/panda.toml")).expect("panda");
+    let text = std::fs::read_to_string(format!("{root}/scenarios/{name}.toml")).expect("scenario");
     format!(
         "{}\n[ros]\ndomain_id = {domain}\nconnect = [\"tcp/127.0.0.1:{port}\"]\n\n\
          [slave]\nbackend = \"ros2\"\n\n[slave.ros2]\njoint_states = \"/fr3/joint_states\"\n\
          command_topic = \"/fr3_arm_controller/CMD\"\ncommand = \"{command}\"\n{extra}\n\
          [slave.ros2.watch]\ntimeout_ms = 300.0\n",
-        text.replace("../robots/panda.urdf", &format!("{root}/robots/panda.urdf"))
-            .replace("samples = 4000", &format!("samples = {samples}"))
+        text.replace(
+            &format!("../robots/{urdf}"),
+            &format!("{root}/robots/{urdf}")
+        )
+        .replace("samples = 4000", &format!("samples = {samples}"))
     )
 }
 
@@ -936,7 +958,20 @@ fn run_panda(
             "[ros.live]\nenabled = true\nrate_hz = 50.0\n\n[slave]\n",
         );
     }
-    let scenario = sb.write("panda.toml", &text);
+    run_arm(sb, arm, &text, port, samples)
+}
+
+/// Runs the scenario `text` against the stand-in `arm` listening on `port`: the
+/// stand-in's report and the run's summary, the run completed and every command well
+/// formed.
+fn run_arm(
+    sb: &Sandbox,
+    arm: Child,
+    text: &str,
+    port: u16,
+    samples: u64,
+) -> (serde_json::Value, serde_json::Value) {
+    let scenario = sb.write("arm.toml", text);
     listening(port);
     sb.run(&scenario, "out");
     let r = report(sb, arm, "arm.json");
@@ -1003,22 +1038,9 @@ fn a_panda_over_ros2_follows_through_a_position_controller() {
     // stand-in's 20 ms lag at the press's 30 mm/s is 0.6 mm); a Python stand-in
     // starved by the rest of the suite lags more (4.7 mm once in CI): within 1 cm.
     let trace = sb.trace("out");
-    let col = |c: &str| util::column(&trace, c);
-    let (t, v, h) = (
-        [1, 2, 3].map(|i| col(&format!("tool_{i}"))),
-        [1, 2, 3].map(|i| col(&format!("v_{i}"))),
-        col("h_3"),
-    );
-    let worst = (500..h.len())
-        .filter(|&k| h[k] == 0.0)
-        .map(|k| {
-            (0..3)
-                .map(|i| (t[i][k] - v[i][k]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
-        .fold(0.0, f64::max);
+    let (worst, _) = util::free_space_error(&trace, 500);
     assert!(worst < 1e-2, "free-space error {worst} m");
+    let h = util::column(&trace, "h_3");
     assert!(h.iter().any(|f| *f > 1.0), "the wall pushed back");
     // The live view names the arm's joints, in chain order, and puts its tool in the
     // base's frame (4 s at 50 Hz: 200 states, some lost to a busy machine).
@@ -1218,24 +1240,80 @@ fn a_mujoco_panda_presses_a_wall_and_its_force_comes_back() {
         wrench,
         false,
     );
+    mujoco_checks(&sb, &r);
+}
+
+/// The shipped UR5 scenario against a UR5 simulated by MuJoCo, driven as UR's driver
+/// takes a forward position controller's `Float64MultiArray` (the joints in chain
+/// order), its contact force on the flange as a sensor in `tool0`: as the Panda's,
+/// and every command inside the URDF's limits and velocity limits.
+#[test]
+fn a_mujoco_ur5_follows_a_position_controller_and_its_force_comes_back() {
+    if !mujoco_ready() {
+        return cannot("python3 lacks eclipse-zenoh, rosbags or mujoco");
+    }
+    let _serial = one_at_a_time();
+    let sb = Sandbox::new("ros2-mujoco-ur5");
+    let port = free_port();
+    let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/ur5_robot.urdf");
+    let (domain, listen) = ("19", format!("tcp/127.0.0.1:{port}"));
+    let arm = standin(
+        &sb,
+        &[
+            "arm", "--domain", domain, "--listen", &listen,
+            "--names",
+            "shoulder_pan_joint,shoulder_lift_joint,elbow_joint,wrist_1_joint,wrist_2_joint,wrist_3_joint",
+            "--initial", "0.0,-1.2,1.6,-1.97,-1.5708,0.0",
+            "--joint-topic", "/joint_states",
+            "--command-topic", "/forward_position_controller/commands",
+            "--command-type", "positions",
+            "--duration", "60", "--idle-exit", "2", "--report", "arm.json",
+            "--mujoco", urdf, "--tool", "tool0", "--wall-below", "0.045",
+            "--wrench-topic", "/force_torque_sensor_broadcaster/wrench", "--wrench-frame", "tool0",
+        ],
+    );
+    let extra = "wrench_topic = \"/force_torque_sensor_broadcaster/wrench\"\n";
+    let text = over_ros(
+        ("ur5", "ur5_robot.urdf"),
+        19,
+        port,
+        3000,
+        "positions",
+        extra,
+    )
+    .replace(
+        "/fr3_arm_controller/CMD",
+        "/forward_position_controller/commands",
+    )
+    .replace("/fr3/joint_states", "/joint_states");
+    let (r, _) = run_arm(&sb, arm, &text, port, 3000);
+    assert!(num(&r["commands"]) > 2500.0, "{r}");
+    // The URDF's velocity limit, 3.15 rad/s: 3.15 mrad a period at 1 kHz, for every
+    // step of the loop; the end's hold commands the joints where MuJoCo's arm stands
+    // (pressed into the wall, it lags its last reference by up to 16 mrad).
+    let step = floats(&r["max_step_before_last"]);
+    assert!(step.iter().all(|s| *s <= 3.15e-3 + 1e-12), "{step:?}");
+    let (last, at) = (floats(&r["last"]), floats(&r["q_at_last"]));
+    assert!(
+        last.iter().zip(&at).all(|(a, b)| (a - b).abs() < 1e-3),
+        "{last:?} {at:?}"
+    );
+    mujoco_checks(&sb, &r);
+}
+
+/// What a MuJoCo arm's run of the shipped press shows (the Panda's or the UR5's): free
+/// space followed, the wall's force back, the loop's tool where MuJoCo's is.
+fn mujoco_checks(sb: &Sandbox, r: &serde_json::Value) {
     let trace = sb.trace("out");
     let col = |c: &str| util::column(&trace, c);
-    let (t, v, h) = (
-        [1, 2, 3].map(|i| col(&format!("tool_{i}"))),
-        [1, 2, 3].map(|i| col(&format!("v_{i}"))),
-        col("h_3"),
-    );
+    let (t, h) = ([1, 2, 3].map(|i| col(&format!("tool_{i}"))), col("h_3"));
     // Free space (the first second: the hand 1.5 cm or more above the wall): no force,
     // and the tool follows (MuJoCo's servo lags the moving reference by about 3 mm at
     // the press's 30 mm/s; a starved stand-in more): within 1 cm.
     assert!(h[..1000].iter().all(|f| *f == 0.0));
-    let worst = (300..1000)
-        .map(|k| {
-            (0..3)
-                .map(|i| (t[i][k] - v[i][k]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
+    let worst = util::tracking(&trace)[300..1000]
+        .iter()
+        .map(|(e, _)| *e)
         .fold(0.0, f64::max);
     assert!(worst < 1e-2, "free-space error {worst} m");
     // Pressed 1.5 cm past the wall by a stiff servo: MuJoCo's contact pushes back up
@@ -1255,6 +1333,14 @@ fn a_mujoco_panda_presses_a_wall_and_its_force_comes_back() {
         .sum::<f64>()
         .sqrt();
     assert!(d < 2e-3, "the loop's tool {ours:?}, MuJoCo's hand {hand:?}");
+    eprintln!(
+        "free space within {:.2} mm; h_3 at the end {:.1} N, MuJoCo's largest {:.1} N; \
+         the loop's tool {:.2} mm from MuJoCo's",
+        worst * 1e3,
+        h[end],
+        num(&r["max_force"]),
+        d * 1e3
+    );
     // The hand stands on the wall, not through it.
     assert!((t[2][end] - (-0.08)).abs() < 2e-3, "tool z {}", t[2][end]);
 }

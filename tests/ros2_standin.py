@@ -395,6 +395,9 @@ def arm(a):
             rep["bad_commands"].append(list(values))
             return
         if rep["last"] is not None:
+            # The steps before this command (the last may be the end's hold, at the
+            # joints measured, which a robot pressed into a wall lags its reference by).
+            rep["max_step_before_last"] = list(rep["max_step"])
             rep["max_step"] = [max(m, abs(v - w)) for m, v, w in zip(rep["max_step"], values, rep["last"])]
         rep["lowest"] = [min(m, v) for m, v in zip(rep["lowest"], values)]
         rep["highest"] = [max(m, v) for m, v in zip(rep["highest"], values)]

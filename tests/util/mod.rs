@@ -237,6 +237,32 @@ pub fn pid_of(prefix: &str, role: &str) -> Option<i32> {
     })
 }
 
+/// A trace's tracking, sample by sample: the distance from the slave's tool to the
+/// position it received (`tool` against `v`, m) and the contact force along z (`h_3`,
+/// N; zero in free space).
+pub fn tracking(trace: &str) -> Vec<(f64, f64)> {
+    let t = [1, 2, 3].map(|i| column(trace, &format!("tool_{i}")));
+    let v = [1, 2, 3].map(|i| column(trace, &format!("v_{i}")));
+    let h = column(trace, "h_3");
+    (0..h.len())
+        .map(|k| {
+            let e = (0..3).map(|i| (t[i][k] - v[i][k]).powi(2)).sum::<f64>();
+            (e.sqrt(), h[k])
+        })
+        .collect()
+}
+
+/// The largest tracking error among samples `from..` in free space, and how many.
+pub fn free_space_error(trace: &str, from: usize) -> (f64, usize) {
+    let free: Vec<f64> = tracking(trace)
+        .into_iter()
+        .skip(from)
+        .filter(|(_, h)| *h == 0.0)
+        .map(|(e, _)| e)
+        .collect();
+    (free.iter().copied().fold(0.0, f64::max), free.len())
+}
+
 /// Column `name` of a CSV text as numbers.
 pub fn column(csv: &str, name: &str) -> Vec<f64> {
     let mut lines = csv.lines();
