@@ -1078,6 +1078,10 @@ fn a_panda_over_ros2_takes_trajectories_and_its_wrench_turns_into_the_base() {
             "0",
             "0",
             "5",
+            "--torque",
+            "0.2",
+            "0",
+            "0",
         ],
     );
     let wrench = "wrench_topic = \"/fts/wrench\"\n";
@@ -1105,6 +1109,12 @@ fn a_panda_over_ros2_takes_trajectories_and_its_wrench_turns_into_the_base() {
         h[1][k],
         h[2][k]
     );
+    // Its torque, 0.2 N m about the hand's x, turns with the hand into the base's axes
+    // (about the hand, where it was measured): horizontal at the ready pose.
+    let joints = std::fs::read_to_string(sb.path("out").join("joints.csv")).expect("joints");
+    let t = [1, 2, 3].map(|i| util::column(&joints, &format!("h_torque_{i}"))[k]);
+    let norm = t.iter().map(|x| x * x).sum::<f64>().sqrt();
+    assert!((norm - 0.2).abs() < 1e-3 && t[2].abs() < 1e-3, "{t:?}");
 }
 
 /// True if python3 also has Pinocchio (tests/servo_ik.py).

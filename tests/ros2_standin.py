@@ -200,14 +200,14 @@ def joint_state(names, values):
     )
 
 
-def wrench_stamped(frame, force):
-    """A WrenchStamped now in `frame`: `force`, no torque."""
+def wrench_stamped(frame, force, torque=(0.0, 0.0, 0.0)):
+    """A WrenchStamped now in `frame`: `force` and `torque`."""
     Header = TS.types["std_msgs/msg/Header"]
     V = TS.types["geometry_msgs/msg/Vector3"]
     return TS.types[WRENCH](
         header=Header(stamp=stamp(time.time_ns()), frame_id=frame),
         wrench=TS.types["geometry_msgs/msg/Wrench"](
-            force=V(x=force[0], y=force[1], z=force[2]), torque=V(x=0.0, y=0.0, z=0.0)))
+            force=V(x=force[0], y=force[1], z=force[2]), torque=V(x=torque[0], y=torque[1], z=torque[2])))
 
 
 def stopping():
@@ -484,7 +484,7 @@ def arm(a):
             if sim:
                 force = sim.force_in(a.wrench_frame)
                 rep["max_force"] = max(rep["max_force"], math.hypot(*force))
-            put_wrench(wrench_stamped(a.wrench_frame, force))
+            put_wrench(wrench_stamped(a.wrench_frame, force, a.torque))
         return True
 
     at_rate(1000.0, stop, a.duration, step)
@@ -548,6 +548,7 @@ def main():
     m.add_argument("--wrench-topic", default="")
     m.add_argument("--wrench-frame", default="")
     m.add_argument("--wrench", type=float, nargs=3, default=[0.0, 0.0, 0.0])
+    m.add_argument("--torque", type=float, nargs=3, default=[0.0, 0.0, 0.0])
     m.add_argument("--live", action="store_true", help="take the slave's live view")
     m.add_argument("--mujoco", default="", help="simulate the arm of this URDF in MuJoCo")
     m.add_argument("--tool", default="", help="the link whose contact force is measured")

@@ -52,6 +52,10 @@ struct Hardware<V> {
     due: Option<V>,
 }
 
+/// What a robot gave for one tick: its joints, its force sensor's force (`None`
+/// without one) and the torque that came with it.
+type Reading<V> = (V, Option<[f64; 3]>, [f64; 3]);
+
 impl<V: Clone + Default> Hardware<V> {
     fn new(robot: Box<dyn Robot<V>>) -> Self {
         Hardware {
@@ -62,16 +66,17 @@ impl<V: Clone + Default> Hardware<V> {
         }
     }
 
-    /// Reads the robot for this tick (its joints, its force sensor's force); says so
-    /// in the record when it is lost or back.
-    fn read(&mut self, n: u64, io: &mut Io) -> Result<(V, Option<[f64; 3]>), Failure> {
+    /// Reads the robot for this tick (its joints, its force sensor's force and
+    /// torque); says so in the record when it is lost or back.
+    fn read(&mut self, n: u64, io: &mut Io) -> Result<Reading<V>, Failure> {
         let who = self.robot.describe();
         let judged = self.robot.read(io.now());
         let meanwhile = "holding its last safe reference";
         if let Some(what) = self.held.take(judged, ("robot", &who), meanwhile) {
             io.event(n, &what)?;
         }
-        Ok((self.held.theta.clone(), self.robot.force(io.now())))
+        let force = self.robot.force(io.now());
+        Ok((self.held.theta.clone(), force, self.robot.torque()))
     }
 
     /// Commands `reference`, or, while the robot is lost, the last reference it had.
@@ -237,12 +242,12 @@ impl Follower for SlaveHandler {
         match &mut self.robot {
             Robots::None => {}
             Robots::Paper(hw) => {
-                let (theta, force) = hw.read(v.seq, io)?;
+                let (theta, force, _) = hw.read(v.seq, io)?;
                 self.slave.measure(Measured { theta, force });
             }
             Robots::Arm(hw) => {
-                let (q, force) = hw.read(v.seq, io)?;
-                self.slave.measure_arm(q, force);
+                let (q, force, torque) = hw.read(v.seq, io)?;
+                self.slave.measure_arm(q, force, torque);
             }
         }
         let (h, step) = self.slave.step(v);
@@ -253,7 +258,7 @@ impl Follower for SlaveHandler {
         }
         self.last_step = Some(step);
         let record = match self.slave.arm() {
-            Some(a) => SlaveSample::ArmStep(step, joints(a)),
+            Some(a) => SlaveSample::ArmStep(step, joints(a, h.torque)),
             None => SlaveSample::Step(step),
         };
         Ok(Reply {
@@ -302,13 +307,13 @@ impl Follower for SlaveHandler {
         let held = match &mut self.robot {
             Robots::None => self.slave.hold(),
             Robots::Paper(hw) => {
-                let (theta, _) = hw.read(last, io)?;
+                let (theta, ..) = hw.read(last, io)?;
                 let held = self.slave.hold_measured(theta);
                 hw.command(held.theta_ref);
                 held
             }
             Robots::Arm(hw) => {
-                let (q, _) = hw.read(last, io)?;
+                let (q, ..) = hw.read(last, io)?;
                 let held = self.slave.hold_measured_arm(&q);
                 if let Some(a) = self.slave.arm_state() {
                     hw.command(a.q_ref.clone());
@@ -317,19 +322,20 @@ impl Follower for SlaveHandler {
             }
         };
         Ok(Some(match self.slave.arm() {
-            Some(a) => SlaveSample::ArmHold(held, joints(a)),
+            Some(a) => SlaveSample::ArmHold(held, joints(a, [0.0; 3])),
             None => SlaveSample::Hold(held),
         }))
     }
 }
 
 /// A URDF arm's joints and tool orientation as its record holds them.
-fn joints(arm: &UrdfArm) -> ArmJoints {
+fn joints(arm: &UrdfArm, torque: [f64; 3]) -> ArmJoints {
     let a = arm.state();
     ArmJoints {
         q_ref: a.q_ref.clone(),
         q: a.q.clone(),
         tau: a.tau.clone(),
+        torque,
         target_rotation: arm.target_rotation(),
         tool_rotation: arm.tool_rotation(),
         released: arm.released(),

@@ -54,6 +54,8 @@ pub struct Slave {
     arm: Option<UrdfArm>,
     /// A 6-DoF master's last accepted orientation (held while none valid comes).
     rotation: Option<[f64; 4]>,
+    /// A real arm's measured torque about the tool for the next step, N m.
+    measured_torque: [f64; 3],
 }
 
 /// What a real robot measured for one step.
@@ -113,6 +115,7 @@ impl Slave {
             measured_arm: None,
             arm,
             rotation: None,
+            measured_torque: [0.0; 3],
         })
     }
 
@@ -207,8 +210,9 @@ impl Slave {
 
     /// A real arm's state for the next step: its joints `q` (the URDF's order and
     /// units) and its force sensor's force in the base's axes, if it has one.
-    pub fn measure_arm(&mut self, q: Vec<f64>, force: Option<[f64; 3]>) {
+    pub fn measure_arm(&mut self, q: Vec<f64>, force: Option<[f64; 3]>, torque: [f64; 3]) {
         self.measured_arm = Some(q);
+        self.measured_torque = torque;
         self.measured = Some(Measured {
             theta: [0.0; 3],
             force,
@@ -457,8 +461,9 @@ impl Slave {
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
         out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
         out.signal.flags |= flags;
-        // A 6-DoF sample is answered with a wrench: the torque of a point contact at
-        // the tool is zero.
+        // A 6-DoF sample is answered with a wrench: a real arm's measured torque about
+        // the tool; the torque of the simulated point contact at the tool is zero.
+        out.torque = std::mem::take(&mut self.measured_torque);
         out.signal.flags |= v.signal.flags & FLAG_POSE;
         out
     }

@@ -88,14 +88,15 @@ impl ArmJointMap {
     }
 }
 
-/// A measured force and the frame it is in.
-pub type FramedForce = ([f64; 3], String);
+/// A measured wrench, force (N) and torque (N m) about the frame's origin, and the
+/// frame it is in.
+pub type FramedForce = ([f64; 3], [f64; 3], String);
 
-/// The force of a CDR `WrenchStamped` and its frame, if `tree` has it (an empty frame
+/// The wrench of a CDR `WrenchStamped` and its frame, if `tree` has it (an empty frame
 /// is taken as the base's); not finite, or in a frame the URDF lacks, is rejected.
 pub fn framed_force_cdr(cdr: &[u8], tree: &Tree, base: &str) -> Result<FramedForce, Reject> {
     let w = WrenchStamped::from_cdr(cdr)?;
-    if !w.force.iter().all(|f| f.is_finite()) {
+    if !w.force.iter().chain(&w.torque).all(|f| f.is_finite()) {
         return Err(Reject::ForceNotFinite);
     }
     let frame = match w.header.frame_id.as_str() {
@@ -106,33 +107,37 @@ pub fn framed_force_cdr(cdr: &[u8], tree: &Tree, base: &str) -> Result<FramedFor
     if tree.pose(&frame, &none).is_none() {
         return Err(Reject::UnknownFrame(frame));
     }
-    Ok((w.force, frame))
+    Ok((w.force, w.torque, frame))
 }
 
-/// The force `f` in frame `frame` turned into `base`'s axes, the arm's joints at `q`
-/// (named by `names`).
+/// The wrench `(f, t, frame)` turned into `base`'s axes, the arm's joints at `q`
+/// (named by `names`): the force, and the torque about the tool `tip`'s origin
+/// (`t + (sensor - tool) x f`), as the loop's h(n) carries them.
 pub fn in_base(
     tree: &Tree,
-    base: &str,
+    (base, tip): (&str, &str),
     names: &[String],
     q: &[f64],
-    (f, frame): &FramedForce,
-) -> [f64; 3] {
-    if frame == base {
-        return *f;
-    }
+    (f, t, frame): &FramedForce,
+) -> ([f64; 3], [f64; 3]) {
     let value = |n: &str| {
         names
             .iter()
             .position(|m| m == n)
             .and_then(|k| q.get(k).copied())
     };
-    let (Some(b), Some(s)) = (tree.pose(base, &value), tree.pose(frame, &value)) else {
-        return *f;
+    let poses = (
+        tree.pose(base, &value),
+        tree.pose(frame, &value),
+        tree.pose(tip, &value),
+    );
+    let (Some(b), Some(s), Some(tool)) = poses else {
+        return (*f, *t);
     };
-    let r: Frame = b.inverse().then(&s);
-    let v = r.r * nalgebra::Vector3::from(*f);
-    [v.x, v.y, v.z]
+    let (sensor, tool): (Frame, Frame) = (b.inverse().then(&s), b.inverse().then(&tool));
+    let force = sensor.r * nalgebra::Vector3::from(*f);
+    let torque = sensor.r * nalgebra::Vector3::from(*t) + (sensor.p - tool.p).cross(&force);
+    (force.into(), torque.into())
 }
 
 #[cfg(test)]
@@ -199,10 +204,40 @@ mod tests {
             torque: [0.0; 3],
         };
         let framed = framed_force_cdr(&w.to_cdr(), &tree, "panda_link0").expect("framed");
-        let f = in_base(&tree, "panda_link0", &names, &q, &framed);
-        // At the ready pose the hand's z points down.
+        let (f, t) = in_base(&tree, ("panda_link0", "panda_hand"), &names, &q, &framed);
+        // At the ready pose the hand's z points down; no torque about the hand itself.
         let hand = chain.fk(&q).r * nalgebra::Vector3::new(0.0, 0.0, 5.0);
         assert!((f[2] - hand.z).abs() < 1e-12 && f[2] < -4.99, "{f:?}");
+        assert_eq!(t, [0.0; 3]);
+        // The same wrench measured in the base (its torque about the base's origin):
+        // about the hand the torque is the base's minus p_hand x f, zero again.
+        let p = chain.fk(&q).p;
+        let fb = nalgebra::Vector3::from(f);
+        let at_base = WrenchStamped {
+            header: Header::at(1, ""),
+            force: f,
+            torque: p.cross(&fb).into(),
+        };
+        let framed = framed_force_cdr(&at_base.to_cdr(), &tree, "panda_link0").expect("framed");
+        let (f2, t2) = in_base(&tree, ("panda_link0", "panda_hand"), &names, &q, &framed);
+        assert!(
+            f2.iter().zip(&f).all(|(a, b)| (a - b).abs() < 1e-12),
+            "{f2:?}"
+        );
+        assert!(t2.iter().all(|x| x.abs() < 1e-12), "{t2:?}");
+        // A torque measured in the hand turns with it.
+        let twist = WrenchStamped {
+            header: Header::at(1, "panda_hand"),
+            force: [0.0; 3],
+            torque: [0.2, 0.0, 0.0],
+        };
+        let framed = framed_force_cdr(&twist.to_cdr(), &tree, "panda_link0").expect("framed");
+        let (_, t3) = in_base(&tree, ("panda_link0", "panda_hand"), &names, &q, &framed);
+        let want = chain.fk(&q).r * nalgebra::Vector3::new(0.2, 0.0, 0.0);
+        assert!(
+            (nalgebra::Vector3::from(t3) - want).norm() < 1e-12,
+            "{t3:?}"
+        );
         let mut bad = w.clone();
         bad.header.frame_id = "tool0_controller".into();
         assert_eq!(

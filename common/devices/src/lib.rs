@@ -67,6 +67,11 @@ pub trait Robot<V = [f64; 3]>: Peripheral {
     /// axes), if the robot has a force sensor (else the environment model gives it);
     /// zero when the sensor's newest reading is older than the timeout.
     fn force(&mut self, now_ns: u64) -> Option<[f64; 3]>;
+    /// The torque that came with the last [`Robot::force`], about the tool, in the
+    /// base's axes, N m (zero for a robot whose sensor gives none).
+    fn torque(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
     /// Sends the joint references (rad in the paper's convention; an arm's in its
     /// URDF's), through the gate.
     fn command(&mut self, reference: V, now_ns: u64);

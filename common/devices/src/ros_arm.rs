@@ -37,6 +37,8 @@ pub struct RosArm {
     /// The chain, for a pose command's FK.
     chain: Chain,
     base: String,
+    /// The torque that came with the last force, about the tool, in the base's axes.
+    torque: [f64; 3],
     gate: JointGate<Vec<f64>>,
     watch: Watch,
     topic: String,
@@ -97,6 +99,7 @@ impl RosArm {
             tree,
             chain: chain.clone(),
             base: chain.base.clone(),
+            torque: [0.0; 3],
             watch: Watch::new(&cfg.watch, t_s_ns),
             topic: cfg.joint_states.clone(),
             last_tick_ns: 0,
@@ -149,18 +152,30 @@ impl Robot<Vec<f64>> for RosArm {
             at_ns: l.at_ns,
         });
         // Judged (and counted) as the paper robot's sensor is; turned into the base's
-        // axes at the joints last read.
+        // axes at the joints last read. The torque comes with a fresh force only.
         let judged = self.watch.force(force, now_ns);
+        self.torque = [0.0; 3];
         let (Some(l), Some(q)) = (fresh, self.joints.latest()) else {
             return Some(judged);
         };
-        Some(in_base(
+        let torque = if judged == l.value.0 {
+            l.value.1
+        } else {
+            [0.0; 3]
+        };
+        let (f, t) = in_base(
             &self.tree,
-            &self.base,
+            (&self.base, &self.chain.tip),
             &self.map.names,
             &q.value,
-            &(judged, l.value.1.clone()),
-        ))
+            &(judged, torque, l.value.2.clone()),
+        );
+        self.torque = t;
+        Some(f)
+    }
+
+    fn torque(&self) -> [f64; 3] {
+        self.torque
     }
 
     fn command(&mut self, reference: Vec<f64>, now_ns: u64) {

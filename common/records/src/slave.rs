@@ -97,6 +97,9 @@ pub struct ArmJoints {
     pub q: Vec<f64>,
     /// Efforts the servo applied, N m or N.
     pub tau: Vec<f64>,
+    /// h(n)'s torque about the tool in the base's axes (a real arm's sensor's; zero
+    /// for the simulated point contact), N m.
+    pub torque: [f64; 3],
     /// The tool's orientation reference relative to its home, about the base's axes,
     /// `[x, y, z, w]` (a 6-DoF master's rotation, moved by the clutch's offsets; the
     /// identity for a 3-DoF master).

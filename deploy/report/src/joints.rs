@@ -6,9 +6,10 @@ use std::fmt::Write as _;
 use tactile_records::slave::ArmJoints;
 
 /// The header line (without newline) for an arm of `dof` joints: the IK's references,
-/// the joints and their efforts per joint, then the orientation reference and the
-/// tool's orientation relative to the tool's home (`[x, y, z, w]`, about the base's
-/// axes), the angle between them, and the clutch.
+/// the joints and their efforts per joint, h(n)'s torque about the tool (a real arm's
+/// sensor's), then the orientation reference and the tool's orientation relative to
+/// the tool's home (`[x, y, z, w]`, about the base's axes), the angle between them,
+/// and the clutch.
 pub fn header(dof: usize) -> String {
     let mut h = String::from("n");
     for field in ["q_ref", "q", "tau"] {
@@ -16,6 +17,7 @@ pub fn header(dof: usize) -> String {
             let _ = write!(h, ",{field}_{i}");
         }
     }
+    h.push_str(",h_torque_1,h_torque_2,h_torque_3");
     for field in ["target_rot", "tool_rot"] {
         for c in ["x", "y", "z", "w"] {
             let _ = write!(h, ",{field}_{c}");
@@ -28,7 +30,7 @@ pub fn header(dof: usize) -> String {
 /// Appends sample `n`'s row (with newline) to `line`.
 pub fn row(line: &mut String, n: u64, j: &ArmJoints) {
     let _ = write!(line, "{n}");
-    let values = j.q_ref.iter().chain(&j.q).chain(&j.tau);
+    let values = j.q_ref.iter().chain(&j.q).chain(&j.tau).chain(&j.torque);
     for x in values.chain(&j.target_rotation).chain(&j.tool_rotation) {
         let _ = write!(line, ",{x:?}");
     }
@@ -84,6 +86,7 @@ mod tests {
             q_ref: vec![0.1; 7],
             q: vec![0.2; 7],
             tau: vec![0.3; 7],
+            torque: [0.0; 3],
             target_rotation: [0.0, 0.0, 0.0, 1.0],
             tool_rotation: [0.0, 0.0, 0.0, 1.0],
             released: true,
