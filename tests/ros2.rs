@@ -1117,6 +1117,77 @@ fn a_panda_over_ros2_takes_trajectories_and_its_wrench_turns_into_the_base() {
     assert!((norm - 0.2).abs() < 1e-3 && t[2].abs() < 1e-3, "{t:?}");
 }
 
+/// The live view serves a simulated arm as `robot_state_publisher` serves a robot:
+/// a viewer started after the run began (RViz opened late) still gets the URDF on
+/// `/robot_description` and the fixed joints on `/tf_static`, from the publishers'
+/// caches as rmw_zenoh's transient-local subscriptions ask for them (Zenoh's own
+/// AdvancedSubscriber in Python), whose tokens say transient-local; `/tf` carries every
+/// moving joint.
+#[test]
+fn a_viewer_started_late_still_gets_the_arms_description_and_fixed_frames() {
+    if !python_ready() {
+        return cannot("python3 lacks eclipse-zenoh or rosbags");
+    }
+    let sb = Sandbox::new("ros2-latched");
+    let port = free_port();
+    let listen = format!("tcp/127.0.0.1:{port}");
+    let viewer = standin(
+        &sb,
+        &[
+            "viewer",
+            "--domain",
+            "21",
+            "--listen",
+            &listen,
+            "--names",
+            "-",
+            "--joint-topic",
+            "/-",
+            "--report",
+            "viewer.json",
+            "--late",
+            "1.0",
+        ],
+    );
+    let root = env!("CARGO_MANIFEST_DIR");
+    let urdf = format!("{root}/robots/panda.urdf");
+    let text = std::fs::read_to_string(format!("{root}/scenarios/panda.toml"))
+        .expect("panda")
+        .replace("../robots/panda.urdf", &urdf)
+        .replace("samples = 4000", "samples = 3000")
+        .replace(
+            "[slave.arm]",
+            &format!(
+                "[ros]\ndomain_id = 21\nconnect = [\"{listen}\"]\n\n\
+                 [ros.live]\nenabled = true\nrate_hz = 50.0\n\n[slave.arm]"
+            ),
+        );
+    let scenario = sb.write("live.toml", &text);
+    listening(port);
+    sb.run(&scenario, "out");
+    let r = report(&sb, viewer, "viewer.json");
+    assert_eq!(r["errors"], serde_json::json!([]), "{r}");
+    let want = std::fs::read_to_string(&urdf).expect("urdf");
+    assert!(
+        r["description"].as_str() == Some(want.as_str()),
+        "description: {}",
+        r["description"]
+    );
+    // The Panda's fixed joints (link7 -> link8 -> hand), and every moving link.
+    let fixed = r["static"].to_string();
+    assert!(fixed.contains(r#"["panda_link8","panda_hand"]"#), "{fixed}");
+    let frames = r["tf_frames"].to_string();
+    for link in ["panda_link1", "panda_link7", "panda_leftfinger"] {
+        assert!(frames.contains(link), "{link} not in /tf: {frames}");
+    }
+    assert!(num(&r["tf"]) > 50.0, "{r}");
+    let qos = &r["qos"];
+    for topic in ["/robot_description", "/tf_static"] {
+        assert_eq!(qos[topic], ":1:,1:,:,:,,", "{topic}: {qos}");
+    }
+    assert_eq!(qos["/tf"], "::,10:,:,:,,", "{qos}");
+}
+
 /// True if python3 also has Pinocchio (tests/servo_ik.py).
 fn pinocchio_ready() -> bool {
     python_ready()

@@ -9,6 +9,10 @@ independent of Tactile's, for tests/ros2.rs.
           times publishes junk, then goes silent. Its clock starts at the first force.
   robot:  follows Float64MultiArray joint commands with first-order dynamics and
           publishes its JointState at 1 kHz.
+  viewer: RViz started after the run began: once the run's /tf flows it waits, then
+          subscribes to /robot_description and /tf_static as rmw_zenoh does for a
+          transient-local subscription (an AdvancedSubscriber asking the publishers'
+          caches for their history), and reads the tokens' QoS.
   arm:    an arm of any number of joints under ros2_control: follows a forward
           position controller's Float64MultiArray (the joints in order) or a
           joint_trajectory_controller's JointTrajectory (joints by name; the point
@@ -51,6 +55,8 @@ WRENCH = "geometry_msgs/msg/WrenchStamped"
 ARRAY = "std_msgs/msg/Float64MultiArray"
 TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
 POSE = "geometry_msgs/msg/PoseStamped"
+TF = "tf2_msgs/msg/TFMessage"
+STRING = "std_msgs/msg/String"
 
 
 def dds(ty):
@@ -508,10 +514,67 @@ def arm(a):
     node.s.close()
 
 
+def viewer(a):
+    node = Node("viewer_standin", a.listen, a.domain)
+    rep = {"description": None, "static": [], "tf": 0, "tf_frames": set(), "qos": {},
+           "errors": []}
+    got = threading.Event()
+
+    def decoded(sample, ty):
+        try:
+            return TS.deserialize_cdr(sample.payload.to_bytes(), ty)
+        except Exception as e:  # noqa: BLE001 - reported, never fatal
+            rep["errors"].append(f"{sample.key_expr}: {e}")
+            return None
+
+    def on_tf(sample):
+        msg = decoded(sample, TF)
+        if msg is not None:
+            rep["tf"] += 1
+            rep["tf_frames"].update(t.child_frame_id for t in msg.transforms)
+            got.set()
+
+    def on_description(sample):
+        msg = decoded(sample, STRING)
+        if msg is not None:
+            rep["description"] = msg.data
+
+    def on_static(sample):
+        msg = decoded(sample, TF)
+        if msg is not None:
+            rep["static"] = sorted([t.header.frame_id, t.child_frame_id] for t in msg.transforms)
+
+    tf_sub = node.s.declare_subscriber(f"{a.domain}/tf/{dds(TF)}/*", on_tf)
+    if not got.wait(a.duration):
+        rep["errors"].append("no /tf came")
+    time.sleep(a.late)
+    history = zenoh.ext.HistoryConfig(detect_late_publishers=True, max_samples=1)
+    latched = [
+        zenoh.ext.declare_advanced_subscriber(
+            node.s, f"{a.domain}/{topic}/{dds(ty)}/*", on, history=history,
+            subscriber_detection=True)
+        for topic, ty, on in [("robot_description", STRING, on_description),
+                              ("tf_static", TF, on_static)]
+    ]
+    end = time.monotonic() + a.duration
+    while time.monotonic() < end and (rep["description"] is None or not rep["static"]):
+        time.sleep(0.05)
+    for k in node.tokens_seen():
+        parts = k.split("/")
+        # @ros2_lv/domain/zid/nid/eid/kind/%/namespace/node/topic/type/hash/qos
+        if len(parts) > 12 and parts[5] == "MP":
+            rep["qos"][parts[9].replace("%", "/")] = parts[12]
+    del tf_sub, latched
+    rep["tf_frames"] = sorted(rep["tf_frames"])
+    with open(a.report, "w") as f:
+        json.dump(rep, f)
+    node.s.close()
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = p.add_subparsers(dest="role", required=True)
-    for role in ("device", "robot", "arm"):
+    for role in ("device", "robot", "arm", "viewer"):
         q = sub.add_parser(role)
         q.add_argument("--listen", action="append", required=True)
         q.add_argument("--domain", type=int, default=0)
@@ -554,8 +617,12 @@ def main():
     m.add_argument("--tool", default="", help="the link whose contact force is measured")
     m.add_argument("--wall-below", type=float, default=1.0,
                    help="the wall's surface this far under the tool's start, m (MuJoCo)")
+    v = sub.choices["viewer"]
+    v.add_argument("--late", type=float, default=1.0,
+                   help="seconds after the first /tf before subscribing to the latched topics")
+    v.add_argument("--duration", type=float, default=30.0)
     a = p.parse_args()
-    {"device": device, "robot": robot, "arm": arm}[a.role](a)
+    {"device": device, "robot": robot, "arm": arm, "viewer": viewer}[a.role](a)
 
 
 if __name__ == "__main__":

@@ -10,6 +10,8 @@ pub mod arm_map;
 pub mod gate;
 pub mod held;
 #[cfg(feature = "zenoh")]
+pub mod live_arm;
+#[cfg(feature = "zenoh")]
 pub mod live_view;
 pub mod map;
 #[cfg(feature = "zenoh")]

@@ -3,6 +3,7 @@
 //! few; a publisher thread encodes and puts it. A full queue drops the offer and
 //! counts it: the view thins out, the loop keeps its time.
 
+use crate::live_arm::{ArmPublishers, LiveArm};
 use crate::rmw_node::{wall_ns, RosNode, RosPublisher};
 use crate::{LiveSink, RosError};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -45,7 +46,8 @@ impl Sink for Publishers {
 
 impl LiveView {
     /// Declares `topics` (places in `tactile_ros::topics::TOPICS`) on `node` and starts
-    /// the publisher thread; every `every`-th sample is published. The thread first calls `below_loop`, which puts it below
+    /// the publisher thread; every `every`-th sample is published. A simulated URDF
+    /// `arm` is served as `robot_state_publisher` serves a robot ([`ArmPublishers`]). The thread first calls `below_loop`, which puts it below
     /// the loop's scheduling (a SCHED_FIFO node's threads inherit its policy, and the
     /// view must wait for the loop, never the loop for the view).
     pub fn start(
@@ -53,7 +55,9 @@ impl LiveView {
         every: u64,
         below_loop: fn() -> std::io::Result<()>,
         topics: &[usize],
+        arm: Option<LiveArm>,
     ) -> Result<LiveView, RosError> {
+        let arm = arm.map(|a| ArmPublishers::start(&node, a)).transpose()?;
         let mut by_topic: Vec<Option<RosPublisher>> = Vec::new();
         for &i in topics {
             let t = &tactile_ros::topics::TOPICS[i];
@@ -77,7 +81,11 @@ impl LiveView {
                 let _node = node;
                 for state in rx {
                     let before = pubs.published;
-                    let Ok(()) = state.emit(wall_ns(), &mut pubs);
+                    let stamp = wall_ns();
+                    let Ok(()) = state.emit(stamp, &mut pubs);
+                    if let (Some(a), Some(s)) = (&arm, &state.arm) {
+                        pubs.published += u64::from(a.put_tf(stamp, s));
+                    }
                     count.fetch_add(pubs.published - before, Ordering::Relaxed);
                 }
             })

@@ -131,10 +131,20 @@ impl RosNode {
         topic: &str,
         ty: &str,
     ) -> Result<(String, LivelinessToken), RosError> {
+        self.token_qos(kind, topic, ty, &rmw::qos_reliable(10))
+    }
+
+    fn token_qos(
+        &self,
+        kind: EntityKind,
+        topic: &str,
+        ty: &str,
+        qos: &str,
+    ) -> Result<(String, LivelinessToken), RosError> {
         let eid = self.next_id.fetch_add(1, Ordering::Relaxed);
         let key = self
             .id
-            .entity_token(eid, kind, topic, ty)
+            .entity_token_qos(eid, kind, (topic, ty), qos)
             .ok_or_else(|| err(topic, format!("no type hash for {ty}")))?;
         let token = self
             .session
@@ -160,6 +170,41 @@ impl RosNode {
         Ok(RosPublisher {
             publisher,
             session: self.session.clone(),
+            gid: rmw::gid(&token_key),
+            seq: AtomicI64::new(0),
+            topic: topic.to_string(),
+            _token: token,
+        })
+    }
+
+    /// A transient-local publisher of `ty` on `topic`, as rmw_zenoh makes one for a
+    /// durable QoS (`robot_state_publisher`'s `/robot_description`, `/tf_static`): an
+    /// AdvancedPublisher that keeps its last `depth` messages for subscribers that come
+    /// later, detectable by them, with sporadic heartbeats so a missed message is
+    /// fetched again; its token says durability transient-local.
+    pub fn latched_publisher(
+        &self,
+        topic: &str,
+        ty: &str,
+        depth: usize,
+    ) -> Result<RosLatched, RosError> {
+        use zenoh_ext::{AdvancedPublisherBuilderExt, CacheConfig, MissDetectionConfig};
+        let key = rmw::topic_key(self.id.domain, topic, ty)
+            .ok_or_else(|| err(topic, format!("no type hash for {ty}")))?;
+        let qos = rmw::qos_latched(depth as u32);
+        let (token_key, token) = self.token_qos(EntityKind::Publisher, topic, ty, &qos)?;
+        let heartbeat = MissDetectionConfig::default().sporadic_heartbeat(LATCHED_HEARTBEAT);
+        let publisher = self
+            .session
+            .declare_publisher(key)
+            .congestion_control(CongestionControl::Drop)
+            .cache(CacheConfig::default().max_samples(depth))
+            .publisher_detection()
+            .sample_miss_detection(heartbeat)
+            .wait()
+            .map_err(|e| err(&format!("declaring the publisher of {topic}"), e))?;
+        Ok(RosLatched {
+            publisher,
             gid: rmw::gid(&token_key),
             seq: AtomicI64::new(0),
             topic: topic.to_string(),
@@ -214,14 +259,53 @@ impl std::fmt::Debug for RosPublisher {
     }
 }
 
+/// rmw_zenoh's attachment of a publisher's next message: its sequence number (from
+/// 1), the wall clock, its gid.
+fn attachment(seq: &AtomicI64, gid: [u8; 16]) -> Vec<u8> {
+    let a = Attachment {
+        seq: seq.fetch_add(1, Ordering::Relaxed) + 1,
+        stamp_ns: wall_ns() as i64,
+        gid,
+    };
+    a.to_bytes().to_vec()
+}
+
+/// rmw_zenoh's heartbeat period for a reliable transient-local publisher's sample miss
+/// detection (its `SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD`, sporadic: only after a put).
+const LATCHED_HEARTBEAT: std::time::Duration = std::time::Duration::from_millis(500);
+
+/// A transient-local ROS 2 publisher ([`RosNode::latched_publisher`]).
+pub struct RosLatched {
+    publisher: zenoh_ext::AdvancedPublisher<'static>,
+    gid: [u8; 16],
+    seq: AtomicI64,
+    topic: String,
+    _token: LivelinessToken,
+}
+
+impl std::fmt::Debug for RosLatched {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RosLatched")
+            .field("topic", &self.topic)
+            .finish_non_exhaustive()
+    }
+}
+
+impl RosLatched {
+    /// Publishes one CDR message and keeps it for subscribers that come later; false
+    /// if Zenoh refused it.
+    pub fn put(&self, cdr: &[u8]) -> bool {
+        self.publisher
+            .put(cdr)
+            .attachment(attachment(&self.seq, self.gid))
+            .wait()
+            .is_ok()
+    }
+}
+
 impl RosPublisher {
     fn attachment(&self) -> Vec<u8> {
-        let a = Attachment {
-            seq: self.seq.fetch_add(1, Ordering::Relaxed) + 1,
-            stamp_ns: wall_ns() as i64,
-            gid: self.gid,
-        };
-        a.to_bytes().to_vec()
+        attachment(&self.seq, self.gid)
     }
 
     /// Publishes one CDR message, dropped rather than waited for if the network is

@@ -97,6 +97,13 @@ pub fn qos_reliable(depth: u32) -> String {
     format!("::,{depth}:,:,:,,")
 }
 
+/// The QoS of a token for reliable, transient-local (durability 1), keep-last `depth`
+/// delivery, what `robot_state_publisher` gives `/robot_description` and
+/// `/tf_static`: `:1:,1:,:,:,,` for depth 1.
+pub fn qos_latched(depth: u32) -> String {
+    format!(":1:,{depth}:,:,:,,")
+}
+
 /// Where a token's node is: domain, session id (Zenoh's id as it prints), node id,
 /// namespace and name.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -139,13 +146,25 @@ impl NodeId {
         self.prefix(self.nid, "NN")
     }
 
-    /// A publisher's or subscription's token.
+    /// A publisher's or subscription's token, reliable, volatile, depth 10.
     pub fn entity_token(
         &self,
         eid: u32,
         kind: EntityKind,
         topic: &str,
         ty: &str,
+    ) -> Option<String> {
+        self.entity_token_qos(eid, kind, (topic, ty), &qos_reliable(10))
+    }
+
+    /// A publisher's or subscription's token with the QoS `qos` (as [`qos_reliable`]
+    /// or [`qos_latched`] write it).
+    pub fn entity_token_qos(
+        &self,
+        eid: u32,
+        kind: EntityKind,
+        (topic, ty): (&str, &str),
+        qos: &str,
     ) -> Option<String> {
         let k = match kind {
             EntityKind::Publisher => "MP",
@@ -157,7 +176,7 @@ impl NodeId {
             mangle(topic),
             dds_type(ty)?,
             type_hash(ty)?,
-            qos_reliable(10)
+            qos
         ))
     }
 }

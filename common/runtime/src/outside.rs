@@ -104,11 +104,32 @@ fn open_ros(sc: &Scenario, role: Role, base_dir: &std::path::Path) -> Result<Out
             _ => &tactile_ros::view::SLAVE_LIVE,
         };
         let every = every(sc.rate_hz, sc.ros.live.rate_hz);
-        let live =
-            LiveView::start(node, every, crate::sched::set_thread_other, topics).map_err(failed)?;
+        let arm = match (role, &sc.slave.arm) {
+            (Role::Slave, Some(arm)) if sc.slave.backend != Backend::Ros2 => {
+                Some(live_arm(arm, base_dir)?)
+            }
+            _ => None,
+        };
+        let live = LiveView::start(node, every, crate::sched::set_thread_other, topics, arm)
+            .map_err(failed)?;
         out.live = Some(Box::new(live));
     }
     Ok(out)
+}
+
+/// A simulated `[slave.arm]` for the live view: its URDF as written and its tree.
+#[cfg(feature = "zenoh")]
+fn live_arm(
+    arm: &tactile_scenario::ArmConfig,
+    base_dir: &std::path::Path,
+) -> Result<tactile_devices::live_arm::LiveArm, NodeError> {
+    use tactile_chain::{Robot as Urdf, Tree};
+    let path = base_dir.join(&arm.urdf);
+    let bad = |e: String| NodeError::BadInput(format!("slave.arm: {}: {e}", path.display()));
+    let urdf = crate::files::read_text(&path, "URDF", 16 << 20).map_err(NodeError::BadInput)?;
+    let robot = Urdf::parse(&urdf).map_err(|e| bad(e.to_string()))?;
+    let tree = Tree::new(&robot).map_err(|e| bad(e.to_string()))?;
+    Ok(tactile_devices::live_arm::LiveArm { urdf, tree })
 }
 
 /// The arm of `[slave.arm]` over ROS 2: its URDF read for the joints' names, limits and
