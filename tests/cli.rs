@@ -319,3 +319,26 @@ fn a_short_fuzz_campaign_finds_no_panic() {
     let bad = sb.tactile(&["fuzz", "--target", "nothing"]);
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// Every shipped scenario (`deploy/scenarios/*.toml`, those for a real robot too) is
+/// valid as shipped: `tactile check` reads it, its trajectory and its URDF, exit 0.
+#[test]
+fn every_shipped_scenario_checks() {
+    let sb = Sandbox::new("shipped");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut checked = 0;
+    for e in std::fs::read_dir(&dir).expect("scenarios") {
+        let p = e.expect("entry").path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            let o = sb.tactile(&["check", p.to_str().expect("utf-8")]);
+            assert!(
+                o.status.success(),
+                "{}: {}",
+                p.display(),
+                String::from_utf8_lossy(&o.stderr)
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 8, "{checked} scenarios");
+}
