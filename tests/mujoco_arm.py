@@ -68,8 +68,12 @@ class MujocoArm:
         self.tool = tool
         self.tip = self.m.geom("tool_tip").id
 
-    def step(self, target):
-        self.d.ctrl[:] = target
+    def step(self, target, velocity):
+        """One step toward the joint reference `target` moving at `velocity`: a
+        position actuator's force is kp (ctrl - q) - kv q', so commanding target +
+        (kv / kp) velocity makes it kp (target - q) + kv (velocity - q'), a PD with
+        the velocity feedforward a trajectory controller gives."""
+        self.d.ctrl[:] = [q + KV / KP * v for q, v in zip(target, velocity)]
         mujoco.mj_step(self.m, self.d)
 
     def q(self):

@@ -1389,14 +1389,29 @@ fn mujoco_checks(sb: &Sandbox, r: &serde_json::Value) {
     let col = |c: &str| util::column(&trace, c);
     let (t, h) = ([1, 2, 3].map(|i| col(&format!("tool_{i}"))), col("h_3"));
     // Free space (the first second: the hand 1.5 cm or more above the wall): no force,
-    // and the tool follows (MuJoCo's servo lags the moving reference by about 3 mm at
-    // the press's 30 mm/s; a starved stand-in more): within 1 cm.
+    // and the tool (FK of the joints MuJoCo reports) follows within 1 mm and 1 degree
+    // (0.13 mm for the Panda by hand: the servo has the reference's velocity as its
+    // feedforward), at 95 % of the samples; a stand-in starved by the rest of the
+    // suite lags now and then, so the worst sample is allowed 1 cm and 5 degrees.
     assert!(h[..1000].iter().all(|f| *f == 0.0));
-    let worst = util::tracking(&trace)[300..1000]
+    let mut errors: Vec<f64> = util::tracking(&trace)[300..1000]
         .iter()
         .map(|(e, _)| *e)
-        .fold(0.0, f64::max);
-    assert!(worst < 1e-2, "free-space error {worst} m");
+        .collect();
+    let joints = std::fs::read_to_string(sb.path("out").join("joints.csv")).expect("joints");
+    let mut turns = util::column(&joints, "rot_error_deg")[300..1000].to_vec();
+    errors.sort_by(f64::total_cmp);
+    turns.sort_by(f64::total_cmp);
+    let p95 = |v: &[f64]| v[v.len() * 95 / 100];
+    let worst = errors[errors.len() - 1];
+    assert!(
+        p95(&errors) < 1e-3 && worst < 1e-2,
+        "free-space error {errors:?} m"
+    );
+    assert!(
+        p95(&turns) < 1.0 && turns[turns.len() - 1] < 5.0,
+        "{turns:?} degrees"
+    );
     // Pressed 1.5 cm past the wall by a stiff servo: MuJoCo's contact pushes back up
     // (the base's z, the master's too), through the hand's frame and the chain.
     let end = h.len() - 1;
@@ -1415,9 +1430,10 @@ fn mujoco_checks(sb: &Sandbox, r: &serde_json::Value) {
         .sqrt();
     assert!(d < 2e-3, "the loop's tool {ours:?}, MuJoCo's hand {hand:?}");
     eprintln!(
-        "free space within {:.2} mm; h_3 at the end {:.1} N, MuJoCo's largest {:.1} N; \
+        "free space within {:.2} mm and {:.3} degrees; h_3 at the end {:.1} N, MuJoCo's largest {:.1} N; \
          the loop's tool {:.2} mm from MuJoCo's",
         worst * 1e3,
+        turns[turns.len() - 1],
         h[end],
         num(&r["max_force"]),
         d * 1e3

@@ -394,13 +394,15 @@ def arm(a):
     rep = {"commands": 0, "bad_commands": [], "first": None, "last": None,
            "max_step": [0.0] * n, "lowest": [math.inf] * n, "highest": [-math.inf] * n,
            "point_times": set(), "q_at_last": None, "t_last": None}
-    target = {"q": None}
+    target = {"q": None, "qd": [0.0] * n}
 
     def take(values):
         if len(values) != n or not all(math.isfinite(x) for x in values):
             rep["bad_commands"].append(list(values))
             return
         if rep["last"] is not None:
+            # The reference's velocity, one command a period (the servo's feedforward).
+            target["qd"] = [(v - w) / a.period for v, w in zip(values, rep["last"])]
             # The steps before this command (the last may be the end's hold, at the
             # joints measured, which a robot pressed into a wall lags its reference by).
             rep["max_step_before_last"] = list(rep["max_step"])
@@ -479,7 +481,12 @@ def arm(a):
         if a.idle_exit and rep["t_last"] is not None and time.monotonic() - rep["t_last"] > a.idle_exit:
             return False
         if sim:
-            sim.step(target["q"] if target["q"] is not None else start)
+            if target["q"] is None:
+                sim.step(start, [0.0] * n)
+            else:
+                # No command for two periods: the reference stands still.
+                moving = time.monotonic() - rep["t_last"] < 2 * a.period
+                sim.step(target["q"], target["qd"] if moving else [0.0] * n)
             q[:] = sim.q()
         elif target["q"] is not None:
             for i in range(n):
@@ -606,6 +613,7 @@ def main():
     m.add_argument("--pose-frame", default="", help="pose: the frame_id poses must have")
     m.add_argument("--initial", required=True, help="the joints' start, comma-separated")
     m.add_argument("--tau", type=float, default=0.02)
+    m.add_argument("--period", type=float, default=1e-3, help="the commands' period, s")
     m.add_argument("--duration", type=float, required=True)
     m.add_argument("--idle-exit", type=float, default=0.0)
     m.add_argument("--wrench-topic", default="")
