@@ -92,13 +92,15 @@ fn the_panda_turns_with_the_operator_holds_when_released_and_continues_without_a
             .sum::<f64>()
             .sqrt()
     };
+    // The reference held is the joints' own, within 1e-5 of the last target.
+    assert!(apart(rot("target", r0), rot("target", r0 - 1)) < 1e-5);
     for n in r0..=r1 {
         assert!(
             dist(n, r0) < 1e-3,
             "sample {n}: moved {} m while released",
             dist(n, r0)
         );
-        assert_eq!(rot("target", n), rot("target", r0 - 1), "sample {n}");
+        assert_eq!(rot("target", n), rot("target", r0), "sample {n}");
     }
 
     // Engaged again at 4 s with the hand back home: the Panda continues from where it
@@ -116,7 +118,7 @@ fn the_panda_turns_with_the_operator_holds_when_released_and_continues_without_a
         );
     }
     let h = 10f64.to_radians();
-    let want = mul([0.0, 0.0, h.sin(), h.cos()], rot("target", r0 - 1));
+    let want = mul([0.0, 0.0, h.sin(), h.cos()], rot("target", r0));
     assert!(
         apart(rot("target", 5999), want) < 1e-6,
         "{:?} vs {want:?}",
@@ -255,4 +257,52 @@ fn a_corrupted_pose_is_rejected_and_counted_and_the_hand_keeps_its_course() {
         "{:?}",
         err.iter().copied().fold(0.0, f64::max)
     );
+}
+
+/// The clutch travels with the pose it belongs to: 200 ms late, the Panda stops where
+/// the operator let go (the file's row at 3 s, arriving at 3.2 s) and starts again
+/// where the operator engaged (4 s, arriving at 4.2 s), not 200 ms of motion earlier.
+#[test]
+fn a_late_clutch_arrives_with_its_pose() {
+    let sb = Sandbox::new("poselate");
+    let text = pose_text().replace(
+        "[slave.arm]",
+        "[network.forward]\ndelay = [200, 200, 200]\n\n[slave.arm]",
+    );
+    let scenario = sb.write("late.toml", &text);
+    sb.simulate(&scenario, "a");
+    let joints = std::fs::read_to_string(sb.path("a").join("joints.csv")).expect("joints");
+    let released = joint_col(&joints, "released");
+    let first = released.iter().position(|r| *r == 1.0).expect("a release");
+    let last = released.iter().rposition(|r| *r == 1.0).expect("a release");
+    assert_eq!((first, last), (3200, 4199));
+    // Released where the operator let go: the file's orientation at 3 s.
+    let row_3s = [
+        0.167731259497,
+        -0.044943455528,
+        0.254887002244,
+        0.951251242564,
+    ];
+    let at = ["x", "y", "z", "w"].map(|c| joint_col(&joints, &format!("target_rot_{c}"))[first]);
+    assert!(apart(at, row_3s) < 1e-5, "{at:?}");
+    // Held while released; engaged, it follows the master's moves since the engage.
+    let trace = sb.trace("a");
+    let tool = [1, 2, 3].map(|i| column(&trace, &format!("tool_{i}")));
+    let v = [1, 2, 3].map(|i| column(&trace, &format!("v_{i}")));
+    let moved = |a: usize, b: usize, of: &[Vec<f64>; 3]| [0, 1, 2].map(|k| of[k][a] - of[k][b]);
+    for n in first..=last {
+        let d = moved(n, first, &tool);
+        assert!(
+            d.iter().map(|x| x * x).sum::<f64>().sqrt() < 1e-3,
+            "sample {n}: {d:?}"
+        );
+    }
+    for n in last + 1..6000 {
+        let (t, m) = (moved(n, last + 1, &tool), moved(n, last + 1, &v));
+        let e = (0..3).map(|k| (t[k] - m[k]).powi(2)).sum::<f64>().sqrt();
+        assert!(
+            e < 1e-3,
+            "sample {n}: {e} m off the master's move since the engage"
+        );
+    }
 }

@@ -23,7 +23,12 @@ class ServoIk:
         if not self.model.existFrame(tool):
             raise SystemExit(f"{urdf} has no frame {tool}")
         self.fid = self.model.getFrameId(tool)
+        missing = [n for n in names if not self.model.existJointName(n)]
+        if missing:
+            raise SystemExit(f"{urdf} has no joints {missing}")
         ids = [self.model.getJointId(n) for n in names]
+        if any(self.model.joints[j].nq != 1 for j in ids):
+            raise SystemExit("only revolute and prismatic joints (one coordinate each)")
         self.iq = [self.model.joints[j].idx_q for j in ids]
         self.iv = [self.model.joints[j].idx_v for j in ids]
         self.q = pin.neutral(self.model)

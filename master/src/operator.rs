@@ -214,13 +214,17 @@ impl OperatorSource {
                 problem: format!("the operator's trajectory has an orientation or a clutch (a 6-DoF run): {problem}"),
             })
         };
-        let f = &sc.network.forward;
         let equal = |d: [i64; 3]| d[0] == d[1] && d[1] == d[2];
         if sc.slave.arm.is_none() {
             return bad("slave.arm", "the paper's arm has three joints and cannot turn its tool; a 6-DoF run needs [slave.arm]");
         }
-        if !equal(f.delay) || f.schedule.iter().any(|e| !equal([e[1], e[2], e[3]])) {
-            return bad("network.forward.delay", "the pose crosses in one packet, so the three forward delays (and every schedule row's) must be equal");
+        for (dir, c) in [
+            ("forward", &sc.network.forward),
+            ("backward", &sc.network.backward),
+        ] {
+            if !equal(c.delay) || c.schedule.iter().any(|e| !equal([e[1], e[2], e[3]])) {
+                return bad(&format!("network.{dir}.delay"), "a pose (a wrench back) crosses in one packet, so the three delays (and every schedule row's) must be equal");
+            }
         }
         if sc.codec.forward.kind != CodecKind::None {
             return bad("codec.forward.kind", "the deadband codecs weigh positions only and would leave turns unsent; use \"none\"");

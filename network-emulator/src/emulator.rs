@@ -12,8 +12,14 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use tactile_messages::samples::{
-    Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_POSE, FLAG_SUBSTITUTED, FLAG_UNSENT,
+    Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_POSE, FLAG_RELEASED, FLAG_SUBSTITUTED,
+    FLAG_UNSENT,
 };
+
+/// The flags that belong to a sample's packet and arrive with it, not with the sample
+/// that triggers the emulator's output: the clutch (released at the pose it was
+/// released at, however late that pose arrives).
+const CARRIED: u32 = FLAG_RELEASED;
 use tactile_netem::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
 use tactile_netem::{Loss, Replay};
 use tactile_records::emulator::{Direction, EmulatorCounters, Fate, Passage};
@@ -215,10 +221,12 @@ fn pass(
     // gets nothing). What leaves is what the network delivers at this sample.
     let unsent = signal.flags & FLAG_UNSENT != 0;
     let model_lost = faults.packet_lost() && !unsent;
-    let e = channel.push_packet(seq, values(signal), *extra, !unsent && !model_lost);
+    let rest = (*extra, signal.flags & CARRIED);
+    let e = channel.push_packet(seq, values(signal), rest, !unsent && !model_lost);
     signal.flags &= !FLAG_UNSENT;
     apply(signal, &e);
-    *extra = e.extra;
+    *extra = e.extra.0;
+    signal.flags = (signal.flags & !CARRIED) | (e.extra.1 & CARRIED);
     let fate = faults.fate();
     if fate == Fate::Corrupt {
         signal.value = [f64::NAN; 3];

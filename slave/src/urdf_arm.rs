@@ -241,6 +241,12 @@ impl UrdfArm {
 
     /// The clutch is released this sample: the references stay (the robot holds).
     pub fn release(&mut self) {
+        if !self.released {
+            // What the arm holds is its joints' reference, which a limited or refused
+            // IK step may have left short of the last target: the engage continues
+            // from there.
+            self.reference.0 = self.chain.fk(&self.state.q_ref);
+        }
         self.released = true;
         self.state.qd_ref.iter_mut().for_each(|v| *v = 0.0);
         self.reference.1 = Vector6::zeros();

@@ -275,3 +275,48 @@ fn the_clutch_holds_the_references_and_reengages_without_a_step() {
         "{p:?} from {at_engage:?}"
     );
 }
+
+/// The clutch with the operator's hand turned: released at one orientation, engaged
+/// at another, the reference does not step, and the operator's turn since the engage
+/// turns the tool about the base's axes from where it held.
+#[test]
+fn a_turned_reengage_continues_from_the_held_orientation() {
+    let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    let about = |axis: usize, deg: f64| {
+        let h = deg.to_radians() / 2.0;
+        let mut q = [0.0, 0.0, 0.0, h.cos()];
+        q[axis] = h.sin();
+        q
+    };
+    for _ in 0..1000 {
+        arm.follow(HOME, Some(about(2, 20.0)), 1e-3);
+        arm.advance(1e-3, &[]);
+    }
+    let held = arm.target_rotation();
+    for _ in 0..100 {
+        arm.release();
+        arm.advance(1e-3, &[]);
+    }
+    // Engaged with the hand turned elsewhere (30 degrees about x): no step.
+    let before = arm.state().q_ref.clone();
+    arm.follow(HOME, Some(about(0, 30.0)), 1e-3);
+    let step = arm
+        .state()
+        .q_ref
+        .iter()
+        .zip(&before)
+        .map(|(a, b)| (a - b).abs());
+    assert!(step.fold(0.0, f64::max) < 1e-9);
+    // Then 10 degrees more about the base's z: the tool turns by it from the hold.
+    let turned = quaternion(&(rotation_matrix(about(2, 10.0)) * rotation_matrix(about(0, 30.0))));
+    for _ in 0..1500 {
+        arm.follow(HOME, Some(turned), 1e-3);
+        arm.advance(1e-3, &[]);
+    }
+    let want = quaternion(&(rotation_matrix(about(2, 10.0)) * rotation_matrix(held)));
+    let got = arm.target_rotation();
+    let apart = (0..4).map(|k| (got[k] - want[k]).abs()).fold(0.0, f64::max);
+    assert!(apart < 1e-9, "{got:?} vs {want:?}");
+    let tool = arm.tool_rotation();
+    assert!((0..4).all(|k| (tool[k] - want[k]).abs() < 1e-3), "{tool:?}");
+}

@@ -127,7 +127,8 @@ pub fn rotation_matrix(q: [f64; 4]) -> Matrix3<f64> {
 /// A rotation matrix as a unit quaternion `[x, y, z, w]` with `w >= 0` (one of the
 /// two that are the same rotation, so equal rotations give equal numbers).
 pub fn quaternion(r: &Matrix3<f64>) -> [f64; 4] {
-    let q = UnitQuaternion::from_matrix(r);
+    // Closed form (Shepperd's): nalgebra's iterative `from_matrix` loops on a NaN.
+    let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(*r));
     let s = if q.w < 0.0 { -1.0 } else { 1.0 };
     [s * q.i, s * q.j, s * q.k, s * q.w]
 }
@@ -169,6 +170,29 @@ pub fn log_rotation(r: &Matrix3<f64>) -> Vector3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quaternions_of_known_rotations_and_back() {
+        let half_x = Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0);
+        let q = quaternion(&half_x);
+        assert!(
+            (q[0].abs() - 1.0).abs() < 1e-15 && q[1] == 0.0 && q[2] == 0.0,
+            "{q:?}"
+        );
+        let h = 0.3_f64;
+        let about_z = [0.0, 0.0, h.sin(), h.cos()];
+        let r = rotation_matrix(about_z);
+        assert!((r[(0, 1)] + (2.0 * h).sin()).abs() < 1e-15);
+        let back = quaternion(&r);
+        assert!(
+            back.iter()
+                .zip(&about_z)
+                .all(|(a, b)| (a - b).abs() < 1e-15),
+            "{back:?}"
+        );
+        // Not a rotation: an answer (NaN), not a hang.
+        assert!(quaternion(&Matrix3::from_element(f64::NAN))[3].is_nan());
+    }
 
     #[test]
     fn the_log_of_a_rotation_gives_back_its_axis_and_angle() {

@@ -8,6 +8,7 @@
 use crate::map::Reject;
 use tactile_chain::{Chain, Frame, Tree};
 use tactile_ros::msg::{Decode, JointState, WrenchStamped};
+use tactile_scenario::TorqueAbout;
 
 /// How far past a URDF limit a reading may be and still be taken, rad or m: encoders
 /// report a little beyond the limit a controller stops at.
@@ -112,10 +113,11 @@ pub fn framed_force_cdr(cdr: &[u8], tree: &Tree, base: &str) -> Result<FramedFor
 
 /// The wrench `(f, t, frame)` turned into `base`'s axes, the arm's joints at `q`
 /// (named by `names`): the force, and the torque about the tool `tip`'s origin
-/// (`t + (sensor - tool) x f`), as the loop's h(n) carries them.
+/// (`t + (sensor - tool) x f` for a torque about the frame's origin; turned only for
+/// one already about the tool), as the loop's h(n) carries them.
 pub fn in_base(
     tree: &Tree,
-    (base, tip): (&str, &str),
+    (base, tip, about): (&str, &str, TorqueAbout),
     names: &[String],
     q: &[f64],
     (f, t, frame): &FramedForce,
@@ -136,7 +138,11 @@ pub fn in_base(
     };
     let (sensor, tool): (Frame, Frame) = (b.inverse().then(&s), b.inverse().then(&tool));
     let force = sensor.r * nalgebra::Vector3::from(*f);
-    let torque = sensor.r * nalgebra::Vector3::from(*t) + (sensor.p - tool.p).cross(&force);
+    let lever = match about {
+        TorqueAbout::Frame => sensor.p - tool.p,
+        TorqueAbout::Tool => nalgebra::Vector3::zeros(),
+    };
+    let torque = sensor.r * nalgebra::Vector3::from(*t) + lever.cross(&force);
     (force.into(), torque.into())
 }
 
@@ -204,7 +210,13 @@ mod tests {
             torque: [0.0; 3],
         };
         let framed = framed_force_cdr(&w.to_cdr(), &tree, "panda_link0").expect("framed");
-        let (f, t) = in_base(&tree, ("panda_link0", "panda_hand"), &names, &q, &framed);
+        let (f, t) = in_base(
+            &tree,
+            ("panda_link0", "panda_hand", TorqueAbout::Frame),
+            &names,
+            &q,
+            &framed,
+        );
         // At the ready pose the hand's z points down; no torque about the hand itself.
         let hand = chain.fk(&q).r * nalgebra::Vector3::new(0.0, 0.0, 5.0);
         assert!((f[2] - hand.z).abs() < 1e-12 && f[2] < -4.99, "{f:?}");
@@ -219,7 +231,13 @@ mod tests {
             torque: p.cross(&fb).into(),
         };
         let framed = framed_force_cdr(&at_base.to_cdr(), &tree, "panda_link0").expect("framed");
-        let (f2, t2) = in_base(&tree, ("panda_link0", "panda_hand"), &names, &q, &framed);
+        let (f2, t2) = in_base(
+            &tree,
+            ("panda_link0", "panda_hand", TorqueAbout::Frame),
+            &names,
+            &q,
+            &framed,
+        );
         assert!(
             f2.iter().zip(&f).all(|(a, b)| (a - b).abs() < 1e-12),
             "{f2:?}"
@@ -232,12 +250,29 @@ mod tests {
             torque: [0.2, 0.0, 0.0],
         };
         let framed = framed_force_cdr(&twist.to_cdr(), &tree, "panda_link0").expect("framed");
-        let (_, t3) = in_base(&tree, ("panda_link0", "panda_hand"), &names, &q, &framed);
+        let (_, t3) = in_base(
+            &tree,
+            ("panda_link0", "panda_hand", TorqueAbout::Frame),
+            &names,
+            &q,
+            &framed,
+        );
         let want = chain.fk(&q).r * nalgebra::Vector3::new(0.2, 0.0, 0.0);
         assert!(
             (nalgebra::Vector3::from(t3) - want).norm() < 1e-12,
             "{t3:?}"
         );
+        // Franka's base-frame wrench has its torque about the tool already: turned
+        // only, not moved (the force's moment about the base would otherwise add in).
+        let franka = WrenchStamped {
+            header: Header::at(1, ""),
+            force: f,
+            torque: [0.1, 0.0, 0.0],
+        };
+        let framed = framed_force_cdr(&franka.to_cdr(), &tree, "panda_link0").expect("framed");
+        let about = ("panda_link0", "panda_hand", TorqueAbout::Tool);
+        let (_, t4) = in_base(&tree, about, &names, &q, &framed);
+        assert_eq!(t4, [0.1, 0.0, 0.0]);
         let mut bad = w.clone();
         bad.header.frame_id = "tool0_controller".into();
         assert_eq!(

@@ -39,6 +39,8 @@ pub struct RosArm {
     base: String,
     /// The torque that came with the last force, about the tool, in the base's axes.
     torque: [f64; 3],
+    /// The point the wrench's torque is about.
+    torque_about: tactile_scenario::TorqueAbout,
     gate: JointGate<Vec<f64>>,
     watch: Watch,
     topic: String,
@@ -100,6 +102,7 @@ impl RosArm {
             chain: chain.clone(),
             base: chain.base.clone(),
             torque: [0.0; 3],
+            torque_about: cfg.wrench_torque,
             watch: Watch::new(&cfg.watch, t_s_ns),
             topic: cfg.joint_states.clone(),
             last_tick_ns: 0,
@@ -165,7 +168,7 @@ impl Robot<Vec<f64>> for RosArm {
         };
         let (f, t) = in_base(
             &self.tree,
-            (&self.base, &self.chain.tip),
+            (&self.base, &self.chain.tip, self.torque_about),
             &self.map.names,
             &q.value,
             &(judged, torque, l.value.2.clone()),

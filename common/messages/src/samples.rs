@@ -179,9 +179,9 @@ pub struct Backward {
     pub run: u64,
     /// Contact force.
     pub signal: Signal,
-    /// With `FLAG_POSE`: the contact torque about the tool, in the master's frame, N m
-    /// (zero for a point contact; what a real robot's wrench sensor measured). It
-    /// crosses the network in the force's packet.
+    /// The contact torque about the tool, in the master's frame, N m: what a real
+    /// arm's wrench sensor measured, zero for a point contact; flagged `FLAG_POSE` in
+    /// a 6-DoF run. It crosses the network in the force's packet.
     pub torque: [f64; 3],
     /// Stamps of the triggering forward sample, then the backward stages.
     pub stamps: [u64; stage::COUNT],

@@ -48,8 +48,8 @@ pub struct Emitted {
     pub values: [Value; 3],
     /// The noise added to each value.
     pub noise: [f64; 3],
-    /// The rotational half that came with the first value's packet.
-    pub extra: [f64; 4],
+    /// The rest of the sample that came with the first value's packet.
+    pub extra: Rest,
     /// The jitter drawn for the input packet, samples (before rounding).
     pub jitter: f64,
     /// True if a replayed network lost the input packet.
@@ -65,8 +65,14 @@ pub struct Emitted {
 struct Slot {
     seq: u64,
     values: [Value; 3],
-    extra: [f64; 4],
+    extra: Rest,
 }
+
+/// A 6-DoF sample's rest beside its three values, carried in the first value's
+/// packet: its rotational half (an orientation forward, a torque backward) and the
+/// flags that belong to the packet (the clutch's), so both arrive with the pose they
+/// came with, however late.
+pub type Rest = ([f64; 4], u32);
 
 /// One signal's packets in flight: arrival sample -> newest sequence arriving then;
 /// and the newest arrived, with its value copied when it arrives (its slot in the ring
@@ -74,7 +80,7 @@ struct Slot {
 #[derive(Debug, Clone, Default)]
 struct InFlight {
     arriving: BTreeMap<u64, u64>,
-    newest: Option<(u64, Value, [f64; 4])>,
+    newest: Option<(u64, Value, Rest)>,
     last_arrival: u64,
     last_emitted: Option<u64>,
 }
@@ -90,12 +96,7 @@ impl InFlight {
     /// The newest packet arrived by sample `now`, its value read from `ring` as it
     /// arrives (every packet arrives within the ring's length of being sent, so its
     /// slot still holds it then).
-    fn receive(
-        &mut self,
-        now: u64,
-        ring: &[Option<Slot>],
-        i: usize,
-    ) -> Option<(u64, Value, [f64; 4])> {
+    fn receive(&mut self, now: u64, ring: &[Option<Slot>], i: usize) -> Option<(u64, Value, Rest)> {
         let len = ring.len() as u64;
         while let Some((&at, &seq)) = self.arriving.first_key_value() {
             if at > now {
@@ -219,18 +220,18 @@ impl Channel {
 
     /// Takes input sample `seq` and returns the output for the same sample index.
     pub fn push(&mut self, seq: u64, values: [Value; 3]) -> Emitted {
-        self.push_packet(seq, values, [0.0; 4], true)
+        self.push_packet(seq, values, ([0.0; 4], 0), true)
     }
 
     /// As [`Channel::push`]; `sent` false when the sender's codec sent no packet for
     /// this sample (it still draws its jitter, so enabling a codec leaves the network
     /// the same): the receiver then gets whatever arrived, or the last value again.
-    /// `extra` is the sample's rotational half (zero in a 3-DoF run).
+    /// `extra` is the sample's [`Rest`] (zero in a 3-DoF run).
     pub fn push_packet(
         &mut self,
         seq: u64,
         values: [Value; 3],
-        extra: [f64; 4],
+        extra: Rest,
         sent: bool,
     ) -> Emitted {
         let (sent, replayed) = self.admit(Slot { seq, values, extra }, sent);
@@ -247,7 +248,7 @@ impl Channel {
         };
         let mut out = [Value::default(); 3];
         let mut noise = [0.0; 3];
-        let mut extra = [0.0; 4];
+        let mut extra = ([0.0; 4], 0);
         let mut substituted = false;
         for i in 0..3 {
             let (v, r, held, x) = self.axis(i, &packet);
@@ -320,7 +321,7 @@ impl Channel {
     /// Axis `i` of the sample: its packet (and copy) in flight, the newest arrived
     /// value out with its age added to its delay and its noise; true if it was held
     /// (no newer packet came); and the rotational half of the packet it came in.
-    fn axis(&mut self, i: usize, p: &Packet) -> (Value, f64, bool, [f64; 4]) {
+    fn axis(&mut self, i: usize, p: &Packet) -> (Value, f64, bool, Rest) {
         // When a copy sent now with this jitter arrives: the replay's delay, or the
         // configured one plus jitter; in sending order unless reordering is on.
         let reorder = self.reorder;
@@ -356,7 +357,7 @@ impl Channel {
                 let s = self.first.unwrap_or(Slot {
                     seq: p.seq,
                     values: [Value::default(); 3],
-                    extra: [0.0; 4],
+                    extra: ([0.0; 4], 0),
                 });
                 (s.seq, s.values[i], true, s.extra)
             }

@@ -342,7 +342,7 @@ fn the_rotational_half_rides_the_first_values_packet() {
             ..Default::default()
         })
     };
-    let extra = |n: u64| [n as f64, -(n as f64), 0.5, 1.0];
+    let extra = |n: u64| ([n as f64, -(n as f64), 0.5, 1.0], (n % 3) as u32);
     let (mut with, mut without) = (
         Channel::new(&cfg, 3, FORWARD_STREAM),
         Channel::new(&cfg, 3, FORWARD_STREAM),
@@ -351,7 +351,7 @@ fn the_rotational_half_rides_the_first_values_packet() {
         // Every fifth sample unsent: the receiver holds the last packet, rotation too.
         let sent = n % 5 != 1;
         let e = with.push_packet(n, vals(n), extra(n), sent);
-        let plain = without.push_packet(n, vals(n), [0.0; 4], sent);
+        let plain = without.push_packet(n, vals(n), ([0.0; 4], 0), sent);
         assert_eq!(e.values, plain.values, "sample {n}");
         assert_eq!(e.extra, extra(e.values[0].origin_seq), "sample {n}");
     }

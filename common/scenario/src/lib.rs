@@ -37,7 +37,7 @@ pub use network::{
 pub use operator::{Operator, TrajectoryEnd};
 pub use ros::{
     topic_name, AngleUnit, Backend, ForceMapConfig, JointMapConfig, LiveConfig, RobotCommand,
-    RosConfig, RosDeviceConfig, RosRobotConfig, WatchConfig,
+    RosConfig, RosDeviceConfig, RosRobotConfig, TorqueAbout, WatchConfig,
 };
 use serde::{Deserialize, Serialize};
 pub use slave::{

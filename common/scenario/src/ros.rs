@@ -375,6 +375,22 @@ pub struct RosRobotConfig {
     pub command: RobotCommand,
     /// A trajectory point's `time_from_start`, s (default: one period).
     pub trajectory_time_s: Option<f64>,
+    /// With `[slave.arm]`: the point the wrench's torque is about, `frame` (the
+    /// message frame's origin, as a sensor measures it) or `tool` (the tool, in the
+    /// frame's axes: Franka's `external_wrench_in_base_frame`, about its stiffness
+    /// frame, given in the base).
+    pub wrench_torque: TorqueAbout,
+}
+
+/// Where a wrench's torque is taken about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum TorqueAbout {
+    /// The origin of the message's frame.
+    #[default]
+    Frame,
+    /// The arm's tool (its URDF tip).
+    Tool,
 }
 
 impl Default for RosRobotConfig {
@@ -390,6 +406,7 @@ impl Default for RosRobotConfig {
             max_velocity: [2.0; 3],
             command: RobotCommand::Positions,
             trajectory_time_s: None,
+            wrench_torque: TorqueAbout::Frame,
         }
     }
 }
