@@ -33,6 +33,34 @@ fn joint_col(text: &str, name: &str) -> Vec<f64> {
     column(text, name)
 }
 
+/// `text` with the TOML `table` put before its `[slave.arm]`.
+fn with_table(text: &str, table: &str) -> String {
+    text.replace("[slave.arm]", &format!("{table}\n\n[slave.arm]"))
+}
+
+/// The clutch in a run's trace: over `released` the tool stays within a millimetre of
+/// where it was at the release; from the engage after it to the run's end its moves
+/// equal the master's (`v`) since the engage within a millimetre (the map's scale is 1).
+fn held_then_followed(trace: &str, released: std::ops::RangeInclusive<usize>) {
+    let tool = [1, 2, 3].map(|i| column(trace, &format!("tool_{i}")));
+    let v = [1, 2, 3].map(|i| column(trace, &format!("v_{i}")));
+    let moved = |of: &[Vec<f64>; 3], a: usize, b: usize| [0, 1, 2].map(|k| of[k][a] - of[k][b]);
+    let norm = |d: [f64; 3]| d.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let (first, engage) = (*released.start(), released.end() + 1);
+    for n in released {
+        let d = norm(moved(&tool, n, first));
+        assert!(d < 1e-3, "sample {n}: moved {d} m while released");
+    }
+    for n in engage..tool[0].len() {
+        let (t, m) = (moved(&tool, n, engage), moved(&v, n, engage));
+        let e = norm([0, 1, 2].map(|k| t[k] - m[k]));
+        assert!(
+            e < 1e-3,
+            "sample {n}: {e} m off the master's move since the engage"
+        );
+    }
+}
+
 /// Hamilton product of quaternions `[x, y, z, w]`.
 fn mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
     let ([ax, ay, az, aw], [bx, by, bz, bw]) = (a, b);
@@ -83,40 +111,16 @@ fn the_panda_turns_with_the_operator_holds_when_released_and_continues_without_a
         rot("target", 2000)
     );
 
-    // Released, the references hold: the hand stays within a millimetre.
-    let tool = [1, 2, 3].map(|i| column(&trace, &format!("tool_{i}")));
-    let v = [1, 2, 3].map(|i| column(&trace, &format!("v_{i}")));
-    let dist = |a: usize, b: usize| {
-        (0..3)
-            .map(|k| (tool[k][a] - tool[k][b]).powi(2))
-            .sum::<f64>()
-            .sqrt()
-    };
-    // The reference held is the joints' own, within 1e-5 of the last target.
+    // Released, the references hold (the joints' own, within 1e-5 of the last target)
+    // and the hand stays within a millimetre. Engaged again at 4 s with the hand back
+    // home: the Panda continues from where it held, its hand moving as the master's
+    // since then, and the operator's turn since then (20 degrees about z) turns it
+    // about the base's z.
     assert!(apart(rot("target", r0), rot("target", r0 - 1)) < 1e-5);
     for n in r0..=r1 {
-        assert!(
-            dist(n, r0) < 1e-3,
-            "sample {n}: moved {} m while released",
-            dist(n, r0)
-        );
         assert_eq!(rot("target", n), rot("target", r0), "sample {n}");
     }
-
-    // Engaged again at 4 s with the hand back home: the Panda continues from where it
-    // held. Its hand moves as the master's since then (the map's scale is 1), and the
-    // operator's turn since then (20 degrees about z) turns it about the base's z.
-    let engage = r1 + 1;
-    for n in engage..6000 {
-        let e = (0..3)
-            .map(|k| ((tool[k][n] - tool[k][engage]) - (v[k][n] - v[k][engage])).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        assert!(
-            e < 1e-3,
-            "sample {n}: {e} m off the master's move since the engage"
-        );
-    }
+    held_then_followed(&trace, r0..=r1);
     let h = 10f64.to_radians();
     let want = mul([0.0, 0.0, h.sin(), h.cos()], rot("target", r0));
     assert!(
@@ -157,13 +161,12 @@ fn the_panda_turns_with_the_operator_holds_when_released_and_continues_without_a
 #[test]
 fn the_node_programs_carry_the_pose_as_the_in_process_run_does() {
     let sb = Sandbox::new("posenodes");
-    let text = pose_text()
-        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
-        .replace("samples = 6000", "samples = 800")
-        .replace(
-            "[slave.arm]",
-            "[network.forward]\ndelay = [3, 3, 3]\n\n[slave.arm]",
-        );
+    let text = with_table(
+        &pose_text()
+            .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+            .replace("samples = 6000", "samples = 800"),
+        "[network.forward]\ndelay = [3, 3, 3]",
+    );
     let scenario = sb.write("pose.toml", &text);
     sb.simulate(&scenario, "sim");
     sb.run(&scenario, "nodes");
@@ -195,17 +198,11 @@ fn a_six_dof_run_the_scenario_cannot_carry_is_refused_naming_the_field() {
     let cases: Vec<(String, &str)> = vec![
         (base[..arm_block].to_string(), "field `slave.arm`"),
         (
-            base.replace(
-                "[slave.arm]",
-                "[network.forward]\ndelay = [0, 5, 0]\n\n[slave.arm]",
-            ),
+            with_table(&base, "[network.forward]\ndelay = [0, 5, 0]"),
             "field `network.forward.delay`",
         ),
         (
-            base.replace(
-                "[slave.arm]",
-                "[codec.forward]\nkind = \"deadband\"\n\n[slave.arm]",
-            ),
+            with_table(&base, "[codec.forward]\nkind = \"deadband\""),
             "field `codec.forward.kind`",
         ),
         (
@@ -234,12 +231,10 @@ fn a_six_dof_run_the_scenario_cannot_carry_is_refused_naming_the_field() {
 #[test]
 fn a_corrupted_pose_is_rejected_and_counted_and_the_hand_keeps_its_course() {
     let sb = Sandbox::new("posecorrupt");
-    let text = pose_text()
-        .replace("samples = 6000", "samples = 3000")
-        .replace(
-            "[slave.arm]",
-            "[network.forward]\ncorrupt = 0.02\n\n[slave.arm]",
-        );
+    let text = with_table(
+        &pose_text().replace("samples = 6000", "samples = 3000"),
+        "[network.forward]\ncorrupt = 0.02",
+    );
     let scenario = sb.write("corrupt.toml", &text);
     sb.simulate(&scenario, "a");
     let s = sb.json("a", "summary.json");
@@ -265,10 +260,7 @@ fn a_corrupted_pose_is_rejected_and_counted_and_the_hand_keeps_its_course() {
 #[test]
 fn a_late_clutch_arrives_with_its_pose() {
     let sb = Sandbox::new("poselate");
-    let text = pose_text().replace(
-        "[slave.arm]",
-        "[network.forward]\ndelay = [200, 200, 200]\n\n[slave.arm]",
-    );
+    let text = with_table(&pose_text(), "[network.forward]\ndelay = [200, 200, 200]");
     let scenario = sb.write("late.toml", &text);
     sb.simulate(&scenario, "a");
     let joints = std::fs::read_to_string(sb.path("a").join("joints.csv")).expect("joints");
@@ -286,23 +278,5 @@ fn a_late_clutch_arrives_with_its_pose() {
     let at = ["x", "y", "z", "w"].map(|c| joint_col(&joints, &format!("target_rot_{c}"))[first]);
     assert!(apart(at, row_3s) < 1e-5, "{at:?}");
     // Held while released; engaged, it follows the master's moves since the engage.
-    let trace = sb.trace("a");
-    let tool = [1, 2, 3].map(|i| column(&trace, &format!("tool_{i}")));
-    let v = [1, 2, 3].map(|i| column(&trace, &format!("v_{i}")));
-    let moved = |a: usize, b: usize, of: &[Vec<f64>; 3]| [0, 1, 2].map(|k| of[k][a] - of[k][b]);
-    for n in first..=last {
-        let d = moved(n, first, &tool);
-        assert!(
-            d.iter().map(|x| x * x).sum::<f64>().sqrt() < 1e-3,
-            "sample {n}: {d:?}"
-        );
-    }
-    for n in last + 1..6000 {
-        let (t, m) = (moved(n, last + 1, &tool), moved(n, last + 1, &v));
-        let e = (0..3).map(|k| (t[k] - m[k]).powi(2)).sum::<f64>().sqrt();
-        assert!(
-            e < 1e-3,
-            "sample {n}: {e} m off the master's move since the engage"
-        );
-    }
+    held_then_followed(&sb.trace("a"), first..=last);
 }

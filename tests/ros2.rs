@@ -909,6 +909,19 @@ fn arm_standin(
     topic: &str,
     extra: &[&str],
 ) -> Child {
+    let panda = (PANDA_JOINTS, PANDA_READY, "/fr3/joint_states");
+    any_arm_standin(sb, panda, (domain, port), (command, topic), extra)
+}
+
+/// The `arm` stand-in of the robot `(joint names, their start, joint states topic)`
+/// listening on `port` in `domain`, taking `command` messages on `topic`.
+fn any_arm_standin(
+    sb: &Sandbox,
+    (names, initial, joint_topic): (&str, &str, &str),
+    (domain, port): (u32, u16),
+    (command, topic): (&str, &str),
+    extra: &[&str],
+) -> Child {
     let (domain, listen) = (domain.to_string(), format!("tcp/127.0.0.1:{port}"));
     let mut args = vec![
         "arm",
@@ -917,11 +930,11 @@ fn arm_standin(
         "--listen",
         &listen,
         "--names",
-        PANDA_JOINTS,
+        names,
         "--initial",
-        PANDA_READY,
+        initial,
         "--joint-topic",
-        "/fr3/joint_states",
+        joint_topic,
         "--command-topic",
         topic,
         "--command-type",
@@ -1337,30 +1350,34 @@ fn a_mujoco_ur5_follows_a_position_controller_and_its_force_comes_back() {
     let sb = Sandbox::new("ros2-mujoco-ur5");
     let port = free_port();
     let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/ur5_robot.urdf");
-    let (domain, listen) = ("19", format!("tcp/127.0.0.1:{port}"));
-    let arm = standin(
-        &sb,
-        &[
-            "arm", "--domain", domain, "--listen", &listen,
-            "--names",
-            "shoulder_pan_joint,shoulder_lift_joint,elbow_joint,wrist_1_joint,wrist_2_joint,wrist_3_joint",
-            "--initial", "0.0,-1.2,1.6,-1.97,-1.5708,0.0",
-            "--joint-topic", "/joint_states",
-            "--command-topic", "/forward_position_controller/commands",
-            "--command-type", "positions",
-            "--duration", "60", "--idle-exit", "2", "--report", "arm.json",
-            "--mujoco", urdf, "--tool", "tool0", "--wall-below", "0.045",
-            "--wrench-topic", "/force_torque_sensor_broadcaster/wrench", "--wrench-frame", "tool0",
-        ],
+    let ur5 = (
+        "shoulder_pan_joint,shoulder_lift_joint,elbow_joint,wrist_1_joint,wrist_2_joint,wrist_3_joint",
+        "0.0,-1.2,1.6,-1.97,-1.5708,0.0",
+        "/joint_states",
     );
-    let extra = "wrench_topic = \"/force_torque_sensor_broadcaster/wrench\"\n";
+    let wrench = "/force_torque_sensor_broadcaster/wrench";
+    let sim = [
+        "--mujoco",
+        urdf,
+        "--tool",
+        "tool0",
+        "--wall-below",
+        "0.045",
+        "--wrench-topic",
+        wrench,
+        "--wrench-frame",
+        "tool0",
+    ];
+    let command = ("positions", "/forward_position_controller/commands");
+    let arm = any_arm_standin(&sb, ur5, (19, port), command, &sim);
+    let extra = format!("wrench_topic = \"{wrench}\"\n");
     let text = over_ros(
         ("ur5", "ur5_robot.urdf"),
         19,
         port,
         3000,
         "positions",
-        extra,
+        &extra,
     )
     .replace(
         "/fr3_arm_controller/CMD",

@@ -130,15 +130,6 @@ impl RosNode {
         kind: EntityKind,
         topic: &str,
         ty: &str,
-    ) -> Result<(String, LivelinessToken), RosError> {
-        self.token_qos(kind, topic, ty, &rmw::qos_reliable(10))
-    }
-
-    fn token_qos(
-        &self,
-        kind: EntityKind,
-        topic: &str,
-        ty: &str,
         qos: &str,
     ) -> Result<(String, LivelinessToken), RosError> {
         let eid = self.next_id.fetch_add(1, Ordering::Relaxed);
@@ -157,9 +148,7 @@ impl RosNode {
 
     /// A publisher of `ty` on `topic`.
     pub fn publisher(&self, topic: &str, ty: &str) -> Result<RosPublisher, RosError> {
-        let key = rmw::topic_key(self.id.domain, topic, ty)
-            .ok_or_else(|| err(topic, format!("no type hash for {ty}")))?;
-        let (token_key, token) = self.token(EntityKind::Publisher, topic, ty)?;
+        let (key, id) = self.announce(topic, ty, &rmw::qos_reliable(10))?;
         let publisher = self
             .session
             .declare_publisher(key)
@@ -170,11 +159,23 @@ impl RosNode {
         Ok(RosPublisher {
             publisher,
             session: self.session.clone(),
+            id,
+        })
+    }
+
+    /// A publisher's data key expression and its identity on the graph: its token
+    /// (with QoS `qos`) declared, its gid, its sequence numbers from 1.
+    fn announce(&self, topic: &str, ty: &str, qos: &str) -> Result<(String, Announced), RosError> {
+        let key = rmw::topic_key(self.id.domain, topic, ty)
+            .ok_or_else(|| err(topic, format!("no type hash for {ty}")))?;
+        let (token_key, token) = self.token(EntityKind::Publisher, topic, ty, qos)?;
+        let id = Announced {
             gid: rmw::gid(&token_key),
             seq: AtomicI64::new(0),
             topic: topic.to_string(),
             _token: token,
-        })
+        };
+        Ok((key, id))
     }
 
     /// A transient-local publisher of `ty` on `topic`, as rmw_zenoh makes one for a
@@ -189,10 +190,7 @@ impl RosNode {
         depth: usize,
     ) -> Result<RosLatched, RosError> {
         use zenoh_ext::{AdvancedPublisherBuilderExt, CacheConfig, MissDetectionConfig};
-        let key = rmw::topic_key(self.id.domain, topic, ty)
-            .ok_or_else(|| err(topic, format!("no type hash for {ty}")))?;
-        let qos = rmw::qos_latched(depth as u32);
-        let (token_key, token) = self.token_qos(EntityKind::Publisher, topic, ty, &qos)?;
+        let (key, id) = self.announce(topic, ty, &rmw::qos_latched(depth as u32))?;
         let heartbeat = MissDetectionConfig::default().sporadic_heartbeat(LATCHED_HEARTBEAT);
         let publisher = self
             .session
@@ -203,13 +201,7 @@ impl RosNode {
             .sample_miss_detection(heartbeat)
             .wait()
             .map_err(|e| err(&format!("declaring the publisher of {topic}"), e))?;
-        Ok(RosLatched {
-            publisher,
-            gid: rmw::gid(&token_key),
-            seq: AtomicI64::new(0),
-            topic: topic.to_string(),
-            _token: token,
-        })
+        Ok(RosLatched { publisher, id })
     }
 
     /// Calls `on(payload, arrival ns on CLOCK_MONOTONIC)` for every message of `ty` on
@@ -223,7 +215,7 @@ impl RosNode {
         let dds = rmw::dds_type(ty).ok_or_else(|| err(topic, format!("bad type {ty}")))?;
         let name = topic.trim_matches('/');
         let key = format!("{}/{name}/{dds}/*", self.id.domain);
-        let (_, token) = self.token(EntityKind::Subscription, topic, ty)?;
+        let (_, token) = self.token(EntityKind::Subscription, topic, ty, &rmw::qos_reliable(10))?;
         let sub = self
             .session
             .declare_subscriber(key)
@@ -245,29 +237,36 @@ pub struct RosPublisher {
     publisher: zenoh::pubsub::Publisher<'static>,
     /// For the last message, put reliably (congestion control `Block`).
     session: zenoh::Session,
+    id: Announced,
+}
+
+impl std::fmt::Debug for RosPublisher {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RosPublisher")
+            .field("topic", &self.id.topic)
+            .finish_non_exhaustive()
+    }
+}
+
+/// A publisher as the ROS 2 graph knows it: its token, its gid, its messages' count.
+struct Announced {
     gid: [u8; 16],
     seq: AtomicI64,
     topic: String,
     _token: LivelinessToken,
 }
 
-impl std::fmt::Debug for RosPublisher {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RosPublisher")
-            .field("topic", &self.topic)
-            .finish_non_exhaustive()
+impl Announced {
+    /// rmw_zenoh's attachment of the next message: its sequence number (from 1), the
+    /// wall clock, the gid.
+    fn attachment(&self) -> Vec<u8> {
+        let a = Attachment {
+            seq: self.seq.fetch_add(1, Ordering::Relaxed) + 1,
+            stamp_ns: wall_ns() as i64,
+            gid: self.gid,
+        };
+        a.to_bytes().to_vec()
     }
-}
-
-/// rmw_zenoh's attachment of a publisher's next message: its sequence number (from
-/// 1), the wall clock, its gid.
-fn attachment(seq: &AtomicI64, gid: [u8; 16]) -> Vec<u8> {
-    let a = Attachment {
-        seq: seq.fetch_add(1, Ordering::Relaxed) + 1,
-        stamp_ns: wall_ns() as i64,
-        gid,
-    };
-    a.to_bytes().to_vec()
 }
 
 /// rmw_zenoh's heartbeat period for a reliable transient-local publisher's sample miss
@@ -277,16 +276,13 @@ const LATCHED_HEARTBEAT: std::time::Duration = std::time::Duration::from_millis(
 /// A transient-local ROS 2 publisher ([`RosNode::latched_publisher`]).
 pub struct RosLatched {
     publisher: zenoh_ext::AdvancedPublisher<'static>,
-    gid: [u8; 16],
-    seq: AtomicI64,
-    topic: String,
-    _token: LivelinessToken,
+    id: Announced,
 }
 
 impl std::fmt::Debug for RosLatched {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("RosLatched")
-            .field("topic", &self.topic)
+            .field("topic", &self.id.topic)
             .finish_non_exhaustive()
     }
 }
@@ -297,23 +293,19 @@ impl RosLatched {
     pub fn put(&self, cdr: &[u8]) -> bool {
         self.publisher
             .put(cdr)
-            .attachment(attachment(&self.seq, self.gid))
+            .attachment(self.id.attachment())
             .wait()
             .is_ok()
     }
 }
 
 impl RosPublisher {
-    fn attachment(&self) -> Vec<u8> {
-        attachment(&self.seq, self.gid)
-    }
-
     /// Publishes one CDR message, dropped rather than waited for if the network is
     /// behind; false if Zenoh refused it.
     pub fn put(&self, cdr: &[u8]) -> bool {
         self.publisher
             .put(cdr)
-            .attachment(self.attachment())
+            .attachment(self.id.attachment())
             .wait()
             .is_ok()
     }
@@ -332,7 +324,7 @@ impl RosPublisher {
             .put(self.publisher.key_expr().clone(), cdr)
             .congestion_control(CongestionControl::Block)
             .express(true)
-            .attachment(self.attachment())
+            .attachment(self.id.attachment())
             .wait()
             .is_ok();
         (put, matched)
