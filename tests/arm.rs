@@ -56,9 +56,9 @@ fn a_panda_follows_in_free_space_presses_the_wall_and_stays_in_its_limits() {
     // joints.csv: a row a sample, 7 references, 7 angles, 7 efforts, all in limits.
     let j = rows(&sb.path("a").join("joints.csv"));
     assert_eq!(j.len(), 4001);
-    // Then h(n)'s torque, the orientation reference and the tool's, the angle
-    // between them, the clutch.
-    assert_eq!(j[0].len(), 1 + 3 * 7 + 3 + 4 + 4 + 2);
+    // Then h(n)'s torque, the orientation reference, the tool's and the master's, the
+    // clutch's offsets, the angle between reference and tool, the clutch.
+    assert_eq!(j[0].len(), 1 + 3 * 7 + 3 + 4 + 4 + 4 + 3 + 4 + 2);
     assert_eq!(j[0][1], "q_ref_1");
     assert_eq!(j[0][15], "tau_1");
     let chain = tactile_chain::Chain::from_urdf(

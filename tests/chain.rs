@@ -136,3 +136,65 @@ fn kinematics_and_dynamics_equal_pinocchios_on_the_panda_the_ur5_and_the_xarm7()
         );
     }
 }
+
+/// The Touch's gimbal (deploy/devices/phantom_omni.urdf, the omni_common drivers'
+/// chain) against Pinocchio's FK of the same URDF at random joint values, through the
+/// master's own reading of a driver's `JointState` (joints in another order, and the
+/// URDF's base turned into the paper's frame): the orientation to 1e-9.
+#[test]
+fn the_touchs_gimbal_turns_as_pinocchio_says() {
+    use tactile_devices::hand::Gimbal;
+    use tactile_ros::msg::JointState;
+    use tactile_scenario::FrameRotation;
+    if !pin_ready() {
+        return cannot("python3 lacks pinocchio (pin) (tests/requirements.txt)");
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let urdf = root.join("devices/phantom_omni.urdf");
+    let o = Command::new("python3")
+        .arg(root.join("../tests/gimbal_reference.py"))
+        .arg("--urdf")
+        .arg(&urdf)
+        .output()
+        .expect("python3 runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let reference: Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    let xml = std::fs::read_to_string(&urdf).expect("the URDF");
+    let frame = FrameRotation::RpyDeg([-90.0, 0.0, 0.0]);
+    let gimbal = Gimbal::new(&xml, "base", "stylus", &frame).expect("gimbal");
+    let names: Vec<String> = reference["joints"]
+        .as_array()
+        .expect("joints")
+        .iter()
+        .map(|v| v.as_str().expect("a name").to_string())
+        .collect();
+    assert_eq!(gimbal.names(), names.as_slice());
+    let f = nalgebra::Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, -1.0, 0.0);
+    let mut worst_seen = 0.0f64;
+    for case in reference["cases"].as_array().expect("cases") {
+        let q = floats(&case["q"]);
+        let r: Vec<f64> = case["r"]
+            .as_array()
+            .expect("r")
+            .iter()
+            .flat_map(floats)
+            .collect();
+        let theirs = f * nalgebra::Matrix3::from_row_slice(&r);
+        // The driver's message: its joints in reverse order, one it has besides.
+        let mut js = JointState::default();
+        for (name, v) in names.iter().zip(&q).rev() {
+            js.name.push(name.clone());
+            js.position.push(*v);
+        }
+        js.name.push("gripper".into());
+        js.position.push(0.0);
+        let x = gimbal.read(&js).expect("a reading");
+        let ours = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            x[3], x[0], x[1], x[2],
+        ))
+        .to_rotation_matrix();
+        worst_seen = worst_seen.max((ours.matrix() - theirs).abs().max());
+    }
+    eprintln!("the gimbal against pinocchio: {worst_seen:.1e}");
+    assert!(worst_seen < 1e-9, "{worst_seen:e}");
+}

@@ -14,6 +14,7 @@ mod chain;
 mod channels;
 mod cli;
 mod faults;
+mod hand;
 mod hdl;
 mod hosts;
 mod layout;

@@ -13,28 +13,28 @@ use std::process::{Child, Command, Stdio};
 /// message or a lagging robot.
 static STANDINS_AT_1KHZ: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
-fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+pub(crate) fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
     STANDINS_AT_1KHZ
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// True if python3 has eclipse-zenoh and rosbags.
-fn python_ready() -> bool {
+pub(crate) fn python_ready() -> bool {
     Command::new("python3")
         .args(["-c", "import zenoh, zenoh.ext, rosbags, numpy"])
         .output()
         .is_ok_and(|o| o.status.success())
 }
 
-fn free_port() -> u16 {
+pub(crate) fn free_port() -> u16 {
     let l = TcpListener::bind("127.0.0.1:0").expect("bind");
     l.local_addr().expect("addr").port()
 }
 
 /// Waits until a stand-in listens on `port` (Zenoh retries a refused connection only
 /// after a growing back-off, so the nodes start after their peers are up).
-fn listening(port: u16) {
+pub(crate) fn listening(port: u16) {
     util::wait_for(
         "a stand-in's listener",
         std::time::Duration::from_secs(30),
@@ -43,7 +43,12 @@ fn listening(port: u16) {
 }
 
 fn standin(sb: &Sandbox, args: &[&str]) -> Child {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/ros2_standin.py");
+    python_in(sb, "ros2_standin.py", args)
+}
+
+/// tests/`script` run with `args` in the sandbox's folder.
+pub(crate) fn python_in(sb: &Sandbox, script: &str, args: &[&str]) -> Child {
+    let script = format!("{}/../tests/{script}", env!("CARGO_MANIFEST_DIR"));
     Command::new("python3")
         .arg(script)
         .args(args)
@@ -55,7 +60,7 @@ fn standin(sb: &Sandbox, args: &[&str]) -> Child {
         .expect("python3")
 }
 
-fn report(sb: &Sandbox, child: Child, name: &str) -> serde_json::Value {
+pub(crate) fn report(sb: &Sandbox, child: Child, name: &str) -> serde_json::Value {
     let o = util::wait_within(child, util::LIMIT);
     assert!(
         o.status.success(),
@@ -897,11 +902,11 @@ fn over_ros(
     )
 }
 
-const PANDA_JOINTS: &str =
+pub(crate) const PANDA_JOINTS: &str =
     "panda_joint1,panda_joint2,panda_joint3,panda_joint4,panda_joint5,panda_joint6,panda_joint7";
-const PANDA_READY: &str = "0.0,-0.785398,0.0,-2.356194,0.0,1.570796,0.785398";
+pub(crate) const PANDA_READY: &str = "0.0,-0.785398,0.0,-2.356194,0.0,1.570796,0.785398";
 
-fn arm_standin(
+pub(crate) fn arm_standin(
     sb: &Sandbox,
     domain: u32,
     port: u16,
@@ -915,7 +920,7 @@ fn arm_standin(
 
 /// The `arm` stand-in of the robot `(joint names, their start, joint states topic)`
 /// listening on `port` in `domain`, taking `command` messages on `topic`.
-fn any_arm_standin(
+pub(crate) fn any_arm_standin(
     sb: &Sandbox,
     (names, initial, joint_topic): (&str, &str, &str),
     (domain, port): (u32, u16),
@@ -996,7 +1001,7 @@ fn run_arm(
     (r, s)
 }
 
-fn floats(v: &serde_json::Value) -> Vec<f64> {
+pub(crate) fn floats(v: &serde_json::Value) -> Vec<f64> {
     v.as_array().expect("array").iter().map(num).collect()
 }
 
@@ -1202,7 +1207,7 @@ fn a_viewer_started_late_still_gets_the_arms_description_and_fixed_frames() {
 }
 
 /// True if python3 also has Pinocchio (tests/servo_ik.py).
-fn pinocchio_ready() -> bool {
+pub(crate) fn pinocchio_ready() -> bool {
     python_ready()
         && Command::new("python3")
             .args(["-c", "import pinocchio"])
@@ -1282,7 +1287,22 @@ fn a_panda_over_ros2_takes_poses_as_moveit_servo_does() {
 }
 
 /// True if python3 also has MuJoCo (tests/mujoco_arm.py).
-fn mujoco_ready() -> bool {
+/// The arm stand-in as a Panda in MuJoCo, a wall 4.5 cm under its hand and the
+/// contact force on the hand published as a force-torque sensor's in its frame.
+pub(crate) const MUJOCO_PANDA: [&str; 10] = [
+    "--mujoco",
+    concat!(env!("CARGO_MANIFEST_DIR"), "/robots/panda.urdf"),
+    "--tool",
+    "panda_hand",
+    "--wall-below",
+    "0.045",
+    "--wrench-topic",
+    "/fts/wrench",
+    "--wrench-frame",
+    "panda_hand",
+];
+
+pub(crate) fn mujoco_ready() -> bool {
     python_ready()
         && Command::new("python3")
             .args(["-c", "import mujoco"])
@@ -1304,26 +1324,7 @@ fn a_mujoco_panda_presses_a_wall_and_its_force_comes_back() {
     let sb = Sandbox::new("ros2-mujoco");
     let port = free_port();
     let topic = "/fr3_arm_controller/joint_trajectory";
-    let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/panda.urdf");
-    let arm = arm_standin(
-        &sb,
-        18,
-        port,
-        "trajectory",
-        topic,
-        &[
-            "--mujoco",
-            urdf,
-            "--tool",
-            "panda_hand",
-            "--wall-below",
-            "0.045",
-            "--wrench-topic",
-            "/fts/wrench",
-            "--wrench-frame",
-            "panda_hand",
-        ],
-    );
+    let arm = arm_standin(&sb, 18, port, "trajectory", topic, &MUJOCO_PANDA);
     let wrench = "wrench_topic = \"/fts/wrench\"\n";
     let (r, _) = run_panda(
         &sb,

@@ -412,6 +412,10 @@ def arm(a):
         rep["first"] = rep["first"] or list(values)
         rep["last"] = list(values)
         rep["q_at_last"] = list(q)
+        # MuJoCo's contact force when the command before the last came (the last may
+        # be the end's hold, after which the robot relaxes).
+        rep["force_before_last"] = rep.get("force_at_last")
+        rep["force_at_last"] = target.get("force")
         rep["commands"] += 1
         rep["t_last"] = time.monotonic()
         target["q"] = list(values)
@@ -497,6 +501,7 @@ def arm(a):
             if sim:
                 force = sim.force_in(a.wrench_frame)
                 rep["max_force"] = max(rep["max_force"], math.hypot(*force))
+                target["force"] = list(force)
             put_wrench(wrench_stamped(a.wrench_frame, force, a.torque))
         return True
 

@@ -18,8 +18,8 @@ use tactile_runtime::driver::{changed, Counts, Failure, Handler, Io, Leader};
 pub struct MasterHandler {
     master: Master,
     device: Option<Box<dyn HapticDevice>>,
-    /// The real device's angles as the loop holds them.
-    held: Held,
+    /// The real device's reading as the loop holds it.
+    held: Held<tactile_devices::hand::Hand>,
     peer_timeout: u64,
     /// The sample in hand, as it went out.
     sent: Sent,
@@ -161,7 +161,9 @@ impl Leader for MasterHandler {
                 {
                     io.event(n, &what)?;
                 }
-                self.master.forward_measured(n, origin_ns, self.held.theta)
+                let (input, clutch) = (d.input(), d.clutch());
+                self.master
+                    .forward_measured(n, origin_ns, self.held.theta, input, clutch)
             }
         };
         self.sent = sent;

@@ -16,6 +16,7 @@ use crate::operator::{Approach, OperatorSource, Target, IDENTITY};
 use crate::simulated::HeldDevice;
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::{MasterForce, MasterSide};
+use tactile_devices::hand::Hand;
 use tactile_math::engine::Engine;
 use tactile_math::kernels::IkStatus;
 use tactile_messages::samples::{
@@ -24,7 +25,7 @@ use tactile_messages::samples::{
 };
 use tactile_records::master::{Answer, Effect, MasterCounters, Miss, Sent};
 use tactile_scenario::ControlKind;
-use tactile_scenario::{HandMode, MasterConfig, Scenario, ScenarioError};
+use tactile_scenario::{HandInput, HandMode, MasterConfig, Scenario, ScenarioError};
 
 /// The master: operator source, device model and HMD kernels.
 #[derive(Debug)]
@@ -50,6 +51,24 @@ pub struct Master {
     last_theta: [f64; 3],
     codec: Deadband,
     predictor: Predictor,
+    /// The operator's clutch is released at this sample (6-DoF only).
+    released: bool,
+    /// A real device's first reading: its pose is measured from there.
+    origin: Option<Hand>,
+    /// The devices' home (the handle with the joints at zero), m.
+    home: [f64; 3],
+    /// Where the handle is at this sample, m (the clutch spring's end).
+    handle: [f64; 3],
+}
+
+/// `q` relative to `q0` (both `[x, y, z, w]`): the turn from `q0` to `q`, about the
+/// base's axes (`q q0^-1`).
+fn relative(q: [f64; 4], q0: [f64; 4]) -> [f64; 4] {
+    let unit = |r: [f64; 4]| {
+        nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(r[3], r[0], r[1], r[2]))
+    };
+    let d = unit(q) * unit(q0).inverse();
+    [d.i, d.j, d.k, d.w]
 }
 
 impl Master {
@@ -110,6 +129,10 @@ impl Master {
                 if wave { 1e6 } else { 1e5 },
             ),
             control: MasterSide::new(&scenario.control, scenario.t_s()),
+            released: false,
+            origin: None,
+            home,
+            handle: home,
         })
     }
 
@@ -126,35 +149,68 @@ impl Master {
             true => self.impedance_hand(n),
         };
         let (mut f, mut sent) = self.encode(n, now_ns, target, hand_force);
-        self.turn(n, &mut f, &mut sent);
+        if self.source.six_dof() {
+            let t = n as f64 * self.t_s;
+            let r = self.source.rotation(n, self.t_s).unwrap_or(IDENTITY);
+            let r = match &self.approach {
+                Some(a) => a.apply_rotation(r, t),
+                None => r,
+            };
+            self.turn(&mut f, &mut sent, r, self.source.engaged(n, self.t_s));
+        }
         (f, sent)
     }
 
-    /// A 6-DoF operator's orientation and clutch onto c(n) and its record.
-    fn turn(&self, n: u64, f: &mut Forward, sent: &mut Sent) {
-        if !self.source.six_dof() {
-            return;
-        }
-        let t = n as f64 * self.t_s;
-        let r = self.source.rotation(n, self.t_s).unwrap_or(IDENTITY);
-        f.rotation = match &self.approach {
-            Some(a) => a.apply_rotation(r, t),
-            None => r,
-        };
+    /// A 6-DoF sample's orientation `r` and clutch onto c(n) and its record; released,
+    /// the operator feels the clutch spring instead of the robot.
+    fn turn(&mut self, f: &mut Forward, sent: &mut Sent, r: [f64; 4], engaged: bool) {
+        f.rotation = r;
         f.signal.flags |= FLAG_POSE;
-        sent.rotation = Some(f.rotation);
-        if !self.source.engaged(n, self.t_s) {
+        sent.rotation = Some(r);
+        self.released = !engaged;
+        if self.released {
             f.signal.flags |= FLAG_RELEASED;
             sent.released = true;
         }
     }
 
-    /// Sample n forward from a real device's encoders: b(n) = `theta` as measured (the
-    /// operator's hand is the real one, so the target is where the handle is).
-    pub fn forward_measured(&mut self, n: u64, now_ns: u64, theta: [f64; 3]) -> (Forward, Sent) {
-        self.theta_md = theta;
-        let handle = self.truth.fk(theta);
-        self.encode(n, now_ns, handle, [0.0; 3])
+    /// Sample n forward from a real device's reading (the operator's hand is the real
+    /// one, so the target is where the handle is): b(n) = three joints as measured, or
+    /// a pose device's position moved so that its first reading is the devices' home.
+    /// A 6-DoF device's orientation goes relative to its first reading (the operator's
+    /// home, as a trajectory's), with its clutch (`None`: none, always engaged).
+    pub fn forward_measured(
+        &mut self,
+        n: u64,
+        now_ns: u64,
+        hand: Hand,
+        input: HandInput,
+        clutch: Option<bool>,
+    ) -> (Forward, Sent) {
+        let origin = *self.origin.get_or_insert(hand);
+        let (mut f, mut sent) = match input {
+            HandInput::Joints => {
+                self.theta_md = hand.point;
+                let handle = self.truth.fk(hand.point);
+                self.encode(n, now_ns, handle, [0.0; 3])
+            }
+            HandInput::Pose => {
+                let c = [0, 1, 2].map(|k| self.home[k] + hand.point[k] - origin.point[k]);
+                let moved = match n {
+                    0 => [0.0; 3],
+                    _ => [0, 1, 2].map(|k| c[k] - self.handle[k]),
+                };
+                self.encode_at(n, now_ns, (c, c, [0.0; 3]), moved)
+            }
+        };
+        if hand.rotation.is_some() || clutch.is_some() {
+            let r = match (hand.rotation, origin.rotation) {
+                (Some(q), Some(q0)) => relative(q, q0),
+                _ => IDENTITY,
+            };
+            self.turn(&mut f, &mut sent, r, clutch.unwrap_or(true));
+        }
+        (f, sent)
     }
 
     /// The torques commanded now, N m.
@@ -177,6 +233,23 @@ impl Master {
     ) -> (Forward, Sent) {
         let c = self.engine.fk(self.theta_md);
         let moved = self.moved(n);
+        let handle = self.truth.fk(self.theta_md);
+        let (f, mut sent) = self.encode_at(n, now_ns, (c, target, hand_force), moved);
+        self.handle = handle;
+        sent.handle = handle;
+        (f, sent)
+    }
+
+    /// c(n) (`at`: c, the hand's target and its force) having `moved` since the last
+    /// sample, through the control and codec, and the record of the sample.
+    fn encode_at(
+        &mut self,
+        n: u64,
+        now_ns: u64,
+        (c, target, hand_force): ([f64; 3], [f64; 3], [f64; 3]),
+        moved: [f64; 3],
+    ) -> (Forward, Sent) {
+        self.handle = c;
         self.control.measure(moved);
         let mut f = Forward {
             seq: n,
@@ -200,7 +273,7 @@ impl Master {
             target,
             theta_md: self.theta_md,
             c,
-            handle: self.truth.fk(self.theta_md),
+            handle: c,
             hand_force,
             tick_ns: now_ns,
             send_ns: 0,
@@ -325,7 +398,10 @@ impl Master {
     /// Takes the control's force as the felt force and its KFF-HMD torques, clamped;
     /// counts the clamps and says whether there were any.
     fn command(&mut self, out: &MasterForce) -> bool {
-        let felt = out.force;
+        let felt = match self.released {
+            false => out.force,
+            true => self.clutch_spring(),
+        };
         let raw = self.engine.kff(self.theta_md, felt);
         let tau: [f64; 3] = [0, 1, 2].map(|j| {
             let l = self.limits.torque_limit[j];
@@ -337,6 +413,16 @@ impl Master {
         self.last_felt = felt;
         self.last_tau = tau;
         u64::from(out.clamped) + tau_clamped > 0
+    }
+
+    /// While the clutch is released: the spring towards the devices' home, within the
+    /// force limit (zero without one).
+    fn clutch_spring(&self) -> [f64; 3] {
+        let (k, limit) = (self.limits.clutch_spring, self.limits.force_limit);
+        if k == 0.0 {
+            return [0.0; 3];
+        }
+        [0, 1, 2].map(|i| (k * (self.home[i] - self.handle[i])).clamp(-limit, limit))
     }
 
     fn answer(&self, q: &Backward, flags: u32, out: &MasterForce) -> Answer {
@@ -477,3 +563,7 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "hmd_device_tests.rs"]
+mod device_tests;

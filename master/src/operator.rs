@@ -10,7 +10,7 @@ use crate::trajectory::Trajectory;
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::path::Path;
 use tactile_math::validation::{paper_joint_path, MOVE_S};
-use tactile_scenario::{CodecKind, Operator, Scenario, ScenarioError};
+use tactile_scenario::{Operator, Scenario, ScenarioError};
 
 /// No turn, `[x, y, z, w]`.
 pub const IDENTITY: [f64; 4] = [0.0, 0.0, 0.0, 1.0];
@@ -208,28 +208,7 @@ impl OperatorSource {
         if !self.six_dof() {
             return Ok(());
         }
-        let bad = |field: &str, problem: &str| {
-            Err(ScenarioError::Invalid {
-                field: field.into(),
-                problem: format!("the operator's trajectory has an orientation or a clutch (a 6-DoF run): {problem}"),
-            })
-        };
-        let equal = |d: [i64; 3]| d[0] == d[1] && d[1] == d[2];
-        if sc.slave.arm.is_none() {
-            return bad("slave.arm", "the paper's arm has three joints and cannot turn its tool; a 6-DoF run needs [slave.arm]");
-        }
-        for (dir, c) in [
-            ("forward", &sc.network.forward),
-            ("backward", &sc.network.backward),
-        ] {
-            if !equal(c.delay) || c.schedule.iter().any(|e| !equal([e[1], e[2], e[3]])) {
-                return bad(&format!("network.{dir}.delay"), "a pose (a wrench back) crosses in one packet, so the three delays (and every schedule row's) must be equal");
-            }
-        }
-        if sc.codec.forward.kind != CodecKind::None {
-            return bad("codec.forward.kind", "the deadband codecs weigh positions only and would leave turns unsent; use \"none\"");
-        }
-        Ok(())
+        sc.check_six_dof("the operator's trajectory has an orientation or a clutch (a 6-DoF run)")
     }
 
     /// The target at sample `n` with sampling period `t_s`.

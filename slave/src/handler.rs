@@ -258,7 +258,7 @@ impl Follower for SlaveHandler {
         }
         self.last_step = Some(step);
         let record = match self.slave.arm() {
-            Some(a) => SlaveSample::ArmStep(step, joints(a, h.torque)),
+            Some(a) => SlaveSample::ArmStep(step, joints(a, h.torque, self.slave.rotation())),
             None => SlaveSample::Step(step),
         };
         Ok(Reply {
@@ -322,15 +322,16 @@ impl Follower for SlaveHandler {
             }
         };
         Ok(Some(match self.slave.arm() {
-            Some(a) => SlaveSample::ArmHold(held, joints(a, [0.0; 3])),
+            Some(a) => SlaveSample::ArmHold(held, joints(a, [0.0; 3], self.slave.rotation())),
             None => SlaveSample::Hold(held),
         }))
     }
 }
 
 /// A URDF arm's joints and tool orientation as its record holds them.
-fn joints(arm: &UrdfArm, torque: [f64; 3]) -> ArmJoints {
+fn joints(arm: &UrdfArm, torque: [f64; 3], master: Option<[f64; 4]>) -> ArmJoints {
     let a = arm.state();
+    let (offset, offset_rotation) = arm.offsets();
     ArmJoints {
         q_ref: a.q_ref.clone(),
         q: a.q.clone(),
@@ -339,5 +340,8 @@ fn joints(arm: &UrdfArm, torque: [f64; 3]) -> ArmJoints {
         target_rotation: arm.target_rotation(),
         tool_rotation: arm.tool_rotation(),
         released: arm.released(),
+        master_rotation: master.unwrap_or([0.0, 0.0, 0.0, 1.0]),
+        offset,
+        offset_rotation,
     }
 }

@@ -416,7 +416,9 @@ impl Slave {
         let contact = deepest_contact(&self.objects, truth);
         let (force, surface, object) = match (sensor, contact) {
             (Some(f), _) => {
-                // A force-torque sensor: its force is h(n); no surface is known.
+                // A force-torque sensor: its force is h(n); no surface is known. An
+                // arm's is in its base's axes: turned into the master's and scaled.
+                let f = self.arm.as_ref().map_or(f, |a| a.felt(f));
                 if f.iter().any(|x| *x != 0.0) {
                     *flags |= FLAG_CONTACT;
                     self.counters.contact_steps += 1;
@@ -426,8 +428,8 @@ impl Slave {
             (None, Some(c)) => {
                 *flags |= FLAG_CONTACT;
                 self.counters.contact_steps += 1;
-                let f = match self.arm {
-                    Some(_) => kernels::fbf(c.surface, tool, c.stiffness),
+                let f = match &self.arm {
+                    Some(a) => a.felt_environment(kernels::fbf(c.surface, tool, c.stiffness)),
                     None => self.engine.fbf(c.surface, tool, c.stiffness),
                 };
                 (f, c.surface, c.object as u32)
@@ -463,7 +465,8 @@ impl Slave {
         out.signal.flags |= flags;
         // A 6-DoF sample is answered with a wrench: a real arm's measured torque about
         // the tool; the torque of the simulated point contact at the tool is zero.
-        out.torque = std::mem::take(&mut self.measured_torque);
+        let torque = std::mem::take(&mut self.measured_torque);
+        out.torque = self.arm.as_ref().map_or(torque, |a| a.felt(torque));
         out.signal.flags |= v.signal.flags & FLAG_POSE;
         out
     }
@@ -486,6 +489,10 @@ fn count_followed(c: &mut SlaveCounters, f: Followed) -> u32 {
     if f.refused {
         flags |= FLAG_REJECTED;
         c.rejected += 1;
+    }
+    if f.workspace_clamped {
+        flags |= FLAG_IK_CLAMPED;
+        c.workspace_clamped += 1;
     }
     flags
 }

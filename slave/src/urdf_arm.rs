@@ -55,6 +55,8 @@ pub struct UrdfArm {
     /// The offsets captured at the last re-engage: the master's mapped pose moved by
     /// these is the target (`None` until the clutch was first released).
     indexing: Option<Indexing>,
+    /// The master's base frame in the arm's (`cfg.rotation`), `None` for none.
+    frame: Option<Matrix3<f64>>,
 }
 
 /// Where the master's mapped pose met the robot's reference at a re-engage: the
@@ -96,6 +98,8 @@ pub struct Followed {
     pub damped: bool,
     /// The IK refused the call (a non-finite input): the reference held.
     pub refused: bool,
+    /// The target was outside the workspace box and clamped onto it.
+    pub workspace_clamped: bool,
 }
 
 /// What one period of holding did.
@@ -190,6 +194,8 @@ impl UrdfArm {
             held: None,
             released: false,
             indexing: None,
+            frame: (!cfg.rotation.is_identity())
+                .then(|| Matrix3::from_fn(|i, j| cfg.rotation.matrix()[i][j])),
         })
     }
 
@@ -206,11 +212,23 @@ impl UrdfArm {
     /// The tool's target in the arm's base frame for the master's `position` and,
     /// from a 6-DoF master, `rotation` (a unit quaternion `[x, y, z, w]` relative to
     /// the operator's home), moved by the clutch's offsets.
-    pub fn target(&self, position: [f64; 3], rotation: Option<[f64; 4]>) -> Frame {
+    /// A target outside the workspace box is clamped onto it (the second value says
+    /// so).
+    pub fn target(&self, position: [f64; 3], rotation: Option<[f64; 4]>) -> (Frame, bool) {
+        let mut t = self.unclamped_target(position, rotation);
+        let (p, clamped) = self.cfg.clamp(t.p.into());
+        t.p = Vector3::from(p);
+        (t, clamped)
+    }
+
+    /// [`UrdfArm::target`] before the workspace box: the master's turn, in its base's
+    /// axes, is the same turn about the arm's base's axes it maps to.
+    fn unclamped_target(&self, position: [f64; 3], rotation: Option<[f64; 4]>) -> Frame {
         let home = self.home_tool.p.into();
-        let r = match rotation {
-            Some(q) => rotation_matrix(q) * self.home_tool.r,
-            None => self.home_tool.r,
+        let r = match (rotation, &self.frame) {
+            (Some(q), None) => rotation_matrix(q) * self.home_tool.r,
+            (Some(q), Some(m)) => m * rotation_matrix(q) * m.transpose() * self.home_tool.r,
+            (None, _) => self.home_tool.r,
         };
         let p = Vector3::from(self.cfg.to_robot(home, self.master_home, position));
         match self.indexing {
@@ -232,6 +250,15 @@ impl UrdfArm {
     /// The orientation reference relative to the tool's home, `[x, y, z, w]`.
     pub fn target_rotation(&self) -> [f64; 4] {
         quaternion(&(self.reference.0.r * self.home_tool.r.transpose()))
+    }
+
+    /// The clutch's offsets captured at the last engage: position (m, base frame) and
+    /// orientation `[x, y, z, w]`; zero and the identity before the first release.
+    pub fn offsets(&self) -> ([f64; 3], [f64; 4]) {
+        match &self.indexing {
+            Some(ix) => (ix.dp.into(), quaternion(&ix.dr)),
+            None => ([0.0; 3], [0.0, 0.0, 0.0, 1.0]),
+        }
     }
 
     /// True while the operator's clutch is released.
@@ -259,7 +286,7 @@ impl UrdfArm {
             return;
         }
         self.indexing = None;
-        let raw = self.target(position, rotation);
+        let raw = self.unclamped_target(position, rotation);
         let held = self.reference.0;
         self.indexing = Some(Indexing {
             dp: held.p - raw.p,
@@ -277,6 +304,26 @@ impl UrdfArm {
         self.chain.fk(&self.state.q).p.into()
     }
 
+    /// A displacement's length in the master's workspace, m.
+    fn master_distance(&self, d: Vector3<f64>) -> f64 {
+        match self.cfg.scale {
+            tactile_scenario::Scale::Uniform(s) => d.norm() / s,
+            tactile_scenario::Scale::PerAxis(s) => Vector3::from_fn(|k, _| d[k] / s[k]).norm(),
+        }
+    }
+
+    /// A force at the tool in the base's axes (a sensor's) as the operator is to feel
+    /// it: in the master's axes, scaled (`slave.arm.rotation`, `force_scale`).
+    pub fn felt(&self, f: [f64; 3]) -> [f64; 3] {
+        self.cfg.force_to_master(f)
+    }
+
+    /// The environment's force, evaluated in the master's axes, as the operator is to
+    /// feel it: scaled.
+    pub fn felt_environment(&self, f: [f64; 3]) -> [f64; 3] {
+        f.map(|v| self.cfg.force_scale * v)
+    }
+
     fn to_master(&self, p: &Vector3<f64>) -> [f64; 3] {
         let home = self.home_tool.p.into();
         self.cfg.to_master(home, self.master_home, (*p).into())
@@ -287,7 +334,7 @@ impl UrdfArm {
     /// servo follows, as a trajectory generator's).
     pub fn follow(&mut self, position: [f64; 3], rotation: Option<[f64; 4]>, dt: f64) -> Followed {
         self.engage(position, rotation);
-        let target = self.target(position, rotation);
+        let (target, workspace_clamped) = self.target(position, rotation);
         let v = (target.p - self.reference.0.p) / dt;
         let w = match rotation.is_some() || self.indexing.is_some() {
             true => {
@@ -315,10 +362,12 @@ impl UrdfArm {
                     velocity_limited: s.velocity_limited,
                     damped: s.damping > 0.0,
                     refused: false,
+                    workspace_clamped,
                 }
             }
             Err(_) => Followed {
                 refused: true,
+                workspace_clamped,
                 ..Followed::default()
             },
         }
@@ -340,7 +389,7 @@ impl UrdfArm {
             started,
             clamps,
             // Measured in the master's frame, as the paper arm's drift is.
-            drift_m: (p - p0).norm() / self.cfg.scale,
+            drift_m: self.master_distance(p - p0),
             tool: self.to_master(&p),
         }
     }
@@ -373,7 +422,7 @@ impl UrdfArm {
         Holding {
             started,
             clamps: 0,
-            drift_m: (p - p0).norm() / self.cfg.scale,
+            drift_m: self.master_distance(p - p0),
             tool: self.to_master(&p),
         }
     }
@@ -476,7 +525,10 @@ impl UrdfArm {
         let Some(c) = deepest_contact(objects, tool) else {
             return vec![0.0; self.chain.dof()];
         };
-        let f = Vector3::from(kernels::fbf(c.surface, tool, c.stiffness));
+        let f = Vector3::from(
+            self.cfg
+                .force_to_robot(kernels::fbf(c.surface, tool, c.stiffness)),
+        );
         (0..self.chain.dof())
             .map(|i| self.jac.fixed_view::<3, 1>(0, i).dot(&f))
             .collect()

@@ -2,7 +2,7 @@
 use super::*;
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
-use tactile_scenario::{ArmIkConfig, CartesianConfig};
+use tactile_scenario::{ArmIkConfig, CartesianConfig, FrameRotation, Scale, Workspace};
 
 fn panda_xml() -> String {
     let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../deploy/robots/panda.urdf");
@@ -25,7 +25,10 @@ fn panda_cfg() -> ArmConfig {
         ],
         kp: vec![600.0, 600.0, 600.0, 600.0, 250.0, 150.0, 50.0],
         kd: vec![50.0, 50.0, 50.0, 50.0, 30.0, 25.0, 15.0],
-        scale: 1.0,
+        scale: Scale::Uniform(1.0),
+        rotation: FrameRotation::default(),
+        workspace: None,
+        force_scale: 1.0,
         step_s: 2.5e-4,
         gravity: [0.0, 0.0, -9.81],
         ik: ArmIkConfig::default(),
@@ -68,7 +71,7 @@ fn at_rest_the_servo_gives_the_gravity_torques() {
 #[test]
 fn the_tool_follows_a_scaled_displacement_and_maps_back() {
     let cfg = ArmConfig {
-        scale: 2.0,
+        scale: Scale::Uniform(2.0),
         ..panda_cfg()
     };
     let mut arm = UrdfArm::new(&cfg, &panda_xml(), HOME).expect("arm");
@@ -88,6 +91,77 @@ fn the_tool_follows_a_scaled_displacement_and_maps_back() {
     for k in 0..3 {
         assert!((t[k] - goal[k]).abs() < 1e-5, "{t:?}");
     }
+}
+
+/// The map of a Touch on a desk (its y up, its z towards the operator) onto a robot
+/// (z up): a quarter turn about x, a per-axis scale. The tool follows `S R d`, the
+/// master's turn about its own up axis turns the tool about the robot's up axis, and
+/// a force the robot measures comes back in the master's axes, scaled.
+#[test]
+fn a_rotated_per_axis_map_moves_turns_and_feels_in_the_right_axes() {
+    let cfg = ArmConfig {
+        scale: Scale::PerAxis([2.0, 3.0, 1.5]),
+        rotation: FrameRotation::RpyDeg([90.0, 0.0, 0.0]),
+        force_scale: 0.5,
+        ..panda_cfg()
+    };
+    let arm = UrdfArm::new(&cfg, &panda_xml(), HOME).expect("arm");
+    let home_tool = arm.chain().fk(&cfg.home);
+    // Master: 1 cm right, 2 cm up, 1 cm towards the operator.
+    let goal = [HOME[0] + 0.01, HOME[1] + 0.02, HOME[2] + 0.01];
+    let (t, clamped) = arm.target(goal, None);
+    assert!(!clamped);
+    let d = t.p - home_tool.p;
+    // Right stays x (x2), up becomes z (x1.5), towards the operator becomes -y (x3).
+    for (k, want) in [0.02, -0.03, 0.03].iter().enumerate() {
+        assert!((d[k] - want).abs() < 1e-12, "{d:?}");
+    }
+    let back = cfg.to_master(home_tool.p.into(), HOME, t.p.into());
+    for k in 0..3 {
+        assert!((back[k] - goal[k]).abs() < 1e-12, "{back:?}");
+    }
+    // A turn about the master's up axis (y) is a turn about the robot's up axis (z).
+    let turn = UnitQuaternion::from_axis_angle(&nalgebra::Vector3::y_axis(), 0.3);
+    let (t, _) = arm.target(HOME, Some([turn.i, turn.j, turn.k, turn.w]));
+    let about = tactile_chain::spatial::log_rotation(&(t.r * home_tool.r.transpose()));
+    assert!(
+        (about - nalgebra::Vector3::new(0.0, 0.0, 0.3)).norm() < 1e-12,
+        "{about:?}"
+    );
+    // 10 N pushing the robot's tool down (-z) is 5 N pushing the hand down (-y).
+    let f = arm.felt([0.0, 0.0, -10.0]);
+    for (k, want) in [0.0, -5.0, 0.0].iter().enumerate() {
+        assert!((f[k] - want).abs() < 1e-12, "{f:?}");
+    }
+}
+
+/// A target beyond the workspace box is clamped onto it and said to be; the arm goes
+/// no further however far the master goes.
+#[test]
+fn a_target_outside_the_workspace_is_clamped_and_counted() {
+    let probe = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    let home = probe.chain().fk(&panda_cfg().home).p;
+    let cfg = ArmConfig {
+        workspace: Some(Workspace {
+            min: [home.x - 0.5, home.y - 0.5, home.z - 0.02],
+            max: [home.x + 0.5, home.y + 0.5, home.z + 0.5],
+        }),
+        ..panda_cfg()
+    };
+    let mut arm = UrdfArm::new(&cfg, &panda_xml(), HOME).expect("arm");
+    let down = [HOME[0], HOME[1], HOME[2] - 0.05];
+    let mut clamped = 0;
+    for _ in 0..3000 {
+        clamped += u32::from(arm.follow(down, None, 1e-3).workspace_clamped);
+        arm.advance(1e-3, &[]);
+    }
+    assert!(clamped > 2000, "{clamped}");
+    let z = arm.chain().fk(&arm.state().q).p.z;
+    assert!(
+        (z - (home.z - 0.02)).abs() < 1e-4,
+        "{z} against the floor {}",
+        home.z - 0.02
+    );
 }
 
 /// The Cartesian impedance is a spring at the tool: held 2 cm into a 1000 N/m wall

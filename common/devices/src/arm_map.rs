@@ -58,15 +58,7 @@ impl ArmJointMap {
     pub fn positions(&self, js: &JointState) -> Result<Vec<f64>, Reject> {
         let mut q = Vec::with_capacity(self.names.len());
         for (i, name) in self.names.iter().enumerate() {
-            let v = *js
-                .name
-                .iter()
-                .position(|n| n == name)
-                .and_then(|k| js.position.get(k))
-                .ok_or_else(|| Reject::Missing(name.clone()))?;
-            if !v.is_finite() {
-                return Err(Reject::NotFinite(name.clone()));
-            }
+            let v = crate::map::position_of(js, name)?;
             let (min, max) = (self.lower[i] - LIMIT_MARGIN, self.upper[i] + LIMIT_MARGIN);
             if !(min..=max).contains(&v) {
                 return Err(Reject::OutOfRange {

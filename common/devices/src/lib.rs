@@ -2,12 +2,14 @@
 //! operator's hand and a robot arm, with their joints mapped and checked ([`map`]),
 //! each tick's judgement of how fresh their newest sample is ([`watch`]) and what the
 //! loop holds through staleness and loss ([`held`]); over ROS 2 on rmw_zenoh (the
-//! node's session [`rmw_node`], the devices [`ros_devices`] and the live view
+//! node's session [`rmw_node`], the device [`ros_hand`], the robots [`ros_devices`]
+//! and [`ros_arm`], and the live view
 //! [`live_view`], behind the `zenoh` feature). The judgements are pure and always
 //! built; the I/O only with Zenoh.
 
 pub mod arm_map;
 pub mod gate;
+pub mod hand;
 pub mod held;
 #[cfg(feature = "zenoh")]
 pub mod live_arm;
@@ -20,6 +22,8 @@ pub mod rmw_node;
 pub mod ros_arm;
 #[cfg(feature = "zenoh")]
 pub mod ros_devices;
+#[cfg(feature = "zenoh")]
+pub mod ros_hand;
 pub mod watch;
 
 pub use map::{JointMap, Reject};
@@ -46,10 +50,19 @@ pub trait Peripheral {
     }
 }
 
-/// A real master device, as the master's loop uses it: encoders in, force out.
+/// A real master device, as the master's loop uses it: the handle in (three joints,
+/// or a pose; with an orientation and a clutch on a 6-DoF device), force out.
 pub trait HapticDevice: Peripheral {
-    /// The encoders' newest angles at this tick, judged.
-    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change);
+    /// The handle's newest reading at this tick, judged.
+    fn read(&mut self, now_ns: u64) -> (Reading<hand::Hand>, Change);
+    /// What a reading's point is: three joint angles or a position.
+    fn input(&self) -> tactile_scenario::HandInput {
+        tactile_scenario::HandInput::Joints
+    }
+    /// The clutch: engaged (true) or released; `None` for a device without one.
+    fn clutch(&self) -> Option<bool> {
+        None
+    }
     /// Sends the force to render, N, in the paper's base frame, through the gate.
     fn render(&mut self, force: [f64; 3], now_ns: u64);
     /// The force rises from zero again (the device or the loop back from a loss).

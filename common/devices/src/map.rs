@@ -33,10 +33,28 @@ pub enum Reject {
     /// A force that is NaN or infinite.
     #[error("force is not finite")]
     ForceNotFinite,
+    /// A pose that is not one: not finite, or an orientation that is not a rotation.
+    #[error("not a pose: {0}")]
+    BadPose(String),
     /// A force in a frame the arm's URDF does not have (it cannot be turned into the
     /// base's).
     #[error("force in frame {0:?}, which is not a link of the arm's URDF")]
     UnknownFrame(String),
+}
+
+/// The position of the joint `name` in a `JointState` (any order, other joints
+/// ignored): present and finite.
+pub fn position_of(js: &JointState, name: &str) -> Result<f64, Reject> {
+    let v = *js
+        .name
+        .iter()
+        .position(|n| n == name)
+        .and_then(|k| js.position.get(k))
+        .ok_or_else(|| Reject::Missing(name.to_string()))?;
+    match v.is_finite() {
+        true => Ok(v),
+        false => Err(Reject::NotFinite(name.to_string())),
+    }
 }
 
 /// Three named joints of a `JointState`, in the paper's convention.
@@ -61,13 +79,17 @@ impl JointMap {
     pub fn angles(&self, js: &JointState) -> Result<[f64; 3], Reject> {
         let mut theta = [0.0; 3];
         for (i, name) in self.names.iter().enumerate() {
+            let coupled = i == 2 && self.cfg.elbow_after_shoulder;
             let raw = js
                 .name
                 .iter()
                 .position(|n| n == name)
                 .and_then(|k| js.position.get(k))
                 .ok_or_else(|| Reject::Missing(name.clone()))?;
-            let t = self.cfg.sign[i] * raw * self.cfg.unit.radians() + self.cfg.offset[i];
+            let mut t = self.cfg.sign[i] * raw * self.cfg.unit.radians() + self.cfg.offset[i];
+            if coupled {
+                t += theta[1];
+            }
             if !t.is_finite() {
                 return Err(Reject::NotFinite(name.clone()));
             }
@@ -108,8 +130,12 @@ impl JointMap {
     }
 
     fn unclamped_raw(&self, theta: [f64; 3]) -> [f64; 3] {
+        let mut t = theta;
+        if self.cfg.elbow_after_shoulder {
+            t[2] -= t[1];
+        }
         [0, 1, 2]
-            .map(|i| (theta[i] - self.cfg.offset[i]) / (self.cfg.sign[i] * self.cfg.unit.radians()))
+            .map(|i| (t[i] - self.cfg.offset[i]) / (self.cfg.sign[i] * self.cfg.unit.radians()))
     }
 }
 
@@ -124,12 +150,12 @@ pub fn force_cdr(cdr: &[u8]) -> Result<[f64; 3], Reject> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use tactile_ros::msg::{Header, Message};
     use tactile_scenario::AngleUnit;
 
-    fn js(names: &[&str], pos: &[f64]) -> JointState {
+    pub(crate) fn js(names: &[&str], pos: &[f64]) -> JointState {
         JointState {
             header: Header::at(1, "base"),
             name: names.iter().map(|s| s.to_string()).collect(),
@@ -193,6 +219,25 @@ mod tests {
             ..WrenchStamped::default()
         };
         assert_eq!(force_cdr(&w.to_cdr()), Err(Reject::ForceNotFinite));
+    }
+
+    /// omni_common's elbow is measured from the shoulder: the paper's theta_3 is their
+    /// sum, and back.
+    #[test]
+    fn an_elbow_given_after_the_shoulder_is_added_to_it() {
+        let cfg = JointMapConfig {
+            elbow_after_shoulder: true,
+            ..JointMapConfig::default()
+        };
+        let m = JointMap::new(["a".into(), "b".into(), "c".into()], cfg);
+        let t = m
+            .angles(&js(&["a", "b", "c"], &[0.1, 0.4, -0.3]))
+            .expect("mapped");
+        assert_eq!(t, [0.1, 0.4, 0.4 + -0.3]);
+        let raw = m.raw(t);
+        for (r, w) in raw.iter().zip([0.1, 0.4, -0.3]) {
+            assert!((r - w).abs() < 1e-15, "{raw:?}");
+        }
     }
 
     #[test]

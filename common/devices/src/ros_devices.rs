@@ -1,16 +1,17 @@
-//! The master's haptic device and the slave's robot over ROS 2: subscriptions that
-//! fill an [`Inbox`] (decoded, mapped and checked on Zenoh's threads), a [`Watch`] the
-//! loop asks each tick, and the publisher of what the loop sends back.
+//! The slave's robot over ROS 2 (the master's device is in [`crate::ros_hand`]):
+//! subscriptions that fill an [`Inbox`] (decoded, mapped and checked on Zenoh's
+//! threads), a [`Watch`] the loop asks each tick, and the publisher of what the loop
+//! sends back.
 
-use crate::gate::{ForceGate, JointGate};
+use crate::gate::JointGate;
 use crate::map::force_cdr;
-use crate::rmw_node::{wall_ns, RosNode, RosPublisher, RosSubscription};
+use crate::rmw_node::{RosNode, RosPublisher, RosSubscription};
 use crate::watch::{Inbox, Latest, Watch};
 use crate::RosError;
-use crate::{Change, DeviceCounters, HapticDevice, JointMap, Peripheral, Reading, Reject, Robot};
+use crate::{Change, JointMap, Reading, Robot};
 use std::sync::Arc;
-use tactile_ros::msg::{Float64MultiArray, Header, JointState, Message, WrenchStamped};
-use tactile_scenario::{RosDeviceConfig, RosRobotConfig};
+use tactile_ros::msg::{Float64MultiArray, JointState, Message, WrenchStamped};
+use tactile_scenario::RosRobotConfig;
 
 /// Three joint angles or a force, as the loop takes them.
 type Inbox3 = Arc<Inbox<[f64; 3]>>;
@@ -26,136 +27,6 @@ fn joints_in(
         fill.offer(map.angles_cdr(cdr), at);
     })?;
     Ok((inbox, sub))
-}
-
-/// A haptic device through its ROS 2 driver.
-#[derive(Debug)]
-pub struct RosHapticDevice {
-    /// The session everything below lives on, kept open while the device is.
-    node: Arc<RosNode>,
-    joints: Arc<Inbox<[f64; 3]>>,
-    _sub: RosSubscription,
-    force: RosPublisher,
-    frame: String,
-    force_map: tactile_scenario::ForceMapConfig,
-    gate: ForceGate,
-    watch: Watch,
-    topic: String,
-    released: bool,
-}
-
-impl RosHapticDevice {
-    /// Subscribes to the encoders and declares the force publisher; forces stay
-    /// within `force_limit` N per axis.
-    pub fn open(
-        node: &Arc<RosNode>,
-        cfg: &RosDeviceConfig,
-        t_s_ns: u64,
-        force_limit: f64,
-    ) -> Result<Self, RosError> {
-        let t_s = t_s_ns as f64 * 1e-9;
-        let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
-        let (joints, sub) = joints_in(node, &cfg.joint_states, map)?;
-        Ok(RosHapticDevice {
-            node: Arc::clone(node),
-            joints,
-            _sub: sub,
-            force: node.publisher(&cfg.force_topic, WrenchStamped::TYPE)?,
-            frame: cfg.frame_id.clone(),
-            force_map: cfg.force_map.clone(),
-            gate: ForceGate::new(force_limit, cfg.max_force_rate, cfg.ramp_s, t_s),
-            watch: Watch::new(&cfg.watch, t_s_ns),
-            topic: cfg.joint_states.clone(),
-            released: false,
-        })
-    }
-
-    fn wrench(&self, force: [f64; 3]) -> Vec<u8> {
-        WrenchStamped {
-            header: Header::at(wall_ns(), &self.frame),
-            force,
-            torque: [0.0; 3],
-        }
-        .to_cdr()
-    }
-}
-
-/// How many times the zero at the end is put, and how far apart: a driver that misses
-/// one (a subscriber's queue full) takes the next.
-const RELEASE_PUTS: u32 = 3;
-const RELEASE_GAP: std::time::Duration = std::time::Duration::from_millis(5);
-
-impl Drop for RosHapticDevice {
-    /// A driver holds its last command: leave the device rendering nothing, however
-    /// the run ends (the loop's driver releases it first; this is the last resort).
-    fn drop(&mut self) {
-        if !self.released {
-            self.release();
-        }
-    }
-}
-
-impl Peripheral for RosHapticDevice {
-    fn kind(&self) -> &'static str {
-        "device"
-    }
-
-    fn heard(&self) -> bool {
-        self.joints.latest().is_some()
-    }
-
-    fn counters(&self) -> DeviceCounters {
-        self.watch.counters(&[self.joints.counts()])
-    }
-
-    fn take_reject(&self) -> Option<Reject> {
-        self.joints.take_reject()
-    }
-
-    fn describe(&self) -> String {
-        format!("the device on {}", self.topic)
-    }
-
-    fn unreached(&self) -> Option<String> {
-        self.node.unreached()
-    }
-}
-
-impl HapticDevice for RosHapticDevice {
-    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change) {
-        self.watch.judge(self.joints.latest(), now_ns)
-    }
-
-    fn render(&mut self, force: [f64; 3], _now_ns: u64) {
-        let passed = self.gate.pass(self.force_map.to_device(force));
-        self.watch.gated(&passed);
-        self.watch.ramps(self.gate.ramps());
-        if let Some(f) = passed.value() {
-            let ok = self.force.put(&self.wrench(f));
-            self.watch.published(ok);
-        }
-    }
-
-    fn restart_ramp(&mut self) {
-        self.gate.restart();
-        self.watch.ramps(self.gate.ramps());
-    }
-
-    fn release(&mut self) -> bool {
-        let zero = self.wrench([0.0; 3]);
-        let (mut sent, mut matched) = (false, false);
-        for k in 0..RELEASE_PUTS {
-            if k > 0 {
-                std::thread::sleep(RELEASE_GAP);
-            }
-            let (s, m) = self.force.put_reliably(&zero);
-            self.watch.published(s);
-            (sent, matched) = (sent || s, matched || m);
-        }
-        self.released = true;
-        self.watch.released(sent && matched);
-        sent && matched
-    }
 }
 
 /// A robot arm through ros2_control (and a force-torque sensor, if named).

@@ -33,6 +33,8 @@ pub struct SlaveCounters {
     pub ik_velocity_limited: u64,
     /// A URDF arm: IK calls that damped near a singularity.
     pub ik_damped: u64,
+    /// Targets outside the arm's workspace box, clamped onto it.
+    pub workspace_clamped: u64,
 }
 
 /// One step on a received v(n).
@@ -106,6 +108,17 @@ pub struct ArmJoints {
     pub target_rotation: [f64; 4],
     /// The tool's orientation (FK of the joints) relative to its home, `[x, y, z, w]`.
     pub tool_rotation: [f64; 4],
+    /// The 6-DoF master's orientation the arm follows (relative to the operator's
+    /// home, about the master base's axes), as last accepted; the identity for a 3-DoF
+    /// master.
+    pub master_rotation: [f64; 4],
+    /// The clutch's position offset captured at the last engage, m in the base frame:
+    /// where the master's mapped position met the robot's held reference (zero before
+    /// the first release).
+    pub offset: [f64; 3],
+    /// The clutch's orientation offset captured then, `[x, y, z, w]` (applied on the
+    /// right of the mapped orientation).
+    pub offset_rotation: [f64; 4],
     /// The operator's clutch was released: the references held.
     pub released: bool,
 }

@@ -7,6 +7,7 @@
 
 pub mod arm;
 pub mod cdr;
+pub mod hand_msg;
 pub mod msg;
 pub mod rmw;
 pub mod schema;

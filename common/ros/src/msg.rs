@@ -89,12 +89,12 @@ impl Header {
         }
     }
 
-    fn encode(&self, w: &mut CdrWriter) {
+    pub(crate) fn encode(&self, w: &mut CdrWriter) {
         self.stamp.encode(w);
         w.string(&self.frame_id);
     }
 
-    fn decode(r: &mut CdrReader<'_>) -> Result<Header, CdrError> {
+    pub(crate) fn decode(r: &mut CdrReader<'_>) -> Result<Header, CdrError> {
         Ok(Header {
             stamp: Time::decode(r)?,
             frame_id: r.string()?,
@@ -102,24 +102,24 @@ impl Header {
     }
 }
 
-fn vec3(w: &mut CdrWriter, v: &[f64; 3]) {
+pub(crate) fn vec3(w: &mut CdrWriter, v: &[f64; 3]) {
     v.iter().for_each(|x| w.f64(*x));
 }
 
-fn read_vec3(r: &mut CdrReader<'_>) -> Result<[f64; 3], CdrError> {
+pub(crate) fn read_vec3(r: &mut CdrReader<'_>) -> Result<[f64; 3], CdrError> {
     Ok([r.f64()?, r.f64()?, r.f64()?])
 }
 
-fn read_f64s(r: &mut CdrReader<'_>) -> Result<Vec<f64>, CdrError> {
+pub(crate) fn read_f64s(r: &mut CdrReader<'_>) -> Result<Vec<f64>, CdrError> {
     let n = r.seq_len()?;
     (0..n).map(|_| r.f64()).collect()
 }
 
-fn quat(w: &mut CdrWriter, q: &[f64; 4]) {
+pub(crate) fn quat(w: &mut CdrWriter, q: &[f64; 4]) {
     q.iter().for_each(|x| w.f64(*x));
 }
 
-fn f64s(w: &mut CdrWriter, v: &[f64]) {
+pub(crate) fn f64s(w: &mut CdrWriter, v: &[f64]) {
     w.seq_len(v.len());
     v.iter().for_each(|x| w.f64(*x));
 }

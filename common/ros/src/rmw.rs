@@ -29,6 +29,22 @@ pub const TYPE_HASHES: &[(&str, &str)] = &[
         "RIHS01_10f3786d7d40fd2b54367835614bff85d4ad3b5dab62bf8bca0cc232d73b4cd8",
     ),
     (
+        "std_msgs/msg/Bool",
+        "RIHS01_feb91e995ff9ebd09c0cb3d2aed18b11077585839fb5db80193b62d74528f6c9",
+    ),
+    (
+        "sensor_msgs/msg/Joy",
+        "RIHS01_0d356c79cad3401e35ffeb75a96a96e08be3ef896b8b83841d73e890989372c5",
+    ),
+    (
+        "omni_msgs/msg/OmniButtonEvent",
+        "RIHS01_3d8e3c256b4d68ef6679f98b28e039d4dc1a01fe243d8b286137c73157937d78",
+    ),
+    (
+        "omni_msgs/msg/OmniFeedback",
+        "RIHS01_ba84a6b698946ddb497c4d4b2062955836546f699b10724f3357b0a82c41dfff",
+    ),
+    (
         "geometry_msgs/msg/WrenchStamped",
         "RIHS01_8dc3deaf06b2ab281f9f9a742a8961c328ca7cec16e3fd6586d3a5c83fa78f77",
     ),

@@ -86,6 +86,17 @@ pub const DEFINITIONS: &[(&str, &str)] = &[
         "trajectory_msgs/JointTrajectory",
         "std_msgs/Header header\nstring[] joint_names\ntrajectory_msgs/JointTrajectoryPoint[] points\n",
     ),
+    ("std_msgs/Bool", "bool data\n"),
+    (
+        "sensor_msgs/Joy",
+        "std_msgs/Header header\nfloat32[] axes\nint32[] buttons\n",
+    ),
+    // The omni_common drivers' own (omni_msgs/msg/*.msg).
+    ("omni_msgs/OmniButtonEvent", "int32 grey_button\nint32 white_button\n"),
+    (
+        "omni_msgs/OmniFeedback",
+        "geometry_msgs/Vector3 force\ngeometry_msgs/Vector3 position\n",
+    ),
     (
         "tactile_msgs/SampleTiming",
         "uint64 sample\nbool answered\nint64 round_trip_ns\nint64 overhead_ns\n\

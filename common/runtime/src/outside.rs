@@ -79,14 +79,16 @@ fn open_ros(sc: &Scenario, role: Role, base_dir: &std::path::Path) -> Result<Out
     use std::sync::Arc;
     use tactile_devices::live_view::{every, LiveView};
     use tactile_devices::rmw_node::RosNode;
-    use tactile_devices::ros_devices::{RosHapticDevice, RosRobot};
+    use tactile_devices::ros_devices::RosRobot;
+    use tactile_devices::ros_hand::RosHapticDevice;
     let failed = |e: tactile_devices::RosError| NodeError::Failed(e.to_string());
     let node = Arc::new(RosNode::open(&sc.ros, &format!("tactile_{role}")).map_err(failed)?);
     let mut out = Outside::default();
     if role == Role::Master && sc.master.backend == Backend::Ros2 {
         let limit = sc.master.force_limit;
-        let d =
-            RosHapticDevice::open(&node, &sc.master.ros2, sc.t_s_ns(), limit).map_err(failed)?;
+        let gimbal = gimbal(sc, base_dir)?;
+        let d = RosHapticDevice::open(&node, &sc.master.ros2, gimbal, sc.t_s_ns(), limit)
+            .map_err(failed)?;
         out.haptic = Some(Box::new(d));
     }
     if role == Role::Slave && sc.slave.backend == Backend::Ros2 {
@@ -115,6 +117,21 @@ fn open_ros(sc: &Scenario, role: Role, base_dir: &std::path::Path) -> Result<Out
         out.live = Some(Box::new(live));
     }
     Ok(out)
+}
+
+/// The device's gimbal (`[master.ros2.gimbal]`), its URDF read and its chain checked.
+pub fn gimbal(
+    sc: &Scenario,
+    base_dir: &std::path::Path,
+) -> Result<Option<tactile_devices::hand::Gimbal>, NodeError> {
+    let Some(g) = &sc.master.ros2.gimbal else {
+        return Ok(None);
+    };
+    let path = base_dir.join(&g.urdf);
+    let xml = crate::files::read_text(&path, "URDF", 16 << 20).map_err(NodeError::BadInput)?;
+    tactile_devices::hand::Gimbal::new(&xml, &g.base, &g.tip, &g.frame)
+        .map(Some)
+        .map_err(|e| NodeError::BadInput(format!("master.ros2.gimbal: {}: {e}", path.display())))
 }
 
 /// A simulated `[slave.arm]` for the live view: its URDF as written and its tree.

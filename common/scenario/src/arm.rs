@@ -9,6 +9,7 @@
 //! mapped back into the master's frame, so a scenario's objects and stiffnesses keep
 //! their meaning whatever the arm.
 
+use crate::workspace::{self, apply, apply_transpose, FrameRotation, Scale, Workspace};
 use crate::{invalid, positive, ScenarioError};
 use serde::{Deserialize, Serialize};
 
@@ -28,9 +29,22 @@ pub struct ArmConfig {
     pub kp: Vec<f64>,
     /// Derivative gains, one per degree of freedom, N m s/rad.
     pub kd: Vec<f64>,
-    /// Metres the arm's tool moves per metre of the master's.
+    /// Metres the arm's tool moves per metre of the master's: one number, or one per
+    /// axis of the arm's base frame.
+    #[serde(default)]
+    pub scale: Scale,
+    /// The master's base frame in the arm's (`{ rpy_deg = [r, p, y] }` or `{ quaternion
+    /// = [x, y, z, w] }`): the master's displacements and turns are rotated by it on the
+    /// way out, the force back by its inverse. None by default.
+    #[serde(default)]
+    pub rotation: FrameRotation,
+    /// The box of the base frame the tool may be sent into (`{ min = [..], max = [..] }`,
+    /// m): a target outside is clamped onto it and counted. None by default.
+    #[serde(default)]
+    pub workspace: Option<Workspace>,
+    /// Newtons the operator feels per newton at the robot's tool.
     #[serde(default = "one")]
-    pub scale: f64,
+    pub force_scale: f64,
     /// Integration step of the arm's dynamics, s (at most 10 ms).
     #[serde(default = "step")]
     pub step_s: f64,
@@ -153,21 +167,64 @@ impl Default for ArmIkConfig {
 
 impl ArmConfig {
     /// Where the tool goes in the arm's base frame for the master's `position`: the
-    /// master's displacement from `master_home`, scaled, from the tool's home
-    /// `home_tool` (the frames' axes are the same). The loop's one map from the
-    /// master's workspace to the arm's; [`ArmConfig::to_master`] undoes it.
+    /// master's displacement from `master_home`, rotated into the arm's axes and
+    /// scaled, from the tool's home `home_tool`. The loop's one map from the master's
+    /// workspace to the arm's; [`ArmConfig::to_master`] undoes it. The workspace box is
+    /// applied by the arm after the clutch's offsets ([`ArmConfig::clamp`]).
     pub fn to_robot(
         &self,
         home_tool: [f64; 3],
         master_home: [f64; 3],
         position: [f64; 3],
     ) -> [f64; 3] {
-        [0, 1, 2].map(|k| home_tool[k] + self.scale * (position[k] - master_home[k]))
+        let d = self.rotate([0, 1, 2].map(|k| position[k] - master_home[k]));
+        let s = self.scale.axes();
+        [0, 1, 2].map(|k| home_tool[k] + s[k] * d[k])
     }
 
     /// The master's position for the tool at `p` in the arm's base frame.
     pub fn to_master(&self, home_tool: [f64; 3], master_home: [f64; 3], p: [f64; 3]) -> [f64; 3] {
-        [0, 1, 2].map(|k| master_home[k] + (p[k] - home_tool[k]) / self.scale)
+        let s = self.scale.axes();
+        let d = self.rotate_back([0, 1, 2].map(|k| (p[k] - home_tool[k]) / s[k]));
+        [0, 1, 2].map(|k| master_home[k] + d[k])
+    }
+
+    /// A force or torque at the arm's tool, in its base's axes, as the operator is
+    /// made to feel it: rotated into the master's axes and scaled by `force_scale`.
+    pub fn force_to_master(&self, f: [f64; 3]) -> [f64; 3] {
+        self.rotate_back(f).map(|v| self.force_scale * v)
+    }
+
+    /// A force in the master's axes (the environment's, evaluated there) as it acts on
+    /// the arm's tool, in the base's axes.
+    pub fn force_to_robot(&self, f: [f64; 3]) -> [f64; 3] {
+        self.rotate(f)
+    }
+
+    /// A vector of the master's axes in the base's (untouched, signs of zero and all,
+    /// without a rotation).
+    fn rotate(&self, v: [f64; 3]) -> [f64; 3] {
+        match self.rotation.is_identity() {
+            true => v,
+            false => apply(&self.rotation.matrix(), v),
+        }
+    }
+
+    /// A vector of the base's axes in the master's.
+    fn rotate_back(&self, v: [f64; 3]) -> [f64; 3] {
+        match self.rotation.is_identity() {
+            true => v,
+            false => apply_transpose(&self.rotation.matrix(), v),
+        }
+    }
+
+    /// A point of the base frame clamped into the workspace box, and whether it had to
+    /// be (never, without a box).
+    pub fn clamp(&self, p: [f64; 3]) -> ([f64; 3], bool) {
+        match &self.workspace {
+            Some(w) => w.clamp(p),
+            None => (p, false),
+        }
     }
 
     /// Checks what can be checked without the URDF; the lengths of `home`, `kp` and
@@ -206,12 +263,12 @@ impl ArmConfig {
                 positive(*x, &format!("slave.arm.{field}[{i}]"), zero_ok)?;
             }
         }
-        if !(self.scale.is_finite() && self.scale > 0.0 && self.scale <= 100.0) {
-            return Err(invalid(
-                "slave.arm.scale",
-                format!("{} is outside (0, 100]", self.scale),
-            ));
-        }
+        workspace::validate(
+            &self.scale,
+            &self.rotation,
+            self.workspace.as_ref(),
+            self.force_scale,
+        )?;
         if !self.step_s.is_finite() || self.step_s < 1e-6 || self.step_s > 0.01 {
             return Err(invalid(
                 "slave.arm.step_s",

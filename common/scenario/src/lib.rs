@@ -13,6 +13,7 @@ pub mod csv;
 mod device;
 pub mod endpoint;
 mod error;
+pub mod hand;
 mod lengths;
 mod master;
 mod network;
@@ -21,6 +22,9 @@ pub mod overrides;
 mod ros;
 mod slave;
 mod validate;
+mod watch;
+pub use watch::WatchConfig;
+pub mod workspace;
 
 pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
 pub use control::{
@@ -29,6 +33,7 @@ pub use control::{
 pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
 pub(crate) use error::{finite3, invalid, positive, positive3};
 pub use error::{one_line, ScenarioError};
+pub use hand::{ClutchConfig, ForceMessage, GimbalConfig, HandInput, OmniButton};
 pub use master::{FaultConfig, HandConfig, HandMode, MasterConfig, MasterDeviceConfig};
 pub use network::{
     ChannelConfig, JitterConfig, JitterDistribution, LossModel, Network, ReplayConfig,
@@ -37,7 +42,7 @@ pub use network::{
 pub use operator::{Operator, TrajectoryEnd};
 pub use ros::{
     topic_name, AngleUnit, Backend, ForceMapConfig, JointMapConfig, LiveConfig, RobotCommand,
-    RosConfig, RosDeviceConfig, RosRobotConfig, TorqueAbout, WatchConfig,
+    RosConfig, RosDeviceConfig, RosRobotConfig, TorqueAbout,
 };
 use serde::{Deserialize, Serialize};
 pub use slave::{
@@ -45,6 +50,7 @@ pub use slave::{
     NOMINAL_MAX_STIFFNESS,
 };
 pub use tactile_math::arith::ArithKind;
+pub use workspace::{FrameRotation, Scale, Workspace};
 
 /// How the master paces the loop.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]

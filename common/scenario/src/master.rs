@@ -26,6 +26,11 @@ pub struct MasterConfig {
     pub backend: Backend,
     /// The ROS 2 device, with `backend = "ros2"`.
     pub ros2: RosDeviceConfig,
+    /// While the operator's clutch is released the robot holds and the handle moves
+    /// freely: no force, or with this stiffness, N/m, a spring pulling the handle back
+    /// towards the device's home (the middle of its workspace, or where a pose device
+    /// started), so the next stroke starts there.
+    pub clutch_spring: f64,
 }
 
 impl Default for MasterConfig {
@@ -38,6 +43,7 @@ impl Default for MasterConfig {
             predictor: PredictorConfig::default(),
             backend: Backend::default(),
             ros2: RosDeviceConfig::default(),
+            clutch_spring: 0.0,
         }
     }
 }
@@ -185,6 +191,16 @@ impl MasterConfig {
         self.hand.validate()?;
         self.device.validate()?;
         self.predictor.validate("master.predictor")?;
+        positive(self.clutch_spring, "master.clutch_spring", true)?;
+        if self.clutch_spring > 1000.0 {
+            return Err(invalid(
+                "master.clutch_spring",
+                format!(
+                    "{} N/m is stiffer than a desk device renders (1000 N/m)",
+                    self.clutch_spring
+                ),
+            ));
+        }
         self.ros2.validate()
     }
 }

@@ -8,6 +8,8 @@
 //! names (`waist`, `shoulder`, `elbow`) and ros2_control's forward position
 //! controller; every one of them is to be checked against the driver at hand.
 
+use crate::hand::{ClutchConfig, ForceMessage, GimbalConfig, HandInput};
+use crate::watch::WatchConfig;
 use crate::{finite3, invalid, positive, ScenarioError};
 use serde::{Deserialize, Serialize};
 
@@ -112,6 +114,11 @@ pub struct JointMapConfig {
     pub min: [f64; 3],
     /// Largest paper angle accepted per joint, rad.
     pub max: [f64; 3],
+    /// The driver gives the third joint relative to the second, as the omni_common
+    /// drivers and sawSensablePhantom give a Touch's elbow (`J2 - J1` of OpenHaptics'
+    /// angles), where the paper's theta_3 is measured as OpenHaptics' J2: then
+    /// `theta_3 = sign raw_3 unit + offset + theta_2`.
+    pub elbow_after_shoulder: bool,
 }
 
 impl Default for JointMapConfig {
@@ -122,6 +129,7 @@ impl Default for JointMapConfig {
             unit: AngleUnit::Rad,
             min: [-std::f64::consts::PI; 3],
             max: [std::f64::consts::PI; 3],
+            elbow_after_shoulder: false,
         }
     }
 }
@@ -235,53 +243,6 @@ fn joint_names(names: &[String; 3], field: &str) -> Result<(), ScenarioError> {
     Ok(())
 }
 
-/// When a device's samples stop being trusted.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct WatchConfig {
-    /// A sample older than this many loop periods is stale: held and counted.
-    pub stale_periods: u32,
-    /// Silent this long, ms, the device is lost: the master renders zero force, the
-    /// slave holds its last safe reference; counted, and the run goes on.
-    pub timeout_ms: f64,
-}
-
-impl Default for WatchConfig {
-    fn default() -> Self {
-        WatchConfig {
-            stale_periods: 3,
-            timeout_ms: 100.0,
-        }
-    }
-}
-
-impl WatchConfig {
-    fn validate(&self, field: &str) -> Result<(), ScenarioError> {
-        if self.stale_periods == 0 {
-            return Err(invalid(
-                format!("{field}.stale_periods"),
-                "must be at least 1",
-            ));
-        }
-        positive(self.timeout_ms, &format!("{field}.timeout_ms"), false)
-    }
-
-    /// The timeout must outlast the stale window, or loss would come only after it.
-    pub fn validate_at(&self, field: &str, rate_hz: f64) -> Result<(), ScenarioError> {
-        let stale_ms = f64::from(self.stale_periods) * 1e3 / rate_hz;
-        if self.timeout_ms <= stale_ms {
-            return Err(invalid(
-                format!("{field}.timeout_ms"),
-                format!(
-                    "{} ms is not longer than the stale window ({} periods, {stale_ms} ms)",
-                    self.timeout_ms, self.stale_periods
-                ),
-            ));
-        }
-        Ok(())
-    }
-}
-
 /// `[master.ros2]`: a haptic device through its ROS 2 driver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -308,6 +269,19 @@ pub struct RosDeviceConfig {
     pub ramp_s: f64,
     /// The fastest the force rendered may change, N/s per axis.
     pub max_force_rate: f64,
+    /// Where the handle's position comes from: `joints` or `pose`.
+    pub input: HandInput,
+    /// The driver's `geometry_msgs/msg/PoseStamped` topic, with `input = "pose"`.
+    pub pose_topic: String,
+    /// The handle's orientation from all of the device's joints through its URDF (a
+    /// Touch's gimbal), with `input = "joints"`; none: a 3-DoF master.
+    pub gimbal: Option<GimbalConfig>,
+    /// The clutch (`{ kind = "bool" | "joy" | "omni_button", topic = .. }`); none by
+    /// default.
+    pub clutch: ClutchConfig,
+    /// The message the force goes out in: `wrench`, `omni_feedback` or
+    /// `float64_multi_array`.
+    pub force_message: ForceMessage,
 }
 
 impl Default for RosDeviceConfig {
@@ -322,6 +296,11 @@ impl Default for RosDeviceConfig {
             watch: WatchConfig::default(),
             ramp_s: 0.5,
             max_force_rate: 1000.0,
+            input: HandInput::default(),
+            pose_topic: "/fd/ee_pose".into(),
+            gimbal: None,
+            clutch: ClutchConfig::default(),
+            force_message: ForceMessage::default(),
         }
     }
 }
@@ -477,6 +456,11 @@ impl RosConfig {
 }
 
 impl RosDeviceConfig {
+    /// True if the device sends more than a position: an orientation or a clutch.
+    pub fn six_dof(&self) -> bool {
+        self.input == HandInput::Pose || self.gimbal.is_some() || self.clutch != ClutchConfig::None
+    }
+
     /// Checks the ranges; errors name `master.ros2.*`.
     pub fn validate(&self) -> Result<(), ScenarioError> {
         topic_name(&self.joint_states, "master.ros2.joint_states")?;
@@ -491,6 +475,13 @@ impl RosDeviceConfig {
             ));
         }
         positive(self.max_force_rate, "master.ros2.max_force_rate", false)?;
+        crate::hand::validate(
+            self.input,
+            &self.pose_topic,
+            self.gimbal.as_ref(),
+            &self.clutch,
+            topic_name,
+        )?;
         self.watch.validate("master.ros2.watch")
     }
 }

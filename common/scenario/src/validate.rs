@@ -49,6 +49,32 @@ impl Scenario {
                 "a device over ROS 2 runs in real time: lockstep has no clock a device follows",
             ));
         }
+        if self.master.backend == Backend::Ros2 && self.master.ros2.six_dof() {
+            self.check_six_dof("the ROS 2 device has an orientation or a clutch (a 6-DoF run)")?;
+        }
         self.bounded()
+    }
+
+    /// What a 6-DoF run (`why` says what makes it one) needs of the rest: an arm that
+    /// can turn its tool, equal delays per direction (a pose, or a wrench back, crosses
+    /// in one packet), no forward deadband (it weighs positions only).
+    pub fn check_six_dof(&self, why: &str) -> Result<(), ScenarioError> {
+        let bad = |field: &str, problem: &str| Err(invalid(field, format!("{why}: {problem}")));
+        let equal = |d: [i64; 3]| d[0] == d[1] && d[1] == d[2];
+        if self.slave.arm.is_none() {
+            return bad("slave.arm", "the paper's arm has three joints and cannot turn its tool; a 6-DoF run needs [slave.arm]");
+        }
+        for (dir, c) in [
+            ("forward", &self.network.forward),
+            ("backward", &self.network.backward),
+        ] {
+            if !equal(c.delay) || c.schedule.iter().any(|e| !equal([e[1], e[2], e[3]])) {
+                return bad(&format!("network.{dir}.delay"), "a pose (a wrench back) crosses in one packet, so the three delays (and every schedule row's) must be equal");
+            }
+        }
+        if self.codec.forward.kind != CodecKind::None {
+            return bad("codec.forward.kind", "the deadband codecs weigh positions only and would leave turns unsent; use \"none\"");
+        }
+        Ok(())
     }
 }

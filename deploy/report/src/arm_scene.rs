@@ -127,9 +127,16 @@ impl ArmScene {
     }
 
     /// An environment object of the loop as the robot meets it: placed by the map,
-    /// sized by its scale.
+    /// sized by its scale. A box is drawn as the box of the base's axes around its map (the map itself,
+    /// for rotations by quarter turns), a sphere with the scales' geometric mean.
     pub fn object(&self, o: &Object) -> Object {
-        let s = self.cfg.scale;
+        let scale = self.cfg.scale.axes();
+        let s = scale.iter().product::<f64>().cbrt();
+        let s = match self.cfg.scale {
+            tactile_scenario::Scale::Uniform(u) => u,
+            tactile_scenario::Scale::PerAxis(_) => s,
+        };
+        let r = self.cfg.rotation.matrix();
         match o.clone() {
             Object::Sphere {
                 center,
@@ -146,7 +153,9 @@ impl ArmScene {
                 stiffness,
             } => Object::Box {
                 center: self.to_robot(center),
-                half_extents: half_extents.map(|h| h * s),
+                half_extents: [0, 1, 2].map(|k| {
+                    (0..3).map(|j| r[k][j].abs() * half_extents[j]).sum::<f64>() * scale[k]
+                }),
                 stiffness,
             },
             Object::Plane {
@@ -155,10 +164,25 @@ impl ArmScene {
                 stiffness,
             } => Object::Plane {
                 point: self.to_robot(point),
-                normal,
+                normal: self.normal(normal),
                 stiffness,
             },
         }
+    }
+
+    /// A plane's normal as the map carries it: `S^-1 R n`, normalized (untouched by the
+    /// identity and a uniform scale).
+    fn normal(&self, n: [f64; 3]) -> [f64; 3] {
+        if self.cfg.rotation.is_identity()
+            && matches!(self.cfg.scale, tactile_scenario::Scale::Uniform(_))
+        {
+            return n;
+        }
+        let s = self.cfg.scale.axes();
+        let m = tactile_scenario::workspace::apply(&self.cfg.rotation.matrix(), n);
+        let v = [0, 1, 2].map(|k| m[k] / s[k]);
+        let len = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        v.map(|x| x / len)
     }
 }
 
@@ -236,7 +260,7 @@ mod tests {
         let text = include_str!("../../scenarios/panda.toml");
         let s = Scenario::from_toml_str(text).expect("the shipped scenario");
         ArmConfig {
-            scale,
+            scale: tactile_scenario::Scale::Uniform(scale),
             ..s.slave.arm.expect("an arm")
         }
     }

@@ -8,8 +8,10 @@ use tactile_records::slave::ArmJoints;
 /// The header line (without newline) for an arm of `dof` joints: the IK's references,
 /// the joints and their efforts per joint, h(n)'s torque about the tool (a real arm's
 /// sensor's), then the orientation reference and the tool's orientation relative to
-/// the tool's home (`[x, y, z, w]`, about the base's axes), the angle between them,
-/// and the clutch.
+/// the tool's home (`[x, y, z, w]`, about the base's axes), the 6-DoF master's
+/// orientation as the arm took it, the clutch's offsets captured at the last engage
+/// (position in the base frame, m; orientation), the angle between the reference and
+/// the tool, and the clutch.
 pub fn header(dof: usize) -> String {
     let mut h = String::from("n");
     for field in ["q_ref", "q", "tau"] {
@@ -18,10 +20,14 @@ pub fn header(dof: usize) -> String {
         }
     }
     h.push_str(",h_torque_1,h_torque_2,h_torque_3");
-    for field in ["target_rot", "tool_rot"] {
+    for field in ["target_rot", "tool_rot", "master_rot"] {
         for c in ["x", "y", "z", "w"] {
             let _ = write!(h, ",{field}_{c}");
         }
+    }
+    h.push_str(",offset_1,offset_2,offset_3");
+    for c in ["x", "y", "z", "w"] {
+        let _ = write!(h, ",offset_rot_{c}");
     }
     h.push_str(",rot_error_deg,released");
     h
@@ -31,7 +37,13 @@ pub fn header(dof: usize) -> String {
 pub fn row(line: &mut String, n: u64, j: &ArmJoints) {
     let _ = write!(line, "{n}");
     let values = j.q_ref.iter().chain(&j.q).chain(&j.tau).chain(&j.torque);
-    for x in values.chain(&j.target_rotation).chain(&j.tool_rotation) {
+    let turns = j.target_rotation.iter().chain(&j.tool_rotation);
+    let map = j
+        .master_rotation
+        .iter()
+        .chain(&j.offset)
+        .chain(&j.offset_rotation);
+    for x in values.chain(turns).chain(map) {
         let _ = write!(line, ",{x:?}");
     }
     let error = angle_deg(j.target_rotation, j.tool_rotation);
@@ -90,6 +102,7 @@ mod tests {
             target_rotation: [0.0, 0.0, 0.0, 1.0],
             tool_rotation: [0.0, 0.0, 0.0, 1.0],
             released: true,
+            ..ArmJoints::default()
         };
         let mut line = String::new();
         row(&mut line, 5, &j);

@@ -11,6 +11,7 @@ use crate::analysis::Latency;
 use crate::trace::TraceRow;
 use plotters::prelude::*;
 use std::path::Path;
+use tactile_messages::samples::FLAG_RELEASED;
 
 mod timeplot;
 pub(crate) use timeplot::tick;
@@ -108,12 +109,20 @@ pub struct Series {
     dissipated: Thinned,
     slave_net: f64,
     dissipated_sum: f64,
+    /// The stretches the operator's clutch was released, s (a 6-DoF run's).
+    released: Vec<(f64, f64)>,
 }
 
 impl Series {
     /// Adds one row at its time.
     pub fn add(&mut self, row: &TraceRow, t_s: f64) {
         let t = row.n as f64 * t_s;
+        if row.flags_f & FLAG_RELEASED != 0 {
+            match self.released.last_mut() {
+                Some((_, end)) if (t - *end - t_s).abs() < 0.5 * t_s => *end = t,
+                _ => self.released.push((t, t)),
+            }
+        }
         let low = |w: [f64; 3]| w.iter().copied().fold(f64::INFINITY, f64::min);
         if row.stepped {
             self.slave_net = row.port_net_s;
@@ -142,17 +151,20 @@ impl Series {
         whole_svg(&out.join("positions.svg"), |p| {
             timeplot::time_series(
                 p,
-                "Master handle and slave tool position",
-                "position (m)",
+                ("Master handle and slave tool position", "position (m)"),
                 &pairs(&self.handle, &self.tool, "master handle", "slave tool", ""),
+                (&self.released, "clutch released: the robot holds"),
             )
         })?;
         whole_svg(&out.join("forces.svg"), |p| {
             timeplot::time_series(
                 p,
-                "Contact force (slave) and feedback force (master)",
-                "force (N)",
+                (
+                    "Contact force (slave) and feedback force (master)",
+                    "force (N)",
+                ),
                 &pairs(&self.felt, &self.force, "felt", "slave h(n)", "F"),
+                (&self.released, "clutch released: the clutch spring is felt"),
             )
         })?;
         // No line here is another's reference: all are drawn plain.
@@ -172,9 +184,12 @@ impl Series {
         whole_svg(&out.join("passivity.svg"), |p| {
             timeplot::time_series(
                 p,
-                "Channel energy (below zero: the channel made energy), observers, dissipation",
-                "energy (mJ)",
+                (
+                    "Channel energy (below zero: the channel made energy), observers, dissipation",
+                    "energy (mJ)",
+                ),
                 &lines,
+                (&[], ""),
             )
         })
     }

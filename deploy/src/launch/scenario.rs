@@ -78,6 +78,10 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     tactile_slave::urdf_arm::UrdfArm::of_scenario(&scenario, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    if scenario.master.backend == tactile_scenario::Backend::Ros2 {
+        tactile_runtime::outside::gimbal(&scenario, &base_dir)
+            .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    }
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
     for c in [&scenario.network.forward, &scenario.network.backward] {
         if let Some(r) = &c.replay {
@@ -89,6 +93,9 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
     }
     if let Some(arm) = &scenario.slave.arm {
         inputs.push(base_dir.join(&arm.urdf));
+    }
+    if let Some(g) = &scenario.master.ros2.gimbal {
+        inputs.push(base_dir.join(&g.urdf));
     }
     Ok(Loaded {
         scenario,

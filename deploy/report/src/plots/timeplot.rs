@@ -44,8 +44,23 @@ fn style(colour: RGBColor, reference: bool, paired: bool) -> ShapeStyle {
     }
 }
 
-/// Lines of (t, y) points on linear axes from 0 to the last time, with a legend below.
-pub(super) fn time_series(path: &Path, title: &str, y_desc: &str, series: &[Line]) -> PlotResult {
+/// The shade of the stretches a plot marks (the operator's clutch released).
+const SHADE: RGBColor = RGBColor(150, 150, 150);
+
+/// Lines of (t, y) points on linear axes from 0 to the last time, with a legend below;
+/// the stretches `shade` (from, to, s) marked with a grey band and a legend entry
+/// `shade_label`.
+pub(super) fn time_series(
+    path: &Path,
+    (title, y_desc): (&str, &str),
+    series: &[Line],
+    (shade, shade_label): (&[(f64, f64)], &str),
+) -> PlotResult {
+    let mut series = series.to_vec();
+    if !shade.is_empty() {
+        series.push((shade_label.to_string(), SHADE, false, Vec::new()));
+    }
+    let series = &series[..];
     let rows = if series.len() <= 3 { 1 } else { 2 };
     let strip = (rows * ROW + 16) as u32;
     let root = SVGBackend::new(path, (WIDTH, PLOT_HEIGHT + strip)).into_drawing_area();
@@ -78,6 +93,11 @@ pub(super) fn time_series(path: &Path, title: &str, y_desc: &str, series: &[Line
         .x_label_formatter(&tick)
         .y_label_formatter(&tick)
         .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(shade.iter().map(|(a, b)| {
+            Rectangle::new([(*a, lo - pad), (*b, hi + pad)], SHADE.mix(0.25).filled())
+        }))
         .map_err(err)?;
     let paired = series.iter().any(|s| s.2);
     // Measured lines first, references over them.
@@ -168,7 +188,7 @@ mod tests {
             line("y ref", true),
             line("y measured", false),
         ];
-        time_series(&path, "title", "y", &lines).expect("plot");
+        time_series(&path, ("title", "y"), &lines, (&[], "")).expect("plot");
         let svg = std::fs::read_to_string(&path).expect("svg");
         for (label, ..) in &lines {
             let (_, y) = text_at(&svg, label);

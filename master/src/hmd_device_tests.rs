@@ -1,0 +1,126 @@
+//! The master with a real 6-DoF device (beside [`super`], which they would double): a
+//! pose device's position and every device's orientation measured from its first
+//! reading, the clutch onto c(n), and the spring the hand feels while it is released.
+use super::*;
+use tactile_messages::samples::Signal;
+
+fn master(spring: f64) -> Master {
+    let mut sc = Scenario::paper();
+    sc.rate_hz = 1000.0;
+    sc.master.clutch_spring = spring;
+    let source = OperatorSource::load(&sc.operator, std::path::Path::new(".")).expect("op");
+    Master::new(&sc, source).expect("master")
+}
+
+fn home() -> [f64; 3] {
+    let lengths = tactile_math::geometry::Geometry::PAPER.lengths();
+    tactile_math::kernels::fk(&lengths, &tactile_math::arith::StdTrig, [0.0; 3])
+}
+
+/// A quarter turn about z, then `deg` more.
+fn about_z(deg: f64) -> [f64; 4] {
+    let h = deg.to_radians() / 2.0;
+    [0.0, 0.0, h.sin(), h.cos()]
+}
+
+#[test]
+fn a_pose_device_starts_at_home_and_turns_from_its_first_reading() {
+    let mut m = master(0.0);
+    let first = Hand {
+        point: [0.3, -0.1, 0.05],
+        rotation: Some(about_z(90.0)),
+    };
+    let (f, sent) = m.forward_measured(0, 0, first, HandInput::Pose, None);
+    assert_eq!(f.signal.value, home());
+    assert_eq!(f.rotation, IDENTITY);
+    assert_eq!(f.signal.flags & (FLAG_POSE | FLAG_RELEASED), FLAG_POSE);
+    assert_eq!(sent.handle, home());
+    let later = Hand {
+        point: [0.31, -0.1, 0.03],
+        rotation: Some(about_z(120.0)),
+    };
+    let (f, _) = m.forward_measured(1, 1, later, HandInput::Pose, None);
+    let want = [home()[0] + 0.01, home()[1], home()[2] - 0.02];
+    for (got, want) in f.signal.value.iter().zip(want) {
+        assert!((got - want).abs() < 1e-15, "{:?}", f.signal.value);
+    }
+    // 30 degrees about z since the first reading.
+    let turn = about_z(30.0);
+    for (got, want) in f.rotation.iter().zip(turn) {
+        assert!((got - want).abs() < 1e-12, "{:?}", f.rotation);
+    }
+}
+
+#[test]
+fn a_3dof_device_without_a_clutch_sends_what_it_always_did() {
+    let mut m = master(0.0);
+    let theta = [0.1, 0.2, 0.3];
+    let hand = Hand {
+        point: theta,
+        rotation: None,
+    };
+    let (f, sent) = m.forward_measured(0, 0, hand, HandInput::Joints, None);
+    assert_eq!(f.signal.flags & FLAG_POSE, 0);
+    assert_eq!(sent.theta_md, theta);
+    let truth = tactile_math::kernels::fk(
+        &tactile_math::geometry::Geometry::PAPER.lengths(),
+        &tactile_math::arith::StdTrig,
+        theta,
+    );
+    assert_eq!(sent.handle, truth);
+}
+
+/// The answer of sample `n` carrying `force`.
+fn answer(n: u64, force: [f64; 3]) -> Backward {
+    Backward {
+        seq: n,
+        signal: Signal {
+            value: force,
+            sent_seq: [n; 3],
+            ..Signal::default()
+        },
+        ..Backward::default()
+    }
+}
+
+#[test]
+fn released_the_hand_feels_the_spring_not_the_robot() {
+    for spring in [0.0, 100.0] {
+        let mut m = master(spring);
+        let at = |x: f64| Hand {
+            point: [x, 0.0, 0.0],
+            rotation: None,
+        };
+        m.forward_measured(0, 0, at(0.0), HandInput::Pose, Some(true));
+        m.backward(&answer(0, [1.0, 0.5, 0.0]));
+        assert_eq!(m.felt(), [1.0, 0.5, 0.0], "engaged: the robot's force");
+        // Released 2 cm to the right of where it started.
+        let (f, sent) = m.forward_measured(1, 1, at(0.02), HandInput::Pose, Some(false));
+        assert_ne!(f.signal.flags & FLAG_RELEASED, 0);
+        assert!(sent.released);
+        m.backward(&answer(1, [1.0, 0.5, 0.0]));
+        let felt = m.felt();
+        assert!(
+            (felt[0] + spring * 0.02).abs() < 1e-12,
+            "{spring}: {felt:?}"
+        );
+        assert_eq!([felt[1], felt[2]], [0.0, 0.0]);
+        // Engaged again: the robot's force.
+        m.forward_measured(2, 2, at(0.02), HandInput::Pose, Some(true));
+        m.backward(&answer(2, [1.0, 0.5, 0.0]));
+        assert_eq!(m.felt(), [1.0, 0.5, 0.0]);
+    }
+}
+
+#[test]
+fn the_spring_stays_within_the_force_limit() {
+    let mut m = master(1000.0);
+    let far = Hand {
+        point: [0.5, 0.0, 0.0],
+        rotation: None,
+    };
+    m.forward_measured(0, 0, Hand::default(), HandInput::Pose, Some(false));
+    m.forward_measured(1, 1, far, HandInput::Pose, Some(false));
+    m.backward(&answer(1, [0.0; 3]));
+    assert_eq!(m.felt()[0], -3.3);
+}
