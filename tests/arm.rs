@@ -176,11 +176,14 @@ fn mcap_readers() -> bool {
 
 /// tests/mcap_arm_check.py on the report in `out`: its output.
 fn mcap_arm_check(sb: &Sandbox, out: &str, base: &str, tip: &str) -> String {
+    mcap_arm_check_with(sb, out, &["--base", base, "--tip", tip])
+}
+
+/// tests/mcap_arm_check.py on the report in `out` with `args`: its output.
+fn mcap_arm_check_with(sb: &Sandbox, out: &str, args: &[&str]) -> String {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/mcap_arm_check.py");
     let mut c = std::process::Command::new("python3");
-    c.arg(script)
-        .arg(sb.path(out))
-        .args(["--base", base, "--tip", tip]);
+    c.arg(script).arg(sb.path(out)).args(args);
     let o = util::output_within(c, util::LIMIT);
     let text =
         String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
@@ -202,6 +205,32 @@ fn the_recording_draws_the_arm_where_its_joints_put_it() {
         text.contains("4000 samples, 41 drawn and compared"),
         "{text}"
     );
+}
+
+/// A 6-DoF operator's recording (panda-pose.toml): the handle turns in run.mcap as the
+/// operator turned it, read by the same independent readers.
+#[test]
+fn the_recording_turns_the_handle_as_the_operator_did() {
+    if !mcap_readers() {
+        return util::cannot("python3 lacks mcap, mcap-ros2-support, yourdfpy or numpy");
+    }
+    let sb = Sandbox::new("armmcappose");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/panda-pose.toml");
+    sb.simulate(&scenario, "a");
+    let args = [
+        "--base",
+        "panda_link0",
+        "--tip",
+        "panda_hand",
+        "--handles-only",
+    ];
+    let text = mcap_arm_check_with(&sb, "a", &args);
+    let turned: u64 = text
+        .strip_prefix("mcap_arm_check: ")
+        .and_then(|t| t.strip_suffix(" handles turned\n"))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(0);
+    assert!(turned > 5000, "{text}");
 }
 
 /// The shipped UR5 scenario: six joints, a URDF rooted in `world` (drawn where its

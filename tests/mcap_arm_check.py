@@ -16,6 +16,9 @@ forward kinematics). Checks, each failure one line on stderr and exit status 1:
     and 1e-9 rad, and so does the master's tool;
   - /slave/tool, in the base frame, is the tip's position yourdfpy gives within 1e-9 m;
   - the environment markers are in the base frame.
+With --handles-only: /master/handle's orientation is joints.csv's master_rot at every
+sample: a rotation (norm within 1e-6 of one), normalized within 1e-12 of what the
+slave took (equal to the master's at zero delay), and nothing else.
 
 Packages: as tests/mcap_check.py (mcap, mcap-ros2-support, yourdfpy, numpy).
 """
@@ -74,15 +77,45 @@ def close(a, b, what):
         fail(f"{what}: differ by {dp:.3g} m, {dr:.3g} in rotation")
 
 
+def check_handles(run, msgs):
+    """A 6-DoF master's orientation: /master/handle turns as joints.csv's master_rot
+    (the rotation the slave took; equal to the master's at zero delay) at every
+    sample. Returns how many were turned."""
+    with open(os.path.join(run, "joints.csv")) as f:
+        rows = list(csv.reader(f))
+    header, rows = rows[0], rows[1:]
+    rcols = [header.index(f"master_rot_{c}") for c in "xyzw"]
+    handles = msgs["/master/handle"]
+    if len(handles) != len(rows):
+        fail(f"{len(handles)} handles, {len(rows)} joints.csv rows")
+    turned = 0
+    for k, (h, row) in enumerate(zip(handles, rows)):
+        o = h.pose.orientation
+        want = [float(row[c]) for c in rcols]
+        got = np.array([o.x, o.y, o.z, o.w])
+        if abs(np.linalg.norm(got) - 1.0) > 1e-6:
+            fail(f"sample {k}: /master/handle's orientation {got} is not a rotation")
+        # The slave normalizes what it takes: equal, normalized, to rounding.
+        if np.abs(got / np.linalg.norm(got) - want).max() > 1e-12:
+            fail(f"sample {k}: /master/handle turned {[o.x, o.y, o.z, o.w]}, joints.csv says {want}")
+        turned += want != [0.0, 0.0, 0.0, 1.0]
+    return turned
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("run")
     ap.add_argument("--base", required=True)
     ap.add_argument("--tip", required=True)
+    ap.add_argument("--handles-only", action="store_true",
+                    help="check only the handle's orientation against joints.csv")
     a = ap.parse_args()
     msgs = {}
     for m in read_ros2_messages(os.path.join(a.run, "run.mcap")):
         msgs.setdefault(m.channel.topic, []).append(m.ros_msg)
+    if a.handles_only:
+        print(f"mcap_arm_check: {check_handles(a.run, msgs)} handles turned")
+        return
     desc = msgs["/robot_description"]
     if len(desc) != 1:
         fail(f"{len(desc)} /robot_description messages, not 1")

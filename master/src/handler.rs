@@ -120,6 +120,7 @@ impl Handler for MasterHandler {
             tau: self.master.tau(),
             target: s.target,
             handle: s.handle,
+            rotation: s.rotation.unwrap_or(tactile_ros::msg::IDENTITY),
             q: a.map_or([0.0; 3], |a| a.q.value),
             felt: self.felt,
         };
@@ -161,9 +162,12 @@ impl Leader for MasterHandler {
                 {
                     io.event(n, &what)?;
                 }
-                let (input, clutch) = (d.input(), d.clutch());
+                // A lost device's clutch is released: the robot holds until the
+                // device is back and the button says engaged.
+                let clutch = d.clutch().map(|c| c && !self.held.lost);
+                let hand = self.held.taken.then_some(self.held.theta);
                 self.master
-                    .forward_measured(n, origin_ns, self.held.theta, input, clutch)
+                    .forward_measured(n, origin_ns, hand, d.input(), clutch)
             }
         };
         self.sent = sent;

@@ -59,6 +59,8 @@ pub struct Master {
     home: [f64; 3],
     /// Where the handle is at this sample, m (the clutch spring's end).
     handle: [f64; 3],
+    /// The device gives a position, not joints: there are no joint torques to compute.
+    pose_input: bool,
 }
 
 /// `q` relative to `q0` (both `[x, y, z, w]`): the turn from `q0` to `q`, about the
@@ -133,6 +135,7 @@ impl Master {
             origin: None,
             home,
             handle: home,
+            pose_input: false,
         })
     }
 
@@ -179,15 +182,27 @@ impl Master {
     /// a pose device's position moved so that its first reading is the devices' home.
     /// A 6-DoF device's orientation goes relative to its first reading (the operator's
     /// home, as a trajectory's), with its clutch (`None`: none, always engaged).
+    /// `hand` is `None` until the device has given a reading: the handle is then taken
+    /// to be at home, unturned (no origin is captured from it).
     pub fn forward_measured(
         &mut self,
         n: u64,
         now_ns: u64,
-        hand: Hand,
+        hand: Option<Hand>,
         input: HandInput,
         clutch: Option<bool>,
     ) -> (Forward, Sent) {
-        let origin = *self.origin.get_or_insert(hand);
+        self.pose_input = input == HandInput::Pose;
+        let (hand, origin) = match hand {
+            Some(h) => (h, *self.origin.get_or_insert(h)),
+            None => {
+                let home = Hand {
+                    point: [0.0; 3],
+                    rotation: None,
+                };
+                (home, home)
+            }
+        };
         let (mut f, mut sent) = match input {
             HandInput::Joints => {
                 self.theta_md = hand.point;
@@ -402,7 +417,11 @@ impl Master {
             false => out.force,
             true => self.clutch_spring(),
         };
-        let raw = self.engine.kff(self.theta_md, felt);
+        // A pose device takes the force itself: no joints, no torques to clamp.
+        let raw = match self.pose_input {
+            false => self.engine.kff(self.theta_md, felt),
+            true => [0.0; 3],
+        };
         let tau: [f64; 3] = [0, 1, 2].map(|j| {
             let l = self.limits.torque_limit[j];
             raw[j].clamp(-l, l)

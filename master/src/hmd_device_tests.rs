@@ -30,7 +30,7 @@ fn a_pose_device_starts_at_home_and_turns_from_its_first_reading() {
         point: [0.3, -0.1, 0.05],
         rotation: Some(about_z(90.0)),
     };
-    let (f, sent) = m.forward_measured(0, 0, first, HandInput::Pose, None);
+    let (f, sent) = m.forward_measured(0, 0, Some(first), HandInput::Pose, None);
     assert_eq!(f.signal.value, home());
     assert_eq!(f.rotation, IDENTITY);
     assert_eq!(f.signal.flags & (FLAG_POSE | FLAG_RELEASED), FLAG_POSE);
@@ -39,7 +39,7 @@ fn a_pose_device_starts_at_home_and_turns_from_its_first_reading() {
         point: [0.31, -0.1, 0.03],
         rotation: Some(about_z(120.0)),
     };
-    let (f, _) = m.forward_measured(1, 1, later, HandInput::Pose, None);
+    let (f, _) = m.forward_measured(1, 1, Some(later), HandInput::Pose, None);
     let want = [home()[0] + 0.01, home()[1], home()[2] - 0.02];
     for (got, want) in f.signal.value.iter().zip(want) {
         assert!((got - want).abs() < 1e-15, "{:?}", f.signal.value);
@@ -51,6 +51,56 @@ fn a_pose_device_starts_at_home_and_turns_from_its_first_reading() {
     }
 }
 
+/// The turn since the first reading is about the base's axes (`q q0^-1`): held turned
+/// a quarter about x, then turned 30 degrees about the base's z, the master sends 30
+/// degrees about z (about the stylus' own axes it would be a turn about y).
+#[test]
+fn a_turn_is_measured_about_the_bases_axes() {
+    let mut m = master(0.0);
+    let h = std::f64::consts::FRAC_PI_4.sin();
+    let x90 = [h, 0.0, 0.0, h];
+    let (s, c) = (15f64.to_radians().sin(), 15f64.to_radians().cos());
+    // Rz(30) Rx(90), multiplied out by hand.
+    let turned = [c * h, s * h, s * h, c * h];
+    let at = |r| Hand {
+        point: [0.0; 3],
+        rotation: Some(r),
+    };
+    m.forward_measured(0, 0, Some(at(x90)), HandInput::Pose, None);
+    let (f, _) = m.forward_measured(1, 1, Some(at(turned)), HandInput::Pose, None);
+    for (got, want) in f.rotation.iter().zip(about_z(30.0)) {
+        assert!((got - want).abs() < 1e-12, "{:?}", f.rotation);
+    }
+}
+
+/// Until the device has given a reading the handle is home and unturned, and the first
+/// real reading is the origin, not the placeholder.
+#[test]
+fn no_origin_is_taken_before_the_device_is_read() {
+    let mut m = master(0.0);
+    let (f, _) = m.forward_measured(0, 0, None, HandInput::Pose, Some(false));
+    assert_eq!(f.signal.value, home());
+    assert_eq!(f.rotation, IDENTITY);
+    let first = Hand {
+        point: [0.3, 0.2, 0.1],
+        rotation: Some(about_z(45.0)),
+    };
+    let (f, _) = m.forward_measured(1, 1, Some(first), HandInput::Pose, Some(true));
+    assert_eq!(f.signal.value, home());
+    assert_eq!(f.rotation, IDENTITY);
+}
+
+/// A pose device takes the force itself: no joint torques, none clamped.
+#[test]
+fn a_pose_device_has_no_torques_to_clamp() {
+    let mut m = master(0.0);
+    m.forward_measured(0, 0, Some(Hand::default()), HandInput::Pose, None);
+    m.backward(&answer(0, [3.0, 3.0, 3.0]));
+    assert_eq!(m.tau(), [0.0; 3]);
+    assert_eq!(m.counters().torque_clamps, 0);
+    assert_eq!(m.felt(), [3.0, 3.0, 3.0]);
+}
+
 #[test]
 fn a_3dof_device_without_a_clutch_sends_what_it_always_did() {
     let mut m = master(0.0);
@@ -59,7 +109,7 @@ fn a_3dof_device_without_a_clutch_sends_what_it_always_did() {
         point: theta,
         rotation: None,
     };
-    let (f, sent) = m.forward_measured(0, 0, hand, HandInput::Joints, None);
+    let (f, sent) = m.forward_measured(0, 0, Some(hand), HandInput::Joints, None);
     assert_eq!(f.signal.flags & FLAG_POSE, 0);
     assert_eq!(sent.theta_md, theta);
     let truth = tactile_math::kernels::fk(
@@ -91,11 +141,11 @@ fn released_the_hand_feels_the_spring_not_the_robot() {
             point: [x, 0.0, 0.0],
             rotation: None,
         };
-        m.forward_measured(0, 0, at(0.0), HandInput::Pose, Some(true));
+        m.forward_measured(0, 0, Some(at(0.0)), HandInput::Pose, Some(true));
         m.backward(&answer(0, [1.0, 0.5, 0.0]));
         assert_eq!(m.felt(), [1.0, 0.5, 0.0], "engaged: the robot's force");
         // Released 2 cm to the right of where it started.
-        let (f, sent) = m.forward_measured(1, 1, at(0.02), HandInput::Pose, Some(false));
+        let (f, sent) = m.forward_measured(1, 1, Some(at(0.02)), HandInput::Pose, Some(false));
         assert_ne!(f.signal.flags & FLAG_RELEASED, 0);
         assert!(sent.released);
         m.backward(&answer(1, [1.0, 0.5, 0.0]));
@@ -106,7 +156,7 @@ fn released_the_hand_feels_the_spring_not_the_robot() {
         );
         assert_eq!([felt[1], felt[2]], [0.0, 0.0]);
         // Engaged again: the robot's force.
-        m.forward_measured(2, 2, at(0.02), HandInput::Pose, Some(true));
+        m.forward_measured(2, 2, Some(at(0.02)), HandInput::Pose, Some(true));
         m.backward(&answer(2, [1.0, 0.5, 0.0]));
         assert_eq!(m.felt(), [1.0, 0.5, 0.0]);
     }
@@ -119,8 +169,8 @@ fn the_spring_stays_within_the_force_limit() {
         point: [0.5, 0.0, 0.0],
         rotation: None,
     };
-    m.forward_measured(0, 0, Hand::default(), HandInput::Pose, Some(false));
-    m.forward_measured(1, 1, far, HandInput::Pose, Some(false));
+    m.forward_measured(0, 0, Some(Hand::default()), HandInput::Pose, Some(false));
+    m.forward_measured(1, 1, Some(far), HandInput::Pose, Some(false));
     m.backward(&answer(1, [0.0; 3]));
     assert_eq!(m.felt()[0], -3.3);
 }

@@ -174,6 +174,14 @@ impl UrdfArm {
         };
         let ik = Ik::new(&chain, ik_cfg).map_err(|e| e.to_string())?;
         let home_tool = chain.fk(&cfg.home);
+        if let (Some(w), p) = (&cfg.workspace, home_tool.p) {
+            if w.clamp(p.into()).1 {
+                return Err(format!(
+                    "field `slave.arm.workspace`: the tool's home [{:.3}, {:.3}, {:.3}] m is outside the box {:?} to {:?}: the robot would move at the first sample",
+                    p.x, p.y, p.z, w.min, w.max
+                ));
+            }
+        }
         let state = ArmState {
             q_ref: cfg.home.clone(),
             qd_ref: vec![0.0; dof],

@@ -149,6 +149,19 @@ fn a_target_outside_the_workspace_is_clamped_and_counted() {
         ..panda_cfg()
     };
     let mut arm = UrdfArm::new(&cfg, &panda_xml(), HOME).expect("arm");
+    // A box the tool's home is not in is refused: the robot would move at once.
+    let outside = ArmConfig {
+        workspace: Some(Workspace {
+            min: [home.x + 0.1, home.y - 0.5, home.z - 0.5],
+            max: [home.x + 0.5, home.y + 0.5, home.z + 0.5],
+        }),
+        ..panda_cfg()
+    };
+    let e = UrdfArm::new(&outside, &panda_xml(), HOME).expect_err("refused");
+    assert!(
+        e.contains("slave.arm.workspace") && e.contains("outside the box"),
+        "{e}"
+    );
     let down = [HOME[0], HOME[1], HOME[2] - 0.05];
     let mut clamped = 0;
     for _ in 0..3000 {

@@ -6,7 +6,7 @@
 //! messages come from [`crate::ros_hand`] (or a test).
 
 use crate::map::{JointMap, Reject};
-use nalgebra::{Matrix3, UnitQuaternion};
+use nalgebra::Matrix3;
 use tactile_chain::Chain;
 use tactile_ros::hand_msg::{Bool, Joy, OmniButtonEvent, OmniFeedback};
 use tactile_ros::msg::{
@@ -89,12 +89,12 @@ impl Gimbal {
     }
 }
 
-/// `[x, y, z, w]` of a rotation matrix, w >= 0.
-pub fn quaternion(r: &Matrix3<f64>) -> [f64; 4] {
-    let q = UnitQuaternion::from_matrix(r);
-    let s = if q.w < 0.0 { -1.0 } else { 1.0 };
-    [s * q.i, s * q.j, s * q.k, s * q.w]
-}
+pub use tactile_chain::spatial::quaternion;
+
+/// How far from the device's base a pose's position may be, m: a desk device reaches a
+/// few tens of centimetres; beyond two metres is a broken value or a driver in the wrong
+/// unit (millimetres), refused before it can reach the robot.
+pub const POSE_RANGE: f64 = 2.0;
 
 /// A joint device's reading from a CDR `JointState`: three joints through `map`, and
 /// with a `gimbal` the orientation.
@@ -112,6 +112,12 @@ pub fn pose_cdr(cdr: &[u8]) -> Result<Hand, Reject> {
     let p = PoseStamped::from_cdr(cdr)?;
     if !p.position.iter().all(|v| v.is_finite()) {
         return Err(Reject::BadPose("position is not finite".into()));
+    }
+    if p.position.iter().any(|v| v.abs() > POSE_RANGE) {
+        return Err(Reject::BadPose(format!(
+            "position {:?} m is more than {POSE_RANGE} m from the base",
+            p.position
+        )));
     }
     let q = p.orientation;
     let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -135,7 +141,7 @@ pub fn clutch_cdr(cfg: &ClutchConfig, cdr: &[u8]) -> Result<bool, Reject> {
             let j = Joy::from_cdr(cdr)?;
             j.buttons
                 .get(*button as usize)
-                .map(|b| *b != 0)
+                .map(|b| *b == 1)
                 .ok_or_else(|| Reject::Missing(format!("buttons[{button}]")))
         }
         ClutchConfig::OmniButton { button, .. } => {

@@ -55,6 +55,7 @@ fn a_pose_is_taken_normalized_and_a_non_rotation_is_refused() {
     assert!((q.iter().map(|v| v * v).sum::<f64>() - 1.0).abs() < 1e-15);
     for bad in [
         p([0.0, f64::NAN, 0.0], [0.0, 0.0, 0.0, 1.0]),
+        p([0.0, 120.0, 0.0], [0.0, 0.0, 0.0, 1.0]),
         p([0.0; 3], [0.0; 4]),
         p([0.0; 3], [0.0, 0.0, 0.0, f64::INFINITY]),
         p([0.0; 3], [0.5, 0.5, 0.5, 0.6]),
@@ -82,8 +83,8 @@ fn each_clutch_reads_its_own_message() {
         .to_cdr()
     };
     assert_eq!(clutch_cdr(&j, &joy(vec![0, 1])), Ok(true));
-    // CRTK's "clicked" (2) is pressed too.
-    assert_eq!(clutch_cdr(&j, &joy(vec![0, 2])), Ok(true));
+    // CRTK's "clicked" (2) has been let go already: released.
+    assert_eq!(clutch_cdr(&j, &joy(vec![0, 2])), Ok(false));
     assert_eq!(clutch_cdr(&j, &joy(vec![1, 0])), Ok(false));
     assert_eq!(
         clutch_cdr(&j, &joy(vec![1])),

@@ -13,6 +13,9 @@ pub struct Held<V = [f64; 3]> {
     pub theta: V,
     /// True while the device is lost.
     pub lost: bool,
+    /// True once a fresh or stale reading was taken (`theta` is the device's, not the
+    /// default).
+    pub taken: bool,
 }
 
 impl<V> Held<V> {
@@ -27,7 +30,10 @@ impl<V> Held<V> {
     ) -> Option<String> {
         self.lost = matches!(reading, Reading::Lost);
         match reading {
-            Reading::Fresh(t) | Reading::Stale(t) => self.theta = t,
+            Reading::Fresh(t) | Reading::Stale(t) => {
+                self.theta = t;
+                self.taken = true;
+            }
             Reading::Lost => {}
         }
         match change {
@@ -81,7 +87,8 @@ mod tests {
             h,
             Held {
                 theta: t,
-                lost: true
+                lost: true,
+                taken: true,
             }
         );
         let back = h.take((Reading::Stale(t), Change::Back), who, "x");

@@ -138,6 +138,9 @@ pub struct MasterView {
     pub target: [f64; 3],
     /// The handle's position, m.
     pub handle: [f64; 3],
+    /// The handle's (and the target's) orientation relative to the operator's home, `[x,
+    /// y, z, w]`: a 6-DoF master's; the identity for the paper's.
+    pub rotation: [f64; 4],
     /// q(n) as received, N (zero without an answer).
     pub q: [f64; 3],
     /// The force the operator feels, N.
@@ -267,6 +270,11 @@ fn pose(stamp: u64, frame: &str, p: [f64; 3]) -> PoseStamped {
     }
 }
 
+fn turned(mut p: PoseStamped, rotation: [f64; 4]) -> PoseStamped {
+    p.orientation = rotation;
+    p
+}
+
 fn wrench(stamp: u64, frame: &str, f: [f64; 3]) -> WrenchStamped {
     WrenchStamped {
         header: Header::at(stamp, frame),
@@ -298,12 +306,12 @@ impl SampleView {
             sink.put(
                 MASTER_TARGET,
                 MasterTick,
-                &pose(stamp, MASTER_BASE, m.target),
+                &turned(pose(stamp, MASTER_BASE, m.target), m.rotation),
             )?;
             sink.put(
                 MASTER_HANDLE,
                 MasterTick,
-                &pose(stamp, MASTER_BASE, m.handle),
+                &turned(pose(stamp, MASTER_BASE, m.handle), m.rotation),
             )?;
         }
         if let Some(s) = &self.slave {

@@ -66,8 +66,9 @@ pub enum ClutchConfig {
         /// The topic.
         topic: String,
     },
-    /// A `sensor_msgs/msg/Joy` button, nonzero engaged (CRTK's `button1`, `front`:
-    /// `buttons[0]`, 1 pressed, 0 released).
+    /// A `sensor_msgs/msg/Joy` button, 1 engaged (CRTK's `button1`, `front`:
+    /// `buttons[0]`, 1 pressed, 0 released, 2 clicked: a click has been let go, so it
+    /// is released).
     Joy {
         /// The topic.
         topic: String,

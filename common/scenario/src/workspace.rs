@@ -45,12 +45,6 @@ impl Scale {
         }
     }
 
-    /// The smallest factor: how much a distance in the arm's frame shrinks at least
-    /// when taken back into the master's.
-    pub fn min(&self) -> f64 {
-        self.axes().into_iter().fold(f64::INFINITY, f64::min)
-    }
-
     fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         for (i, s) in self.axes().iter().enumerate() {
             if !(s.is_finite() && *s > 0.0 && *s <= 100.0) {
@@ -293,6 +287,38 @@ mod tests {
         let r = FrameRotation::RpyDeg([90.0, 0.0, 0.0]).matrix();
         assert!(close(apply(&r, [0.0, 1.0, 0.0]), [0.0, 0.0, 1.0]));
         assert!(close(apply(&r, [0.0, 0.0, 1.0]), [0.0, -1.0, 0.0]));
+    }
+
+    /// Roll, pitch and yaw compose about the fixed axes, yaw last (URDF's order): a desk
+    /// device facing a robot, rpy (90, 0, -90), takes the device's right to the robot's
+    /// -y, its up to z, towards the operator to -x; and a general one equals the
+    /// product of the three turns written out.
+    #[test]
+    fn rpy_composes_about_fixed_axes_yaw_last() {
+        let m = FrameRotation::RpyDeg([90.0, 0.0, -90.0]).matrix();
+        assert!(close(apply(&m, [1.0, 0.0, 0.0]), [0.0, -1.0, 0.0]));
+        assert!(close(apply(&m, [0.0, 1.0, 0.0]), [0.0, 0.0, 1.0]));
+        assert!(close(apply(&m, [0.0, 0.0, 1.0]), [-1.0, 0.0, 0.0]));
+        let (r, p, y) = (0.3f64, -0.4f64, 1.1f64);
+        let rx = [
+            [1.0, 0.0, 0.0],
+            [0.0, r.cos(), -r.sin()],
+            [0.0, r.sin(), r.cos()],
+        ];
+        let ry = [
+            [p.cos(), 0.0, p.sin()],
+            [0.0, 1.0, 0.0],
+            [-p.sin(), 0.0, p.cos()],
+        ];
+        let rz = [
+            [y.cos(), -y.sin(), 0.0],
+            [y.sin(), y.cos(), 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let m = FrameRotation::RpyDeg([r, p, y].map(f64::to_degrees)).matrix();
+        let v = [0.2, -0.7, 0.5];
+        let want = apply(&rz, apply(&ry, apply(&rx, v)));
+        assert!(close(apply(&m, v), want), "{:?} {want:?}", apply(&m, v));
     }
 
     #[test]

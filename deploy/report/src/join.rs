@@ -471,11 +471,16 @@ impl Sources {
 }
 
 /// Joins the records found in `dirs`, handing each sample's row to `each` in order,
-/// with a URDF arm's joints where the slave is one. `each` may stop the join early (a
-/// stop request): the logs then hold what was read so far.
+/// with a URDF arm's joints where the slave is one and a 6-DoF master's orientation.
+/// `each` may stop the join early (a stop request): the logs then hold what was read
+/// so far.
 pub fn join(
     dirs: &[PathBuf],
-    mut each: impl FnMut(&TraceRow, Option<&ArmJoints>) -> Result<ControlFlow<()>, Error>,
+    mut each: impl FnMut(
+        &TraceRow,
+        Option<&ArmJoints>,
+        Option<[f64; 4]>,
+    ) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
     let [m, e, s] = locate(dirs)?;
     let mut src = Sources {
@@ -504,7 +509,8 @@ pub fn join(
                 SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
             })
             .unwrap_or((None, None));
-        if each(&row(&part, &passages, step.as_ref()), joints)?.is_break() {
+        let rotation = part.sent.rotation;
+        if each(&row(&part, &passages, step.as_ref()), joints, rotation)?.is_break() {
             return src.logs(false);
         }
         n += 1;

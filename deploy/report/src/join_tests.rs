@@ -135,7 +135,7 @@ fn records_of_two_clock_domains_join_sample_by_sample_within_the_window() {
     let clocks: Vec<String> = starts.iter().flatten().map(|s| s.clock.clone()).collect();
     assert_eq!(clocks, ["host-a", "host-b", "host-b"]);
     let mut rows = Vec::new();
-    let logs = join(&dirs, |r, _| {
+    let logs = join(&dirs, |r, _, _| {
         rows.push(*r);
         Ok(ControlFlow::Continue(()))
     })
@@ -169,7 +169,7 @@ fn records_of_two_clock_domains_join_sample_by_sample_within_the_window() {
 fn records_of_another_run_are_refused() {
     let dir = tempfile::tempdir().expect("tempdir");
     let dirs = write_run(dir.path(), RUN + 1);
-    let e = join(&dirs, |_, _| Ok(ControlFlow::Continue(()))).expect_err("two runs");
+    let e = join(&dirs, |_, _, _| Ok(ControlFlow::Continue(()))).expect_err("two runs");
     assert!(e.to_string().contains("not one run"), "{e}");
 }
 
@@ -178,7 +178,7 @@ fn a_stop_ends_the_join_with_what_it_has() {
     let dir = tempfile::tempdir().expect("tempdir");
     let dirs = write_run(dir.path(), RUN);
     let mut seen = 0;
-    let logs = join(&dirs, |r, _| {
+    let logs = join(&dirs, |r, _, _| {
         seen += 1;
         Ok(if r.n == 99 {
             ControlFlow::Break(())

@@ -112,7 +112,12 @@ impl<W: Write> Recording<W> {
 
     /// Adds one sample's messages; `joints` are a URDF arm's (a row without them
     /// draws the arm where it last was).
-    pub fn add(&mut self, row: &TraceRow, joints: Option<&ArmJoints>) -> io::Result<()> {
+    pub fn add(
+        &mut self,
+        row: &TraceRow,
+        joints: Option<&ArmJoints>,
+        rotation: Option<[f64; 4]>,
+    ) -> io::Result<()> {
         let log = self.log_time(row);
         if self.prev.is_none() {
             self.first(log)?;
@@ -130,6 +135,7 @@ impl<W: Write> Recording<W> {
                 tau: row.tau,
                 target: row.target,
                 handle: row.handle,
+                rotation: rotation.unwrap_or(tactile_ros::msg::IDENTITY),
                 q: row.q,
                 felt: row.felt,
             }),

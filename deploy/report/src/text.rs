@@ -157,11 +157,20 @@ fn counters(t: &mut String, s: &Summary) {
     );
     if let Some(sl) = &s.slave {
         let c = &sl.counters;
-        let _ = writeln!(
+        let _ = write!(
             t,
             "slave: {} IK targets clamped, {} samples rejected, {} torque clamps, {} holds",
             c.ik_clamped, c.rejected, c.torque_clamps, c.holds
         );
+        // Only an arm with a workspace box clamps there: other runs' lines stay.
+        if c.workspace_clamped > 0 {
+            let _ = write!(
+                t,
+                ", {} targets clamped to the workspace box",
+                c.workspace_clamped
+            );
+        }
+        t.push('\n');
     }
 }
 

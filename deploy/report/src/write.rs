@@ -404,7 +404,12 @@ impl Streams {
         })
     }
 
-    fn add(&mut self, row: &trace::TraceRow, joints: Option<&ArmJoints>) -> Result<(), Error> {
+    fn add(
+        &mut self,
+        row: &trace::TraceRow,
+        joints: Option<&ArmJoints>,
+        rotation: Option<[f64; 4]>,
+    ) -> Result<(), Error> {
         if let (Some(w), Some(j)) = (self.joints.as_mut(), joints) {
             self.line.clear();
             crate::joints::row(&mut self.line, row.n, j);
@@ -419,7 +424,8 @@ impl Streams {
                 .map_err(Error::io("writing trace.csv"))?;
         }
         if let Some(r) = self.recording.as_mut() {
-            r.add(row, joints).map_err(Error::io("writing run.mcap"))?;
+            r.add(row, joints, rotation)
+                .map_err(Error::io("writing run.mcap"))?;
         }
         Ok(())
     }
@@ -527,7 +533,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
             || launch.until.is_some_and(|u| Instant::now() >= u)
     };
     let mut cut_short = None;
-    let logs = join::join(dirs, |row, joints| {
+    let logs = join::join(dirs, |row, joints, rotation| {
         // Looked at every 1024 samples: a clock read per sample would cost.
         if row.n % 1024 == 0 && stopped() {
             cut_short = Some(row.n);
@@ -535,7 +541,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         }
         analysis.add(row);
         series.add(row, t_s);
-        streams.add(row, joints)?;
+        streams.add(row, joints, rotation)?;
         Ok(ControlFlow::Continue(()))
     })
     .inspect_err(|_| discard(out))?;
@@ -572,9 +578,9 @@ pub fn write_mcap(dirs: &[PathBuf], out: &Path) -> Result<(u64, Option<String>),
         run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
 
     let mut samples = 0;
-    join::join(dirs, |row, joints| {
+    join::join(dirs, |row, joints, rotation| {
         samples += 1;
-        rec.add(row, joints)
+        rec.add(row, joints, rotation)
             .map_err(Error::io("writing run.mcap"))?;
         Ok(ControlFlow::Continue(()))
     })
