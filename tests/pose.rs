@@ -280,3 +280,67 @@ fn a_late_clutch_arrives_with_its_pose() {
     // Held while released; engaged, it follows the master's moves since the engage.
     held_then_followed(&sb.trace("a"), first..=last);
 }
+
+/// The shipped clutch scenario (`panda-reach.toml`): three 6 cm strokes with two
+/// releases between them carry the Panda's hand 27 cm along its x through the map (a
+/// quarter turn between the bases, 1.5 times the motion), the robot holding while the
+/// hand goes back; released, the hand feels the clutch spring, not the robot; at the
+/// end the wall pushes back, scaled by a half; the plots shade the two releases.
+#[test]
+fn the_reach_scenario_clutches_twice_to_go_three_times_as_far() {
+    let sb = Sandbox::new("reach");
+    sb.simulate(&scenarios().join("panda-reach.toml"), "a");
+    let trace = sb.trace("a");
+    let col = |c: &str| column(&trace, c);
+    let tool = [1, 2, 3].map(|i| col(&format!("tool_{i}")));
+    let handle = [1, 2, 3].map(|i| col(&format!("handle_{i}")));
+    let felt = [1, 2, 3].map(|i| col(&format!("felt_{i}")));
+    let joints = std::fs::read_to_string(sb.path("a").join("joints.csv")).expect("joints");
+    let released = joint_col(&joints, "released");
+    let changes: Vec<usize> = (1..released.len())
+        .filter(|&n| released[n] != released[n - 1])
+        .collect();
+    assert_eq!(changes, [2200, 3400, 5100, 6300], "two releases");
+    // The tool in the master's frame, back through the map: its move towards -z (away
+    // from the operator) is the robot's along +x, divided by the scale.
+    let end = tool[2].len() - 1;
+    let reach = 1.5 * (tool[2][0] - tool[2][end]);
+    assert!((reach - 0.27).abs() < 2e-3, "the hand went {reach} m");
+    for (a, b) in [(2200, 3400), (5100, 6300)] {
+        let drift = (a..b)
+            .map(|n| {
+                (0..3)
+                    .map(|k| (tool[k][n] - tool[k][a]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            drift * 1.5 < 2e-4,
+            "moved {} mm while released",
+            drift * 1.5e3
+        );
+        // The spring: 50 N/m towards home, within the 3.3 N limit.
+        let n = (a + b) / 2;
+        let home = [0.0, -0.107, -0.035];
+        for k in 0..3 {
+            let want = (50.0 * (home[k] - handle[k][n])).clamp(-3.3, 3.3);
+            assert!(
+                (felt[k][n] - want).abs() < 1e-9,
+                "felt {k} {} against {want}",
+                felt[k][n]
+            );
+        }
+    }
+    assert!(felt[2][end] > 2.0, "the wall at the end: {}", felt[2][end]);
+    let svg = std::fs::read_to_string(sb.path("a").join("positions.svg")).expect("svg");
+    assert!(
+        svg.contains("clutch released"),
+        "the legend names the shading"
+    );
+    assert_eq!(
+        svg.matches("opacity=\"0.25\"").count(),
+        2,
+        "two shaded stretches"
+    );
+}
