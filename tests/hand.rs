@@ -292,14 +292,7 @@ fn check_touch_run(sb: &Sandbox, r: &serde_json::Value, d: &serde_json::Value) {
     // Released: the tool holds while the hand goes back.
     let tool = [1, 2, 3].map(|i| util::column(&trace, &format!("tool_{i}")));
     let (a, b) = (stretches[0].1 + 100, stretches[1].0 - 1);
-    let drift = (a..=b)
-        .map(|n| {
-            (0..3)
-                .map(|k| (tool[k][n] - tool[k][a]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
-        .fold(0.0, f64::max);
+    let drift = util::largest_move(&tool, a, b + 1);
     assert!(
         drift * 1.5 < 1e-3,
         "the robot moved {} mm while released",

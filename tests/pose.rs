@@ -307,14 +307,7 @@ fn the_reach_scenario_clutches_twice_to_go_three_times_as_far() {
     let reach = 1.5 * (tool[2][0] - tool[2][end]);
     assert!((reach - 0.27).abs() < 2e-3, "the hand went {reach} m");
     for (a, b) in [(2200, 3400), (5100, 6300)] {
-        let drift = (a..b)
-            .map(|n| {
-                (0..3)
-                    .map(|k| (tool[k][n] - tool[k][a]).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .fold(0.0, f64::max);
+        let drift = util::largest_move(&tool, a, b);
         assert!(
             drift * 1.5 < 2e-4,
             "moved {} mm while released",

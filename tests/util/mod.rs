@@ -383,3 +383,16 @@ pub fn num(v: &serde_json::Value) -> f64 {
     v.as_f64()
         .unwrap_or_else(|| panic!("expected a number, found {v}"))
 }
+
+/// The largest distance of the points `p` (three columns) over samples `from..to` from
+/// where they were at `from`.
+pub fn largest_move(p: &[Vec<f64>; 3], from: usize, to: usize) -> f64 {
+    (from..to)
+        .map(|n| {
+            (0..3)
+                .map(|k| (p[k][n] - p[k][from]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .fold(0.0, f64::max)
+}
