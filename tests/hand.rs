@@ -87,6 +87,9 @@ fn engaged_stretches(released: &[f64]) -> Vec<(usize, usize)> {
     out
 }
 
+/// The most samples the robot may follow the master's path late, in the checks.
+const LAG: usize = 50;
+
 /// Over each engaged stretch (from 50 samples after the engage, free space only: no
 /// force back), how far the robot's tool moved from where the map says: its move
 /// since the engage against `S R` times the master's (m, the robot's frame), and its
@@ -116,13 +119,18 @@ fn following(trace: &str, joints: &str, scale: f64, r: &Matrix3<f64>) -> (Vec<f6
                 break;
             }
             // Since the engage: the robot's move against S R times the master's, its
-            // turn against the master's turn carried by R.
+            // turn against the master's turn carried by R; the nearest of the
+            // master's last 50 samples (a stand-in starved by the suite follows the
+            // same path late: this measures the map, not the stand-in's timing).
             let tool = fk(n);
-            let d_v = at(&v, n) - at(&v, e);
-            moves.push((tool.p - tool_e.p - scale * r * d_v).norm());
-            let m = rot(&quat(&master_rot, n)) * m_e.transpose();
-            let want = r * m * r.transpose() * tool_e.r;
-            turns.push(angle_deg(&tool.r, &want));
+            let lagged = n.saturating_sub(LAG).max(e)..=n;
+            let moved = |m: usize| (tool.p - tool_e.p - scale * r * (at(&v, m) - at(&v, e))).norm();
+            moves.push(lagged.clone().map(moved).fold(f64::INFINITY, f64::min));
+            let turned = |m: usize| {
+                let turn = rot(&quat(&master_rot, m)) * m_e.transpose();
+                angle_deg(&tool.r, &(r * turn * r.transpose() * tool_e.r))
+            };
+            turns.push(lagged.map(turned).fold(f64::INFINITY, f64::min));
         }
     }
     moves.sort_by(f64::total_cmp);
@@ -307,15 +315,20 @@ fn check_touch_run(sb: &Sandbox, r: &serde_json::Value, d: &serde_json::Value) {
         .map(|i| (q_ref[i][e] - q_ref[i][e - 1]).abs())
         .fold(0.0, f64::max);
     assert!(step < 1e-6, "the engage stepped a reference {step} rad");
-    // The largest step of any command but the end's hold (at the joints measured,
-    // which a robot pressed into a wall lags its reference by).
-    let max_step = floats(&r["max_step_before_last"])
-        .into_iter()
-        .fold(0.0, f64::max);
-    assert!(
-        max_step < 2.175e-3,
-        "a command stepped {max_step} rad in 1 ms"
-    );
+    // No command steps a joint further than its URDF velocity limit allows in 1 ms,
+    // but the end's hold (at the joints measured, which a robot pressed into a wall
+    // lags its reference by: the step that takes the force off).
+    let xml = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/robots/panda.urdf"))
+        .expect("panda.urdf");
+    let chain = tactile_chain::Chain::from_urdf(&xml, "panda_link0", "panda_hand").expect("chain");
+    for (d, step) in chain.dofs.iter().zip(floats(&r["max_step_before_last"])) {
+        assert!(
+            step <= d.velocity * 1e-3 + 1e-12,
+            "{} stepped {step} rad in 1 ms, past {} rad/s",
+            d.name,
+            d.velocity
+        );
+    }
     // The wall: MuJoCo's contact pushes the hand up (the robot's z), the master's up
     // (its y) at 0.02 of it, the Touch's z (the omni_common frame's up).
     let h = [1, 2, 3].map(|i| util::column(&trace, &format!("h_{i}")));

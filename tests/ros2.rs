@@ -1413,10 +1413,9 @@ fn mujoco_checks(sb: &Sandbox, r: &serde_json::Value) {
     // 0.23 mm at the median, 1.3 mm at the 95th percentile once here; so half the
     // samples must be within 1 mm and 1 degree, the worst within 1 cm and 5 degrees.
     assert!(h[..1000].iter().all(|f| *f == 0.0));
-    let mut errors: Vec<f64> = util::tracking(&trace)[300..1000]
-        .iter()
-        .map(|(e, _)| *e)
-        .collect();
+    // The path the hand drew against the reference's, up to 50 ms late: a stand-in
+    // starved by the whole suite (CI) lagged 4 mm at the same sample, on the path.
+    let mut errors = util::path_error(&trace, 300..1000, 50);
     let joints = std::fs::read_to_string(sb.path("out").join("joints.csv")).expect("joints");
     let mut turns = util::column(&joints, "rot_error_deg")[300..1000].to_vec();
     errors.sort_by(f64::total_cmp);

@@ -396,3 +396,25 @@ pub fn largest_move(p: &[Vec<f64>; 3], from: usize, to: usize) -> f64 {
         })
         .fold(0.0, f64::max)
 }
+
+/// How far the robot's tool (`tool_*`) is from the path the reference (`v_*`) drew, at
+/// each sample of `range`: the distance to the nearest of the reference's last
+/// `max_lag + 1` samples. A robot simulated by a stand-in that the rest of a test
+/// suite starves on two cores follows the same path late; this measures the path,
+/// not the stand-in's timing.
+pub fn path_error(trace: &str, range: std::ops::Range<usize>, max_lag: usize) -> Vec<f64> {
+    let t = [1, 2, 3].map(|i| column(trace, &format!("tool_{i}")));
+    let v = [1, 2, 3].map(|i| column(trace, &format!("v_{i}")));
+    range
+        .map(|n| {
+            (n.saturating_sub(max_lag)..=n)
+                .map(|m| {
+                    (0..3)
+                        .map(|i| (t[i][n] - v[i][m]).powi(2))
+                        .sum::<f64>()
+                        .sqrt()
+                })
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect()
+}
