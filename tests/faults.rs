@@ -33,8 +33,8 @@ fn kill(pid: i32, signal: rustix::process::Signal) {
     let _ = rustix::process::kill_process(pid, signal);
 }
 
-/// Waits until the master of the run into `out` has recorded `bytes` (about 400 a sample at 1 kHz:
-/// 1,500 samples are 600 kB), then kills `role` with SIGKILL.
+/// Waits until the master of the run into `out` has recorded `bytes` (about 57 a sample at
+/// 1 kHz in blocks of 50 ms: 1,500 samples are 85 kB), then kills `role` with SIGKILL.
 fn kill_mid_run(sb: &Sandbox, out: &str, role: &str, bytes: u64) {
     let rec = sb.path(out).join("master.rec");
     util::wait_for("the run got going", Duration::from_secs(30), || {
@@ -59,7 +59,7 @@ fn peer_dies_and_the_loop_resumes(role: &str) {
     let sb = Sandbox::new(role);
     let scenario = sb.write("s.toml", &util::paper_1khz(4000));
     let child = spawn_run(&sb, &scenario, "run");
-    kill_mid_run(&sb, "run", role, 600_000);
+    kill_mid_run(&sb, "run", role, 85_000);
     let (code, stdout, stderr) = finish(child);
     sb.assert_no_leftover_processes();
     assert_eq!(
@@ -145,7 +145,7 @@ fn lockstep_drops_and_stalls_change_nothing() {
     let scenario = sb.write("s.toml", &text);
     let child = spawn_run(&sb, &scenario, "run");
     let rec = sb.path("run").join("master.rec");
-    for (role, bytes) in [("emulator", 400_000), ("master", 1_600_000)] {
+    for (role, bytes) in [("emulator", 57_000), ("master", 230_000)] {
         util::wait_for("the run got going", Duration::from_secs(30), || {
             std::fs::metadata(&rec).is_ok_and(|m| m.len() >= bytes)
         });
@@ -183,7 +183,7 @@ fn master_killed_the_slave_holds_and_the_launcher_fails_cleanly() {
     let sb = Sandbox::new("master");
     let scenario = sb.write("s.toml", &util::paper_1khz(5000));
     let child = spawn_run(&sb, &scenario, "run");
-    kill_mid_run(&sb, "run", "master", 600_000);
+    kill_mid_run(&sb, "run", "master", 85_000);
     let (code, _stdout, stderr) = finish(child);
     sb.assert_no_leftover_processes();
     assert_eq!(code, Some(1), "{stderr}");
@@ -227,7 +227,7 @@ fn a_new_run_after_a_crash_starts_cleanly() {
     let sb = Sandbox::new("crash");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let child = spawn_run(&sb, &scenario, "first");
-    kill_mid_run(&sb, "first", "master", 200_000);
+    kill_mid_run(&sb, "first", "master", 28_000);
     // Kill the launcher first, so nobody cleans up, then every process of the run.
     let launcher = child.id() as i32;
     let (m, e, s) = (

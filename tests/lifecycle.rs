@@ -112,8 +112,9 @@ fn a_restarted_nodes_counters_are_summed_over_its_segments() {
     let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
     let slave = start_node(&sb, "slave", &scenario, "s", &[]);
     let rec = sb.path("s").join("slave.rec");
-    // Past a second, so the first segment has written its counters.
-    kill_once_recorded(slave, &rec, 700_000);
+    // Past a second (about 64 bytes a sample at 1 kHz), so the first segment has
+    // written its counters.
+    kill_once_recorded(slave, &rec, 110_000);
     let slave = start_node(&sb, "slave", &scenario, "s", &["--append"]);
     for (role, child) in [("master", master), ("emulator", emulator), ("slave", slave)] {
         let (code, err) = finish(child);

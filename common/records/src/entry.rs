@@ -25,6 +25,49 @@ pub enum Record<S, C> {
     Counters(Totals<C>),
     /// The node ended normally; nothing follows in this segment.
     Stop(Stop),
+    /// Samples stored together as columns ([`crate::block`]): how a writer stores
+    /// them; a reader hands them out one by one as [`Record::Sample`].
+    Samples(SampleBlock),
+}
+
+/// Consecutive samples of one record, packed ([`crate::block::pack`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SampleBlock {
+    /// Samples in the block.
+    pub samples: u32,
+    /// Length of the planes before zstd, bytes.
+    pub raw_len: u32,
+    /// The packed planes.
+    pub packed: Packed,
+}
+
+/// Bytes stored as one string (serde's bytes), not as a sequence of numbers.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Packed(pub Vec<u8>);
+
+impl Serialize for Packed {
+    fn serialize<Z: serde::Serializer>(&self, s: Z) -> Result<Z::Ok, Z::Error> {
+        s.serialize_bytes(&self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for Packed {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Bytes;
+        impl serde::de::Visitor<'_> for Bytes {
+            type Value = Packed;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("bytes")
+            }
+            fn visit_bytes<E: serde::de::Error>(self, v: &[u8]) -> Result<Packed, E> {
+                Ok(Packed(v.to_vec()))
+            }
+            fn visit_byte_buf<E: serde::de::Error>(self, v: Vec<u8>) -> Result<Packed, E> {
+                Ok(Packed(v))
+            }
+        }
+        d.deserialize_byte_buf(Bytes)
+    }
 }
 
 /// A record of any role read for its role-independent entries (`Start`, `Run`): the

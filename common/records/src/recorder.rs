@@ -43,6 +43,22 @@ pub struct Recorder<S, C> {
     appended: Option<(u64, Vec<u64>)>,
     /// Set once the segment was taken back out: nothing more is written to the file.
     withdrawn: bool,
+    role: Role,
+}
+
+/// Rows a block of `role`'s samples holds: 50 ms of samples at `rate_hz` (the master
+/// writes two rows a sample, what it sent and the answer or miss; the emulator two,
+/// a passage each way; the slave one).
+pub fn block_rows(role: Role, rate_hz: f64) -> usize {
+    let per_sample = if role == Role::Slave { 1 } else { 2 };
+    let samples = (rate_hz * crate::file::BLOCK_NS as f64 * 1e-9).floor();
+    // Any rate: a finite positive count, at least one sample.
+    let samples = if samples.is_finite() {
+        samples.clamp(1.0, 1e6) as usize
+    } else {
+        1
+    };
+    samples * per_sample
 }
 
 /// Counters are written this often, ns.
@@ -60,7 +76,7 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
         let writer = RecordWriter::create(&path, append).map_err(opening)?;
         let appended = if append {
             let end = std::fs::metadata(&path).map_err(opening)?.len();
-            Some((end, crate::frames::runs_in(&path)))
+            Some((end, crate::file::runs_in(&path)))
         } else {
             None
         };
@@ -69,6 +85,7 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
             next_counters_ns: now_ns() + COUNTERS_EVERY_NS,
             appended,
             withdrawn: false,
+            role,
         })
     }
 
@@ -100,6 +117,8 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
             s.poll_us,
             s.cpu.map_or(String::new(), |c| format!(", CPU {c}"))
         );
+        self.writer
+            .set_block_rows(block_rows(self.role, start.rate_hz));
         self.put(&Record::Start(start))
     }
 
@@ -228,7 +247,7 @@ mod tests {
         assert_eq!(std::fs::read(&path).expect("record"), before);
         // The same run continues.
         segment(dir.path(), true, 1).expect("same run");
-        assert_eq!(crate::frames::runs_in(&path), vec![1]);
+        assert_eq!(crate::file::runs_in(&path), vec![1]);
         assert!(std::fs::read(&path).expect("record").len() > before.len());
     }
 }

@@ -113,6 +113,8 @@ impl<C: Clone> NodeLog<C> {
                     *last = Some(s.reason);
                 }
             }
+            // The reader hands a block's samples out one by one: none comes whole.
+            Record::Samples(_) => {}
         }
         None
     }

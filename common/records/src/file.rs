@@ -1,0 +1,311 @@
+//! A record file written and read entry by entry: samples gathered into blocks of at
+//! most 50 ms of the run ([`crate::block`], one frame each), every other entry (start,
+//! run, event, counters, stop) a frame of its own, written at once.
+//!
+//! A block goes to the operating system when it is full, when 50 ms have passed since
+//! its first sample, before any other entry, and when the writer is dropped; so a node
+//! killed by SIGKILL loses at most the block in hand (50 ms of samples), and damage on
+//! disk costs the blocks it touches, never the file.
+
+use crate::block;
+use crate::entry::{Record, SampleBlock};
+use crate::frames::MAX_FRAME;
+use crate::frames::{config, frame, open_for_writing, Damage, Frames, RecordError, HEADER};
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::collections::VecDeque;
+use std::io::Write;
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
+use tactile_messages::clock::now_ns;
+
+/// A block is written at the latest this long after its first sample, ns.
+pub const BLOCK_NS: u64 = 50_000_000;
+
+/// Samples of a block are encoded with fixed-width integers, so each field sits at
+/// the same offset in rows of one shape ([`crate::block`]); with the frames' limit.
+fn row_config() -> impl bincode::config::Config {
+    bincode::config::standard()
+        .with_fixed_int_encoding()
+        .with_limit::<{ MAX_FRAME as usize }>()
+}
+
+/// Appends records to a node's file: entries one `write` each, samples a block at a
+/// time.
+pub struct RecordWriter<T> {
+    file: std::fs::File,
+    buf: Vec<u8>,
+    /// The block in hand: its rows, concatenated, and their lengths.
+    rows: Vec<u8>,
+    lens: Vec<usize>,
+    started_ns: u64,
+    block_rows: usize,
+    planes: Vec<u8>,
+    scratch: Vec<u8>,
+    z: zstd::bulk::Compressor<'static>,
+    path: PathBuf,
+    _t: PhantomData<fn(&T)>,
+}
+
+impl<T> std::fmt::Debug for RecordWriter<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RecordWriter")
+            .field("path", &self.path)
+            .field("pending", &self.lens.len())
+            .field("block_rows", &self.block_rows)
+            .finish()
+    }
+}
+
+impl<T> RecordWriter<T> {
+    /// Rows a block holds at most (a node's rows for 50 ms of its samples).
+    pub fn set_block_rows(&mut self, rows: usize) {
+        self.block_rows = rows.max(1);
+    }
+
+    /// Writes the block in hand, if any (one frame, one system call).
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        if self.lens.is_empty() {
+            return Ok(());
+        }
+        let (raw_len, packed) = block::pack(
+            &mut self.z,
+            &self.rows,
+            &self.lens,
+            &mut self.planes,
+            &mut self.scratch,
+        )?;
+        let entry = Record::<(), ()>::Samples(SampleBlock {
+            samples: u32::try_from(self.lens.len()).map_err(std::io::Error::other)?,
+            raw_len,
+            packed: crate::entry::Packed(packed),
+        });
+        self.rows.clear();
+        self.lens.clear();
+        self.put(&entry)
+    }
+
+    fn put<E: Serialize>(&mut self, entry: &E) -> std::io::Result<()> {
+        self.buf.clear();
+        bincode::serde::encode_into_std_write(entry, &mut self.buf, config())
+            .map_err(std::io::Error::other)?;
+        if self.buf.len() > MAX_FRAME as usize {
+            // A reader would take it for damage: refuse it here instead.
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!(
+                    "a record of {} bytes is longer than a frame may be",
+                    self.buf.len()
+                ),
+            ));
+        }
+        self.file.write_all(&frame(&self.buf))
+    }
+
+    /// Cuts the file back to `len` bytes (a segment taken back out), the block in
+    /// hand with it.
+    pub fn truncate(&mut self, len: u64) -> std::io::Result<()> {
+        self.rows.clear();
+        self.lens.clear();
+        self.file.set_len(len)
+    }
+
+    /// The file written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl<T> Drop for RecordWriter<T> {
+    /// However the writer goes (a node's error included), the block in hand is written.
+    fn drop(&mut self) {
+        if let Err(e) = self.flush() {
+            tracing::warn!(
+                "{}: the last block of samples was lost: {e}",
+                self.path.display()
+            );
+        }
+    }
+}
+
+impl<S: Serialize, C: Serialize> RecordWriter<Record<S, C>> {
+    /// Creates `path` afresh, or with `append` continues an existing record file (a
+    /// restarted node of the same run) after trimming a torn tail; a file that is not
+    /// a record of this format is never touched.
+    pub fn create(path: &Path, append: bool) -> std::io::Result<Self> {
+        Ok(RecordWriter {
+            file: open_for_writing(path, append)?,
+            buf: Vec::with_capacity(512),
+            rows: Vec::new(),
+            lens: Vec::new(),
+            started_ns: 0,
+            block_rows: 1,
+            planes: Vec::new(),
+            scratch: Vec::new(),
+            z: zstd::bulk::Compressor::new(block::LEVEL)?,
+            path: path.to_path_buf(),
+            _t: PhantomData,
+        })
+    }
+
+    /// Writes one record: a sample into the block in hand, anything else in a frame
+    /// of its own at once (after the block, so the file keeps the order).
+    pub fn write(&mut self, record: &Record<S, C>) -> std::io::Result<()> {
+        match record {
+            Record::Sample(s) => self.write_sample(s),
+            other => {
+                self.flush()?;
+                self.put(other)
+            }
+        }
+    }
+
+    /// Adds one sample to the block in hand, written when full or 50 ms old.
+    pub fn write_sample(&mut self, sample: &S) -> std::io::Result<()> {
+        let before = self.rows.len();
+        bincode::serde::encode_into_std_write(sample, &mut self.rows, row_config())
+            .map_err(std::io::Error::other)?;
+        self.lens.push(self.rows.len() - before);
+        let n = self.lens.len();
+        if n == 1 {
+            self.started_ns = now_ns();
+        }
+        // The clock is read every eighth sample: a block is late by a few samples at
+        // most, for an eighth of the cost.
+        if n >= self.block_rows
+            || (n % 8 == 0 && now_ns().saturating_sub(self.started_ns) >= BLOCK_NS)
+        {
+            self.flush()?;
+        }
+        Ok(())
+    }
+}
+
+/// The run tokens a record holds (`Record::Run`), in order, each once; none if the
+/// file cannot be read. Sample blocks are skipped unpacked.
+pub fn runs_in(path: &Path) -> Vec<u64> {
+    let mut runs = Vec::new();
+    let Ok(mut r) = RecordReader::<crate::AnyRecord>::open(path) else {
+        return runs;
+    };
+    r.samples = false;
+    while let Ok(Some(rec)) = r.next_record() {
+        if let Record::Run(t) = rec {
+            if !runs.contains(&t) {
+                runs.push(t);
+            }
+        }
+    }
+    runs
+}
+
+/// Reads a record file back, record by record, in bounded memory: damaged stretches
+/// are skipped and reported in [`RecordReader::damage`], never the whole file.
+pub struct RecordReader<T> {
+    frames: Frames,
+    path: String,
+    /// Samples of the block read last, not handed out yet.
+    pending: VecDeque<T>,
+    /// Whether sample blocks are unpacked (or skipped).
+    samples: bool,
+    z: zstd::bulk::Decompressor<'static>,
+}
+
+impl<T> std::fmt::Debug for RecordReader<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RecordReader")
+            .field("path", &self.path)
+            .field("pending", &self.pending.len())
+            .finish()
+    }
+}
+
+impl<S: DeserializeOwned, C: DeserializeOwned> RecordReader<Record<S, C>> {
+    /// Opens a record file and checks its magic.
+    pub fn open(path: &Path) -> Result<Self, RecordError> {
+        Ok(RecordReader {
+            frames: Frames::open(path)?,
+            path: path.display().to_string(),
+            pending: VecDeque::new(),
+            samples: true,
+            z: zstd::bulk::Decompressor::new().map_err(|source| RecordError::Io {
+                path: path.display().to_string(),
+                source,
+            })?,
+        })
+    }
+
+    /// The next record, `None` at the end of the file. A frame whose checksum holds
+    /// but whose body does not decode (another build's types) counts as damage too,
+    /// and a block that does not unpack as a whole.
+    pub fn next_record(&mut self) -> Result<Option<Record<S, C>>, RecordError> {
+        loop {
+            if let Some(r) = self.pending.pop_front() {
+                return Ok(Some(r));
+            }
+            let more = self.frames.next_frame().map_err(|source| RecordError::Io {
+                path: self.path.clone(),
+                source,
+            })?;
+            if !more {
+                return Ok(None);
+            }
+            let body = &self.frames.body;
+            let decoded = bincode::serde::decode_from_slice::<Record<S, C>, _>(body, config());
+            let whole = match decoded {
+                Ok((Record::Samples(b), used)) if used == body.len() => {
+                    !self.samples || self.unpack(&b)
+                }
+                Ok((r, used)) if used == body.len() => return Ok(Some(r)),
+                _ => false,
+            };
+            if !whole {
+                let bytes = (HEADER + self.frames.body.len()) as u64;
+                let start = self.frames.offset - bytes;
+                self.frames.note_damage(start, bytes);
+            }
+        }
+    }
+
+    /// Puts a block's samples in `pending`; false (and none of them) if any row does
+    /// not decode.
+    fn unpack(&mut self, b: &SampleBlock) -> bool {
+        let Ok((rows, lens)) = block::unpack(&mut self.z, b.raw_len, &b.packed.0) else {
+            return false;
+        };
+        if lens.len() != b.samples as usize {
+            return false;
+        }
+        let mut at = 0;
+        for l in lens {
+            let row = &rows[at..at + l];
+            at += l;
+            match bincode::serde::decode_from_slice::<S, _>(row, row_config()) {
+                Ok((s, used)) if used == l => self.pending.push_back(Record::Sample(s)),
+                _ => {
+                    self.pending.clear();
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// The damaged stretches skipped so far (the first [`crate::frames::MAX_KEPT_DAMAGE`]).
+    pub fn damage(&self) -> &[Damage] {
+        &self.frames.damage
+    }
+
+    /// Bytes and stretches skipped so far, all of them.
+    pub fn damaged(&self) -> (u64, u64) {
+        (self.frames.damaged_bytes, self.frames.damaged_stretches)
+    }
+}
+
+/// The magic this build writes, for the tests' hand-made files.
+#[cfg(test)]
+pub(crate) const THIS_MAGIC: [u8; 8] = crate::frames::MAGIC;
+
+#[cfg(test)]
+#[path = "file_tests.rs"]
+mod tests;
