@@ -12,7 +12,7 @@ trace's tool comes from the run's arithmetic, which may be the hybrid fixed-poin
 
 What it checks (the file's spec is docs of issue 20; each failure prints one clear line
 on stderr and exits with status 1):
-  - the file reads with mcap's reader (CRCs validated), is chunked with lz4, has message
+  - the file reads with mcap's reader (CRCs validated), is chunked with lz4 (or zstd), has message
     indexes, chunk indexes, statistics and summary offsets; the header's profile is ros2;
   - exactly the spec's channels, each with message encoding cdr and a ros2msg schema of
     the spec's type, whose text is the rosbag2 concatenation (main type, then
@@ -420,7 +420,7 @@ def urdf_pose(robot, parent, child):
     return [[float(m[i][j]) for j in range(4)] for i in range(4)]
 
 
-def check_file_structure(path):
+def check_file_structure(path, compression="lz4"):
     counts = {}
     compressions = set()
     with open(path, "rb") as f:
@@ -439,8 +439,8 @@ def check_file_structure(path):
                  f"summary offsets expected); records: {counts}")
     if counts.get("Message"):
         fail(f"run.mcap: {counts['Message']} messages are outside chunks")
-    if compressions != {"lz4"}:
-        fail(f"run.mcap: chunk compressions {sorted(compressions)}, expected lz4 only")
+    if compressions != {compression}:
+        fail(f"run.mcap: chunk compressions {sorted(compressions)}, expected {compression} only")
 
 
 def run(args):
@@ -473,7 +473,7 @@ def run(args):
         ticks = [trace.i(k, "t_master_tick") for k in range(rows)]
     env_rows = [k for k in range(rows) if k == 0 or trace.i(k, "n") % rate_hz == 0]
 
-    check_file_structure(mcap_path)
+    check_file_structure(mcap_path, args.compression)
 
     jazzy = get_typestore(Stores.ROS2_JAZZY)
     timing_ref = get_types_from_msg(SAMPLE_TIMING_MSG, SAMPLE_TIMING)[SAMPLE_TIMING]
@@ -872,6 +872,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("run_dir", help="directory with run.mcap, trace.csv and scenario.toml")
     ap.add_argument("--fk", help='JSON: [{"theta": [t1, t2, t3], "xyz": [x, y, z]}, ...]')
+    ap.add_argument("--compression", default="lz4", choices=["lz4", "zstd"],
+                    help="the chunks' compression expected (default lz4)")
     ap.add_argument("--tool-tol", type=float, default=1e-3,
                     help="bound on |FK(theta_sd) - trace tool|, m (default 1e-3)")
     args = ap.parse_args()

@@ -8,12 +8,14 @@
 
 pub mod analysis;
 pub mod arm_scene;
+pub mod columns;
 pub mod error;
 pub mod join;
 pub mod joints;
 pub mod mcap;
 pub mod metrics;
 pub mod out;
+pub mod parquet_trace;
 pub mod plots;
 pub mod run_mcap;
 pub mod summary;

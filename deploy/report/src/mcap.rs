@@ -1,5 +1,5 @@
 //! An MCAP writer (<https://mcap.dev/spec>), streaming: messages go into a chunk
-//! buffer that is compressed (LZ4 frame) and written when it passes a size, followed
+//! buffer that is compressed (an LZ4 frame, or a zstd frame: [`Compression`]) and written when it passes a size, followed
 //! by its message indexes; the summary at the end holds the schemas, channels,
 //! statistics, chunk indexes and the offsets of each group, so readers can seek and
 //! `ros2 bag info` can count without reading the data. Memory is one chunk plus one
@@ -24,6 +24,50 @@ mod op {
     pub const STATISTICS: u8 = 0x0B;
     pub const SUMMARY_OFFSET: u8 = 0x0E;
     pub const DATA_END: u8 = 0x0F;
+}
+
+/// How chunks are compressed: the two the MCAP spec names, both read by Foxglove,
+/// `mcap` and rosbag2.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Compression {
+    /// LZ4 frames: the faster to write and to read.
+    #[default]
+    Lz4,
+    /// zstd frames (level 3): the smaller file.
+    Zstd,
+}
+
+impl Compression {
+    /// The name the chunk records carry.
+    pub fn name(self) -> &'static str {
+        match self {
+            Compression::Lz4 => "lz4",
+            Compression::Zstd => "zstd",
+        }
+    }
+
+    fn compress(self, data: &[u8]) -> io::Result<Vec<u8>> {
+        match self {
+            Compression::Lz4 => {
+                let mut enc =
+                    lz4_flex::frame::FrameEncoder::new(Vec::with_capacity(data.len() / 2));
+                enc.write_all(data)?;
+                enc.finish().map_err(io::Error::other)
+            }
+            Compression::Zstd => zstd::bulk::compress(data, 3),
+        }
+    }
+}
+
+impl std::str::FromStr for Compression {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "lz4" => Ok(Compression::Lz4),
+            "zstd" => Ok(Compression::Zstd),
+            _ => Err(format!("{s:?}: give lz4 or zstd")),
+        }
+    }
 }
 
 /// Uncompressed bytes a chunk collects before it is written.
@@ -85,6 +129,7 @@ struct ChunkIndex {
     index_length: u64,
     compressed: u64,
     uncompressed: u64,
+    compression: Compression,
 }
 
 /// Writes one MCAP file to `W`.
@@ -101,6 +146,7 @@ pub struct McapWriter<W: Write> {
     chunks: Vec<ChunkIndex>,
     counts: BTreeMap<u16, u64>,
     times: Option<(u64, u64)>,
+    compression: Compression,
 }
 
 impl<W: Write> McapWriter<W> {
@@ -117,6 +163,7 @@ impl<W: Write> McapWriter<W> {
             chunks: Vec::new(),
             counts: BTreeMap::new(),
             times: None,
+            compression: Compression::default(),
         };
         w.put(&MAGIC)?;
         w.put(&record(
@@ -124,6 +171,11 @@ impl<W: Write> McapWriter<W> {
             Fields::default().str(profile).str(library),
         ))?;
         Ok(w)
+    }
+
+    /// Compresses the chunks from here on with `c` (LZ4 unless told).
+    pub fn compress_with(&mut self, c: Compression) {
+        self.compression = c;
     }
 
     fn put(&mut self, b: &[u8]) -> io::Result<()> {
@@ -206,15 +258,13 @@ impl<W: Write> McapWriter<W> {
             return Ok(());
         };
         let crc = crc32fast::hash(&self.chunk);
-        let mut enc = lz4_flex::frame::FrameEncoder::new(Vec::with_capacity(self.chunk.len() / 2));
-        enc.write_all(&self.chunk)?;
-        let compressed = enc.finish().map_err(io::Error::other)?;
+        let compressed = self.compression.compress(&self.chunk)?;
         let mut f = Fields::default();
         f.u64(start)
             .u64(end)
             .u64(self.chunk.len() as u64)
             .u32(crc)
-            .str("lz4")
+            .str(self.compression.name())
             .u64(compressed.len() as u64);
         f.0.extend_from_slice(&compressed);
         let chunk = record(op::CHUNK, &f);
@@ -242,6 +292,7 @@ impl<W: Write> McapWriter<W> {
             index_length: self.pos - index_start,
             compressed: compressed.len() as u64,
             uncompressed: self.chunk.len() as u64,
+            compression: self.compression,
         });
         self.chunk.clear();
         Ok(())
@@ -322,7 +373,7 @@ fn chunk_index(c: &ChunkIndex) -> Vec<u8> {
         .u64(c.length)
         .prefixed(&offsets)
         .u64(c.index_length)
-        .str("lz4")
+        .str(c.compression.name())
         .u64(c.compressed)
         .u64(c.uncompressed);
     record(op::CHUNK_INDEX, &f)

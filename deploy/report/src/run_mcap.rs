@@ -50,6 +50,11 @@ pub struct Recording<W: Write> {
 }
 
 impl<W: Write> Recording<W> {
+    /// Compresses the chunks from here on with `c`.
+    pub fn compress_with(&mut self, c: crate::mcap::Compression) {
+        self.mcap.compress_with(c);
+    }
+
     /// Starts the file with a channel per topic; `arm` draws a URDF slave.
     pub fn new(out: W, scenario: &Scenario, arm: Option<ArmScene>) -> io::Result<Self> {
         let geometry = scenario.device.geometry().map_err(io::Error::other)?;
@@ -324,6 +329,7 @@ pub type FileRecording = Recording<std::io::BufWriter<std::fs::File>>;
 pub fn create(
     dir: &std::path::Path,
     scenario: &Scenario,
+    compression: crate::mcap::Compression,
 ) -> io::Result<(FileRecording, Option<String>)> {
     let (arm, warning) = match ArmScene::of_scenario(scenario) {
         Ok(arm) => (arm, None),
@@ -333,7 +339,8 @@ pub fn create(
         ),
     };
     let f = std::fs::File::create(dir.join(format!("{FILE}.partial")))?;
-    let rec = Recording::new(std::io::BufWriter::with_capacity(1 << 16, f), scenario, arm)?;
+    let mut rec = Recording::new(std::io::BufWriter::with_capacity(1 << 16, f), scenario, arm)?;
+    rec.compress_with(compression);
     Ok((rec, warning))
 }
 

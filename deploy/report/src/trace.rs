@@ -9,6 +9,7 @@
 //! can cut the timing columns off by name. Floats are written in shortest round-trip
 //! form, so equal values give equal text and the file reads back exactly.
 
+use crate::columns::{Columns, Kind};
 use std::fmt::Write;
 use tactile_messages::samples::stage;
 
@@ -21,11 +22,15 @@ trait Cells {
     fn names(field: &str, h: &mut String);
     /// Appends `,value` for each column; `t0` is subtracted from stamps.
     fn cells(&self, line: &mut String, t0: u64);
+    /// Appends each column's name and kind (the columnar files' schema).
+    fn kinds(field: &str, k: &mut Vec<(String, Kind)>);
+    /// Pushes each column's value; `t0` is subtracted from stamps.
+    fn push(&self, cols: &mut Columns, t0: u64);
 }
 
-/// Integers as they print.
+/// Integers as they print; in columns, as their bits in the signed type of their width.
 macro_rules! integer_cells {
-    ($($t:ty),*) => {$(
+    ($($t:ty => $kind:ident, $col:ident, $bits:ty);*) => {$(
         impl Cells for $t {
             fn names(field: &str, h: &mut String) {
                 let _ = write!(h, ",{field}");
@@ -33,11 +38,17 @@ macro_rules! integer_cells {
             fn cells(&self, line: &mut String, _: u64) {
                 let _ = write!(line, ",{self}");
             }
+            fn kinds(field: &str, k: &mut Vec<(String, Kind)>) {
+                k.push((field.to_string(), Kind::$kind));
+            }
+            fn push(&self, cols: &mut Columns, _: u64) {
+                cols.$col(*self as $bits);
+            }
         }
     )*};
 }
 
-integer_cells!(u64, u32, i64);
+integer_cells!(u64 => U64, i64, i64; u32 => U32, i32, i32; i64 => I64, i64, i64);
 
 impl Cells for bool {
     fn names(field: &str, h: &mut String) {
@@ -45,6 +56,12 @@ impl Cells for bool {
     }
     fn cells(&self, line: &mut String, _: u64) {
         let _ = write!(line, ",{}", u8::from(*self));
+    }
+    fn kinds(field: &str, k: &mut Vec<(String, Kind)>) {
+        k.push((field.to_string(), Kind::Bool));
+    }
+    fn push(&self, cols: &mut Columns, _: u64) {
+        cols.bool(*self);
     }
 }
 
@@ -54,6 +71,12 @@ impl Cells for f64 {
     }
     fn cells(&self, line: &mut String, _: u64) {
         let _ = write!(line, ",{self:?}");
+    }
+    fn kinds(field: &str, k: &mut Vec<(String, Kind)>) {
+        k.push((field.to_string(), Kind::F64));
+    }
+    fn push(&self, cols: &mut Columns, _: u64) {
+        cols.f64(*self);
     }
 }
 
@@ -67,6 +90,16 @@ impl<T: Cells> Cells for [T; 3] {
     fn cells(&self, line: &mut String, t0: u64) {
         for x in self {
             x.cells(line, t0);
+        }
+    }
+    fn kinds(field: &str, k: &mut Vec<(String, Kind)>) {
+        for axis in ["1", "2", "3"] {
+            T::kinds(&format!("{field}_{axis}"), k);
+        }
+    }
+    fn push(&self, cols: &mut Columns, t0: u64) {
+        for x in self {
+            x.push(cols, t0);
         }
     }
 }
@@ -99,6 +132,16 @@ impl Cells for Stamps {
             let _ = write!(line, ",{}", t.saturating_sub(t0));
         }
     }
+    fn kinds(_: &str, k: &mut Vec<(String, Kind)>) {
+        for name in stage::NAMES {
+            k.push((format!("t_{name}"), Kind::U64));
+        }
+    }
+    fn push(&self, cols: &mut Columns, t0: u64) {
+        for t in self.0 {
+            cols.i64(t.saturating_sub(t0) as i64);
+        }
+    }
 }
 
 /// Declares [`TraceRow`] from its columns in CSV order, with the header and the
@@ -125,6 +168,13 @@ macro_rules! trace_row {
             h.split_off(1)
         }
 
+        /// Every column's name and kind, in the header's order.
+        pub fn kinds() -> Vec<(String, Kind)> {
+            let mut k = Vec::new();
+            $(<$ty as Cells>::kinds(stringify!($field), &mut k);)*
+            k
+        }
+
         impl TraceRow {
             /// Appends this row as one CSV line (with newline); `t0` is subtracted
             /// from stamps.
@@ -133,6 +183,12 @@ macro_rules! trace_row {
                 $(self.$field.cells(line, t0);)*
                 line.remove(start);
                 line.push('\n');
+            }
+
+            /// Pushes this row's values into `cols` (made from [`kinds`]); `t0` is
+            /// subtracted from stamps.
+            pub fn push(&self, cols: &mut Columns, t0: u64) {
+                $(self.$field.push(cols, t0);)*
             }
         }
     };

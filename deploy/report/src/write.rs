@@ -25,8 +25,45 @@ use tactile_records::slave::{ArmJoints, SlaveTotals};
 use tactile_records::Start;
 use tactile_scenario::Scenario;
 
+/// The Parquet trace's file name.
+pub const PARQUET_FILE: &str = "trace.parquet";
+
 /// The link name an in-process simulation records.
 pub const IN_PROCESS: &str = "in-process";
+
+/// Which trace files a report writes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum TraceFormat {
+    /// `trace.csv` (the default: text that any tool and any diff reads, and what the
+    /// determinism checks compare).
+    #[default]
+    Csv,
+    /// `trace.parquet` alone (long runs, studies read with pandas or Arrow).
+    Parquet,
+    /// Both.
+    Both,
+}
+
+impl std::str::FromStr for TraceFormat {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "csv" => Ok(TraceFormat::Csv),
+            "parquet" => Ok(TraceFormat::Parquet),
+            "both" => Ok(TraceFormat::Both),
+            _ => Err(format!("{s:?}: give csv, parquet or both")),
+        }
+    }
+}
+
+impl TraceFormat {
+    fn csv(self) -> bool {
+        self != TraceFormat::Parquet
+    }
+    fn parquet(self) -> bool {
+        self != TraceFormat::Csv
+    }
+}
 
 /// What the launcher adds to a report (nothing, for `tactile report`).
 #[derive(Debug, Clone, Default)]
@@ -39,6 +76,13 @@ pub struct Launch {
     pub interrupted: bool,
     /// Write no trace.csv (long runs).
     pub no_trace: bool,
+    /// Which trace files to write (`trace.csv`, `trace.parquet` or both).
+    pub trace_format: TraceFormat,
+    /// Constant text columns `trace.parquet` carries after the trace's (a sweep's
+    /// combination: key, value).
+    pub trace_columns: Vec<(String, String)>,
+    /// How `run.mcap`'s chunks are compressed.
+    pub mcap_compression: crate::mcap::Compression,
     /// A stop request (SIGINT, SIGTERM): set, the report is written from the samples
     /// joined so far and says it was interrupted.
     pub stop: Option<Arc<AtomicBool>>,
@@ -79,6 +123,7 @@ fn remove_if_there(path: &Path) -> Result<(), Error> {
 fn discard(out: &Path) {
     run_mcap::discard(out);
     let _ = std::fs::remove_file(crate::out::partial(&out.join("trace.csv")));
+    let _ = std::fs::remove_file(crate::out::partial(&out.join(PARQUET_FILE)));
     let _ = std::fs::remove_file(crate::out::partial(&out.join(JOINTS_FILE)));
 }
 
@@ -355,6 +400,7 @@ fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
 /// `run.mcap` (neither with `--no-trace`).
 struct Streams {
     trace: Option<std::io::BufWriter<std::fs::File>>,
+    parquet: Option<crate::parquet_trace::ParquetTrace>,
     /// A URDF arm's joints, one row a sample (`[slave.arm]`).
     joints: Option<std::io::BufWriter<std::fs::File>>,
     recording: Option<run_mcap::FileRecording>,
@@ -365,15 +411,23 @@ struct Streams {
 }
 
 impl Streams {
-    /// Starts both files in `out` (or removes old ones with `no_trace`).
-    fn create(out: &Path, scenario: &Scenario, no_trace: bool) -> Result<Streams, Error> {
+    /// Starts the files in `out` (or removes old ones with `no_trace`).
+    fn create(out: &Path, scenario: &Scenario, launch: &Launch) -> Result<Streams, Error> {
         let trace_path = out.join("trace.csv");
-        if no_trace {
+        let parquet_path = out.join(PARQUET_FILE);
+        let format = launch.trace_format;
+        if launch.no_trace || !format.csv() {
             let _ = std::fs::remove_file(&trace_path);
+        }
+        if launch.no_trace || !format.parquet() {
+            let _ = std::fs::remove_file(&parquet_path);
+        }
+        if launch.no_trace {
             let _ = std::fs::remove_file(out.join(run_mcap::FILE));
             let _ = std::fs::remove_file(out.join(JOINTS_FILE));
             return Ok(Streams {
                 trace: None,
+                parquet: None,
                 joints: None,
                 recording: None,
                 warning: None,
@@ -381,12 +435,28 @@ impl Streams {
                 t0: None,
             });
         }
-        let f = std::fs::File::create(crate::out::partial(&trace_path))
-            .map_err(Error::io(format!("writing {}", trace_path.display())))?;
-        let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
-        writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
-        let (recording, warning) =
-            run_mcap::create(out, scenario).map_err(Error::io("writing run.mcap"))?;
+        let trace = if format.csv() {
+            let f = std::fs::File::create(crate::out::partial(&trace_path))
+                .map_err(Error::io(format!("writing {}", trace_path.display())))?;
+            let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
+            writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
+            Some(w)
+        } else {
+            None
+        };
+        let parquet = if format.parquet() {
+            Some(
+                crate::parquet_trace::ParquetTrace::create(
+                    &crate::out::partial(&parquet_path),
+                    launch.trace_columns.clone(),
+                )
+                .map_err(Error::io(format!("writing {PARQUET_FILE}")))?,
+            )
+        } else {
+            None
+        };
+        let (recording, warning) = run_mcap::create(out, scenario, launch.mcap_compression)
+            .map_err(Error::io("writing run.mcap"))?;
         let joints = match &scenario.slave.arm {
             Some(arm) => Some(joints_csv(out, arm.home.len())?),
             None => {
@@ -395,7 +465,8 @@ impl Streams {
             }
         };
         Ok(Streams {
-            trace: Some(w),
+            trace,
+            parquet,
             joints,
             recording: Some(recording),
             warning,
@@ -416,8 +487,12 @@ impl Streams {
             w.write_all(self.line.as_bytes())
                 .map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
         }
+        let t0 = *self.t0.get_or_insert(row.stamps[0]);
+        if let Some(p) = self.parquet.as_mut() {
+            p.add(row, t0)
+                .map_err(Error::io(format!("writing {PARQUET_FILE}")))?;
+        }
         if let Some(w) = self.trace.as_mut() {
-            let t0 = *self.t0.get_or_insert(row.stamps[0]);
             self.line.clear();
             row.write_csv(&mut self.line, t0);
             w.write_all(self.line.as_bytes())
@@ -443,6 +518,12 @@ impl Streams {
             let path = out.join("trace.csv");
             std::fs::rename(crate::out::partial(&path), &path)
                 .map_err(Error::io("writing trace.csv"))?;
+        }
+        if let Some(p) = self.parquet {
+            let path = out.join(PARQUET_FILE);
+            p.finish()
+                .and_then(|()| std::fs::rename(crate::out::partial(&path), &path))
+                .map_err(Error::io(format!("writing {PARQUET_FILE}")))?;
         }
         if let Some(r) = self.recording {
             run_mcap::commit(r, out).map_err(Error::io("writing run.mcap"))?;
@@ -523,7 +604,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     remove_if_there(&out.join("summary.json"))?;
     let t_s = scenario.t_s();
     let mut series = Series::default();
-    let mut streams = Streams::create(out, &scenario, launch.no_trace)?;
+    let mut streams = Streams::create(out, &scenario, launch)?;
     let warning = streams.warning.clone();
     let stopped = || {
         launch
@@ -571,11 +652,15 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
 /// Joins the records in `dirs` and writes only `out/run.mcap` (old records converted
 /// without redoing the report). Returns the number of samples recorded, and what the
 /// recording leaves out, if anything (an arm whose URDF cannot be read).
-pub fn write_mcap(dirs: &[PathBuf], out: &Path) -> Result<(u64, Option<String>), Error> {
+pub fn write_mcap(
+    dirs: &[PathBuf],
+    out: &Path,
+    compression: crate::mcap::Compression,
+) -> Result<(u64, Option<String>), Error> {
     let (_, scenario) = recorded(dirs)?;
     make_out_dir(out)?;
     let (mut rec, warning) =
-        run_mcap::create(out, &scenario).map_err(Error::io("writing run.mcap"))?;
+        run_mcap::create(out, &scenario, compression).map_err(Error::io("writing run.mcap"))?;
 
     let mut samples = 0;
     join::join(dirs, |row, joints, rotation| {

@@ -25,6 +25,9 @@ pub struct ReportArgs {
     /// `ros2 bag` (converts old records without redoing the report).
     #[arg(long)]
     pub mcap_only: bool,
+    /// The trace's and the recording's formats.
+    #[command(flatten)]
+    pub formats: super::formats::FormatArgs,
 }
 
 /// `tactile report DIR... [--out OUT]`.
@@ -40,7 +43,7 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
     let holder = format!("tactile report (pid {})", std::process::id());
     let _held = tactile_report::out::take(&out, &holder)?;
     if args.mcap_only {
-        let (samples, warning) = write_mcap(&args.dirs, &out)?;
+        let (samples, warning) = write_mcap(&args.dirs, &out, args.formats.mcap_compression)?;
         if let Some(w) = warning {
             crate::noteln!("warning: {w}");
         }
@@ -53,9 +56,8 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
     let stop =
         tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let launch = Launch {
-        no_trace: args.no_trace,
         stop: Some(stop),
-        ..Launch::default()
+        ..args.formats.outputs(args.no_trace).launch()
     };
     let summary = write_report(&args.dirs, &out, &launch)?;
     crate::out!("{}", render(&summary, &out));

@@ -57,6 +57,9 @@ pub struct RunArgs {
     /// else is reported.
     #[arg(long)]
     pub no_trace: bool,
+    /// The trace's and the recording's formats.
+    #[command(flatten)]
+    pub formats: super::formats::FormatArgs,
 }
 
 /// A stall limit: 0 (never) or 1.5 to 3600 seconds (a job-control stop and continue
@@ -78,14 +81,14 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
         crate::noteln!("tactile: warning: {w}");
     }
     let summary = if args.in_process {
-        launch::sim::run_in_process(&loaded, &args.out, args.no_trace)?
+        launch::sim::run_in_process(&loaded, &args.out, &args.formats.outputs(args.no_trace))?
     } else {
         launch::clean_stale_runs();
         let link = Links::on_this_host(if args.udp { LinkKind::Udp } else { args.link })?;
         let sup = Supervision {
             progress: !args.quiet,
             max_restarts: args.max_restarts,
-            no_trace: args.no_trace,
+            outputs: args.formats.outputs(args.no_trace),
             stall: (args.stall_s > 0.0).then(|| std::time::Duration::from_secs_f64(args.stall_s)),
             ..args.nodes.supervision(link, "")
         };

@@ -72,8 +72,34 @@ impl NodeOptions {
             pin: !self.no_pin,
             sched: self.sched,
             idle: self.idle,
-            no_trace: false,
+            outputs: Outputs::default(),
             stall: Some(stall::DEFAULT_STALL),
+        }
+    }
+}
+
+/// What a run's report writes besides its summary, histograms and plots.
+#[derive(Debug, Clone, Default)]
+pub struct Outputs {
+    /// No trace and no run.mcap.
+    pub no_trace: bool,
+    /// `trace.csv`, `trace.parquet` or both.
+    pub trace_format: tactile_report::write::TraceFormat,
+    /// How run.mcap's chunks are compressed.
+    pub mcap_compression: tactile_report::mcap::Compression,
+    /// Constant text columns of `trace.parquet` (a sweep's combination).
+    pub trace_columns: Vec<(String, String)>,
+}
+
+impl Outputs {
+    /// The report's settings for these outputs.
+    pub fn launch(&self) -> tactile_report::write::Launch {
+        tactile_report::write::Launch {
+            no_trace: self.no_trace,
+            trace_format: self.trace_format,
+            mcap_compression: self.mcap_compression,
+            trace_columns: self.trace_columns.clone(),
+            ..Default::default()
         }
     }
 }
@@ -102,8 +128,8 @@ pub struct Supervision {
     pub sched: tactile_runtime::sched::Policy,
     /// What each node's CPU does while the node sleeps (realtime, SCHED_FIFO).
     pub idle: tactile_runtime::sched::IdleMode,
-    /// Write no trace.csv and no run.mcap.
-    pub no_trace: bool,
+    /// What the report writes besides the summary.
+    pub outputs: Outputs,
     /// How long a node's record may stand still before the node counts as frozen
     /// (None: never).
     pub stall: Option<Duration>,
@@ -111,7 +137,7 @@ pub struct Supervision {
 
 /// How `tactile sweep --processes` runs each combination: as `tactile run` does by
 /// default, no restarts, no progress line.
-pub fn sweep_supervision(no_trace: bool) -> Supervision {
+pub fn sweep_supervision(outputs: Outputs) -> Supervision {
     Supervision {
         prefix: format!("tactile{}s", std::process::id()),
         spin: None,
@@ -123,7 +149,7 @@ pub fn sweep_supervision(no_trace: bool) -> Supervision {
         pin: true,
         sched: tactile_runtime::sched::Policy::Fifo,
         idle: tactile_runtime::sched::IdleMode::Halt,
-        no_trace,
+        outputs,
         stall: Some(stall::DEFAULT_STALL),
     }
 }

@@ -125,7 +125,7 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<bool
 pub fn run_in_process(
     loaded: &super::Loaded,
     out: &Path,
-    no_trace: bool,
+    outputs: &super::Outputs,
 ) -> Result<tactile_report::summary::Summary, Error> {
     if tactile_runtime::outside::ros_in_run(&loaded.scenario) {
         return Err(Error::BadInput(
@@ -135,9 +135,8 @@ pub fn run_in_process(
     let (bundled, _held) = super::prepare_out(out, loaded)?;
     let completed = simulate(&bundled.scenario, &bundled.base_dir, out)?;
     let launch = tactile_report::write::Launch {
-        no_trace,
         stop: tactile_runtime::signals::stop_flag().ok(),
-        ..Default::default()
+        ..outputs.launch()
     };
     let launch = if completed {
         launch

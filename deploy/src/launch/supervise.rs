@@ -475,11 +475,11 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     run.watch(&loaded.scenario, &stop)?;
     let w = run.finish();
     tactile_transport::ipc::remove_run_files(&sup.prefix);
-    report(out, w, sup.no_trace)
+    report(out, w, &sup.outputs)
 }
 
 /// The report of a supervised run, or the error that ended it.
-fn report(out: &Path, w: Watch, no_trace: bool) -> Result<Summary, Error> {
+fn report(out: &Path, w: Watch, outputs: &super::Outputs) -> Result<Summary, Error> {
     if let Some(msg) = w.config_error {
         return Err(Error::BadInput(msg));
     }
@@ -492,9 +492,8 @@ fn report(out: &Path, w: Watch, no_trace: bool) -> Result<Summary, Error> {
     let launch = Launch {
         events: w.events,
         failed: w.failed,
-        no_trace,
         stop: tactile_runtime::signals::stop_flag().ok(),
-        ..Launch::default()
+        ..outputs.launch()
     };
     let launch = if w.interrupted {
         launch.interrupted()

@@ -22,6 +22,9 @@ pub struct Work {
     pub dir: PathBuf,
     /// `KEY=VALUE ...` for the progress line.
     pub what: String,
+    /// The combination as `trace.parquet`'s text columns: each key and its value as
+    /// written, the seed with `--seeds`, and the run's name.
+    pub columns: Vec<(String, String)>,
     /// Its scenario, checked.
     pub loaded: Loaded,
 }
@@ -41,14 +44,24 @@ pub fn plan(
             let seed = (args.seeds > 1).then(|| base.wrapping_add(s as u64));
             let loaded = load_scenario(Some(scenario), &sets_of(axes, &combos[k], seed)?)?;
             let mut what = describe(axes, &combos[k]);
+            let dir = run_dir(&args.out, k, s, args.seeds);
+            let mut columns: Vec<(String, String)> = axes
+                .iter()
+                .zip(&combos[k])
+                .map(|(a, &i)| (a.key.clone(), a.values[i].clone()))
+                .collect();
             if let Some(x) = seed {
                 what += &format!(" seed={x}");
+                columns.push(("seed".into(), x.to_string()));
             }
+            let name = dir.file_name().map(|f| f.to_string_lossy().into_owned());
+            columns.push(("run".into(), name.unwrap_or_default()));
             work.push(Work {
                 k,
                 seed: s,
-                dir: run_dir(&args.out, k, s, args.seeds),
+                dir,
                 what,
+                columns,
                 loaded,
             });
         }
@@ -172,12 +185,16 @@ fn progress(n: usize, total: usize, start: Instant, w: &Work) {
 /// a stop request cut it short.
 fn run_one(w: &Work, args: &SweepArgs) -> Result<Option<Vec<Option<f64>>>, Error> {
     let l = &w.loaded;
+    let outputs = launch::Outputs {
+        trace_columns: w.columns.clone(),
+        ..args.formats.outputs(!args.trace)
+    };
     let summary = if args.processes {
         launch::clean_stale_runs();
-        let sup = launch::sweep_supervision(!args.trace);
+        let sup = launch::sweep_supervision(outputs);
         launch::run_processes(l, &w.dir, &sup)?
     } else {
-        launch::sim::run_in_process(l, &w.dir, !args.trace)?
+        launch::sim::run_in_process(l, &w.dir, &outputs)?
     };
     if summary.interrupted {
         return Ok(None);

@@ -16,6 +16,7 @@
 
 mod exec;
 mod table;
+mod traces;
 
 use crate::error::Error;
 use clap::Args;
@@ -49,6 +50,12 @@ pub struct SweepArgs {
     /// sample).
     #[arg(long)]
     pub trace: bool,
+    /// With --trace: the trace's and the recording's formats. With
+    /// --trace-format parquet (or both), every run's trace.parquet carries its
+    /// combination as text columns and is linked into traces/, one table for pandas
+    /// (`pandas.read_parquet("OUT/traces")`).
+    #[command(flatten)]
+    pub formats: crate::cmd::formats::FormatArgs,
     /// Runs at once [default: the CPUs this process may use; 1 with --processes].
     /// The results equal --jobs 1's: every run has its own scenario and seed.
     #[arg(long, value_name = "N")]
@@ -172,6 +179,7 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
     table::check_resume(&args.out, &spec, args.resume)?;
     table::write_spec(&args.out, &spec)?;
     let done = exec::run_all(&work, jobs, args)?;
+    traces::gather(&args.out, work.iter().map(|w| w.dir.as_path()))?;
     let complete = done.iter().all(Option::is_some);
     let results: Vec<_> = work
         .iter()

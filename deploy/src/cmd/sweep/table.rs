@@ -161,6 +161,14 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
         },
     )?;
     write_tables(out, &axes, first.seeds, &results)?;
+    let runs: Vec<PathBuf> = dirs
+        .iter()
+        .flat_map(|d| {
+            (0..first.combinations)
+                .flat_map(move |k| (0..first.seeds).map(move |s| run_dir(d, k, s, first.seeds)))
+        })
+        .collect();
+    super::traces::gather(out, runs.iter().map(PathBuf::as_path))?;
     if !missing.is_empty() {
         let shown: Vec<_> = missing.iter().take(5).cloned().collect();
         return Err(Error::Failed(format!(

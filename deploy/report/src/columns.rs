@@ -1,0 +1,147 @@
+//! A trace's rows as typed columns, for the columnar files (`trace.parquet`): each
+//! trace field says its columns' kinds and pushes its values ([`crate::trace`]), so
+//! the Parquet trace has exactly the CSV's columns, in the same order.
+
+/// The type of one column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Unsigned 64-bit integer (sample numbers, stamps).
+    U64,
+    /// Unsigned 32-bit integer (flags, delays in samples).
+    U32,
+    /// Signed 64-bit integer.
+    I64,
+    /// IEEE double.
+    F64,
+    /// True or false (`0` or `1` in the CSV).
+    Bool,
+}
+
+impl Kind {
+    /// Its Parquet physical type, as the schema's text writes it.
+    pub fn physical(self) -> &'static str {
+        match self {
+            Kind::U64 | Kind::I64 => "int64",
+            Kind::U32 => "int32",
+            Kind::F64 => "double",
+            Kind::Bool => "boolean",
+        }
+    }
+
+    /// Its Parquet logical type (unsigned integers), as the schema's text writes it.
+    pub fn logical(self) -> &'static str {
+        match self {
+            Kind::U64 => " (INTEGER(64,false))",
+            Kind::U32 => " (INTEGER(32,false))",
+            Kind::I64 | Kind::F64 | Kind::Bool => "",
+        }
+    }
+}
+
+/// One column's values so far. Unsigned values are kept in their signed twins' bits:
+/// Parquet stores them so, and the schema's logical type says they are unsigned.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Values {
+    /// `U64` and `I64` columns.
+    I64(Vec<i64>),
+    /// `U32` columns.
+    I32(Vec<i32>),
+    /// `F64` columns.
+    F64(Vec<f64>),
+    /// `Bool` columns.
+    Bool(Vec<bool>),
+}
+
+/// Columns being filled row by row: each push goes into the next column of the row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Columns {
+    /// Names and kinds, in order.
+    pub names: Vec<(String, Kind)>,
+    /// The values, one entry per column.
+    pub values: Vec<Values>,
+    at: usize,
+}
+
+impl Columns {
+    /// Empty columns of these names and kinds.
+    pub fn new(names: Vec<(String, Kind)>) -> Columns {
+        let values = names
+            .iter()
+            .map(|(_, k)| match k {
+                Kind::U64 | Kind::I64 => Values::I64(Vec::new()),
+                Kind::U32 => Values::I32(Vec::new()),
+                Kind::F64 => Values::F64(Vec::new()),
+                Kind::Bool => Values::Bool(Vec::new()),
+            })
+            .collect();
+        Columns {
+            names,
+            values,
+            at: 0,
+        }
+    }
+
+    fn next(&mut self) -> Option<&mut Values> {
+        let v = self.values.get_mut(self.at);
+        self.at += 1;
+        v
+    }
+
+    /// The next column's value (an unsigned one as its bits).
+    pub fn i64(&mut self, x: i64) {
+        if let Some(Values::I64(v)) = self.next() {
+            v.push(x);
+        }
+    }
+
+    /// The next column's value (as its bits).
+    pub fn i32(&mut self, x: i32) {
+        if let Some(Values::I32(v)) = self.next() {
+            v.push(x);
+        }
+    }
+
+    /// The next column's value.
+    pub fn f64(&mut self, x: f64) {
+        if let Some(Values::F64(v)) = self.next() {
+            v.push(x);
+        }
+    }
+
+    /// The next column's value.
+    pub fn bool(&mut self, x: bool) {
+        if let Some(Values::Bool(v)) = self.next() {
+            v.push(x);
+        }
+    }
+
+    /// Ends a row: the next push goes into the first column again.
+    pub fn end_row(&mut self) {
+        debug_assert_eq!(self.at, self.names.len(), "a row filled every column");
+        self.at = 0;
+    }
+
+    /// Rows held.
+    pub fn rows(&self) -> usize {
+        match self.values.first() {
+            Some(Values::I64(v)) => v.len(),
+            Some(Values::I32(v)) => v.len(),
+            Some(Values::F64(v)) => v.len(),
+            Some(Values::Bool(v)) => v.len(),
+            None => 0,
+        }
+    }
+
+    /// Empties every column (kinds kept).
+    pub fn clear(&mut self) {
+        for v in &mut self.values {
+            match v {
+                Values::I64(v) => v.clear(),
+                Values::I32(v) => v.clear(),
+                Values::F64(v) => v.clear(),
+                Values::Bool(v) => v.clear(),
+            }
+        }
+        self.at = 0;
+    }
+}

@@ -1,0 +1,39 @@
+//! The output format options `tactile run`, `report` and `sweep` share.
+
+use clap::Args;
+use tactile_report::mcap::Compression;
+use tactile_report::write::TraceFormat;
+
+/// Which trace files a report writes and how run.mcap is compressed.
+#[derive(Debug, Clone, Args)]
+pub struct FormatArgs {
+    /// The trace's files: csv (trace.csv, the default: any tool and any diff reads
+    /// it), parquet (trace.parquet, columnar with zstd: a fifth of the CSV's size,
+    /// loaded by pandas in a fraction of its time) or both. The same columns and values.
+    #[arg(long, value_name = "csv|parquet|both", default_value = "csv", value_parser = parse_trace)]
+    pub trace_format: TraceFormat,
+    /// run.mcap's chunk compression: lz4 (the default, the faster) or zstd (the
+    /// smaller); Foxglove, the mcap CLI and rosbag2 read both.
+    #[arg(long, value_name = "lz4|zstd", default_value = "lz4", value_parser = parse_mcap)]
+    pub mcap_compression: Compression,
+}
+
+fn parse_trace(s: &str) -> Result<TraceFormat, String> {
+    s.parse()
+}
+
+fn parse_mcap(s: &str) -> Result<Compression, String> {
+    s.parse()
+}
+
+impl FormatArgs {
+    /// The launcher's outputs for these options.
+    pub fn outputs(&self, no_trace: bool) -> crate::launch::Outputs {
+        crate::launch::Outputs {
+            no_trace,
+            trace_format: self.trace_format,
+            mcap_compression: self.mcap_compression,
+            trace_columns: Vec::new(),
+        }
+    }
+}
