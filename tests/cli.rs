@@ -300,6 +300,7 @@ fn a_short_fuzz_campaign_finds_no_panic() {
     );
     for t in [
         "records",
+        "blocks",
         "cdr",
         "wire",
         "attachment",

@@ -99,21 +99,25 @@ fn a_sweeps_traces_read_as_one_table() {
         "wall.toml",
         &util::wall_delay().replace("samples = 8000", "samples = 400"),
     );
-    let o = sb.tactile(&[
-        "sweep",
-        wall.to_str().expect("utf-8"),
-        "--set",
-        "control.kind=none,tdpa",
-        "--set",
-        "network.forward.delay=[0,0,0],[20,20,20]",
-        "--trace",
-        "--trace-format",
-        "parquet",
-        "--jobs",
-        "2",
-        "--out",
-        "sw",
-    ]);
+    // An indexed key among the combination's columns.
+    let sweep = |format: &str| {
+        sb.tactile(&[
+            "sweep",
+            wall.to_str().expect("utf-8"),
+            "--set",
+            "control.kind=none,tdpa",
+            "--set",
+            "environment.objects[0].stiffness=[300.0,300.0,300.0],[600.0,600.0,600.0]",
+            "--trace",
+            "--trace-format",
+            format,
+            "--jobs",
+            "2",
+            "--out",
+            "sw",
+        ])
+    };
+    let o = sweep("parquet");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(!sb.path("sw/run-0000/trace.csv").exists());
     check(
@@ -126,8 +130,27 @@ fn a_sweeps_traces_read_as_one_table() {
             "--rows",
             "400",
             "--keys",
-            "control.kind,network.forward.delay",
+            "control.kind,environment.objects[0].stiffness",
         ],
         "the sweep's traces read as one table: 1600 rows, 4 runs",
     );
+    // The same sweep again with CSV traces: the dataset keeps no stale Parquet trace.
+    let o = sweep("csv");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let left = std::fs::read_dir(sb.path("sw/traces")).map_or(0, |d| d.count());
+    assert_eq!(left, 0, "stale traces left in sw/traces");
+    // A format that would change nothing is refused before anything runs.
+    let o = sb.tactile(&[
+        "sweep",
+        wall.to_str().expect("utf-8"),
+        "--set",
+        "control.kind=none",
+        "--trace-format",
+        "parquet",
+        "--out",
+        "none",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--trace-format without --trace"));
+    assert!(!sb.path("none").exists());
 }

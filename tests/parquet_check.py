@@ -70,6 +70,12 @@ def check_dataset(folder, runs, rows, keys):
             fail(f"no column {key!r}")
     if df["run"].nunique() != runs:
         fail(f"{df['run'].nunique()} runs in the dataset, want {runs}")
+    # Each run one combination, each combination its own run.
+    combos = df.groupby("run")[keys].nunique()
+    if (combos != 1).any().any():
+        fail(f"a run with more than one value of a key: {combos.to_dict()}")
+    if len(df.drop_duplicates(keys + ["run"])) != runs or len(df.drop_duplicates(keys)) != runs:
+        fail("two runs share a combination")
     per = df.groupby(keys)["n"].count()
     if (per != rows * runs // len(per)).any():
         fail(f"rows per combination: {per.to_dict()}")

@@ -129,7 +129,7 @@ fn a_job_array_and_its_merge_give_the_unsharded_sweep() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let started = Instant::now();
     let array = script("sweep-array.sbatch");
-    let mut args = vec!["--array=1-3", array.as_str(), "study", s];
+    let mut args = vec!["--array=1-3", array.as_str(), "3", "study", s];
     args.extend(SETS);
     let job = sbatch(&sb, &args);
     let merge = sbatch(
@@ -173,7 +173,7 @@ fn a_requeued_task_keeps_the_runs_it_finished() {
     );
     let s = s.to_str().expect("utf-8");
     let array = script("sweep-array.sbatch");
-    let mut args = vec!["--array=1-1", array.as_str(), "study", s];
+    let mut args = vec!["--array=1-1", array.as_str(), "1", "study", s];
     args.extend(SETS);
     let job = sbatch(&sb, &args);
     let task = format!("{job}_1");

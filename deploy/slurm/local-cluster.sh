@@ -18,6 +18,7 @@ if scontrol ping 2>/dev/null | grep -q UP && sinfo -h -o %T 2>/dev/null | grep -
 fi
 cpus=$(nproc)
 mem=$(( $(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 - 1024 ))
+[ "$mem" -ge 256 ] || mem=256
 mkdir -p /etc/slurm /var/spool/slurmctld /var/spool/slurmd /var/log/slurm /run/munge /var/lib/munge /var/log/munge
 # munge: a key, and the daemon (as root: the packaged unit is not started in a container).
 if [ ! -s /etc/munge/munge.key ]; then

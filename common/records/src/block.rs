@@ -23,6 +23,10 @@ pub struct BlockError(&'static str);
 /// Largest unpacked block a reader accepts (a whole frame's rows can claim no more).
 pub const MAX_RAW: usize = 64 << 20;
 
+/// Most rows a block may hold: far above any writer's (2 rows a sample for 50 ms at
+/// 10 MHz), so a crafted block cannot make a reader allocate or loop for long.
+pub const MAX_ROWS: usize = 1 << 20;
+
 /// Appends `v` as a LEB128 varint.
 fn put_varint(out: &mut Vec<u8>, mut v: u64) {
     while v >= 0x80 {
@@ -46,20 +50,19 @@ fn get_varint(b: &[u8], at: &mut usize) -> Result<u64, BlockError> {
     Err(BlockError("a length of more than 64 bits"))
 }
 
-/// The distinct row lengths in order of first appearance, with the rows of each.
+/// The distinct row lengths in order of first appearance, with the rows (their start
+/// offsets) of each.
 fn groups(lens: &[usize]) -> Vec<(usize, Vec<usize>)> {
     let mut out: Vec<(usize, Vec<usize>)> = Vec::new();
-    let mut starts = Vec::with_capacity(lens.len());
+    let mut index = std::collections::HashMap::new();
     let mut at = 0;
     for &l in lens {
-        starts.push(at);
+        let k = *index.entry(l).or_insert_with(|| {
+            out.push((l, Vec::new()));
+            out.len() - 1
+        });
+        out[k].1.push(at);
         at += l;
-    }
-    for (&l, &s) in lens.iter().zip(&starts) {
-        match out.iter_mut().find(|(len, _)| *len == l) {
-            Some((_, rows)) => rows.push(s),
-            None => out.push((l, vec![s])),
-        }
     }
     out
 }
@@ -107,12 +110,17 @@ pub fn to_planes(rows: &[u8], lens: &[usize], out: &mut Vec<u8>, scratch: &mut V
     }
 }
 
-/// The rows back from [`to_planes`]'s bytes: concatenated, with their lengths.
-pub fn from_planes(b: &[u8]) -> Result<(Vec<u8>, Vec<usize>), BlockError> {
+/// The rows back from [`to_planes`]'s bytes: concatenated, with their lengths; a block
+/// of other than `rows` rows is refused before anything is allocated for it.
+pub fn from_planes(b: &[u8], rows: u32) -> Result<(Vec<u8>, Vec<usize>), BlockError> {
     let mut at = 0;
-    let count = get_varint(b, &mut at)? as usize;
-    if count > b.len() {
-        return Err(BlockError("more rows than bytes"));
+    let count = get_varint(b, &mut at)?;
+    if count != u64::from(rows) {
+        return Err(BlockError("not the rows its entry says"));
+    }
+    let count = count as usize;
+    if count > b.len() || count > MAX_ROWS {
+        return Err(BlockError("more rows than a block may hold"));
     }
     let mut lens = Vec::with_capacity(count);
     let mut total = 0usize;
@@ -124,7 +132,7 @@ pub fn from_planes(b: &[u8]) -> Result<(Vec<u8>, Vec<usize>), BlockError> {
     if total > MAX_RAW {
         return Err(BlockError("rows longer than a block may be"));
     }
-    let mut rows = vec![0u8; total];
+    let mut out = vec![0u8; total];
     for (len, starts) in groups(&lens) {
         let bitmap = b
             .get(at..at + len.div_ceil(8))
@@ -141,14 +149,14 @@ pub fn from_planes(b: &[u8]) -> Result<(Vec<u8>, Vec<usize>), BlockError> {
             let mut prev = 0u8;
             for (&s, &x) in starts.iter().zip(plane) {
                 prev ^= x;
-                rows[s + j] = prev;
+                out[s + j] = prev;
             }
         }
     }
     if at != b.len() {
         return Err(BlockError("bytes after the last plane"));
     }
-    Ok((rows, lens))
+    Ok((out, lens))
 }
 
 /// zstd's level for blocks: the fastest that still entropy-codes the planes well (the
@@ -173,6 +181,7 @@ pub fn pack(
 /// decompressor costs more than a block).
 pub fn unpack(
     z: &mut zstd::bulk::Decompressor<'static>,
+    rows: u32,
     raw_len: u32,
     packed: &[u8],
 ) -> Result<(Vec<u8>, Vec<usize>), BlockError> {
@@ -185,7 +194,7 @@ pub fn unpack(
     if planes.len() != raw_len as usize {
         return Err(BlockError("not the length it claims"));
     }
-    from_planes(&planes)
+    from_planes(&planes, rows)
 }
 
 #[cfg(test)]
@@ -212,7 +221,8 @@ mod tests {
             let (raw, packed) =
                 pack(&mut z, &flat, &lens, &mut Vec::new(), &mut Vec::new()).expect("pack");
             let mut d = zstd::bulk::Decompressor::new().expect("zstd");
-            let (back, back_lens) = unpack(&mut d, raw, &packed).expect("unpack");
+            let (back, back_lens) =
+                unpack(&mut d, lens.len() as u32, raw, &packed).expect("unpack");
             prop_assert_eq!(back, flat);
             prop_assert_eq!(back_lens, lens);
         }
@@ -220,9 +230,10 @@ mod tests {
         /// Garbage never panics: it unpacks to something or is refused.
         #[test]
         fn garbage_is_refused_not_a_crash(b in proptest::collection::vec(any::<u8>(), 0..200)) {
-            let _ = from_planes(&b);
+            let rows = b.first().copied().unwrap_or(0).into();
+            let _ = from_planes(&b, rows);
             let mut d = zstd::bulk::Decompressor::new().expect("zstd");
-            let _ = unpack(&mut d, b.len() as u32, &b);
+            let _ = unpack(&mut d, rows, b.len() as u32, &b);
         }
     }
 
@@ -254,8 +265,12 @@ mod tests {
         put_varint(&mut b, MAX_RAW as u64);
         put_varint(&mut b, 1);
         assert_eq!(
-            from_planes(&b),
+            from_planes(&b, 2),
             Err(BlockError("rows longer than a block may be"))
+        );
+        assert_eq!(
+            from_planes(&b, 3),
+            Err(BlockError("not the rows its entry says"))
         );
     }
 }

@@ -3,9 +3,9 @@
 //! run, event, counters, stop) a frame of its own, written at once.
 //!
 //! A block goes to the operating system when it is full, when 50 ms have passed since
-//! its first sample, before any other entry, and when the writer is dropped; so a node
-//! killed by SIGKILL loses at most the block in hand (50 ms of samples), and damage on
-//! disk costs the blocks it touches, never the file.
+//! its first sample (checked as samples come, every eighth), before any other entry,
+//! and when the writer is dropped; so a node killed by SIGKILL loses at most the block
+//! in hand, and damage on disk costs the blocks it touches, never the file.
 
 use crate::block;
 use crate::entry::{Record, SampleBlock};
@@ -163,8 +163,12 @@ impl<S: Serialize, C: Serialize> RecordWriter<Record<S, C>> {
     /// Adds one sample to the block in hand, written when full or 50 ms old.
     pub fn write_sample(&mut self, sample: &S) -> std::io::Result<()> {
         let before = self.rows.len();
-        bincode::serde::encode_into_std_write(sample, &mut self.rows, row_config())
-            .map_err(std::io::Error::other)?;
+        if let Err(e) = bincode::serde::encode_into_std_write(sample, &mut self.rows, row_config())
+        {
+            // The rows in hand stay whole: a half-encoded row would shift every later one.
+            self.rows.truncate(before);
+            return Err(std::io::Error::other(e));
+        }
         self.lens.push(self.rows.len() - before);
         let n = self.lens.len();
         if n == 1 {
@@ -270,12 +274,9 @@ impl<S: DeserializeOwned, C: DeserializeOwned> RecordReader<Record<S, C>> {
     /// Puts a block's samples in `pending`; false (and none of them) if any row does
     /// not decode.
     fn unpack(&mut self, b: &SampleBlock) -> bool {
-        let Ok((rows, lens)) = block::unpack(&mut self.z, b.raw_len, &b.packed.0) else {
+        let Ok((rows, lens)) = block::unpack(&mut self.z, b.samples, b.raw_len, &b.packed.0) else {
             return false;
         };
-        if lens.len() != b.samples as usize {
-            return false;
-        }
         let mut at = 0;
         for l in lens {
             let row = &rows[at..at + l];

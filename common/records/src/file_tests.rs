@@ -194,6 +194,40 @@ fn a_block_is_written_when_50_ms_old_though_not_full() {
     assert_eq!(read(&path), ((0..17).collect(), 0));
 }
 
+/// Cuts the record at `path` at `cut` bytes past its magic and overwrites the
+/// stretches (offset, length, value) given; the indices of `spans` (byte ranges of
+/// frames) none of whose bytes were touched and that the cut left whole.
+fn damage(
+    path: &Path,
+    cut: usize,
+    stretches: &[(usize, usize, u8)],
+    spans: &[(u64, u64)],
+) -> Vec<usize> {
+    let mut bytes = std::fs::read(path).expect("read");
+    let magic = THIS_MAGIC.len();
+    let cut = magic + cut.min(bytes.len() - magic);
+    let mut touched = vec![false; bytes.len()];
+    for (at, n, v) in stretches {
+        let at = magic + at % (bytes.len() - magic);
+        for i in at..(at + n).min(bytes.len()) {
+            if bytes[i] != *v {
+                bytes[i] = *v;
+                touched[i] = true;
+            }
+        }
+    }
+    bytes.truncate(cut.max(magic));
+    std::fs::write(path, &bytes).expect("write");
+    spans
+        .iter()
+        .enumerate()
+        .filter(|(_, (s, e))| {
+            (*e as usize) <= bytes.len() && !touched[*s as usize..*e as usize].contains(&true)
+        })
+        .map(|(k, _)| k)
+        .collect()
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -207,28 +241,40 @@ proptest! {
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join("x.rec");
         let spans = write(&path, 200);
-        let mut bytes = std::fs::read(&path).expect("read");
-        let magic = THIS_MAGIC.len();
-        let cut = magic + cut.min(bytes.len() - magic);
-        let mut touched = vec![false; bytes.len()];
-        for (at, n, v) in &stretches {
-            let at = magic + at % (bytes.len() - magic);
-            for i in at..(at + n).min(bytes.len()) {
-                if bytes[i] != *v {
-                    bytes[i] = *v;
-                    touched[i] = true;
-                }
+        let intact = damage(&path, cut, &stretches, &spans);
+        let whole: Vec<u64> = intact
+            .into_iter()
+            .map(|k| k as u64)
+            .collect();
+        let (got, _) = read(&path);
+        prop_assert_eq!(got, whole);
+    }
+
+    /// The same for blocks: every block none of whose bytes was touched gives back all
+    /// its samples, in order, and nothing else.
+    #[test]
+    fn no_whole_block_is_lost(
+        cut in 0usize..6000,
+        stretches in proptest::collection::vec((0usize..6000, 1usize..40, any::<u8>()), 0..4),
+    ) {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("x.rec");
+        let mut w = RecordWriter::<R>::create(&path, false).expect("create");
+        w.set_block_rows(10);
+        let mut spans = Vec::new();
+        for b in 0..30u64 {
+            let start = std::fs::metadata(&path).expect("meta").len();
+            for k in 0..10 {
+                let n = b * 10 + k;
+                w.write(&Record::Sample((n, "v".repeat((n % 5) as usize)))).expect("sample");
             }
+            spans.push((start, std::fs::metadata(&path).expect("meta").len()));
         }
-        bytes.truncate(cut.max(magic));
-        std::fs::write(&path, &bytes).expect("write");
-        let whole: Vec<u64> = spans
-            .iter()
-            .enumerate()
-            .filter(|(_, (s, e))| {
-                (*e as usize) <= bytes.len() && !touched[*s as usize..*e as usize].contains(&true)
-            })
-            .map(|(k, _)| k as u64)
+        drop(w);
+        let intact = damage(&path, cut, &stretches, &spans);
+        let whole: Vec<u64> = intact
+            .into_iter()
+            .flat_map(|b| (b as u64 * 10)..(b as u64 * 10 + 10))
             .collect();
         let (got, _) = read(&path);
         prop_assert_eq!(got, whole);

@@ -52,6 +52,23 @@ pub enum Values {
     Bool(Vec<bool>),
 }
 
+impl Values {
+    /// Values held.
+    pub fn len(&self) -> usize {
+        match self {
+            Values::I64(v) => v.len(),
+            Values::I32(v) => v.len(),
+            Values::F64(v) => v.len(),
+            Values::Bool(v) => v.len(),
+        }
+    }
+
+    /// True if none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
 /// Columns being filled row by row: each push goes into the next column of the row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Columns {
@@ -121,15 +138,15 @@ impl Columns {
         self.at = 0;
     }
 
-    /// Rows held.
+    /// Rows held (of the first column: [`Columns::whole`] says whether all agree).
     pub fn rows(&self) -> usize {
-        match self.values.first() {
-            Some(Values::I64(v)) => v.len(),
-            Some(Values::I32(v)) => v.len(),
-            Some(Values::F64(v)) => v.len(),
-            Some(Values::Bool(v)) => v.len(),
-            None => 0,
-        }
+        self.values.first().map_or(0, Values::len)
+    }
+
+    /// True if every column holds the same number of values (no push went astray).
+    pub fn whole(&self) -> bool {
+        let rows = self.rows();
+        self.values.iter().all(|v| v.len() == rows)
     }
 
     /// Empties every column (kinds kept).

@@ -18,6 +18,7 @@ pub mod out;
 pub mod parquet_trace;
 pub mod plots;
 pub mod run_mcap;
+mod streams;
 pub mod summary;
 pub mod sweep;
 pub mod sweep_plots;

@@ -16,9 +16,10 @@ use tactile_scenario::Mode;
 pub const JOINTS_FILE: &str = "joints.csv";
 
 /// Files a report writes into its folder.
-pub const REPORT_FILES: [&str; 12] = [
+pub const REPORT_FILES: [&str; 13] = [
     "summary.json",
     "trace.csv",
+    "trace.parquet",
     JOINTS_FILE,
     "run.mcap",
     "round_trip.hgrm",

@@ -5,14 +5,15 @@ use crate::analysis::{Analysis, STAGES};
 use crate::join::{self, Logs, NodeLog};
 use crate::metrics::Packets;
 use crate::plots::{self, Series};
+use crate::run_mcap;
+use crate::streams::Streams;
+pub use crate::streams::{TraceFormat, PARQUET_FILE};
 use crate::summary::{ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
 pub use crate::summary::{JOINTS_FILE, REPORT_FILES};
 use crate::Error;
-use crate::{run_mcap, trace};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::io::Write as _;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -21,49 +22,12 @@ use std::time::{Duration, Instant};
 use tactile_messages::Role;
 use tactile_records::emulator::EmulatorTotals;
 use tactile_records::master::MasterTotals;
-use tactile_records::slave::{ArmJoints, SlaveTotals};
+use tactile_records::slave::SlaveTotals;
 use tactile_records::Start;
 use tactile_scenario::Scenario;
 
-/// The Parquet trace's file name.
-pub const PARQUET_FILE: &str = "trace.parquet";
-
 /// The link name an in-process simulation records.
 pub const IN_PROCESS: &str = "in-process";
-
-/// Which trace files a report writes.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum TraceFormat {
-    /// `trace.csv` (the default: text that any tool and any diff reads, and what the
-    /// determinism checks compare).
-    #[default]
-    Csv,
-    /// `trace.parquet` alone (long runs, studies read with pandas or Arrow).
-    Parquet,
-    /// Both.
-    Both,
-}
-
-impl std::str::FromStr for TraceFormat {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "csv" => Ok(TraceFormat::Csv),
-            "parquet" => Ok(TraceFormat::Parquet),
-            "both" => Ok(TraceFormat::Both),
-            _ => Err(format!("{s:?}: give csv, parquet or both")),
-        }
-    }
-}
-
-impl TraceFormat {
-    fn csv(self) -> bool {
-        self != TraceFormat::Parquet
-    }
-    fn parquet(self) -> bool {
-        self != TraceFormat::Csv
-    }
-}
 
 /// What the launcher adds to a report (nothing, for `tactile report`).
 #[derive(Debug, Clone, Default)]
@@ -396,153 +360,6 @@ fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
     Ok((starts, scenario))
 }
 
-/// What a report streams its rows into besides the statistics: `trace.csv` and
-/// `run.mcap` (neither with `--no-trace`).
-struct Streams {
-    trace: Option<std::io::BufWriter<std::fs::File>>,
-    parquet: Option<crate::parquet_trace::ParquetTrace>,
-    /// A URDF arm's joints, one row a sample (`[slave.arm]`).
-    joints: Option<std::io::BufWriter<std::fs::File>>,
-    recording: Option<run_mcap::FileRecording>,
-    /// Why the recording leaves something out, for the summary's events.
-    warning: Option<String>,
-    line: String,
-    t0: Option<u64>,
-}
-
-impl Streams {
-    /// Starts the files in `out` (or removes old ones with `no_trace`).
-    fn create(out: &Path, scenario: &Scenario, launch: &Launch) -> Result<Streams, Error> {
-        let trace_path = out.join("trace.csv");
-        let parquet_path = out.join(PARQUET_FILE);
-        let format = launch.trace_format;
-        if launch.no_trace || !format.csv() {
-            let _ = std::fs::remove_file(&trace_path);
-        }
-        if launch.no_trace || !format.parquet() {
-            let _ = std::fs::remove_file(&parquet_path);
-        }
-        if launch.no_trace {
-            let _ = std::fs::remove_file(out.join(run_mcap::FILE));
-            let _ = std::fs::remove_file(out.join(JOINTS_FILE));
-            return Ok(Streams {
-                trace: None,
-                parquet: None,
-                joints: None,
-                recording: None,
-                warning: None,
-                line: String::new(),
-                t0: None,
-            });
-        }
-        let trace = if format.csv() {
-            let f = std::fs::File::create(crate::out::partial(&trace_path))
-                .map_err(Error::io(format!("writing {}", trace_path.display())))?;
-            let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
-            writeln!(w, "{}", trace::header()).map_err(Error::io("writing trace.csv"))?;
-            Some(w)
-        } else {
-            None
-        };
-        let parquet = if format.parquet() {
-            Some(
-                crate::parquet_trace::ParquetTrace::create(
-                    &crate::out::partial(&parquet_path),
-                    launch.trace_columns.clone(),
-                )
-                .map_err(Error::io(format!("writing {PARQUET_FILE}")))?,
-            )
-        } else {
-            None
-        };
-        let (recording, warning) = run_mcap::create(out, scenario, launch.mcap_compression)
-            .map_err(Error::io("writing run.mcap"))?;
-        let joints = match &scenario.slave.arm {
-            Some(arm) => Some(joints_csv(out, arm.home.len())?),
-            None => {
-                let _ = std::fs::remove_file(out.join(JOINTS_FILE));
-                None
-            }
-        };
-        Ok(Streams {
-            trace,
-            parquet,
-            joints,
-            recording: Some(recording),
-            warning,
-            line: String::with_capacity(2048),
-            t0: None,
-        })
-    }
-
-    fn add(
-        &mut self,
-        row: &trace::TraceRow,
-        joints: Option<&ArmJoints>,
-        rotation: Option<[f64; 4]>,
-    ) -> Result<(), Error> {
-        if let (Some(w), Some(j)) = (self.joints.as_mut(), joints) {
-            self.line.clear();
-            crate::joints::row(&mut self.line, row.n, j);
-            w.write_all(self.line.as_bytes())
-                .map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
-        }
-        let t0 = *self.t0.get_or_insert(row.stamps[0]);
-        if let Some(p) = self.parquet.as_mut() {
-            p.add(row, t0)
-                .map_err(Error::io(format!("writing {PARQUET_FILE}")))?;
-        }
-        if let Some(w) = self.trace.as_mut() {
-            self.line.clear();
-            row.write_csv(&mut self.line, t0);
-            w.write_all(self.line.as_bytes())
-                .map_err(Error::io("writing trace.csv"))?;
-        }
-        if let Some(r) = self.recording.as_mut() {
-            r.add(row, joints, rotation)
-                .map_err(Error::io("writing run.mcap"))?;
-        }
-        Ok(())
-    }
-
-    /// Flushes the trace and gives the recording its name.
-    fn finish(self, out: &Path) -> Result<(), Error> {
-        if let Some(mut w) = self.joints {
-            let path = out.join(JOINTS_FILE);
-            w.flush()
-                .and_then(|()| std::fs::rename(crate::out::partial(&path), &path))
-                .map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
-        }
-        if let Some(mut w) = self.trace {
-            w.flush().map_err(Error::io("writing trace.csv"))?;
-            let path = out.join("trace.csv");
-            std::fs::rename(crate::out::partial(&path), &path)
-                .map_err(Error::io("writing trace.csv"))?;
-        }
-        if let Some(p) = self.parquet {
-            let path = out.join(PARQUET_FILE);
-            p.finish()
-                .and_then(|()| std::fs::rename(crate::out::partial(&path), &path))
-                .map_err(Error::io(format!("writing {PARQUET_FILE}")))?;
-        }
-        if let Some(r) = self.recording {
-            run_mcap::commit(r, out).map_err(Error::io("writing run.mcap"))?;
-        }
-        Ok(())
-    }
-}
-
-/// Starts `joints.csv` (as its partial file) with its header, for `dof` joints.
-fn joints_csv(out: &Path, dof: usize) -> Result<std::io::BufWriter<std::fs::File>, Error> {
-    let path = out.join(JOINTS_FILE);
-    let f = std::fs::File::create(crate::out::partial(&path))
-        .map_err(Error::io(format!("writing {}", path.display())))?;
-    let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
-    writeln!(w, "{}", crate::joints::header(dof))
-        .map_err(Error::io(format!("writing {JOINTS_FILE}")))?;
-    Ok(w)
-}
-
 /// The histograms and the plots of a run.
 fn figures(out: &Path, analysis: &Analysis, series: &Series) -> Result<(), Error> {
     let round_trip = analysis.round_trip.hgrm();
@@ -604,7 +421,13 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     remove_if_there(&out.join("summary.json"))?;
     let t_s = scenario.t_s();
     let mut series = Series::default();
-    let mut streams = Streams::create(out, &scenario, launch)?;
+    let want = crate::streams::Wanted {
+        no_trace: launch.no_trace,
+        format: launch.trace_format,
+        columns: launch.trace_columns.clone(),
+        compression: launch.mcap_compression,
+    };
+    let mut streams = Streams::create(out, &scenario, &want)?;
     let warning = streams.warning.clone();
     let stopped = || {
         launch

@@ -19,13 +19,14 @@ pub struct CheckArgs {
 }
 
 /// Bytes per sample each file takes, measured on the million-sample lockstep run
-/// (`deploy/scenarios/lockstep-1e6.toml`, record format 6; docs/06 and docs/10).
+/// (`deploy/scenarios/lockstep-1e6.toml`, record format 11; docs/06 and docs/10; a
+/// realtime run's master and slave records take a little more, up to 64 bytes).
 const PER_SAMPLE: [(&str, f64); 5] = [
-    ("master.rec", 470.0),
-    ("emulator.rec", 370.0),
-    ("slave.rec", 339.0),
-    ("trace.csv", 1187.0),
-    ("run.mcap", 734.0),
+    ("master.rec", 57.0),
+    ("emulator.rec", 36.0),
+    ("slave.rec", 86.0),
+    ("trace.csv", 1135.0),
+    ("run.mcap", 589.0),
 ];
 
 /// Lockstep samples per second of the in-process trio on this project's 2-core

@@ -27,6 +27,29 @@ fn parse_mcap(s: &str) -> Result<Compression, String> {
 }
 
 impl FormatArgs {
+    /// The first format option given another value than its default, if any.
+    fn given(&self) -> Option<&'static str> {
+        if self.trace_format != TraceFormat::Csv {
+            Some("--trace-format")
+        } else if self.mcap_compression != Compression::Lz4 {
+            Some("--mcap-compression")
+        } else {
+            None
+        }
+    }
+
+    /// Refuses a format option that would change nothing (`writes`: the command writes
+    /// the trace and the recording), so a study does not find out at its end that its
+    /// Parquet traces were never written.
+    pub fn refuse_unless(&self, writes: bool, why: &str) -> Result<(), crate::error::Error> {
+        match self.given() {
+            Some(flag) if !writes => Err(crate::error::Error::BadInput(format!(
+                "{flag} {why}: no trace and no recording are written"
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     /// The launcher's outputs for these options.
     pub fn outputs(&self, no_trace: bool) -> crate::launch::Outputs {
         crate::launch::Outputs {

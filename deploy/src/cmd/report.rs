@@ -32,6 +32,13 @@ pub struct ReportArgs {
 
 /// `tactile report DIR... [--out OUT]`.
 pub fn main(args: &ReportArgs) -> Result<(), Error> {
+    args.formats
+        .refuse_unless(!args.no_trace, "with --no-trace")?;
+    if args.mcap_only && args.formats.trace_format != tactile_report::write::TraceFormat::Csv {
+        return Err(Error::BadInput(
+            "--trace-format with --mcap-only: only run.mcap is written".into(),
+        ));
+    }
     let [master, _, _] = join::locate(&args.dirs)?;
     let out = match &args.out {
         Some(o) => o.clone(),

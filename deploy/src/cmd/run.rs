@@ -75,6 +75,8 @@ fn stall_parser(text: &str) -> Result<f64, String> {
 
 /// `tactile run`.
 pub fn main(args: &RunArgs) -> Result<(), Error> {
+    args.formats
+        .refuse_unless(!args.no_trace, "with --no-trace")?;
     let sets = parse_sets(&args.set)?;
     let loaded = load_scenario(args.scenario.as_deref(), &sets)?;
     for w in &loaded.warnings {

@@ -21,8 +21,8 @@ use std::time::{Duration, Instant};
 /// Arguments of `tactile fuzz`.
 #[derive(Debug, Args)]
 pub struct FuzzArgs {
-    /// Targets to fuzz (default: all): records, cdr, wire, attachment, scenario,
-    /// trajectory, kernels.
+    /// Targets to fuzz (default: all): records, blocks, cdr, wire, attachment,
+    /// scenario, trajectory, kernels.
     #[arg(long = "target", value_name = "NAME")]
     pub targets: Vec<String>,
     /// Seconds per target.

@@ -28,6 +28,7 @@ pub struct Target {
 pub fn all(scratch: &Path) -> Result<Vec<Target>, String> {
     Ok(vec![
         records(scratch)?,
+        blocks(),
         cdr(),
         wire(),
         attachment(),
@@ -39,6 +40,28 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>, String> {
 
 fn outcome<T, E: std::fmt::Display>(r: Result<T, E>) -> String {
     r.map_or_else(|e| e.to_string(), |_| "ok".into())
+}
+
+/// A record's sample block past its checksum (what a crafted record, or another
+/// build's, hands the reader): the planes' layout unpacked, the rows it claims taken
+/// from its first varint so the deeper paths are reached.
+fn blocks() -> Target {
+    use tactile_records::block;
+    let mut seeds = Vec::new();
+    for (rows, len) in [(50usize, 24usize), (7, 9)] {
+        let flat: Vec<u8> = (0..rows * len).map(|i| (i * 37 % 251) as u8).collect();
+        let mut planes = Vec::new();
+        block::to_planes(&flat, &vec![len; rows], &mut planes, &mut Vec::new());
+        seeds.push(planes);
+    }
+    Target {
+        name: "blocks",
+        seeds,
+        run: Box::new(|b| {
+            let rows = b.first().map_or(0, |r| u32::from(r & 0x7f));
+            outcome(block::from_planes(b, rows))
+        }),
+    }
 }
 
 /// The three nodes' record files: the reader of each role over the same bytes.

@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 use tactile_report::sweep::{describe, values, Axis};
+use tactile_report::write::{TraceFormat, PARQUET_FILE};
 
 /// One run of the sweep.
 #[derive(Debug)]
@@ -90,8 +91,19 @@ pub fn failed(dir: &Path) -> bool {
 
 /// What `--resume` keeps of a folder: a run that ended, did not fail, and ran this
 /// very combination (its `scenario.toml`, input paths aside, is `w`'s scenario), never
-/// another scenario's summary left in the folder.
-fn kept(w: &Work) -> Option<Vec<Option<f64>>> {
+/// another scenario's summary left in the folder; with `--trace`, one that wrote the
+/// trace files asked for.
+fn kept(w: &Work, args: &SweepArgs) -> Option<Vec<Option<f64>>> {
+    // With --trace, a run kept has the trace files asked for (else it runs again).
+    if args.trace {
+        let f = args.formats.trace_format;
+        let csv = f != TraceFormat::Parquet;
+        let parquet = f != TraceFormat::Csv;
+        let has = |name: &str| w.dir.join(name).is_file();
+        if (csv && !has("trace.csv")) || (parquet && !has(PARQUET_FILE)) {
+            return None;
+        }
+    }
     let text = std::fs::read_to_string(w.dir.join("scenario.toml")).ok()?;
     let mut theirs = tactile_scenario::Scenario::from_toml_str(&text).ok()?;
     let mut ours = w.loaded.scenario.clone();
@@ -117,7 +129,7 @@ pub fn run_all(
     let results: Mutex<Vec<Option<Vec<Option<f64>>>>> = Mutex::new(vec![None; work.len()]);
     let mut todo = Vec::new();
     for (i, w) in work.iter().enumerate() {
-        match args.resume.then(|| kept(w)).flatten() {
+        match args.resume.then(|| kept(w, args)).flatten() {
             Some(v) => lock(&results)[i] = Some(v),
             None => todo.push(i),
         }

@@ -147,6 +147,10 @@ fn warn_once(work: &[exec::Work]) {
 
 /// `tactile sweep`.
 pub fn main(args: &SweepArgs) -> Result<(), Error> {
+    args.formats.refuse_unless(
+        args.trace && args.merge.is_empty(),
+        "without --trace (or with --merge)",
+    )?;
     if !args.merge.is_empty() {
         return table::merge(&args.merge, &args.out);
     }
@@ -178,8 +182,10 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
     let _held = tactile_report::out::take(&args.out, &holder)?;
     table::check_resume(&args.out, &spec, args.resume)?;
     table::write_spec(&args.out, &spec)?;
-    let done = exec::run_all(&work, jobs, args)?;
+    let done = exec::run_all(&work, jobs, args);
+    // Even after a failure: the dataset then holds the runs that ended, no stale ones.
     traces::gather(&args.out, work.iter().map(|w| w.dir.as_path()))?;
+    let done = done?;
     let complete = done.iter().all(Option::is_some);
     let results: Vec<_> = work
         .iter()

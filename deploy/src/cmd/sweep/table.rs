@@ -161,11 +161,14 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
         },
     )?;
     write_tables(out, &axes, first.seeds, &results)?;
-    let runs: Vec<PathBuf> = dirs
-        .iter()
-        .flat_map(|d| {
-            (0..first.combinations)
-                .flat_map(move |k| (0..first.seeds).map(move |s| run_dir(d, k, s, first.seeds)))
+    // Each run once, from the folder that holds it whole (none: its trace is dropped).
+    let runs: Vec<PathBuf> = (0..first.combinations)
+        .flat_map(|k| (0..first.seeds).map(move |s| (k, s)))
+        .map(|(k, s)| {
+            dirs.iter()
+                .map(|d| run_dir(d, k, s, first.seeds))
+                .find(|r| super::exec::finished(r).is_some())
+                .unwrap_or_else(|| run_dir(out, k, s, first.seeds))
         })
         .collect();
     super::traces::gather(out, runs.iter().map(PathBuf::as_path))?;

@@ -8,8 +8,10 @@ use std::path::Path;
 /// The dataset's folder in a sweep's output.
 pub const DIR: &str = "traces";
 
-/// Links (or copies, across file systems) each run folder's `trace.parquet` into
-/// `out/traces/RUN.parquet`, replacing what was there; returns how many.
+/// Links (or copies, across file systems) the `trace.parquet` of each run folder that
+/// holds a whole run (its summary written, not cut short: the runs `sweep.csv` holds)
+/// into `out/traces/RUN.parquet`; a run without one loses what `traces/` had of it, so
+/// the dataset never holds a stale or partial trace. Returns how many are linked.
 pub fn gather<'a>(out: &Path, runs: impl IntoIterator<Item = &'a Path>) -> Result<usize, Error> {
     let dir = out.join(DIR);
     let mut n = 0;
@@ -18,12 +20,17 @@ pub fn gather<'a>(out: &Path, runs: impl IntoIterator<Item = &'a Path>) -> Resul
         let Some(name) = run.file_name() else {
             continue;
         };
-        if !from.is_file() {
+        let to = dir.join(format!("{}.parquet", name.to_string_lossy()));
+        match std::fs::remove_file(&to) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(Error::io(format!("removing {}", to.display()))(e));
+            }
+            _ => {}
+        }
+        if !from.is_file() || super::exec::finished(run).is_none() {
             continue;
         }
         std::fs::create_dir_all(&dir).map_err(Error::io(format!("creating {}", dir.display())))?;
-        let to = dir.join(format!("{}.parquet", name.to_string_lossy()));
-        let _ = std::fs::remove_file(&to);
         std::fs::hard_link(&from, &to)
             .or_else(|_| std::fs::copy(&from, &to).map(|_| ()))
             .map_err(Error::io(format!("linking {}", to.display())))?;
