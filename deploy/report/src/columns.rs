@@ -17,27 +17,6 @@ pub enum Kind {
     Bool,
 }
 
-impl Kind {
-    /// Its Parquet physical type, as the schema's text writes it.
-    pub fn physical(self) -> &'static str {
-        match self {
-            Kind::U64 | Kind::I64 => "int64",
-            Kind::U32 => "int32",
-            Kind::F64 => "double",
-            Kind::Bool => "boolean",
-        }
-    }
-
-    /// Its Parquet logical type (unsigned integers), as the schema's text writes it.
-    pub fn logical(self) -> &'static str {
-        match self {
-            Kind::U64 => " (INTEGER(64,false))",
-            Kind::U32 => " (INTEGER(32,false))",
-            Kind::I64 | Kind::F64 | Kind::Bool => "",
-        }
-    }
-}
-
 /// One column's values so far. Unsigned values are kept in their signed twins' bits:
 /// Parquet stores them so, and the schema's logical type says they are unsigned.
 #[derive(Debug, Clone, PartialEq)]

@@ -190,14 +190,14 @@ impl ParquetTrace {
     }
 }
 
-/// The trace's column names, as the CSV's header has them (for the tests).
-pub fn names() -> Vec<String> {
-    trace::kinds().into_iter().map(|(n, _)| n).collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The trace's column names, as the CSV's header has them (for the tests).
+    fn names() -> Vec<String> {
+        trace::kinds().into_iter().map(|(n, _)| n).collect()
+    }
 
     #[test]
     fn the_parquet_columns_are_the_csvs() {

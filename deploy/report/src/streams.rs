@@ -46,17 +46,19 @@ impl TraceFormat {
     }
 }
 
-/// The files a report is asked for.
+/// What a report writes besides its summary, histograms and plots: the one
+/// description the CLI, the launcher and the report share.
 #[derive(Debug, Clone, Default)]
-pub(crate) struct Wanted {
-    /// No trace and no recording.
+pub struct Outputs {
+    /// No trace and no run.mcap (long runs).
     pub no_trace: bool,
-    /// Which trace files.
-    pub format: TraceFormat,
-    /// `trace.parquet`'s constant text columns.
-    pub columns: Vec<(String, String)>,
-    /// `run.mcap`'s chunks.
-    pub compression: crate::mcap::Compression,
+    /// `trace.csv`, `trace.parquet` or both.
+    pub trace_format: TraceFormat,
+    /// Constant text columns `trace.parquet` carries after the trace's (a sweep's
+    /// combination: key, value).
+    pub trace_columns: Vec<(String, String)>,
+    /// How `run.mcap`'s chunks are compressed.
+    pub mcap_compression: crate::mcap::Compression,
 }
 
 /// What a report streams its rows into besides the statistics: `trace.csv` and
@@ -75,10 +77,14 @@ pub(crate) struct Streams {
 
 impl Streams {
     /// Starts the files in `out` (or removes old ones with `no_trace`).
-    pub(crate) fn create(out: &Path, scenario: &Scenario, want: &Wanted) -> Result<Streams, Error> {
+    pub(crate) fn create(
+        out: &Path,
+        scenario: &Scenario,
+        want: &Outputs,
+    ) -> Result<Streams, Error> {
         let trace_path = out.join("trace.csv");
         let parquet_path = out.join(PARQUET_FILE);
-        let format = want.format;
+        let format = want.trace_format;
         if want.no_trace || !format.csv() {
             let _ = std::fs::remove_file(&trace_path);
         }
@@ -111,14 +117,14 @@ impl Streams {
             Some(
                 crate::parquet_trace::ParquetTrace::create(
                     &crate::out::partial(&parquet_path),
-                    want.columns.clone(),
+                    want.trace_columns.clone(),
                 )
                 .map_err(Error::io(format!("writing {PARQUET_FILE}")))?,
             )
         } else {
             None
         };
-        let (recording, warning) = run_mcap::create(out, scenario, want.compression)
+        let (recording, warning) = run_mcap::create(out, scenario, want.mcap_compression)
             .map_err(Error::io("writing run.mcap"))?;
         let joints = match &scenario.slave.arm {
             Some(arm) => Some(joints_csv(out, arm.home.len())?),

@@ -7,7 +7,7 @@ use crate::metrics::Packets;
 use crate::plots::{self, Series};
 use crate::run_mcap;
 use crate::streams::Streams;
-pub use crate::streams::{TraceFormat, PARQUET_FILE};
+pub use crate::streams::{Outputs, TraceFormat, PARQUET_FILE};
 use crate::summary::{ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
 pub use crate::summary::{JOINTS_FILE, REPORT_FILES};
 use crate::Error;
@@ -38,15 +38,8 @@ pub struct Launch {
     pub failed: bool,
     /// A stop request cut the run short.
     pub interrupted: bool,
-    /// Write no trace.csv (long runs).
-    pub no_trace: bool,
-    /// Which trace files to write (`trace.csv`, `trace.parquet` or both).
-    pub trace_format: TraceFormat,
-    /// Constant text columns `trace.parquet` carries after the trace's (a sweep's
-    /// combination: key, value).
-    pub trace_columns: Vec<(String, String)>,
-    /// How `run.mcap`'s chunks are compressed.
-    pub mcap_compression: crate::mcap::Compression,
+    /// The trace's and the recording's files.
+    pub outputs: Outputs,
     /// A stop request (SIGINT, SIGTERM): set, the report is written from the samples
     /// joined so far and says it was interrupted.
     pub stop: Option<Arc<AtomicBool>>,
@@ -421,13 +414,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     remove_if_there(&out.join("summary.json"))?;
     let t_s = scenario.t_s();
     let mut series = Series::default();
-    let want = crate::streams::Wanted {
-        no_trace: launch.no_trace,
-        format: launch.trace_format,
-        columns: launch.trace_columns.clone(),
-        compression: launch.mcap_compression,
-    };
-    let mut streams = Streams::create(out, &scenario, &want)?;
+    let mut streams = Streams::create(out, &scenario, &launch.outputs)?;
     let warning = streams.warning.clone();
     let stopped = || {
         launch

@@ -64,7 +64,8 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
         tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let launch = Launch {
         stop: Some(stop),
-        ..args.formats.outputs(args.no_trace).launch()
+        outputs: args.formats.outputs(args.no_trace),
+        ..Launch::default()
     };
     let summary = write_report(&args.dirs, &out, &launch)?;
     crate::out!("{}", render(&summary, &out));

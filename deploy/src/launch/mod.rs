@@ -78,31 +78,7 @@ impl NodeOptions {
     }
 }
 
-/// What a run's report writes besides its summary, histograms and plots.
-#[derive(Debug, Clone, Default)]
-pub struct Outputs {
-    /// No trace and no run.mcap.
-    pub no_trace: bool,
-    /// `trace.csv`, `trace.parquet` or both.
-    pub trace_format: tactile_report::write::TraceFormat,
-    /// How run.mcap's chunks are compressed.
-    pub mcap_compression: tactile_report::mcap::Compression,
-    /// Constant text columns of `trace.parquet` (a sweep's combination).
-    pub trace_columns: Vec<(String, String)>,
-}
-
-impl Outputs {
-    /// The report's settings for these outputs.
-    pub fn launch(&self) -> tactile_report::write::Launch {
-        tactile_report::write::Launch {
-            no_trace: self.no_trace,
-            trace_format: self.trace_format,
-            mcap_compression: self.mcap_compression,
-            trace_columns: self.trace_columns.clone(),
-            ..Default::default()
-        }
-    }
-}
+pub use tactile_report::write::Outputs;
 
 /// How `tactile run` supervises its processes.
 #[derive(Debug, Clone)]

@@ -136,7 +136,8 @@ pub fn run_in_process(
     let completed = simulate(&bundled.scenario, &bundled.base_dir, out)?;
     let launch = tactile_report::write::Launch {
         stop: tactile_runtime::signals::stop_flag().ok(),
-        ..outputs.launch()
+        outputs: outputs.clone(),
+        ..Default::default()
     };
     let launch = if completed {
         launch

@@ -493,7 +493,8 @@ fn report(out: &Path, w: Watch, outputs: &super::Outputs) -> Result<Summary, Err
         events: w.events,
         failed: w.failed,
         stop: tactile_runtime::signals::stop_flag().ok(),
-        ..outputs.launch()
+        outputs: outputs.clone(),
+        ..Launch::default()
     };
     let launch = if w.interrupted {
         launch.interrupted()
