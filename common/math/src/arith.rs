@@ -174,10 +174,14 @@ pub enum ArithKind {
     /// f32 with CORDIC in signed fixed point: the paper's FPGA datapath.
     #[default]
     Hybrid,
+    /// The paper's modules as RTL, simulated clock by clock (Verilator): bit for bit
+    /// `Hybrid`, and the clocks each sample took (built with the feature `rtl`).
+    Rtl,
 }
 
 impl ArithKind {
-    /// Every arithmetic, in reporting order.
+    /// Every arithmetic computed in software, in reporting order (`Rtl` computes
+    /// `Hybrid`'s results in simulated hardware).
     pub const ALL: [ArithKind; 3] = [ArithKind::F64, ArithKind::F32, ArithKind::Hybrid];
 
     /// The name used on the command line and in scenario files.
@@ -186,6 +190,7 @@ impl ArithKind {
             ArithKind::F64 => "f64",
             ArithKind::F32 => "f32",
             ArithKind::Hybrid => "hybrid",
+            ArithKind::Rtl => "rtl",
         }
     }
 }
@@ -203,8 +208,9 @@ impl std::str::FromStr for ArithKind {
             "f64" => Ok(ArithKind::F64),
             "f32" => Ok(ArithKind::F32),
             "hybrid" => Ok(ArithKind::Hybrid),
+            "rtl" => Ok(ArithKind::Rtl),
             other => Err(format!(
-                "unknown arithmetic {other:?}: expected f64, f32 or hybrid"
+                "unknown arithmetic {other:?}: expected f64, f32, hybrid or rtl"
             )),
         }
     }

@@ -9,7 +9,9 @@
 use crate::arith::{ArithKind, StdTrig};
 use crate::cordic::{Cordic, CordicConfig, CordicError};
 use crate::geometry::{Geometry, Lengths};
+use crate::hardware::{Clocks, Hardware};
 use crate::kernels::{self, IkStatus};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// Kernels bound to one geometry and one arithmetic.
 #[derive(Debug, Clone)]
@@ -19,6 +21,22 @@ pub struct Engine {
     g64: Lengths<f64>,
     g32: Lengths<f32>,
     cordic: Cordic,
+    /// The RTL under simulation, for [`ArithKind::Rtl`] (shared by clones: one chip).
+    hardware: Option<Arc<Mutex<Box<dyn Hardware>>>>,
+}
+
+/// Why an engine cannot be made.
+#[derive(Debug, PartialEq, Eq, thiserror::Error)]
+pub enum EngineError {
+    /// The fixed-point format is not one the model takes.
+    #[error(transparent)]
+    Cordic(#[from] CordicError),
+    /// `rtl` runs on hardware, which [`Engine::new`] cannot make.
+    #[error(
+        "arithmetic \"rtl\" needs the RTL simulated by Verilator: this program was built \
+         without it (build with --features rtl)"
+    )]
+    NoHardware,
 }
 
 /// Result of [`Engine::ik`].
@@ -39,19 +57,58 @@ fn to64(v: [f32; 3]) -> [f64; 3] {
 }
 
 impl Engine {
-    /// An engine for `kind`; `cordic` matters only for [`ArithKind::Hybrid`].
+    /// An engine for `kind`; `cordic` matters only for [`ArithKind::Hybrid`]. `Rtl`
+    /// needs its hardware: [`Engine::with_hardware`].
     pub fn new(
         kind: ArithKind,
         geometry: Geometry,
         cordic: CordicConfig,
-    ) -> Result<Self, CordicError> {
+    ) -> Result<Self, EngineError> {
+        if kind == ArithKind::Rtl {
+            return Err(EngineError::NoHardware);
+        }
         Ok(Engine {
             kind,
             geometry,
             g64: geometry.lengths(),
             g32: geometry.lengths(),
             cordic: Cordic::new(cordic)?,
+            hardware: None,
         })
+    }
+
+    /// An [`ArithKind::Rtl`] engine: every kernel computed by `hardware`, which must
+    /// have been built for this geometry and format (the caller's contract).
+    pub fn with_hardware(
+        geometry: Geometry,
+        cordic: CordicConfig,
+        hardware: Box<dyn Hardware>,
+    ) -> Result<Self, EngineError> {
+        Ok(Engine {
+            kind: ArithKind::Rtl,
+            geometry,
+            g64: geometry.lengths(),
+            g32: geometry.lengths(),
+            cordic: Cordic::new(cordic)?,
+            hardware: Some(Arc::new(Mutex::new(hardware))),
+        })
+    }
+
+    /// The hardware, for [`ArithKind::Rtl`]. A panic while it was held leaves it
+    /// usable: every call sets all its inputs.
+    fn hw(&self) -> MutexGuard<'_, Box<dyn Hardware>> {
+        let hw = self
+            .hardware
+            .as_ref()
+            .expect("an rtl engine is made with its hardware");
+        hw.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// The clocks the hardware has spent in each module; zero for software.
+    pub fn hardware_clocks(&self) -> Clocks {
+        self.hardware
+            .as_ref()
+            .map_or_else(Clocks::default, |_| self.hw().clocks())
     }
 
     /// The arithmetic in use.
@@ -75,6 +132,7 @@ impl Engine {
             ArithKind::F64 => kernels::fk(&self.g64, &StdTrig, theta),
             ArithKind::F32 => to64(kernels::fk(&self.g32, &StdTrig, to32(theta))),
             ArithKind::Hybrid => to64(kernels::fk(&self.g32, &self.cordic, to32(theta))),
+            ArithKind::Rtl => to64(self.hw().fk(to32(theta))),
         }
     }
 
@@ -102,6 +160,13 @@ impl Engine {
                     status: s.status,
                 }
             }
+            ArithKind::Rtl => {
+                let (theta, status) = self.hw().ik(to32(pos));
+                IkOut {
+                    theta: to64(theta),
+                    status,
+                }
+            }
         }
     }
 
@@ -112,6 +177,8 @@ impl Engine {
             ArithKind::F64 => kernels::jacobian(&self.g64, &StdTrig, theta),
             ArithKind::F32 => widen(kernels::jacobian(&self.g32, &StdTrig, to32(theta))),
             ArithKind::Hybrid => widen(kernels::jacobian(&self.g32, &self.cordic, to32(theta))),
+            // KFF computes J on its way to the torques: the module's own stage.
+            ArithKind::Rtl => widen(self.hw().kff(to32(theta), [0.0; 3]).1),
         }
     }
 
@@ -126,6 +193,7 @@ impl Engine {
                 to32(theta),
                 to32(force),
             )),
+            ArithKind::Rtl => to64(self.hw().kff(to32(theta), to32(force)).0),
         }
     }
 
@@ -134,6 +202,7 @@ impl Engine {
         match self.kind {
             ArithKind::F64 => kernels::fbf(obj, env, h),
             ArithKind::F32 | ArithKind::Hybrid => to64(kernels::fbf(to32(obj), to32(env), to32(h))),
+            ArithKind::Rtl => to64(self.hw().fbf(to32(obj), to32(env), to32(h))),
         }
     }
 }

@@ -123,16 +123,54 @@ impl<R> IkSolution<R> {
     }
 }
 
+/// The constants of [`ik`], each computed in `R` from the lengths exactly as the kernel
+/// always has (left to right): the RTL's `kin_params.vh` takes them from here, so the
+/// hardware and the model cannot disagree on a rounding.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IkConstants<R> {
+    /// `L1 L1 - L2 L2`, the numerator's constant of cos gamma.
+    pub c_gamma: R,
+    /// `2 L1`, the denominator's factor of cos gamma (times r).
+    pub two_l1: R,
+    /// `L1 L1 + L2 L2`, the numerator's constant of cos alpha.
+    pub c_alpha: R,
+    /// `2 L1 L2`, the denominator of cos alpha.
+    pub d_alpha: R,
+    /// Twice the reach `L1 + L2`: where a far target is pulled in to.
+    pub reach2: R,
+    /// Four times the reach: beyond it a target is pulled in.
+    pub reach4: R,
+    /// `1 + 16 eps`: an acos argument beyond it (either sign) is a clamp, not rounding.
+    pub one_tol: R,
+}
+
+impl<R: Real> IkConstants<R> {
+    /// The constants for `g`.
+    #[inline(always)]
+    pub fn of(g: &Lengths<R>) -> Self {
+        let two = R::ONE + R::ONE;
+        let reach = g.l1 + g.l2;
+        IkConstants {
+            c_gamma: g.l1 * g.l1 - g.l2 * g.l2,
+            two_l1: two * g.l1,
+            c_alpha: g.l1 * g.l1 + g.l2 * g.l2,
+            d_alpha: two * g.l1 * g.l2,
+            reach2: reach + reach,
+            reach4: reach + reach + reach + reach,
+            one_tol: R::ONE + R::from_f64(16.0) * R::EPSILON,
+        }
+    }
+}
+
 /// Clamps an acos argument into [-1, 1]. Overshoots of a few ulps are rounding at the
 /// workspace boundary (a fully stretched arm), not an unreachable target.
 #[inline(always)]
-fn clamp_unit<R: Real>(a: R, clamped: &mut bool) -> R {
-    let tol = R::from_f64(16.0) * R::EPSILON;
+fn clamp_unit<R: Real>(a: R, one_tol: R, clamped: &mut bool) -> R {
     if a > R::ONE {
-        *clamped |= a > R::ONE + tol;
+        *clamped |= a > one_tol;
         R::ONE
     } else if a < -R::ONE {
-        *clamped |= a < -R::ONE - tol;
+        *clamped |= a < -one_tol;
         -R::ONE
     } else if a.is_finite() {
         a
@@ -141,6 +179,37 @@ fn clamp_unit<R: Real>(a: R, clamped: &mut bool) -> R {
         *clamped = true;
         R::ONE
     }
+}
+
+/// Every value [`ik`] computes on its way, as the RTL's IK-HSD has them at its stage
+/// boundaries (the co-simulation compares each). Meaningful unless the status is
+/// [`IkStatus::Invalid`], where only the (zero) angles are.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IkTaps<R> {
+    /// x, y - L3 and z + L4, after pulling a far target in.
+    pub shoulder: [R; 3],
+    /// atan2(x, z + L4), before its negation into theta1.
+    pub atan: R,
+    /// x^2 + (z + L4)^2.
+    pub rr2: R,
+    /// Its square root, R.
+    pub big_r: R,
+    /// r^2 = R^2 + (y - L3)^2.
+    pub r2: R,
+    /// r.
+    pub r: R,
+    /// cos gamma as the acos takes it (clamped).
+    pub cos_gamma: R,
+    /// gamma.
+    pub gamma: R,
+    /// beta = atan2(y - L3, R).
+    pub beta: R,
+    /// cos alpha as the acos takes it (clamped).
+    pub cos_alpha: R,
+    /// alpha.
+    pub alpha: R,
+    /// The result.
+    pub solution: IkSolution<R>,
 }
 
 /// Inverse kinematics (IK-HSD): tool xyz in metres to joint angles, elbow-up branch.
@@ -155,51 +224,85 @@ fn clamp_unit<R: Real>(a: R, clamped: &mut bool) -> R {
 /// [`IkStatus::Clamped`]; a non-finite target gives zeros flagged [`IkStatus::Invalid`].
 #[inline(always)]
 pub fn ik<R: Real, T: Trig<R>>(g: &Lengths<R>, trig: &T, p: [R; 3]) -> IkSolution<R> {
+    ik_taps(g, trig, p).solution
+}
+
+/// [`ik`] with every intermediate value ([`IkTaps`]); `ik` is this, so the two cannot
+/// differ.
+#[inline(always)]
+pub fn ik_taps<R: Real, T: Trig<R>>(g: &Lengths<R>, trig: &T, p: [R; 3]) -> IkTaps<R> {
     let [x, y, z] = p;
     if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-        return IkSolution {
-            theta: [R::ZERO; 3],
-            status: IkStatus::Invalid,
+        let z = R::ZERO;
+        return IkTaps {
+            shoulder: [z; 3],
+            atan: z,
+            rr2: z,
+            big_r: z,
+            r2: z,
+            r: z,
+            cos_gamma: z,
+            gamma: z,
+            beta: z,
+            cos_alpha: z,
+            alpha: z,
+            solution: IkSolution {
+                theta: [z; 3],
+                status: IkStatus::Invalid,
+            },
         };
     }
+    let k = IkConstants::of(g);
     let (mut x, mut yl, mut zl) = (x, y - g.l3, z + g.l4);
     let mut clamped = false;
     // A target far beyond reach, possibly so far that squaring it overflows, is pulled
     // in along the same direction from the shoulder to twice the reach: the clamped
     // angles are the same and every intermediate stays finite.
-    let reach = g.l1 + g.l2;
     let far = x.abs().max_of(yl.abs()).max_of(zl.abs());
-    if far > reach + reach + reach + reach {
-        let k = (reach + reach) / far;
-        (x, yl, zl) = (x * k, yl * k, zl * k);
+    if far > k.reach4 {
+        let s = k.reach2 / far;
+        (x, yl, zl) = (x * s, yl * s, zl * s);
         clamped = true;
     }
-    let theta1 = -trig.atan2(x, zl);
+    let atan = trig.atan2(x, zl);
     let rr2 = x * x + zl * zl;
     let big_r = rr2.sqrt();
     let r2 = rr2 + yl * yl;
     let r = r2.sqrt();
-    let two = R::ONE + R::ONE;
     // At r = 0 (target on the shoulder joint) gamma is undefined; with L1 = L2 it is the
     // boundary of the workspace, otherwise outside it. Treat it as the limit r -> 0+.
     let cos_gamma = if r > R::ZERO {
-        (g.l1 * g.l1 - g.l2 * g.l2 + r2) / (two * g.l1 * r)
+        (k.c_gamma + r2) / (k.two_l1 * r)
     } else {
         clamped |= g.l1 != g.l2;
         R::ZERO
     };
-    let gamma = trig.acos(clamp_unit(cos_gamma, &mut clamped));
+    let cos_gamma = clamp_unit(cos_gamma, k.one_tol, &mut clamped);
+    let gamma = trig.acos(cos_gamma);
     let beta = trig.atan2(yl, big_r);
-    let cos_alpha = (g.l1 * g.l1 + g.l2 * g.l2 - r2) / (two * g.l1 * g.l2);
-    let alpha = trig.acos(clamp_unit(cos_alpha, &mut clamped));
+    let cos_alpha = clamp_unit((k.c_alpha - r2) / k.d_alpha, k.one_tol, &mut clamped);
+    let alpha = trig.acos(cos_alpha);
     let theta2 = gamma + beta;
     let theta3 = theta2 + alpha - R::FRAC_PI_2;
-    IkSolution {
-        theta: [theta1, theta2, theta3],
-        status: if clamped {
-            IkStatus::Clamped
-        } else {
-            IkStatus::Reachable
+    IkTaps {
+        shoulder: [x, yl, zl],
+        atan,
+        rr2,
+        big_r,
+        r2,
+        r,
+        cos_gamma,
+        gamma,
+        beta,
+        cos_alpha,
+        alpha,
+        solution: IkSolution {
+            theta: [-atan, theta2, theta3],
+            status: if clamped {
+                IkStatus::Clamped
+            } else {
+                IkStatus::Reachable
+            },
         },
     }
 }

@@ -11,6 +11,7 @@ pub mod arith;
 pub mod cordic;
 pub mod engine;
 pub mod geometry;
+pub mod hardware;
 pub mod kernels;
 pub mod validation;
 pub mod vec3;
