@@ -1,0 +1,160 @@
+//! With the feature `verilator`: writes the RTL for one format and geometry (from the
+//! model, as `tactile hdl rtl` does), has Verilator turn each module into C++, and
+//! compiles that, the glue (`src/glue.cpp`) and Verilator's runtime into this crate.
+//!
+//! The format and geometry: `TACTILE_RTL_WORD`, `TACTILE_RTL_FRAC`,
+//! `TACTILE_RTL_ROUNDING` (`nearest`, `truncate`) and `TACTILE_RTL_DEVICE` (`paper`,
+//! `omni`); by default the paper's `[s16.13]`, nearest, and its geometry. A run whose
+//! scenario asks for another is refused with these variables named.
+
+fn main() {
+    println!("cargo:rerun-if-changed=../../deploy/hdl");
+    println!("cargo:rerun-if-changed=src/glue.cpp");
+    println!("cargo:rerun-if-changed=src/text.rs");
+    #[cfg(feature = "verilator")]
+    verilate::build();
+}
+
+#[cfg(feature = "verilator")]
+#[allow(dead_code)]
+#[path = "src/text.rs"]
+mod text;
+
+#[cfg(feature = "verilator")]
+mod verilate {
+    use super::text;
+
+    use std::path::{Path, PathBuf};
+    use std::process::Command;
+    use tactile_math::cordic::{Cordic, CordicConfig, Rounding};
+    use tactile_math::geometry::Geometry;
+
+    /// The modules simulated, each a Verilator model of its own (one `eval` per module).
+    const TOPS: [&str; 4] = ["kin_fk", "kin_kff", "kin_fbf", "kin_ik"];
+
+    fn env(name: &str, default: &str) -> String {
+        println!("cargo:rerun-if-env-changed={name}");
+        std::env::var(name).unwrap_or_else(|_| default.to_string())
+    }
+
+    fn fail(msg: String) -> ! {
+        eprintln!("tactile-rtl: {msg}");
+        std::process::exit(1);
+    }
+
+    pub fn build() {
+        let out =
+            PathBuf::from(std::env::var("OUT_DIR").unwrap_or_else(|_| fail("no OUT_DIR".into())));
+        let rtl = out.join("rtl");
+        write_rtl(&rtl);
+        let include = verilator_include();
+        for top in TOPS {
+            verilate(&rtl, &out, top);
+        }
+        let mut glue = cc::Build::new();
+        glue.cpp(true)
+            .file("src/glue.cpp")
+            .include(&include)
+            .include(include.join("vltstd"))
+            .flag_if_supported("-std=c++17")
+            .warnings(false);
+        for top in TOPS {
+            glue.include(out.join(top));
+        }
+        glue.compile("tactile_rtl_glue");
+        for top in TOPS {
+            println!("cargo:rustc-link-search=native={}", out.join(top).display());
+            println!("cargo:rustc-link-lib=static=V{top}");
+        }
+        cc::Build::new()
+            .cpp(true)
+            .file(include.join("verilated.cpp"))
+            .file(include.join("verilated_threads.cpp"))
+            .include(&include)
+            .include(include.join("vltstd"))
+            .flag_if_supported("-std=c++17")
+            .warnings(false)
+            .compile("tactile_verilated");
+        println!("cargo:rustc-link-lib=pthread");
+        println!("cargo:rustc-link-lib=atomic");
+    }
+
+    /// The RTL's files for the format and geometry asked for, into `dir`.
+    fn write_rtl(dir: &Path) {
+        let word: u32 = env("TACTILE_RTL_WORD", "16")
+            .parse()
+            .unwrap_or_else(|e| fail(format!("TACTILE_RTL_WORD: {e}")));
+        let frac: u32 = env("TACTILE_RTL_FRAC", "13")
+            .parse()
+            .unwrap_or_else(|e| fail(format!("TACTILE_RTL_FRAC: {e}")));
+        let rounding = match env("TACTILE_RTL_ROUNDING", "nearest").as_str() {
+            "nearest" => Rounding::Nearest,
+            "truncate" => Rounding::Truncate,
+            other => fail(format!(
+                "TACTILE_RTL_ROUNDING: {other:?} is not nearest or truncate"
+            )),
+        };
+        let device = env("TACTILE_RTL_DEVICE", "paper");
+        let geometry = Geometry::preset(&device).unwrap_or_else(|| {
+            fail(format!(
+                "TACTILE_RTL_DEVICE: {device:?} is not paper or omni"
+            ))
+        });
+        let cfg = CordicConfig::new(word, frac, None, rounding)
+            .unwrap_or_else(|e| fail(format!("bad fixed-point format: {e}")));
+        let cordic =
+            Cordic::new(cfg).unwrap_or_else(|e| fail(format!("bad fixed-point format: {e}")));
+        let constants = cordic.rtl_constants();
+        if let Some(a) = cordic.rtl_reduction_mismatch(&constants) {
+            fail(format!("no RTL for [s{word}.{frac}]: its range reduction differs from the model's at {a:e}"));
+        }
+        std::fs::create_dir_all(dir).unwrap_or_else(|e| fail(format!("{}: {e}", dir.display())));
+        for (name, text) in text::files(&constants, &geometry) {
+            std::fs::write(dir.join(name), text).unwrap_or_else(|e| fail(format!("{name}: {e}")));
+        }
+    }
+
+    /// Verilator's include folder (`verilator --getenv VERILATOR_ROOT`).
+    fn verilator_include() -> PathBuf {
+        let out = Command::new("verilator")
+            .args(["--getenv", "VERILATOR_ROOT"])
+            .output()
+            .unwrap_or_else(|e| fail(format!("cannot run verilator ({e}): the feature rtl needs it (Debian: apt-get install verilator)")));
+        PathBuf::from(String::from_utf8_lossy(&out.stdout).trim()).join("include")
+    }
+
+    /// Verilator's C++ model of `top`, built into `out/top/libVtop.a`.
+    fn verilate(rtl: &Path, out: &Path, top: &str) {
+        let mdir = out.join(top);
+        let mut cmd = Command::new("verilator");
+        cmd.current_dir(rtl)
+            .args([
+                "--cc",
+                "--build",
+                "-O3",
+                "-Wno-fatal",
+                "-Wno-lint",
+                "-Wno-style",
+                "-I.",
+            ])
+            .args([
+                "--top-module",
+                top,
+                "--prefix",
+                &format!("V{top}"),
+                "--Mdir",
+            ])
+            .arg(&mdir)
+            .args(["-CFLAGS", "-fPIC -O2", "-j", "2"])
+            .args(text::MODULES);
+        let status = cmd
+            .status()
+            .unwrap_or_else(|e| fail(format!("cannot run verilator: {e}")));
+        if !status.success() {
+            fail(format!("verilator failed on {top} ({status})"));
+        }
+        let archive = mdir.join(format!("V{top}__ALL.a"));
+        std::fs::copy(&archive, mdir.join(format!("libV{top}.a")))
+            .unwrap_or_else(|e| fail(format!("{}: {e}", archive.display())));
+    }
+}

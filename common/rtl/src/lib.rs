@@ -1,0 +1,57 @@
+//! The paper's hardware as RTL.
+//!
+//! - [`text`]: the hand-written Verilog (`deploy/hdl/`) and its generated parameters,
+//!   from the model; `tactile hdl` writes them, co-simulates and synthesizes them.
+//! - [`engine`]: the kernels' [`Engine`] for any arithmetic, `rtl` included: with the
+//!   feature `verilator`, the modules FK, KFF, FBF and IK are compiled by Verilator
+//!   into this crate (its build script) and every call runs them clock by clock.
+//!   Without it, `rtl` is refused with the reason.
+
+pub mod text;
+
+#[cfg(feature = "verilator")]
+mod sim;
+
+#[cfg(feature = "verilator")]
+pub use sim::{Rtl, BUILT_FOR};
+
+use tactile_math::arith::ArithKind;
+use tactile_math::cordic::CordicConfig;
+use tactile_math::engine::{Engine, EngineError};
+use tactile_math::geometry::Geometry;
+
+/// Why the RTL cannot serve a run.
+#[derive(Debug, thiserror::Error)]
+pub enum RtlError {
+    /// The engine refused (format, or no hardware in this build).
+    #[error(transparent)]
+    Engine(#[from] EngineError),
+    /// The RTL in this build was generated for another format or geometry.
+    #[error("{0}")]
+    Mismatch(String),
+}
+
+/// True when this build simulates the RTL (`arithmetic = "rtl"` works).
+pub const AVAILABLE: bool = cfg!(feature = "verilator");
+
+/// The engine for `kind`: software, or for [`ArithKind::Rtl`] the modules simulated
+/// by Verilator (refused by a build without the feature, or built for another format
+/// or geometry, with what to do).
+pub fn engine(
+    kind: ArithKind,
+    geometry: Geometry,
+    cordic: CordicConfig,
+) -> Result<Engine, RtlError> {
+    if kind != ArithKind::Rtl {
+        return Ok(Engine::new(kind, geometry, cordic)?);
+    }
+    #[cfg(feature = "verilator")]
+    {
+        let rtl = Rtl::new(&cordic, &geometry)?;
+        Ok(Engine::with_hardware(geometry, cordic, Box::new(rtl))?)
+    }
+    #[cfg(not(feature = "verilator"))]
+    {
+        Err(RtlError::Engine(EngineError::NoHardware))
+    }
+}
