@@ -17,6 +17,7 @@ mod faults;
 mod formats;
 mod hand;
 mod hdl;
+mod hdl_modules;
 mod hosts;
 mod layout;
 mod lifecycle;

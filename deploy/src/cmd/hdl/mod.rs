@@ -3,17 +3,21 @@
 //! synthesis (Yosys, Virtex-6) that hold the RTL against the model
 //! (docs/09-the-hardware.md).
 
+mod kin;
 mod params;
 mod sim;
+mod synth;
+mod units;
 mod vectors;
 
-use super::datapath::FormatArgs;
+use super::datapath::DatapathArgs;
 use crate::error::Error;
 use clap::{Args, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
 
-pub use params::{latency, model, params_vh, write_rtl, MODULES};
+pub use params::{latency, model, write_rtl};
+pub use tactile_rtl::text::{params_vh, MODULES};
 pub use vectors::vectors;
 
 /// Arguments of `tactile hdl`.
@@ -32,13 +36,13 @@ pub enum HdlCommand {
         /// Folder to write (created if missing).
         #[arg(long)]
         out: PathBuf,
-        /// Fixed-point format.
+        /// Fixed-point format and the arm's geometry (the modules' constants).
         #[command(flatten)]
-        format: FormatArgs,
+        datapath: DatapathArgs,
     },
     /// Write test vectors from the hybrid model (stdout, or --out).
     Vectors {
-        /// Which function.
+        /// Which block: a TFB function, an f32 unit or a module.
         #[arg(long, value_enum)]
         function: Function,
         /// Samples beyond the edge cases: half an even sweep of the input range, half
@@ -51,30 +55,75 @@ pub enum HdlCommand {
         /// File to write instead of stdout.
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Fixed-point format.
+        /// Fixed-point format and the arm's geometry (the modules' constants).
         #[command(flatten)]
-        format: FormatArgs,
+        datapath: DatapathArgs,
     },
     /// Run the RTL over the model's vectors in Icarus Verilog, bit for bit.
     Cosim(sim::CosimArgs),
     /// Synthesize each function with Yosys for Virtex-6 and print its resources.
-    Synth(sim::SynthArgs),
+    Synth(synth::SynthArgs),
 }
 
-/// A function of the TFB.
+/// A block of the hardware: a TFB function, an f32 unit or one of the paper's modules.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Function {
-    /// Rotation mode: sin and cos of an angle.
+    /// TFB, rotation mode: sin and cos of an angle.
     Sincos,
-    /// Vectoring mode: the angle of (x, y).
+    /// TFB, vectoring mode: the angle of (x, y).
     Atan2,
-    /// acos(a) = atan2(sqrt((1 - a)(1 + a)), a), the root in f32.
+    /// TFB: acos(a) = atan2(sqrt((1 - a)(1 + a)), a), the root in f32.
     Acos,
+    /// f32 unit: a + b.
+    Add,
+    /// f32 unit: a - b (the adder with b negated).
+    Sub,
+    /// f32 unit: a * b.
+    Mul,
+    /// f32 unit: a / b.
+    Div,
+    /// f32 unit: sqrt(a).
+    Sqrt,
+    /// Module FK-HMD / FK-HSD: forward kinematics.
+    Fk,
+    /// Module KFF-HMD: joint torques J^T F.
+    Kff,
+    /// Module FBF-HSD: the feedback force h (obj - env).
+    Fbf,
+    /// Module IK-HSD: inverse kinematics.
+    Ik,
+}
+
+/// What kind of block a [`Function`] is: each kind has its own testbench.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Family {
+    /// A TFB function (`tb_tfb.v`).
+    Tfb,
+    /// An f32 unit (`tb_f32.v`).
+    Unit(units::Unit),
+    /// One of the paper's modules (`tb_kin.v`).
+    Module(kin::Module),
 }
 
 impl Function {
-    /// Every function, in the order the reports list them.
-    pub const ALL: [Function; 3] = [Function::Sincos, Function::Atan2, Function::Acos];
+    /// Every block, in the order the reports list them.
+    pub const ALL: [Function; 12] = [
+        Function::Sincos,
+        Function::Atan2,
+        Function::Acos,
+        Function::Add,
+        Function::Sub,
+        Function::Mul,
+        Function::Div,
+        Function::Sqrt,
+        Function::Fk,
+        Function::Kff,
+        Function::Fbf,
+        Function::Ik,
+    ];
+
+    /// The TFB's three functions.
+    pub const TFB: [Function; 3] = [Function::Sincos, Function::Atan2, Function::Acos];
 
     /// The CLI and report name.
     pub fn name(self) -> &'static str {
@@ -82,6 +131,33 @@ impl Function {
             Function::Sincos => "sincos",
             Function::Atan2 => "atan2",
             Function::Acos => "acos",
+            Function::Add => "add",
+            Function::Sub => "sub",
+            Function::Mul => "mul",
+            Function::Div => "div",
+            Function::Sqrt => "sqrt",
+            Function::Fk => "fk",
+            Function::Kff => "kff",
+            Function::Fbf => "fbf",
+            Function::Ik => "ik",
+        }
+    }
+
+    /// Which kind of block it is.
+    pub fn family(self) -> Family {
+        use kin::Module;
+        use units::Unit;
+        match self {
+            Function::Sincos | Function::Atan2 | Function::Acos => Family::Tfb,
+            Function::Add => Family::Unit(Unit::Add),
+            Function::Sub => Family::Unit(Unit::Sub),
+            Function::Mul => Family::Unit(Unit::Mul),
+            Function::Div => Family::Unit(Unit::Div),
+            Function::Sqrt => Family::Unit(Unit::Sqrt),
+            Function::Fk => Family::Module(Module::Fk),
+            Function::Kff => Family::Module(Module::Kff),
+            Function::Fbf => Family::Module(Module::Fbf),
+            Function::Ik => Family::Module(Module::Ik),
         }
     }
 
@@ -91,15 +167,57 @@ impl Function {
             Function::Sincos => "angle range_err code folded flip sin_code cos_code sin cos",
             Function::Atan2 => "y x stages x_code y_code z_code angle",
             Function::Acos => "a stages root x_code y_code z_code angle",
+            Function::Add | Function::Sub | Function::Mul | Function::Div => "a b r",
+            Function::Sqrt => "a r",
+            Function::Fk => "t1 t2 t3 err s1 c1 s2 c2 s3 c3 x y z",
+            Function::Kff => {
+                "t1 t2 t3 f1 f2 f3 err s1 c1 s2 c2 s3 c3 j11 j12 j13 j21 j22 j23 j31 j32 j33 \
+                 tau1 tau2 tau3"
+            }
+            Function::Fbf => "o1 o2 o3 e1 e2 e3 h1 h2 h3 d1 d2 d3 f1 f2 f3",
+            Function::Ik => {
+                "x y z status xs ys zs atan rr2 big_r r2 r cg gamma beta ca alpha t1 t2 t3"
+            }
         }
     }
 
-    /// The testbench's define and the synthesis top.
-    fn define(self) -> &'static str {
-        match self {
-            Function::Sincos => "FUNC_SINCOS",
-            Function::Atan2 => "FUNC_ATAN2",
-            Function::Acos => "FUNC_ACOS",
+    /// The testbench's define (the synthesis top is `top_<name>`).
+    fn define(self) -> String {
+        let prefix = match self.family() {
+            Family::Tfb => "FUNC",
+            Family::Unit(_) => "OP",
+            Family::Module(_) => "MOD",
+        };
+        format!("{prefix}_{}", self.name().to_uppercase())
+    }
+
+    /// The testbench and the prefix of its result line.
+    fn testbench(self) -> (&'static str, &'static str) {
+        match self.family() {
+            Family::Tfb => ("tb_tfb.v", "tfb-cosim"),
+            Family::Unit(_) => ("tb_f32.v", "f32-cosim"),
+            Family::Module(_) => ("tb_kin.v", "kin-cosim"),
+        }
+    }
+}
+
+/// The vectors of any block: its text and number of samples.
+pub fn block_vectors(
+    cordic: &tactile_math::cordic::Cordic,
+    k: &tactile_math::cordic::hdl::RtlConstants,
+    geometry: &tactile_math::geometry::Geometry,
+    f: Function,
+    count: usize,
+    seed: u64,
+) -> (String, usize) {
+    match f.family() {
+        Family::Tfb => vectors(cordic, k, f, count, seed),
+        Family::Unit(u) => units::unit_vectors(u, f.name(), count, seed),
+        Family::Module(m) => {
+            let (mut text, n) =
+                kin::kin_vectors(m, f.name(), cordic, k.three_pi_up, geometry, count, seed);
+            text.insert_str(0, &format!("// fields: {}\n", f.fields()));
+            (text, n)
         }
     }
 }
@@ -107,9 +225,9 @@ impl Function {
 /// Runs `tactile hdl`.
 pub fn main(args: &HdlArgs) -> Result<(), Error> {
     match &args.command {
-        HdlCommand::Rtl { out, format } => {
-            let (_, k) = model(format.cordic()?)?;
-            write_rtl(out, &k)?;
+        HdlCommand::Rtl { out, datapath } => {
+            let (_, k) = model(datapath.cordic()?)?;
+            write_rtl(out, &k, &datapath.geometry()?)?;
             crate::outln!("wrote the TFB's RTL for this format into {}", out.display());
             Ok(())
         }
@@ -118,10 +236,11 @@ pub fn main(args: &HdlArgs) -> Result<(), Error> {
             count,
             seed,
             out,
-            format,
+            datapath,
         } => {
-            let (cordic, k) = model(format.cordic()?)?;
-            let (text, _) = vectors(&cordic, &k, *function, *count, *seed);
+            let (cordic, k) = model(datapath.cordic()?)?;
+            let geometry = datapath.geometry()?;
+            let (text, _) = block_vectors(&cordic, &k, &geometry, *function, *count, *seed);
             match out {
                 Some(path) => std::fs::write(path, text)
                     .map_err(Error::io(format!("writing {}", path.display()))),
@@ -132,6 +251,6 @@ pub fn main(args: &HdlArgs) -> Result<(), Error> {
             }
         }
         HdlCommand::Cosim(a) => sim::cosim_main(a),
-        HdlCommand::Synth(a) => sim::synth_main(a),
+        HdlCommand::Synth(a) => synth::synth_main(a),
     }
 }

@@ -2,8 +2,8 @@
 //! testbench over the vectors, Yosys synthesizes each function for Virtex-6 (the
 //! paper's family). Each run works in a fresh folder of its own.
 
-use super::{latency, model, vectors, write_rtl, Function, MODULES};
-use crate::cmd::datapath::FormatArgs;
+use super::{block_vectors, latency, model, write_rtl, Function, MODULES};
+use crate::cmd::datapath::DatapathArgs;
 use crate::error::Error;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -22,10 +22,11 @@ pub fn count_parser() -> clap::builder::RangedU64ValueParser<usize> {
 /// Arguments of `tactile hdl cosim`.
 #[derive(Debug, Args)]
 pub struct CosimArgs {
-    /// Functions to run (default: all three).
+    /// Blocks to run (default: all: the TFB's three functions, the f32 units, the
+    /// paper's modules).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub function: Vec<Function>,
-    /// Samples beyond the edge cases, per function (1 to 10^7).
+    /// Samples beyond the edge cases, per block (1 to 10^7).
     #[arg(long, default_value_t = 20_000, value_parser = count_parser())]
     pub count: usize,
     /// Seed of the random inputs.
@@ -33,39 +34,26 @@ pub struct CosimArgs {
     pub seed: u64,
     /// A Verilog macro to define when compiling the RTL (repeatable): the RTL's
     /// deliberately wrong variants are TFB_MUTANT_SHIFT (one iteration shifts one bit
-    /// too far) and TFB_MUTANT_ROUND (shifts truncate where they must round).
+    /// too far), TFB_MUTANT_ROUND (shifts truncate where they must round) and one per
+    /// module, KIN_MUTANT_FK, KIN_MUTANT_KFF, KIN_MUTANT_FBF and KIN_MUTANT_IK.
     #[arg(long = "define", value_name = "MACRO")]
     pub defines: Vec<String>,
     /// Keep the work folder (RTL, vectors, simulator) here instead of a temporary one.
     #[arg(long)]
     pub keep: Option<PathBuf>,
-    /// Fixed-point format.
+    /// Fixed-point format and the arm's geometry.
     #[command(flatten)]
-    pub format: FormatArgs,
-}
-
-/// Arguments of `tactile hdl synth`.
-#[derive(Debug, Args)]
-pub struct SynthArgs {
-    /// Functions to synthesize (default: all three).
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub function: Vec<Function>,
-    /// Keep the work folder (RTL, scripts, Yosys logs) here.
-    #[arg(long)]
-    pub keep: Option<PathBuf>,
-    /// Fixed-point format.
-    #[command(flatten)]
-    pub format: FormatArgs,
+    pub datapath: DatapathArgs,
 }
 
 /// A work folder, removed on drop unless the user asked to keep it.
-struct Work {
-    dir: PathBuf,
+pub(super) struct Work {
+    pub(super) dir: PathBuf,
     keep: bool,
 }
 
 impl Work {
-    fn new(keep: Option<&Path>) -> Result<Work, Error> {
+    pub(super) fn new(keep: Option<&Path>) -> Result<Work, Error> {
         let (dir, kept) = match keep {
             Some(d) => (d.to_path_buf(), true),
             None => {
@@ -90,7 +78,7 @@ impl Drop for Work {
 }
 
 /// Runs a tool, naming it and the package to install when it is missing.
-fn tool(cmd: &mut Command, name: &str, package: &str) -> Result<String, Error> {
+pub(super) fn tool(cmd: &mut Command, name: &str, package: &str) -> Result<String, Error> {
     let out = cmd.output().map_err(|e| {
         Error::Failed(format!(
             "cannot run {name} ({e}): install it (Debian: apt-get install {package})"
@@ -118,9 +106,9 @@ fn tail(text: &str, lines: usize) -> String {
     s
 }
 
-fn chosen(functions: &[Function]) -> Vec<Function> {
+pub(super) fn chosen(functions: &[Function], default: &[Function]) -> Vec<Function> {
     if functions.is_empty() {
-        Function::ALL.to_vec()
+        default.to_vec()
     } else {
         functions.to_vec()
     }
@@ -139,16 +127,18 @@ fn cosim_one(
     std::fs::write(&vec_path, text)
         .map_err(Error::io(format!("writing {}", vec_path.display())))?;
     let sim = work.join(format!("{name}.vvp"));
+    let (bench, prefix) = function.testbench();
+    let words = function.fields().split_whitespace().count();
     let mut cc = Command::new("iverilog");
     cc.current_dir(work)
         .args(["-g2005", "-I", ".", "-o"])
         .arg(&sim)
         .arg(format!("-D{}", function.define()))
-        .arg(format!("-DMAXWORDS={}", (n * 9).next_power_of_two()));
+        .arg(format!("-DMAXWORDS={}", (n * words).next_power_of_two()));
     for d in defines {
         cc.arg(format!("-D{d}"));
     }
-    cc.arg("tb_tfb.v").args(MODULES);
+    cc.arg(bench).args(MODULES);
     tool(&mut cc, "iverilog", "iverilog")?;
     let mut run = Command::new("vvp");
     run.current_dir(work)
@@ -160,7 +150,7 @@ fn cosim_one(
     let last = out
         .lines()
         .rev()
-        .find_map(|l| l.strip_prefix(&format!("tfb-cosim: {name} ")))
+        .find_map(|l| l.strip_prefix(&format!("{prefix}: {name} ")))
         .ok_or_else(|| {
             Error::Failed(format!("the testbench gave no result:\n{}", tail(&out, 20)))
         })?;
@@ -184,13 +174,14 @@ fn cosim_one(
 
 /// `tactile hdl cosim`.
 pub fn cosim_main(args: &CosimArgs) -> Result<(), Error> {
-    let cfg = args.format.cordic()?;
+    let cfg = args.datapath.cordic()?;
+    let geometry = args.datapath.geometry()?;
     let (cordic, k) = model(cfg)?;
     let work = Work::new(args.keep.as_deref())?;
-    write_rtl(&work.dir, &k)?;
+    write_rtl(&work.dir, &k, &geometry)?;
     let mut failed = 0;
-    for f in chosen(&args.function) {
-        let (text, n) = vectors(&cordic, &k, f, args.count, args.seed);
+    for f in chosen(&args.function, &Function::ALL) {
+        let (text, n) = block_vectors(&cordic, &k, &geometry, f, args.count, args.seed);
         let (v, m) = cosim_one(&work.dir, f, &text, n, &args.defines)?;
         crate::outln!(
             "{:<7} [s{}.{}] {} iterations {:<8} {v} vectors, {m} mismatches (latency {} clocks)",
@@ -213,85 +204,6 @@ pub fn cosim_main(args: &CosimArgs) -> Result<(), Error> {
         return Err(Error::Failed(format!(
             "co-simulation: {failed} outputs differ from the model"
         )));
-    }
-    Ok(())
-}
-
-/// Resources of one synthesized function, from Yosys's `stat`.
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
-pub struct Resources {
-    /// Flip-flops (FDRE, FDSE, FDCE, FDPE).
-    pub registers: u64,
-    /// LUTs used as logic (LUT1..LUT6).
-    pub luts: u64,
-    /// LUTs used as shift registers (SRL16E, SRLC32E): delay lines.
-    pub srls: u64,
-    /// DSP48E1 slices.
-    pub dsps: u64,
-    /// CARRY4 chains.
-    pub carry: u64,
-}
-
-/// Parses the cell counts of Yosys's `stat` (the flattened top's list).
-pub fn parse_stat(text: &str) -> Resources {
-    let mut r = Resources::default();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        let (Some(cell), Some(n), None) = (it.next(), it.next(), it.next()) else {
-            continue;
-        };
-        let Ok(n) = n.parse::<u64>() else { continue };
-        match cell {
-            "FDRE" | "FDSE" | "FDCE" | "FDPE" => r.registers += n,
-            c if c.starts_with("LUT") && c.len() == 4 => r.luts += n,
-            "SRL16E" | "SRLC32E" => r.srls += n,
-            "DSP48E1" => r.dsps += n,
-            "CARRY4" => r.carry += n,
-            _ => {}
-        }
-    }
-    r
-}
-
-/// `tactile hdl synth`.
-pub fn synth_main(args: &SynthArgs) -> Result<(), Error> {
-    let cfg = args.format.cordic()?;
-    let (_, k) = model(cfg)?;
-    let work = Work::new(args.keep.as_deref())?;
-    write_rtl(&work.dir, &k)?;
-    crate::outln!(
-        "| function | format | rounding | registers | LUTs | SRLs | DSP48E1 | CARRY4 | latency (clocks) |"
-    );
-    crate::outln!("|---|---|---|---:|---:|---:|---:|---:|---:|");
-    for f in chosen(&args.function) {
-        let stat = work.dir.join(format!("{}.stat", f.name()));
-        let script = format!(
-            "read_verilog -I . {modules} tfb_top.v; \
-             synth_xilinx -family xc6v -flatten -top top_{name}; tee -q -o {stat} stat",
-            modules = MODULES.join(" "),
-            name = f.name(),
-            stat = stat.display()
-        );
-        let mut y = Command::new("yosys");
-        y.current_dir(&work.dir).args(["-q", "-p", &script]);
-        tool(&mut y, "yosys", "yosys")?;
-        let text = std::fs::read_to_string(&stat)
-            .map_err(Error::io(format!("reading {}", stat.display())))?;
-        let r = parse_stat(&text);
-        crate::outln!(
-            "| {} | [s{}.{}] {} it. | {} | {} | {} | {} | {} | {} | {} |",
-            f.name(),
-            cfg.word,
-            cfg.frac,
-            cfg.iterations,
-            format!("{:?}", cfg.rounding).to_lowercase(),
-            r.registers,
-            r.luts,
-            r.srls,
-            r.dsps,
-            r.carry,
-            latency(f, &cfg)
-        );
     }
     Ok(())
 }

@@ -1,0 +1,233 @@
+//! The f32 units and the paper's modules (FK, KFF, FBF, IK) as RTL against the hybrid
+//! model (`tactile hdl`): bit for bit in the three formats, every stage tap included;
+//! a wrong variant of each module caught; synthesized for Virtex-6; and in the loop,
+//! simulated by Verilator (`arithmetic = "rtl"`), byte-identical to the model.
+
+use crate::hdl::{cosim, have, synth_row};
+use crate::util::{cannot, Sandbox};
+
+#[test]
+fn the_f32_units_are_ieee_round_to_nearest_even_bit_for_bit() {
+    if !have("iverilog") {
+        return cannot("iverilog is not installed");
+    }
+    let sb = Sandbox::new("hdl-units");
+    let args = ["--function", "add,sub,mul,div,sqrt", "--count", "40000"];
+    let (ok, r, text) = cosim(&sb, &args);
+    assert!(ok, "{text}");
+    assert_eq!(r.len(), 5, "{text}");
+    for (f, vectors, mismatches) in r {
+        // The special values (29 of them, every pair for the binary ones), the ties and
+        // the 40000 random operands.
+        assert!(vectors > 40_000, "{f}: {vectors}");
+        assert_eq!(mismatches, 0, "{f}:\n{text}");
+    }
+}
+
+#[test]
+fn the_modules_match_the_model_bit_for_bit_in_three_formats() {
+    if !have("iverilog") {
+        return cannot("iverilog is not installed");
+    }
+    let sb = Sandbox::new("hdl-modules");
+    for (word, frac) in [("16", "13"), ("24", "21"), ("32", "29")] {
+        let args = [
+            "--function",
+            "fk,kff,fbf,ik",
+            "--count",
+            "2000",
+            "--word",
+            word,
+            "--frac",
+            frac,
+        ];
+        let (ok, r, text) = cosim(&sb, &args);
+        assert!(ok, "[s{word}.{frac}]:\n{text}");
+        assert_eq!(r.len(), 4, "{text}");
+        for (f, vectors, mismatches) in r {
+            // The paper's validation run (1,200 samples) and the 2,000 others.
+            assert!(vectors > 3_000, "{f}: {vectors}");
+            assert_eq!(mismatches, 0, "{f} [s{word}.{frac}]:\n{text}");
+        }
+    }
+}
+
+#[test]
+fn a_wrong_module_is_caught_by_the_same_test() {
+    if !have("iverilog") {
+        return cannot("iverilog is not installed");
+    }
+    let sb = Sandbox::new("hdl-kin-mutant");
+    for module in ["fk", "kff", "fbf", "ik"] {
+        let define = format!("KIN_MUTANT_{}", module.to_uppercase());
+        let args = ["--function", module, "--count", "1000", "--define", &define];
+        let (ok, r, text) = cosim(&sb, &args);
+        assert!(!ok, "{define} passed:\n{text}");
+        assert!(text.contains("outputs differ from the model"), "{text}");
+        let (_, vectors, mismatches) = r[0];
+        // Rounding-level mistakes: a few percent of the vectors at least.
+        assert!(
+            mismatches > vectors / 100,
+            "{define}: only {mismatches} of {vectors}"
+        );
+    }
+}
+
+#[test]
+fn module_vectors_hold_the_papers_run_and_follow_the_seed() {
+    let sb = Sandbox::new("hdl-kin-vectors");
+    let run = |function: &str, seed: &str| {
+        let o = sb.tactile(&[
+            "hdl",
+            "vectors",
+            "--function",
+            function,
+            "--count",
+            "100",
+            "--seed",
+            seed,
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).expect("utf-8")
+    };
+    let (a, b, c) = (run("ik", "3"), run("ik", "3"), run("ik", "4"));
+    assert_eq!(a, b);
+    assert_ne!(a, c);
+    assert!(a.contains(
+        "// fields: x y z status xs ys zs atan rr2 big_r r2 r cg gamma beta ca alpha t1 t2 t3"
+    ));
+    let lines: Vec<&str> = a.lines().filter(|l| !l.starts_with("//")).collect();
+    // The ten edges, the paper's 1,200 samples, the stretched arm (40 directions, 6
+    // radii), a 3 x 3 x 3 sweep and 50 random.
+    assert_eq!(lines.len(), 10 + 1200 + 240 + 27 + 50);
+    // Some stretched-arm targets are within clamp_unit's tolerance (reachable), some
+    // beyond it (clamped).
+    let status = |l: &&str| l.split_whitespace().nth(3).map(str::to_string);
+    let stretched: Vec<String> = lines[1210..1450].iter().filter_map(status).collect();
+    assert!(stretched.iter().any(|s| s == "0") && stretched.iter().any(|s| s == "1"));
+    assert!(lines.iter().all(|l| l.split_whitespace().count() == 20));
+    // A target at infinity is invalid (2) with zero angles.
+    let inf = lines
+        .iter()
+        .find(|l| l.starts_with("00000000 7f800000 "))
+        .expect("the inf edge");
+    let zeros = [" 00000000"; 16].concat();
+    assert!(inf.ends_with(&format!(" 2{zeros}")), "{inf}");
+}
+
+#[test]
+fn yosys_synthesizes_fbf_with_its_multipliers_in_dsp48() {
+    if !have("yosys") {
+        return cannot("yosys is not installed");
+    }
+    let sb = Sandbox::new("hdl-kin-synth");
+    let row = synth_row(&sb, "fbf");
+    let n = |i: usize| row[i];
+    // Three f32 multipliers: their 24 x 24 significand products in DSP48E1s.
+    assert!(n(7) >= 3, "DSP48E1 {}", n(7));
+    assert!(n(4) > 3 * 32, "registers {}", n(4));
+    assert_eq!(n(9), 8, "latency");
+    assert!(n(10) > 0, "depth");
+}
+
+/// The paper scenario in lockstep, through the RTL and through the model.
+fn paper_run(sb: &Sandbox, arithmetic: &str, in_process: bool, out: &str) -> std::process::Output {
+    let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/paper.toml");
+    let out = sb.path(out);
+    let mut args = vec![
+        "run",
+        scenario,
+        "--set",
+        "mode=lockstep",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "-q",
+    ];
+    let set = format!("arithmetic={arithmetic}");
+    args.extend(["--set", &set]);
+    if in_process {
+        args.push("--in-process");
+    } else {
+        args.extend(["--prefix", &sb.prefix]);
+    }
+    sb.tactile(&args)
+}
+
+#[test]
+fn the_rtl_in_the_loop_gives_the_hybrid_models_trace_byte_for_byte() {
+    let sb = Sandbox::new("rtl-loop");
+    if !cfg!(feature = "rtl") {
+        let o = paper_run(&sb, "rtl", true, "rtl");
+        assert_eq!(o.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("--features rtl"));
+        assert!(
+            !sb.path("rtl").join("trace.csv").exists(),
+            "nothing started"
+        );
+        return cannot("tactile was built without the feature rtl");
+    }
+    for (arith, in_process, out) in [
+        ("hybrid", true, "hybrid"),
+        ("rtl", true, "rtl"),
+        ("rtl", false, "rtl-nodes"),
+    ] {
+        let o = paper_run(&sb, arith, in_process, out);
+        assert!(
+            o.status.success(),
+            "{arith}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let trace = |d: &str| std::fs::read(sb.path(d).join("trace.csv")).expect("trace.csv");
+    let hybrid = trace("hybrid");
+    assert!(hybrid.len() > 100_000);
+    assert!(
+        trace("rtl") == hybrid,
+        "the RTL in-process differs from the model"
+    );
+    // The node programs' trace has wall-clock columns (stamps, round trips): the rest
+    // must be the model's.
+    let untimed = |csv: &[u8]| -> Vec<Vec<String>> {
+        let text = String::from_utf8_lossy(csv);
+        let rows: Vec<Vec<String>> = text
+            .lines()
+            .map(|l| l.split(',').map(str::to_string).collect())
+            .collect();
+        let keep: Vec<usize> = (0..rows[0].len())
+            .filter(|&i| !(rows[0][i].ends_with("_ns") || rows[0][i].starts_with("t_")))
+            .collect();
+        rows.iter()
+            .map(|r| keep.iter().map(|&i| r[i].clone()).collect())
+            .collect()
+    };
+    let nodes = untimed(&trace("rtl-nodes"));
+    assert!(nodes[0].len() > 70, "{:?}", nodes[0]);
+    assert!(
+        nodes == untimed(&hybrid),
+        "the RTL in the node programs differs"
+    );
+    // The clocks each module took a sample, recorded by the nodes.
+    let summary: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(sb.path("rtl-nodes").join("summary.json")).expect("summary"),
+    )
+    .expect("json");
+    let m = &summary["hardware"]["modules"];
+    for (name, clocks, calls) in [
+        ("FK-HMD", 35, 1200),
+        ("IK-HSD", 175, 1200),
+        ("FK-HSD", 35, 1200),
+        ("FBF-HSD", 8, 812),
+    ] {
+        assert_eq!(m[name]["min"], clocks, "{name}: {m}");
+        assert_eq!(m[name]["max"], clocks, "{name}: {m}");
+        assert_eq!(m[name]["calls"], calls, "{name}: {m}");
+    }
+    assert_eq!(m["KFF-HMD"]["min"], 43);
+    assert_eq!(summary["hardware"]["faults"], 0);
+    let hybrid_summary =
+        std::fs::read_to_string(sb.path("hybrid").join("summary.json")).expect("summary");
+    assert!(
+        !hybrid_summary.contains("\"hardware\""),
+        "no hardware part without the RTL"
+    );
+}
