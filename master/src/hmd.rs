@@ -79,8 +79,8 @@ impl Master {
         source.check_six_dof(scenario)?;
         let geometry = scenario.device.geometry()?;
         let cordic = scenario.cordic.config()?;
-        let bad = |e: tactile_math::cordic::CordicError| ScenarioError::Invalid {
-            field: "cordic".into(),
+        let no_engine = |e: tactile_rtl::RtlError| ScenarioError::Invalid {
+            field: "arithmetic".into(),
             problem: e.to_string(),
         };
         let lengths = geometry.lengths();
@@ -104,9 +104,10 @@ impl Master {
             (device, home)
         });
         Ok(Master {
-            engine: Engine::new(scenario.arithmetic, geometry, cordic).map_err(bad)?,
+            engine: tactile_rtl::engine(scenario.arithmetic, geometry, cordic)
+                .map_err(no_engine)?,
             truth: Engine::new(tactile_math::arith::ArithKind::F64, geometry, cordic)
-                .map_err(bad)?,
+                .map_err(|e| no_engine(e.into()))?,
             source,
             t_s: scenario.t_s(),
             t_s_ns: scenario.t_s_ns(),
@@ -141,7 +142,10 @@ impl Master {
 
     /// Counters so far.
     pub fn counters(&self) -> MasterCounters {
-        self.counters
+        MasterCounters {
+            rtl: self.engine.hardware_clocks(),
+            ..self.counters
+        }
     }
 
     /// Sample n forward: operator a(n) -> MD encoders b(n) -> FK-HMD c(n).

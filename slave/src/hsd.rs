@@ -78,9 +78,9 @@ impl Slave {
             });
         }
         let geometry = scenario.device.geometry()?;
-        let engine = Engine::new(scenario.arithmetic, geometry, scenario.cordic.config()?)
+        let engine = tactile_rtl::engine(scenario.arithmetic, geometry, scenario.cordic.config()?)
             .map_err(|e| ScenarioError::Invalid {
-                field: "cordic".into(),
+                field: "arithmetic".into(),
                 problem: e.to_string(),
             })?;
         let truth = geometry.lengths();
@@ -121,7 +121,10 @@ impl Slave {
 
     /// Counters so far.
     pub fn counters(&self) -> SlaveCounters {
-        self.counters
+        SlaveCounters {
+            rtl: self.engine.hardware_clocks(),
+            ..self.counters
+        }
     }
 
     /// The device's joint state.

@@ -3,6 +3,7 @@
 
 use crate::device::DeviceCounters;
 use serde::{Deserialize, Serialize};
+use tactile_math::hardware::Clocks;
 use tactile_messages::samples::{stage, Signal};
 use tactile_messages::stream::{InboxStats, OutboxStats};
 
@@ -32,6 +33,8 @@ pub struct MasterCounters {
     pub loop_breaks: u64,
     /// Times answers came back after a break.
     pub resumes: u64,
+    /// `arithmetic = "rtl"`: the clocks FK-HMD and KFF-HMD spent (zero otherwise).
+    pub rtl: Clocks,
 }
 
 /// Sample n as it left the master.

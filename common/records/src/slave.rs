@@ -2,6 +2,7 @@
 //! report joins it with the master's and the emulator's records by sample number.
 
 use serde::{Deserialize, Serialize};
+use tactile_math::hardware::Clocks;
 use tactile_messages::samples::Signal;
 use tactile_messages::stream::{InboxStats, OutboxStats};
 
@@ -35,6 +36,9 @@ pub struct SlaveCounters {
     pub ik_damped: u64,
     /// Targets outside the arm's workspace box, clamped onto it.
     pub workspace_clamped: u64,
+    /// `arithmetic = "rtl"`: the clocks IK-HSD, FK-HSD and FBF-HSD spent (zero
+    /// otherwise).
+    pub rtl: Clocks,
 }
 
 /// One step on a received v(n).

@@ -199,6 +199,9 @@ pub struct Summary {
     pub emulator: Option<EmulatorTotals>,
     /// The slave's counters (summed over its segments).
     pub slave: Option<SlaveTotals>,
+    /// `arithmetic = "rtl"`: the clocks each module took, at a stated clock.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hardware: Option<crate::hardware::HardwareSummary>,
     /// Each node: where it ran, its memory, how its record ends.
     pub nodes: BTreeMap<&'static str, NodeSummary>,
     /// What happened: processes that died and were restarted, loop breaks, resumes.

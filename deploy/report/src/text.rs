@@ -19,6 +19,11 @@ pub fn render(s: &Summary, out: &Path) -> String {
     samples(&mut t, s);
     motion(&mut t, s);
     counters(&mut t, s);
+    if let Some(h) = &s.hardware {
+        for line in crate::hardware::lines(h, &s.stages_ns) {
+            let _ = writeln!(t, "{line}");
+        }
+    }
     devices(&mut t, s);
     nodes(&mut t, s);
     let files: Vec<&str> = REPORT_FILES

@@ -94,8 +94,10 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), Error> {
     write_file(path, &text)
 }
 
-/// Adds the counters of a later segment to `acc`: every number is summed, except the
-/// maxima (a key with `max` in its name), which take the larger value.
+/// Adds the counters of a later segment to `acc`: every number is summed, arrays
+/// element by element, except the maxima (a key with `max` in its name), which take
+/// the larger value, and the minima (`min`), the smaller one that is not zero (no
+/// sample).
 fn add_json(acc: &mut serde_json::Value, more: &serde_json::Value, key: &str) {
     use serde_json::Value;
     match (acc, more) {
@@ -106,9 +108,16 @@ fn add_json(acc: &mut serde_json::Value, more: &serde_json::Value, key: &str) {
                 }
             }
         }
+        (Value::Array(a), Value::Array(b)) => {
+            for (x, y) in a.iter_mut().zip(b) {
+                add_json(x, y, key);
+            }
+        }
         (x @ Value::Number(_), Value::Number(b)) => {
             let sum = if let (Some(p), Some(q)) = (x.as_u64(), b.as_u64()) {
-                if key.contains("max") {
+                if key == "min" {
+                    Value::from(if p == 0 || q == 0 { p.max(q) } else { p.min(q) })
+                } else if key.contains("max") {
                     Value::from(p.max(q))
                 } else {
                     Value::from(p.saturating_add(q))
@@ -267,6 +276,10 @@ fn summarise(
     let elapsed = master_totals.elapsed_ns;
     let lockstep = scenario.mode == tactile_scenario::Mode::Lockstep;
     let samples = a.round_trip_samples.percentiles();
+    let hardware = crate::hardware::summary(
+        &master_totals.counters.rtl,
+        &slave.as_ref().map(|s| s.counters.rtl).unwrap_or_default(),
+    );
     Summary {
         scenario: scenario.name.clone(),
         mode: scenario.mode,
@@ -312,6 +325,7 @@ fn summarise(
                 0.0
             },
         },
+        hardware,
         emulator,
         slave,
         nodes: nodes(logs),

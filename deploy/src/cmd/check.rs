@@ -19,7 +19,7 @@ pub struct CheckArgs {
 }
 
 /// Bytes per sample each file takes, measured on the million-sample lockstep run
-/// (`deploy/scenarios/lockstep-1e6.toml`, record format 11; docs/06 and docs/10; a
+/// (`deploy/scenarios/lockstep-1e6.toml`, record format 12; docs/06 and docs/10; a
 /// realtime run's master and slave records take a little more, up to 64 bytes).
 const PER_SAMPLE: [(&str, f64); 5] = [
     ("master.rec", 57.0),

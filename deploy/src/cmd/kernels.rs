@@ -59,7 +59,7 @@ fn push_float(out: &mut String, v: f64, kind: ArithKind) {
     // Writing into a String cannot fail.
     let _ = match kind {
         ArithKind::F64 => write!(out, "{v:?}"),
-        ArithKind::F32 | ArithKind::Hybrid => write!(out, "{:?}", v as f32),
+        ArithKind::F32 | ArithKind::Hybrid | ArithKind::Rtl => write!(out, "{:?}", v as f32),
     };
 }
 

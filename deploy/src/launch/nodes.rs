@@ -62,10 +62,16 @@ fn cargo_build(dir: &Path) -> Result<(), String> {
             "tactile-slave",
             "--bins",
         ])
-        // The node programs link Zenoh when the launcher does.
+        // The node programs link Zenoh, and simulate the RTL, when the launcher does.
         .args(
             cfg!(feature = "zenoh")
                 .then_some(["--features", "tactile/zenoh"])
+                .into_iter()
+                .flatten(),
+        )
+        .args(
+            cfg!(feature = "rtl")
+                .then_some(["--features", "tactile/rtl"])
                 .into_iter()
                 .flatten(),
         )

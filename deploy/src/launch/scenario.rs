@@ -61,6 +61,20 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
         };
         Error::BadInput(format!("{name}{with}: {}", msg.trim_end()))
     })?;
+    if scenario.arithmetic == tactile_math::arith::ArithKind::Rtl {
+        // Made once here so a build without the RTL, or with the RTL of another format
+        // or geometry, is refused before anything starts.
+        let cordic = scenario
+            .cordic
+            .config()
+            .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+        let geometry = scenario
+            .device
+            .geometry()
+            .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+        tactile_rtl::engine(scenario.arithmetic, geometry, cordic)
+            .map_err(|e| Error::BadInput(format!("{name}: arithmetic: {e}")))?;
+    }
     if tactile_runtime::outside::ros_in_run(&scenario) && !cfg!(feature = "zenoh") {
         return Err(Error::BadInput(format!(
             "{name}: {}",
