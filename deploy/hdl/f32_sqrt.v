@@ -29,7 +29,7 @@ localparam [31:0] QNAN = 32'h7FC00000;
 // nearest even; a carry out of the significand bumps e (kept for safety: it
 // cannot happen for a root). Returns {exponent, fraction}.
 // F32_MUTANT_ROUND (test only): truncate instead, to show the co-simulation fails.
-function [30:0] rnd_pack;
+function [30:0] rnd_root;
     input [7:0]  e;
     input [23:0] m;
     input        g;
@@ -41,20 +41,11 @@ function [30:0] rnd_pack;
 `else
         q = {1'b0, m} + {24'd0, g & (st | m[0])};
 `endif
-        rnd_pack = q[24] ? {e + 8'd1, 23'd0} : {e, q[22:0]};
+        rnd_root = q[24] ? {e + 8'd1, 23'd0} : {e, q[22:0]};
     end
 endfunction
 
-// Leading-zero count of a 24-bit word (24 when zero).
-function [4:0] lzc24;
-    input [23:0] x;
-    integer i;
-    begin
-        lzc24 = 5'd24;
-        for (i = 0; i < 24; i = i + 1)
-            if (x[i]) lzc24 = 5'd23 - i[4:0];
-    end
-endfunction
+`include "f32_round.vh"
 
 // ---------------------------------------------------------------- stage 1
 // a = m * 2^(e - 127 - 23) with m in [2^23, 2^24): a subnormal (field 0, scale
@@ -137,7 +128,7 @@ endgenerate
 wire [24:0] qf   = q_root[25*(NQ-1) +: 25];
 wire        qst  = |q_rem[26*(NQ-1) +: 26];
 wire [10:0] qsd  = q_side[11*(NQ-1) +: 11];
-wire [30:0] mag  = rnd_pack(qsd[7:0], qf[24:1], qf[0], qst);
+wire [30:0] mag  = rnd_root(qsd[7:0], qf[24:1], qf[0], qst);
 always @(posedge clk)
     r <= (qsd[10:9] == 2'd3) ? QNAN :
          (qsd[10:9] == 2'd2) ? 32'h7F800000 :

@@ -14,7 +14,7 @@ use tactile_math::kernels::IkConstants;
 
 /// The hand-written, parameterized RTL (deploy/hdl), carried in the binary so that
 /// `tactile hdl` works from any folder.
-pub const SOURCES: [(&str, &str); 23] = [
+pub const SOURCES: [(&str, &str); 25] = [
     ("tfb_fp.vh", include_str!("../../../deploy/hdl/tfb_fp.vh")),
     (
         "tfb_delay.v",
@@ -45,11 +45,19 @@ pub const SOURCES: [(&str, &str); 23] = [
     ("tb_tfb.v", include_str!("../../../deploy/hdl/tb_tfb.v")),
     ("f32_lat.vh", include_str!("../../../deploy/hdl/f32_lat.vh")),
     ("f32_fn.vh", include_str!("../../../deploy/hdl/f32_fn.vh")),
+    (
+        "f32_round.vh",
+        include_str!("../../../deploy/hdl/f32_round.vh"),
+    ),
     ("f32_add.v", include_str!("../../../deploy/hdl/f32_add.v")),
     ("f32_mul.v", include_str!("../../../deploy/hdl/f32_mul.v")),
     ("f32_div.v", include_str!("../../../deploy/hdl/f32_div.v")),
     ("f32_sqrt.v", include_str!("../../../deploy/hdl/f32_sqrt.v")),
     ("tb_f32.v", include_str!("../../../deploy/hdl/tb_f32.v")),
+    (
+        "kin_sincos3.v",
+        include_str!("../../../deploy/hdl/kin_sincos3.v"),
+    ),
     ("kin_fk.v", include_str!("../../../deploy/hdl/kin_fk.v")),
     ("kin_kff.v", include_str!("../../../deploy/hdl/kin_kff.v")),
     ("kin_fbf.v", include_str!("../../../deploy/hdl/kin_fbf.v")),
@@ -60,7 +68,7 @@ pub const SOURCES: [(&str, &str); 23] = [
 
 /// The modules of the hardware, in compile order: the TFB's, the f32 units, the
 /// paper's modules (the testbenches and the synthesis tops come on top of these).
-pub const MODULES: [&str; 15] = [
+pub const MODULES: [&str; 16] = [
     "tfb_delay.v",
     "tfb_stage.v",
     "tfb_sincos.v",
@@ -72,6 +80,7 @@ pub const MODULES: [&str; 15] = [
     "f32_mul.v",
     "f32_div.v",
     "f32_sqrt.v",
+    "kin_sincos3.v",
     "kin_fk.v",
     "kin_kff.v",
     "kin_fbf.v",
