@@ -57,33 +57,10 @@ module kin_kff (
 
     // ---- 0 .. SC: the three TFBs ----
     wire [31:0] s1, c1, s2, c2, s3, c3;
-    wire        r1, r2, r3;
-    tfb_sincos #(
-        .WORD(WORD), .FRAC(FRAC), .ITER(ITER), .NEAREST(NEAREST), .GUARD(GUARD),
-        .GAIN(GAIN), .PI_Q(PI_Q), .HALF_PI_Q(HALF_PI_Q), .ATAN(ATAN), .TWO_PI(TWO_PI),
-        .PI_UP(PI_UP), .THREE_PI_UP(THREE_PI_UP)
-    ) tfb1 (
-        .clk(clk), .in_valid(in_valid), .angle(t1), .out_valid(), .sin_out(s1),
-        .cos_out(c1), .range_err(r1), .dbg_code(), .dbg_folded(), .dbg_flip(),
-        .dbg_sin(), .dbg_cos()
-    );
-    tfb_sincos #(
-        .WORD(WORD), .FRAC(FRAC), .ITER(ITER), .NEAREST(NEAREST), .GUARD(GUARD),
-        .GAIN(GAIN), .PI_Q(PI_Q), .HALF_PI_Q(HALF_PI_Q), .ATAN(ATAN), .TWO_PI(TWO_PI),
-        .PI_UP(PI_UP), .THREE_PI_UP(THREE_PI_UP)
-    ) tfb2 (
-        .clk(clk), .in_valid(in_valid), .angle(t2), .out_valid(), .sin_out(s2),
-        .cos_out(c2), .range_err(r2), .dbg_code(), .dbg_folded(), .dbg_flip(),
-        .dbg_sin(), .dbg_cos()
-    );
-    tfb_sincos #(
-        .WORD(WORD), .FRAC(FRAC), .ITER(ITER), .NEAREST(NEAREST), .GUARD(GUARD),
-        .GAIN(GAIN), .PI_Q(PI_Q), .HALF_PI_Q(HALF_PI_Q), .ATAN(ATAN), .TWO_PI(TWO_PI),
-        .PI_UP(PI_UP), .THREE_PI_UP(THREE_PI_UP)
-    ) tfb3 (
-        .clk(clk), .in_valid(in_valid), .angle(t3), .out_valid(), .sin_out(s3),
-        .cos_out(c3), .range_err(r3), .dbg_code(), .dbg_folded(), .dbg_flip(),
-        .dbg_sin(), .dbg_cos()
+    wire        rng;
+    kin_sincos3 sc (
+        .clk(clk), .in_valid(in_valid), .t1(t1), .t2(t2), .t3(t3), .s1(s1), .c1(c1),
+        .s2(s2), .c2(c2), .s3(s3), .c3(c3), .range_err(rng)
     );
 
     // ---- SC .. SC+MUL: the products of a constant ----
@@ -160,7 +137,7 @@ module kin_kff (
 `endif
 
     // ---- line up the flags and taps ----
-    tfb_delay #(.W(1), .N(LATENCY - SC)) d_err (.clk(clk), .d(r1 | r2 | r3), .q(err));
+    tfb_delay #(.W(1), .N(LATENCY - SC)) d_err (.clk(clk), .d(rng), .q(err));
     tfb_delay #(.W(192), .N(LATENCY - SC)) d_dbg_t (
         .clk(clk), .d({s1, c1, s2, c2, s3, c3}), .q(dbg[32*15-1 : 32*9]));
     tfb_delay #(.W(288), .N(LATENCY - JT)) d_dbg_j (
