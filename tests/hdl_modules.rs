@@ -53,6 +53,32 @@ fn the_modules_match_the_model_bit_for_bit_in_three_formats() {
 }
 
 #[test]
+fn a_unit_that_truncates_is_caught() {
+    if !have("iverilog") {
+        return cannot("iverilog is not installed");
+    }
+    let sb = Sandbox::new("hdl-unit-mutant");
+    // F32_MUTANT_ROUND: every unit truncates where it must round to nearest even.
+    for unit in ["add", "mul", "div", "sqrt"] {
+        let args = [
+            "--function",
+            unit,
+            "--count",
+            "2000",
+            "--define",
+            "F32_MUTANT_ROUND",
+        ];
+        let (ok, r, text) = cosim(&sb, &args);
+        assert!(!ok, "{unit} passed truncating:\n{text}");
+        let (_, vectors, mismatches) = r[0];
+        assert!(
+            mismatches > vectors / 10,
+            "{unit}: only {mismatches} of {vectors}"
+        );
+    }
+}
+
+#[test]
 fn a_wrong_module_is_caught_by_the_same_test() {
     if !have("iverilog") {
         return cannot("iverilog is not installed");
