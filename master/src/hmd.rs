@@ -80,7 +80,7 @@ impl Master {
         let geometry = scenario.device.geometry()?;
         let cordic = scenario.cordic.config()?;
         let no_engine = |e: tactile_rtl::RtlError| ScenarioError::Invalid {
-            field: "arithmetic".into(),
+            field: e.field().into(),
             problem: e.to_string(),
         };
         let lengths = geometry.lengths();

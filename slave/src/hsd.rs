@@ -80,7 +80,7 @@ impl Slave {
         let geometry = scenario.device.geometry()?;
         let engine = tactile_rtl::engine(scenario.arithmetic, geometry, scenario.cordic.config()?)
             .map_err(|e| ScenarioError::Invalid {
-                field: "arithmetic".into(),
+                field: e.field().into(),
                 problem: e.to_string(),
             })?;
         let truth = geometry.lengths();

@@ -31,8 +31,33 @@ pub enum RtlError {
     Mismatch(String),
 }
 
+impl RtlError {
+    /// The scenario field the error is about: the format (`cordic`) or the choice of
+    /// arithmetic.
+    pub fn field(&self) -> &'static str {
+        match self {
+            RtlError::Engine(EngineError::Cordic(_)) => "cordic",
+            _ => "arithmetic",
+        }
+    }
+}
+
 /// True when this build simulates the RTL (`arithmetic = "rtl"` works).
 pub const AVAILABLE: bool = cfg!(feature = "verilator");
+
+/// Whether this build can run `arithmetic = "rtl"` for `cordic` and `geometry`, without
+/// making the simulator: what a launcher asks before it starts anything.
+pub fn check(cordic: CordicConfig, geometry: Geometry) -> Result<(), RtlError> {
+    #[cfg(feature = "verilator")]
+    {
+        sim::check_built_for(&cordic, &geometry)
+    }
+    #[cfg(not(feature = "verilator"))]
+    {
+        let _ = (cordic, geometry);
+        Err(RtlError::Engine(EngineError::NoHardware))
+    }
+}
 
 /// The engine for `kind`: software, or for [`ArithKind::Rtl`] the modules simulated
 /// by Verilator (refused by a build without the feature, or built for another format

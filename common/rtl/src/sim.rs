@@ -50,25 +50,31 @@ fn floats<const N: usize>(v: [u32; N]) -> [f32; N] {
     v.map(f32::from_bits)
 }
 
+/// Whether the simulated RTL was built for `cordic` and `geometry`: the parameter files
+/// are generated again and must equal the built ones.
+pub(crate) fn check_built_for(cordic: &CordicConfig, geometry: &Geometry) -> Result<(), RtlError> {
+    let model = Cordic::new(*cordic).map_err(tactile_math::engine::EngineError::from)?;
+    if params_vh(&model.rtl_constants()) != BUILT_FOR.0 {
+        return Err(RtlError::Mismatch(format!(
+            "the RTL in this build is for another fixed-point format than [s{}.{}] {:?} \
+             (rebuild with TACTILE_RTL_WORD, TACTILE_RTL_FRAC and TACTILE_RTL_ROUNDING set)",
+            cordic.word, cordic.frac, cordic.rounding
+        )));
+    }
+    if kin_params_vh(geometry) != BUILT_FOR.1 {
+        return Err(RtlError::Mismatch(
+            "the RTL in this build is for another device geometry \
+             (rebuild with TACTILE_RTL_DEVICE=paper or omni)"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
 impl Rtl {
-    /// The chip, if it was built for `cordic` and `geometry`: the parameter files are
-    /// generated again for the run and must equal the built ones.
+    /// The chip, if it was built for `cordic` and `geometry` ([`check_built_for`]).
     pub fn new(cordic: &CordicConfig, geometry: &Geometry) -> Result<Rtl, RtlError> {
-        let model = Cordic::new(*cordic).map_err(tactile_math::engine::EngineError::from)?;
-        if params_vh(&model.rtl_constants()) != BUILT_FOR.0 {
-            return Err(RtlError::Mismatch(format!(
-                "the RTL in this build is for another fixed-point format than [s{}.{}] {:?} \
-                 (rebuild with TACTILE_RTL_WORD, TACTILE_RTL_FRAC and TACTILE_RTL_ROUNDING set)",
-                cordic.word, cordic.frac, cordic.rounding
-            )));
-        }
-        if kin_params_vh(geometry) != BUILT_FOR.1 {
-            return Err(RtlError::Mismatch(
-                "the RTL in this build is for another device geometry \
-                 (rebuild with TACTILE_RTL_DEVICE=paper or omni)"
-                    .into(),
-            ));
-        }
+        check_built_for(cordic, geometry)?;
         // SAFETY: tactile_rtl_new allocates and returns a chip, never null (new throws).
         let chip = NonNull::new(unsafe { tactile_rtl_new() })
             .ok_or_else(|| RtlError::Mismatch("the simulator could not be created".into()))?;

@@ -62,8 +62,8 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
         Error::BadInput(format!("{name}{with}: {}", msg.trim_end()))
     })?;
     if scenario.arithmetic == tactile_math::arith::ArithKind::Rtl {
-        // Made once here so a build without the RTL, or with the RTL of another format
-        // or geometry, is refused before anything starts.
+        // A build without the RTL, or with the RTL of another format or geometry, is
+        // refused before anything starts.
         let cordic = scenario
             .cordic
             .config()
@@ -72,8 +72,8 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
             .device
             .geometry()
             .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
-        tactile_rtl::engine(scenario.arithmetic, geometry, cordic)
-            .map_err(|e| Error::BadInput(format!("{name}: arithmetic: {e}")))?;
+        tactile_rtl::check(cordic, geometry)
+            .map_err(|e| Error::BadInput(format!("{name}: {}: {e}", e.field())))?;
     }
     if tactile_runtime::outside::ros_in_run(&scenario) && !cfg!(feature = "zenoh") {
         return Err(Error::BadInput(format!(

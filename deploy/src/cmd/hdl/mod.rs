@@ -228,7 +228,10 @@ pub fn main(args: &HdlArgs) -> Result<(), Error> {
         HdlCommand::Rtl { out, datapath } => {
             let (_, k) = model(datapath.cordic()?)?;
             write_rtl(out, &k, &datapath.geometry()?)?;
-            crate::outln!("wrote the TFB's RTL for this format into {}", out.display());
+            crate::outln!(
+                "wrote the RTL (TFB, f32 units, modules) for this format and geometry into {}",
+                out.display()
+            );
             Ok(())
         }
         HdlCommand::Vectors {
