@@ -3,14 +3,15 @@
 //!
 //! Each sample is one row: its bincode encoding with fixed-width integers, so a field
 //! sits at the same byte offset in every row of the same shape (the same variant, the
-//! same options present), and rows are grouped by length. Within a group each row is
-//! XORed with the one before it (a value that did not change becomes zeros, a slowly
-//! changing one keeps only its low bytes) and the group is transposed into byte planes:
-//! plane `j` holds byte `j` of every row, so an exponent, a flag or a counter's high
-//! bytes sit together. Planes of zeros are left out (a bitmap says which), and zstd
-//! entropy-codes the rest. Every step is exact: the rows come back byte for byte.
+//! same options present), and rows are grouped by length. A group's first row is kept
+//! as it is; every later row is XORed with the one before it (a value that did not
+//! change becomes zeros, a slowly changing one keeps only its low bytes) and those
+//! deltas are transposed into byte planes: plane `j` holds byte `j` of every later row,
+//! so an exponent, a flag or a counter's high bytes sit together. Planes of zeros (a
+//! byte that stays as the first row has it) are left out, a bitmap says which, and
+//! zstd codes the rest. Every step is exact: the rows come back byte for byte.
 //!
-//! A block is self-contained (its first row is XORed with zeros), so damage to one
+//! A block is self-contained (each group starts from its first row), so damage to one
 //! block costs that block alone.
 
 use thiserror::Error;
@@ -67,35 +68,30 @@ fn groups(lens: &[usize]) -> Vec<(usize, Vec<usize>)> {
     out
 }
 
-/// Lays out `rows` (concatenated, `lens` long each) as XORed, transposed byte planes
-/// with zero planes left out: the bytes zstd then compresses. `scratch` is reused.
+/// Lays out `rows` (concatenated, `lens` long each) per group as its first row, then
+/// the later rows' XOR deltas as transposed byte planes with zero planes left out: the
+/// bytes zstd then compresses. `scratch` is reused.
 pub fn to_planes(rows: &[u8], lens: &[usize], out: &mut Vec<u8>, scratch: &mut Vec<u8>) {
     put_varint(out, lens.len() as u64);
     for &l in lens {
         put_varint(out, l as u64);
     }
     for (len, starts) in groups(lens) {
-        // Row-major XOR deltas first (the compiler vectorises these loops), then the
-        // planes that are not all zero gathered from them.
-        let r = starts.len();
+        out.extend_from_slice(&rows[starts[0]..starts[0] + len]);
+        // Row-major XOR deltas of the later rows first (the compiler vectorises these
+        // loops), then the planes that are not all zero gathered from them.
+        let r = starts.len() - 1;
         scratch.clear();
         scratch.resize(r * len + len, 0);
         let (deltas, any) = scratch.split_at_mut(r * len);
-        let mut prev: Option<&[u8]> = None;
-        for (d, &s) in deltas.chunks_exact_mut(len.max(1)).zip(&starts) {
-            let row = &rows[s..s + len];
-            match prev {
-                None => d.copy_from_slice(row),
-                Some(p) => {
-                    for ((d, a), b) in d.iter_mut().zip(row).zip(p) {
-                        *d = a ^ b;
-                    }
-                }
+        for (d, pair) in deltas.chunks_exact_mut(len.max(1)).zip(starts.windows(2)) {
+            let (prev, row) = (&rows[pair[0]..pair[0] + len], &rows[pair[1]..pair[1] + len]);
+            for ((d, a), b) in d.iter_mut().zip(row).zip(prev) {
+                *d = a ^ b;
             }
             for (o, x) in any.iter_mut().zip(d.iter()) {
                 *o |= x;
             }
-            prev = Some(row);
         }
         let bitmap_at = out.len();
         out.resize(bitmap_at + len.div_ceil(8), 0);
@@ -134,20 +130,29 @@ pub fn from_planes(b: &[u8], rows: u32) -> Result<(Vec<u8>, Vec<usize>), BlockEr
     }
     let mut out = vec![0u8; total];
     for (len, starts) in groups(&lens) {
+        let first = b
+            .get(at..at + len)
+            .ok_or(BlockError("cut inside a first row"))?;
+        at += len;
+        // Every row starts as the first; the planes then say where later rows differ.
+        for &s in &starts {
+            out[s..s + len].copy_from_slice(first);
+        }
         let bitmap = b
             .get(at..at + len.div_ceil(8))
             .ok_or(BlockError("cut inside a bitmap"))?;
         at += bitmap.len();
-        for j in 0..len {
+        let later = &starts[1..];
+        for (j, &first_byte) in first.iter().enumerate() {
             if bitmap[j / 8] & (1 << (j % 8)) == 0 {
                 continue;
             }
             let plane = b
-                .get(at..at + starts.len())
+                .get(at..at + later.len())
                 .ok_or(BlockError("cut inside a plane"))?;
             at += plane.len();
-            let mut prev = 0u8;
-            for (&s, &x) in starts.iter().zip(plane) {
+            let mut prev = first_byte;
+            for (&s, &x) in later.iter().zip(plane) {
                 prev ^= x;
                 out[s + j] = prev;
             }
@@ -248,15 +253,9 @@ mod tests {
         }
         let mut planes = Vec::new();
         to_planes(&flat, &[16; 50], &mut planes, &mut Vec::new());
-        // count and lengths (51), bitmap (2), the counter's low plane and the first
-        // row's constant (a plane per nonzero byte of 1234.5).
-        let nonzero = 1234.5f64
-            .to_bits()
-            .to_le_bytes()
-            .iter()
-            .filter(|b| **b != 0)
-            .count();
-        assert_eq!(planes.len(), 51 + 2 + 50 * (1 + nonzero));
+        // count and lengths (51), the first row (16), bitmap (2) and the counter's low
+        // plane over the 49 later rows: the constant costs its first row alone.
+        assert_eq!(planes.len(), 51 + 16 + 2 + 49);
     }
 
     #[test]
