@@ -13,8 +13,18 @@ fn samples() -> Vec<MasterSample> {
     let mut out = Vec::new();
     for n in 0..50u64 {
         let t = n as f64 * 1e-3;
-        let at = |k: f64| [0.05 * (t + k).sin(), 0.04 * (2.0 * t + k).cos(), -0.1 + 0.01 * t];
-        let mut answer = Answer { n, round_trip_ns: 41_000 + n % 7, ..Answer::default() };
+        let at = |k: f64| {
+            [
+                0.05 * (t + k).sin(),
+                0.04 * (2.0 * t + k).cos(),
+                -0.1 + 0.01 * t,
+            ]
+        };
+        let mut answer = Answer {
+            n,
+            round_trip_ns: 41_000 + n % 7,
+            ..Answer::default()
+        };
         answer.q.value = at(0.3);
         answer.q.origin_seq = [n; 3];
         answer.q.origin_ns = [1_000_000 * n; 3];
@@ -35,13 +45,15 @@ fn samples() -> Vec<MasterSample> {
     out
 }
 
-/// Encodes samples into rows as the writer does: concatenated, with their lengths.
+/// Encodes samples into rows as the writer does: each into a scratch buffer, then
+/// onto the rows, with their lengths.
 fn encode(samples: &[MasterSample], rows: &mut Vec<u8>, lens: &mut Vec<usize>) {
     let config = bincode::config::standard().with_fixed_int_encoding();
+    let mut scratch = [0u8; 1024];
     for s in samples {
-        let before = rows.len();
-        bincode::serde::encode_into_std_write(s, &mut *rows, config).expect("encode");
-        lens.push(rows.len() - before);
+        let n = bincode::serde::encode_into_slice(s, &mut scratch, config).expect("encode");
+        rows.extend_from_slice(&scratch[..n]);
+        lens.push(n);
     }
 }
 
@@ -70,8 +82,7 @@ fn blocks(c: &mut Criterion) {
     g.bench_function("pack", |b| {
         b.iter(|| block::pack(&mut z, black_box(&rows), &lens, &mut planes, &mut scratch))
     });
-    let (raw, packed) =
-        block::pack(&mut z, &rows, &lens, &mut planes, &mut scratch).expect("pack");
+    let (raw, packed) = block::pack(&mut z, &rows, &lens, &mut planes, &mut scratch).expect("pack");
     let mut d = zstd::bulk::Decompressor::new().expect("zstd");
     g.bench_function("unpack", |b| {
         b.iter(|| block::unpack(&mut d, lens.len() as u32, raw, black_box(&packed)))
