@@ -5,8 +5,8 @@
 //! `cargo bench -p tactile-records --bench blocks`
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
-use tactile_records::block;
 use tactile_records::master::{Answer, MasterSample, Sent};
+use tactile_records::{block, file};
 
 /// The samples of one block.
 fn samples() -> Vec<MasterSample> {
@@ -45,15 +45,13 @@ fn samples() -> Vec<MasterSample> {
     out
 }
 
-/// Encodes samples into rows as the writer does: each into a scratch buffer, then
-/// onto the rows, with their lengths.
+/// Encodes samples into rows as the writer does: concatenated, with their lengths.
 fn encode(samples: &[MasterSample], rows: &mut Vec<u8>, lens: &mut Vec<usize>) {
-    let config = bincode::config::standard().with_fixed_int_encoding();
-    let mut scratch = [0u8; 1024];
+    let mut row = file::RowEncoder::default();
     for s in samples {
-        let n = bincode::serde::encode_into_slice(s, &mut scratch, config).expect("encode");
-        rows.extend_from_slice(&scratch[..n]);
-        lens.push(n);
+        let before = rows.len();
+        row.append(s, rows).expect("encode");
+        lens.push(rows.len() - before);
     }
 }
 

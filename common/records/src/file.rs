@@ -26,6 +26,45 @@ pub const BLOCK_NS: u64 = 50_000_000;
 /// seven-joint arm takes.
 const ROW: usize = 1024;
 
+/// Encodes samples into a block's rows.
+pub struct RowEncoder {
+    row: Box<[u8; ROW]>,
+}
+
+impl Default for RowEncoder {
+    fn default() -> Self {
+        RowEncoder {
+            row: Box::new([0; ROW]),
+        }
+    }
+}
+
+impl RowEncoder {
+    /// Appends `sample`'s row to `rows`; on an error `rows` is as it was (a
+    /// half-encoded row would shift every later one). The row is encoded into a slice
+    /// first and then copied: half the time of encoding through `io::Write` (the block
+    /// bench); a row longer than the slice (a long arm's joints) takes that way.
+    pub fn append<S: Serialize>(
+        &mut self,
+        sample: &S,
+        rows: &mut Vec<u8>,
+    ) -> Result<(), bincode::error::EncodeError> {
+        match bincode::serde::encode_into_slice(sample, &mut self.row[..], row_config()) {
+            Ok(n) => {
+                rows.extend_from_slice(&self.row[..n]);
+                Ok(())
+            }
+            Err(bincode::error::EncodeError::UnexpectedEnd) => {
+                let before = rows.len();
+                bincode::serde::encode_into_std_write(sample, &mut *rows, row_config())
+                    .map(|_| ())
+                    .inspect_err(|_| rows.truncate(before))
+            }
+            Err(e) => Err(e),
+        }
+    }
+}
+
 /// Samples of a block are encoded with fixed-width integers, so each field sits at
 /// the same offset in rows of one shape ([`crate::block`]); with the frames' limit.
 fn row_config() -> impl bincode::config::Config {
@@ -41,8 +80,8 @@ pub struct RecordWriter<T> {
     buf: Vec<u8>,
     /// The block in hand: its rows, concatenated, and their lengths.
     rows: Vec<u8>,
-    /// Where a row is encoded before it joins them.
-    row: Box<[u8; ROW]>,
+    /// Encodes each row before it joins them.
+    row: RowEncoder,
     lens: Vec<usize>,
     started_ns: u64,
     block_rows: usize,
@@ -143,7 +182,7 @@ impl<S: Serialize, C: Serialize> RecordWriter<Record<S, C>> {
             file: open_for_writing(path, append)?,
             buf: Vec::with_capacity(512),
             rows: Vec::new(),
-            row: Box::new([0; ROW]),
+            row: RowEncoder::default(),
             lens: Vec::new(),
             started_ns: 0,
             block_rows: 1,
@@ -170,25 +209,9 @@ impl<S: Serialize, C: Serialize> RecordWriter<Record<S, C>> {
     /// Adds one sample to the block in hand, written when full or 50 ms old.
     pub fn write_sample(&mut self, sample: &S) -> std::io::Result<()> {
         let before = self.rows.len();
-        // Into a slice first: half the time of encoding through `io::Write` (the block
-        // bench); a row longer than the slice (a long arm's joints) takes that way.
-        let encoded =
-            match bincode::serde::encode_into_slice(sample, &mut self.row[..], row_config()) {
-                Ok(n) => {
-                    self.rows.extend_from_slice(&self.row[..n]);
-                    Ok(())
-                }
-                Err(bincode::error::EncodeError::UnexpectedEnd) => {
-                    bincode::serde::encode_into_std_write(sample, &mut self.rows, row_config())
-                        .map(|_| ())
-                }
-                Err(e) => Err(e),
-            };
-        if let Err(e) = encoded {
-            // The rows in hand stay whole: a half-encoded row would shift every later one.
-            self.rows.truncate(before);
-            return Err(std::io::Error::other(e));
-        }
+        self.row
+            .append(sample, &mut self.rows)
+            .map_err(std::io::Error::other)?;
         self.lens.push(self.rows.len() - before);
         let n = self.lens.len();
         if n == 1 {
