@@ -27,6 +27,7 @@ pub const BLOCK_NS: u64 = 50_000_000;
 const ROW: usize = 1024;
 
 /// Encodes samples into a block's rows.
+#[derive(Debug)]
 pub struct RowEncoder {
     row: Box<[u8; ROW]>,
 }
