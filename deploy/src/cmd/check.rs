@@ -20,7 +20,7 @@ pub struct CheckArgs {
 
 /// Bytes per sample each file takes, measured on the million-sample lockstep run
 /// (`deploy/scenarios/lockstep-1e6.toml`, record format 13; docs/06 and docs/10; a
-/// realtime run's master and slave records take a little more, up to 64 bytes).
+/// realtime run's records differ a little, their stamps being real).
 const PER_SAMPLE: [(&str, f64); 5] = [
     ("master.rec", 58.0),
     ("emulator.rec", 37.0),
