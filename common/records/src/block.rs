@@ -24,9 +24,11 @@ pub struct BlockError(&'static str);
 /// Largest unpacked block a reader accepts (a whole frame's rows can claim no more).
 pub const MAX_RAW: usize = 64 << 20;
 
-/// Most rows a block may hold: far above any writer's (2 rows a sample for 50 ms at
-/// 10 MHz), so a crafted block cannot make a reader allocate or loop for long.
-pub const MAX_ROWS: usize = 1 << 20;
+/// Most rows a block may hold: 16 times a writer's at the highest rate a scenario
+/// allows (2 rows a sample for 50 ms at 10 kHz), and writers hold no more at any rate
+/// ([`crate::recorder::block_rows`]). A reader holds a block's samples at once: a
+/// crafted block cannot make it hold more than this many.
+pub const MAX_ROWS: usize = 1 << 14;
 
 /// Appends `v` as a LEB128 varint.
 fn put_varint(out: &mut Vec<u8>, mut v: u64) {
@@ -316,6 +318,13 @@ mod tests {
         assert_eq!(
             from_planes(&b, 3),
             Err(BlockError("not the rows its entry says"))
+        );
+        let mut b = Vec::new();
+        put_varint(&mut b, MAX_ROWS as u64 + 1);
+        b.resize(2 * MAX_ROWS + 8, 0);
+        assert_eq!(
+            from_planes(&b, MAX_ROWS as u32 + 1),
+            Err(BlockError("more rows than a block may hold"))
         );
     }
 }

@@ -104,9 +104,10 @@ impl<T> std::fmt::Debug for RecordWriter<T> {
 }
 
 impl<T> RecordWriter<T> {
-    /// Rows a block holds at most (a node's rows for 50 ms of its samples).
+    /// Rows a block holds at most (a node's rows for 50 ms of its samples; never more
+    /// than a reader accepts).
     pub fn set_block_rows(&mut self, rows: usize) {
-        self.block_rows = rows.max(1);
+        self.block_rows = rows.clamp(1, block::MAX_ROWS);
     }
 
     /// Writes the block in hand, if any (one frame, one system call).

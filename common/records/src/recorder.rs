@@ -58,7 +58,7 @@ pub fn block_rows(role: Role, rate_hz: f64) -> usize {
     } else {
         1
     };
-    samples * per_sample
+    (samples * per_sample).min(crate::block::MAX_ROWS)
 }
 
 /// Counters are written this often, ns.
@@ -212,6 +212,16 @@ mod tests {
         r.sample(run)?;
         r.stop(0, 0, "failed")?;
         joined
+    }
+
+    #[test]
+    fn blocks_hold_50_ms_and_never_more_than_a_reader_accepts() {
+        assert_eq!(block_rows(Role::Master, 1000.0), 100);
+        assert_eq!(block_rows(Role::Slave, 1000.0), 50);
+        assert_eq!(block_rows(Role::Emulator, 10_000.0), 1000);
+        assert_eq!(block_rows(Role::Slave, 1.0), 1);
+        assert_eq!(block_rows(Role::Master, 1e9), crate::block::MAX_ROWS);
+        assert_eq!(block_rows(Role::Master, f64::NAN), 2);
     }
 
     #[test]
