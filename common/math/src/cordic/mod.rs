@@ -199,7 +199,8 @@ impl Default for CordicConfig {
     }
 }
 
-/// The TFB with all constants and error bounds precomputed (about 0.9 KB, no heap).
+/// The TFB with all constants and error bounds precomputed (about 0.9 KB), and for
+/// short fractions the rotation's outputs tabled at the first sine ([`table`]).
 #[derive(Debug, Clone)]
 pub struct Cordic {
     cfg: CordicConfig,
@@ -228,6 +229,9 @@ pub struct Cordic {
     xy_out: f32,
     angle_out: f32,
     bounds: [f64; 3],
+    /// The rotation's outputs by folded angle, made at the first sine (short
+    /// fractions only: [`table`]).
+    table: std::sync::OnceLock<Option<table::Table>>,
 }
 
 impl Cordic {
@@ -261,6 +265,7 @@ impl Cordic {
             xy_out: pow2(-frac - 1) as f32,
             angle_out: pow2(-frac) as f32,
             bounds: [0.0; 3],
+            table: std::sync::OnceLock::new(),
         };
         c.bounds = c.derive_bounds();
         Ok(c)
@@ -287,8 +292,21 @@ impl Cordic {
             return self.sin_cos_cold(angle);
         }
         let (z, flip) = self.fold(i64::from(floor_code(self.angle_prefloor(a))));
-        let (s, c) = self.rotate(z, flip);
+        let (s, c) = self.rotated(z, flip);
         (s as f32 * self.xy_out, c as f32 * self.xy_out)
+    }
+
+    /// [`Self::rotate`]'s codes, from the table where there is one.
+    #[inline(always)]
+    fn rotated(&self, z: i64, flip: i64) -> (i64, i64) {
+        match self.table().and_then(|t| t.get(z, flip)) {
+            Some(sc) => sc,
+            None => self.rotate(z, flip),
+        }
+    }
+
+    fn table(&self) -> Option<&table::Table> {
+        self.table.get_or_init(|| table::Table::of(self)).as_ref()
     }
 
     /// [`Self::sin_cos`] of three angles, bit-identical per angle, with the three
@@ -306,7 +324,17 @@ impl Cordic {
                 self.angle_prefloor(f64::from(angles[k])),
             )));
         }
-        let (s, c) = self.rotate3(z, flip);
+        let (s, c) = match self.table() {
+            Some(t) => match (
+                t.get(z[0], flip[0]),
+                t.get(z[1], flip[1]),
+                t.get(z[2], flip[2]),
+            ) {
+                (Some(a), Some(b), Some(c)) => ([a.0, b.0, c.0], [a.1, b.1, c.1]),
+                _ => self.rotate3(z, flip),
+            },
+            None => self.rotate3(z, flip),
+        };
         (
             s.map(|v| v as f32 * self.xy_out),
             c.map(|v| v as f32 * self.xy_out),
@@ -455,6 +483,7 @@ mod batch;
 mod bounds;
 mod datapath;
 pub mod hdl;
+mod table;
 
 /// Whether `angle` takes the fast range reduction (false for NaN and infinities).
 #[inline(always)]
