@@ -19,7 +19,7 @@ use crate::{Jitter, Replay};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use std::collections::BTreeMap;
+use std::collections::VecDeque;
 use tactile_scenario::ChannelConfig;
 
 /// One signal value with its provenance.
@@ -74,12 +74,15 @@ struct Slot {
 /// came with, however late.
 pub type Rest = ([f64; 4], u32);
 
-/// One signal's packets in flight: arrival sample -> newest sequence arriving then;
-/// and the newest arrived, with its value copied when it arrives (its slot in the ring
-/// may be reused by a later packet while the receiver still holds it).
+/// One signal's packets in flight: `(arrival sample, newest sequence arriving then)`
+/// in order of arrival, one entry an arrival sample; and the newest arrived, with its
+/// value copied when it arrives (its slot in the ring may be reused by a later packet
+/// while the receiver still holds it). A queue rather than a map: packets mostly
+/// arrive in the order they were sent, so an entry joins at the back and leaves at
+/// the front, where a map would rebalance its nodes twice a packet.
 #[derive(Debug, Clone, Default)]
 struct InFlight {
-    arriving: BTreeMap<u64, u64>,
+    arriving: VecDeque<(u64, u64)>,
     newest: Option<(u64, Value, Rest)>,
     last_arrival: u64,
     last_emitted: Option<u64>,
@@ -88,8 +91,11 @@ struct InFlight {
 impl InFlight {
     /// Packet `seq` arrives at `at`.
     fn send(&mut self, seq: u64, at: u64) {
-        let e = self.arriving.entry(at).or_insert(seq);
-        *e = (*e).max(seq);
+        let i = self.arriving.partition_point(|&(a, _)| a < at);
+        match self.arriving.get_mut(i) {
+            Some((a, s)) if *a == at => *s = (*s).max(seq),
+            _ => self.arriving.insert(i, (at, seq)),
+        }
         self.last_arrival = self.last_arrival.max(at);
     }
 
@@ -98,11 +104,11 @@ impl InFlight {
     /// slot still holds it then).
     fn receive(&mut self, now: u64, ring: &[Option<Slot>], i: usize) -> Option<(u64, Value, Rest)> {
         let len = ring.len() as u64;
-        while let Some((&at, &seq)) = self.arriving.first_key_value() {
+        while let Some(&(at, seq)) = self.arriving.front() {
             if at > now {
                 break;
             }
-            self.arriving.remove(&at);
+            self.arriving.pop_front();
             if self.newest.is_none_or(|(n, ..)| seq > n) {
                 if let Some(s) = ring[(seq % len) as usize].filter(|s| s.seq == seq) {
                     self.newest = Some((seq, s.values[i], s.extra));
@@ -397,6 +403,32 @@ struct Packet {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Packets in flight are held as the map from arrival sample to the newest
+        /// sequence arriving then that they replace would hold them, sent and received
+        /// in any order.
+        #[test]
+        fn in_flight_is_the_map_it_replaces(
+            steps in proptest::collection::vec((0u64..40, 0u64..12, any::<bool>()), 0..200),
+        ) {
+            let (mut f, mut map) = (InFlight::default(), std::collections::BTreeMap::new());
+            let ring = vec![None; 64];
+            for (now, (seq, ahead, receive)) in steps.into_iter().enumerate() {
+                let now = now as u64;
+                f.send(seq, now + ahead);
+                let e = map.entry(now + ahead).or_insert(seq);
+                *e = (*e).max(seq);
+                if receive {
+                    f.receive(now, &ring, 0);
+                    map.retain(|&at, _| at > now);
+                }
+                let held: Vec<(u64, u64)> = f.arriving.iter().copied().collect();
+                prop_assert_eq!(held, map.iter().map(|(&a, &s)| (a, s)).collect::<Vec<_>>());
+            }
+        }
+    }
 
     fn vals(n: u64) -> [Value; 3] {
         [0, 1, 2].map(|i| Value {
