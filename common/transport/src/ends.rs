@@ -40,6 +40,12 @@ pub trait Subscribe<T> {
     /// A sample if one waits, counted (with any lost before it); what is not a whole
     /// sample of this run's format is counted and passed over.
     fn try_recv(&mut self) -> Result<Option<T>, LinkError>;
+    /// False when nothing can be waiting (a queue in memory that is empty), so a poll
+    /// skips [`Self::try_recv`]: in one process the loop polls its empty inputs ten
+    /// times a sample, and each miss would still copy a whole sample's slot.
+    fn may_have(&self) -> bool {
+        true
+    }
     /// What it counted.
     fn stats(&self) -> InboxStats;
 }

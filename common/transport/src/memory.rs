@@ -66,6 +66,10 @@ impl<T: Sequenced> Subscribe<T> for MemorySubscriber<T> {
         Ok(got)
     }
 
+    fn may_have(&self) -> bool {
+        !self.queue.borrow().is_empty()
+    }
+
     fn stats(&self) -> InboxStats {
         self.stats
     }

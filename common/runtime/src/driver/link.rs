@@ -94,12 +94,12 @@ impl Link {
 
     /// A sample if one waits, backward first.
     pub fn poll(&mut self) -> Result<Option<Arrival>, LinkError> {
-        if let Some(b) = &mut self.ports.backward_in {
+        if let Some(b) = self.ports.backward_in.as_mut().filter(|b| b.may_have()) {
             if let Some(h) = b.try_recv()? {
                 return Ok(Some(Arrival::Backward(h)));
             }
         }
-        match &mut self.ports.forward_in {
+        match self.ports.forward_in.as_mut().filter(|f| f.may_have()) {
             Some(f) => Ok(f.try_recv()?.map(Arrival::Forward)),
             None => Ok(None),
         }
