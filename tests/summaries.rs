@@ -120,7 +120,7 @@ fn check_prints_the_scenario_as_it_would_run_and_what_it_writes() {
         "{said}"
     );
     assert!(
-        said.contains("master.rec 232 kB") && said.contains("trace.csv 4.5 MB"),
+        said.contains("master.rec 244 kB") && said.contains("trace.csv 4.5 MB"),
         "{said}"
     );
     assert!(!said.contains("warning"), "{said}");

@@ -76,14 +76,30 @@ fn blocks(c: &mut Criterion) {
             block::to_planes(black_box(&rows), &lens, &mut planes, &mut scratch);
         })
     });
-    let mut z = zstd::bulk::Compressor::new(block::LEVEL).expect("zstd");
+    let mut packed = Vec::new();
     g.bench_function("pack", |b| {
-        b.iter(|| block::pack(&mut z, black_box(&rows), &lens, &mut planes, &mut scratch))
+        b.iter(|| {
+            block::pack(
+                black_box(&rows),
+                &lens,
+                &mut planes,
+                &mut scratch,
+                &mut packed,
+            )
+        })
     });
-    let (raw, packed) = block::pack(&mut z, &rows, &lens, &mut planes, &mut scratch).expect("pack");
-    let mut d = zstd::bulk::Decompressor::new().expect("zstd");
+    // Format 13's coder on the same planes, for the comparison docs/06 makes.
+    let mut z = zstd::bulk::Compressor::new(-1).expect("zstd");
+    g.bench_function("pack_zstd_format_13", |b| {
+        b.iter(|| {
+            planes.clear();
+            block::to_planes(black_box(&rows), &lens, &mut planes, &mut scratch);
+            z.compress(&planes)
+        })
+    });
+    let raw = block::pack(&rows, &lens, &mut planes, &mut scratch, &mut packed).expect("pack");
     g.bench_function("unpack", |b| {
-        b.iter(|| block::unpack(&mut d, lens.len() as u32, raw, black_box(&packed)))
+        b.iter(|| block::unpack(lens.len() as u32, raw, black_box(&packed)))
     });
     g.finish();
 }

@@ -35,7 +35,7 @@ pub enum Record<S, C> {
 pub struct SampleBlock {
     /// Samples in the block.
     pub samples: u32,
-    /// Length of the planes before zstd, bytes.
+    /// Length of the planes before LZ4, bytes.
     pub raw_len: u32,
     /// The packed planes.
     pub packed: Packed,

@@ -88,7 +88,8 @@ pub struct RecordWriter<T> {
     block_rows: usize,
     planes: Vec<u8>,
     scratch: Vec<u8>,
-    z: zstd::bulk::Compressor<'static>,
+    /// The block in hand packed: kept, so a block costs no allocation.
+    packed: Vec<u8>,
     path: PathBuf,
     _t: PhantomData<fn(&T)>,
 }
@@ -115,21 +116,25 @@ impl<T> RecordWriter<T> {
         if self.lens.is_empty() {
             return Ok(());
         }
-        let (raw_len, packed) = block::pack(
-            &mut self.z,
+        let raw_len = block::pack(
             &self.rows,
             &self.lens,
             &mut self.planes,
             &mut self.scratch,
+            &mut self.packed,
         )?;
         let entry = Record::<(), ()>::Samples(SampleBlock {
             samples: u32::try_from(self.lens.len()).map_err(std::io::Error::other)?,
             raw_len,
-            packed: crate::entry::Packed(packed),
+            packed: crate::entry::Packed(std::mem::take(&mut self.packed)),
         });
         self.rows.clear();
         self.lens.clear();
-        self.put(&entry)
+        let put = self.put(&entry);
+        if let Record::Samples(b) = entry {
+            self.packed = b.packed.0;
+        }
+        put
     }
 
     fn put<E: Serialize>(&mut self, entry: &E) -> std::io::Result<()> {
@@ -190,7 +195,7 @@ impl<S: Serialize, C: Serialize> RecordWriter<Record<S, C>> {
             block_rows: 1,
             planes: Vec::new(),
             scratch: Vec::new(),
-            z: zstd::bulk::Compressor::new(block::LEVEL)?,
+            packed: Vec::new(),
             path: path.to_path_buf(),
             _t: PhantomData,
         })
@@ -257,7 +262,6 @@ pub struct RecordReader<T> {
     pending: VecDeque<T>,
     /// Whether sample blocks are unpacked (or skipped).
     samples: bool,
-    z: zstd::bulk::Decompressor<'static>,
 }
 
 impl<T> std::fmt::Debug for RecordReader<T> {
@@ -277,10 +281,6 @@ impl<S: DeserializeOwned, C: DeserializeOwned> RecordReader<Record<S, C>> {
             path: path.display().to_string(),
             pending: VecDeque::new(),
             samples: true,
-            z: zstd::bulk::Decompressor::new().map_err(|source| RecordError::Io {
-                path: path.display().to_string(),
-                source,
-            })?,
         })
     }
 
@@ -319,7 +319,7 @@ impl<S: DeserializeOwned, C: DeserializeOwned> RecordReader<Record<S, C>> {
     /// Puts a block's samples in `pending`; false (and none of them) if any row does
     /// not decode.
     fn unpack(&mut self, b: &SampleBlock) -> bool {
-        let Ok((rows, lens)) = block::unpack(&mut self.z, b.samples, b.raw_len, &b.packed.0) else {
+        let Ok((rows, lens)) = block::unpack(b.samples, b.raw_len, &b.packed.0) else {
             return false;
         };
         let mut at = 0;
