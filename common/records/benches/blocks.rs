@@ -46,22 +46,20 @@ fn samples() -> Vec<MasterSample> {
 }
 
 /// Encodes samples into rows as the writer does: concatenated, with their lengths.
-fn encode(samples: &[MasterSample], rows: &mut Vec<u8>, lens: &mut Vec<usize>) {
-    let mut row = file::RowEncoder::default();
+fn encode(samples: &[MasterSample], rows: &mut file::Rows, lens: &mut Vec<usize>) {
     for s in samples {
-        let before = rows.len();
-        row.append(s, rows).expect("encode");
-        lens.push(rows.len() - before);
+        lens.push(rows.append(s).expect("encode"));
     }
 }
 
 fn blocks(c: &mut Criterion) {
     let samples = samples();
-    let (mut rows, mut lens) = (Vec::new(), Vec::new());
-    encode(&samples, &mut rows, &mut lens);
+    let (mut encoded, mut lens) = (file::Rows::default(), Vec::new());
+    encode(&samples, &mut encoded, &mut lens);
+    let rows = encoded.as_slice().to_vec();
     let mut g = c.benchmark_group("block");
     g.throughput(Throughput::Bytes(rows.len() as u64));
-    let (mut r, mut l) = (Vec::new(), Vec::new());
+    let (mut r, mut l) = (file::Rows::default(), Vec::new());
     g.bench_function("encode", |b| {
         b.iter(|| {
             r.clear();

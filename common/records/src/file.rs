@@ -26,43 +26,54 @@ pub const BLOCK_NS: u64 = 50_000_000;
 /// seven-joint arm takes.
 const ROW: usize = 1024;
 
-/// Encodes samples into a block's rows.
-#[derive(Debug)]
-pub struct RowEncoder {
-    row: Box<[u8; ROW]>,
+/// A block's rows, concatenated, each sample encoded straight into its place.
+///
+/// The buffer keeps a row's worth of room past the rows at all times (zeroed once,
+/// when it first grows), so a row is encoded in place, with no copy: the fastest of
+/// the ways the block bench measured (through `io::Write` took twice as long, into a
+/// slice and then copied a fifth longer). A row longer than the room (a long arm's
+/// joints) goes through `io::Write`.
+#[derive(Debug, Default)]
+pub struct Rows {
+    buf: Vec<u8>,
+    used: usize,
 }
 
-impl Default for RowEncoder {
-    fn default() -> Self {
-        RowEncoder {
-            row: Box::new([0; ROW]),
-        }
-    }
-}
-
-impl RowEncoder {
-    /// Appends `sample`'s row to `rows`; on an error `rows` is as it was (a
-    /// half-encoded row would shift every later one). The row is encoded into a slice
-    /// first and then copied: half the time of encoding through `io::Write` (the block
-    /// bench); a row longer than the slice (a long arm's joints) takes that way.
+impl Rows {
+    /// Appends `sample`'s row and returns its length; on an error the rows are as
+    /// they were (a half-encoded row would shift every later one).
     pub fn append<S: Serialize>(
         &mut self,
         sample: &S,
-        rows: &mut Vec<u8>,
-    ) -> Result<(), bincode::error::EncodeError> {
-        match bincode::serde::encode_into_slice(sample, &mut self.row[..], row_config()) {
-            Ok(n) => {
-                rows.extend_from_slice(&self.row[..n]);
-                Ok(())
-            }
-            Err(bincode::error::EncodeError::UnexpectedEnd) => {
-                let before = rows.len();
-                bincode::serde::encode_into_std_write(sample, &mut *rows, row_config())
-                    .map(|_| ())
-                    .inspect_err(|_| rows.truncate(before))
-            }
-            Err(e) => Err(e),
+    ) -> Result<usize, bincode::error::EncodeError> {
+        if self.buf.len() < self.used + ROW {
+            self.buf.resize(self.used + ROW, 0);
         }
+        let room = &mut self.buf[self.used..self.used + ROW];
+        let n = match bincode::serde::encode_into_slice(sample, room, row_config()) {
+            Err(bincode::error::EncodeError::UnexpectedEnd) => {
+                self.buf.truncate(self.used);
+                let long =
+                    bincode::serde::encode_into_std_write(sample, &mut self.buf, row_config());
+                if long.is_err() {
+                    self.buf.truncate(self.used);
+                }
+                long?
+            }
+            n => n?,
+        };
+        self.used += n;
+        Ok(n)
+    }
+
+    /// The rows so far, concatenated.
+    pub fn as_slice(&self) -> &[u8] {
+        &self.buf[..self.used]
+    }
+
+    /// No rows (the buffer and its room kept).
+    pub fn clear(&mut self) {
+        self.used = 0;
     }
 }
 
@@ -79,10 +90,8 @@ fn row_config() -> impl bincode::config::Config {
 pub struct RecordWriter<T> {
     file: std::fs::File,
     buf: Vec<u8>,
-    /// The block in hand: its rows, concatenated, and their lengths.
-    rows: Vec<u8>,
-    /// Encodes each row before it joins them.
-    row: RowEncoder,
+    /// The block in hand: its rows, and their lengths.
+    rows: Rows,
     lens: Vec<usize>,
     started_ns: u64,
     block_rows: usize,
@@ -117,7 +126,7 @@ impl<T> RecordWriter<T> {
             return Ok(());
         }
         let raw_len = block::pack(
-            &self.rows,
+            self.rows.as_slice(),
             &self.lens,
             &mut self.planes,
             &mut self.scratch,
@@ -188,8 +197,7 @@ impl<S: Serialize, C: Serialize> RecordWriter<Record<S, C>> {
         Ok(RecordWriter {
             file: open_for_writing(path, append)?,
             buf: Vec::with_capacity(512),
-            rows: Vec::new(),
-            row: RowEncoder::default(),
+            rows: Rows::default(),
             lens: Vec::new(),
             started_ns: 0,
             block_rows: 1,
@@ -215,11 +223,8 @@ impl<S: Serialize, C: Serialize> RecordWriter<Record<S, C>> {
 
     /// Adds one sample to the block in hand, written when full or 50 ms old.
     pub fn write_sample(&mut self, sample: &S) -> std::io::Result<()> {
-        let before = self.rows.len();
-        self.row
-            .append(sample, &mut self.rows)
-            .map_err(std::io::Error::other)?;
-        self.lens.push(self.rows.len() - before);
+        let len = self.rows.append(sample).map_err(std::io::Error::other)?;
+        self.lens.push(len);
         let n = self.lens.len();
         if n == 1 {
             self.started_ns = now_ns();

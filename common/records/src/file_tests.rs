@@ -306,3 +306,30 @@ fn rows_longer_than_the_row_buffer_come_back_whole() {
     }
     assert_eq!(got, samples);
 }
+
+/// Writes `len` bytes of a string, then fails: a sample that cannot be encoded.
+struct FailsAfter(usize);
+
+impl serde::Serialize for FailsAfter {
+    fn serialize<Z: serde::Serializer>(&self, s: Z) -> Result<Z::Ok, Z::Error> {
+        use serde::ser::{Error, SerializeTuple};
+        let mut t = s.serialize_tuple(2)?;
+        t.serialize_element(&"x".repeat(self.0))?;
+        t.end()?;
+        Err(Z::Error::custom("this sample cannot be encoded"))
+    }
+}
+
+#[test]
+fn a_row_that_fails_to_encode_leaves_the_rows_as_they_were() {
+    let mut rows = Rows::default();
+    assert_eq!(rows.append(&(7u64, 9u32)).expect("a row"), 12);
+    let before = rows.as_slice().to_vec();
+    // Failing inside the room, and past it (the long way in).
+    for len in [10, ROW + 100] {
+        assert!(rows.append(&FailsAfter(len)).is_err());
+        assert_eq!(rows.as_slice(), &before[..]);
+    }
+    assert_eq!(rows.append(&(8u64, 1u32)).expect("a row"), 12);
+    assert_eq!(rows.as_slice().len(), 24);
+}
