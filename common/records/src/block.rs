@@ -58,15 +58,29 @@ fn get_varint(b: &[u8], at: &mut usize) -> Result<u64, BlockError> {
     Err(BlockError("a length of more than 64 bits"))
 }
 
+/// Groups a block finds by looking through them; past this many, by a hash map (a
+/// crafted block of thousands of lengths must not cost a search through them all
+/// for each row). A node's rows have one to four shapes.
+const FEW_GROUPS: usize = 8;
+
 /// The distinct row lengths in order of first appearance, with the rows (their start
 /// offsets) of each.
 fn groups(lens: &[usize]) -> Vec<(usize, Vec<usize>)> {
     let mut out: Vec<(usize, Vec<usize>)> = Vec::new();
-    let mut index = std::collections::HashMap::new();
+    let mut index: Option<std::collections::HashMap<usize, usize>> = None;
     let mut at = 0;
     for &l in lens {
-        let k = *index.entry(l).or_insert_with(|| {
+        let found = match &index {
+            Some(ix) => ix.get(&l).copied(),
+            None => out.iter().position(|(g, _)| *g == l),
+        };
+        let k = found.unwrap_or_else(|| {
             out.push((l, Vec::new()));
+            if let Some(ix) = &mut index {
+                ix.insert(l, out.len() - 1);
+            } else if out.len() > FEW_GROUPS {
+                index = Some(out.iter().enumerate().map(|(k, (g, _))| (*g, k)).collect());
+            }
             out.len() - 1
         });
         out[k].1.push(at);
@@ -306,6 +320,24 @@ mod tests {
         // count and lengths (51), the first row (16), bitmap (2) and the counter's low
         // plane over the 49 later rows: the constant costs its first row alone.
         assert_eq!(planes.len(), 51 + 16 + 2 + 49);
+    }
+
+    #[test]
+    fn groups_are_the_lengths_in_order_of_first_appearance_few_or_many() {
+        for distinct in [1, 3, FEW_GROUPS, FEW_GROUPS + 1, 100] {
+            let lens: Vec<usize> = (0..500).map(|i| (i * 7) % distinct + 1).collect();
+            let got = groups(&lens);
+            let mut want: Vec<(usize, Vec<usize>)> = Vec::new();
+            let mut at = 0;
+            for &l in &lens {
+                match want.iter_mut().find(|(g, _)| *g == l) {
+                    Some((_, rows)) => rows.push(at),
+                    None => want.push((l, vec![at])),
+                }
+                at += l;
+            }
+            assert_eq!(got, want, "{distinct} lengths");
+        }
     }
 
     #[test]
