@@ -200,7 +200,7 @@ impl Default for CordicConfig {
 }
 
 /// The TFB with all constants and error bounds precomputed (about 0.9 KB), and for
-/// short fractions the rotation's outputs tabled at the first sine ([`table`]).
+/// short fractions the rotation's outputs tabled ([`table`]).
 #[derive(Debug, Clone)]
 pub struct Cordic {
     cfg: CordicConfig,
@@ -229,9 +229,9 @@ pub struct Cordic {
     xy_out: f32,
     angle_out: f32,
     bounds: [f64; 3],
-    /// The rotation's outputs by folded angle, made at the first sine (short
-    /// fractions only: [`table`]).
-    table: std::sync::OnceLock<Option<table::Table>>,
+    /// The rotation's outputs by folded angle (short fractions only: [`table`]), made
+    /// with the block, so a node's first sine costs no more than its others.
+    table: Option<table::Table>,
 }
 
 impl Cordic {
@@ -265,9 +265,10 @@ impl Cordic {
             xy_out: pow2(-frac - 1) as f32,
             angle_out: pow2(-frac) as f32,
             bounds: [0.0; 3],
-            table: std::sync::OnceLock::new(),
+            table: None,
         };
         c.bounds = c.derive_bounds();
+        c.table = table::Table::of(&c);
         Ok(c)
     }
 
@@ -299,14 +300,10 @@ impl Cordic {
     /// [`Self::rotate`]'s codes, from the table where there is one.
     #[inline(always)]
     fn rotated(&self, z: i64, flip: i64) -> (i64, i64) {
-        match self.table().and_then(|t| t.get(z, flip)) {
+        match self.table.as_ref().and_then(|t| t.get(z, flip)) {
             Some(sc) => sc,
             None => self.rotate(z, flip),
         }
-    }
-
-    fn table(&self) -> Option<&table::Table> {
-        self.table.get_or_init(|| table::Table::of(self)).as_ref()
     }
 
     /// [`Self::sin_cos`] of three angles, bit-identical per angle, with the three
@@ -324,7 +321,7 @@ impl Cordic {
                 self.angle_prefloor(f64::from(angles[k])),
             )));
         }
-        let (s, c) = match self.table() {
+        let (s, c) = match &self.table {
             Some(t) => match (
                 t.get(z[0], flip[0]),
                 t.get(z[1], flip[1]),

@@ -10,8 +10,8 @@
 //! (`clamp(-v) = -clamp(v)`). Tests compare every entry, both signs, with the
 //! iterations. The RTL comparisons keep using the iterations.
 
-use super::Cordic;
-use std::sync::Arc;
+use super::{Cordic, CordicConfig};
+use std::sync::{Arc, Mutex};
 
 /// Largest `frac` tabled: the table then has at most `pi 2^15` entries.
 pub(super) const MAX_FRAC: u32 = 14;
@@ -31,12 +31,37 @@ impl std::fmt::Debug for Table {
     }
 }
 
+/// Tables made so far in this process, by format: an engine made again (per test case,
+/// per run of a sweep in one process) takes its format's table instead of making it
+/// again (about a millisecond). At most [`KEPT`] formats are kept, so a process that
+/// tries formats without end holds a bounded amount.
+static MADE: Mutex<Vec<(CordicConfig, Table)>> = Mutex::new(Vec::new());
+
+/// Formats whose tables a process keeps.
+const KEPT: usize = 4;
+
 impl Table {
     /// The table of `c`'s rotation, or `None` for a fraction too long to table.
     pub(super) fn of(c: &Cordic) -> Option<Table> {
         if c.cfg.frac > MAX_FRAC {
             return None;
         }
+        // A poisoned lock only costs the sharing.
+        if let Ok(made) = MADE.lock() {
+            if let Some((_, t)) = made.iter().find(|(cfg, _)| *cfg == c.cfg) {
+                return Some(t.clone());
+            }
+        }
+        let t = Table::make(c);
+        if let Ok(mut made) = MADE.lock() {
+            if made.len() < KEPT {
+                made.push((c.cfg, t.clone()));
+            }
+        }
+        Some(t)
+    }
+
+    fn make(c: &Cordic) -> Table {
         // A folded angle is within pi/2 and its rounding; two codes of margin.
         let reach = c.half_pi + 2;
         let codes = (-reach..=reach)
@@ -46,7 +71,7 @@ impl Table {
                 [s as i32, c as i32]
             })
             .collect();
-        Some(Table { reach, codes })
+        Table { reach, codes }
     }
 
     /// `rotate(z, flip)`'s codes, if `z` is in the table.
@@ -61,7 +86,7 @@ impl Table {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cordic::{CordicConfig, Rounding};
+    use crate::cordic::Rounding;
 
     /// Every entry, both signs, equals the iterations, for every tabled fraction and
     /// iteration count of a 16-bit word and the paper's, in both roundings.
@@ -79,7 +104,8 @@ mod tests {
         for (word, frac, iterations, rounding) in configs {
             let cfg = CordicConfig::new(word, frac, Some(iterations), rounding).expect("config");
             let c = Cordic::new(cfg).expect("cordic");
-            let t = Table::of(&c).expect("tabled");
+            let t = Table::make(&c);
+            assert_eq!(Table::of(&c).map(|k| k.codes), Some(t.codes.clone()));
             for z in -t.reach..=t.reach {
                 for flip in [0, -1] {
                     assert_eq!(t.get(z, flip), Some(c.rotate(z, flip)), "{cfg:?} z {z}");
