@@ -79,7 +79,9 @@ pub type Rest = ([f64; 4], u32);
 /// value copied when it arrives (its slot in the ring may be reused by a later packet
 /// while the receiver still holds it). A queue rather than a map: packets mostly
 /// arrive in the order they were sent, so an entry joins at the back and leaves at
-/// the front, where a map would rebalance its nodes twice a packet.
+/// the front, where a map would rebalance its nodes twice a packet. A packet that
+/// overtakes others (jitter with `reorder`) is inserted among them, which moves at
+/// most the packets in flight (bounded by the longest delay).
 #[derive(Debug, Clone, Default)]
 struct InFlight {
     arriving: VecDeque<(u64, u64)>,

@@ -13,7 +13,7 @@
 use super::{Cordic, CordicConfig};
 use std::sync::{Arc, Mutex};
 
-/// Largest `frac` tabled: the table then has at most `pi 2^15` entries.
+/// Largest `frac` tabled: the table then has at most 51,477 entries (`pi 2^14`).
 pub(super) const MAX_FRAC: u32 = 14;
 
 /// `(sin, cos)` codes of `rotate(z, 0)` for `z` in `[-reach, reach]`.
@@ -54,7 +54,8 @@ impl Table {
         }
         let t = Table::make(c);
         if let Ok(mut made) = MADE.lock() {
-            if made.len() < KEPT {
+            // Another thread may have made the same meanwhile: one slot a format.
+            if made.len() < KEPT && !made.iter().any(|(cfg, _)| *cfg == c.cfg) {
                 made.push((c.cfg, t.clone()));
             }
         }
@@ -88,8 +89,8 @@ mod tests {
     use super::*;
     use crate::cordic::Rounding;
 
-    /// Every entry, both signs, equals the iterations, for every tabled fraction and
-    /// iteration count of a 16-bit word and the paper's, in both roundings.
+    /// Every entry, both signs, equals the iterations, for fractions from 1 to the
+    /// longest tabled and a few iteration counts each, in both roundings.
     #[test]
     fn every_entry_is_the_datapaths_own() {
         let mut configs = vec![];
@@ -113,6 +114,39 @@ mod tests {
             }
             assert_eq!(t.get(t.reach + 1, 0), None);
             assert_eq!(t.get(-t.reach - 1, -1), None);
+        }
+    }
+
+    /// Every angle the fast path takes folds into the table: swept over the whole
+    /// range, densest near the fold's edges (+-pi/2, +-pi), in both roundings, each
+    /// found in the table and equal to the iterations; `sin_cos` gives the same.
+    #[test]
+    fn every_folded_angle_is_in_the_table() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        for rounding in [Rounding::Nearest, Rounding::Truncate] {
+            let cfg = CordicConfig::new(16, 13, None, rounding).expect("config");
+            let c = Cordic::new(cfg).expect("cordic");
+            let t = c.table.clone().expect("tabled");
+            let mut angles: Vec<f32> = (-40_000..=40_000).map(|k| k as f32 * 1e-4).collect();
+            for edge in [-PI, -FRAC_PI_2, FRAC_PI_2, PI, 2.0 * PI, 1e3 * PI] {
+                let e = edge as f32;
+                let mut below = e;
+                let mut above = e;
+                for _ in 0..64 {
+                    angles.extend([below, above]);
+                    below = f32::from_bits(below.to_bits() - 1);
+                    above = f32::from_bits(above.to_bits() + 1);
+                }
+            }
+            for a in angles {
+                let (z, flip) = c.fold(i64::from(super::super::floor_code(
+                    c.angle_prefloor(f64::from(a)),
+                )));
+                let want = c.rotate(z, flip);
+                assert_eq!(t.get(z, flip), Some(want), "{rounding:?} angle {a}");
+                let xy = c.xy_out;
+                assert_eq!(c.sin_cos(a), (want.0 as f32 * xy, want.1 as f32 * xy));
+            }
         }
     }
 
