@@ -205,7 +205,9 @@ fn a_requeued_task_keeps_the_runs_it_finished() {
         String::from_utf8_lossy(&o.stderr)
     );
     // Slurm holds a requeued job for two minutes (its BeginTime); the guide says so,
-    // and how to start it at once, as here.
+    // and how to start it at once, as here: but not within the second of the requeue,
+    // whose credential slurmd revokes by the second (a start then fails at once with
+    // "Job credential revoked").
     let asked = Instant::now();
     while state(&task) != "PENDING" {
         assert!(
@@ -215,6 +217,7 @@ fn a_requeued_task_keeps_the_runs_it_finished() {
         );
         std::thread::sleep(Duration::from_millis(200));
     }
+    std::thread::sleep(Duration::from_secs(2).saturating_sub(asked.elapsed()));
     let o = Command::new("scontrol")
         .args(["update", &format!("JobId={task}"), "StartTime=now"])
         .output()

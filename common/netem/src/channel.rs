@@ -75,13 +75,11 @@ struct Slot {
 pub type Rest = ([f64; 4], u32);
 
 /// One signal's packets in flight: `(arrival sample, newest sequence arriving then)`
-/// in order of arrival, one entry an arrival sample; and the newest arrived, with its
-/// value copied when it arrives (its slot in the ring may be reused by a later packet
-/// while the receiver still holds it). A queue rather than a map: packets mostly
-/// arrive in the order they were sent, so an entry joins at the back and leaves at
-/// the front, where a map would rebalance its nodes twice a packet. A packet that
-/// overtakes others (jitter with `reorder`) is inserted among them, which moves at
-/// most the packets in flight (bounded by the longest delay).
+/// by arrival, one entry a sample; and the newest arrived, its value copied on arrival
+/// (its ring slot may be reused while the receiver still holds it). A queue, not a
+/// map: packets mostly arrive in sending order, joining at the back and leaving at the
+/// front (a map rebalanced twice a packet); one that overtakes (jitter with `reorder`)
+/// is inserted, moving at most the packets in flight (bounded by the longest delay).
 #[derive(Debug, Clone, Default)]
 struct InFlight {
     arriving: VecDeque<(u64, u64)>,
@@ -408,9 +406,8 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
-        /// Packets in flight are held as the map from arrival sample to the newest
-        /// sequence arriving then that they replace would hold them, sent and received
-        /// in any order.
+        /// Packets in flight are held as the map they replace held them (arrival
+        /// sample to newest sequence), sent and received in any order.
         #[test]
         fn in_flight_is_the_map_it_replaces(
             steps in proptest::collection::vec((0u64..40, 0u64..12, any::<bool>()), 0..200),
