@@ -321,15 +321,15 @@ impl Cordic {
                 self.angle_prefloor(f64::from(angles[k])),
             )));
         }
-        let (s, c) = match &self.table {
-            Some(t) => match (
-                t.get(z[0], flip[0]),
-                t.get(z[1], flip[1]),
-                t.get(z[2], flip[2]),
-            ) {
-                (Some(a), Some(b), Some(c)) => ([a.0, b.0, c.0], [a.1, b.1, c.1]),
-                _ => self.rotate3(z, flip),
-            },
+        let looked = self.table.as_ref().and_then(|t| {
+            Some([
+                t.get(z[0], flip[0])?,
+                t.get(z[1], flip[1])?,
+                t.get(z[2], flip[2])?,
+            ])
+        });
+        let (s, c) = match looked {
+            Some(sc) => (sc.map(|v| v.0), sc.map(|v| v.1)),
             None => self.rotate3(z, flip),
         };
         (
