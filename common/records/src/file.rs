@@ -10,7 +10,7 @@
 use crate::block;
 use crate::entry::{Record, SampleBlock};
 use crate::frames::MAX_FRAME;
-use crate::frames::{config, frame, open_for_writing, Damage, Frames, RecordError, HEADER};
+use crate::frames::{config, open_for_writing, seal, Damage, Frames, RecordError, HEADER};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -148,20 +148,21 @@ impl<T> RecordWriter<T> {
     }
 
     fn put<E: Serialize>(&mut self, entry: &E) -> std::io::Result<()> {
+        // The entry is encoded after room for the frame's header, filled in after.
         self.buf.clear();
+        self.buf.resize(HEADER, 0);
         bincode::serde::encode_into_std_write(entry, &mut self.buf, config())
             .map_err(std::io::Error::other)?;
-        if self.buf.len() > MAX_FRAME as usize {
+        let body = self.buf.len() - HEADER;
+        if body > MAX_FRAME as usize {
             // A reader would take it for damage: refuse it here instead.
             return Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,
-                format!(
-                    "a record of {} bytes is longer than a frame may be",
-                    self.buf.len()
-                ),
+                format!("a record of {body} bytes is longer than a frame may be"),
             ));
         }
-        self.file.write_all(&frame(&self.buf))
+        seal(&mut self.buf);
+        self.file.write_all(&self.buf)
     }
 
     /// Cuts the file back to `len` bytes (a segment taken back out), the block in

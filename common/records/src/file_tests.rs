@@ -1,5 +1,6 @@
 use super::*;
 use crate::entry::Event;
+use crate::frames::frame;
 use proptest::prelude::*;
 
 type R = Record<(u64, String), u64>;

@@ -71,13 +71,22 @@ pub struct Damage {
 }
 
 /// One frame's bytes for `body`.
+#[cfg(test)]
 pub(crate) fn frame(body: &[u8]) -> Vec<u8> {
-    let mut f = Vec::with_capacity(HEADER + body.len());
-    f.extend_from_slice(&SYNC);
-    f.extend_from_slice(&u32::try_from(body.len()).unwrap_or(u32::MAX).to_le_bytes());
-    f.extend_from_slice(&crc32fast::hash(body).to_le_bytes());
+    let mut f = vec![0; HEADER];
     f.extend_from_slice(body);
+    seal(&mut f);
     f
+}
+
+/// Makes `f` a frame: fills its first [`HEADER`] bytes (left for it) for the body
+/// after them. The writer encodes an entry straight after the room it leaves, so a
+/// block is not copied into a frame of its own.
+pub(crate) fn seal(f: &mut [u8]) {
+    let (head, body) = f.split_at_mut(HEADER);
+    head[..4].copy_from_slice(&SYNC);
+    head[4..8].copy_from_slice(&u32::try_from(body.len()).unwrap_or(u32::MAX).to_le_bytes());
+    head[8..].copy_from_slice(&crc32fast::hash(body).to_le_bytes());
 }
 
 /// Opens `path` for a node's writer: created afresh, or with `append` an existing

@@ -90,10 +90,19 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
     }
 
     fn put(&mut self, r: &Record<S, C>) -> Result<(), WriteError> {
+        self.writing(|w| w.write(r))
+    }
+
+    /// Writes with `write`, unless the segment was taken back out; an error names the
+    /// file.
+    fn writing(
+        &mut self,
+        write: impl FnOnce(&mut RecordWriter<Record<S, C>>) -> std::io::Result<()>,
+    ) -> Result<(), WriteError> {
         if self.withdrawn {
             return Ok(());
         }
-        self.writer.write(r).map_err(|source| WriteError {
+        write(&mut self.writer).map_err(|source| WriteError {
             action: "writing",
             path: self.writer.path().display().to_string(),
             source,
@@ -153,9 +162,10 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
         self.put(&Record::Run(token))
     }
 
-    /// One sample's record.
-    pub fn sample(&mut self, s: S) -> Result<(), WriteError> {
-        self.put(&Record::Sample(s))
+    /// One sample's record, encoded from where it is: a sample is hundreds of bytes,
+    /// and wrapping it in a [`Record`] first copied it once more.
+    pub fn sample(&mut self, s: &S) -> Result<(), WriteError> {
+        self.writing(|w| w.write_sample(s))
     }
 
     /// True once a second has passed since the counters were last written (then the
@@ -209,7 +219,7 @@ mod tests {
         let mut r = Rec::open(dir, Role::Slave, append)?;
         let joined = r.run(run);
         // A node that failed still ends its segment: nothing of it may reach the file.
-        r.sample(run)?;
+        r.sample(&run)?;
         r.stop(0, 0, "failed")?;
         joined
     }

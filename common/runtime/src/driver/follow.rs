@@ -375,7 +375,7 @@ impl<H: Follower> Follow<H> {
                 }
             }
         }
-        if let Some(r) = record {
+        if let Some(r) = &record {
             self.rec.sample(r)?;
         }
         Ok(())
@@ -389,7 +389,7 @@ impl<H: Follower> Follow<H> {
         let none = || Vec::new();
         let mut io = Io::new(&mut self.rec, 0, &self.timing, &none);
         if let Some(r) = self.handler.idle(self.last_seq, &mut io)? {
-            self.rec.sample(r)?;
+            self.rec.sample(&r)?;
         }
         self.idle_at = Some(Instant::now() + every);
         Ok(())

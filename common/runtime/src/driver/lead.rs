@@ -290,7 +290,7 @@ impl<H: Leader> Lead<H> {
         self.link.send_forward(c, false)?;
         self.window.send(n);
         let sent = self.handler.sent(&c);
-        self.rec.sample(sent)?;
+        self.rec.sample(&sent)?;
         loop {
             match self.link.wait(deadline, block)? {
                 Ok(super::Arrival::Backward(q)) => {
@@ -353,7 +353,7 @@ impl<H: Leader> Lead<H> {
         let dead = || link.dead_peers();
         let mut io = Io::new(&mut self.rec, origin, &timing, &dead);
         let a = self.handler.answer(&q, late, &mut io)?;
-        self.rec.sample(a)?;
+        self.rec.sample(&a)?;
         Ok(Some(q.seq))
     }
 
@@ -367,7 +367,7 @@ impl<H: Leader> Lead<H> {
         let dead = || link.dead_peers();
         let mut io = Io::new(&mut self.rec, origin, &timing, &dead);
         let m = self.handler.miss(n, &mut io)?;
-        self.rec.sample(m)?;
+        self.rec.sample(&m)?;
         Ok(())
     }
 
