@@ -258,7 +258,9 @@ impl Follower for SlaveHandler {
         }
         self.last_step = Some(step);
         let record = match self.slave.arm() {
-            Some(a) => SlaveSample::ArmStep(step, joints(a, h.torque, self.slave.rotation())),
+            Some(a) => {
+                SlaveSample::ArmStep(step, Box::new(joints(a, h.torque, self.slave.rotation())))
+            }
             None => SlaveSample::Step(step),
         };
         Ok(Reply {
@@ -322,7 +324,9 @@ impl Follower for SlaveHandler {
             }
         };
         Ok(Some(match self.slave.arm() {
-            Some(a) => SlaveSample::ArmHold(held, joints(a, [0.0; 3], self.slave.rotation())),
+            Some(a) => {
+                SlaveSample::ArmHold(held, Box::new(joints(a, [0.0; 3], self.slave.rotation())))
+            }
             None => SlaveSample::Hold(held),
         }))
     }

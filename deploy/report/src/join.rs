@@ -507,7 +507,7 @@ pub fn join(
             .iter()
             .find_map(|x| match x {
                 SlaveSample::Step(s) => Some((Some(*s), None)),
-                SlaveSample::ArmStep(s, j) => Some((Some(*s), Some(j))),
+                SlaveSample::ArmStep(s, j) => Some((Some(*s), Some(&**j))),
                 SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
             })
             .unwrap_or((None, None));
