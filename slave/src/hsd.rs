@@ -13,7 +13,7 @@
 //! (the device's true tool position and the contact force on it) is f64.
 
 use crate::arm::{Controller, Dynamics, JointState};
-use crate::environment::deepest_contact;
+use crate::environment::{deepest_contact, Scene};
 use crate::urdf_arm::{ArmState, Followed, UrdfArm};
 use tactile_control::codec::{Deadband, Estimate, Predictor};
 use tactile_control::passivity::SlaveSide;
@@ -27,7 +27,7 @@ use tactile_messages::samples::{
     FLAG_SUBSTITUTED, FLAG_UNSENT,
 };
 use tactile_records::slave::{HoldStep, SlaveCounters, Step};
-use tactile_scenario::{Object, Scenario, ScenarioError};
+use tactile_scenario::{Scenario, ScenarioError};
 
 /// The slave: HSD kernels, controller, device and environment.
 #[derive(Debug)]
@@ -36,7 +36,7 @@ pub struct Slave {
     truth: Lengths<f64>,
     controller: Controller,
     dynamics: Dynamics,
-    objects: Vec<Object>,
+    objects: Scene,
     t_s: f64,
     reference: [f64; 3],
     counters: SlaveCounters,
@@ -106,7 +106,7 @@ impl Slave {
             ),
             controller: Controller::new(scenario.slave.controller.clone()),
             dynamics: Dynamics::new(scenario.slave.dynamics.clone(), [0.0; 3]),
-            objects: scenario.environment.objects.clone(),
+            objects: Scene::new(&scenario.environment.objects),
             t_s: scenario.t_s(),
             reference: [0.0; 3],
             counters: SlaveCounters::default(),

@@ -26,9 +26,9 @@ use std::path::Path;
 pub use tactile_chain::spatial::{quaternion, rotation_matrix};
 use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
 use tactile_math::arith::StdTrig;
-use tactile_scenario::{ArmConfig, ArmServo, Object, Scenario};
+use tactile_scenario::{ArmConfig, ArmServo, Scenario};
 
-use crate::environment::deepest_contact;
+use crate::environment::{deepest_contact, Scene};
 use tactile_math::kernels;
 
 /// Largest URDF file read, bytes (the Panda's is 15 kB; meshes are separate files).
@@ -383,7 +383,7 @@ impl UrdfArm {
 
     /// One period of `dt` with no input: the servo holds the joints where they were
     /// when the input went silent, the arm integrated as in [`UrdfArm::advance`].
-    pub fn hold(&mut self, dt: f64, objects: &[Object]) -> Holding {
+    pub fn hold(&mut self, dt: f64, objects: &Scene) -> Holding {
         let started = self.held.is_none();
         let from = self.held.get_or_insert_with(|| self.state.q.clone());
         self.state.q_ref.copy_from_slice(from);
@@ -442,7 +442,7 @@ impl UrdfArm {
 
     /// Integrates the arm over `dt` under its servo, pushed by whatever the tool
     /// touches among `objects`. Returns how many joints hit their effort limit.
-    pub fn advance(&mut self, dt: f64, objects: &[Object]) -> u32 {
+    pub fn advance(&mut self, dt: f64, objects: &Scene) -> u32 {
         let steps = (dt / self.cfg.step_s).ceil().max(1.0) as u32;
         let h = dt / f64::from(steps);
         let mut clamped = vec![false; self.chain.dof()];
@@ -527,7 +527,7 @@ impl UrdfArm {
 
     /// The contact force at the tool (the environment's, evaluated in the master's
     /// frame) as joint efforts: J_v^T f.
-    fn contact_torques(&mut self, objects: &[Object]) -> Vec<f64> {
+    fn contact_torques(&mut self, objects: &Scene) -> Vec<f64> {
         let tip = self.chain.jacobian(&self.state.q, &mut self.jac);
         let tool = self.to_master(&tip.p);
         let Some(c) = deepest_contact(objects, tool) else {
