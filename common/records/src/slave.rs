@@ -130,7 +130,7 @@ pub struct ArmJoints {
 /// One entry per step the slave took. A sample lives for one write or one read, and
 /// steps outnumber holds: boxing the step would allocate on every sample for nothing.
 /// A URDF arm's joints are boxed (their vectors allocate anyway), so the paper arm's
-/// samples are 392 bytes, not 624, wherever they are moved (the encoding is the same:
+/// samples are 384 bytes, not 624, wherever they are moved (the encoding is the same:
 /// a box encodes as what it holds).
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
