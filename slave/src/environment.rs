@@ -30,8 +30,8 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// The scenario's objects as the contact test takes them: a plane's unit normal is
 /// worked out once here rather than at every test (the dynamics test contact at each
-/// of a sample's substeps, and the square root and divisions were a quarter of the
-/// test's time), with the same operations, so contacts are bit for bit as before.
+/// of a sample's substeps), with the same operations, so contacts are bit for bit as
+/// before.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
     objects: Vec<(Object, [f64; 3])>,
