@@ -84,9 +84,10 @@ where
     let per_block = tactile_records::recorder::block_rows(role, rate);
     let (mut rows, mut lens, mut count) = (file::Rows::default(), Vec::new(), 0);
     let mut t: Tally = [(0, 0); 4];
+    let mut buffers = Buffers::default();
     let mut code = |rows: &mut file::Rows, lens: &mut Vec<usize>| {
         if !lens.is_empty() {
-            block_tally(rows.as_slice(), lens, &mut t);
+            block_tally(rows.as_slice(), lens, &mut buffers, &mut t);
         }
         rows.clear();
         lens.clear();
@@ -104,28 +105,40 @@ where
     (t, count)
 }
 
+/// The buffers the codings write into, kept from block to block as the writer keeps
+/// its own, so no coding's time includes growing them.
+#[derive(Default)]
+struct Buffers {
+    planes: Vec<u8>,
+    scratch: Vec<u8>,
+    packed: Vec<u8>,
+    words: Vec<u8>,
+}
+
 /// Adds one block's bytes and time under each coding to `t`.
-fn block_tally(rows: &[u8], lens: &[usize], t: &mut Tally) {
-    let (mut planes, mut scratch, mut packed, mut words) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+fn block_tally(rows: &[u8], lens: &[usize], b: &mut Buffers, t: &mut Tally) {
     let at = Instant::now();
-    let _ = block::pack(rows, lens, &mut planes, &mut scratch, &mut packed);
+    let _ = block::pack(rows, lens, &mut b.planes, &mut b.scratch, &mut b.packed);
     t[0].1 += at.elapsed().as_nanos();
-    t[0].0 += packed.len() as u64;
+    t[0].0 += b.packed.len() as u64;
     let at = Instant::now();
-    planes.clear();
-    block::to_planes(rows, lens, &mut planes, &mut scratch);
+    b.planes.clear();
+    block::to_planes(rows, lens, &mut b.planes, &mut b.scratch);
     t[1].1 += at.elapsed().as_nanos();
-    t[1].0 += planes.len() as u64;
+    t[1].0 += b.planes.len() as u64;
+    // Timed on its own, then again with LZ4 after it.
     let at = Instant::now();
-    xor_words(rows, lens, &mut words);
+    xor_words(rows, lens, &mut b.words);
     t[2].1 += at.elapsed().as_nanos();
-    t[2].0 += words.len() as u64;
+    t[2].0 += b.words.len() as u64;
     let at = Instant::now();
-    xor_words(rows, lens, &mut words);
-    let lz = lz4_flex::block::compress(&words);
+    xor_words(rows, lens, &mut b.words);
+    b.packed.clear();
+    b.packed
+        .resize(lz4_flex::block::get_maximum_output_size(b.words.len()), 0);
+    let n = lz4_flex::block::compress_into(&b.words, &mut b.packed).unwrap_or(0);
     t[3].1 += at.elapsed().as_nanos();
-    t[3].0 += lz.len() as u64;
+    t[3].0 += n as u64;
 }
 
 /// Each row XORed with the last row of its length, as 8-byte words: a mask byte of
@@ -135,7 +148,14 @@ fn xor_words(rows: &[u8], lens: &[usize], out: &mut Vec<u8>) {
     let mut last: Vec<(usize, usize)> = Vec::new();
     let mut at = 0;
     for &l in lens {
-        let prev = last.iter().find(|(len, _)| *len == l).map(|(_, s)| *s);
+        let k = match last.iter().position(|(len, _)| *len == l) {
+            Some(k) => k,
+            None => {
+                last.push((l, usize::MAX));
+                last.len() - 1
+            }
+        };
+        let prev = Some(last[k].1).filter(|&s| s != usize::MAX);
         for w in (0..l).step_by(8) {
             let end = (w + 8).min(l);
             let mut x = [0u8; 8];
@@ -154,10 +174,7 @@ fn xor_words(rows: &[u8], lens: &[usize], out: &mut Vec<u8>) {
             out.push(mask);
             out.extend(bytes.iter().filter(|b| **b != 0));
         }
-        match last.iter_mut().find(|(len, _)| *len == l) {
-            Some(e) => e.1 = at,
-            None => last.push((l, at)),
-        }
+        last[k].1 = at;
         at += l;
     }
 }
