@@ -307,6 +307,62 @@ mod tests {
         }
     }
 
+    /// [`to_planes`] by its definition, one byte at a time: the rows' lengths, then
+    /// per group its first row, the bitmap of planes where a later row differs from
+    /// the one before it, and those planes.
+    fn planes_by_definition(rows: &[u8], lens: &[usize]) -> Vec<u8> {
+        let mut out = Vec::new();
+        put_varint(&mut out, lens.len() as u64);
+        for &l in lens {
+            put_varint(&mut out, l as u64);
+        }
+        for (len, starts) in groups(lens) {
+            out.extend_from_slice(&rows[starts[0]..starts[0] + len]);
+            let plane = |j: usize| -> Vec<u8> {
+                starts
+                    .windows(2)
+                    .map(|p| rows[p[1] + j] ^ rows[p[0] + j])
+                    .collect()
+            };
+            let kept: Vec<usize> = (0..len)
+                .filter(|&j| plane(j).iter().any(|&b| b != 0))
+                .collect();
+            let mut bitmap = vec![0u8; len.div_ceil(8)];
+            for &j in &kept {
+                bitmap[j / 8] |= 1 << (j % 8);
+            }
+            out.extend_from_slice(&bitmap);
+            for j in kept {
+                out.extend(plane(j));
+            }
+        }
+        out
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// The planes are the bytes their definition gives (format 14).
+        #[test]
+        fn planes_are_their_definition(rows in proptest::collection::vec(
+            prop_oneof![
+                proptest::collection::vec(any::<u8>(), 0..40),
+                proptest::collection::vec(0u8..2, 9),
+                Just(vec![7u8; 17]),
+            ],
+            0..60,
+        )) {
+            let lens: Vec<usize> = rows.iter().map(Vec::len).collect();
+            let flat = rows.concat();
+            let mut planes = vec![1, 2, 3];
+            let mut scratch = vec![9; 5];
+            to_planes(&flat, &lens, &mut planes, &mut scratch);
+            prop_assert_eq!(&planes[..3], &[1, 2, 3]);
+            let want = planes_by_definition(&flat, &lens);
+            prop_assert_eq!(&planes[3..], want.as_slice());
+        }
+    }
+
     #[test]
     fn unchanged_values_cost_nothing_and_counters_little() {
         // 50 rows of a counter and a constant: the constant's planes are left out.
