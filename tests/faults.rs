@@ -267,7 +267,7 @@ fn a_full_subscriber_buffer_loses_exactly_the_overwritten_samples() {
             seq: n,
             ..Forward::default()
         };
-        out.publish(f, false).expect("send");
+        out.publish(&f, false).expect("send");
     }
     // Every publish reached the one subscriber.
     assert_eq!(out.stats().no_receiver, 0);
@@ -289,7 +289,7 @@ fn a_full_subscriber_buffer_loses_exactly_the_overwritten_samples() {
             seq: n,
             ..Forward::default()
         };
-        out.publish(f, false).expect("send");
+        out.publish(&f, false).expect("send");
     }
     while inbox.try_recv().expect("recv").is_some() {}
     let st = inbox.stats();

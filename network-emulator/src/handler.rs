@@ -39,21 +39,27 @@ impl Handler for EmulatorHandler {
 }
 
 impl Follower for EmulatorHandler {
-    fn forward(&mut self, c: &Forward, _: &mut Io) -> Result<Reply<Passage>, Failure> {
+    fn forward(
+        &mut self,
+        c: &Forward,
+        out: &mut Reply<Passage>,
+        _: &mut Io,
+    ) -> Result<(), Failure> {
         let (v, passage) = self.emulator.forward(c);
-        Ok(Reply {
-            forward: v,
-            backward: None,
-            record: Some(passage),
-        })
+        out.forward = v;
+        out.record = Some(passage);
+        Ok(())
     }
 
-    fn backward(&mut self, h: &Backward, _: &mut Io) -> Result<Reply<Passage>, Failure> {
+    fn backward(
+        &mut self,
+        h: &Backward,
+        out: &mut Reply<Passage>,
+        _: &mut Io,
+    ) -> Result<(), Failure> {
         let (q, passage) = self.emulator.backward(h);
-        Ok(Reply {
-            forward: None,
-            backward: q,
-            record: Some(passage),
-        })
+        out.backward = q;
+        out.record = Some(passage);
+        Ok(())
     }
 }

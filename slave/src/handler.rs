@@ -234,7 +234,12 @@ impl Handler for SlaveHandler {
 }
 
 impl Follower for SlaveHandler {
-    fn forward(&mut self, v: &Forward, io: &mut Io) -> Result<Reply<SlaveSample>, Failure> {
+    fn forward(
+        &mut self,
+        v: &Forward,
+        out: &mut Reply<SlaveSample>,
+        io: &mut Io,
+    ) -> Result<(), Failure> {
         if self.holding {
             self.holding = false;
             io.event(v.seq, "input back: following the master again")?;
@@ -257,26 +262,24 @@ impl Follower for SlaveHandler {
             Robots::Arm(hw) => hw.due = self.slave.arm_state().map(|a| a.q_ref.clone()),
         }
         self.last_step = Some(step);
-        let record = match self.slave.arm() {
+        out.record = Some(match self.slave.arm() {
             Some(a) => {
                 SlaveSample::ArmStep(step, Box::new(joints(a, h.torque, self.slave.rotation())))
             }
             None => SlaveSample::Step(step),
-        };
-        Ok(Reply {
-            forward: None,
-            backward: Some(h),
-            record: Some(record),
-        })
+        });
+        out.backward = Some(h);
+        Ok(())
     }
 
     /// Nothing comes backward to the slave: a backward sample is another node's.
-    fn backward(&mut self, _: &Backward, _: &mut Io) -> Result<Reply<SlaveSample>, Failure> {
-        Ok(Reply {
-            forward: None,
-            backward: None,
-            record: None,
-        })
+    fn backward(
+        &mut self,
+        _: &Backward,
+        _: &mut Reply<SlaveSample>,
+        _: &mut Io,
+    ) -> Result<(), Failure> {
+        Ok(())
     }
 
     fn after(&mut self, _: &mut Io) {

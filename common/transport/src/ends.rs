@@ -28,9 +28,12 @@ impl LinkError {
 
 /// The sending end of a stream.
 pub trait Publish<T> {
-    /// Publishes `value`, stamped with this hop's publish counter and counted, or, with
-    /// `control` (a start-up probe, the end of a run), marked so neither end counts it.
-    fn publish(&mut self, value: T, control: bool) -> Result<(), LinkError>;
+    /// Publishes a copy of `value`, stamped with this hop's publish counter and
+    /// counted, or, with `control` (a start-up probe, the end of a run), marked so
+    /// neither end counts it. By reference: a sample is hundreds of bytes, and the
+    /// transport copies it once, where it goes (a queue's slot, shared memory, a
+    /// datagram's encoding).
+    fn publish(&mut self, value: &T, control: bool) -> Result<(), LinkError>;
     /// What it counted.
     fn stats(&self) -> OutboxStats;
 }
@@ -40,6 +43,19 @@ pub trait Subscribe<T> {
     /// A sample if one waits, counted (with any lost before it); what is not a whole
     /// sample of this run's format is counted and passed over.
     fn try_recv(&mut self) -> Result<Option<T>, LinkError>;
+    /// [`Self::try_recv`] into `slot`: true if a sample came (then it is in `slot`),
+    /// false if none (`slot` is left as it was). The in-process runner polls this
+    /// way, so a sample is copied once, from the queue to where it is handled, not
+    /// out through each `Option` and `Result` in between.
+    fn recv_into(&mut self, slot: &mut T) -> Result<bool, LinkError> {
+        match self.try_recv()? {
+            Some(v) => {
+                *slot = v;
+                Ok(true)
+            }
+            None => Ok(false),
+        }
+    }
     /// False when nothing can be waiting (a queue in memory that is empty), so a poll
     /// skips [`Self::try_recv`]: in one process the loop polls its empty inputs ten
     /// times a sample, and each miss would still copy a whole sample's slot.

@@ -179,7 +179,8 @@ impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> IpcPublisher<T> {
 }
 
 impl<T: Debug + ZeroCopySend + Copy + Sequenced + 'static> Publish<T> for IpcPublisher<T> {
-    fn publish(&mut self, mut value: T, control: bool) -> Result<(), LinkError> {
+    fn publish(&mut self, value: &T, control: bool) -> Result<(), LinkError> {
+        let mut value = *value;
         self.stats.stamp(&mut value, control);
         let n = map(
             self.publisher.send_copy(value),

@@ -44,10 +44,13 @@ pub fn stream<T>() -> (MemoryPublisher<T>, MemorySubscriber<T>) {
     )
 }
 
-impl<T: Sequenced> Publish<T> for MemoryPublisher<T> {
-    fn publish(&mut self, mut value: T, control: bool) -> Result<(), LinkError> {
-        self.stats.stamp(&mut value, control);
-        self.queue.borrow_mut().push_back(value);
+impl<T: Sequenced + Clone> Publish<T> for MemoryPublisher<T> {
+    fn publish(&mut self, value: &T, control: bool) -> Result<(), LinkError> {
+        let mut queue = self.queue.borrow_mut();
+        queue.push_back(value.clone());
+        if let Some(v) = queue.back_mut() {
+            self.stats.stamp(v, control);
+        }
         self.stats.count(1, control);
         Ok(())
     }
@@ -57,13 +60,24 @@ impl<T: Sequenced> Publish<T> for MemoryPublisher<T> {
     }
 }
 
-impl<T: Sequenced> Subscribe<T> for MemorySubscriber<T> {
+impl<T: Sequenced + Clone> Subscribe<T> for MemorySubscriber<T> {
     fn try_recv(&mut self) -> Result<Option<T>, LinkError> {
         let got = self.queue.borrow_mut().pop_front();
         if let Some(v) = &got {
             self.stats.count(v, &mut self.next);
         }
         Ok(got)
+    }
+
+    fn recv_into(&mut self, slot: &mut T) -> Result<bool, LinkError> {
+        let mut queue = self.queue.borrow_mut();
+        let Some(v) = queue.front() else {
+            return Ok(false);
+        };
+        slot.clone_from(v);
+        queue.pop_front();
+        self.stats.count(slot, &mut self.next);
+        Ok(true)
     }
 
     fn may_have(&self) -> bool {
@@ -85,7 +99,7 @@ mod tests {
         let (mut tx, mut rx) = stream::<Forward>();
         for (seq, control) in [(0, false), (1, true), (2, false)] {
             tx.publish(
-                Forward {
+                &Forward {
                     seq,
                     ..Forward::default()
                 },
@@ -98,6 +112,30 @@ mod tests {
             .collect();
         assert_eq!(got, [0, 1, 2]);
         assert_eq!(tx.stats().published, 2);
+        assert_eq!((rx.stats().received, rx.stats().overwritten), (2, 0));
+    }
+
+    #[test]
+    fn receiving_into_a_slot_takes_and_counts_as_try_recv_does() {
+        let (mut tx, mut rx) = stream::<Forward>();
+        let mut slot = Forward {
+            seq: 99,
+            ..Forward::default()
+        };
+        assert!(!rx.recv_into(&mut slot).expect("recv"));
+        assert_eq!(slot.seq, 99, "an empty stream leaves the slot as it was");
+        for (seq, control) in [(0, false), (1, true), (2, false)] {
+            let f = Forward {
+                seq,
+                ..Forward::default()
+            };
+            tx.publish(&f, control).expect("publish");
+        }
+        let mut got = Vec::new();
+        while rx.recv_into(&mut slot).expect("recv") {
+            got.push(slot.seq);
+        }
+        assert_eq!(got, [0, 1, 2]);
         assert_eq!((rx.stats().received, rx.stats().overwritten), (2, 0));
     }
 }

@@ -165,7 +165,7 @@ impl<T> UdpPublisher<T> {
 }
 
 impl<T: OnWire> Publish<T> for UdpPublisher<T> {
-    fn publish(&mut self, value: T, control: bool) -> Result<(), LinkError> {
+    fn publish(&mut self, value: &T, control: bool) -> Result<(), LinkError> {
         let (socket, to) = (&self.ep.socket, self.to);
         wire::send_counted(value, control, &mut self.stats, &mut self.buf, |frame| {
             match socket.send_to(frame, to) {

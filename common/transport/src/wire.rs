@@ -119,12 +119,13 @@ pub fn encode<T: OnWire>(value: &T, buf: &mut Vec<u8>) -> Result<(), String> {
 /// it into `buf`, hands the frame to `send` (which says how many receivers it reached)
 /// and counts it: UDP and Zenoh stamp and count exactly as iceoryx2 does.
 pub fn send_counted<T: OnWire>(
-    mut value: T,
+    value: &T,
     control: bool,
     stats: &mut OutboxStats,
     buf: &mut Vec<u8>,
     send: impl FnOnce(&[u8]) -> Result<usize, crate::LinkError>,
 ) -> Result<(), crate::LinkError> {
+    let mut value = *value;
     stats.stamp(&mut value, control);
     encode(&value, buf).map_err(|e| crate::LinkError::new("encoding a sample", e))?;
     let receivers = send(buf)?;

@@ -198,7 +198,7 @@ impl<T> ZenohPublisher<T> {
 }
 
 impl<T: OnWire> Publish<T> for ZenohPublisher<T> {
-    fn publish(&mut self, value: T, control: bool) -> Result<(), LinkError> {
+    fn publish(&mut self, value: &T, control: bool) -> Result<(), LinkError> {
         let (publisher, name) = (&self.publisher, self.stream.name());
         wire::send_counted(value, control, &mut self.stats, &mut self.buf, |frame| {
             publisher

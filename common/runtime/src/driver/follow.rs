@@ -6,7 +6,7 @@
 //! call the handler's idle tick when input goes silent.
 
 use super::link::{Arrival, Block, Idle, Link};
-use super::{Counts, Failure, Follower, Io, Timing};
+use super::{Counts, Failure, Follower, Io, Reply, Timing};
 use crate::pace::Pacer;
 use std::time::{Duration, Instant};
 use tactile_devices::{DeviceCounters, LiveSink};
@@ -97,6 +97,11 @@ pub struct Follow<H: Follower> {
     /// When the idle tick is due (None: no input yet, or no idle tick).
     idle_at: Option<Instant>,
     device_seen: DeviceCounters,
+    /// Where [`Follow::step`] takes each sample and handles it (kept from step to
+    /// step; None only while a step holds it).
+    slot: Option<Box<Arrival>>,
+    /// What the handler made of the sample in hand, emptied before each.
+    reply: Reply<H::Sample>,
 }
 
 impl<H: Follower> std::fmt::Debug for Follow<H> {
@@ -143,6 +148,8 @@ impl<H: Follower> Follow<H> {
             last_seq: 0,
             idle_at: None,
             device_seen: DeviceCounters::default(),
+            slot: None,
+            reply: Reply::default(),
         }
     }
 
@@ -173,8 +180,8 @@ impl<H: Follower> Follow<H> {
             let paced = pacing(&self.pacer, self.awaiting);
             let (got, waiting) = self.link.recv_paced(paced, until, block)?;
             match got {
-                Ok(a) => {
-                    if self.handle(a, waiting)? == Flow::End {
+                Ok(mut a) => {
+                    if self.handle(&mut a, waiting)? == Flow::End {
                         // The master's end came, but if this node was asked to stop
                         // too (SIGTERM to the whole run, its launcher gone), it was
                         // interrupted like the master: one ending for one cause.
@@ -191,14 +198,18 @@ impl<H: Follower> Follow<H> {
     /// Handles every sample already waiting, without waiting for more (the
     /// in-process runner's step): whether any came, and whether the run ended.
     pub fn step(&mut self) -> Result<(bool, Flow), Failure> {
+        let mut slot = self
+            .slot
+            .take()
+            .unwrap_or_else(|| Box::new(Arrival::Forward(Forward::default())));
         let mut any = false;
-        while let Some(a) = self.link.poll()? {
+        let mut flow = Flow::Continue;
+        while flow == Flow::Continue && self.link.poll_into(&mut slot)? {
             any = true;
-            if self.handle(a, false)? == Flow::End {
-                return Ok((true, Flow::End));
-            }
+            flow = self.handle(&mut slot, false)?;
         }
-        Ok((any, Flow::Continue))
+        self.slot = Some(slot);
+        Ok((any, flow))
     }
 
     fn wait_for_device(&mut self) -> Result<bool, Failure> {
@@ -229,8 +240,9 @@ impl<H: Follower> Follow<H> {
         }
     }
 
-    /// One arrival: this run's or dropped, control or data.
-    fn handle(&mut self, a: Arrival, waiting: bool) -> Result<Flow, Failure> {
+    /// One arrival: this run's or dropped, control or data. Stamped where it is: a
+    /// sample is hundreds of bytes.
+    fn handle(&mut self, a: &mut Arrival, waiting: bool) -> Result<Flow, Failure> {
         let (token, _) = a.run_and_seq();
         let mut joined = None;
         if !self.filter.admit(token, &mut joined) {
@@ -252,7 +264,7 @@ impl<H: Follower> Follow<H> {
 
     /// A probe or the end of the run: passed on forward, or at the end of the chain a
     /// probe echoed back.
-    fn control(&mut self, c: Forward) -> Result<Flow, Failure> {
+    fn control(&mut self, c: &Forward) -> Result<Flow, Failure> {
         if self.place == Place::Middle {
             self.link.send_forward(c, true)?;
         } else if c.signal.flags & FLAG_PROBE != 0 {
@@ -262,7 +274,7 @@ impl<H: Follower> Follow<H> {
                 ..Backward::default()
             };
             echo.signal.flags = FLAG_PROBE;
-            self.link.send_backward(echo, true)?;
+            self.link.send_backward(&echo, true)?;
         }
         if c.signal.flags & FLAG_END != 0 {
             Events::event(&mut self.rec, self.last_seq, "end of run from the master")?;
@@ -273,7 +285,7 @@ impl<H: Follower> Follow<H> {
 
     /// A forward data sample: stamped, handed to the handler, its reply sent on,
     /// then recorded.
-    fn forward(&mut self, mut c: Forward, waiting: bool) -> Result<(), Failure> {
+    fn forward(&mut self, c: &mut Forward, waiting: bool) -> Result<(), Failure> {
         if !self.seen_first {
             self.seen_first = true;
             Events::event(&mut self.rec, c.seq, "first sample from the master")?;
@@ -291,16 +303,18 @@ impl<H: Follower> Follow<H> {
             &self.timing,
             &none,
         );
-        let reply = self.handler.forward(&c, &mut io)?;
+        let reply = &mut self.reply;
+        *reply = Reply::default();
+        self.handler.forward(c, reply, &mut io)?;
         let mut sent = false;
-        if let Some(mut v) = reply.forward {
+        if let Some(v) = &mut reply.forward {
             self.awaiting = Some(v.seq);
             v.stamps[fwd_send] = self.timing.stamp();
             sent |= self.link.send_forward(v, false)?;
         } else if self.place == Place::Middle {
-            self.dropped(c.seq, c.run)?;
+            Self::dropped(&mut self.link, self.timing, c.seq, c.run)?;
         }
-        if let Some(mut h) = reply.backward {
+        if let Some(h) = &mut reply.backward {
             h.run = c.run;
             h.stamps[bwd_send] = self.timing.stamp();
             sent |= self.link.send_backward(h, false)?;
@@ -319,7 +333,7 @@ impl<H: Follower> Follow<H> {
             &none,
         );
         self.handler.after(&mut io);
-        self.finish(c.seq, reply.record)?;
+        self.finish(c.seq)?;
         // Lockstep has no clock: silence is slowness, not a lost master, and a held
         // step would change the signals with the machine's load.
         self.idle_at = self
@@ -333,8 +347,8 @@ impl<H: Follower> Follow<H> {
     /// Lockstep: tells the master that sample `seq` was dropped here, so it counts the
     /// miss at once (in realtime the tick's deadline does; in one process, the
     /// runner sees nothing more can come).
-    fn dropped(&mut self, seq: u64, run: u64) -> Result<(), Failure> {
-        if self.timing != Timing::Lockstep {
+    fn dropped(link: &mut Link, timing: Timing, seq: u64, run: u64) -> Result<(), Failure> {
+        if timing != Timing::Lockstep {
             return Ok(());
         }
         let mut notice = Backward {
@@ -343,31 +357,33 @@ impl<H: Follower> Follow<H> {
             ..Backward::default()
         };
         notice.signal.flags = FLAG_DROPPED;
-        self.link.send_backward(notice, true)?;
+        link.send_backward(&notice, true)?;
         Ok(())
     }
 
     /// A backward data sample (at the emulator): stamped, handed over, its reply sent
     /// back, recorded.
-    fn backward(&mut self, mut h: Backward) -> Result<(), Failure> {
+    fn backward(&mut self, h: &mut Backward) -> Result<(), Failure> {
         h.stamps[stage::EMU_BWD_RECV] = self.timing.stamp();
         if self.awaiting.is_some_and(|s| h.seq >= s) {
             self.awaiting = None;
         }
         let none = || Vec::new();
         let mut io = Io::new(&mut self.rec, 0, &self.timing, &none);
-        let reply = self.handler.backward(&h, &mut io)?;
-        if let Some(mut q) = reply.backward {
+        let reply = &mut self.reply;
+        *reply = Reply::default();
+        self.handler.backward(h, reply, &mut io)?;
+        if let Some(q) = &mut reply.backward {
             q.stamps[stage::EMU_BWD_SEND] = self.timing.stamp();
             self.link.send_backward(q, false)?;
         } else {
-            self.dropped(h.seq, h.run)?;
+            Self::dropped(&mut self.link, self.timing, h.seq, h.run)?;
         }
-        self.finish(h.seq, reply.record)
+        self.finish(h.seq)
     }
 
-    /// The live view's state of sample `n`, and the record.
-    fn finish(&mut self, n: u64, record: Option<H::Sample>) -> Result<(), Failure> {
+    /// The live view's state of sample `n`, and the record of the reply.
+    fn finish(&mut self, n: u64) -> Result<(), Failure> {
         if let Some(l) = &mut self.live {
             if l.due(n) {
                 if let Some(state) = self.handler.live() {
@@ -375,7 +391,7 @@ impl<H: Follower> Follow<H> {
                 }
             }
         }
-        if let Some(r) = &record {
+        if let Some(r) = &self.reply.record {
             self.rec.sample(r)?;
         }
         Ok(())
@@ -453,7 +469,7 @@ fn answer_waiting(
                     ..Backward::default()
                 };
                 echo.signal.flags = FLAG_PROBE | FLAG_WAITING;
-                link.send_backward(echo, true)?;
+                link.send_backward(&echo, true)?;
             }
         }
     }
@@ -479,19 +495,25 @@ mod tests {
     }
 
     impl Follower for Pass {
-        fn forward(&mut self, c: &Forward, _: &mut Io) -> Result<Reply<u64>, Failure> {
-            Ok(Reply {
-                forward: Some(*c),
-                backward: None,
-                record: Some(c.seq),
-            })
+        fn forward(
+            &mut self,
+            c: &Forward,
+            out: &mut Reply<u64>,
+            _: &mut Io,
+        ) -> Result<(), Failure> {
+            out.forward = Some(*c);
+            out.record = Some(c.seq);
+            Ok(())
         }
-        fn backward(&mut self, h: &Backward, _: &mut Io) -> Result<Reply<u64>, Failure> {
-            Ok(Reply {
-                forward: None,
-                backward: Some(*h),
-                record: Some(h.seq),
-            })
+        fn backward(
+            &mut self,
+            h: &Backward,
+            out: &mut Reply<u64>,
+            _: &mut Io,
+        ) -> Result<(), Failure> {
+            out.backward = Some(*h);
+            out.record = Some(h.seq);
+            Ok(())
         }
     }
 
@@ -516,13 +538,13 @@ mod tests {
                 .forward_out
                 .as_mut()
                 .expect("c")
-                .publish(s, false)
+                .publish(&s, false)
                 .expect("c");
         };
         let mut paced_after = Vec::new();
         let step = |f: &mut Follow<Pass>| {
-            let a = f.link.poll().expect("poll").expect("a sample");
-            f.handle(a, false).expect("handle");
+            let mut a = f.link.poll().expect("poll").expect("a sample");
+            f.handle(&mut a, false).expect("handle");
             pacing(&f.pacer, f.awaiting).is_some()
         };
         c(0);
@@ -537,7 +559,7 @@ mod tests {
                 .backward_out
                 .as_mut()
                 .expect("h")
-                .publish(s, false)
+                .publish(&s, false)
                 .expect("h");
         };
         h(0);

@@ -213,7 +213,7 @@ impl<H: Leader> Lead<H> {
                 ..Forward::default()
             };
             p.signal.flags = FLAG_PROBE;
-            self.link.send_forward(p, true)?;
+            self.link.send_forward(&p, true)?;
             k += 1;
             let deadline = Instant::now() + Duration::from_millis(20);
             loop {
@@ -287,7 +287,7 @@ impl<H: Leader> Lead<H> {
         let mut c = self.handler.tick(n, origin, &mut io)?;
         c.run = self.opts.run;
         c.stamps[stage::MASTER_SEND] = timing.stamp();
-        self.link.send_forward(c, false)?;
+        self.link.send_forward(&c, false)?;
         self.window.send(n);
         let sent = self.handler.sent(&c);
         self.rec.sample(&sent)?;
@@ -383,7 +383,7 @@ impl<H: Leader> Lead<H> {
             ..Forward::default()
         };
         end.signal.flags = FLAG_END;
-        self.link.send_forward(end, true)?;
+        self.link.send_forward(&end, true)?;
         let reason = if completed {
             "completed"
         } else {

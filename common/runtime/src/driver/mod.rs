@@ -244,6 +244,8 @@ pub trait Handler {
 }
 
 /// What a follower's handler made of a sample: what goes on each way, and its record.
+/// The handler fills one its loop keeps (a reply is most of a kilobyte, and returning
+/// it by value copied it through each `Result` on the way out).
 #[derive(Debug)]
 pub struct Reply<S> {
     /// Passed on forward (v(n) at the emulator).
@@ -254,12 +256,34 @@ pub struct Reply<S> {
     pub record: Option<S>,
 }
 
+impl<S> Default for Reply<S> {
+    fn default() -> Self {
+        Reply {
+            forward: None,
+            backward: None,
+            record: None,
+        }
+    }
+}
+
 /// A node that takes what comes and passes it on: the emulator, the slave.
 pub trait Follower: Handler {
-    /// A forward sample (c(n), v(n)), stamped at its arrival.
-    fn forward(&mut self, s: &Forward, io: &mut Io) -> Result<Reply<Self::Sample>, Failure>;
-    /// A backward sample (h(n) at the emulator), stamped at its arrival.
-    fn backward(&mut self, s: &Backward, io: &mut Io) -> Result<Reply<Self::Sample>, Failure>;
+    /// A forward sample (c(n), v(n)), stamped at its arrival: what it makes of it
+    /// into `out`, which comes empty.
+    fn forward(
+        &mut self,
+        s: &Forward,
+        out: &mut Reply<Self::Sample>,
+        io: &mut Io,
+    ) -> Result<(), Failure>;
+    /// A backward sample (h(n) at the emulator), stamped at its arrival: what it
+    /// makes of it into `out`, which comes empty.
+    fn backward(
+        &mut self,
+        s: &Backward,
+        out: &mut Reply<Self::Sample>,
+        io: &mut Io,
+    ) -> Result<(), Failure>;
     /// After the reply went out: what the node does outside the loop (the robot's
     /// command).
     fn after(&mut self, _io: &mut Io) {}

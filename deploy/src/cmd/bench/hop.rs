@@ -38,7 +38,7 @@ pub fn echo(prefix: &str, spin: Duration) -> Result<(), Failure> {
         match link.wait(deadline, &mut OnTransports)? {
             Ok(Arrival::Forward(f)) if f.signal.flags & FLAG_END != 0 => return Ok(()),
             Ok(Arrival::Forward(f)) => {
-                link.send_forward(f, f.signal.flags & FLAG_PROBE != 0)?;
+                link.send_forward(&f, f.signal.flags & FLAG_PROBE != 0)?;
             }
             Ok(Arrival::Backward(_)) | Err(Idle::Timeout) => {}
             Err(Idle::Stop) => return Ok(()),
@@ -93,7 +93,7 @@ fn find_echo(link: &mut Link) -> Result<(), Error> {
     loop {
         let mut p = Forward::default();
         p.signal.flags = FLAG_PROBE;
-        link.send_forward(p, true).map_err(fail)?;
+        link.send_forward(&p, true).map_err(fail)?;
         let until = Instant::now() + Duration::from_millis(20);
         if link.wait(until, &mut OnTransports).map_err(fail)?.is_ok() {
             break;
@@ -124,7 +124,7 @@ fn ping(link: &mut Link, rate: f64, n: u64) -> Result<(Latency, u64), Error> {
             seq: i,
             ..Forward::default()
         };
-        link.send_forward(ping, false).map_err(fail)?;
+        link.send_forward(&ping, false).map_err(fail)?;
         let deadline = Instant::now() + Duration::from_nanos(t_s);
         loop {
             match link.wait(deadline, &mut OnTransports).map_err(fail)? {
@@ -142,7 +142,7 @@ fn ping(link: &mut Link, rate: f64, n: u64) -> Result<(Latency, u64), Error> {
     }
     let mut end = Forward::default();
     end.signal.flags = FLAG_END;
-    link.send_forward(end, true).map_err(fail)?;
+    link.send_forward(&end, true).map_err(fail)?;
     Ok((lat, misses))
 }
 
