@@ -31,8 +31,8 @@ pub trait Publish<T> {
     /// Publishes a copy of `value`, stamped with this hop's publish counter and
     /// counted, or, with `control` (a start-up probe, the end of a run), marked so
     /// neither end counts it. By reference: a sample is hundreds of bytes, and the
-    /// transport copies it once, where it goes (a queue's slot, shared memory, a
-    /// datagram's encoding).
+    /// in-memory queue copies it once, into its slot (the other transports copy it to
+    /// stamp it, then into shared memory or an encoding).
     fn publish(&mut self, value: &T, control: bool) -> Result<(), LinkError>;
     /// What it counted.
     fn stats(&self) -> OutboxStats;
@@ -57,7 +57,7 @@ pub trait Subscribe<T> {
         }
     }
     /// False when nothing can be waiting (a queue in memory that is empty), so a poll
-    /// skips [`Self::try_recv`]: in one process the loop polls its empty inputs ten
+    /// skips [`Self::try_recv`] (or [`Self::recv_into`]): in one process the loop polls its empty inputs ten
     /// times a sample, and each miss would still copy a whole sample's slot.
     fn may_have(&self) -> bool {
         true

@@ -48,6 +48,7 @@ impl<T: Sequenced + Clone> Publish<T> for MemoryPublisher<T> {
     fn publish(&mut self, value: &T, control: bool) -> Result<(), LinkError> {
         let mut queue = self.queue.borrow_mut();
         queue.push_back(value.clone());
+        // Always there: it was just pushed.
         if let Some(v) = queue.back_mut() {
             self.stats.stamp(v, control);
         }

@@ -97,8 +97,8 @@ pub struct Follow<H: Follower> {
     /// When the idle tick is due (None: no input yet, or no idle tick).
     idle_at: Option<Instant>,
     device_seen: DeviceCounters,
-    /// Where [`Follow::step`] takes each sample and handles it (kept from step to
-    /// step; None only while a step holds it).
+    /// Where [`Follow::step`] takes each sample and handles it, kept from step to step
+    /// (None before the first step, while a step holds it, and after one failed).
     slot: Option<Box<Arrival>>,
     /// What the handler made of the sample in hand, emptied before each.
     reply: Reply<H::Sample>,

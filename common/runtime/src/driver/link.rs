@@ -106,8 +106,8 @@ impl Link {
     }
 
     /// [`Link::poll`] into `slot`, backward first: true if a sample came (then it is
-    /// in `slot`), false if none (`slot` then holds no sample to handle). A sample is
-    /// copied once, from its stream to `slot`.
+    /// in `slot`), false if none (`slot` then holds no sample to handle). From an
+    /// in-memory stream a sample is copied once, from its queue to `slot`.
     pub fn poll_into(&mut self, slot: &mut Arrival) -> Result<bool, LinkError> {
         if let Some(b) = self.ports.backward_in.as_mut().filter(|b| b.may_have()) {
             if !matches!(slot, Arrival::Backward(_)) {
