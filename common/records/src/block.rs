@@ -120,8 +120,8 @@ pub fn to_planes(rows: &[u8], lens: &[usize], out: &mut Vec<u8>, scratch: &mut V
         out.resize(planes_at + kept * r, 0);
         let (head, planes) = out.split_at_mut(planes_at);
         let bitmap = &mut head[bitmap_at..];
-        // Eight columns at a time: their bitmap byte, then their kept planes, one
-        // after another.
+        // Eight columns at a time: their byte of the bitmap (which comes before all
+        // the planes), and their kept planes after those of the columns before them.
         let mut at = 0;
         for (c0, any) in (0..len).step_by(8).zip(any.chunks(8)) {
             let mask = any
@@ -133,26 +133,25 @@ pub fn to_planes(rows: &[u8], lens: &[usize], out: &mut Vec<u8>, scratch: &mut V
             let here = &mut planes[at..at + n * r];
             at += n * r;
             if any.len() == 8 && n >= TILE_PLANES {
-                planes_by_tiles(deltas, len, c0, mask, here);
+                planes_by_tiles(deltas, len, r, c0, mask, here);
             } else {
-                planes_by_bytes(deltas, len, c0, mask, 0, here);
+                planes_by_bytes(deltas, len, r, c0, mask, 0, here);
             }
         }
     }
 }
 
-/// Kept planes of eight or more columns a tile takes fewer steps than byte by byte
-/// (`cargo bench -p tactile-records --bench blocks`, and the `block_sizes` example on a
-/// real run's rows): a tile moves all eight of its columns, and most of a real row's
-/// eight-byte runs keep only a few.
+/// Kept planes, of a run of eight columns, from which the run goes by tiles. A tile
+/// moves all eight columns, kept or not: tiles on every run made the million-sample
+/// run slower, tiles from 4 kept planes left it with a lower median (docs/06). 2, 3
+/// and 6 measured the same as 4 on a real run's rows (the `block_sizes` example).
 const TILE_PLANES: usize = 4;
 
 /// The planes of columns `c0..c0 + 8` picked by `mask` (bit `j`: column `c0 + j`),
-/// from `deltas` (rows of `len` bytes) into `out` one after another, eight rows at a
-/// time as 8-by-8 tiles transposed in registers, the rows past the last whole tile
+/// from `deltas` (`r` rows of `len` bytes) into `out` one after another, eight rows at
+/// a time as 8-by-8 tiles transposed in registers, the rows past the last whole tile
 /// byte by byte.
-fn planes_by_tiles(deltas: &[u8], len: usize, c0: usize, mask: u8, out: &mut [u8]) {
-    let r = deltas.len() / len;
+fn planes_by_tiles(deltas: &[u8], len: usize, r: usize, c0: usize, mask: u8, out: &mut [u8]) {
     let whole = r / 8 * 8;
     for i0 in (0..whole).step_by(8) {
         let mut tile = [0u64; 8];
@@ -171,13 +170,20 @@ fn planes_by_tiles(deltas: &[u8], len: usize, c0: usize, mask: u8, out: &mut [u8
             }
         }
     }
-    planes_by_bytes(deltas, len, c0, mask, whole, out);
+    planes_by_bytes(deltas, len, r, c0, mask, whole, out);
 }
 
-/// The planes of columns `c0 + j` for each bit `j` of `mask`, rows `from..` of
-/// `deltas` (rows of `len` bytes), into `out` one after another (each `r` long).
-fn planes_by_bytes(deltas: &[u8], len: usize, c0: usize, mask: u8, from: usize, out: &mut [u8]) {
-    let r = deltas.len() / len.max(1);
+/// The planes of columns `c0 + j` for each bit `j` of `mask`, rows `from..r` of
+/// `deltas` (`r` rows of `len` bytes), into `out` one after another (each `r` long).
+fn planes_by_bytes(
+    deltas: &[u8],
+    len: usize,
+    r: usize,
+    c0: usize,
+    mask: u8,
+    from: usize,
+    out: &mut [u8],
+) {
     let kept = (0..8).filter(|j| mask & (1 << j) != 0);
     for (n, j) in kept.enumerate() {
         for (o, i) in out[n * r + from..(n + 1) * r].iter_mut().zip(from..r) {
@@ -453,6 +459,37 @@ mod tests {
             prop_assert_eq!(&planes[..3], &[1, 2, 3]);
             let want = planes_by_definition(&flat, &lens);
             prop_assert_eq!(&planes[3..], want.as_slice());
+        }
+    }
+
+    /// Every choice of kept planes in a run of eight columns, by tiles or byte by
+    /// byte, whole tiles or not, a last run of fewer than eight columns or not: the
+    /// planes their definition gives. Column `c` changes from row to row only if bit
+    /// `c % 8` of the mask is set.
+    #[test]
+    fn every_mask_of_kept_planes_lays_out_as_defined() {
+        for mask in 0..=255u8 {
+            for rows in [1, 2, 8, 9, 10, 17] {
+                for len in [8, 11, 16, 19] {
+                    let flat: Vec<u8> = (0..rows)
+                        .flat_map(|i| {
+                            (0..len).map(move |c| {
+                                let changes = mask & (1 << (c % 8)) != 0;
+                                let v = if changes { i * 31 + c * 7 } else { c };
+                                (v % 251) as u8
+                            })
+                        })
+                        .collect();
+                    let lens = vec![len; rows];
+                    let mut planes = Vec::new();
+                    to_planes(&flat, &lens, &mut planes, &mut Vec::new());
+                    assert_eq!(
+                        planes,
+                        planes_by_definition(&flat, &lens),
+                        "mask {mask:08b}, {rows} rows of {len}"
+                    );
+                }
+            }
         }
     }
 
