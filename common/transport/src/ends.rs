@@ -57,8 +57,9 @@ pub trait Subscribe<T> {
         }
     }
     /// False when nothing can be waiting (a queue in memory that is empty), so a poll
-    /// skips [`Self::try_recv`] (or [`Self::recv_into`]): in one process the loop polls its empty inputs ten
-    /// times a sample, and each miss would still copy a whole sample's slot.
+    /// skips [`Self::try_recv`] (or [`Self::recv_into`]): in one process the loop
+    /// polls its empty inputs ten times a sample, and each miss would still copy a
+    /// whole sample's slot.
     fn may_have(&self) -> bool {
         true
     }

@@ -116,8 +116,9 @@ pub fn encode<T: OnWire>(value: &T, buf: &mut Vec<u8>) -> Result<(), String> {
 }
 
 /// Stamps a copy of `value` with its hop's next publish counter (or the control
-/// marker), encodes it into `buf`, hands the frame to `send` (which says how many receivers it reached)
-/// and counts it: UDP and Zenoh stamp and count exactly as iceoryx2 does.
+/// marker), encodes it into `buf`, hands the frame to `send` (which says how many
+/// receivers it reached) and counts it: UDP and Zenoh stamp and count exactly as
+/// iceoryx2 does.
 pub fn send_counted<T: OnWire>(
     value: &T,
     control: bool,
