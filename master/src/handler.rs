@@ -8,7 +8,7 @@ use crate::hmd::Master;
 use tactile_devices::held::Held;
 use tactile_devices::{Change, HapticDevice, Peripheral};
 use tactile_messages::samples::{stage, Backward, Forward};
-use tactile_records::master::{Answer, MasterCounters, MasterSample, MasterTotals, Sent};
+use tactile_records::master::{MasterCounters, MasterSample, MasterTotals, Sent};
 use tactile_ros::msg::SampleTiming;
 use tactile_ros::view::{MasterView, SampleView};
 use tactile_runtime::driver::{changed, Counts, Failure, Handler, Io, Leader};
@@ -23,7 +23,9 @@ pub struct MasterHandler {
     peer_timeout: u64,
     /// The sample in hand, as it went out.
     sent: Sent,
-    last_answer: Option<Answer>,
+    /// The last answer as the live view shows it: its sample, q(n)'s value and its
+    /// timing (an answer's record is 336 bytes, copied here at every answer before).
+    heard: Option<(u64, [f64; 3], SampleTiming)>,
     /// The force the operator was last made to feel (zero while the device is lost).
     felt: [f64; 3],
     clamps_seen: (u64, u64),
@@ -47,7 +49,7 @@ impl MasterHandler {
             held: Held::default(),
             peer_timeout,
             sent: Sent::default(),
-            last_answer: None,
+            heard: None,
             felt: [0.0; 3],
             clamps_seen: (0, 0),
         }
@@ -113,7 +115,7 @@ impl Handler for MasterHandler {
 
     fn live(&self) -> Option<SampleView> {
         let s = &self.sent;
-        let a = self.last_answer.filter(|a| a.n == s.n);
+        let a = self.heard.filter(|(n, ..)| *n == s.n);
         let master = MasterView {
             theta: s.theta_md,
             velocity: None,
@@ -121,19 +123,13 @@ impl Handler for MasterHandler {
             target: s.target,
             handle: s.handle,
             rotation: s.rotation.unwrap_or(tactile_ros::msg::IDENTITY),
-            q: a.map_or([0.0; 3], |a| a.q.value),
+            q: a.map_or([0.0; 3], |(_, q, _)| q),
             felt: self.felt,
         };
         let timing = SampleTiming {
             sample: s.n,
             answered: a.is_some(),
-            round_trip_ns: a.map_or(0, |a| a.round_trip_ns as i64),
-            overhead_ns: a.map_or(0, |a| a.overhead_ns),
-            delay_backward: a.map_or([0; 3], |a| a.q.delay_samples),
-            flags_backward: a.map_or(0, |a| a.q.flags),
-            flags_master: a.map_or(0, |a| a.effect.flags),
-            observer_master: a.map_or([0.0; 3], |a| a.effect.observer),
-            ..SampleTiming::default()
+            ..a.map_or_else(SampleTiming::default, |(.., t)| t)
         };
         Some(SampleView {
             master: Some(master),
@@ -146,9 +142,15 @@ impl Handler for MasterHandler {
 impl Leader for MasterHandler {
     /// b(n): the simulated hand and device, or the real device's newest angles (held
     /// while stale or lost; lost renders zero force).
-    fn tick(&mut self, n: u64, origin_ns: u64, io: &mut Io) -> Result<Forward, Failure> {
-        let (c, sent) = match self.device.as_deref_mut() {
-            None => self.master.forward(n, origin_ns),
+    fn tick(
+        &mut self,
+        n: u64,
+        origin_ns: u64,
+        io: &mut Io,
+        c: &mut Forward,
+    ) -> Result<(), Failure> {
+        match self.device.as_deref_mut() {
+            None => self.master.forward(n, origin_ns, (c, &mut self.sent)),
             Some(d) => {
                 let who = d.describe();
                 let judged = d.read(io.now());
@@ -166,12 +168,17 @@ impl Leader for MasterHandler {
                 // device is back and the button says engaged.
                 let clutch = d.clutch().map(|c| c && !self.held.lost);
                 let hand = self.held.taken.then_some(self.held.theta);
-                self.master
-                    .forward_measured(n, origin_ns, hand, d.input(), clutch)
+                self.master.forward_measured(
+                    n,
+                    origin_ns,
+                    hand,
+                    d.input(),
+                    clutch,
+                    (c, &mut self.sent),
+                );
             }
-        };
-        self.sent = sent;
-        Ok(c)
+        }
+        Ok(())
     }
 
     fn sent(&mut self, c: &Forward) -> MasterSample {
@@ -180,7 +187,13 @@ impl Leader for MasterHandler {
     }
 
     /// KFF-HMD on q(n); its round trip on the master's clock.
-    fn answer(&mut self, q: &Backward, late: bool, io: &mut Io) -> Result<MasterSample, Failure> {
+    fn answer(
+        &mut self,
+        q: &Backward,
+        late: bool,
+        io: &mut Io,
+        record: &mut Option<MasterSample>,
+    ) -> Result<(), Failure> {
         if self.master.peer_lost() {
             io.event(q.seq, "loop resumed: answers are back")?;
             if let Some(d) = self.device.as_deref_mut() {
@@ -191,8 +204,18 @@ impl Leader for MasterHandler {
         a.stamps[stage::MASTER_DONE] = io.now();
         self.master.account(&mut a);
         a.late = late;
-        self.last_answer = Some(a);
-        Ok(MasterSample::Answer(a))
+        let timing = SampleTiming {
+            round_trip_ns: a.round_trip_ns as i64,
+            overhead_ns: a.overhead_ns,
+            delay_backward: a.q.delay_samples,
+            flags_backward: a.q.flags,
+            flags_master: a.effect.flags,
+            observer_master: a.effect.observer,
+            ..SampleTiming::default()
+        };
+        self.heard = Some((a.n, a.q.value, timing));
+        *record = Some(MasterSample::Answer(a));
+        Ok(())
     }
 
     /// Hold or zero the torque, and say so when the loop breaks.

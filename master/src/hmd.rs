@@ -148,14 +148,17 @@ impl Master {
         }
     }
 
-    /// Sample n forward: operator a(n) -> MD encoders b(n) -> FK-HMD c(n).
+    /// Sample n forward: operator a(n) -> MD encoders b(n) -> FK-HMD c(n), written
+    /// with its record into `out` (filled where they lie: returned, they were copied
+    /// at each call on the way out, a dozen copies a sample).
     /// `now_ns` is the tick time; it becomes the origin timestamp of all three values.
-    pub fn forward(&mut self, n: u64, now_ns: u64) -> (Forward, Sent) {
+    pub fn forward(&mut self, n: u64, now_ns: u64, out: (&mut Forward, &mut Sent)) {
         let (target, hand_force) = match self.held.is_some() {
             false => (self.ideal_hand(n), [0.0; 3]),
             true => self.impedance_hand(n),
         };
-        let (mut f, mut sent) = self.encode(n, now_ns, target, hand_force);
+        let (f, sent) = out;
+        self.encode(n, now_ns, target, hand_force, (&mut *f, &mut *sent));
         if self.source.six_dof() {
             let t = n as f64 * self.t_s;
             let r = self.source.rotation(n, self.t_s).unwrap_or(IDENTITY);
@@ -163,9 +166,8 @@ impl Master {
                 Some(a) => a.apply_rotation(r, t),
                 None => r,
             };
-            self.turn(&mut f, &mut sent, r, self.source.engaged(n, self.t_s));
+            self.turn(f, sent, r, self.source.engaged(n, self.t_s));
         }
-        (f, sent)
     }
 
     /// A 6-DoF sample's orientation `r` and clutch onto c(n) and its record; released,
@@ -187,7 +189,8 @@ impl Master {
     /// A 6-DoF device's orientation goes relative to its first reading (the operator's
     /// home, as a trajectory's), with its clutch (`None`: none, always engaged).
     /// `hand` is `None` until the device has given a reading: the handle is then taken
-    /// to be at home, unturned (no origin is captured from it).
+    /// to be at home, unturned (no origin is captured from it). Into `out`, as
+    /// [`Master::forward`].
     pub fn forward_measured(
         &mut self,
         n: u64,
@@ -195,7 +198,8 @@ impl Master {
         hand: Option<Hand>,
         input: HandInput,
         clutch: Option<bool>,
-    ) -> (Forward, Sent) {
+        out: (&mut Forward, &mut Sent),
+    ) {
         self.pose_input = input == HandInput::Pose;
         let (hand, origin) = match hand {
             Some(h) => (h, *self.origin.get_or_insert(h)),
@@ -207,11 +211,12 @@ impl Master {
                 (home, home)
             }
         };
-        let (mut f, mut sent) = match input {
+        let (f, sent) = out;
+        match input {
             HandInput::Joints => {
                 self.theta_md = hand.point;
                 let handle = self.truth.fk(hand.point);
-                self.encode(n, now_ns, handle, [0.0; 3])
+                self.encode(n, now_ns, handle, [0.0; 3], (&mut *f, &mut *sent));
             }
             HandInput::Pose => {
                 let c = [0, 1, 2].map(|k| self.home[k] + hand.point[k] - origin.point[k]);
@@ -219,17 +224,16 @@ impl Master {
                     0 => [0.0; 3],
                     _ => [0, 1, 2].map(|k| c[k] - self.handle[k]),
                 };
-                self.encode_at(n, now_ns, (c, c, [0.0; 3]), moved)
+                self.encode_at(n, now_ns, (c, c, [0.0; 3]), moved, (&mut *f, &mut *sent));
             }
-        };
+        }
         if hand.rotation.is_some() || clutch.is_some() {
             let r = match (hand.rotation, origin.rotation) {
                 (Some(q), Some(q0)) => relative(q, q0),
                 _ => IDENTITY,
             };
-            self.turn(&mut f, &mut sent, r, clutch.unwrap_or(true));
+            self.turn(f, sent, r, clutch.unwrap_or(true));
         }
-        (f, sent)
     }
 
     /// The torques commanded now, N m.
@@ -249,28 +253,30 @@ impl Master {
         now_ns: u64,
         target: [f64; 3],
         hand_force: [f64; 3],
-    ) -> (Forward, Sent) {
+        out: (&mut Forward, &mut Sent),
+    ) {
         let c = self.engine.fk(self.theta_md);
         let moved = self.moved(n);
         let handle = self.truth.fk(self.theta_md);
-        let (f, mut sent) = self.encode_at(n, now_ns, (c, target, hand_force), moved);
+        let (f, sent) = out;
+        self.encode_at(n, now_ns, (c, target, hand_force), moved, (f, &mut *sent));
         self.handle = handle;
         sent.handle = handle;
-        (f, sent)
     }
 
     /// c(n) (`at`: c, the hand's target and its force) having `moved` since the last
-    /// sample, through the control and codec, and the record of the sample.
+    /// sample, through the control and codec, and the record of the sample, into `out`.
     fn encode_at(
         &mut self,
         n: u64,
         now_ns: u64,
         (c, target, hand_force): ([f64; 3], [f64; 3], [f64; 3]),
         moved: [f64; 3],
-    ) -> (Forward, Sent) {
+        (f, sent): (&mut Forward, &mut Sent),
+    ) {
         self.handle = c;
         self.control.measure(moved);
-        let mut f = Forward {
+        *f = Forward {
             seq: n,
             ..Forward::default()
         };
@@ -287,7 +293,7 @@ impl Master {
         f.signal.origin_ns = [now_ns; 3];
         f.stamps[stage::MASTER_TICK] = now_ns;
         self.counters.sent += 1;
-        let sent = Sent {
+        *sent = Sent {
             n,
             target,
             theta_md: self.theta_md,
@@ -299,7 +305,6 @@ impl Master {
             rotation: None,
             released: false,
         };
-        (f, sent)
     }
 
     /// The handle's displacement since the last sample, J(b(n)) (b(n) - b(n-1)), in
@@ -529,7 +534,13 @@ mod tests {
         sc.master.hand.mode = hand;
         let source = OperatorSource::load(&sc.operator, std::path::Path::new(".")).expect("op");
         let mut m = Master::new(&sc, source).expect("master");
-        (0..samples).map(|n| m.forward(n, 0).1.target).collect()
+        let (mut f, mut sent) = (Forward::default(), Sent::default());
+        (0..samples)
+            .map(|n| {
+                m.forward(n, 0, (&mut f, &mut sent));
+                sent.target
+            })
+            .collect()
     }
 
     fn home() -> [f64; 3] {

@@ -12,6 +12,20 @@ fn master(spring: f64) -> Master {
     Master::new(&sc, source).expect("master")
 }
 
+/// [`Master::forward_measured`]'s c(n) and record, returned.
+fn measured(
+    m: &mut Master,
+    n: u64,
+    now_ns: u64,
+    hand: Option<Hand>,
+    input: HandInput,
+    clutch: Option<bool>,
+) -> (Forward, Sent) {
+    let (mut f, mut sent) = (Forward::default(), Sent::default());
+    m.forward_measured(n, now_ns, hand, input, clutch, (&mut f, &mut sent));
+    (f, sent)
+}
+
 fn home() -> [f64; 3] {
     let lengths = tactile_math::geometry::Geometry::PAPER.lengths();
     tactile_math::kernels::fk(&lengths, &tactile_math::arith::StdTrig, [0.0; 3])
@@ -30,7 +44,7 @@ fn a_pose_device_starts_at_home_and_turns_from_its_first_reading() {
         point: [0.3, -0.1, 0.05],
         rotation: Some(about_z(90.0)),
     };
-    let (f, sent) = m.forward_measured(0, 0, Some(first), HandInput::Pose, None);
+    let (f, sent) = measured(&mut m, 0, 0, Some(first), HandInput::Pose, None);
     assert_eq!(f.signal.value, home());
     assert_eq!(f.rotation, IDENTITY);
     assert_eq!(f.signal.flags & (FLAG_POSE | FLAG_RELEASED), FLAG_POSE);
@@ -39,7 +53,7 @@ fn a_pose_device_starts_at_home_and_turns_from_its_first_reading() {
         point: [0.31, -0.1, 0.03],
         rotation: Some(about_z(120.0)),
     };
-    let (f, _) = m.forward_measured(1, 1, Some(later), HandInput::Pose, None);
+    let (f, _) = measured(&mut m, 1, 1, Some(later), HandInput::Pose, None);
     let want = [home()[0] + 0.01, home()[1], home()[2] - 0.02];
     for (got, want) in f.signal.value.iter().zip(want) {
         assert!((got - want).abs() < 1e-15, "{:?}", f.signal.value);
@@ -66,8 +80,8 @@ fn a_turn_is_measured_about_the_bases_axes() {
         point: [0.0; 3],
         rotation: Some(r),
     };
-    m.forward_measured(0, 0, Some(at(x90)), HandInput::Pose, None);
-    let (f, _) = m.forward_measured(1, 1, Some(at(turned)), HandInput::Pose, None);
+    measured(&mut m, 0, 0, Some(at(x90)), HandInput::Pose, None);
+    let (f, _) = measured(&mut m, 1, 1, Some(at(turned)), HandInput::Pose, None);
     for (got, want) in f.rotation.iter().zip(about_z(30.0)) {
         assert!((got - want).abs() < 1e-12, "{:?}", f.rotation);
     }
@@ -78,14 +92,14 @@ fn a_turn_is_measured_about_the_bases_axes() {
 #[test]
 fn no_origin_is_taken_before_the_device_is_read() {
     let mut m = master(0.0);
-    let (f, _) = m.forward_measured(0, 0, None, HandInput::Pose, Some(false));
+    let (f, _) = measured(&mut m, 0, 0, None, HandInput::Pose, Some(false));
     assert_eq!(f.signal.value, home());
     assert_eq!(f.rotation, IDENTITY);
     let first = Hand {
         point: [0.3, 0.2, 0.1],
         rotation: Some(about_z(45.0)),
     };
-    let (f, _) = m.forward_measured(1, 1, Some(first), HandInput::Pose, Some(true));
+    let (f, _) = measured(&mut m, 1, 1, Some(first), HandInput::Pose, Some(true));
     assert_eq!(f.signal.value, home());
     assert_eq!(f.rotation, IDENTITY);
 }
@@ -94,7 +108,7 @@ fn no_origin_is_taken_before_the_device_is_read() {
 #[test]
 fn a_pose_device_has_no_torques_to_clamp() {
     let mut m = master(0.0);
-    m.forward_measured(0, 0, Some(Hand::default()), HandInput::Pose, None);
+    measured(&mut m, 0, 0, Some(Hand::default()), HandInput::Pose, None);
     m.backward(&answer(0, [3.0, 3.0, 3.0]));
     assert_eq!(m.tau(), [0.0; 3]);
     assert_eq!(m.counters().torque_clamps, 0);
@@ -109,7 +123,7 @@ fn a_3dof_device_without_a_clutch_sends_what_it_always_did() {
         point: theta,
         rotation: None,
     };
-    let (f, sent) = m.forward_measured(0, 0, Some(hand), HandInput::Joints, None);
+    let (f, sent) = measured(&mut m, 0, 0, Some(hand), HandInput::Joints, None);
     assert_eq!(f.signal.flags & FLAG_POSE, 0);
     assert_eq!(sent.theta_md, theta);
     let truth = tactile_math::kernels::fk(
@@ -141,11 +155,11 @@ fn released_the_hand_feels_the_spring_not_the_robot() {
             point: [x, 0.0, 0.0],
             rotation: None,
         };
-        m.forward_measured(0, 0, Some(at(0.0)), HandInput::Pose, Some(true));
+        measured(&mut m, 0, 0, Some(at(0.0)), HandInput::Pose, Some(true));
         m.backward(&answer(0, [1.0, 0.5, 0.0]));
         assert_eq!(m.felt(), [1.0, 0.5, 0.0], "engaged: the robot's force");
         // Released 2 cm to the right of where it started.
-        let (f, sent) = m.forward_measured(1, 1, Some(at(0.02)), HandInput::Pose, Some(false));
+        let (f, sent) = measured(&mut m, 1, 1, Some(at(0.02)), HandInput::Pose, Some(false));
         assert_ne!(f.signal.flags & FLAG_RELEASED, 0);
         assert!(sent.released);
         m.backward(&answer(1, [1.0, 0.5, 0.0]));
@@ -156,7 +170,7 @@ fn released_the_hand_feels_the_spring_not_the_robot() {
         );
         assert_eq!([felt[1], felt[2]], [0.0, 0.0]);
         // Engaged again: the robot's force.
-        m.forward_measured(2, 2, Some(at(0.02)), HandInput::Pose, Some(true));
+        measured(&mut m, 2, 2, Some(at(0.02)), HandInput::Pose, Some(true));
         m.backward(&answer(2, [1.0, 0.5, 0.0]));
         assert_eq!(m.felt(), [1.0, 0.5, 0.0]);
     }
@@ -169,8 +183,15 @@ fn the_spring_stays_within_the_force_limit() {
         point: [0.5, 0.0, 0.0],
         rotation: None,
     };
-    m.forward_measured(0, 0, Some(Hand::default()), HandInput::Pose, Some(false));
-    m.forward_measured(1, 1, Some(far), HandInput::Pose, Some(false));
+    measured(
+        &mut m,
+        0,
+        0,
+        Some(Hand::default()),
+        HandInput::Pose,
+        Some(false),
+    );
+    measured(&mut m, 1, 1, Some(far), HandInput::Pose, Some(false));
     m.backward(&answer(1, [0.0; 3]));
     assert_eq!(m.felt()[0], -3.3);
 }

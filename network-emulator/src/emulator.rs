@@ -138,68 +138,80 @@ impl Emulator {
         self.counters
     }
 
-    /// c(n) in, v(n) out (`None` when the loss model drops it), and the record of it.
-    pub fn forward(&mut self, c: &Forward) -> (Option<Forward>, Passage) {
-        let mut v = *c;
+    /// c(n) in: v(n) into `v` (`None` when the loss model drops it) and the record of
+    /// it into `record`. Both are filled where they lie: they are hundreds of bytes
+    /// each, and returning them copied each on its way out to the follower's reply.
+    pub fn forward(&mut self, c: &Forward, v: &mut Option<Forward>, record: &mut Option<Passage>) {
+        let out = v.insert(*c);
         let (fate, noise, jitter, lost, duplicated) = pass(
             &mut self.forward,
             &mut self.forward_faults,
             c.seq,
-            &mut v.signal,
-            &mut v.rotation,
+            &mut out.signal,
+            &mut out.rotation,
         );
         let k = &mut self.counters;
         k.forward += 1;
-        k.forward_substituted += u64::from(v.signal.flags & FLAG_SUBSTITUTED != 0);
+        k.forward_substituted += u64::from(out.signal.flags & FLAG_SUBSTITUTED != 0);
         k.forward_corrupted += u64::from(fate == Fate::Corrupt);
         k.forward_dropped += u64::from(fate == Fate::Drop);
         k.forward_packets_lost += u64::from(lost);
         k.forward_duplicated += u64::from(duplicated);
-        let record = Passage {
+        *record = Some(Passage {
             dir: Direction::Forward,
             n: c.seq,
             input: c.signal.value,
-            out: v.signal,
-            rotational: (c.signal.flags & FLAG_POSE != 0).then_some(v.rotation),
+            out: out.signal,
+            rotational: (c.signal.flags & FLAG_POSE != 0).then_some(out.rotation),
             noise,
             jitter,
             lost,
             fate,
-        };
-        ((fate != Fate::Drop).then_some(v), record)
+        });
+        if fate == Fate::Drop {
+            *v = None;
+        }
     }
 
-    /// h(n) in, q(n) out (`None` when the loss model drops it), and the record of it.
-    pub fn backward(&mut self, h: &Backward) -> (Option<Backward>, Passage) {
-        let mut q = *h;
-        let mut torque = [q.torque[0], q.torque[1], q.torque[2], 0.0];
+    /// h(n) in: q(n) into `q` (`None` when the loss model drops it) and the record of
+    /// it into `record`, filled where they lie as [`Emulator::forward`] does.
+    pub fn backward(
+        &mut self,
+        h: &Backward,
+        q: &mut Option<Backward>,
+        record: &mut Option<Passage>,
+    ) {
+        let out = q.insert(*h);
+        let mut torque = [h.torque[0], h.torque[1], h.torque[2], 0.0];
         let (fate, noise, jitter, lost, duplicated) = pass(
             &mut self.backward,
             &mut self.backward_faults,
             h.seq,
-            &mut q.signal,
+            &mut out.signal,
             &mut torque,
         );
-        q.torque = [torque[0], torque[1], torque[2]];
+        out.torque = [torque[0], torque[1], torque[2]];
         let k = &mut self.counters;
         k.backward += 1;
-        k.backward_substituted += u64::from(q.signal.flags & FLAG_SUBSTITUTED != 0);
+        k.backward_substituted += u64::from(out.signal.flags & FLAG_SUBSTITUTED != 0);
         k.backward_corrupted += u64::from(fate == Fate::Corrupt);
         k.backward_dropped += u64::from(fate == Fate::Drop);
         k.backward_packets_lost += u64::from(lost);
         k.backward_duplicated += u64::from(duplicated);
-        let record = Passage {
+        *record = Some(Passage {
             dir: Direction::Backward,
             n: h.seq,
             input: h.signal.value,
-            out: q.signal,
+            out: out.signal,
             rotational: (h.signal.flags & FLAG_POSE != 0).then_some(torque),
             noise,
             jitter,
             lost,
             fate,
-        };
-        ((fate != Fate::Drop).then_some(q), record)
+        });
+        if fate == Fate::Drop {
+            *q = None;
+        }
     }
 }
 
@@ -236,4 +248,54 @@ fn pass(
         signal.flags |= FLAG_CORRUPTED;
     }
     (fate, e.noise, e.jitter, e.lost || model_lost, e.duplicated)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(seq: u64) -> Forward {
+        let mut c = Forward {
+            seq,
+            run: 7,
+            ..Forward::default()
+        };
+        c.signal.value = [0.1, 0.2, seq as f64];
+        c.stamps[0] = 1000 + seq;
+        c
+    }
+
+    #[test]
+    fn a_passed_sample_fills_both_slots_whatever_they_held() {
+        let mut e = Emulator::new(&Scenario::paper());
+        let mut v = Some(Forward::default());
+        let mut record = None;
+        for seq in 0..3 {
+            e.forward(&sample(seq), &mut v, &mut record);
+            let (v, r) = (v.expect("passed on"), record.expect("recorded"));
+            // No delay, no noise: c(n) through, and its record says so.
+            assert_eq!((v.seq, v.run, v.stamps), (seq, 7, sample(seq).stamps));
+            assert_eq!(v.signal.value, sample(seq).signal.value);
+            assert_eq!((r.n, r.fate, r.out), (seq, Fate::Deliver, v.signal));
+            assert_eq!(r.input, sample(seq).signal.value);
+        }
+    }
+
+    #[test]
+    fn a_dropped_sample_empties_its_slot_and_is_recorded() {
+        let mut sc = Scenario::paper();
+        sc.network.backward.loss = 1.0;
+        let mut e = Emulator::new(&sc);
+        let h = Backward {
+            seq: 4,
+            ..Backward::default()
+        };
+        let mut q = Some(Backward::default());
+        let mut record = None;
+        e.backward(&h, &mut q, &mut record);
+        assert_eq!(q, None);
+        let r = record.expect("recorded");
+        assert_eq!((r.n, r.dir, r.fate), (4, Direction::Backward, Fate::Drop));
+        assert_eq!(e.counters().backward_dropped, 1);
+    }
 }

@@ -45,9 +45,7 @@ impl Follower for EmulatorHandler {
         out: &mut Reply<Passage>,
         _: &mut Io,
     ) -> Result<(), Failure> {
-        let (v, passage) = self.emulator.forward(c);
-        out.forward = v;
-        out.record = Some(passage);
+        self.emulator.forward(c, &mut out.forward, &mut out.record);
         Ok(())
     }
 
@@ -57,9 +55,8 @@ impl Follower for EmulatorHandler {
         out: &mut Reply<Passage>,
         _: &mut Io,
     ) -> Result<(), Failure> {
-        let (q, passage) = self.emulator.backward(h);
-        out.backward = q;
-        out.record = Some(passage);
+        self.emulator
+            .backward(h, &mut out.backward, &mut out.record);
         Ok(())
     }
 }

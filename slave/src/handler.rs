@@ -11,7 +11,7 @@ use std::time::Duration;
 use tactile_devices::held::Held;
 use tactile_devices::{Peripheral, Robot};
 use tactile_messages::samples::{Backward, Forward};
-use tactile_records::slave::{ArmJoints, SlaveCounters, SlaveSample, SlaveTotals, Step};
+use tactile_records::slave::{ArmJoints, SlaveCounters, SlaveSample, SlaveTotals};
 use tactile_ros::view::{ArmSample, SampleView, SlaveView};
 use tactile_runtime::driver::{changed, Counts, Failure, Follower, Handler, Io, Reply};
 use tactile_scenario::Scenario;
@@ -119,7 +119,9 @@ pub struct SlaveHandler {
     arm_names: Option<(Arc<str>, Arc<[String]>)>,
     holding: bool,
     idle: (Duration, Duration),
-    last_step: Option<Step>,
+    /// The last step's state for the live view (a step's record is 368 bytes; the
+    /// view needs a quarter of it).
+    last_view: Option<SlaveView>,
     clamps_seen: (u64, u64),
 }
 
@@ -154,7 +156,7 @@ impl SlaveHandler {
                 hold_timeout(scenario),
                 Duration::from_nanos(scenario.t_s_ns()),
             ),
-            last_step: None,
+            last_view: None,
             clamps_seen: (0, 0),
         }
     }
@@ -205,7 +207,7 @@ impl Handler for SlaveHandler {
     }
 
     fn live(&self) -> Option<SampleView> {
-        let s = self.last_step?;
+        let s = self.last_view?;
         if let (Some(arm), Some((base, names))) = (self.slave.arm(), &self.arm_names) {
             let a = arm.state();
             return Some(SampleView {
@@ -221,13 +223,7 @@ impl Handler for SlaveHandler {
             });
         }
         Some(SampleView {
-            slave: Some(SlaveView {
-                theta: s.theta,
-                velocity: None,
-                torque: s.torque,
-                tool: s.tool,
-                force: s.force,
-            }),
+            slave: Some(s),
             ..SampleView::default()
         })
     }
@@ -255,20 +251,26 @@ impl Follower for SlaveHandler {
                 self.slave.measure_arm(q, force, torque);
             }
         }
-        let (h, step) = self.slave.step(v);
+        let step = self.slave.step(v, &mut out.backward);
         match &mut self.robot {
             Robots::None => {}
             Robots::Paper(hw) => hw.due = Some(step.theta_ref),
             Robots::Arm(hw) => hw.due = self.slave.arm_state().map(|a| a.q_ref.clone()),
         }
-        self.last_step = Some(step);
+        self.last_view = Some(SlaveView {
+            theta: step.theta,
+            velocity: None,
+            torque: step.torque,
+            tool: step.tool,
+            force: step.force,
+        });
+        let torque = out.backward.as_ref().map_or([0.0; 3], |h| h.torque);
         out.record = Some(match self.slave.arm() {
             Some(a) => {
-                SlaveSample::ArmStep(step, Box::new(joints(a, h.torque, self.slave.rotation())))
+                SlaveSample::ArmStep(step, Box::new(joints(a, torque, self.slave.rotation())))
             }
             None => SlaveSample::Step(step),
         });
-        out.backward = Some(h);
         Ok(())
     }
 

@@ -262,8 +262,10 @@ impl Slave {
         }
     }
 
-    /// One sample: v(n) in, h(n) out. Stamps are copied from `v`; the edge sets its own.
-    pub fn step(&mut self, v: &Forward) -> (Backward, Step) {
+    /// One sample: v(n) in, h(n) into `h`, and the step's record. Stamps are copied
+    /// from `v`; the edge sets its own. h(n) is filled where it lies (a follower's
+    /// reply): returned, it was copied twice a sample on its way there.
+    pub fn step(&mut self, v: &Forward, h: &mut Option<Backward>) -> Step {
         self.counters.steps += 1;
         self.hold_from = None;
         if let Some(arm) = self.arm.as_mut() {
@@ -274,8 +276,8 @@ impl Slave {
         let (theta, torque, clamps) = self.move_joints(measured);
         let (tool, force, surface, contact_object) =
             self.sense(theta, measured.and_then(|m| m.force), &mut flags);
-        let out = self.reply(v, force, tool, flags);
-        let step = Step {
+        self.reply(v, force, tool, flags, h);
+        Step {
             n: v.seq,
             received: v.signal,
             reference: self.control.position(),
@@ -291,8 +293,7 @@ impl Slave {
             clamps,
             contact_object,
             flags,
-        };
-        (out, step)
+        }
     }
 
     /// CPD-HSD, the channel's control and IK-HSD: the new reference angles from v(n).
@@ -442,16 +443,23 @@ impl Slave {
         (tool, force, surface, object)
     }
 
-    /// h(n): the control's value of the force, through the codec, with the provenance
-    /// of the oldest position value it used.
-    fn reply(&mut self, v: &Forward, force: [f64; 3], tool: [f64; 3], flags: u32) -> Backward {
+    /// h(n) into `h`: the control's value of the force, through the codec, with the
+    /// provenance of the oldest position value it used.
+    fn reply(
+        &mut self,
+        v: &Forward,
+        force: [f64; 3],
+        tool: [f64; 3],
+        flags: u32,
+        h: &mut Option<Backward>,
+    ) {
         self.last_force = force;
         let oldest = (0..3).min_by_key(|&i| v.signal.origin_seq[i]).unwrap_or(0);
-        let mut out = Backward {
+        let out = h.insert(Backward {
             seq: v.seq,
             stamps: v.stamps,
             ..Backward::default()
-        };
+        });
         out.signal.value = self.control.transmit(force);
         out.signal.energy = self.control.energy();
         out.signal.sent_seq = [v.seq; 3];
@@ -471,7 +479,6 @@ impl Slave {
         let torque = std::mem::take(&mut self.measured_torque);
         out.torque = self.arm.as_ref().map_or(torque, |a| a.felt(torque));
         out.signal.flags |= v.signal.flags & FLAG_POSE;
-        out
     }
 }
 

@@ -110,7 +110,8 @@ impl InFlight {
             }
             self.arriving.pop_front();
             if self.newest.is_none_or(|(n, ..)| seq > n) {
-                if let Some(s) = ring[(seq % len) as usize].filter(|s| s.seq == seq) {
+                // By reference: a slot is 144 bytes, read three times a packet.
+                if let Some(s) = ring[(seq % len) as usize].as_ref().filter(|s| s.seq == seq) {
                     self.newest = Some((seq, s.values[i], s.extra));
                 }
             }
@@ -296,7 +297,9 @@ impl Channel {
         if sent {
             let len = self.ring.len() as u64;
             self.ring[(seq % len) as usize] = Some(slot);
-            self.first.get_or_insert(slot);
+            if self.first.is_none() {
+                self.first = Some(slot);
+            }
         }
         (sent, replayed)
     }
@@ -360,12 +363,10 @@ impl Channel {
             Some((from, v, x)) => (from, v, !fresh, x),
             None => {
                 // Nothing has arrived yet: hold the first value sent.
-                let s = self.first.unwrap_or(Slot {
-                    seq: p.seq,
-                    values: [Value::default(); 3],
-                    extra: ([0.0; 4], 0),
-                });
-                (s.seq, s.values[i], true, s.extra)
+                match &self.first {
+                    Some(s) => (s.seq, s.values[i], true, s.extra),
+                    None => (p.seq, Value::default(), true, ([0.0; 4], 0)),
+                }
             }
         };
         // The delay injected is the value's age here: the packet's delay, and any

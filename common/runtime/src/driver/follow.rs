@@ -421,6 +421,9 @@ impl<H: Follower> Follow<H> {
     }
 
     fn counters_if_due(&mut self) -> Result<(), Failure> {
+        if !self.rec.counters_due() {
+            return Ok(());
+        }
         let counts = self.counts();
         super::each_second(
             &mut self.rec,

@@ -5,7 +5,7 @@
 //! a late one is still recorded. At the end: collect stragglers, send the end of the
 //! run.
 
-use super::link::{Block, Idle, Link};
+use super::link::{Arrival, Block, Idle, Link};
 use super::waits::{Notes, Waited};
 use super::{Counts, Failure, Io, Leader, Timing};
 use std::time::{Duration, Instant};
@@ -89,6 +89,13 @@ pub struct Lead<H: Leader> {
     foreign: u64,
     started: Option<Instant>,
     device_seen: DeviceCounters,
+    /// The sample in hand, c(n), kept from sample to sample.
+    forward: Forward,
+    /// Where each arrival is taken while an answer is awaited, kept from sample to
+    /// sample (None before the first, and after a wait that failed).
+    slot: Option<Box<Arrival>>,
+    /// The record of the answer in hand, kept from answer to answer.
+    record: Option<H::Sample>,
 }
 
 impl<H: Leader> std::fmt::Debug for Lead<H> {
@@ -119,6 +126,9 @@ impl<H: Leader> Lead<H> {
             foreign: 0,
             started: None,
             device_seen: DeviceCounters::default(),
+            forward: Forward::default(),
+            slot: None,
+            record: None,
         }
     }
 
@@ -284,35 +294,22 @@ impl<H: Leader> Lead<H> {
         let link = &self.link;
         let dead = || link.dead_peers();
         let mut io = Io::new(&mut self.rec, origin, &timing, &dead);
-        let mut c = self.handler.tick(n, origin, &mut io)?;
+        let c = &mut self.forward;
+        self.handler.tick(n, origin, &mut io, c)?;
         c.run = self.opts.run;
         c.stamps[stage::MASTER_SEND] = timing.stamp();
-        self.link.send_forward(&c, false)?;
+        self.link.send_forward(c, false)?;
         self.window.send(n);
-        let sent = self.handler.sent(&c);
+        let sent = self.handler.sent(c);
         self.rec.sample(&sent)?;
-        loop {
-            match self.link.wait(deadline, block)? {
-                Ok(super::Arrival::Backward(q)) => {
-                    if q.signal.flags & FLAG_DROPPED != 0 {
-                        // The emulator dropped sample n: no answer comes.
-                        if q.run == self.opts.run && q.seq == n {
-                            self.miss(n, origin)?;
-                            break;
-                        }
-                        continue;
-                    }
-                    if self.absorb(q, n, origin)? == Some(n) {
-                        break;
-                    }
-                }
-                Ok(super::Arrival::Forward(_)) => {}
-                Err(Idle::Timeout) => {
-                    self.miss(n, origin)?;
-                    break;
-                }
-                Err(Idle::Stop) => return Ok(false),
-            }
+        let mut slot = self
+            .slot
+            .take()
+            .unwrap_or_else(|| Box::new(Arrival::Backward(Backward::default())));
+        let went_on = self.await_answer(&mut slot, n, origin, deadline, block);
+        self.slot = Some(slot);
+        if !went_on? {
+            return Ok(false);
         }
         self.handler.after(n);
         if let Some(l) = &mut self.live {
@@ -325,12 +322,49 @@ impl<H: Leader> Lead<H> {
         Ok(true)
     }
 
+    /// Waits until sample n is answered, missed (dropped on the way, or no answer by
+    /// `deadline`) or a stop request comes (false), taking each arrival into `slot`.
+    fn await_answer(
+        &mut self,
+        slot: &mut Arrival,
+        n: u64,
+        origin: u64,
+        deadline: Instant,
+        block: &mut dyn Block,
+    ) -> Result<bool, Failure> {
+        loop {
+            match self.link.wait_into(deadline, block, slot)? {
+                Ok(()) => {
+                    let Arrival::Backward(q) = slot else {
+                        continue;
+                    };
+                    if q.signal.flags & FLAG_DROPPED != 0 {
+                        // The emulator dropped sample n: no answer comes.
+                        if q.run == self.opts.run && q.seq == n {
+                            self.miss(n, origin)?;
+                            return Ok(true);
+                        }
+                        continue;
+                    }
+                    if self.absorb(q, n, origin)? == Some(n) {
+                        return Ok(true);
+                    }
+                }
+                Err(Idle::Timeout) => {
+                    self.miss(n, origin)?;
+                    return Ok(true);
+                }
+                Err(Idle::Stop) => return Ok(false),
+            }
+        }
+    }
+
     /// Stamps q's arrival and hands it to the handler if it answers a sample awaiting
     /// it. Returns the sample it answers, or None for one that answers nothing (a
     /// probe, another run, a duplicate, a number never sent or too old).
     fn absorb(
         &mut self,
-        mut q: Backward,
+        q: &mut Backward,
         current: u64,
         origin: u64,
     ) -> Result<Option<u64>, Failure> {
@@ -352,8 +386,12 @@ impl<H: Leader> Lead<H> {
         let link = &self.link;
         let dead = || link.dead_peers();
         let mut io = Io::new(&mut self.rec, origin, &timing, &dead);
-        let a = self.handler.answer(&q, late, &mut io)?;
-        self.rec.sample(&a)?;
+        let record = &mut self.record;
+        *record = None;
+        self.handler.answer(q, late, &mut io, record)?;
+        if let Some(a) = record {
+            self.rec.sample(a)?;
+        }
         Ok(Some(q.seq))
     }
 
@@ -375,8 +413,8 @@ impl<H: Leader> Lead<H> {
     fn end(&mut self, block: &mut dyn Block, completed: bool) -> Result<(), Failure> {
         let last = self.window.sent;
         let grace = Instant::now() + Duration::from_millis(50);
-        while let Ok(super::Arrival::Backward(q)) = self.link.wait(grace, block)? {
-            self.absorb(q, last, 0)?;
+        while let Ok(Arrival::Backward(mut q)) = self.link.wait(grace, block)? {
+            self.absorb(&mut q, last, 0)?;
         }
         let mut end = Forward {
             run: self.opts.run,
@@ -406,6 +444,9 @@ impl<H: Leader> Lead<H> {
     }
 
     fn counters_if_due(&mut self) -> Result<(), Failure> {
+        if !self.rec.counters_due() {
+            return Ok(());
+        }
         let counts = self.counts();
         super::each_second(
             &mut self.rec,

@@ -92,21 +92,14 @@ impl Link {
         Link { ports, spin }
     }
 
-    /// A sample if one waits, backward first.
+    /// A sample if one waits, backward first (as [`Link::poll_into`]).
     pub fn poll(&mut self) -> Result<Option<Arrival>, LinkError> {
-        if let Some(b) = self.ports.backward_in.as_mut().filter(|b| b.may_have()) {
-            if let Some(h) = b.try_recv()? {
-                return Ok(Some(Arrival::Backward(h)));
-            }
-        }
-        match self.ports.forward_in.as_mut().filter(|f| f.may_have()) {
-            Some(f) => Ok(f.try_recv()?.map(Arrival::Forward)),
-            None => Ok(None),
-        }
+        let mut a = Arrival::Forward(Forward::default());
+        Ok(self.poll_into(&mut a)?.then_some(a))
     }
 
-    /// [`Link::poll`] into `slot`, backward first: true if a sample came (then it is
-    /// in `slot`), false if none (`slot` then holds no sample to handle). From an
+    /// A sample if one waits, into `slot`, backward first: true if one came (then it
+    /// is in `slot`), false if none (`slot` then holds no sample to handle). From an
     /// in-memory stream a sample is copied once, from its queue to `slot`.
     pub fn poll_into(&mut self, slot: &mut Arrival) -> Result<bool, LinkError> {
         if let Some(b) = self.ports.backward_in.as_mut().filter(|b| b.may_have()) {
@@ -130,19 +123,31 @@ impl Link {
         Ok(false)
     }
 
-    /// Waits for a sample until `deadline`: polls (yielding the CPU) for the poll
-    /// budget, then blocks with `block`; a stop request ends it.
+    /// Waits for a sample until `deadline` (as [`Link::wait_into`]).
     pub fn wait(
         &mut self,
         deadline: Instant,
         block: &mut dyn Block,
     ) -> Result<Result<Arrival, Idle>, super::Failure> {
+        let mut a = Arrival::Forward(Forward::default());
+        Ok(self.wait_into(deadline, block, &mut a)?.map(|()| a))
+    }
+
+    /// Waits for a sample until `deadline`, taken into `slot` (as
+    /// [`Link::poll_into`]): polls (yielding the CPU) for the poll budget, then blocks
+    /// with `block`; a stop request ends it.
+    pub fn wait_into(
+        &mut self,
+        deadline: Instant,
+        block: &mut dyn Block,
+        slot: &mut Arrival,
+    ) -> Result<Result<(), Idle>, super::Failure> {
         // Without a poll budget (lockstep, one process) the start is never needed:
         // one clock read a wait saved.
         let start = (!self.spin.is_zero()).then(Instant::now);
         loop {
-            if let Some(a) = self.poll()? {
-                return Ok(Ok(a));
+            if self.poll_into(slot)? {
+                return Ok(Ok(()));
             }
             if crate::signals::stop_requested() {
                 return Ok(Err(Idle::Stop));
@@ -158,7 +163,7 @@ impl Link {
                 continue;
             }
             if !block.block(&self.ports.wakes, deadline)? {
-                return Ok(self.poll()?.ok_or(Idle::Timeout));
+                return Ok(self.poll_into(slot)?.then_some(()).ok_or(Idle::Timeout));
             }
         }
     }
@@ -284,6 +289,55 @@ mod tests {
             (stats.forward_in.received, stats.backward_in.received),
             (2, 1)
         );
+    }
+
+    /// Says nothing more can come (the in-process runner's answer once its other
+    /// nodes are idle), counting the calls.
+    struct Settled(u32);
+
+    impl Block for Settled {
+        fn block(
+            &mut self,
+            _: &[Box<dyn tactile_transport::Wake>],
+            _: Instant,
+        ) -> Result<bool, super::super::Failure> {
+            self.0 += 1;
+            Ok(false)
+        }
+    }
+
+    #[test]
+    fn a_wait_into_a_slot_takes_what_came_and_ends_empty_when_nothing_can_come() {
+        let [mut master, emulator, mut slave] = tactile_transport::ports::in_memory();
+        let mut link = Link::new(emulator, Duration::ZERO);
+        let far = Instant::now() + Duration::from_secs(3600);
+        let mut block = Settled(0);
+        let mut slot = Arrival::Forward(Forward::default());
+        let h = Backward {
+            seq: 5,
+            ..Backward::default()
+        };
+        let out = slave.backward_out.as_mut().expect("h");
+        out.publish(&h, false).expect("h");
+        let c = Forward {
+            seq: 6,
+            ..Forward::default()
+        };
+        let out = master.forward_out.as_mut().expect("c");
+        out.publish(&c, false).expect("c");
+        let mut got = Vec::new();
+        while let Ok(()) = link.wait_into(far, &mut block, &mut slot).expect("wait") {
+            got.push(slot.run_and_seq().1);
+        }
+        // Backward first, each taken without blocking; then one block, which says
+        // nothing can come, ends the wait at once rather than at the far deadline.
+        assert_eq!(got, [5, 6]);
+        assert_eq!(block.0, 1);
+        // `wait` is the same wait, returning the sample.
+        out.publish(&c, false).expect("c");
+        let got = link.wait(far, &mut block).expect("wait");
+        assert!(matches!(got, Ok(Arrival::Forward(f)) if f.seq == 6));
+        assert!(matches!(link.wait(far, &mut block), Ok(Err(Idle::Timeout))));
     }
 
     #[test]

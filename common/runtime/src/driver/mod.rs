@@ -183,17 +183,16 @@ pub(crate) fn close<H: Handler>(
     Ok(())
 }
 
-/// Once a second (when the record says they are due): the counters into the record,
-/// the handler's and the device's lines about the last second into the log.
+/// Once a second (when the record says they are due, [`Recorder::counters_due`]): the
+/// counters into the record, the handler's and the device's lines about the last
+/// second into the log. The caller asks whether they are due before it gathers
+/// `counts` (a copy of every port's counters and a clock read, a waste every sample).
 pub(crate) fn each_second<H: Handler>(
     rec: &mut Recorder<H::Sample, H::Totals>,
     handler: &mut H,
     counts: &Counts,
     device_seen: &mut tactile_devices::DeviceCounters,
 ) -> Result<(), Failure> {
-    if !rec.counters_due() {
-        return Ok(());
-    }
     let totals = handler.totals(counts);
     handler.log_second(&totals);
     if let Some(p) = handler.peripheral() {
@@ -301,13 +300,22 @@ pub trait Follower: Handler {
 
 /// The node that makes the samples and waits for their answers: the master.
 pub trait Leader: Handler {
-    /// Sample n, at its instant `origin_ns`: c(n) to send.
-    fn tick(&mut self, n: u64, origin_ns: u64, io: &mut Io) -> Result<Forward, Failure>;
+    /// Sample n, at its instant `origin_ns`: c(n) to send, into `c` (its loop keeps
+    /// it: a sample is hundreds of bytes, copied through each `Result` when returned).
+    fn tick(&mut self, n: u64, origin_ns: u64, io: &mut Io, c: &mut Forward)
+        -> Result<(), Failure>;
     /// c(n) as it went out (stamped): the record of it.
     fn sent(&mut self, c: &Forward) -> Self::Sample;
     /// q(n) back for a sample awaiting it (`late`: after its deadline), stamped at
-    /// its arrival: the record of it.
-    fn answer(&mut self, q: &Backward, late: bool, io: &mut Io) -> Result<Self::Sample, Failure>;
+    /// its arrival: the record of it into `record`, which comes empty (its loop keeps
+    /// it: a master's answer is 336 bytes, copied through each `Result` when returned).
+    fn answer(
+        &mut self,
+        q: &Backward,
+        late: bool,
+        io: &mut Io,
+        record: &mut Option<Self::Sample>,
+    ) -> Result<(), Failure>;
     /// Sample n had no answer by its deadline: the record of it.
     fn miss(&mut self, n: u64, io: &mut Io) -> Result<Self::Sample, Failure>;
     /// After sample n: what the node does outside the loop (the device's force).
