@@ -2,7 +2,7 @@
 //!
 //! [`Master::forward`] turns sample n of the operator's motion into c(n): the master
 //! device's joint encoders b(n) (the MD model), then FK-HMD. [`Master::backward`] turns
-//! a received q(n) into joint torques p(n) = J(b)^T q (KFF-HMD). Each returns the
+//! a received q(n) into joint torques p(n) = J(b)^T q (KFF-HMD). Each gives the
 //! sample for the wire and the master's record of it. The process edge and the
 //! in-process simulation call the same functions.
 //!

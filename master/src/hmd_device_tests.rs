@@ -195,3 +195,42 @@ fn the_spring_stays_within_the_force_limit() {
     m.backward(&answer(1, [0.0; 3]));
     assert_eq!(m.felt()[0], -3.3);
 }
+
+/// c(n) and its record are written whole into the handler's kept slots: reused from
+/// sample to sample (a released sample, then engaged ones, a turned hand, then none,
+/// joints, then a pose), they hold what fresh slots would, with nothing of the
+/// sample before.
+#[test]
+fn kept_slots_hold_each_sample_as_fresh_ones_would() {
+    let (mut kept, mut fresh) = (master(100.0), master(100.0));
+    let (mut f, mut sent) = (Forward::default(), Sent::default());
+    let turned = Hand {
+        point: [0.3, -0.1, 0.05],
+        rotation: Some(about_z(30.0)),
+    };
+    let still = Hand {
+        point: [0.31, -0.1, 0.05],
+        rotation: None,
+    };
+    let joints = Hand {
+        point: [0.1, 0.2, 0.3],
+        rotation: None,
+    };
+    let steps = [
+        (Some(turned), HandInput::Pose, Some(false)),
+        (Some(still), HandInput::Pose, Some(true)),
+        (Some(still), HandInput::Pose, None),
+        (Some(joints), HandInput::Joints, None),
+        (None, HandInput::Pose, None),
+    ];
+    for (n, (hand, input, clutch)) in steps.into_iter().enumerate() {
+        let n = n as u64;
+        kept.forward_measured(n, n, hand, input, clutch, (&mut f, &mut sent));
+        let want = measured(&mut fresh, n, n, hand, input, clutch);
+        assert_eq!((f, sent), want, "sample {n}");
+        kept.backward(&answer(n, [0.5, 0.0, 0.0]));
+        fresh.backward(&answer(n, [0.5, 0.0, 0.0]));
+    }
+    assert_eq!(f.signal.flags & FLAG_RELEASED, 0);
+    assert!(!sent.released);
+}

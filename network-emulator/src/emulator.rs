@@ -7,7 +7,7 @@
 //! [`Channel`]; what comes out
 //! keeps the sample number and stamps of the sample that triggered it, with values (and
 //! their provenance) taken from the delayed one. What was done to each sample (noise
-//! added, delay, drop or corruption) is returned as the emulator's record of it.
+//! added, delay, drop or corruption) is the emulator's record of it.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -138,8 +138,9 @@ impl Emulator {
         self.counters
     }
 
-    /// c(n) in: v(n) into `v` (`None` when the loss model drops it) and the record of
-    /// it into `record`. Both are filled where they lie: they are hundreds of bytes
+    /// c(n) in: v(n) into `v` (`None` when the channel's `loss` drops the sample; a
+    /// packet lost by a loss model still gives a sample) and the record of it into
+    /// `record`. Both are filled where they lie: they are hundreds of bytes
     /// each, and returning them copied each on its way out to the follower's reply.
     pub fn forward(&mut self, c: &Forward, v: &mut Option<Forward>, record: &mut Option<Passage>) {
         let out = v.insert(*c);
@@ -173,8 +174,9 @@ impl Emulator {
         }
     }
 
-    /// h(n) in: q(n) into `q` (`None` when the loss model drops it) and the record of
-    /// it into `record`, filled where they lie as [`Emulator::forward`] does.
+    /// h(n) in: q(n) into `q` (`None` when the channel's `loss` drops the sample) and
+    /// the record of it into `record`, filled where they lie as [`Emulator::forward`]
+    /// does.
     pub fn backward(
         &mut self,
         h: &Backward,
@@ -279,6 +281,29 @@ mod tests {
             assert_eq!((r.n, r.fate, r.out), (seq, Fate::Deliver, v.signal));
             assert_eq!(r.input, sample(seq).signal.value);
         }
+    }
+
+    /// Slots reused from sample to sample, through drops and passes, hold what fresh
+    /// ones would: nothing of the sample before leaks into the next.
+    #[test]
+    fn kept_slots_hold_each_sample_as_fresh_ones_would() {
+        let mut sc = Scenario::paper();
+        sc.network.forward.loss = 0.5;
+        sc.network.forward.delay = [2, 0, 1];
+        sc.network.forward.noise_std = [1e-3, 0.0, 1e-3];
+        let (mut kept, mut fresh) = (Emulator::new(&sc), Emulator::new(&sc));
+        let (mut v, mut record) = (None, None);
+        let mut fates = Vec::new();
+        for seq in 0..64 {
+            kept.forward(&sample(seq), &mut v, &mut record);
+            let (mut v1, mut r1) = (None, None);
+            fresh.forward(&sample(seq), &mut v1, &mut r1);
+            assert_eq!((v, record), (v1, r1), "sample {seq}");
+            fates.push(record.map(|r| r.fate));
+        }
+        // Both kinds came, and a pass right after a drop.
+        let dropped = |f: &Option<Fate>| *f == Some(Fate::Drop);
+        assert!(fates.windows(2).any(|w| dropped(&w[0]) && !dropped(&w[1])));
     }
 
     #[test]

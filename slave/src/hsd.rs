@@ -1,6 +1,6 @@
 //! The slave side's per-sample logic (HSD + SD + ENV) as a pure state machine.
 //!
-//! [`Slave::step`] takes the forward sample v(n) and returns the backward sample h(n).
+//! [`Slave::step`] takes the forward sample v(n) and writes the backward sample h(n).
 //! Its handler ([`crate::handler`]) is what the loop's driver calls, in the node
 //! program and in the in-process simulation alike, so both compute identical values.
 //!

@@ -92,7 +92,7 @@ pub struct Lead<H: Leader> {
     /// The sample in hand, c(n), kept from sample to sample.
     forward: Forward,
     /// Where each arrival is taken while an answer is awaited, kept from sample to
-    /// sample (None before the first, and after a wait that failed).
+    /// sample (None before the first).
     slot: Option<Box<Arrival>>,
     /// The record of the answer in hand, kept from answer to answer.
     record: Option<H::Sample>,

@@ -100,7 +100,12 @@ impl Link {
 
     /// A sample if one waits, into `slot`, backward first: true if one came (then it
     /// is in `slot`), false if none (`slot` then holds no sample to handle). From an
-    /// in-memory stream a sample is copied once, from its queue to `slot`.
+    /// in-memory stream a sample is copied once, from its queue to `slot`. A slot of
+    /// the other kind is first made a default one of the kind polled, even when the
+    /// poll then finds nothing (only where `may_have` is a hint, not in memory):
+    /// receiving and then moving the sample in instead measured 26.7 copies a sample
+    /// against 20.7 in the in-process run, where the emulator's slot changes kind at
+    /// every sample, and a node program's polls yield the CPU between them.
     pub fn poll_into(&mut self, slot: &mut Arrival) -> Result<bool, LinkError> {
         if let Some(b) = self.ports.backward_in.as_mut().filter(|b| b.may_have()) {
             if !matches!(slot, Arrival::Backward(_)) {
@@ -255,7 +260,7 @@ mod tests {
     const T: u64 = 1_000_000;
 
     #[test]
-    fn a_poll_into_a_slot_takes_what_poll_would_backward_first() {
+    fn a_poll_into_a_slot_takes_each_sample_whole_backward_first() {
         let [mut master, emulator, mut slave] = tactile_transport::ports::in_memory();
         let mut link = Link::new(emulator, Duration::ZERO);
         let mut slot = Arrival::Backward(Backward::default());
@@ -307,7 +312,7 @@ mod tests {
     }
 
     #[test]
-    fn a_wait_into_a_slot_takes_what_came_and_ends_empty_when_nothing_can_come() {
+    fn a_wait_into_a_slot_takes_what_came_then_times_out_when_nothing_can_come() {
         let [mut master, emulator, mut slave] = tactile_transport::ports::in_memory();
         let mut link = Link::new(emulator, Duration::ZERO);
         let far = Instant::now() + Duration::from_secs(3600);

@@ -300,15 +300,17 @@ pub trait Follower: Handler {
 
 /// The node that makes the samples and waits for their answers: the master.
 pub trait Leader: Handler {
-    /// Sample n, at its instant `origin_ns`: c(n) to send, into `c` (its loop keeps
-    /// it: a sample is hundreds of bytes, copied through each `Result` when returned).
+    /// Sample n, at its instant `origin_ns`: c(n) to send, into `c`, which holds the
+    /// sample before it and must be written whole (its loop keeps it: a sample is
+    /// hundreds of bytes, copied through each `Result` when returned).
     fn tick(&mut self, n: u64, origin_ns: u64, io: &mut Io, c: &mut Forward)
         -> Result<(), Failure>;
     /// c(n) as it went out (stamped): the record of it.
     fn sent(&mut self, c: &Forward) -> Self::Sample;
     /// q(n) back for a sample awaiting it (`late`: after its deadline), stamped at
     /// its arrival: the record of it into `record`, which comes empty (its loop keeps
-    /// it: a master's answer is 336 bytes, copied through each `Result` when returned).
+    /// it: a master's answer is 336 bytes, copied through each `Result` when returned);
+    /// left empty, nothing is recorded.
     fn answer(
         &mut self,
         q: &Backward,
