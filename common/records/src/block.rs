@@ -20,6 +20,7 @@
 //! block costs that block alone.
 
 use thiserror::Error;
+use wide::u8x16;
 
 /// A packed block that cannot be unpacked: damage, or another build's writer.
 #[derive(Debug, Error, PartialEq, Eq)]
@@ -98,22 +99,21 @@ pub fn to_planes(rows: &[u8], lens: &[usize], out: &mut Vec<u8>, scratch: &mut V
         put_varint(out, l as u64);
     }
     for (len, starts) in groups(lens) {
-        out.extend_from_slice(&rows[starts[0]..starts[0] + len]);
-        // Row-major XOR deltas of the later rows first (the compiler vectorises these
-        // loops), then the planes that are not all zero gathered from them.
-        let r = starts.len() - 1;
+        let first = &rows[starts[0]..starts[0] + len];
+        out.extend_from_slice(first);
+        // A column's plane is all zeros exactly when every row has the first row's
+        // byte there: one pass that only reads (the compiler vectorises it) finds the
+        // planes kept, and the deltas are then worked out only where they are kept,
+        // straight from the rows.
         scratch.clear();
-        scratch.resize(r * len + len, 0);
-        let (deltas, any) = scratch.split_at_mut(r * len);
-        for (d, pair) in deltas.chunks_exact_mut(len.max(1)).zip(starts.windows(2)) {
-            let (prev, row) = (&rows[pair[0]..pair[0] + len], &rows[pair[1]..pair[1] + len]);
-            for ((d, a), b) in d.iter_mut().zip(row).zip(prev) {
-                *d = a ^ b;
-            }
-            for (o, x) in any.iter_mut().zip(d.iter()) {
-                *o |= x;
+        scratch.resize(len, 0);
+        for &s in &starts[1..] {
+            for ((o, a), b) in scratch.iter_mut().zip(&rows[s..s + len]).zip(first) {
+                *o |= a ^ b;
             }
         }
+        let any = &scratch[..];
+        let r = starts.len() - 1;
         let kept = any.iter().filter(|a| **a != 0).count();
         let bitmap_at = out.len();
         let planes_at = bitmap_at + len.div_ceil(8);
@@ -132,85 +132,113 @@ pub fn to_planes(rows: &[u8], lens: &[usize], out: &mut Vec<u8>, scratch: &mut V
             let n = mask.count_ones() as usize;
             let here = &mut planes[at..at + n * r];
             at += n * r;
+            let run = Run {
+                rows,
+                starts: &starts,
+                c0,
+                mask,
+            };
             if any.len() == 8 && n >= TILE_PLANES {
-                planes_by_tiles(deltas, len, r, c0, mask, here);
+                run.by_tiles(here);
             } else {
-                planes_by_bytes(deltas, len, r, c0, mask, 0, here);
+                run.by_bytes(0, here);
             }
         }
     }
 }
 
 /// Kept planes, of a run of eight columns, from which the run goes by tiles. A tile
-/// moves all eight columns, kept or not: tiles on every run made the million-sample
-/// run slower, tiles from 4 kept planes left it with a lower median (docs/06). 2, 3
-/// and 6 measured the same as 4 on a real run's rows (the `block_sizes` example).
-const TILE_PLANES: usize = 4;
+/// moves all eight columns, kept or not. With 16-row tiles in vector registers, 1 and
+/// 2 measured the same on a real run's rows and 4 took 20 % longer (docs/06).
+const TILE_PLANES: usize = 2;
 
-/// The planes of columns `c0..c0 + 8` picked by `mask` (bit `j`: column `c0 + j`),
-/// from `deltas` (`r` rows of `len` bytes) into `out` one after another, eight rows at
-/// a time as 8-by-8 tiles transposed in registers, the rows past the last whole tile
-/// byte by byte.
-fn planes_by_tiles(deltas: &[u8], len: usize, r: usize, c0: usize, mask: u8, out: &mut [u8]) {
-    let whole = r / 8 * 8;
-    for i0 in (0..whole).step_by(8) {
-        let mut tile = [0u64; 8];
-        for (t, word) in tile.iter_mut().enumerate() {
-            let at = (i0 + t) * len + c0;
-            let mut b = [0u8; 8];
-            b.copy_from_slice(&deltas[at..at + 8]);
-            *word = u64::from_le_bytes(b);
+/// Eight columns `c0..c0 + 8` of a group's rows (those past the rows' end are never
+/// read), and `mask` of those whose planes are kept (bit `j`: column `c0 + j`).
+struct Run<'a> {
+    rows: &'a [u8],
+    starts: &'a [usize],
+    c0: usize,
+    mask: u8,
+}
+
+impl Run<'_> {
+    /// The run's eight bytes of row `i` (of `starts`), as a little-endian word.
+    fn word(&self, i: usize) -> u64 {
+        let at = self.starts[i] + self.c0;
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&self.rows[at..at + 8]);
+        u64::from_le_bytes(b)
+    }
+
+    /// The kept planes into `out` one after another (each a plane's `r` bytes),
+    /// [`TILE_ROWS`] rows at a time as tiles of deltas transposed in vector registers,
+    /// the rows past the last whole tile byte by byte. Needs all eight columns in the
+    /// rows.
+    fn by_tiles(&self, out: &mut [u8]) {
+        let r = self.starts.len() - 1;
+        let whole = r / TILE_ROWS * TILE_ROWS;
+        let mut prev = self.word(0);
+        for i0 in (0..whole).step_by(TILE_ROWS) {
+            let mut deltas = [0u64; TILE_ROWS];
+            for (t, delta) in deltas.iter_mut().enumerate() {
+                let row = self.word(i0 + t + 1);
+                *delta = row ^ prev;
+                prev = row;
+            }
+            let columns = transpose(deltas);
+            let mut n = 0;
+            for (j, column) in columns.iter().enumerate() {
+                if self.mask & (1 << j) != 0 {
+                    out[n * r + i0..n * r + i0 + TILE_ROWS].copy_from_slice(column.as_array_ref());
+                    n += 1;
+                }
+            }
         }
-        let columns = transpose8(tile);
-        let mut n = 0;
-        for (j, column) in columns.iter().enumerate() {
-            if mask & (1 << j) != 0 {
-                out[n * r + i0..n * r + i0 + 8].copy_from_slice(&column.to_le_bytes());
-                n += 1;
+        self.by_bytes(whole, out);
+    }
+
+    /// Rows `from..r` of the kept planes (each `r` long, one after another in `out`),
+    /// a byte at a time.
+    fn by_bytes(&self, from: usize, out: &mut [u8]) {
+        let r = self.starts.len() - 1;
+        let kept = (0..8).filter(|j| self.mask & (1 << j) != 0);
+        for (n, j) in kept.enumerate() {
+            let c = self.c0 + j;
+            let pairs = self.starts[from..].windows(2);
+            for (o, pair) in out[n * r + from..(n + 1) * r].iter_mut().zip(pairs) {
+                *o = self.rows[pair[1] + c] ^ self.rows[pair[0] + c];
             }
         }
     }
-    planes_by_bytes(deltas, len, r, c0, mask, whole, out);
 }
 
-/// The planes of columns `c0 + j` for each bit `j` of `mask`, rows `from..r` of
-/// `deltas` (`r` rows of `len` bytes), into `out` one after another (each `r` long).
-fn planes_by_bytes(
-    deltas: &[u8],
-    len: usize,
-    r: usize,
-    c0: usize,
-    mask: u8,
-    from: usize,
-    out: &mut [u8],
-) {
-    let kept = (0..8).filter(|j| mask & (1 << j) != 0);
-    for (n, j) in kept.enumerate() {
-        for (o, i) in out[n * r + from..(n + 1) * r].iter_mut().zip(from..r) {
-            *o = deltas[i * len + c0 + j];
-        }
-    }
-}
+/// Rows a tile holds: one vector register's bytes.
+const TILE_ROWS: usize = 16;
 
-/// An 8-by-8 byte matrix transposed: word `k`'s byte `j` becomes word `j`'s byte `k`
-/// (swapping 4-by-4 blocks, then 2-by-2 blocks within them, then bytes).
-fn transpose8(mut m: [u64; 8]) -> [u64; 8] {
-    for (shift, mask, pairs) in [
-        (
-            32,
-            0x0000_0000_ffff_ffffu64,
-            [(0, 4), (1, 5), (2, 6), (3, 7)],
-        ),
-        (16, 0x0000_ffff_0000_ffff, [(0, 2), (1, 3), (4, 6), (5, 7)]),
-        (8, 0x00ff_00ff_00ff_00ff, [(0, 1), (2, 3), (4, 5), (6, 7)]),
-    ] {
-        for (a, b) in pairs {
-            let t = ((m[a] >> shift) ^ m[b]) & mask;
-            m[a] ^= t << shift;
-            m[b] ^= t;
-        }
+/// 16 rows of eight bytes (little-endian words) transposed: vector `j` holds byte `j`
+/// of each row, in order. Four rounds of byte interleaving (SSE2's `punpcklbw` and
+/// `punpckhbw`, NEON's `zip`), each pairing vector `k` with vector `k + 4` (the first,
+/// row `k` with row `k + 8`): 32 shuffles for 128 bytes, where 8-by-8 tiles in `u64`
+/// registers took about 70 operations for 64.
+fn transpose(rows: [u64; TILE_ROWS]) -> [u8x16; 8] {
+    let low = |w: u64| {
+        let mut b = [0u8; 16];
+        b[..8].copy_from_slice(&w.to_le_bytes());
+        u8x16::new(b)
+    };
+    let mut v: [u8x16; 8] =
+        std::array::from_fn(|k| u8x16::unpack_low(low(rows[k]), low(rows[k + 8])));
+    for _ in 0..3 {
+        v = std::array::from_fn(|m| {
+            let (a, b) = (v[m / 2], v[m / 2 + 4]);
+            if m % 2 == 0 {
+                u8x16::unpack_low(a, b)
+            } else {
+                u8x16::unpack_high(a, b)
+            }
+        });
     }
-    m
+    v
 }
 
 /// The rows back from [`to_planes`]'s bytes: concatenated, with their lengths; a block
@@ -469,7 +497,7 @@ mod tests {
     #[test]
     fn every_mask_of_kept_planes_lays_out_as_defined() {
         for mask in 0..=255u8 {
-            for rows in [1, 2, 8, 9, 10, 17] {
+            for rows in [1, 2, 9, 16, 17, 18, 34, 37] {
                 for len in [8, 11, 16, 19] {
                     let flat: Vec<u8> = (0..rows)
                         .flat_map(|i| {
@@ -494,13 +522,13 @@ mod tests {
     }
 
     proptest! {
-        /// Word `k`'s byte `j` becomes word `j`'s byte `k`.
+        /// Row `k`'s byte `j` becomes vector `j`'s byte `k`.
         #[test]
-        fn a_tile_transposes(m in any::<[u64; 8]>()) {
-            let t = transpose8(m);
+        fn a_tile_transposes(m in any::<[u64; TILE_ROWS]>()) {
+            let t = transpose(m);
             for (k, row) in m.iter().enumerate() {
                 for (j, column) in t.iter().enumerate() {
-                    prop_assert_eq!(row.to_le_bytes()[j], column.to_le_bytes()[k]);
+                    prop_assert_eq!(row.to_le_bytes()[j], column.as_array_ref()[k]);
                 }
             }
         }
