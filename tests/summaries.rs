@@ -120,7 +120,7 @@ fn check_prints_the_scenario_as_it_would_run_and_what_it_writes() {
         "{said}"
     );
     assert!(
-        said.contains("master.rec 244 kB") && said.contains("trace.csv 4.5 MB"),
+        said.contains("master.rec 248 kB") && said.contains("trace.csv 4.5 MB"),
         "{said}"
     );
     assert!(!said.contains("warning"), "{said}");
@@ -139,7 +139,7 @@ fn check_prints_the_scenario_as_it_would_run_and_what_it_writes() {
     assert_eq!(sb.json("r", "summary.json")["samples_sent"], 4000);
     // A long run is warned about; a bad one is bad input and prints nothing.
     let o = sb.tactile(&["check", s, "--set", "samples=2000000"]);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("warning: the run writes about 3.83 GB"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("warning: the run writes about 3.84 GB"));
     let o = sb.tactile(&["check", s, "--set", "rate_hz=5"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(o.stdout.is_empty());
