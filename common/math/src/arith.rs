@@ -107,6 +107,18 @@ pub trait Trig<R: Real> {
         let (a, b, c) = (self.sin_cos(x[0]), self.sin_cos(x[1]), self.sin_cos(x[2]));
         ([a.0, b.0, c.0], [a.1, b.1, c.1])
     }
+    /// IK's four angles, `[atan2(a.0, a.1), acos(b), atan2(c.0, c.1), acos(d)]`, which
+    /// do not depend on one another. The default is four calls; the CORDIC model runs
+    /// the four vectorings side by side, bit for bit the same.
+    #[inline(always)]
+    fn ik_angles(&self, a: (R, R), b: R, c: (R, R), d: R) -> [R; 4] {
+        [
+            self.atan2(a.0, a.1),
+            self.acos(b),
+            self.atan2(c.0, c.1),
+            self.acos(d),
+        ]
+    }
     /// sin and cos over a slice. The default is the scalar loop; the CORDIC model
     /// overrides it with a structure-of-arrays version the compiler vectorises.
     fn sin_cos_batch(&self, x: &[R], sin: &mut [R], cos: &mut [R]) {
@@ -157,6 +169,10 @@ impl Trig<f32> for Cordic {
     #[inline(always)]
     fn sin_cos3(&self, x: [f32; 3]) -> ([f32; 3], [f32; 3]) {
         Cordic::sin_cos3(self, x)
+    }
+    #[inline(always)]
+    fn ik_angles(&self, a: (f32, f32), b: f32, c: (f32, f32), d: f32) -> [f32; 4] {
+        Cordic::ik_angles(self, a, b, c, d)
     }
     fn sin_cos_batch(&self, x: &[f32], sin: &mut [f32], cos: &mut [f32]) {
         Cordic::sin_cos_batch(self, x, sin, cos);

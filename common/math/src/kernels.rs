@@ -264,7 +264,6 @@ pub fn ik_taps<R: Real, T: Trig<R>>(g: &Lengths<R>, trig: &T, p: [R; 3]) -> IkTa
         (x, yl, zl) = (x * s, yl * s, zl * s);
         clamped = true;
     }
-    let atan = trig.atan2(x, zl);
     let rr2 = x * x + zl * zl;
     let big_r = rr2.sqrt();
     let r2 = rr2 + yl * yl;
@@ -278,10 +277,10 @@ pub fn ik_taps<R: Real, T: Trig<R>>(g: &Lengths<R>, trig: &T, p: [R; 3]) -> IkTa
         R::ZERO
     };
     let cos_gamma = clamp_unit(cos_gamma, k.one_tol, &mut clamped);
-    let gamma = trig.acos(cos_gamma);
-    let beta = trig.atan2(yl, big_r);
     let cos_alpha = clamp_unit((k.c_alpha - r2) / k.d_alpha, k.one_tol, &mut clamped);
-    let alpha = trig.acos(cos_alpha);
+    // The four angles depend on none of one another: one call, so the CORDIC model can
+    // run them side by side.
+    let [atan, gamma, beta, alpha] = trig.ik_angles((x, zl), cos_gamma, (yl, big_r), cos_alpha);
     let theta2 = gamma + beta;
     let theta3 = theta2 + alpha - R::FRAC_PI_2;
     IkTaps {

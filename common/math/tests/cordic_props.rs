@@ -504,6 +504,24 @@ proptest! {
         }
     }
 
+    /// IK's four angles side by side, each as its own call gives it: any inputs (NaN,
+    /// infinities, zeros, acos arguments out of range) in any lane.
+    #[test]
+    fn ik_angles_are_bit_identical(
+        cfg in any_config(),
+        a in (any_input(), any_input()),
+        b in any_input(),
+        d in (any_input(), any_input()),
+        e in any_input(),
+    ) {
+        let c = Cordic::new(cfg).expect("strategy yields valid configs");
+        let got = c.ik_angles(a, b, d, e);
+        let want = [c.atan2(a.0, a.1), c.acos(b), c.atan2(d.0, d.1), c.acos(e)];
+        for k in 0..4 {
+            prop_assert_eq!(got[k].to_bits(), want[k].to_bits(), "lane {} of {}", k, name(&c));
+        }
+    }
+
     #[test]
     fn atan2_batch_is_bit_identical(
         cfg in any_config(),

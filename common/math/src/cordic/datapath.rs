@@ -112,30 +112,44 @@ impl Cordic {
 
     /// Vectoring iterations and output stage; returns the angle code. Unrolled like
     /// [`Self::rotate`]; the decision is the sign of y.
-    #[allow(unused_assignments)] // the last unrolled step's x and y are not read
+    #[inline(always)]
     pub(super) fn vector(&self, x: i64, y: i64, z0: i64) -> i64 {
+        self.vector_lanes([(x, y, z0)])[0]
+    }
+
+    /// [`Self::vector`] on `L` independent inputs `(x, y, z0)` at once, lane by lane the
+    /// same integers: interleaving the dependency chains (each step waits for the sign
+    /// of the step before) lets the core overlap their latencies, as [`Self::rotate3`]
+    /// does for rotations. IK-HSD's four angles are four lanes.
+    #[allow(unused_assignments)] // the last unrolled step's x and y are not read
+    #[inline(always)]
+    pub(super) fn vector_lanes<const L: usize>(&self, lanes: [(i64, i64, i64); L]) -> [i64; L] {
         let (n, t) = (self.n, &self.atan);
-        let zero = (x | y) == 0;
-        let (mut x, mut y, mut z) = (x, y, 0i64);
+        let (mut x, mut y, mut z) = (lanes.map(|l| l.0), lanes.map(|l| l.1), [0i64; L]);
         macro_rules! steps {
             ($($i:literal)*) => {'run: {$(
                 if n == $i {
                     break 'run;
                 }
-                let m = y >> 63; // -1: y < 0, rotate counter-clockwise
                 let b = self.bias[$i];
-                let (xs, ys) = ((x + b) >> $i, (y + b) >> $i);
-                x += (ys ^ m) - m;
-                y -= (xs ^ m) - m;
-                z += (t[$i] ^ m) - m;
+                for k in 0..L {
+                    let m = y[k] >> 63; // -1: y < 0, rotate counter-clockwise
+                    let (xs, ys) = ((x[k] + b) >> $i, (y[k] + b) >> $i);
+                    x[k] += (ys ^ m) - m;
+                    y[k] -= (xs ^ m) - m;
+                    z[k] += (t[$i] ^ m) - m;
+                }
             )*}};
         }
         steps!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31);
-        let code = (z + z0).clamp(-self.pi_floor, self.pi_floor);
-        if zero {
-            0
-        } else {
-            code
-        }
+        std::array::from_fn(|k| {
+            let (x0, y0, z0) = lanes[k];
+            let code = (z[k] + z0).clamp(-self.pi_floor, self.pi_floor);
+            if (x0 | y0) == 0 {
+                0
+            } else {
+                code
+            }
+        })
     }
 }

@@ -369,17 +369,25 @@ impl Cordic {
     /// NaN in gives NaN out.
     #[inline]
     pub fn atan2(&self, y: f32, x: f32) -> f32 {
+        match self.atan2_input(y, x) {
+            Some((x, y, z0)) => self.vector(x, y, z0) as f32 * self.angle_out,
+            None => f32::NAN,
+        }
+    }
+
+    /// [`Self::atan2`]'s vectoring input `(x, y, z0)`; `None` for NaN (NaN out).
+    #[inline(always)]
+    fn atan2_input(&self, y: f32, x: f32) -> Option<(i64, i64, i64)> {
         if x.is_nan() || y.is_nan() {
-            return f32::NAN;
+            return None;
         }
         let (y, x) = sanitize(y, x);
         let (wx, wy) = self.vector_prefloor(y, x);
-        let (x, y, z0) = self.half_plane(
+        Some(self.half_plane(
             i64::from(floor_code(wx)),
             i64::from(floor_code(wy)),
             y.is_sign_negative(),
-        );
-        self.vector(x, y, z0) as f32 * self.angle_out
+        ))
     }
 
     /// `acos(a) = atan2(sqrt(1 - a^2), a)` with the square root in f32, the radicand
@@ -388,15 +396,42 @@ impl Cordic {
     /// gives NaN; the result is saturated to `[0, pi]`. NaN in gives NaN out.
     #[inline]
     pub fn acos(&self, a: f32) -> f32 {
+        match self.acos_input(a) {
+            Some((x, y, z0)) => self.vector(x, y, z0).max(0) as f32 * self.angle_out,
+            None => f32::NAN,
+        }
+    }
+
+    /// [`Self::acos`]'s vectoring input `(x, y, z0)`; `None` for NaN (NaN out).
+    #[inline(always)]
+    fn acos_input(&self, a: f32) -> Option<(i64, i64, i64)> {
         if a.is_nan() {
-            return f32::NAN;
+            return None;
         }
         let a = a.clamp(-1.0, 1.0);
         let s = ((1.0 - a) * (1.0 + a)).sqrt();
         let (wx, wy) = self.vector_prefloor(s, a);
-        let (x, y, z0) =
-            self.half_plane(i64::from(floor_code(wx)), i64::from(floor_code(wy)), false);
-        self.vector(x, y, z0).max(0) as f32 * self.angle_out
+        Some(self.half_plane(i64::from(floor_code(wx)), i64::from(floor_code(wy)), false))
+    }
+
+    /// `[atan2(a.0, a.1), acos(b), atan2(c.0, c.1), acos(d)]`, each bit for bit as its
+    /// own call gives it, with the four vectorings interleaved: IK-HSD's angles, which
+    /// do not depend on one another (the FPGA's IK module runs them in parallel TFBs).
+    #[inline]
+    pub fn ik_angles(&self, a: (f32, f32), b: f32, c: (f32, f32), d: f32) -> [f32; 4] {
+        let inputs = [
+            self.atan2_input(a.0, a.1),
+            self.acos_input(b),
+            self.atan2_input(c.0, c.1),
+            self.acos_input(d),
+        ];
+        let codes = self.vector_lanes(inputs.map(|i| i.unwrap_or((0, 0, 0))));
+        std::array::from_fn(|k| match inputs[k] {
+            // The acos lanes' results are saturated at 0, as `acos` does.
+            Some(_) if k % 2 == 1 => codes[k].max(0) as f32 * self.angle_out,
+            Some(_) => codes[k] as f32 * self.angle_out,
+            None => f32::NAN,
+        })
     }
 
     /// Worst-case `|sin_cos(a) - (sin a, cos a)|` for `|a| <= 2^22` (`ulp = 2^-N`,
