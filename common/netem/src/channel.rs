@@ -105,8 +105,9 @@ impl InFlight {
     }
 
     /// The newest packet arrived by sample `now`, its value read from `ring` as it
-    /// arrives (every packet arrives within the ring's length of being sent, so its
-    /// slot still holds it then).
+    /// arrives (every packet arrives within the ring's length of being sent, and
+    /// [`Channel::push_packet`] takes what arrived before it writes a slot, so the
+    /// packet's slot still holds it then).
     fn receive(&mut self, now: u64, ring: &[Option<Slot>], i: usize) -> Option<(u64, Value, Rest)> {
         while let Some(&(at, seq)) = self.arriving.front() {
             if at > now {
