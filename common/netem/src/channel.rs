@@ -267,9 +267,11 @@ impl Channel {
         // a sample lost before this channel) are taken before this one's slot is
         // written, which could otherwise be theirs: a packet arrives within the ring's
         // length of being sent, but with a gap it may not have been read by then.
-        let before = seq.saturating_sub(1);
-        for (i, f) in self.flight.iter_mut().enumerate() {
-            f.receive(before, &self.ring, i);
+        // Without a gap the previous sample took them already.
+        if self.last_seq.is_some_and(|l| seq > l.saturating_add(1)) {
+            for (i, f) in self.flight.iter_mut().enumerate() {
+                f.receive(seq - 1, &self.ring, i);
+            }
         }
         let (sent, replayed) = self.admit(Slot { seq, values, extra }, sent);
         let lost = replayed.is_some_and(|(_, lost)| lost);
