@@ -259,6 +259,26 @@ mod tests {
 
     const T: u64 = 1_000_000;
 
+    /// c(seq) published at the master's end of in-memory ports.
+    fn publish_c(master: &mut tactile_transport::Ports, seq: u64) {
+        let c = Forward {
+            seq,
+            ..Forward::default()
+        };
+        let out = master.forward_out.as_mut().expect("c");
+        out.publish(&c, false).expect("c");
+    }
+
+    /// h(seq) published at the slave's end of in-memory ports.
+    fn publish_h(slave: &mut tactile_transport::Ports, seq: u64) {
+        let h = Backward {
+            seq,
+            ..Backward::default()
+        };
+        let out = slave.backward_out.as_mut().expect("h");
+        out.publish(&h, false).expect("h");
+    }
+
     #[test]
     fn a_poll_into_a_slot_takes_each_sample_whole_backward_first() {
         let [mut master, emulator, mut slave] = tactile_transport::ports::in_memory();
@@ -266,19 +286,9 @@ mod tests {
         let mut slot = Arrival::Backward(Backward::default());
         assert!(!link.poll_into(&mut slot).expect("poll"), "nothing yet");
         for seq in [3, 4] {
-            let c = Forward {
-                seq,
-                ..Forward::default()
-            };
-            let out = master.forward_out.as_mut().expect("c");
-            out.publish(&c, false).expect("c");
+            publish_c(&mut master, seq);
         }
-        let h = Backward {
-            seq: 9,
-            ..Backward::default()
-        };
-        let out = slave.backward_out.as_mut().expect("h");
-        out.publish(&h, false).expect("h");
+        publish_h(&mut slave, 9);
         // The slot's kind changes with what comes; each sample comes whole (its hop
         // counter stamped by the publisher), in order, backward first.
         let mut got = Vec::new();
@@ -318,18 +328,8 @@ mod tests {
         let far = Instant::now() + Duration::from_secs(3600);
         let mut block = Settled(0);
         let mut slot = Arrival::Forward(Forward::default());
-        let h = Backward {
-            seq: 5,
-            ..Backward::default()
-        };
-        let out = slave.backward_out.as_mut().expect("h");
-        out.publish(&h, false).expect("h");
-        let c = Forward {
-            seq: 6,
-            ..Forward::default()
-        };
-        let out = master.forward_out.as_mut().expect("c");
-        out.publish(&c, false).expect("c");
+        publish_h(&mut slave, 5);
+        publish_c(&mut master, 6);
         let mut got = Vec::new();
         while let Ok(()) = link.wait_into(far, &mut block, &mut slot).expect("wait") {
             got.push(slot.run_and_seq().1);
@@ -339,7 +339,7 @@ mod tests {
         assert_eq!(got, [5, 6]);
         assert_eq!(block.0, 1);
         // `wait` is the same wait, returning the sample.
-        out.publish(&c, false).expect("c");
+        publish_c(&mut master, 6);
         let got = link.wait(far, &mut block).expect("wait");
         assert!(matches!(got, Ok(Arrival::Forward(f)) if f.seq == 6));
         assert!(matches!(link.wait(far, &mut block), Ok(Err(Idle::Timeout))));
