@@ -33,11 +33,16 @@ pub trait Events {
 
 /// A node's record writer with its bookkeeping: events go to the log as well, and the
 /// counters are written every second, so a node killed at any moment leaves counters
-/// at most a second old.
+/// at most a second old (and 10 ms of samples: the clock is read every 10 ms of them).
 #[derive(Debug)]
 pub struct Recorder<S, C> {
     writer: RecordWriter<Record<S, C>>,
     next_counters_ns: u64,
+    /// [`Recorder::counters_due`] reads the clock at one call in `clock_every`
+    /// (10 ms of samples): a clock read a sample took about 1 % of the in-process
+    /// run's time; calls left until the next read.
+    clock_every: u32,
+    calls_left: u32,
     /// With `--append`: where the existing record ended and the runs it holds, so a
     /// node that turns out to have joined another run takes its segment back out.
     appended: Option<(u64, Vec<u64>)>,
@@ -64,6 +69,18 @@ pub fn block_rows(role: Role, rate_hz: f64) -> usize {
 /// Counters are written this often, ns.
 pub const COUNTERS_EVERY_NS: u64 = 1_000_000_000;
 
+/// How many calls of [`Recorder::counters_due`] share one clock read at `rate_hz`:
+/// 10 ms of samples (a node calls it about once a sample), at least one, so the
+/// counters are late by 10 ms at most at the run's rate.
+pub fn counters_clock_every(rate_hz: f64) -> u32 {
+    let calls = (rate_hz * 0.01).floor();
+    if calls.is_finite() {
+        calls.clamp(1.0, 1000.0) as u32
+    } else {
+        1
+    }
+}
+
 impl<S: Serialize, C: Serialize> Recorder<S, C> {
     /// Opens `ROLE.rec` in `dir` (afresh, or appended to with `append`).
     pub fn open(dir: &Path, role: Role, append: bool) -> Result<Self, WriteError> {
@@ -83,6 +100,8 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
         Ok(Recorder {
             writer,
             next_counters_ns: now_ns() + COUNTERS_EVERY_NS,
+            clock_every: 1,
+            calls_left: 1,
             appended,
             withdrawn: false,
             role,
@@ -128,6 +147,7 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
         );
         self.writer
             .set_block_rows(block_rows(self.role, start.rate_hz));
+        self.clock_every = counters_clock_every(start.rate_hz);
         self.put(&Record::Start(start))
     }
 
@@ -171,6 +191,11 @@ impl<S: Serialize, C: Serialize> Recorder<S, C> {
     /// True once a second has passed since the counters were last written (then the
     /// node writes them with [`Recorder::counters`]).
     pub fn counters_due(&mut self) -> bool {
+        self.calls_left -= 1;
+        if self.calls_left > 0 {
+            return false;
+        }
+        self.calls_left = self.clock_every;
         let now = now_ns();
         if now < self.next_counters_ns {
             return false;
@@ -232,6 +257,29 @@ mod tests {
         assert_eq!(block_rows(Role::Slave, 1.0), 1);
         assert_eq!(block_rows(Role::Master, 1e9), crate::block::MAX_ROWS);
         assert_eq!(block_rows(Role::Master, f64::NAN), 2);
+    }
+
+    #[test]
+    fn counters_are_due_at_the_first_clock_read_past_the_second() {
+        assert_eq!(counters_clock_every(1000.0), 10);
+        assert_eq!(counters_clock_every(250.0), 2);
+        assert_eq!(counters_clock_every(10.0), 1);
+        assert_eq!(counters_clock_every(1e9), 1000);
+        assert_eq!(counters_clock_every(f64::NAN), 1);
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut r = Rec::open(dir.path(), Role::Master, false).expect("open");
+        // Until the rate is known, every call reads the clock.
+        r.next_counters_ns = 0;
+        assert!(r.counters_due());
+        r.next_counters_ns = 0;
+        assert!(r.counters_due());
+        // At 1 kHz, one call in ten reads the clock: overdue counters wait for it.
+        r.clock_every = counters_clock_every(1000.0);
+        r.next_counters_ns = 0;
+        assert!(r.counters_due());
+        r.next_counters_ns = 0;
+        let due: Vec<usize> = (1..=20).filter(|_| r.counters_due()).collect();
+        assert_eq!(due, [10]);
     }
 
     #[test]

@@ -335,11 +335,13 @@ impl<H: Follower> Follow<H> {
         self.handler.after(&mut io);
         self.finish(c.seq)?;
         // Lockstep has no clock: silence is slowness, not a lost master, and a held
-        // step would change the signals with the machine's load.
+        // step would change the signals with the machine's load. Simulated, the
+        // in-process runner steps the node and never idles it (and a clock read a
+        // sample is saved).
         self.idle_at = self
             .handler
             .idle_timing()
-            .filter(|_| self.timing != Timing::Lockstep)
+            .filter(|_| matches!(self.timing, Timing::Realtime { .. }))
             .map(|(after, _)| Instant::now() + after);
         Ok(())
     }

@@ -36,7 +36,7 @@ impl<E: Follower, S: Follower> Block for Followers<'_, E, S> {
     fn block(
         &mut self,
         _: &[Box<dyn tactile_transport::Wake>],
-        _: Instant,
+        _: Option<Instant>,
     ) -> Result<bool, Failure> {
         self.settle()
     }

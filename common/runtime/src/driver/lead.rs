@@ -260,8 +260,9 @@ impl<H: Leader> Lead<H> {
 
     /// Sample `n`'s instant and the deadline of its answer: realtime sleeps to its
     /// tick (the origin is the tick, not the moment the master woke: a late wake-up is
-    /// overhead the loop adds and must show in the round trip).
-    fn instant(&self, n: u64, t0: u64) -> (u64, Instant) {
+    /// overhead the loop adds and must show in the round trip). Simulated, there is
+    /// no deadline: the in-process runner ends the wait once nothing more can come.
+    fn instant(&self, n: u64, t0: u64) -> (u64, Option<Instant>) {
         match self.opts.timing {
             Timing::Realtime {
                 t_s_ns,
@@ -275,11 +276,10 @@ impl<H: Leader> Lead<H> {
                 while now_ns() < tick {
                     std::thread::yield_now();
                 }
-                (tick, instant_at(t0 + (n + 1) * t_s_ns))
+                (tick, Some(instant_at(t0 + (n + 1) * t_s_ns)))
             }
-            Timing::Lockstep => (now_ns(), Instant::now() + self.opts.answer_timeout),
-            // The in-process runner ends the wait once nothing more can come.
-            Timing::Simulated { t_s_ns } => (n * t_s_ns, far_future()),
+            Timing::Lockstep => (now_ns(), Some(Instant::now() + self.opts.answer_timeout)),
+            Timing::Simulated { t_s_ns } => (n * t_s_ns, None),
         }
     }
 
@@ -329,7 +329,7 @@ impl<H: Leader> Lead<H> {
         slot: &mut Arrival,
         n: u64,
         origin: u64,
-        deadline: Instant,
+        deadline: Option<Instant>,
         block: &mut dyn Block,
     ) -> Result<bool, Failure> {
         loop {
@@ -455,11 +455,6 @@ impl<H: Leader> Lead<H> {
             &mut self.device_seen,
         )
     }
-}
-
-/// A deadline no wait reaches.
-fn far_future() -> Instant {
-    Instant::now() + Duration::from_secs(3600)
 }
 
 /// The `Instant` of a CLOCK_MONOTONIC time (both are monotonic clocks).
