@@ -250,3 +250,75 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    /// The direct path (every packet arrives the sample it is sent) emits what the
+    /// general path emits, bit for bit, noise draws included, for numbers in order,
+    /// repeated, backwards, with gaps or absurd jumps, and packets not sent.
+    #[test]
+    fn the_direct_path_is_the_general_one(
+        noise in any::<bool>(),
+        seed in any::<u64>(),
+        steps in proptest::collection::vec((0u8..10, any::<bool>()), 0..200),
+    ) {
+        let cfg = ChannelConfig {
+            noise_std: if noise { [1e-3, 0.0, 2e-3] } else { [0.0; 3] },
+            ..Default::default()
+        };
+        let mut direct = Channel::new(&cfg, seed, FORWARD_STREAM);
+        let mut general = Channel::new(&cfg, seed, FORWARD_STREAM);
+        prop_assert!(direct.direct);
+        general.direct = false;
+        let mut seq = 0u64;
+        for (step, sent) in steps {
+            seq = match step {
+                0 => seq,
+                1 => seq.saturating_sub(3),
+                2 => seq + 5,
+                3 => seq + MAX_SEQ_JUMP + 1,
+                _ => seq + 1,
+            };
+            let extra = ([seq as f64, 0.5, -0.0, 1.0], seq as u32);
+            let a = direct.push_packet(seq, vals(seq), extra, sent);
+            let b = general.push_packet(seq, vals(seq), extra, sent);
+            // Debug shows -0.0 and 0.0 apart, as bit-for-bit must.
+            prop_assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+    }
+}
+
+#[test]
+fn only_a_channel_whose_packets_arrive_at_once_goes_direct() {
+    let direct = |cfg: ChannelConfig| Channel::new(&cfg, 1, FORWARD_STREAM).direct;
+    assert!(direct(ChannelConfig::default()));
+    // Noise and losses (the emulator's) leave each packet's arrival as it is.
+    assert!(direct(ChannelConfig {
+        noise_std: [1e-3; 3],
+        loss: 0.1,
+        reorder: false,
+        ..Default::default()
+    }));
+    assert!(!direct(ChannelConfig {
+        delay: [0, 0, 1],
+        ..Default::default()
+    }));
+    assert!(!direct(ChannelConfig {
+        schedule: vec![[10, 0, 0, 0]],
+        ..Default::default()
+    }));
+    assert!(!direct(ChannelConfig {
+        jitter: Some(tactile_scenario::JitterConfig {
+            jitter: 1.0,
+            correlation: 0.0,
+            distribution: tactile_scenario::JitterDistribution::Normal,
+        }),
+        ..Default::default()
+    }));
+    assert!(!direct(ChannelConfig {
+        duplicate: 0.1,
+        ..Default::default()
+    }));
+    let replay = Replay::parse_csv("delay,lost\n0,0\n").expect("csv");
+    let ch = Channel::new(&ChannelConfig::default(), 1, FORWARD_STREAM).with_replay(replay, 1e-3);
+    assert!(!ch.direct);
+}
