@@ -259,7 +259,7 @@ proptest! {
     fn the_direct_path_is_the_general_one(
         noise in any::<bool>(),
         seed in any::<u64>(),
-        steps in proptest::collection::vec((0u8..10, any::<bool>()), 0..200),
+        steps in proptest::collection::vec((0u8..40, any::<bool>()), 0..200),
     ) {
         let cfg = ChannelConfig {
             noise_std: if noise { [1e-3, 0.0, 2e-3] } else { [0.0; 3] },
@@ -279,8 +279,13 @@ proptest! {
                 _ => seq + 1,
             };
             let extra = ([seq as f64, 0.5, -0.0, 1.0], seq as u32);
-            let a = direct.push_packet(seq, vals(seq), extra, sent);
-            let b = general.push_packet(seq, vals(seq), extra, sent);
+            // Values that come with a delay already (from a channel before this one).
+            let v = vals(seq).map(|v| Value {
+                delay_samples: (seq % 7) as u32,
+                ..v
+            });
+            let a = direct.push_packet(seq, v, extra, sent);
+            let b = general.push_packet(seq, v, extra, sent);
             // Debug shows -0.0 and 0.0 apart, as bit-for-bit must.
             prop_assert_eq!(format!("{a:?}"), format!("{b:?}"));
         }
@@ -321,4 +326,45 @@ fn only_a_channel_whose_packets_arrive_at_once_goes_direct() {
     let replay = Replay::parse_csv("delay,lost\n0,0\n").expect("csv");
     let ch = Channel::new(&ChannelConfig::default(), 1, FORWARD_STREAM).with_replay(replay, 1e-3);
     assert!(!ch.direct);
+}
+
+/// A sample not sent still moves the channel's numbers on, on either path: after a
+/// stretch of unsent samples longer than [`MAX_SEQ_JUMP`] (a deadband codec in free
+/// space) the next packet is taken, and a packet repeating an unsent sample's number
+/// is refused.
+#[test]
+fn samples_not_sent_move_the_numbers_on() {
+    for delay in [0, 2] {
+        let cfg = ChannelConfig {
+            delay: [delay; 3],
+            ..Default::default()
+        };
+        let mut ch = Channel::new(&cfg, 1, FORWARD_STREAM);
+        assert_eq!(ch.direct, delay == 0);
+        ch.push_packet(0, vals(0), ([0.0; 4], 0), true);
+        let quiet = MAX_SEQ_JUMP + 1;
+        for seq in 1..=quiet {
+            ch.push_packet(seq, vals(seq), ([0.0; 4], 0), false);
+        }
+        let s = quiet + 1;
+        let mut e = ch.push_packet(s, vals(s), ([0.0; 4], 0), true);
+        for seq in s + 1..=s + delay as u64 {
+            e = ch.push_packet(seq, vals(seq), ([0.0; 4], 0), false);
+        }
+        assert!(
+            !e.substituted,
+            "delay {delay}: the packet after the stretch is taken"
+        );
+        assert_eq!(e.values[0].origin_seq, s);
+        let mut ch = Channel::new(&cfg, 1, FORWARD_STREAM);
+        ch.push_packet(5, vals(5), ([0.0; 4], 0), false);
+        for seq in 5..=5 + delay as u64 {
+            e = ch.push_packet(seq, vals(seq), ([0.0; 4], 0), seq == 5);
+        }
+        assert!(
+            e.substituted,
+            "delay {delay}: a repeated number is no packet"
+        );
+        assert_eq!(e.values[0], Value::default());
+    }
 }

@@ -33,15 +33,16 @@ pub trait Events {
 
 /// A node's record writer with its bookkeeping: events go to the log as well, and the
 /// counters are written every second, so a node killed at any moment leaves counters
-/// at most a second old (and 10 ms of samples: the clock is read every 10 ms of them).
+/// at most a second old (and up to 10 ms of calls: [`counters_clock_every`]).
 #[derive(Debug)]
 pub struct Recorder<S, C> {
     writer: RecordWriter<Record<S, C>>,
     next_counters_ns: u64,
     /// [`Recorder::counters_due`] reads the clock at one call in `clock_every`
-    /// (10 ms of samples): a clock read a sample took about 1 % of the in-process
-    /// run's time; calls left until the next read.
+    /// (10 ms of samples, set by [`Recorder::start`]): a clock read a sample took
+    /// about 1 % of the in-process run's time.
     clock_every: u32,
+    /// Calls of [`Recorder::counters_due`] left until it reads the clock (at least 1).
     calls_left: u32,
     /// With `--append`: where the existing record ended and the runs it holds, so a
     /// node that turns out to have joined another run takes its segment back out.
@@ -70,8 +71,9 @@ pub fn block_rows(role: Role, rate_hz: f64) -> usize {
 pub const COUNTERS_EVERY_NS: u64 = 1_000_000_000;
 
 /// How many calls of [`Recorder::counters_due`] share one clock read at `rate_hz`:
-/// 10 ms of samples (a node calls it about once a sample), at least one, so the
-/// counters are late by 10 ms at most at the run's rate.
+/// 10 ms of samples, at least one. A node calls it about once a sample it handles
+/// (the emulator twice), so counters come late by about 10 ms of calls at most: a
+/// node that gets fewer calls (a slave under `loss`) by that many calls.
 pub fn counters_clock_every(rate_hz: f64) -> u32 {
     let calls = (rate_hz * 0.01).floor();
     if calls.is_finite() {

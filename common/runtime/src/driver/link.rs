@@ -143,7 +143,8 @@ impl Link {
     /// Waits for a sample until `deadline`, taken into `slot` (as
     /// [`Link::poll_into`]): polls (yielding the CPU) for the poll budget, then blocks
     /// with `block`; a stop request ends it. With no deadline (`None`, the in-process
-    /// runner's) only `block` ends the wait, and the clock is never read: the clock
+    /// runner's) the wait has no timeout (a sample, a stop request or `block` saying
+    /// nothing more can come ends it), and the clock is never read: the clock
     /// took 6 % of the in-process run's time, and this was one read a sample of five.
     pub fn wait_into(
         &mut self,
