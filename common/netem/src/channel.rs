@@ -322,10 +322,11 @@ impl Channel {
 
     /// [`Channel::push_packet`] when every packet arrives the sample it is sent (no
     /// delay, jitter, replay or duplication: the zero-delay channels of
-    /// `lockstep-1e6.toml`, and of any run that studies no network): the newest packet arrived is the last one sent, so
-    /// no ring and no queues. The same outputs bit for bit, noise draws included
-    /// (a property test drives both paths). A zero-delay channel went from 41.8 to
-    /// 10.9 ns a sample (`cargo bench -p tactile-netem --bench channel`, one session).
+    /// `lockstep-1e6.toml`, and of any run that studies no network): the newest
+    /// packet arrived is the last one sent, so no ring and no queues. The same outputs
+    /// bit for bit, noise draws included (a property test drives both paths). A
+    /// zero-delay channel went from 41.8 to 10.9 ns a sample (`cargo bench -p
+    /// tactile-netem --bench channel`, one session).
     fn push_direct(&mut self, slot: Slot, sent: bool) -> Emitted {
         let seq = slot.seq;
         // Checked whether sent or not: a sample not sent still moves the numbers on.
