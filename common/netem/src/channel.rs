@@ -208,8 +208,16 @@ impl Channel {
             r.set_stream(stream + 200);
             (Jitter::new(j), r)
         });
+        // Duplication draws from its own stream, so turning it on leaves the others'
+        // draws unchanged.
+        let duplicate = (cfg.duplicate > 0.0).then(|| {
+            let mut r = ChaCha8Rng::seed_from_u64(seed);
+            r.set_stream(stream + 300);
+            (cfg.duplicate, r)
+        });
+        // Every packet arrives the sample it is sent (a replay, set later, says not).
         let direct =
-            delay == [0; 3] && schedule.is_empty() && cfg.jitter.is_none() && cfg.duplicate <= 0.0;
+            delay == [0; 3] && schedule.is_empty() && jitter.is_none() && duplicate.is_none();
         Channel {
             delay,
             schedule,
@@ -220,13 +228,7 @@ impl Channel {
             reorder: cfg.reorder,
             flight: Default::default(),
             replay: None,
-            // Duplication draws from its own stream, so turning it on leaves the
-            // others' draws unchanged.
-            duplicate: (cfg.duplicate > 0.0).then(|| {
-                let mut r = ChaCha8Rng::seed_from_u64(seed);
-                r.set_stream(stream + 300);
-                (cfg.duplicate, r)
-            }),
+            duplicate,
             first: None,
             last_seq: None,
             direct,
