@@ -7,10 +7,19 @@
 //! `omni`); by default the paper's `[s16.13]`, nearest, and its geometry. A run whose
 //! scenario asks for another is refused with these variables named.
 
+//!
+//! Without Verilator on `PATH` the crate still builds (a new user's `cargo test
+//! --workspace --all-features` needs only Rust): the build script warns, leaves out
+//! the cfg `tactile_rtl_sim`, and `arithmetic = "rtl"` is refused at run time naming
+//! the tool and its package. Under `CI=true` a missing Verilator fails the build, since
+//! CI installs it and must not pass without the hardware.
+
 fn main() {
     println!("cargo:rerun-if-changed=../../deploy/hdl");
     println!("cargo:rerun-if-changed=src/glue.cpp");
     println!("cargo:rerun-if-changed=src/text.rs");
+    println!("cargo:rerun-if-env-changed=CI");
+    println!("cargo::rustc-check-cfg=cfg(tactile_rtl_sim)");
     #[cfg(feature = "verilator")]
     verilate::build();
 }
@@ -47,7 +56,9 @@ mod verilate {
             PathBuf::from(std::env::var("OUT_DIR").unwrap_or_else(|_| fail("no OUT_DIR".into())));
         let rtl = out.join("rtl");
         write_rtl(&rtl);
-        let include = verilator_include();
+        let Some(include) = verilator_include() else {
+            return;
+        };
         for top in TOPS {
             verilate(&rtl, &out, top);
         }
@@ -77,6 +88,7 @@ mod verilate {
             .compile("tactile_verilated");
         println!("cargo:rustc-link-lib=pthread");
         println!("cargo:rustc-link-lib=atomic");
+        println!("cargo:rustc-cfg=tactile_rtl_sim");
     }
 
     /// The RTL's files for the format and geometry asked for, into `dir`.
@@ -114,13 +126,26 @@ mod verilate {
         }
     }
 
-    /// Verilator's include folder (`verilator --getenv VERILATOR_ROOT`).
-    fn verilator_include() -> PathBuf {
-        let out = Command::new("verilator")
-            .args(["--getenv", "VERILATOR_ROOT"])
-            .output()
-            .unwrap_or_else(|e| fail(format!("cannot run verilator ({e}): the feature rtl needs it (Debian: apt-get install verilator)")));
-        PathBuf::from(String::from_utf8_lossy(&out.stdout).trim()).join("include")
+    /// Verilator's include folder (`verilator --getenv VERILATOR_ROOT`), or `None`
+    /// (with a warning) when Verilator cannot run outside CI: the crate then builds
+    /// without the simulated modules.
+    fn verilator_include() -> Option<PathBuf> {
+        match Command::new("verilator").args(["--getenv", "VERILATOR_ROOT"]).output() {
+            Ok(out) if out.status.success() => {
+                Some(PathBuf::from(String::from_utf8_lossy(&out.stdout).trim()).join("include"))
+            }
+            failed => {
+                let why = match failed {
+                    Ok(out) => format!("verilator --getenv exited with {}", out.status),
+                    Err(e) => format!("cannot run verilator ({e})"),
+                };
+                if std::env::var("CI").is_ok_and(|v| v == "true") {
+                    fail(format!("{why}: the feature rtl needs it (Debian: apt-get install verilator make g++)"));
+                }
+                println!("cargo:warning={why}: built without the RTL simulation, so arithmetic \"rtl\" is refused at run time (Debian: apt-get install verilator make g++, then cargo clean -p tactile-rtl and rebuild)");
+                None
+            }
+        }
     }
 
     /// Verilator's C++ model of `top`, built into `out/top/libVtop.a`.

@@ -5,14 +5,15 @@
 //! - [`engine`]: the kernels' [`Engine`] for any arithmetic, `rtl` included: with the
 //!   feature `verilator`, the modules FK, KFF, FBF and IK are compiled by Verilator
 //!   into this crate (its build script) and every call runs them clock by clock.
-//!   Without it, `rtl` is refused with the reason.
+//!   Without it, or with it but without Verilator when this crate was built (a
+//!   machine with only Rust), `rtl` is refused with the reason.
 
 pub mod text;
 
-#[cfg(feature = "verilator")]
+#[cfg(tactile_rtl_sim)]
 mod sim;
 
-#[cfg(feature = "verilator")]
+#[cfg(tactile_rtl_sim)]
 pub use sim::{Rtl, BUILT_FOR};
 
 use tactile_math::arith::ArithKind;
@@ -29,6 +30,14 @@ pub enum RtlError {
     /// The RTL in this build was generated for another format or geometry.
     #[error("{0}")]
     Mismatch(String),
+    /// Built with the feature `verilator`, but Verilator could not run when this crate
+    /// was built, so the modules are not in it.
+    #[error(
+        "arithmetic \"rtl\" needs the RTL simulated by Verilator: this program was built \
+         with the feature rtl but without Verilator on PATH (Debian: apt-get install \
+         verilator make g++, then cargo clean -p tactile-rtl and rebuild)"
+    )]
+    NoVerilator,
 }
 
 impl RtlError {
@@ -43,19 +52,19 @@ impl RtlError {
 }
 
 /// True when this build simulates the RTL (`arithmetic = "rtl"` works).
-pub const AVAILABLE: bool = cfg!(feature = "verilator");
+pub const AVAILABLE: bool = cfg!(tactile_rtl_sim);
 
 /// Whether this build can run `arithmetic = "rtl"` for `cordic` and `geometry`, without
 /// making the simulator: what a launcher asks before it starts anything.
 pub fn check(cordic: CordicConfig, geometry: Geometry) -> Result<(), RtlError> {
-    #[cfg(feature = "verilator")]
+    #[cfg(tactile_rtl_sim)]
     {
         sim::check_built_for(&cordic, &geometry)
     }
-    #[cfg(not(feature = "verilator"))]
+    #[cfg(not(tactile_rtl_sim))]
     {
         let _ = (cordic, geometry);
-        Err(RtlError::Engine(EngineError::NoHardware))
+        Err(missing())
     }
 }
 
@@ -70,13 +79,23 @@ pub fn engine(
     if kind != ArithKind::Rtl {
         return Ok(Engine::new(kind, geometry, cordic)?);
     }
-    #[cfg(feature = "verilator")]
+    #[cfg(tactile_rtl_sim)]
     {
         let rtl = Rtl::new(&cordic, &geometry)?;
         Ok(Engine::with_hardware(geometry, cordic, Box::new(rtl))?)
     }
-    #[cfg(not(feature = "verilator"))]
+    #[cfg(not(tactile_rtl_sim))]
     {
-        Err(RtlError::Engine(EngineError::NoHardware))
+        Err(missing())
+    }
+}
+
+/// Why this build has no RTL: the feature is off, or Verilator was missing.
+#[cfg(not(tactile_rtl_sim))]
+fn missing() -> RtlError {
+    if cfg!(feature = "verilator") {
+        RtlError::NoVerilator
+    } else {
+        RtlError::Engine(EngineError::NoHardware)
     }
 }
