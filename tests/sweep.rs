@@ -67,15 +67,23 @@ fn a_sweep_runs_every_combination_and_tabulates_the_summaries() {
     let csv = std::fs::read_to_string(sb.path("sw").join("sweep.csv")).expect("csv");
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 1 + 6, "{csv}");
-    assert!(lines[0].starts_with("run,network.forward.delay,seed,samples_sent"));
+    // A swept seed is the seed column every row has.
+    assert!(
+        lines[0].starts_with("run,combination,network.forward.delay,seed,samples_sent"),
+        "{}",
+        lines[0]
+    );
     // Each row is a view of its run's summary.
+    let header = cells(lines[0]);
+    let col = |name: &str| header.iter().position(|h| h == name).expect(name);
     for k in 0..6 {
         let sum = sb.json(&format!("sw/run-{k:04}"), "summary.json");
-        let row: Vec<&str> = lines[1 + k].split("\",").collect();
-        let cells: Vec<&str> = row[1].split(',').collect();
-        assert_eq!(cells[1], sum["samples_sent"].to_string(), "row {k}");
+        let row = cells(lines[1 + k]);
+        assert_eq!(row[0], format!("run-{k:04}"));
+        assert_eq!(row[col("samples_sent")], sum["samples_sent"].to_string());
         let rms = sum["tracking_rms_m"].as_f64().expect("rms");
-        assert_eq!(cells[4].parse::<f64>().expect("rms"), rms, "row {k}");
+        let cell: f64 = row[col("tracking_rms_m")].parse().expect("rms");
+        assert_eq!(cell, rms, "row {k}");
         assert!(!sb.path(&format!("sw/run-{k:04}/trace.csv")).exists());
     }
     // The delay shows in the round trip: 0, 10 and 40 samples forward.
@@ -227,7 +235,7 @@ fn parallel_sharded_and_resumed_sweeps_give_the_same_table() {
 fn seeds_give_a_mean_and_an_interval_per_metric() {
     let sb = Sandbox::new("sweep-seeds");
     sweep(&sb, "s3", &["--seeds", "3"]);
-    let table = read(&sb, "s3", "sweep.csv");
+    let table = read(&sb, "s3", "sweep-summary.csv");
     let header: Vec<&str> = table.lines().next().expect("header").split(',').collect();
     assert_eq!(header[3], "seeds");
     let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
@@ -243,22 +251,17 @@ fn seeds_give_a_mean_and_an_interval_per_metric() {
         let mean: f64 = r[track].parse().expect("mean");
         assert!(ci > 0.0 && ci < mean, "{ci} of {mean}");
     }
-    // runs.csv: every run, its seed; the mean is theirs.
-    let runs = read(&sb, "s3", "runs.csv");
+    // sweep.csv: every run; the mean is theirs.
+    let runs = read(&sb, "s3", "sweep.csv");
     assert_eq!(runs.lines().count(), 1 + 18);
-    assert!(runs.starts_with("run,seed,"));
-    let rc = runs
-        .lines()
-        .next()
-        .expect("h")
-        .split(',')
-        .position(|h| h == "tracking_rms_m")
-        .expect("col");
+    let rh = cells(runs.lines().next().expect("h"));
+    let rc = |name: &str| rh.iter().position(|h| h == name).expect(name);
     let first: Vec<f64> = runs
         .lines()
         .skip(1)
-        .filter(|l| l.starts_with("0,"))
-        .map(|l| cells(l)[rc].parse().expect("f64"))
+        .map(cells)
+        .filter(|r| r[rc("combination")] == "0")
+        .map(|r| r[rc("tracking_rms_m")].parse().expect("f64"))
         .collect();
     assert_eq!(first.len(), 3);
     let mean: f64 = rows[0][track].parse().expect("mean");
@@ -268,6 +271,61 @@ fn seeds_give_a_mean_and_an_interval_per_metric() {
         .join("run-0000-s2")
         .join("summary.json")
         .exists());
+}
+
+/// A script reads the tables the same way whatever `--seeds`: `sweep.csv` one row per
+/// run, `sweep-summary.csv` one per combination, their columns the same for one seed
+/// as for two (an interval of one run is empty), list values as JSON.
+#[test]
+fn the_tables_have_the_same_columns_whatever_the_seeds() {
+    let sb = Sandbox::new("sweep-cols");
+    sweep(&sb, "one", &[]);
+    sweep(&sb, "two", &["--seeds", "2"]);
+    for file in ["sweep.csv", "sweep-summary.csv"] {
+        let head = |out: &str| read(&sb, out, file).lines().next().map(str::to_owned);
+        assert_eq!(head("one"), head("two"), "{file}");
+    }
+    assert_eq!(read(&sb, "one", "sweep.csv").lines().count(), 1 + 6);
+    assert_eq!(read(&sb, "two", "sweep.csv").lines().count(), 1 + 12);
+    let summary = read(&sb, "one", "sweep-summary.csv");
+    let head = cells(summary.lines().next().expect("header"));
+    let ci = head
+        .iter()
+        .position(|h| h == "tracking_rms_m_ci95")
+        .expect("ci");
+    let delay = head
+        .iter()
+        .position(|h| h == "network.forward.delay")
+        .expect("delay");
+    for line in summary.lines().skip(1) {
+        let row = cells(line);
+        assert_eq!(row[ci], "", "one run bounds nothing: {line}");
+        let v: serde_json::Value = serde_json::from_str(&row[delay]).expect("a JSON list");
+        assert_eq!(v.as_array().map(Vec::len), Some(3), "{line}");
+    }
+}
+
+/// `sweep.csv`'s seed is the one each run's `scenario.toml` says it ran with (the
+/// scenario's seed 1, then 2 and 3), not the seed's index.
+#[test]
+fn every_run_s_seed_is_the_one_it_ran_with() {
+    let sb = Sandbox::new("sweep-seed");
+    sweep(&sb, "s", &["--seeds", "3"]);
+    let runs = read(&sb, "s", "sweep.csv");
+    let head = cells(runs.lines().next().expect("header"));
+    let col = |name: &str| head.iter().position(|h| h == name).expect(name);
+    let mut seen = std::collections::BTreeSet::new();
+    for line in runs.lines().skip(1) {
+        let row = cells(line);
+        let toml = read(&sb, &format!("s/{}", row[col("run")]), "scenario.toml");
+        let ran = toml
+            .lines()
+            .find_map(|l| l.strip_prefix("seed = "))
+            .expect("seed line");
+        assert_eq!(row[col("seed")], ran, "{line}");
+        seen.insert(row[col("seed")].clone());
+    }
+    assert_eq!(seen.into_iter().collect::<Vec<_>>(), ["1", "2", "3"]);
 }
 
 /// A CSV line's cells, commas inside quotes kept (`"[0,0,0]"`).

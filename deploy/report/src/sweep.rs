@@ -1,15 +1,16 @@
-//! A sweep's table: the swept keys (axes) and their values, every combination of
-//! them, and the row of `sweep.csv` each run's summary gives. A row is a view of the
-//! run's `summary.json`, picked by the JSON pointers in [`METRICS`], so the table
-//! never says anything the summaries do not.
+//! A sweep's tables: the swept keys (axes) and their values, every combination of
+//! them, the row of `sweep.csv` each run's summary gives and the row of
+//! `sweep-summary.csv` each combination's runs give. A row is a view of the runs'
+//! `summary.json`, picked by the JSON pointers in [`METRICS`], so the tables never
+//! say anything the summaries do not.
 
 use tactile_scenario::overrides::{split_values, Set};
 
-/// The columns of `sweep.csv` after the swept keys: a name, and where the value is in
+/// The metrics of `sweep.csv` after the swept keys and the seed: a name, and where the value is in
 /// a run's `summary.json` (a JSON pointer). `failed` is 1 for a run that failed (a
 /// node died or froze, a wait ran out) and 0 otherwise: a failed run's other values
-/// are what it ran before it failed, so a table never passes one off as whole (with
-/// `--seeds`, `failed_mean` is the share of the seeds' runs that failed).
+/// are what it ran before it failed, so a table never passes one off as whole (in
+/// `sweep-summary.csv`, `failed_mean` is the share of the seeds' runs that failed).
 pub const METRICS: [(&str, &str); 23] = [
     ("samples_sent", "/samples_sent"),
     ("samples_lost", "/samples_lost"),
@@ -108,36 +109,56 @@ pub fn values(summary: &serde_json::Value) -> Vec<Option<f64>> {
         .collect()
 }
 
-/// The header of `sweep.csv` (`lead`: the first columns, `run`, and in `runs.csv`
-/// `run,seed`).
-pub fn header(lead: &str, axes: &[Axis]) -> String {
-    let mut cols: Vec<String> = vec![lead.into()];
-    cols.extend(axes.iter().map(|a| csv_field(&a.key)));
+/// A swept value as the tables write it, so a script reads it back whatever spacing
+/// or quoting the `--set` had: a word as itself (`tdpa`), anything else as JSON (a
+/// number `1000.0`, a boolean `true`, a list `[0,0,0]`, which `json.loads` reads).
+pub fn value_cell(set: &Set) -> String {
+    match serde_json::to_value(&set.value) {
+        Ok(serde_json::Value::String(s)) => s,
+        Ok(v) => v.to_string(),
+        Err(_) => set.value.to_string(),
+    }
+}
+
+/// The swept keys with a column of their own in `sweep.csv`: all but `seed`, which the
+/// `seed` column every row has already says.
+fn keyed(axes: &[Axis]) -> impl Iterator<Item = (usize, &Axis)> {
+    axes.iter().enumerate().filter(|(_, a)| a.key != "seed")
+}
+
+/// The header of `sweep.csv`, one row per run with the same columns whatever
+/// `--seeds`: the run's folder, its combination's index, each swept key, the seed the
+/// run used, every metric.
+pub fn runs_header(axes: &[Axis]) -> String {
+    let mut cols: Vec<String> = vec!["run".into(), "combination".into()];
+    cols.extend(keyed(axes).map(|(_, a)| csv_field(&a.key)));
+    cols.push("seed".into());
     cols.extend(METRICS.iter().map(|(n, _)| n.to_string()));
     cols.join(",") + "\n"
 }
 
-/// One run's line of `sweep.csv` (`lead`: its first cells, the run's number, and in
-/// `runs.csv` its seed too).
-pub fn row(lead: &str, axes: &[Axis], combo: &[usize], values: &[Option<f64>]) -> String {
-    let mut cols: Vec<String> = vec![lead.to_string()];
-    cols.extend(
-        axes.iter()
-            .zip(combo)
-            .map(|(a, &i)| csv_field(&a.values[i])),
-    );
-    cols.extend(
-        values
-            .iter()
-            .map(|v| v.map_or_else(String::new, |x| format!("{x}"))),
-    );
+/// One run's line of `sweep.csv`: its folder's name, combination `k`, the seed it ran
+/// with and its metrics.
+pub fn runs_row(
+    run: &str,
+    k: usize,
+    axes: &[Axis],
+    combo: &[usize],
+    seed: u64,
+    values: &[Option<f64>],
+) -> String {
+    let mut cols: Vec<String> = vec![csv_field(run), k.to_string()];
+    cols.extend(keyed(axes).map(|(j, a)| csv_field(&value_cell(&a.sets[combo[j]]))));
+    cols.push(seed.to_string());
+    cols.extend(values.iter().map(|v| number(*v)));
     cols.join(",") + "\n"
 }
 
-/// The header of `sweep.csv` for a sweep repeated over `seeds` seeds: per metric its
-/// mean and the half width of its 95 % confidence interval, and the runs averaged.
-pub fn header_seeds(axes: &[Axis]) -> String {
-    let mut cols: Vec<String> = vec!["run".into()];
+/// The header of `sweep-summary.csv`, one row per combination with the same columns
+/// whatever `--seeds`: per metric its mean and the half width of its 95 % confidence
+/// interval, and how many runs were averaged.
+pub fn summary_header(axes: &[Axis]) -> String {
+    let mut cols: Vec<String> = vec!["combination".into()];
     cols.extend(axes.iter().map(|a| csv_field(&a.key)));
     cols.push("seeds".into());
     for (n, _) in METRICS {
@@ -145,6 +166,11 @@ pub fn header_seeds(axes: &[Axis]) -> String {
         cols.push(format!("{n}_ci95"));
     }
     cols.join(",") + "\n"
+}
+
+/// A metric's cell: empty where there is no value.
+fn number(v: Option<f64>) -> String {
+    v.map_or_else(String::new, |x| format!("{x}"))
 }
 
 /// Each metric's mean and 95 % half width over one combination's runs (one `Vec` of
@@ -161,8 +187,9 @@ pub fn stats(runs: &[Vec<Option<f64>>]) -> Vec<(Option<f64>, Option<f64>)> {
         .collect()
 }
 
-/// One combination's line of `sweep.csv` over its `seeds` runs, from their [`stats`].
-pub fn row_seeds(
+/// One combination's line of `sweep-summary.csv` over its `seeds` runs, from their
+/// [`stats`]; an interval is empty for one run (one value bounds nothing).
+pub fn summary_row(
     k: usize,
     axes: &[Axis],
     combo: &[usize],
@@ -173,12 +200,12 @@ pub fn row_seeds(
     cols.extend(
         axes.iter()
             .zip(combo)
-            .map(|(a, &i)| csv_field(&a.values[i])),
+            .map(|(a, &i)| csv_field(&value_cell(&a.sets[i]))),
     );
     cols.push(seeds.to_string());
     for (mean, ci) in stats {
-        cols.push(mean.map_or_else(String::new, |x| format!("{x}")));
-        cols.push(ci.map_or_else(String::new, |x| format!("{x}")));
+        cols.push(number(*mean));
+        cols.push(number(*ci));
     }
     cols.join(",") + "\n"
 }
@@ -342,5 +369,22 @@ mod tests {
     fn csv_fields_with_commas_are_quoted() {
         assert_eq!(csv_field("[1,2]"), "\"[1,2]\"");
         assert_eq!(csv_field("tdpa"), "tdpa");
+    }
+
+    /// A list reads back as JSON whatever its spacing; a word as itself.
+    #[test]
+    fn swept_values_are_written_to_be_parsed_back() {
+        let a = axis("network.forward.delay=[0, 0, 0],[5,5, 5]").expect("a");
+        assert_eq!(value_cell(&a.sets[0]), "[0,0,0]");
+        assert_eq!(value_cell(&a.sets[1]), "[5,5,5]");
+        let b = axis("control.kind=tdpa,\"wave\"").expect("b");
+        assert_eq!(value_cell(&b.sets[0]), "tdpa");
+        assert_eq!(value_cell(&b.sets[1]), "wave");
+        let c = axis("rate_hz=1000.0,500").expect("c");
+        assert_eq!(value_cell(&c.sets[0]), "1000.0");
+        assert_eq!(value_cell(&c.sets[1]), "500");
+        let d = axis("scale=[0.5,1e-3]").expect("d");
+        let back: Vec<f64> = serde_json::from_str(&value_cell(&d.sets[0])).expect("json");
+        assert_eq!(back, [0.5, 1e-3]);
     }
 }

@@ -79,6 +79,12 @@ pub fn finished(dir: &Path) -> Option<Vec<Option<f64>>> {
     whole.then(|| values(&json))
 }
 
+/// The seed the run in `dir` used, from its `scenario.toml`.
+pub fn seed_of(dir: &Path) -> Option<u64> {
+    let text = std::fs::read_to_string(dir.join("scenario.toml")).ok()?;
+    Some(tactile_scenario::Scenario::from_toml_str(&text).ok()?.seed)
+}
+
 fn summary(dir: &Path) -> Option<serde_json::Value> {
     let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
     serde_json::from_str(&text).ok()

@@ -1,7 +1,9 @@
 //! `tactile sweep`: one scenario run for every combination of the values given to
 //! `--set KEY=V1,V2,...` (each repeated over `--seeds` seeds), a table of their metrics
-//! (`sweep.csv`) and a plot per metric against the first swept key, one line per
-//! value of the second.
+//! (`sweep.csv`, one row per run), their mean and interval per combination
+//! (`sweep-summary.csv`) and a plot per metric against the first swept key, one line
+//! per value of the second. Both tables have the same columns whatever `--seeds`, so
+//! a script reads any sweep's.
 //!
 //! Each run is an ordinary run with its own folder and full report (without its
 //! trace); its row in `sweep.csv` is read back from its `summary.json`, picked by the
@@ -61,8 +63,8 @@ pub struct SweepArgs {
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
     /// Repeat every combination over N seeds (the scenario's seed, then +1, +2, ...):
-    /// sweep.csv gives each metric's mean and 95 % confidence half width over them,
-    /// runs.csv every run, the plots error bars.
+    /// sweep.csv has every run with the seed it used, sweep-summary.csv each metric's
+    /// mean and 95 % confidence half width over them, the plots error bars.
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub seeds: usize,
     /// Keep the runs whose folders already hold a whole report (a sweep cut short, or
@@ -187,15 +189,22 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
     traces::gather(&args.out, work.iter().map(|w| w.dir.as_path()))?;
     let done = done?;
     let complete = done.iter().all(Option::is_some);
-    let results: Vec<_> = work
+    let results: Vec<table::Ran> = work
         .iter()
         .zip(done)
-        .filter_map(|(w, d)| d.map(|v| (w.k, w.seed, v)))
+        .filter_map(|(w, d)| {
+            d.map(|values| table::Ran {
+                k: w.k,
+                s: w.seed,
+                seed: w.loaded.scenario.seed,
+                values,
+            })
+        })
         .collect();
     table::write_tables(&args.out, &axes, args.seeds, &results)?;
     if !complete {
         crate::noteln!(
-            "tactile sweep: stopped by a signal after {} of {} runs; sweep.csv and the plots hold the combinations whose runs all ended; --resume runs the rest",
+            "tactile sweep: stopped by a signal after {} of {} runs; sweep.csv holds the runs that ended, sweep-summary.csv and the plots the combinations whose runs all ended; --resume runs the rest",
             results.len(),
             work.len()
         );

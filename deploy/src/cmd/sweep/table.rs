@@ -6,11 +6,23 @@ use super::{parse_axes, run_dir, Spec};
 use crate::error::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use tactile_report::sweep::{combinations, header, header_seeds, row, row_seeds, stats, Axis};
+use tactile_report::sweep::{
+    combinations, runs_header, runs_row, stats, summary_header, summary_row, Axis,
+};
 use tactile_report::sweep_plots::{sweep_plots, Point};
 
-/// A run's result: combination, seed index, metrics.
-pub type Result3 = (usize, usize, Vec<Option<f64>>);
+/// A run that ended, as the tables take it.
+#[derive(Debug, Clone)]
+pub struct Ran {
+    /// Its combination's index in the grid.
+    pub k: usize,
+    /// Its seed's index (0 without `--seeds`): names its folder.
+    pub s: usize,
+    /// The seed it ran with (its `scenario.toml`'s), what `sweep.csv` says.
+    pub seed: u64,
+    /// Its metrics.
+    pub values: Vec<Option<f64>>,
+}
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
     Ok(tactile_report::out::write_file(path, text)?)
@@ -49,47 +61,35 @@ pub fn check_resume(out: &Path, spec: &Spec, resume: bool) -> Result<(), Error> 
     Ok(())
 }
 
-/// `sweep.csv` (and with seeds `runs.csv`) and the plots, from `results` in any order:
-/// rows follow the grid, and a combination appears once all its seeds ended.
-pub fn write_tables(
-    out: &Path,
-    axes: &[Axis],
-    seeds: usize,
-    results: &[Result3],
-) -> Result<(), Error> {
+/// `sweep.csv` (every run that ended), `sweep-summary.csv` and the plots (every
+/// combination whose runs all ended), from `results` in any order: rows follow the
+/// grid, so the files do not depend on the order the runs ended in.
+pub fn write_tables(out: &Path, axes: &[Axis], seeds: usize, results: &[Ran]) -> Result<(), Error> {
     let combos = combinations(axes);
-    let mut by: BTreeMap<usize, BTreeMap<usize, &Vec<Option<f64>>>> = BTreeMap::new();
-    for (k, s, v) in results {
-        by.entry(*k).or_default().insert(*s, v);
+    let mut by: BTreeMap<usize, BTreeMap<usize, &Ran>> = BTreeMap::new();
+    for r in results {
+        by.entry(r.k).or_default().insert(r.s, r);
     }
     let mut points: Vec<Point> = Vec::new();
-    let mut csv = if seeds == 1 {
-        header("run", axes)
-    } else {
-        header_seeds(axes)
-    };
-    let mut runs = header("run,seed", axes);
+    let mut runs = runs_header(axes);
+    let mut summary = summary_header(axes);
     for (&k, per_seed) in &by {
         let combo = &combos[k];
-        let values: Vec<Vec<Option<f64>>> = per_seed.values().map(|v| (*v).clone()).collect();
-        for (s, v) in per_seed {
-            runs += &row(&format!("{k},{s}"), axes, combo, v);
+        for r in per_seed.values() {
+            let dir = run_dir(Path::new(""), k, r.s, seeds);
+            let name = dir.display().to_string();
+            runs += &runs_row(&name, k, axes, combo, r.seed, &r.values);
         }
         if per_seed.len() < seeds {
             continue;
         }
+        let values: Vec<Vec<Option<f64>>> = per_seed.values().map(|r| r.values.clone()).collect();
         let stats = stats(&values);
-        if seeds == 1 {
-            csv += &row(&k.to_string(), axes, combo, &values[0]);
-        } else {
-            csv += &row_seeds(k, axes, combo, values.len(), &stats);
-        }
+        summary += &summary_row(k, axes, combo, values.len(), &stats);
         points.push((combo.clone(), stats));
     }
-    write(&out.join("sweep.csv"), &csv)?;
-    if seeds > 1 {
-        write(&out.join("runs.csv"), &runs)?;
-    }
+    write(&out.join("sweep.csv"), &runs)?;
+    write(&out.join("sweep-summary.csv"), &summary)?;
     sweep_plots(out, axes, &points).map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))
 }
 
@@ -115,9 +115,8 @@ fn slices_of_one_sweep(dirs: &[PathBuf]) -> Result<Spec, Error> {
     Ok(first.clone())
 }
 
-/// Every run of the grid found (combination, seed, its metrics), and the runs in
-/// none of the folders.
-type Found = (Vec<(usize, usize, Vec<Option<f64>>)>, Vec<String>);
+/// Every run of the grid found, and the runs in none of the folders.
+type Found = (Vec<Ran>, Vec<String>);
 
 /// Each run of the grid from the one folder that holds it.
 fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
@@ -126,7 +125,7 @@ fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
         for s in 0..spec.seeds {
             let found: Vec<_> = dirs
                 .iter()
-                .filter_map(|d| super::exec::finished(&run_dir(d, k, s, spec.seeds)))
+                .filter_map(|d| ran(&run_dir(d, k, s, spec.seeds)))
                 .collect();
             match found.len() {
                 0 => missing.push(
@@ -134,7 +133,12 @@ fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
                         .display()
                         .to_string(),
                 ),
-                1 => results.extend(found.into_iter().map(|v| (k, s, v))),
+                1 => results.extend(found.into_iter().map(|(seed, values)| Ran {
+                    k,
+                    s,
+                    seed,
+                    values,
+                })),
                 _ => {
                     return Err(Error::BadInput(format!(
                         "combination {k}, seed {s}: in more than one folder"
@@ -144,6 +148,11 @@ fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
         }
     }
     Ok((results, missing))
+}
+
+/// The seed and metrics of the whole run in `dir`, read back from its folder.
+fn ran(dir: &Path) -> Option<(u64, Vec<Option<f64>>)> {
+    Some((super::exec::seed_of(dir)?, super::exec::finished(dir)?))
 }
 
 /// `tactile sweep --merge DIR... --out OUT`.
