@@ -6,9 +6,10 @@
 
 use crate::error::Error;
 use crate::spatial::{inertia, inertia_to_parent, Frame};
+use crate::topology::Index;
 use crate::urdf::{Joint as UrdfJoint, JointType, Robot};
 use nalgebra::{Matrix6, Unit, Vector3};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, HashSet};
 
 /// How a moving joint moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,7 +31,8 @@ pub struct Dof {
     pub upper: f64,
     /// Largest speed (`inf` where the URDF gives none), rad/s or m/s.
     pub velocity: f64,
-    /// Largest effort (`inf` where the URDF gives none), N m or N.
+    /// Largest effort as the URDF gives it (`inf` for a continuous joint without a
+    /// `<limit>`), N m or N: the dynamics refuse anything but a positive finite one.
     pub effort: f64,
     /// Viscous damping, N m s/rad or N s/m.
     pub damping: f64,
@@ -109,12 +111,13 @@ impl Chain {
     /// The chain of `robot` from `base` to `tip`.
     pub fn new(robot: &Robot, base: &str, tip: &str) -> Result<Chain, Error> {
         let err = |p: String| chain_error(base, tip, p);
+        let index = Index::new(robot)?;
         for l in [base, tip] {
-            if robot.link(l).is_none() {
+            if index.link(l).is_none() {
                 return Err(err(format!("the robot `{}` has no link `{l}`", robot.name)));
             }
         }
-        let path = path(robot, base, tip)?;
+        let path = path(&index, base, tip)?;
         let mut joints = Vec::new();
         // Each link on the chain: its body (None for the base's) and frame in it.
         let mut at: BTreeMap<&str, (Option<usize>, Frame)> = BTreeMap::new();
@@ -154,7 +157,7 @@ impl Chain {
             return Err(err("no joint moves between them".into()));
         }
         let dofs = assign_dofs(&path, &mut joints).map_err(err)?;
-        fold_masses(robot, &path, at, &mut joints);
+        fold_masses(&index, &path, at, &mut joints);
         Ok(Chain {
             robot: robot.name.clone(),
             base: base.into(),
@@ -201,31 +204,19 @@ impl Chain {
 }
 
 /// The URDF joints from `base` down to `tip`, in that order.
-fn path<'a>(robot: &'a Robot, base: &str, tip: &str) -> Result<Vec<&'a UrdfJoint>, Error> {
-    let mut parent_of: BTreeMap<&str, &UrdfJoint> = BTreeMap::new();
-    for j in &robot.joints {
-        if parent_of.insert(&j.child, j).is_some() {
-            return Err(Error::Field {
-                at: format!("link `{}`", j.child),
-                field: "parent".into(),
-                problem: "it is the child of two joints".into(),
-            });
-        }
-    }
+fn path<'a>(index: &Index<'a>, base: &str, tip: &str) -> Result<Vec<&'a UrdfJoint>, Error> {
     let mut out = Vec::new();
     let mut link = tip;
+    // The index is a tree: climbing from the tip ends at the root.
     while link != base {
-        let Some(j) = parent_of.get(link) else {
+        let Some(j) = index.parent_joint(link) else {
             return Err(chain_error(
                 base,
                 tip,
                 format!("`{tip}` does not hang from `{base}`"),
             ));
         };
-        if out.len() > robot.joints.len() {
-            return Err(chain_error(base, tip, "the joints form a loop"));
-        }
-        out.push(*j);
+        out.push(j);
         link = &j.parent;
     }
     out.reverse();
@@ -261,7 +252,7 @@ fn assign_dofs(path: &[&UrdfJoint], joints: &mut [Joint]) -> Result<Vec<Dof>, St
                 lim.map_or(0.0, |l| l.upper)
             },
             velocity: or_inf(lim.map_or(0.0, |l| l.velocity)),
-            effort: or_inf(lim.map_or(0.0, |l| l.effort)),
+            effort: lim.map_or(f64::INFINITY, |l| l.effort),
             damping: u.damping,
         });
         j.dof = dofs.len() - 1;
@@ -282,19 +273,18 @@ fn assign_dofs(path: &[&UrdfJoint], joints: &mut [Joint]) -> Result<Vec<Dof>, St
 /// Adds every link's inertia to the body it moves with: the links on the chain where
 /// the chain put them, the others (off the chain, beyond the tip) at zero position.
 fn fold_masses<'a>(
-    robot: &'a Robot,
+    index: &Index<'a>,
     path: &[&UrdfJoint],
     mut at: BTreeMap<&'a str, (Option<usize>, Frame)>,
     joints: &mut [Joint],
 ) {
-    let on_path: BTreeSet<&str> = path.iter().map(|j| j.name.as_str()).collect();
+    let on_path: HashSet<&str> = path.iter().map(|j| j.name.as_str()).collect();
     let mut todo: Vec<&'a str> = at.keys().copied().collect();
     while let Some(link) = todo.pop() {
         let (body, frame) = at[link];
-        for j in robot
-            .joints
-            .iter()
-            .filter(|j| j.parent == link && !on_path.contains(j.name.as_str()))
+        for j in index
+            .children_of(link)
+            .filter(|j| !on_path.contains(j.name.as_str()))
         {
             let x = j.mimic.as_ref().map_or(0.0, |m| m.offset);
             let axis = Unit::new_normalize(j.axis);
@@ -310,7 +300,7 @@ fn fold_masses<'a>(
         }
     }
     for (link, (body, frame)) in at {
-        let (Some(b), Some(i)) = (body, robot.link(link).and_then(|l| l.inertial.as_ref())) else {
+        let (Some(b), Some(i)) = (body, index.link(link).and_then(|l| l.inertial.as_ref())) else {
             continue;
         };
         let com = frame.then(&i.origin);

@@ -31,6 +31,7 @@ impl Dynamics {
                 "the chain has mimic joints: its dynamics are a closed linkage's".into(),
             ));
         }
+        effort_limits(chain)?;
         let s: Vec<Vector6<f64>> = chain.joints.iter().map(subspace).collect();
         // A joint with nothing of mass from it to the tip has no articulated inertia
         // about its axis: its acceleration would be unbounded.
@@ -158,11 +159,76 @@ impl Dynamics {
     }
 }
 
+/// Every degree of freedom has a positive, finite effort limit: a simulated servo's
+/// torques are clamped to it, and without one (a continuous joint without `<limit>`,
+/// or `effort="0"`, which URDF files write for "unknown") nothing bounds them, or
+/// nothing can drive the joint.
+fn effort_limits(chain: &Chain) -> Result<(), Error> {
+    for d in &chain.dofs {
+        if !(d.effort.is_finite() && d.effort > 0.0) {
+            let unit = match chain
+                .joints
+                .iter()
+                .find(|j| j.name == d.name)
+                .map(|j| j.kind)
+            {
+                Some(Kind::Prismatic) => "N",
+                _ => "N m",
+            };
+            let given = match d.effort.is_finite() {
+                true => format!("effort {}", d.effort),
+                false => "no <limit effort>".to_string(),
+            };
+            return Err(Error::Dynamics(format!(
+                "joint `{}` has {given}: its motor's torque is unbounded or nothing; write its largest effort, <limit effort=\"...\"> in {unit}, greater than zero",
+                d.name
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// A joint's motion subspace `[linear; angular]` in its own frame.
 fn subspace(j: &crate::chain::Joint) -> Vector6<f64> {
     let a = j.axis.into_inner();
     match j.kind {
         Kind::Revolute => Vector6::new(0.0, 0.0, 0.0, a.x, a.y, a.z),
         Kind::Prismatic => Vector6::new(a.x, a.y, a.z, 0.0, 0.0, 0.0),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one_joint(kind: &str, limit: &str) -> Chain {
+        let xml = format!(
+            r#"<robot name="r"><link name="base"/>
+            <link name="a"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial></link>
+            <joint name="j1" type="{kind}"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>{limit}</joint></robot>"#
+        );
+        Chain::from_urdf(&xml, "base", "a").expect("chain")
+    }
+
+    /// Issue 51: `effort="0"` (or a continuous joint without `<limit>`) left the
+    /// simulated servo's torques unbounded.
+    #[test]
+    fn a_joint_without_a_positive_effort_limit_is_refused_and_named() {
+        let zero = r#"<limit lower="-1" upper="1" effort="0" velocity="1"/>"#;
+        for (kind, limit, want) in [
+            ("revolute", zero, "joint `j1` has effort 0"),
+            ("prismatic", zero, "in N, greater than zero"),
+            ("continuous", "", "joint `j1` has no <limit effort>"),
+        ] {
+            let e = Dynamics::new(&one_joint(kind, limit), EARTH)
+                .expect_err(want)
+                .to_string();
+            assert!(
+                e.contains(want) && e.contains("<limit effort=\"...\">"),
+                "{e}"
+            );
+        }
+        let ok = r#"<limit lower="-1" upper="1" effort="5" velocity="1"/>"#;
+        Dynamics::new(&one_joint("revolute", ok), EARTH).expect("a motor of 5 N m");
     }
 }

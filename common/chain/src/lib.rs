@@ -18,6 +18,7 @@ mod error;
 pub mod ik;
 pub mod kinematics;
 pub mod spatial;
+pub mod topology;
 pub mod tree;
 pub mod urdf;
 

@@ -7,9 +7,10 @@
 
 use crate::error::Error;
 use crate::spatial::Frame;
+use crate::topology::Index;
 use crate::urdf::{JointType, Robot};
 use nalgebra::{Unit, Vector3};
-use std::collections::BTreeSet;
+use std::collections::HashMap;
 
 /// A transform of the tree: `(parent link, child link, child frame in the parent's)`.
 pub type Edge<'a> = (&'a str, &'a str, Frame);
@@ -49,38 +50,19 @@ pub struct Tree {
     /// their pose from elsewhere).
     fixed: Vec<(String, String, Frame)>,
     moving: Vec<Moving>,
+    /// Each moving joint's rest position by name (what a mimic follows by default).
+    rests: HashMap<String, f64>,
 }
 
 impl Tree {
     /// The tree of `robot`: one root, every other link the child of one joint.
     pub fn new(robot: &Robot) -> Result<Tree, Error> {
-        let err = |problem: String| Error::Xml(format!("robot `{}`: {problem}", robot.name));
-        let mut children = BTreeSet::new();
-        for j in &robot.joints {
-            if !children.insert(j.child.as_str()) {
-                return Err(err(format!(
-                    "link `{}` is the child of two joints",
-                    j.child
-                )));
-            }
-        }
-        let roots: Vec<&str> = robot
-            .links
-            .iter()
-            .map(|l| l.name.as_str())
-            .filter(|l| !children.contains(l))
-            .collect();
-        let [root] = roots[..] else {
-            return Err(err(format!(
-                "{} links are no joint's child ({}): a robot has one root",
-                roots.len(),
-                roots.join(", ")
-            )));
-        };
+        let index = Index::new(robot)?;
         let mut tree = Tree {
-            root: root.to_string(),
+            root: index.root().to_string(),
             fixed: Vec::new(),
             moving: Vec::new(),
+            rests: HashMap::new(),
         };
         for j in &robot.joints {
             let edge = (j.parent.clone(), j.child.clone(), j.origin);
@@ -98,6 +80,7 @@ impl Tree {
             } else {
                 0.0_f64.clamp(lower, upper)
             };
+            tree.rests.insert(j.name.clone(), rest);
             tree.moving.push(Moving {
                 name: j.name.clone(),
                 parent: j.parent.clone(),
@@ -147,13 +130,17 @@ impl Tree {
     }
 
     fn rest_of(&self, joint: &str) -> Option<f64> {
-        self.moving.iter().find(|m| m.name == joint).map(|m| m.rest)
+        self.rests.get(joint).copied()
     }
 
     /// Link `link`'s frame in the root's for the positions `value` gives (what
     /// composing the tree's transforms from the root gives); None for no such link.
     pub fn pose(&self, link: &str, value: &dyn Fn(&str) -> Option<f64>) -> Option<Frame> {
-        let edges: Vec<Edge> = self.fixed().chain(self.moving(value)).collect();
+        let edges: HashMap<&str, (&str, Frame)> = self
+            .fixed()
+            .chain(self.moving(value))
+            .map(|(p, c, f)| (c, (p, f)))
+            .collect();
         let mut at = link;
         let mut frame = Frame::IDENTITY;
         // Each step climbs one joint; a tree of n joints has no path longer than n.
@@ -161,7 +148,7 @@ impl Tree {
             if at == self.root {
                 return Some(frame);
             }
-            let (parent, _, f) = edges.iter().find(|(_, c, _)| *c == at)?;
+            let (parent, f) = edges.get(at)?;
             frame = f.then(&frame);
             at = parent;
         }

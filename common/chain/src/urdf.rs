@@ -10,6 +10,22 @@ use roxmltree::{Document, Node};
 /// xacro's XML namespace.
 const XACRO: &str = "http://www.ros.org/wiki/xacro";
 
+/// The longest offset an `<origin xyz>` may give, m: no robot's link is 10 km long,
+/// and with this bound every sum, product and square the chain and its dynamics
+/// form from a file under the slave's size cap stays finite.
+pub const MAX_LENGTH_M: f64 = 1e4;
+
+/// The heaviest link, kg (a large excavator's arm is a few tonnes).
+pub const MAX_MASS_KG: f64 = 1e6;
+
+/// The largest principal moment of inertia, kg m^2 (the heaviest link spread 30 m
+/// from its centre).
+pub const MAX_INERTIA: f64 = 1e9;
+
+/// How far, relative to the largest principal moment, a link's inertia may miss
+/// positive semi-definiteness or the triangle inequality: a CAD export's rounding.
+const INERTIA_TOLERANCE: f64 = 1e-6;
+
 /// A link's `<inertial>`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Inertial {
@@ -173,6 +189,15 @@ fn what(n: Node) -> String {
     )
 }
 
+/// A number for an error message: as written when it is of an everyday size, in
+/// exponent form otherwise (1e308 is not 309 digits).
+pub(crate) fn shown(x: f64) -> String {
+    match x == 0.0 || (1e-4..1e9).contains(&x.abs()) {
+        true => format!("{x}"),
+        false => format!("{x:e}"),
+    }
+}
+
 fn named(n: Node) -> Result<String, Error> {
     match n.attribute("name") {
         Some(s) if !s.is_empty() => Ok(s.to_string()),
@@ -222,13 +247,27 @@ fn triple(owner: &Node, n: Node, attr: &str) -> Result<[f64; 3], Error> {
     <[f64; 3]>::try_from(v).map_err(|_| bad(owner, &field, format!("`{s}` is not three numbers")))
 }
 
-fn origin(owner: &Node) -> Result<Frame, Error> {
-    match child(*owner, "origin") {
-        None => Ok(Frame::IDENTITY),
-        Some(o) => Ok(Frame::from_xyz_rpy(
-            triple(owner, o, "xyz")?,
-            triple(owner, o, "rpy")?,
-        )),
+/// An `<origin>`: each offset within [`MAX_LENGTH_M`], so that the frames the chain
+/// composes stay finite.
+fn origin(owner: &Node, holder: Node) -> Result<Frame, Error> {
+    let Some(o) = child(holder, "origin") else {
+        return Ok(Frame::IDENTITY);
+    };
+    let xyz = triple(owner, o, "xyz")?;
+    if let Some(x) = xyz.iter().find(|x| x.abs() > MAX_LENGTH_M) {
+        return Err(bad(
+            owner,
+            "origin xyz",
+            format!(
+                "{} m is further than {MAX_LENGTH_M} m: not a robot's link",
+                shown(*x)
+            ),
+        ));
+    }
+    let f = Frame::from_xyz_rpy(xyz, triple(owner, o, "rpy")?);
+    match f.r.iter().chain(f.p.iter()).all(|v| v.is_finite()) {
+        true => Ok(f),
+        false => Err(bad(owner, "origin", "does not make a finite transform")),
     }
 }
 
@@ -242,8 +281,12 @@ fn link(n: Node) -> Result<Link, Error> {
     };
     let mass = child(i, "mass").ok_or_else(|| bad(&n, "inertial mass", "missing"))?;
     let mass = number(&n, mass, "value", None)?;
-    if mass < 0.0 {
-        return Err(bad(&n, "mass value", format!("{mass} is negative")));
+    if !(0.0..=MAX_MASS_KG).contains(&mass) {
+        return Err(bad(
+            &n,
+            "mass value",
+            format!("{} kg is outside 0 to {MAX_MASS_KG} kg", shown(mass)),
+        ));
     }
     let t = child(i, "inertia").ok_or_else(|| bad(&n, "inertial inertia", "missing"))?;
     let e = |a: &str| number(&n, t, a, Some(0.0));
@@ -255,14 +298,43 @@ fn link(n: Node) -> Result<Link, Error> {
         e("iyz")?,
         e("izz")?,
     );
+    let inertia = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+    physical(&inertia).map_err(|p| bad(&n, "inertia", p))?;
     Ok(Link {
         name,
         inertial: Some(Inertial {
-            origin: origin(&i)?,
+            origin: origin(&n, i)?,
             mass,
-            inertia: Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz),
+            inertia,
         }),
     })
+}
+
+/// Whether a rotational inertia is one a rigid body can have: its principal moments
+/// non-negative, at most [`MAX_INERTIA`], and none larger than the other two together
+/// (the triangle inequality: `Ixx + Iyy >= Izz` about the principal axes). Anything
+/// else makes the articulated-body algorithm's inertias indefinite, and every step of
+/// the dynamics fails or diverges.
+fn physical(i: &Matrix3<f64>) -> Result<(), String> {
+    let mut m: Vec<f64> = i.symmetric_eigen().eigenvalues.iter().copied().collect();
+    m.sort_by(f64::total_cmp);
+    let (a, b, c) = (m[0], m[1], m[2]);
+    let tol = INERTIA_TOLERANCE * c.abs();
+    let moments = format!("principal moments {a:e}, {b:e}, {c:e} kg m^2");
+    if !(a.is_finite() && c.is_finite()) || c > MAX_INERTIA {
+        return Err(format!("{moments}: not within 0 to {MAX_INERTIA:e}"));
+    }
+    if a < -tol {
+        return Err(format!(
+            "{moments}: one is negative (not positive semi-definite)"
+        ));
+    }
+    if a + b < c - tol {
+        return Err(format!(
+            "{moments}: the largest exceeds the other two together (the triangle inequality)"
+        ));
+    }
+    Ok(())
 }
 
 fn kind(n: &Node) -> Result<JointType, Error> {
@@ -291,18 +363,28 @@ fn link_of(n: &Node, tag: &str) -> Result<String, Error> {
         .ok_or_else(|| bad(n, &format!("{tag} link"), "missing"))
 }
 
-fn axis(n: &Node) -> Result<Vector3<f64>, Error> {
-    let Some(a) = child(*n, "axis") else {
-        return Ok(Vector3::x());
+/// A moving joint's unit axis. A fixed or floating joint's is not read: URDF (and
+/// urdfdom) ignore it, and real files write `0 0 0` there. The vector is scaled by
+/// its largest component before its norm is taken, so no finite axis overflows.
+fn axis(n: &Node, k: JointType) -> Result<Vector3<f64>, Error> {
+    let a = match child(*n, "axis") {
+        Some(a) if !matches!(k, JointType::Fixed | JointType::Floating) => a,
+        _ => return Ok(Vector3::x()),
     };
     let v = Vector3::from(triple(n, a, "xyz")?);
-    if v.norm() < 1e-9 {
+    let big = v.amax();
+    if big < 1e-9 {
         return Err(bad(n, "axis xyz", "is zero"));
     }
-    Ok(v.normalize())
+    Ok((v / big).normalize())
 }
 
+/// A joint's `<limit>`: required for revolute and prismatic joints, with its `effort`
+/// and `velocity` (as URDF and urdfdom require them); a fixed joint's is ignored.
 fn limit(n: &Node, k: JointType) -> Result<Option<Limit>, Error> {
+    if k == JointType::Fixed {
+        return Ok(None);
+    }
     let Some(l) = child(*n, "limit") else {
         return match k {
             JointType::Revolute | JointType::Prismatic => {
@@ -314,14 +396,28 @@ fn limit(n: &Node, k: JointType) -> Result<Option<Limit>, Error> {
     let lim = Limit {
         lower: number(n, l, "lower", Some(0.0))?,
         upper: number(n, l, "upper", Some(0.0))?,
-        effort: number(n, l, "effort", Some(0.0))?,
-        velocity: number(n, l, "velocity", Some(0.0))?,
+        effort: required(
+            n,
+            l,
+            "effort",
+            "the motor's largest effort, N m (N for a prismatic joint)",
+        )?,
+        velocity: required(
+            n,
+            l,
+            "velocity",
+            "the largest speed, rad/s (m/s for a prismatic joint)",
+        )?,
     };
     if k != JointType::Continuous && lim.lower > lim.upper {
         return Err(bad(
             n,
             "limit",
-            format!("lower {} is above upper {}", lim.lower, lim.upper),
+            format!(
+                "lower {} is above upper {}",
+                shown(lim.lower),
+                shown(lim.upper)
+            ),
         ));
     }
     if lim.velocity < 0.0 || lim.effort < 0.0 {
@@ -330,13 +426,44 @@ fn limit(n: &Node, k: JointType) -> Result<Option<Limit>, Error> {
     Ok(Some(lim))
 }
 
+/// A number URDF requires; missing, the error says what to write.
+fn required(owner: &Node, n: Node, attr: &str, what: &str) -> Result<f64, Error> {
+    match n.attribute(attr) {
+        None => Err(bad(
+            owner,
+            &format!("limit {attr}"),
+            format!("missing: URDF requires it; write {attr}=\"...\", {what}"),
+        )),
+        Some(_) => number(owner, n, attr, None),
+    }
+}
+
+/// `<dynamics damping friction>`: neither may be negative (a negative damping pumps
+/// energy into the joint every step).
+fn damping(n: &Node) -> Result<f64, Error> {
+    let Some(d) = child(*n, "dynamics") else {
+        return Ok(0.0);
+    };
+    for attr in ["damping", "friction"] {
+        let v = number(n, d, attr, Some(0.0))?;
+        if v < 0.0 {
+            return Err(bad(
+                n,
+                &format!("dynamics {attr}"),
+                format!(
+                    "{} is negative: it would push the joint, not resist it",
+                    shown(v)
+                ),
+            ));
+        }
+    }
+    number(n, d, "damping", Some(0.0))
+}
+
 fn joint(n: Node) -> Result<Joint, Error> {
     let name = named(n)?;
     let k = kind(&n)?;
-    let damping = match child(n, "dynamics") {
-        Some(d) => number(&n, d, "damping", Some(0.0))?,
-        None => 0.0,
-    };
+    let damping = damping(&n)?;
     let mimic = match child(n, "mimic") {
         None => None,
         Some(m) => Some(Mimic {
@@ -353,8 +480,8 @@ fn joint(n: Node) -> Result<Joint, Error> {
         kind: k,
         parent: link_of(&n, "parent")?,
         child: link_of(&n, "child")?,
-        origin: origin(&n)?,
-        axis: axis(&n)?,
+        origin: origin(&n, n)?,
+        axis: axis(&n, k)?,
         limit: limit(&n, k)?,
         damping,
         mimic,
@@ -363,56 +490,5 @@ fn joint(n: Node) -> Result<Joint, Error> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    const TWO: &str = r#"<robot name="two">
-      <link name="base"/>
-      <link name="a"><inertial><origin xyz="0 0 0.1"/><mass value="1.5"/>
-        <inertia ixx="0.01" iyy="0.02" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial></link>
-      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
-        <origin xyz="0 0 0.2" rpy="0 0 1.5707963267948966"/><axis xyz="0 0 2"/>
-        <limit lower="-1" upper="1" effort="10" velocity="2"/><dynamics damping="0.5"/></joint>
-    </robot>"#;
-
-    #[test]
-    fn a_urdf_reads_into_links_and_joints() {
-        let r = Robot::parse(TWO).expect("parses");
-        assert_eq!(r.name, "two");
-        assert_eq!(r.links.len(), 2);
-        let j = &r.joints[0];
-        assert_eq!(
-            (j.kind, j.parent.as_str(), j.child.as_str()),
-            (JointType::Revolute, "base", "a")
-        );
-        assert_eq!(j.axis, Vector3::z());
-        assert_eq!(j.damping, 0.5);
-        assert_eq!(j.limit.map(|l| l.velocity), Some(2.0));
-        assert!((j.origin.p.z - 0.2).abs() < 1e-15);
-        assert_eq!(
-            r.link("a")
-                .and_then(|l| l.inertial.as_ref())
-                .map(|i| i.mass),
-            Some(1.5)
-        );
-    }
-
-    #[test]
-    fn faults_name_the_element_and_the_field() {
-        let cases = [
-            (TWO.replace("xyz=\"0 0 0.2\"", "xyz=\"0 0\""), "joint `j1`: origin xyz"),
-            (TWO.replace("lower=\"-1\"", "lower=\"2\""), "joint `j1`: limit: lower 2 is above upper 1"),
-            (TWO.replace("<mass value=\"1.5\"/>", "<mass value=\"nan\"/>"), "link `a`: mass value"),
-            (TWO.replace("revolute", "spherical"), "joint `j1`: type"),
-            (TWO.replace("<axis xyz=\"0 0 2\"/>", "<axis xyz=\"0 0 0\"/>"), "joint `j1`: axis xyz: is zero"),
-            (TWO.replace("<limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"2\"/>", ""), "joint `j1`: limit: missing"),
-            ("<robot name=\"x\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\"><xacro:macro name=\"m\"/></robot>".into(), "xacro"),
-            ("<robot name=\"x\"><xacro:include filename=\"a.xacro\"/></robot>".into(), "xacro"),
-            ("<robot><link".into(), "not XML"),
-        ];
-        for (xml, want) in cases {
-            let e = Robot::parse(&xml).expect_err(want).to_string();
-            assert!(e.contains(want), "`{e}` should contain `{want}`");
-        }
-    }
-}
+#[path = "urdf_tests.rs"]
+mod tests;

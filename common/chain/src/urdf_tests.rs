@@ -1,0 +1,97 @@
+//! The URDF reader's tests (beside the module, which they would double).
+use super::*;
+
+const TWO: &str = r#"<robot name="two">
+  <link name="base"/>
+  <link name="a"><inertial><origin xyz="0 0 0.1"/><mass value="1.5"/>
+    <inertia ixx="0.01" iyy="0.02" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
+    <origin xyz="0 0 0.2" rpy="0 0 1.5707963267948966"/><axis xyz="0 0 2"/>
+    <limit lower="-1" upper="1" effort="10" velocity="2"/><dynamics damping="0.5"/></joint>
+</robot>"#;
+
+#[test]
+fn a_urdf_reads_into_links_and_joints() {
+    let r = Robot::parse(TWO).expect("parses");
+    assert_eq!(r.name, "two");
+    assert_eq!(r.links.len(), 2);
+    let j = &r.joints[0];
+    assert_eq!(
+        (j.kind, j.parent.as_str(), j.child.as_str()),
+        (JointType::Revolute, "base", "a")
+    );
+    assert_eq!(j.axis, Vector3::z());
+    assert_eq!(j.damping, 0.5);
+    assert_eq!(j.limit.map(|l| l.velocity), Some(2.0));
+    assert!((j.origin.p.z - 0.2).abs() < 1e-15);
+    assert_eq!(
+        r.link("a")
+            .and_then(|l| l.inertial.as_ref())
+            .map(|i| i.mass),
+        Some(1.5)
+    );
+}
+
+#[test]
+fn a_fixed_joints_axis_and_limit_are_not_read() {
+    // As Kinova's Jaco2 URDF writes them (example-robot-data's kinova.urdf).
+    let xml = TWO.replace(
+        "</robot>",
+        r#"<link name="tool"/><joint name="mount" type="fixed"><parent link="a"/><child link="tool"/>
+          <axis xyz="0 0 0"/><limit effort="0" lower="0" upper="0" velocity="0"/></joint></robot>"#,
+    );
+    let r = Robot::parse(&xml).expect("a fixed joint's zero axis is ignored");
+    assert_eq!(
+        (r.joints[1].kind, r.joints[1].limit),
+        (JointType::Fixed, None)
+    );
+    // A moving joint's zero axis is still refused.
+    let bad = xml.replace("<axis xyz=\"0 0 2\"/>", "<axis xyz=\"0 0 0\"/>");
+    let e = Robot::parse(&bad).expect_err("zero axis").to_string();
+    assert!(e.contains("joint `j1`: axis xyz: is zero"), "{e}");
+}
+
+#[test]
+fn an_axis_of_huge_or_tiny_components_is_a_unit_vector() {
+    for (a, want) in [
+        ("0 0 1e200", Vector3::z()),
+        ("1e308 1e308 0", Vector3::new(1.0, 1.0, 0.0).normalize()),
+        ("0 -1e-5 0", -Vector3::y()),
+    ] {
+        let r = Robot::parse(&TWO.replace("0 0 2", a)).expect(a);
+        let axis = r.joints[0].axis;
+        assert!(axis.iter().all(|v| v.is_finite()), "{a}: {axis:?}");
+        assert!((axis - want).norm() < 1e-15, "{a}: {axis:?}");
+    }
+}
+
+#[test]
+fn faults_name_the_element_and_the_field() {
+    let cases = [
+        (TWO.replace("xyz=\"0 0 0.2\"", "xyz=\"0 0\""), "joint `j1`: origin xyz"),
+        (TWO.replace("lower=\"-1\"", "lower=\"2\""), "joint `j1`: limit: lower 2 is above upper 1"),
+        (TWO.replace("<mass value=\"1.5\"/>", "<mass value=\"nan\"/>"), "link `a`: mass value"),
+        (TWO.replace("revolute", "spherical"), "joint `j1`: type"),
+        (TWO.replace("<axis xyz=\"0 0 2\"/>", "<axis xyz=\"0 0 0\"/>"), "joint `j1`: axis xyz: is zero"),
+        (TWO.replace("<limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"2\"/>", ""), "joint `j1`: limit: missing"),
+        ("<robot name=\"x\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\"><xacro:macro name=\"m\"/></robot>".into(), "xacro"),
+        ("<robot name=\"x\"><xacro:include filename=\"a.xacro\"/></robot>".into(), "xacro"),
+        ("<robot><link".into(), "not XML"),
+        // Issue 51: numbers that overflow or mean nothing physical.
+        (TWO.replace("xyz=\"0 0 0.2\"", "xyz=\"0 0 1e308\""), "joint `j1`: origin xyz: 1e308 m is further than"),
+        (TWO.replace("xyz=\"0 0 0.1\"", "xyz=\"1e300 0 0\""), "link `a`: origin xyz"),
+        (TWO.replace("damping=\"0.5\"", "damping=\"-0.5\""), "joint `j1`: dynamics damping: -0.5 is negative"),
+        (TWO.replace("damping=\"0.5\"", "friction=\"-1\""), "joint `j1`: dynamics friction: -1 is negative"),
+        (TWO.replace(" effort=\"10\"", ""), "joint `j1`: limit effort: missing: URDF requires it; write effort=\"...\""),
+        (TWO.replace(" velocity=\"2\"", ""), "joint `j1`: limit velocity: missing"),
+        (TWO.replace("1.5\"/>", "1e300\"/>"), "link `a`: mass value: 1e300 kg is outside"),
+        (TWO.replace("ixx=\"0.01\"", "ixx=\"-0.01\""), "link `a`: inertia: principal moments"),
+        (TWO.replace("izz=\"0.03\"", "izz=\"0.5\""), "the triangle inequality"),
+        (TWO.replace("ixx=\"0.01\" iyy=\"0.02\" izz=\"0.03\"", "ixx=\"1e300\" iyy=\"1e300\" izz=\"1e300\""), "not within 0 to"),
+        (TWO.replace("ixy=\"0\"", "ixy=\"0.05\""), "not positive semi-definite"),
+    ];
+    for (xml, want) in cases {
+        let e = Robot::parse(&xml).expect_err(want).to_string();
+        assert!(e.contains(want), "`{e}` should contain `{want}`");
+    }
+}
