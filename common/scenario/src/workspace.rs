@@ -15,6 +15,23 @@ use serde::{Deserialize, Serialize};
 /// A 3x3 rotation matrix, rows.
 pub type Matrix = [[f64; 3]; 3];
 
+/// The range of a position or force scale: from a micromanipulator's 1:1000 to a
+/// macro arm's 100:1. Outside it the map turns a millimetre of the robot into
+/// kilometres of the master's workspace (`slave.arm.scale = 1e-300` made the slave's
+/// force 8e301 N) or the operator's hand into nothing.
+pub const SCALE_RANGE: (f64, f64) = (1e-3, 100.0);
+
+fn in_scale_range(s: f64) -> bool {
+    s.is_finite() && (SCALE_RANGE.0..=SCALE_RANGE.1).contains(&s)
+}
+
+/// Why a scale is refused: the value (in exponent form, so 1e-300 is not 300 digits)
+/// and the range.
+fn out_of_range(s: f64) -> String {
+    let (lo, hi) = SCALE_RANGE;
+    format!("{s:e} is outside [{lo}, {hi}]")
+}
+
 /// How far from one a configured quaternion's norm may be before it is refused (four
 /// or five decimals of a half-angle's sine are what people copy).
 const UNIT_TOLERANCE: f64 = 1e-3;
@@ -47,12 +64,12 @@ impl Scale {
 
     fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         for (i, s) in self.axes().iter().enumerate() {
-            if !(s.is_finite() && *s > 0.0 && *s <= 100.0) {
+            if !in_scale_range(*s) {
                 let f = match self {
                     Scale::Uniform(_) => field.to_string(),
                     Scale::PerAxis(_) => format!("{field}[{i}]"),
                 };
-                return Err(invalid(f, format!("{s} is outside (0, 100]")));
+                return Err(invalid(f, out_of_range(*s)));
             }
         }
         Ok(())
@@ -241,11 +258,8 @@ pub(crate) fn validate(
     if let Some(w) = workspace {
         w.validate("slave.arm.workspace")?;
     }
-    if !(force_scale.is_finite() && force_scale > 0.0 && force_scale <= 100.0) {
-        return Err(invalid(
-            "slave.arm.force_scale",
-            format!("{force_scale} is outside (0, 100]"),
-        ));
+    if !in_scale_range(force_scale) {
+        return Err(invalid("slave.arm.force_scale", out_of_range(force_scale)));
     }
     Ok(())
 }
@@ -376,6 +390,30 @@ mod tests {
             .expect_err("refused")
             .to_string()
             .contains("slave.arm.force_scale"));
+    }
+
+    /// Issue 51: `scale = 1e-300` was taken, and the slave sent 8e301 N.
+    #[test]
+    fn scales_outside_their_range_are_refused() {
+        let map = |scale, force| validate(&scale, &FrameRotation::default(), None, force);
+        for s in [1e-300, 9.9e-4, 100.1, f64::INFINITY, 0.0, -1.0] {
+            let e = map(Scale::Uniform(s), 1.0).expect_err("scale").to_string();
+            assert!(
+                e.contains("slave.arm.scale") && e.contains("outside [0.001, 100]"),
+                "{e}"
+            );
+            let e = map(Scale::Uniform(1.0), s)
+                .expect_err("force scale")
+                .to_string();
+            assert!(e.contains("slave.arm.force_scale"), "{e}");
+        }
+        let e = map(Scale::Uniform(1e-300), 1.0)
+            .expect_err("tiny")
+            .to_string();
+        assert!(e.contains("1e-300 is outside"), "{e}");
+        for s in [1e-3, 0.01, 1.0, 100.0] {
+            map(Scale::Uniform(s), s).expect("in range");
+        }
     }
 
     #[test]
