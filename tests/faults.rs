@@ -10,7 +10,7 @@ use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
 use tactile_report::trace::signal_columns;
 use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber};
 use tactile_transport::{Publish, Subscribe};
-use util::{column, Sandbox};
+use util::{cannot, column, Sandbox};
 
 fn spawn_run(sb: &Sandbox, scenario: &std::path::Path, out: &str) -> Child {
     sb.command(&["run", scenario.to_str().expect("utf-8"), "--out"])
@@ -407,4 +407,57 @@ fn forces_and_torques_are_clamped_to_the_device_limits() {
             .iter()
             .all(|t| t.abs() <= 0.45));
     }
+}
+
+/// Unmounts a test's file system when the test ends, however it ends.
+struct Unmount(std::path::PathBuf);
+
+impl Drop for Unmount {
+    fn drop(&mut self) {
+        let _ = std::process::Command::new("umount")
+            .arg("-l")
+            .arg(&self.0)
+            .status();
+    }
+}
+
+/// Disk full in processes mode: the nodes died writing their records, and the
+/// launcher said only "writing trace.csv: No space left on device". It names each
+/// node's failure (how it ended, its log's last words) before its own error.
+#[test]
+fn a_full_disk_names_the_nodes_that_died_of_it() {
+    if !rustix::process::geteuid().is_root() {
+        cannot("a small tmpfs for the run's folder needs root");
+        return;
+    }
+    let sb = Sandbox::new("diskfull");
+    let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
+    let disk = sb.path("disk");
+    std::fs::create_dir_all(&disk).expect("folder");
+    let mounted = std::process::Command::new("mount")
+        .args(["-t", "tmpfs", "-o", "size=600k", "tmpfs"])
+        .arg(&disk)
+        .status()
+        .is_ok_and(|s| s.success());
+    if !mounted {
+        cannot("mount -t tmpfs was refused");
+        return;
+    }
+    let _unmount = Unmount(disk.clone());
+    let child = sb
+        .command(&["run", scenario.to_str().expect("utf-8"), "--out"])
+        .arg(disk.join("run"))
+        .args(["--prefix", &sb.prefix, "-q", "--max-restarts", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start tactile run");
+    let (code, _, err) = finish(child);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("No space left on device"), "{err}");
+    assert!(
+        err.contains(" exited with status 1 after ") && err.contains("its last words"),
+        "each node's failure is named: {err}"
+    );
+    sb.assert_no_leftover_processes();
 }

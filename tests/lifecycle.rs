@@ -228,21 +228,32 @@ fn an_output_folder_holds_one_run_at_a_time() {
     assert!(names.is_empty(), "{names:?}");
 }
 
+/// `tactile run` into `run` (with `extra`), its slave stopped by SIGSTOP once its
+/// record holds `bytes`; the run's output.
+fn freeze_the_slave(
+    sb: &Sandbox,
+    scenario: &Path,
+    extra: &[&str],
+    bytes: u64,
+) -> std::process::Output {
+    let out = sb.path("run");
+    let child = run_without_restarts(sb, scenario, &out, extra);
+    wait_for("the slave records", Duration::from_secs(20), || {
+        std::fs::metadata(out.join("slave.rec")).is_ok_and(|m| m.len() > bytes)
+    });
+    let slave = util::pid_of(&sb.prefix, "slave").expect("slave");
+    let pid = rustix::process::Pid::from_raw(slave).expect("pid");
+    rustix::process::kill_process(pid, rustix::process::Signal::STOP).expect("SIGSTOP");
+    util::wait_within(child, util::LIMIT)
+}
+
 /// A slave frozen by SIGSTOP: the launcher names it frozen after the stall limit, kills it, and the run is failed (exit 1), not a completed
 /// run with most samples lost.
 #[test]
 fn a_frozen_node_fails_the_run_after_the_stall_limit() {
     let sb = Sandbox::new("frozen");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
-    let out = sb.path("run");
-    let child = run_without_restarts(&sb, &scenario, &out, &["--stall-s", "1.5"]);
-    wait_for("the slave records", Duration::from_secs(20), || {
-        std::fs::metadata(out.join("slave.rec")).is_ok_and(|m| m.len() > 50_000)
-    });
-    let slave = util::pid_of(&sb.prefix, "slave").expect("slave");
-    let pid = rustix::process::Pid::from_raw(slave).expect("pid");
-    rustix::process::kill_process(pid, rustix::process::Signal::STOP).expect("SIGSTOP");
-    let o = util::wait_within(child, util::LIMIT);
+    let o = freeze_the_slave(&sb, &scenario, &["--stall-s", "1.5"], 50_000);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     let s = sb.json("run", "summary.json");
@@ -257,4 +268,47 @@ fn a_frozen_node_fails_the_run_after_the_stall_limit() {
         "stopped early: {s}"
     );
     sb.assert_no_leftover_processes();
+}
+
+/// A slave frozen by SIGSTOP in a run shorter than the stall limit (3 s of samples,
+/// the default 5 s limit): still stopped when the master ends, it fails the run (exit
+/// 1), named with the moment it stopped, not a completed run with most samples lost.
+#[test]
+fn a_node_still_frozen_when_the_run_ends_fails_it() {
+    let sb = Sandbox::new("frozenend");
+    let scenario = sb.write("s.toml", &util::paper_1khz(3000));
+    let o = freeze_the_slave(&sb, &scenario, &[], 20_000);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("slave was still frozen when the run ended"),
+        "{err}"
+    );
+    let s = sb.json("run", "summary.json");
+    assert_eq!(s["failed"], true);
+    let events = s["events"].to_string();
+    assert!(
+        events.contains("the process is stopped (SIGSTOP or a job-control stop) since"),
+        "{events}"
+    );
+    sb.assert_no_leftover_processes();
+}
+
+/// `--append` into a file that is not a record: bad input (exit 2, as documented),
+/// naming the file, the file left as it was; it exited 1, as if the run had failed.
+#[test]
+fn append_into_a_file_that_is_not_a_record_is_bad_input() {
+    let sb = Sandbox::new("appendbad");
+    let scenario = sb.write("s.toml", &util::paper_1khz(1000));
+    std::fs::create_dir_all(sb.path("s")).expect("folder");
+    let rec = sb.write("s/slave.rec", "these are notes, not a record\n");
+    let slave = start_node(&sb, "slave", &scenario, "s", &["--append"]);
+    let (code, err) = finish(slave);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("slave.rec") && err.contains("not a Tactile record"),
+        "{err}"
+    );
+    let kept = std::fs::read_to_string(rec).expect("still there");
+    assert_eq!(kept, "these are notes, not a record\n");
 }

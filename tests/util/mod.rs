@@ -418,3 +418,36 @@ pub fn path_error(trace: &str, range: std::ops::Range<usize>, max_lag: usize) ->
         })
         .collect()
 }
+
+/// Runs `cmd` to its end, its output discarded, and returns how it ended and its peak
+/// resident memory in kB (the kernel's VmHWM, read every 5 ms while it runs: a
+/// process's peak is only readable while it lives, and the last reading before it
+/// ends is its peak but for what it grew in its last 5 ms).
+pub fn run_measured(mut cmd: Command) -> (std::process::ExitStatus, u64) {
+    use std::process::Stdio;
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start");
+    let status = format!("/proc/{}/status", child.id());
+    let started = std::time::Instant::now();
+    let mut peak = 0;
+    loop {
+        let text = std::fs::read_to_string(&status).unwrap_or_default();
+        let hwm = text
+            .lines()
+            .find_map(|l| l.strip_prefix("VmHWM:"))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok());
+        peak = peak.max(hwm.unwrap_or(0));
+        if let Some(s) = child.try_wait().expect("wait") {
+            return (s, peak);
+        }
+        if started.elapsed() > LIMIT {
+            let _ = child.kill();
+            panic!("a command ran past {LIMIT:?} and was killed");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}

@@ -130,7 +130,12 @@ pub(crate) fn open_for_writing(path: &Path, append: bool) -> std::io::Result<std
 
 /// The end of the last whole frame of an existing record: where an append goes.
 pub(crate) fn whole_end(path: &Path) -> std::io::Result<u64> {
-    let mut r = Frames::open(path).map_err(|e| std::io::Error::other(e.to_string()))?;
+    // A file of another kind or version is the user's mistake (bad input), not a
+    // failure of the disk: its kind says so to the node, which exits 2.
+    let mut r = Frames::open(path).map_err(|e| match e {
+        RecordError::Io { source, .. } => source,
+        other => std::io::Error::new(std::io::ErrorKind::InvalidData, other.to_string()),
+    })?;
     let mut end = r.offset;
     while r.next_frame()? {
         end = r.offset;

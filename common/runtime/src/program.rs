@@ -53,8 +53,14 @@ impl Program {
     /// The record, started.
     fn record<H: Handler>(&self) -> Result<Recorder<H::Sample, H::Totals>, NodeError> {
         let failed = |e: tactile_records::WriteError| NodeError::Failed(e.to_string());
-        let mut rec =
-            Recorder::open(&self.args.out, self.role, self.args.append).map_err(failed)?;
+        // `--append` to a file that is no record of this format: bad input, as the
+        // docs say (exit 2), the file untouched.
+        let mut rec = Recorder::open(&self.args.out, self.role, self.args.append).map_err(|e| {
+            match e.source.kind() {
+                std::io::ErrorKind::InvalidData => NodeError::BadInput(e.to_string()),
+                _ => failed(e),
+            }
+        })?;
         let start = start_record(self.role, &self.args, &self.links, &self.prepared);
         rec.start(start).map_err(failed)?;
         Ok(rec)

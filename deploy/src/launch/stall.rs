@@ -33,6 +33,11 @@ impl Progress {
         let since = *self.stopped_since.get_or_insert(now);
         Some(now.saturating_duration_since(since))
     }
+
+    /// Since when the process has been seen stopped, if it is (as of the last look).
+    pub fn since(&self) -> Option<Instant> {
+        self.stopped_since
+    }
 }
 
 /// The state letter of process `pid` (`R`, `S`, `T`, ...), `?` if unknown.

@@ -24,6 +24,10 @@ use tactile_scenario::{Mode, Scenario};
 /// of 10 samples at 100 Hz) rather than a flicker.
 pub const RESTART_BACKOFF: Duration = Duration::from_millis(200);
 
+/// How long the emulator and the slave have to end after a master that completed
+/// (they end on its end-of-run sample, at once).
+const END_GRACE: Duration = Duration::from_secs(3);
+
 /// How often the launcher looks at its processes.
 const POLL: Duration = Duration::from_millis(20);
 
@@ -101,6 +105,16 @@ impl Proc {
 
 /// The last lines of a node's log, bounded: the log of a long run can be large.
 fn log_tail(out: &Path, role: Role) -> String {
+    let tail = log_lines(out, role);
+    if tail.trim().is_empty() {
+        // A full disk leaves the log unwritten too: say so rather than nothing.
+        return format!("(its log, {role}.log, says nothing: it could not be written, or the node wrote nothing before it ended)");
+    }
+    tail
+}
+
+/// The last five lines of a node's log, from its last 4 kB.
+fn log_lines(out: &Path, role: Role) -> String {
     use std::io::{Read, Seek, SeekFrom};
     let Ok(mut f) = std::fs::File::open(out.join(format!("{role}.log"))) else {
         return String::new();
@@ -285,9 +299,10 @@ impl<'a> Supervisor<'a> {
             p.restarts += 1;
             p.restart_at = Some(Instant::now() + RESTART_BACKOFF);
             let role = p.role;
-            self.watch
-                .events
-                .push(format!("{role} {how} after {at:.2} s; restarting"));
+            let tail = log_tail(self.out, role);
+            self.watch.events.push(format!(
+                "{role} {how} after {at:.2} s; restarting; its last words:\n{tail}"
+            ));
             return false;
         }
         p.status = Some(status);
@@ -302,18 +317,20 @@ impl<'a> Supervisor<'a> {
     /// A node stopped for longer than the stall limit is frozen (SIGSTOP, a debugger):
     /// killed, its death then handled like any other (restarted if
     /// allowed, else the run stops), and the run counts as failed.
+    /// Every process is looked at, whatever the limit (or none): a node still
+    /// stopped when the run ends is named with the moment it stopped.
     fn kill_frozen(&mut self) {
-        let Some(limit) = self.sup.stall else { return };
         let now = Instant::now();
         let at = self.elapsed_s();
         for p in &mut self.procs {
             if p.status.is_some() || p.restart_at.is_some() {
                 continue;
             }
-            if p.progress
-                .stopped_for(p.child.id(), now)
-                .is_none_or(|s| s < limit)
-            {
+            let stopped = p.progress.stopped_for(p.child.id(), now);
+            let Some(limit) = self.sup.stall else {
+                continue;
+            };
+            if stopped.is_none_or(|s| s < limit) {
                 continue;
             }
             let state = stall::state_of(p.child.id());
@@ -411,19 +428,77 @@ impl<'a> Supervisor<'a> {
 
     /// After a clean master the end-of-run sample stops the others: a moment for
     /// them, then every process still running is stopped.
+    /// A node that has not ended by then is a failed run: frozen (its process
+    /// stopped, however briefly: the samples it missed are lost), or not answering the
+    /// end-of-run sample. One that ended badly on its own is named with its last words.
     fn finish(mut self) -> Watch {
         let master_ok = self.watch.master.is_some_and(|s| s.success());
-        let until = Instant::now() + Duration::from_secs(if master_ok { 3 } else { 0 });
+        let until = Instant::now() + END_GRACE * u32::from(master_ok);
         while Instant::now() < until && self.procs.iter_mut().any(Proc::running) {
             std::thread::sleep(Duration::from_millis(10));
         }
+        let now = Instant::now();
         for p in &mut self.procs {
             if p.status.is_none() {
-                p.status = p.child.try_wait().ok().flatten();
+                p.progress.stopped_for(p.child.id(), now);
             }
-            p.stop(Duration::from_secs(2));
+        }
+        for k in 0..self.procs.len() {
+            let p = &mut self.procs[k];
+            if p.status.is_none() {
+                p.status = p.child.try_wait().ok().flatten();
+                // One waiting out its restart backoff was named when it died.
+                let waiting = p.restart_at.is_some();
+                match p.status {
+                    _ if waiting => {}
+                    Some(s) if p.role != Role::Master => self.ended_badly(k, s),
+                    None => self.unfinished(k, master_ok),
+                    _ => {}
+                }
+            }
+            self.procs[k].stop(Duration::from_secs(2));
         }
         self.watch
+    }
+
+    /// A node that ended on its own after the master, by a failure (not a stop
+    /// request): named, with its last words, and the run failed.
+    fn ended_badly(&mut self, k: usize, status: ExitStatus) {
+        if status.success() || stopped_by_signal(status) || self.watch.interrupted {
+            return;
+        }
+        let role = self.procs[k].role;
+        self.watch.failed = true;
+        let (how, at) = (describe(status), self.elapsed_s());
+        let tail = log_tail(self.out, role);
+        self.watch.events.push(format!(
+            "{role} {how} after {at:.2} s; its last words:\n{tail}"
+        ));
+    }
+
+    /// A node still running when the run ends: frozen (stopped since a moment the
+    /// launcher names), or deaf to the master's end of the run; either fails the run.
+    /// A frozen one is killed outright (a stopped process cannot take SIGTERM).
+    fn unfinished(&mut self, k: usize, master_ok: bool) {
+        let at = self.elapsed_s();
+        let started = self.started;
+        let p = &mut self.procs[k];
+        let role = p.role;
+        let state = stall::state_of(p.child.id());
+        if let Some(since) = p.progress.since() {
+            let since = since.saturating_duration_since(started).as_secs_f64();
+            self.watch.events.push(format!(
+                "{role} was still frozen when the run ended after {at:.2} s: the process is {state} since {since:.2} s; killed"
+            ));
+            self.watch.failed = true;
+            let _ = p.child.kill();
+        } else if master_ok && !self.watch.interrupted {
+            self.watch.events.push(format!(
+                "{role} had not ended {:.1} s after the master's end of the run (the process is {state}): it never answered the end-of-run sample; stopped",
+                END_GRACE.as_secs_f64()
+            ));
+            self.watch.failed = true;
+        }
     }
 }
 
@@ -501,5 +576,15 @@ fn report(out: &Path, w: Watch, outputs: &super::Outputs) -> Result<Summary, Err
     } else {
         launch
     };
-    Ok(write_report(&[out.to_path_buf()], out, &launch)?)
+    write_report(&[out.to_path_buf()], out, &launch).map_err(|e| {
+        if !launch.failed {
+            return Error::Report(e);
+        }
+        // The nodes failed first (a full disk stops them too): their failures, then
+        // the report's, so the cause is not hidden behind the last symptom.
+        Error::Failed(format!(
+            "the run failed:\n{}\nand its report could not be written: {e}",
+            launch.events.join("\n")
+        ))
+    })
 }
