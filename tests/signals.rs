@@ -51,28 +51,33 @@ fn sigint_stops_an_in_process_run_with_a_report_of_what_ran() {
     drop(scenario);
 }
 
+/// Starts a sweep of six runs of the wall scenario, `samples` samples each, `jobs` at
+/// once, into `sw`.
+fn six_run_sweep(sb: &Sandbox, samples: u64, jobs: &str) -> std::process::Child {
+    let text = util::wall_delay().replace("samples = 8000", &format!("samples = {samples}"));
+    sb.write("s.toml", &text);
+    sb.command(&[
+        "sweep",
+        "s.toml",
+        "--set",
+        "control.kind=none,tdpa,wave,none,tdpa,wave",
+        "--jobs",
+        jobs,
+        "--out",
+        "sw",
+    ])
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped())
+    .spawn()
+    .expect("start")
+}
+
 /// A sweep stopped by SIGINT after its first run (one run at a time): exit 130,
 /// `sweep.csv` holds the runs that finished (and no partial one), no panic.
 #[test]
 fn sigint_stops_a_sweep_keeping_its_finished_rows() {
     let sb = Sandbox::new("sigsweep");
-    let text = util::wall_delay().replace("samples = 8000", "samples = 200000");
-    sb.write("s.toml", &text);
-    let child = sb
-        .command(&[
-            "sweep",
-            "s.toml",
-            "--set",
-            "control.kind=none,tdpa,wave,none,tdpa,wave",
-            "--jobs",
-            "1",
-            "--out",
-            "sw",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start");
+    let child = six_run_sweep(&sb, 200_000, "1");
     let second = sb.path("sw").join("run-0001").join("master.rec");
     wait_for("the second run starts", Duration::from_secs(60), || {
         second.exists()
@@ -91,6 +96,28 @@ fn sigint_stops_a_sweep_keeping_its_finished_rows() {
         2,
         "header and the finished run:\n{table}"
     );
+}
+
+/// A sweep stopped by SIGINT while its first two runs (two at a time) are under way:
+/// neither is counted as ended ("1/6 runs"), each is said as stopped, and the closing
+/// line says none of the 6 ended.
+#[test]
+fn a_sweep_stopped_mid_run_counts_no_run_as_ended() {
+    let sb = Sandbox::new("sigsweep2");
+    let child = six_run_sweep(&sb, 2_000_000, "2");
+    let rec = |k: usize| sb.path("sw").join(format!("run-{k:04}")).join("master.rec");
+    wait_for("both runs start", Duration::from_secs(60), || {
+        rec(0).exists() && rec(1).exists()
+    });
+    signal(child.id() as i32, rustix::process::Signal::INT);
+    let (code, err) = finish(child);
+    assert_eq!(code, Some(130), "{err}");
+    assert!(!err.contains("/6 runs,"), "no run ended:\n{err}");
+    for k in 0..2 {
+        let said = format!("run-{k:04} stopped before it ended");
+        assert!(err.contains(&said), "{said}:\n{err}");
+    }
+    assert!(err.contains("after 0 of 6 runs"), "{err}");
 }
 
 /// The terminal's Ctrl-C reaches the launcher and its nodes at once: exit 130, the

@@ -362,3 +362,46 @@ fn a_sweep_says_its_scenarios_warnings_once() {
     let warned = err.matches("stiffness[0] = 800 N/m is above").count();
     assert_eq!(warned, 1, "two runs share the warning, said once:\n{err}");
 }
+
+/// `-q` and `--quiet` as on `tactile run`: no progress line, the closing line still.
+#[test]
+fn a_quiet_sweep_says_no_progress() {
+    let sb = Sandbox::new("sweep-q");
+    let err = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).into_owned();
+    let loud = sweep(&sb, "loud", &[]);
+    assert!(err(&loud).contains("6/6 runs"), "{}", err(&loud));
+    for (out, q) in [("q1", "-q"), ("q2", "--quiet")] {
+        let o = sweep(&sb, out, &[q]);
+        assert!(!err(&o).contains("runs,"), "{q}: {}", err(&o));
+        assert!(String::from_utf8_lossy(&o.stdout).contains("tactile sweep: 6 runs"));
+        assert_eq!(read(&sb, out, "sweep.csv"), read(&sb, "loud", "sweep.csv"));
+    }
+}
+
+/// `--jobs` past 4 x the CPUs is capped, saying so; `--merge` into one of the folders
+/// it merges (spelt otherwise) is refused with exit 2, naming it, the folder untouched.
+#[test]
+fn jobs_are_capped_and_a_merge_never_writes_into_its_input() {
+    let sb = Sandbox::new("sweep-cap");
+    let o = sweep(&sb, "all", &["--jobs", "100000"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    let cap: usize = err
+        .split("--jobs 100000: capped at ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no cap said: {err}"));
+    let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+    assert!((1..=4 * cpus).contains(&cap), "{cap} for {cpus} CPUs");
+    sweep(&sb, "s1", &["--shard", "1/2"]);
+    sweep(&sb, "s2", &["--shard", "2/2"]);
+    let before = read(&sb, "s1", "sweep.csv");
+    let o = sb.tactile(&["sweep", "--merge", "s1", "s2", "--out", "./s2/../s1"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("one of the folders merged") && err.contains("s1"),
+        "{err}"
+    );
+    assert_eq!(read(&sb, "s1", "sweep.csv"), before, "s1 untouched");
+}

@@ -30,6 +30,15 @@ pub struct Work {
     pub loaded: Loaded,
 }
 
+impl Work {
+    /// Its folder's name, `run-0007`.
+    fn name(&self) -> String {
+        self.dir
+            .file_name()
+            .map_or_else(String::new, |f| f.to_string_lossy().into_owned())
+    }
+}
+
 /// Every run of combinations `mine`, its scenario loaded and checked.
 pub fn plan(
     scenario: &Path,
@@ -161,7 +170,11 @@ pub fn run_all(
                 let w = &work[todo[j]];
                 match run_one(w, args) {
                     Ok(Some(v)) => lock(&results)[todo[j]] = Some(v),
-                    Ok(None) => {}
+                    Ok(None) => {
+                        // Cut short by the stop: not one of the runs that ended.
+                        stopped(w);
+                        continue;
+                    }
                     Err(e) => {
                         abort.store(true, Ordering::SeqCst);
                         lock(&failed).get_or_insert(e);
@@ -169,7 +182,9 @@ pub fn run_all(
                     }
                 }
                 let n = ended.fetch_add(1, Ordering::SeqCst) + 1;
-                progress(n, todo.len(), start, w);
+                if !args.quiet {
+                    progress(n, todo.len(), start, w);
+                }
             });
         }
     });
@@ -192,9 +207,16 @@ fn progress(n: usize, total: usize, start: Instant, w: &Work) {
         "tactile sweep: {n}/{total} runs, {} elapsed, about {} left ({}: {})",
         mmss(elapsed),
         mmss(left),
-        w.dir
-            .file_name()
-            .map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
+        w.name(),
+        w.what
+    );
+}
+
+/// `tactile sweep: run-0003 stopped before it ended (KEY=VALUE ...)`.
+fn stopped(w: &Work) {
+    crate::noteln!(
+        "tactile sweep: {} stopped before it ended ({})",
+        w.name(),
         w.what
     );
 }

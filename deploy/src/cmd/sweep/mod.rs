@@ -75,6 +75,10 @@ pub struct SweepArgs {
     /// K-1+2N, ... with all their seeds. `--merge` joins the slices' folders.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
+    /// No progress line per run (as `tactile run -q`); warnings, errors and the
+    /// closing line still print.
+    #[arg(long, short)]
+    pub quiet: bool,
     /// Join the folders of a sharded sweep into --out: the same sweep.csv and plots as
     /// the sweep run whole.
     #[arg(long, value_name = "DIR", num_args = 1.., conflicts_with_all = ["scenario", "set", "shard", "resume", "processes", "trace", "jobs"])]
@@ -123,17 +127,30 @@ fn check_size(args: &SweepArgs, axes: &[Axis], combinations: usize) -> Result<()
     Ok(())
 }
 
-/// Runs at a time: as given, one with `--processes` (they take the machine's CPUs),
-/// else the CPUs this process may use.
+/// Runs at once per CPU at most: an in-process run keeps a CPU busy, so more only
+/// hold more runs' memory at once (`--jobs 100000` over 400 runs took 1.34 GB).
+pub const JOBS_PER_CPU: usize = 4;
+
+/// Runs at a time: as given, up to [`JOBS_PER_CPU`] x the CPUs this process may use
+/// (and never more than the runs to do, see `exec::run_all`); one with `--processes`
+/// (they take the machine's CPUs), else the CPUs.
 fn jobs(args: &SweepArgs) -> Result<usize, Error> {
+    let cpus = tactile_runtime::sched::allowed_cpus().map_or(1, |c| c.len().max(1));
+    let cap = cpus.saturating_mul(JOBS_PER_CPU);
     match (args.jobs, args.processes) {
         (Some(0), _) => Err(Error::BadInput("--jobs 0: give at least 1".into())),
         (Some(n), true) if n > 1 => Err(Error::BadInput(
             "--processes runs take the machine's CPUs one run at a time: --jobs 1".into(),
         )),
+        (Some(n), _) if n > cap => {
+            crate::noteln!(
+                "tactile sweep: --jobs {n}: capped at {cap} ({JOBS_PER_CPU} x the {cpus} CPUs this process may use; more would only hold more runs in memory)"
+            );
+            Ok(cap)
+        }
         (Some(n), _) => Ok(n),
         (None, true) => Ok(1),
-        (None, false) => Ok(tactile_runtime::sched::allowed_cpus().map_or(1, |c| c.len().max(1))),
+        (None, false) => Ok(cpus),
     }
 }
 

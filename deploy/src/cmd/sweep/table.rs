@@ -155,8 +155,29 @@ fn ran(dir: &Path) -> Option<(u64, Vec<Option<f64>>)> {
     Some((super::exec::seed_of(dir)?, super::exec::finished(dir)?))
 }
 
+/// `--out` is none of the folders merged (compared as canonical paths, so `./a` and
+/// `a` are one): merging into an input would overwrite its tables with the whole
+/// sweep's while its runs stay a slice.
+fn refuse_out_among(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
+    let Ok(target) = out.canonicalize() else {
+        return Ok(()); // not there yet, so none of the inputs
+    };
+    match dirs
+        .iter()
+        .find(|d| d.canonicalize().is_ok_and(|d| d == target))
+    {
+        Some(d) => Err(Error::BadInput(format!(
+            "--out {}: it is {}, one of the folders merged; merge into another folder",
+            out.display(),
+            d.display()
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// `tactile sweep --merge DIR... --out OUT`.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
+    refuse_out_among(dirs, out)?;
     let first = slices_of_one_sweep(dirs)?;
     let axes = parse_axes(&first.sets)?;
     let (results, missing) = gather(dirs, &first)?;
