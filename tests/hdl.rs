@@ -112,6 +112,57 @@ fn vector_counts_are_bounded() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// `hdl vectors --count 10000000` took 4.86 GB for a 1.7 GB file: the whole text and
+/// every line were held before a byte was written. Written a line at a time, 10^6
+/// samples (170 MB) stay within the few MB of their inputs.
+#[test]
+fn vectors_are_written_as_they_are_made() {
+    let sb = Sandbox::new("hdl-stream");
+    let args = [
+        "hdl",
+        "vectors",
+        "--function",
+        "sincos",
+        "--count",
+        "1000000",
+    ];
+    let (status, peak_kb) =
+        crate::util::run_measured(sb.command(&[&args[..], &["--out", "/dev/null"]].concat()));
+    assert!(status.success(), "{status}");
+    assert!(peak_kb > 0 && peak_kb < 64 * 1024, "peak RSS {peak_kb} kB");
+}
+
+/// `--keep k2` (a relative folder) failed: the simulator ran inside the folder and
+/// looked for `k2/add.hex` from there.
+#[test]
+fn a_relative_keep_folder_is_taken_from_the_current_one() {
+    if !have("iverilog") {
+        cannot("Icarus Verilog is not installed (apt-get install iverilog)");
+        return;
+    }
+    let sb = Sandbox::new("hdl-keep");
+    let o = sb.tactile(&[
+        "hdl",
+        "cosim",
+        "--keep",
+        "k2",
+        "--function",
+        "add",
+        "--count",
+        "50",
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let r = results(&stdout);
+    assert_eq!(r.len(), 1, "{stdout}");
+    assert_eq!(r[0].2, 0, "{stdout}");
+    assert!(sb.path("k2").join("add.hex").is_file());
+}
+
 #[test]
 fn a_format_the_model_refuses_the_generator_refuses_alike() {
     let sb = Sandbox::new("hdl-refuse");

@@ -151,3 +151,49 @@ fn a_circle_away_from_home_is_reached_smoothly() {
     assert!(max < 5e-3, "tracking max {max} m");
     assert_eq!(s["slave"]["counters"]["torque_clamps"], 0);
 }
+
+/// A 126 MB trajectory took 1.47 GB: its text, then a vector per row, then the
+/// points. Read a line at a time into its columns, a file of 10^6 rows (29 MB) costs
+/// about its points (24 MB) over a file of one row, checked as `tactile check` loads it.
+#[test]
+fn a_large_file_costs_about_its_values() {
+    let sb = Sandbox::new("trajbig");
+    let scenario = sb.write("s.toml", &csv_scenario(100, "hold"));
+    let peak = |rows: usize| {
+        let mut text = String::with_capacity(rows * 29 + 8);
+        text.push_str("x,y,z\n");
+        for n in 0..rows {
+            let x = (n % 1000) as f64 * 1e-5;
+            text.push_str(&format!("{x:.6},-0.100000,-0.050000\n"));
+        }
+        sb.write("traj.csv", &text);
+        drop(text);
+        let (status, kb) =
+            util::run_measured(sb.command(&["check", scenario.to_str().expect("utf-8")]));
+        assert!(status.success(), "{status}");
+        kb
+    };
+    let (small, large) = (peak(1), peak(1_000_000));
+    let extra_mb = large.saturating_sub(small) / 1024;
+    assert!(extra_mb < 48, "10^6 rows: {extra_mb} MB over one row");
+}
+
+/// A scenario copied to another folder without its trajectory: the message said only
+/// which file it could not read. It says how paths are resolved, and the fix.
+#[test]
+fn a_copied_scenarios_missing_input_says_how_to_copy_it() {
+    let sb = Sandbox::new("trajcopy");
+    sb.write("traj.csv", "x,y,z\n0,-0.1,-0.05\n");
+    std::fs::create_dir_all(sb.path("elsewhere")).expect("folder");
+    let copy = sb.write("elsewhere/s.toml", &csv_scenario(10, "hold"));
+    let o = sb.tactile(&["check", copy.to_str().expect("utf-8")]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("\"traj.csv\" is not there: it is resolved against the scenario's own folder")
+            && err.contains("elsewhere/traj.csv")
+            && err.contains("tactile check ORIGINAL.toml > copy.toml"),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+}

@@ -11,3 +11,4 @@ pub mod node;
 pub mod operator;
 pub mod simulated;
 pub mod trajectory;
+pub mod trajectory_rows;

@@ -11,10 +11,13 @@
 //! timed rows the earlier row's).
 //! Reading is at the edge ([`Trajectory::read`]); [`Trajectory::at`] is pure.
 
-use nalgebra::{Quaternion, UnitQuaternion};
+use crate::trajectory_rows::{Columns, RowProblem};
+use nalgebra::UnitQuaternion;
 use std::path::Path;
 use tactile_scenario::{csv, TrajectoryEnd};
 use thiserror::Error;
+
+pub use crate::trajectory_rows::{MAX_ROWS, UNIT_TOLERANCE};
 
 /// The headers a trajectory file may have: with or without a time column, an
 /// orientation, a clutch (index bits: 1 timed, 2 oriented, 4 clutched).
@@ -28,10 +31,6 @@ const HEADERS: [&[&str]; 8] = [
     &["x", "y", "z", "qx", "qy", "qz", "qw", "engaged"],
     &["t", "x", "y", "z", "qx", "qy", "qz", "qw", "engaged"],
 ];
-
-/// How far a file's quaternion's norm may be from one (rounding in a recorder's
-/// output); it is normalized when read.
-pub const UNIT_TOLERANCE: f64 = 1e-3;
 
 /// A trajectory file that cannot be used.
 #[derive(Debug, Error)]
@@ -84,16 +83,19 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
-    /// Reads and checks the file at `full`.
+    /// Reads and checks the file at `full`, a line at a time (its text is never held
+    /// whole; at most [`MAX_TRAJECTORY_BYTES`](tactile_runtime::files::MAX_TRAJECTORY_BYTES)
+    /// and [`MAX_ROWS`] rows).
     pub fn read(full: &Path, end: TrajectoryEnd) -> Result<Trajectory, OperatorError> {
         let shown = full.display().to_string();
-        let text = tactile_runtime::files::read_text(
+        let file = tactile_runtime::files::open_bounded(
             full,
             "trajectory",
             tactile_runtime::files::MAX_TRAJECTORY_BYTES,
         )
         .map_err(OperatorError::Read)?;
-        Trajectory::parse(&text, shown, end)
+        let lines = csv::reader_lines(std::io::BufReader::new(file));
+        Trajectory::from_lines(lines, shown, end)
     }
 
     /// Parses a file's text; `shown` names the file in errors.
@@ -102,40 +104,38 @@ impl Trajectory {
         shown: String,
         end: TrajectoryEnd,
     ) -> Result<Trajectory, OperatorError> {
-        let (which, rows) =
-            csv::parse_located(text, &HEADERS).map_err(|source| OperatorError::Csv {
-                path: shown.clone(),
-                source,
-            })?;
-        if rows.is_empty() {
+        Trajectory::from_lines(csv::text_lines(text), shown, end)
+    }
+
+    /// The rows of numbered `lines`, checked one at a time.
+    fn from_lines<S: AsRef<str>>(
+        lines: impl Iterator<Item = Result<(usize, S), csv::CsvError>>,
+        shown: String,
+        end: TrajectoryEnd,
+    ) -> Result<Trajectory, OperatorError> {
+        let csv_error = |source| OperatorError::Csv {
+            path: shown.clone(),
+            source,
+        };
+        let mut rows = csv::Rows::new(lines, &HEADERS).map_err(csv_error)?;
+        let mut c = Columns::new(rows.which);
+        while let Some((line, r)) = rows.next_row().map_err(csv_error)? {
+            c.push(line, r)
+                .map_err(|RowProblem { line, problem }| OperatorError::Row {
+                    path: shown.clone(),
+                    line,
+                    problem,
+                })?;
+        }
+        if c.points.is_empty() {
             return Err(OperatorError::NoRows { path: shown });
         }
-        let (timed, oriented, clutched) = (which & 1 != 0, which & 2 != 0, which & 4 != 0);
-        let k = usize::from(timed);
-        let points = rows
-            .iter()
-            .map(|(_, r)| [r[k], r[k + 1], r[k + 2]])
-            .collect();
-        let times = if timed {
-            Some(check_times(&rows, &shown)?)
-        } else {
-            None
-        };
-        let rotations = match oriented {
-            true => Some(check_rotations(&rows, k + 3, &shown)?),
-            false => None,
-        };
-        let last = if oriented { k + 7 } else { k + 3 };
-        let engaged = match clutched {
-            true => Some(check_engaged(&rows, last, &shown)?),
-            false => None,
-        };
         Ok(Trajectory {
             shown,
-            times,
-            points,
-            rotations,
-            engaged,
+            times: c.timed().then(|| std::mem::take(&mut c.times)),
+            rotations: c.oriented().then(|| std::mem::take(&mut c.rotations)),
+            engaged: c.clutched().then(|| std::mem::take(&mut c.engaged)),
+            points: c.points,
             end,
         })
     }
@@ -266,57 +266,6 @@ enum Row {
     Between(usize, f64),
 }
 
-/// The orientation columns from `col`: unit quaternions (within [`UNIT_TOLERANCE`]),
-/// normalized, each on the same side as the row before so a slerp takes the short way.
-fn check_rotations(
-    rows: &[(usize, Vec<f64>)],
-    col: usize,
-    shown: &str,
-) -> Result<Vec<UnitQuaternion<f64>>, OperatorError> {
-    let mut out: Vec<UnitQuaternion<f64>> = Vec::with_capacity(rows.len());
-    for (line, r) in rows {
-        let q = Quaternion::new(r[col + 3], r[col], r[col + 1], r[col + 2]);
-        let norm = q.norm();
-        if (norm - 1.0).abs() > UNIT_TOLERANCE {
-            return Err(OperatorError::Row {
-                path: shown.to_string(),
-                line: *line,
-                problem: format!(
-                    "the quaternion (qx, qy, qz, qw) = ({}, {}, {}, {}) has norm {norm}; an orientation is a unit quaternion (within {UNIT_TOLERANCE})",
-                    r[col], r[col + 1], r[col + 2], r[col + 3]
-                ),
-            });
-        }
-        let mut u = UnitQuaternion::new_normalize(q);
-        if out.last().is_some_and(|p| p.coords.dot(&u.coords) < 0.0) {
-            u = UnitQuaternion::new_unchecked(-u.into_inner());
-        }
-        out.push(u);
-    }
-    Ok(out)
-}
-
-/// The `engaged` column (column `col`): 0 or 1.
-fn check_engaged(
-    rows: &[(usize, Vec<f64>)],
-    col: usize,
-    shown: &str,
-) -> Result<Vec<bool>, OperatorError> {
-    rows.iter()
-        .map(|(line, r)| {
-            let v = r[col];
-            if v == 1.0 || v == 0.0 {
-                return Ok(v == 1.0);
-            }
-            Err(OperatorError::Row {
-                path: shown.to_string(),
-                line: *line,
-                problem: format!("engaged = {v}: it is 1 (clutch held) or 0 (released)"),
-            })
-        })
-        .collect()
-}
-
 /// The first sample whose time, computed as the run computes it, is at or after `t`.
 fn first_sample_at(t: f64, t_s: f64) -> u64 {
     let mut n = (t / t_s).floor().max(0.0) as u64;
@@ -337,34 +286,6 @@ fn first_sample_after(t: f64, t_s: f64) -> u64 {
     } else {
         n + 1
     }
-}
-
-/// The time column: from 0 or later, strictly increasing (each already finite: the
-/// CSV parser refuses anything else). An error names the file, the line and what is
-/// wrong with its time.
-fn check_times(rows: &[(usize, Vec<f64>)], shown: &str) -> Result<Vec<f64>, OperatorError> {
-    let bad = |line: usize, problem: String| OperatorError::Row {
-        path: shown.to_string(),
-        line,
-        problem,
-    };
-    let mut times = Vec::with_capacity(rows.len());
-    for (line, r) in rows {
-        let t = r[0];
-        match times.last() {
-            None if t < 0.0 => {
-                return Err(bad(*line, format!("t = {t} s is before 0 (times start at 0 or later)")))
-            }
-            Some(&prev) if t <= prev => {
-                return Err(bad(
-                    *line,
-                    format!("t = {t} s is not after the previous row's {prev} s (times must increase strictly)"),
-                ))
-            }
-            _ => times.push(t),
-        }
-    }
-    Ok(times)
 }
 
 #[cfg(test)]

@@ -20,6 +20,18 @@ pub const MAX_TRAJECTORY_BYTES: u64 = 128 << 20;
 /// error is one line naming the file and the problem.
 pub fn read_text(path: &Path, what: &str, max: u64) -> Result<String, String> {
     let shown = path.display();
+    let mut bytes = Vec::new();
+    open_bounded(path, what, max)?
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
+    String::from_utf8(bytes).map_err(|e| format!("{what} {shown} is not UTF-8 text: {e}"))
+}
+
+/// Opens `path` for reading a piece at a time if it is a regular file of at most
+/// `max` bytes; reading past `max` (a file that grows while it is read) is an error.
+/// For a large input read as a stream, so its whole text is never held.
+pub fn open_bounded(path: &Path, what: &str, max: u64) -> Result<Bounded, String> {
+    let shown = path.display();
     let meta = std::fs::metadata(path).map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
     if !meta.is_file() {
         let kind = if meta.is_dir() {
@@ -37,16 +49,33 @@ pub fn read_text(path: &Path, what: &str, max: u64) -> Result<String, String> {
         ));
     }
     let file = std::fs::File::open(path).map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
-    let mut bytes = Vec::new();
-    file.take(max + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
-    if bytes.len() as u64 > max {
-        return Err(format!(
-            "{what} {shown} grew past {max} bytes while it was read"
-        ));
+    Ok(Bounded {
+        inner: file.take(max + 1),
+        max,
+        read: 0,
+    })
+}
+
+/// A file read with a bound: an error, not more bytes, past `max`.
+#[derive(Debug)]
+pub struct Bounded {
+    inner: std::io::Take<std::fs::File>,
+    max: u64,
+    read: u64,
+}
+
+impl Read for Bounded {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.read += n as u64;
+        if self.read > self.max {
+            return Err(std::io::Error::other(format!(
+                "grew past {} bytes while it was read",
+                self.max
+            )));
+        }
+        Ok(n)
     }
-    String::from_utf8(bytes).map_err(|e| format!("{what} {shown} is not UTF-8 text: {e}"))
 }
 
 /// The folder a scenario's relative paths are resolved against: the scenario's own.
@@ -65,6 +94,28 @@ pub fn load_scenario(path: &Path) -> Result<(Scenario, PathBuf), String> {
     let scenario = Scenario::from_toml_str(&text)
         .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
     Ok((scenario, base_dir(path)))
+}
+
+/// Checks that every file `scenario` reads (a trajectory, a URDF, a recorded network)
+/// is there, resolved against `base_dir`, the scenario's folder. A relative path that
+/// is not says how paths are resolved and how to copy a scenario elsewhere: a copy of
+/// a shipped scenario keeps its relative paths, which then point nowhere.
+pub fn inputs_present(scenario: &Scenario, base_dir: &Path) -> Result<(), String> {
+    for p in scenario.clone().input_paths_mut() {
+        let full = base_dir.join(p.as_str());
+        if full.exists() || Path::new(p.as_str()).is_absolute() {
+            continue;
+        }
+        return Err(format!(
+            "input file {p:?} is not there: it is resolved against the scenario's own folder, \
+             {}, not the current one, so it names {}; for a scenario copied from another \
+             folder, write the copy with its paths resolved (`tactile check ORIGINAL.toml > \
+             copy.toml`, from anywhere) or give the file's absolute path",
+            base_dir.display(),
+            full.display()
+        ));
+    }
+    Ok(())
 }
 
 /// True if `a` and `b` name the same existing file (same device and inode).

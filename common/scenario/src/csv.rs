@@ -49,6 +49,14 @@ pub enum CsvError {
         /// "number" or "finite number".
         what: &'static str,
     },
+    /// The source could not be read (not UTF-8, an I/O error) at this line.
+    #[error("line {line}: {problem}")]
+    Read {
+        /// 1-based line number.
+        line: usize,
+        /// What went wrong.
+        problem: String,
+    },
 }
 
 /// Longest text of a bad cell or header an error quotes: the rest is elided, so a
@@ -124,34 +132,96 @@ pub type LocatedRows = Vec<(usize, Vec<f64>)>;
 /// header it had and each row with its 1-based line number, so that checks across
 /// rows (times that must increase) can name the line too.
 pub fn parse_located(text: &str, headers: &[&[&str]]) -> Result<(usize, LocatedRows), CsvError> {
-    let expected = || {
-        let names: Vec<String> = headers.iter().map(|h| h.join(",")).collect();
-        names.join(" or ")
-    };
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l))
-        .filter(|(_, l)| !l.trim().is_empty());
-    let (hl, header) = lines.next().ok_or_else(|| CsvError::Empty {
-        expected: expected(),
-    })?;
-    let which = headers
-        .iter()
-        .position(|h| check_header(hl, header, h).is_ok())
-        .ok_or_else(|| CsvError::Header {
-            line: hl,
-            found: shortened(header.trim()),
+    let mut reader = Rows::new(text_lines(text), headers)?;
+    let mut rows = Vec::new();
+    while let Some((line, row)) = reader.next_row()? {
+        rows.push((line, row.to_vec()));
+    }
+    Ok((reader.which, rows))
+}
+
+/// The lines of a text, numbered from 1, for [`Rows`].
+pub fn text_lines(text: &str) -> impl Iterator<Item = Result<(usize, &str), CsvError>> {
+    text.lines().enumerate().map(|(i, l)| Ok((i + 1, l)))
+}
+
+/// The lines of a reader, numbered from 1, for [`Rows`]: a file is read a line at a
+/// time, so only the rows' values are kept, never the whole text (a file's text and
+/// its rows as vectors took ten times the file's size).
+pub fn reader_lines(
+    r: impl std::io::BufRead,
+) -> impl Iterator<Item = Result<(usize, String), CsvError>> {
+    r.lines().enumerate().map(|(i, l)| {
+        l.map(|l| (i + 1, l)).map_err(|e| CsvError::Read {
+            line: i + 1,
+            problem: match e.kind() {
+                std::io::ErrorKind::InvalidData => "not UTF-8 text".to_string(),
+                _ => e.to_string(),
+            },
+        })
+    })
+}
+
+/// A document's rows, one at a time, after its header: what reads a large file
+/// keeps each row's values where they belong instead of a vector per row.
+#[derive(Debug)]
+pub struct Rows<'h, L> {
+    /// Which of the headers the document has (its index).
+    pub which: usize,
+    columns: &'h [&'h str],
+    lines: L,
+    row: Vec<f64>,
+}
+
+impl<'h, S: AsRef<str>, L: Iterator<Item = Result<(usize, S), CsvError>>> Rows<'h, L> {
+    /// Reads the header, which must be one of `headers` (blank lines are skipped).
+    pub fn new(mut lines: L, headers: &'h [&'h [&'h str]]) -> Result<Self, CsvError> {
+        let expected = || {
+            let names: Vec<String> = headers.iter().map(|h| h.join(",")).collect();
+            names.join(" or ")
+        };
+        let (hl, header) = next_filled(&mut lines)?.ok_or_else(|| CsvError::Empty {
             expected: expected(),
         })?;
-    let columns = headers[which];
-    let mut rows = Vec::new();
-    let mut row = Vec::with_capacity(columns.len());
-    for (line, text) in lines {
-        parse_row(line, text, columns, &mut row)?;
-        rows.push((line, row.clone()));
+        let header = header.as_ref();
+        let which = headers
+            .iter()
+            .position(|h| check_header(hl, header, h).is_ok())
+            .ok_or_else(|| CsvError::Header {
+                line: hl,
+                found: shortened(header.trim()),
+                expected: expected(),
+            })?;
+        let columns = headers[which];
+        Ok(Rows {
+            which,
+            columns,
+            lines,
+            row: Vec::with_capacity(columns.len()),
+        })
     }
-    Ok((which, rows))
+
+    /// The next data row and its line number, `None` at the end.
+    pub fn next_row(&mut self) -> Result<Option<(usize, &[f64])>, CsvError> {
+        let Some((line, text)) = next_filled(&mut self.lines)? else {
+            return Ok(None);
+        };
+        parse_row(line, text.as_ref(), self.columns, &mut self.row)?;
+        Ok(Some((line, &self.row)))
+    }
+}
+
+/// The next line that is not blank.
+fn next_filled<S: AsRef<str>>(
+    lines: &mut impl Iterator<Item = Result<(usize, S), CsvError>>,
+) -> Result<Option<(usize, S)>, CsvError> {
+    for l in lines {
+        let (n, text) = l?;
+        if !text.as_ref().trim().is_empty() {
+            return Ok(Some((n, text)));
+        }
+    }
+    Ok(None)
 }
 
 #[cfg(test)]
@@ -212,5 +282,21 @@ mod tests {
             e.to_string(),
             "line 2: expected 4 columns (t,x,y,z), found 3"
         );
+    }
+
+    #[test]
+    fn a_reader_gives_the_same_rows_and_names_bad_bytes() {
+        let both: [&[&str]; 2] = [&["x", "y", "z"], &["t", "x", "y", "z"]];
+        let text = "\nt,x,y,z\n0,1,2,3\n\n0.5,4,5,6\n";
+        let mut r = Rows::new(reader_lines(text.as_bytes()), &both).expect("header");
+        assert_eq!(r.which, 1);
+        assert_eq!(r.next_row(), Ok(Some((3, &[0.0, 1.0, 2.0, 3.0][..]))));
+        assert_eq!(r.next_row(), Ok(Some((5, &[0.5, 4.0, 5.0, 6.0][..]))));
+        assert_eq!(r.next_row(), Ok(None));
+        let bad: &[u8] = b"x,y,z\n1,2,3\n\xff,2,3\n";
+        let mut r = Rows::new(reader_lines(bad), &both).expect("header");
+        assert!(r.next_row().is_ok());
+        let e = r.next_row().expect_err("not UTF-8");
+        assert_eq!(e.to_string(), "line 3: not UTF-8 text");
     }
 }

@@ -13,7 +13,9 @@ use plotters::prelude::*;
 use std::path::Path;
 use tactile_messages::samples::FLAG_RELEASED;
 
+mod stretches;
 mod timeplot;
+use stretches::Stretches;
 pub(crate) use timeplot::tick;
 
 type PlotResult = Result<(), String>;
@@ -83,6 +85,12 @@ impl Thinned {
         }
     }
 
+    /// True once buckets hold more than one sample: the plot shows each pixel
+    /// column's extremes, not every sample.
+    pub fn thinned(&self) -> bool {
+        self.bucket > 1
+    }
+
     /// The points to draw: each bucket's minimum then maximum.
     pub fn points(&self) -> Vec<(f64, f64)> {
         let mut out = Vec::with_capacity(2 * self.points.len() + 2);
@@ -110,7 +118,7 @@ pub struct Series {
     slave_net: f64,
     dissipated_sum: f64,
     /// The stretches the operator's clutch was released, s (a 6-DoF run's).
-    released: Vec<(f64, f64)>,
+    released: Stretches,
 }
 
 impl Series {
@@ -118,10 +126,7 @@ impl Series {
     pub fn add(&mut self, row: &TraceRow, t_s: f64) {
         let t = row.n as f64 * t_s;
         if row.flags_f & FLAG_RELEASED != 0 {
-            match self.released.last_mut() {
-                Some((_, end)) if (t - *end - t_s).abs() < 0.5 * t_s => *end = t,
-                _ => self.released.push((t, t)),
-            }
+            self.released.mark(t, t_s);
         }
         let low = |w: [f64; 3]| w.iter().copied().fold(f64::INFINITY, f64::min);
         if row.stepped {
@@ -148,23 +153,41 @@ impl Series {
 
     /// Writes `positions.svg`, `forces.svg` and `passivity.svg` into `out`.
     pub fn write(&self, out: &Path) -> PlotResult {
+        // A plot that does not show every sample or every release says so.
+        let thinned = if self.channel.thinned() {
+            " (min and max per pixel column)"
+        } else {
+            ""
+        };
+        let merged = if self.released.merged() {
+            " (merged to the plot's width)"
+        } else {
+            ""
+        };
+        let spans = self.released.spans();
         whole_svg(&out.join("positions.svg"), |p| {
             timeplot::time_series(
                 p,
-                ("Master handle and slave tool position", "position (m)"),
+                (
+                    &format!("Master handle and slave tool position{thinned}"),
+                    "position (m)",
+                ),
                 &pairs(&self.handle, &self.tool, "master handle", "slave tool", ""),
-                (&self.released, "clutch released: the robot holds"),
+                (spans, &format!("clutch released: the robot holds{merged}")),
             )
         })?;
         whole_svg(&out.join("forces.svg"), |p| {
             timeplot::time_series(
                 p,
                 (
-                    "Contact force (slave) and feedback force (master)",
+                    &format!("Contact force (slave) and feedback force (master){thinned}"),
                     "force (N)",
                 ),
                 &pairs(&self.felt, &self.force, "felt", "slave h(n)", "F"),
-                (&self.released, "clutch released: the clutch spring is felt"),
+                (
+                    spans,
+                    &format!("clutch released: the clutch spring is felt{merged}"),
+                ),
             )
         })?;
         // No line here is another's reference: all are drawn plain.
@@ -185,7 +208,7 @@ impl Series {
             timeplot::time_series(
                 p,
                 (
-                    "Channel energy (below zero: the channel made energy), observers, dissipation",
+                    &format!("Channel energy (below zero: the channel made energy), observers, dissipation{thinned}"),
                     "energy (mJ)",
                 ),
                 &lines,
@@ -396,6 +419,27 @@ mod tests {
         for label in [">90%<", ">99.9%<", ">99.99%<", ">a<"] {
             assert!(text.contains(label), "{label}");
         }
+    }
+
+    /// A clutch flapping every sample: one grey band per release made a 45 MB SVG at
+    /// 10^6 samples; merged to the plot's width, the file stays small and says so.
+    #[test]
+    fn a_flapping_clutch_makes_a_small_plot_that_says_it_was_merged() {
+        let mut s = Series::default();
+        for n in 0..200_000u64 {
+            let row = TraceRow {
+                n,
+                flags_f: if n % 2 == 0 { FLAG_RELEASED } else { 0 },
+                ..TraceRow::default()
+            };
+            s.add(&row, 1e-3);
+        }
+        let dir = tempfile::tempdir().expect("tempdir");
+        s.write(dir.path()).expect("plots");
+        let svg = std::fs::read_to_string(dir.path().join("positions.svg")).expect("svg");
+        assert!(svg.len() < 400_000, "{} bytes", svg.len());
+        assert!(svg.contains("merged to the plot"), "the plot says so");
+        assert!(svg.contains("min and max per pixel column"), "thinned too");
     }
 
     #[test]

@@ -81,6 +81,8 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
             tactile_runtime::outside::NO_ROS
         )));
     }
+    files::inputs_present(&scenario, &base_dir)
+        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     let source = OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
     source

@@ -11,7 +11,6 @@
 
 use super::vectors::SplitMix;
 use std::f32::consts::PI;
-use std::fmt::Write as _;
 use tactile_math::arith::Trig;
 use tactile_math::cordic::Cordic;
 use tactile_math::geometry::{Geometry, Lengths};
@@ -254,7 +253,9 @@ fn forces(rng: &mut SplitMix, i: usize, lo: f32, hi: f32) -> [f32; 3] {
     }
 }
 
-/// The vector file's text for `module`, and its number of samples.
+/// Writes the vector file for `module` to `out`, a line at a time as each is made;
+/// returns its number of samples.
+#[allow(clippy::too_many_arguments)] // the block, its model and the file: one call site
 pub fn kin_vectors(
     module: Module,
     name: &str,
@@ -263,57 +264,60 @@ pub fn kin_vectors(
     geometry: &Geometry,
     count: usize,
     seed: u64,
-) -> (String, usize) {
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<usize> {
     let g: Lengths<f32> = geometry.lengths();
     let mut rng = SplitMix(seed);
     let cfg = cordic.config();
-    let mut out = format!(
-        "// tactile hdl vectors: {name} for [s{}.{}], {} iterations, {:?}; seed {seed}\n",
+    writeln!(
+        out,
+        "// tactile hdl vectors: {name} for [s{}.{}], {} iterations, {:?}; seed {seed}",
         cfg.word, cfg.frac, cfg.iterations, cfg.rounding
-    );
-    let lines: Vec<String> = match module {
-        Module::Fk => angles(geometry, count, three_pi_up, &mut rng)
-            .into_iter()
-            .map(|t| fk_line(&g, cordic, t, three_pi_up))
-            .collect(),
+    )?;
+    let mut n = 0;
+    let mut line = |text: String| {
+        n += 1;
+        writeln!(out, "{text}")
+    };
+    match module {
+        Module::Fk => {
+            for t in angles(geometry, count, three_pi_up, &mut rng) {
+                line(fk_line(&g, cordic, t, three_pi_up))?;
+            }
+        }
         Module::Kff => {
             let runs = validation_inputs(geometry);
             let t = angles(geometry, count, three_pi_up, &mut rng);
-            t.into_iter()
-                .enumerate()
-                .map(|(i, t)| {
-                    // The paper's run with its own forces, the rest with random ones.
-                    let f = match runs.iter().find(|r| r.theta.map(|a| a as f32) == t) {
-                        Some(r) => r.force.map(|f| f as f32),
-                        None => forces(&mut rng, i, -5.0, 5.0),
-                    };
-                    kff_line(&g, cordic, t, f, three_pi_up)
-                })
-                .collect()
+            for (i, t) in t.into_iter().enumerate() {
+                // The paper's run with its own forces, the rest with random ones.
+                let f = match runs.iter().find(|r| r.theta.map(|a| a as f32) == t) {
+                    Some(r) => r.force.map(|f| f as f32),
+                    None => forces(&mut rng, i, -5.0, 5.0),
+                };
+                line(kff_line(&g, cordic, t, f, three_pi_up))?;
+            }
         }
         Module::Fbf => {
-            let mut v: Vec<String> = validation_inputs(geometry)
-                .iter()
-                .map(|r| {
-                    let h = [tactile_math::validation::SPRING_N_PER_M as f32; 3];
-                    fbf_line(r.home.map(|p| p as f32), r.position.map(|p| p as f32), h)
-                })
-                .collect();
+            for r in validation_inputs(geometry) {
+                let h = [tactile_math::validation::SPRING_N_PER_M as f32; 3];
+                line(fbf_line(
+                    r.home.map(|p| p as f32),
+                    r.position.map(|p| p as f32),
+                    h,
+                ))?;
+            }
             for i in 0..count {
                 let o = forces(&mut rng, i, -0.4, 0.4);
                 let e = forces(&mut rng, i + 1, -0.4, 0.4);
                 let h = forces(&mut rng, i + 2, 0.0, 5000.0);
-                v.push(fbf_line(o, e, h));
+                line(fbf_line(o, e, h))?;
             }
-            v
         }
-        Module::Ik => targets(geometry, &g, count, &mut rng)
-            .into_iter()
-            .map(|p| ik_line(&g, cordic, p))
-            .collect(),
-    };
-    for l in &lines {
-        let _ = writeln!(out, "{l}");
+        Module::Ik => {
+            for p in targets(geometry, &g, count, &mut rng) {
+                line(ik_line(&g, cordic, p))?;
+            }
+        }
     }
-    (out, lines.len())
+    Ok(n)
 }

@@ -201,25 +201,45 @@ impl Function {
     }
 }
 
-/// The vectors of any block: its text and number of samples.
+/// Writes the vectors of any block to `out`, a line at a time; returns their number.
 pub fn block_vectors(
     cordic: &tactile_math::cordic::Cordic,
     k: &tactile_math::cordic::hdl::RtlConstants,
     geometry: &tactile_math::geometry::Geometry,
-    f: Function,
-    count: usize,
-    seed: u64,
-) -> (String, usize) {
+    (f, count, seed): (Function, usize, u64),
+    out: &mut dyn Write,
+) -> std::io::Result<usize> {
     match f.family() {
-        Family::Tfb => vectors(cordic, k, f, count, seed),
-        Family::Unit(u) => units::unit_vectors(u, f.name(), count, seed),
+        Family::Tfb => vectors(cordic, k, f, count, seed, out),
+        Family::Unit(u) => units::unit_vectors(u, f.name(), count, seed, out),
         Family::Module(m) => {
-            let (mut text, n) =
-                kin::kin_vectors(m, f.name(), cordic, k.three_pi_up, geometry, count, seed);
-            text.insert_str(0, &format!("// fields: {}\n", f.fields()));
-            (text, n)
+            writeln!(out, "// fields: {}", f.fields())?;
+            let top = k.three_pi_up;
+            kin::kin_vectors(m, f.name(), cordic, top, geometry, count, seed, out)
         }
     }
+}
+
+/// `tactile hdl vectors`: to a file or stdout, through a buffer, never held whole.
+fn write_vectors(
+    (function, count, seed): (Function, usize, u64),
+    out: Option<&std::path::Path>,
+    datapath: &DatapathArgs,
+) -> Result<(), Error> {
+    let (cordic, k) = model(datapath.cordic()?)?;
+    let geometry = datapath.geometry()?;
+    let (mut sink, shown): (Box<dyn Write>, String) = match out {
+        Some(path) => {
+            let file = std::fs::File::create(path)
+                .map_err(Error::io(format!("writing {}", path.display())))?;
+            (Box::new(file), path.display().to_string())
+        }
+        None => (Box::new(std::io::stdout().lock()), "stdout".to_string()),
+    };
+    let mut buf = std::io::BufWriter::with_capacity(1 << 16, &mut sink);
+    block_vectors(&cordic, &k, &geometry, (function, count, seed), &mut buf)
+        .and_then(|_| buf.flush())
+        .map_err(Error::io(format!("writing {shown}")))
 }
 
 /// Runs `tactile hdl`.
@@ -240,19 +260,7 @@ pub fn main(args: &HdlArgs) -> Result<(), Error> {
             seed,
             out,
             datapath,
-        } => {
-            let (cordic, k) = model(datapath.cordic()?)?;
-            let geometry = datapath.geometry()?;
-            let (text, _) = block_vectors(&cordic, &k, &geometry, *function, *count, *seed);
-            match out {
-                Some(path) => std::fs::write(path, text)
-                    .map_err(Error::io(format!("writing {}", path.display()))),
-                None => std::io::stdout()
-                    .lock()
-                    .write_all(text.as_bytes())
-                    .map_err(Error::io("writing stdout")),
-            }
-        }
+        } => write_vectors((*function, *count, *seed), out.as_deref(), datapath),
         HdlCommand::Cosim(a) => sim::cosim_main(a),
         HdlCommand::Synth(a) => synth::synth_main(a),
     }

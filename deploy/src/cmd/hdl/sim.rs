@@ -53,9 +53,15 @@ pub(super) struct Work {
 }
 
 impl Work {
+    /// A relative `keep` is taken from the current folder, now: the tools run inside
+    /// the folder, and a path relative to where `tactile` started means nothing there.
     pub(super) fn new(keep: Option<&Path>) -> Result<Work, Error> {
         let (dir, kept) = match keep {
-            Some(d) => (d.to_path_buf(), true),
+            Some(d) => (
+                std::path::absolute(d)
+                    .map_err(Error::io(format!("resolving --keep {}", d.display())))?,
+                true,
+            ),
             None => {
                 let nanos = std::time::SystemTime::now()
                     .duration_since(std::time::UNIX_EPOCH)
@@ -114,18 +120,29 @@ pub(super) fn chosen(functions: &[Function], default: &[Function]) -> Vec<Functi
     }
 }
 
+/// Writes a vector file through a buffer, as `make` writes it; returns its samples.
+fn write_hex(
+    path: &Path,
+    make: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<usize>,
+) -> Result<usize, Error> {
+    use std::io::Write as _;
+    let file =
+        std::fs::File::create(path).map_err(Error::io(format!("writing {}", path.display())))?;
+    let mut buf = std::io::BufWriter::with_capacity(1 << 16, file);
+    make(&mut buf)
+        .and_then(|n| buf.flush().map(|()| n))
+        .map_err(Error::io(format!("writing {}", path.display())))
+}
+
 /// Co-simulation of one function: `(vectors, mismatches)` from the testbench's line.
 fn cosim_one(
     work: &Path,
     function: Function,
-    text: &str,
+    vec_path: &Path,
     n: usize,
     defines: &[String],
 ) -> Result<(usize, usize), Error> {
     let name = function.name();
-    let vec_path = work.join(format!("{name}.hex"));
-    std::fs::write(&vec_path, text)
-        .map_err(Error::io(format!("writing {}", vec_path.display())))?;
     let sim = work.join(format!("{name}.vvp"));
     let (bench, prefix) = function.testbench();
     let words = function.fields().split_whitespace().count();
@@ -181,8 +198,11 @@ pub fn cosim_main(args: &CosimArgs) -> Result<(), Error> {
     write_rtl(&work.dir, &k, &geometry)?;
     let mut failed = 0;
     for f in chosen(&args.function, &Function::ALL) {
-        let (text, n) = block_vectors(&cordic, &k, &geometry, f, args.count, args.seed);
-        let (v, m) = cosim_one(&work.dir, f, &text, n, &args.defines)?;
+        let vec_path = work.dir.join(format!("{}.hex", f.name()));
+        let n = write_hex(&vec_path, |out| {
+            block_vectors(&cordic, &k, &geometry, (f, args.count, args.seed), out)
+        })?;
+        let (v, m) = cosim_one(&work.dir, f, &vec_path, n, &args.defines)?;
         crate::outln!(
             "{:<7} [s{}.{}] {} iterations {:<8} {v} vectors, {m} mismatches (latency {} clocks)",
             f.name(),

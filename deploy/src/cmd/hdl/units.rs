@@ -10,7 +10,6 @@
 //! and half operands of nearby exponents (alignment, cancellation, subnormal results).
 
 use super::vectors::SplitMix;
-use std::fmt::Write as _;
 
 /// An f32 unit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -179,21 +178,29 @@ fn inputs(op: Unit, count: usize, rng: &mut SplitMix) -> Vec<(u32, u32)> {
     v
 }
 
-/// The vector file's text for `op`, and its number of samples.
-pub fn unit_vectors(op: Unit, name: &str, count: usize, seed: u64) -> (String, usize) {
+/// Writes the vector file for `op` to `out`, a line at a time; returns its number
+/// of samples.
+pub fn unit_vectors(
+    op: Unit,
+    name: &str,
+    count: usize,
+    seed: u64,
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<usize> {
     let mut rng = SplitMix(seed);
     let fields = if op.binary() { "a b r" } else { "a r" };
-    let mut out = format!(
-        "// tactile hdl vectors: {name}, IEEE binary32 round to nearest even (the model's f32); seed {seed}\n// fields: {fields}\n"
-    );
+    writeln!(
+        out,
+        "// tactile hdl vectors: {name}, IEEE binary32 round to nearest even (the model's f32); seed {seed}\n// fields: {fields}"
+    )?;
     let v = inputs(op, count, &mut rng);
     for &(a, b) in &v {
         let r = op.eval(f32::from_bits(a), f32::from_bits(b)).to_bits();
-        let _ = if op.binary() {
-            writeln!(out, "{a:08x} {b:08x} {r:08x}")
+        if op.binary() {
+            writeln!(out, "{a:08x} {b:08x} {r:08x}")?;
         } else {
-            writeln!(out, "{a:08x} {r:08x}")
-        };
+            writeln!(out, "{a:08x} {r:08x}")?;
+        }
     }
-    (out, v.len())
+    Ok(v.len())
 }

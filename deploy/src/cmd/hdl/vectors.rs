@@ -9,7 +9,7 @@
 
 use super::Function;
 use std::f32::consts::PI;
-use std::fmt::Write as _;
+use std::io::Write;
 use tactile_math::cordic::hdl::RtlConstants;
 use tactile_math::cordic::Cordic;
 
@@ -29,49 +29,59 @@ impl Code {
     }
 }
 
-/// The vector file's text for `function`: a comment header naming the fields, then
-/// one line per sample. Returns the text and the number of samples.
+/// Writes the vector file for `function` to `out`: a comment header naming the
+/// fields, then one line per sample, each written as it is made (a file of 10^7
+/// samples is 1.7 GB; held whole with its lines it took 4.86 GB). Returns the number
+/// of samples.
 pub fn vectors(
     cordic: &Cordic,
     k: &RtlConstants,
     function: Function,
     count: usize,
     seed: u64,
-) -> (String, usize) {
+    out: &mut dyn Write,
+) -> std::io::Result<usize> {
     let mut rng = SplitMix(seed);
     let code = Code {
         width: k.config.word.div_ceil(4) as usize,
         mask: (1u64 << k.config.word) - 1, // word <= 32
     };
-    let mut out = format!(
-        "// tactile hdl vectors: {} for [s{}.{}], {} iterations, {:?}; seed {seed}\n// fields: {}\n",
+    writeln!(
+        out,
+        "// tactile hdl vectors: {} for [s{}.{}], {} iterations, {:?}; seed {seed}\n// fields: {}",
         function.name(),
         k.config.word,
         k.config.frac,
         k.config.iterations,
         k.config.rounding,
         function.fields()
-    );
-    let lines = match function {
+    )?;
+    let mut n = 0;
+    let mut line = |text: String| {
+        n += 1;
+        writeln!(out, "{text}")
+    };
+    match function {
         Function::Sincos => sincos_inputs(k, count, &mut rng)
             .into_iter()
-            .map(|a| sincos_line(cordic, &code, f32::from_bits(a)))
-            .collect::<Vec<_>>(),
+            .try_for_each(|a| line(sincos_line(cordic, &code, f32::from_bits(a))))?,
         Function::Atan2 => atan2_inputs(count, &mut rng)
             .into_iter()
-            .map(|(y, x)| atan2_line(cordic, &code, f32::from_bits(y), f32::from_bits(x)))
-            .collect(),
+            .try_for_each(|(y, x)| {
+                line(atan2_line(
+                    cordic,
+                    &code,
+                    f32::from_bits(y),
+                    f32::from_bits(x),
+                ))
+            })?,
         Function::Acos => acos_inputs(count, &mut rng)
             .into_iter()
-            .map(|a| acos_line(cordic, &code, f32::from_bits(a)))
-            .collect(),
+            .try_for_each(|a| line(acos_line(cordic, &code, f32::from_bits(a))))?,
         // The units' and modules' vectors are made by their own generators.
-        _ => Vec::new(),
-    };
-    for line in &lines {
-        let _ = writeln!(out, "{line}");
+        _ => {}
     }
-    (out, lines.len())
+    Ok(n)
 }
 
 /// One sin/cos vector: input, invalid flag, the stages' codes and the outputs.
