@@ -26,6 +26,7 @@ use std::path::Path;
 pub use tactile_chain::spatial::{quaternion, rotation_matrix};
 use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
 use tactile_math::arith::StdTrig;
+use tactile_scenario::shown::{listed, Num};
 use tactile_scenario::{ArmConfig, ArmServo, Scenario};
 
 use crate::environment::{deepest_contact, Scene};
@@ -148,15 +149,18 @@ impl UrdfArm {
                     v.len(),
                     cfg.base,
                     cfg.tip,
-                    chain.dofs.iter().map(|d| d.name.as_str()).collect::<Vec<_>>().join(", ")
+                    listed(chain.dofs.iter().map(|d| d.name.as_str()))
                 ));
             }
         }
         for (d, q) in chain.dofs.iter().zip(&cfg.home) {
             if *q < d.lower || *q > d.upper {
                 return Err(format!(
-                    "field `slave.arm.home`: {q} for joint `{}` is outside its limits [{}, {}]",
-                    d.name, d.lower, d.upper
+                    "field `slave.arm.home`: {} for joint `{}` is outside its limits [{}, {}]",
+                    Num(*q),
+                    d.name,
+                    Num(d.lower),
+                    Num(d.upper)
                 ));
             }
         }
@@ -177,8 +181,8 @@ impl UrdfArm {
         if let (Some(w), p) = (&cfg.workspace, home_tool.p) {
             if w.clamp(p.into()).1 {
                 return Err(format!(
-                    "field `slave.arm.workspace`: the tool's home [{:.3}, {:.3}, {:.3}] m is outside the box {:?} to {:?}: the robot would move at the first sample",
-                    p.x, p.y, p.z, w.min, w.max
+                    "field `slave.arm.workspace`: the tool's home [{}, {}, {}] m is outside the box {:?} to {:?}: the robot would move at the first sample",
+                    Num(p.x), Num(p.y), Num(p.z), w.min, w.max
                 ));
             }
         }

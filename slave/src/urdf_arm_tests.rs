@@ -407,3 +407,33 @@ fn a_turned_reengage_continues_from_the_held_orientation() {
     let tool = arm.tool_rotation();
     assert!((0..4).all(|k| (tool[k] - want[k]).abs() < 1e-3), "{tool:?}");
 }
+
+/// A chain of 300 joints and a `home` of one value: the error listed every joint's
+/// name on one line (10,000 of them for a 10,000-joint chain); it names the first ten.
+#[test]
+fn a_long_chains_joints_are_listed_short() {
+    let mut xml = String::from("<robot name=\"long\"><link name=\"l0\"/>");
+    for k in 1..=300 {
+        xml += &format!(
+            "<link name=\"l{k}\"><inertial><mass value=\"0.1\"/><inertia ixx=\"1e-3\" ixy=\"0\" ixz=\"0\" iyy=\"1e-3\" iyz=\"0\" izz=\"1e-3\"/></inertial></link>\
+             <joint name=\"j{k}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{k}\"/>\
+             <origin xyz=\"0 0 0.01\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"10\" velocity=\"1\"/></joint>",
+            k - 1
+        );
+    }
+    xml += "</robot>";
+    let cfg = ArmConfig {
+        base: "l0".into(),
+        tip: "l300".into(),
+        home: vec![0.0],
+        ..panda_cfg()
+    };
+    let e = UrdfArm::new(&cfg, &xml, HOME)
+        .err()
+        .expect("home has one value");
+    assert!(
+        e.contains("has 300 joints (j1, j2,") && e.contains("j10, ... and 290 more)"),
+        "{e}"
+    );
+    assert!(e.len() < 300, "{} characters", e.len());
+}

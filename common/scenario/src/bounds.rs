@@ -3,6 +3,7 @@
 //! experiment on a PHANToM Omni class arm. Each bound is written once, here, with the
 //! field it bounds; the error names the field.
 
+use crate::shown::Num;
 use crate::{invalid, Object, Operator, Scenario, ScenarioError};
 
 /// Largest magnitude of a position in the arm's space, m.
@@ -10,7 +11,7 @@ pub const MAX_POSITION_M: f64 = 10.0;
 
 fn at_most(field: &str, v: f64, max: f64) -> Result<(), ScenarioError> {
     if v.abs() > max {
-        return Err(invalid(field, format!("{v} is beyond {max}")));
+        return Err(invalid(field, format!("{} is beyond {max}", Num(v))));
     }
     Ok(())
 }
@@ -126,5 +127,20 @@ impl Scenario {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// 1e308 was shown as its 309 digits.
+    #[test]
+    fn a_huge_value_is_shown_short() {
+        let text = super::at_most("master.force_limit", 1e308, 100.0)
+            .expect_err("beyond")
+            .to_string();
+        assert!(
+            text.contains("1e308 is beyond 100") && text.len() < 120,
+            "{text}"
+        );
     }
 }

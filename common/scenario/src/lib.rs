@@ -19,6 +19,7 @@ mod master;
 mod network;
 mod operator;
 pub mod overrides;
+pub mod shown;
 mod ros;
 mod slave;
 mod validate;
