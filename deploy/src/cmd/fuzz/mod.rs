@@ -1,16 +1,21 @@
 //! `tactile fuzz`: every decoder of outside bytes (records, ROS 2 CDR, the loop's wire
 //! samples, rmw_zenoh attachments, scenario TOML, trajectory CSV, `tactile kernels`
-//! input) driven with mutated inputs on stable Rust, each input under `catch_unwind`.
+//! input, a URDF arm, `[slave.arm]`'s map, a 6-DoF trajectory) driven with mutated
+//! inputs on stable Rust, each input under `catch_unwind`.
 //!
 //! Guidance without compiler instrumentation: an input is kept in the target's corpus
 //! when its outcome has a shape not seen before (the decoder's answer with its numbers
 //! blanked, per decoder): the errors a decoder gives are the paths it can take through
 //! its checks, and mutating an input that reached a new one explores from there. The
 //! count of shapes is what the report calls paths. A panic is written to `--out` as
-//! the input that caused it, and the command exits 1.
+//! the input that caused it (its message beside it), and the command exits 1. The
+//! slowest input's time is reported too: a decoder that is slow on some input (a
+//! quadratic loop) shows there long before it hangs.
 
+mod arm;
 mod mutate;
 mod targets;
+mod trajectory6;
 
 use crate::error::Error;
 use clap::Args;
@@ -22,7 +27,7 @@ use std::time::{Duration, Instant};
 #[derive(Debug, Args)]
 pub struct FuzzArgs {
     /// Targets to fuzz (default: all): records, blocks, cdr, wire, attachment,
-    /// scenario, trajectory, kernels.
+    /// scenario, trajectory, kernels, urdf, map, trajectory6.
     #[arg(long = "target", value_name = "NAME")]
     pub targets: Vec<String>,
     /// Seconds per target.
@@ -31,6 +36,9 @@ pub struct FuzzArgs {
     /// Seed of the mutations (the same seed and time make the same first inputs).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Inputs per target at most (with a seed, the same inputs on any machine).
+    #[arg(long)]
+    pub runs: Option<u64>,
     /// Folder for the inputs that made a decoder panic.
     #[arg(long, default_value = "fuzz-crashes")]
     pub out: PathBuf,
@@ -51,6 +59,17 @@ struct Campaign {
     paths: usize,
     corpus: usize,
     panics: u64,
+    /// The slowest input's time.
+    slowest: Duration,
+    /// The campaign's time.
+    elapsed: Duration,
+}
+
+/// The message of the last panic, as the hook saw it (where and why).
+static LAST_PANIC: std::sync::Mutex<String> = std::sync::Mutex::new(String::new());
+
+fn last_panic() -> String {
+    LAST_PANIC.lock().map(|m| m.clone()).unwrap_or_default()
 }
 
 /// An outcome's shape: numbers blanked and quoted or bracketed text left out (an error quoting the
@@ -104,15 +123,21 @@ fn campaign(t: &targets::Target, args: &FuzzArgs, k: u64) -> Result<Campaign, Er
         paths: 0,
         corpus: 0,
         panics: 0,
+        slowest: Duration::ZERO,
+        elapsed: Duration::ZERO,
     };
-    let until = Instant::now() + Duration::from_secs_f64(args.seconds);
+    let began = Instant::now();
+    let until = began + Duration::from_secs_f64(args.seconds);
     let mut queue: Vec<Vec<u8>> = t.seeds.clone();
-    while Instant::now() < until {
+    while Instant::now() < until && args.runs.is_none_or(|n| c.inputs < n) {
         let input = queue
             .pop()
-            .unwrap_or_else(|| mutate::mutate(&mut rng, &corpus));
+            .unwrap_or_else(|| mutate::mutate(&mut rng, &corpus, t.dict));
         c.inputs += 1;
-        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (t.run)(&input))) {
+        let start = Instant::now();
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| (t.run)(&input)));
+        c.slowest = c.slowest.max(start.elapsed());
+        match result {
             Ok(outcome) => {
                 let new = seen.len() < MAX_PATHS && seen.insert(shape(&outcome));
                 if new && input.len() <= mutate::MAX_LEN {
@@ -131,10 +156,14 @@ fn campaign(t: &targets::Target, args: &FuzzArgs, k: u64) -> Result<Campaign, Er
                 let path = args.out.join(format!("{}-{}.bin", t.name, c.panics));
                 std::fs::write(&path, &input)
                     .map_err(Error::io(format!("writing {}", path.display())))?;
+                let why = path.with_extension("txt");
+                std::fs::write(&why, last_panic())
+                    .map_err(Error::io(format!("writing {}", why.display())))?;
             }
         }
     }
     c.paths = seen.len();
+    c.elapsed = began.elapsed();
     c.corpus = corpus.len();
     Ok(c)
 }
@@ -152,10 +181,15 @@ pub fn main(args: &FuzzArgs) -> Result<(), Error> {
             )));
         }
     }
-    // Panics are counted and their inputs kept; the default hook would print each.
+    // Panics are counted and their inputs kept with their message; the default hook
+    // would print each.
     let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    crate::outln!("target       inputs    inputs/s  paths  corpus  panics");
+    std::panic::set_hook(Box::new(|info| {
+        if let Ok(mut m) = LAST_PANIC.lock() {
+            *m = info.to_string();
+        }
+    }));
+    crate::outln!("target        inputs    inputs/s  paths  corpus  max_ms  panics");
     let mut panics = 0;
     let mut result = Ok(());
     for (k, t) in all.iter().enumerate() {
@@ -171,12 +205,13 @@ pub fn main(args: &FuzzArgs) -> Result<(), Error> {
                     c.paths.to_string()
                 };
                 crate::outln!(
-                    "{:<10} {:>8} {:>11.0} {:>6} {:>7} {:>7}",
+                    "{:<11} {:>8} {:>11.0} {:>6} {:>7} {:>7.1} {:>7}",
                     t.name,
                     c.inputs,
-                    c.inputs as f64 / args.seconds,
+                    c.inputs as f64 / c.elapsed.as_secs_f64().max(1e-9),
                     paths,
                     c.corpus,
+                    c.slowest.as_secs_f64() * 1e3,
                     c.panics
                 );
             }

@@ -1,6 +1,8 @@
 //! Mutations of an input, as byte fuzzers make them: bits flipped, bytes replaced by
 //! boundary values, runs inserted, deleted and repeated, integers overwritten with
-//! extremes (lengths and counts are where decoders go wrong), and two inputs spliced.
+//! extremes (lengths and counts are where decoders go wrong), and two inputs spliced;
+//! for a text format, also its tokens (a number replaced by `1e308`, a `"fixed"`
+//! inserted): what a byte fuzzer seldom makes of `1.5` is what a parser must refuse.
 
 /// Longest input kept in a corpus, bytes.
 pub const MAX_LEN: usize = 1 << 16;
@@ -43,14 +45,47 @@ const WORDS: [u64; 7] = [
     1 << 62,
 ];
 
-/// A new input: one of `corpus`, mutated one to four times.
-pub fn mutate(rng: &mut Rng, corpus: &[Vec<u8>]) -> Vec<u8> {
+/// A new input: one of `corpus`, mutated one to four times, with the format's
+/// tokens `dict` among the mutations (none without).
+pub fn mutate(rng: &mut Rng, corpus: &[Vec<u8>], dict: &[&str]) -> Vec<u8> {
     let mut b = corpus[rng.below(corpus.len())].clone();
     for _ in 0..=rng.below(4) {
-        step(rng, &mut b, corpus);
+        if !dict.is_empty() && rng.below(3) == 0 {
+            token(rng, &mut b, dict);
+        } else {
+            step(rng, &mut b, corpus);
+        }
     }
     b.truncate(MAX_LEN);
     b
+}
+
+/// Part of a number: a digit, a point, a sign, an exponent.
+fn numeric(c: u8) -> bool {
+    c.is_ascii_digit() || matches!(c, b'.' | b'-' | b'+' | b'e' | b'E')
+}
+
+/// One of `dict` in place of the number at or after a random byte (inserted there
+/// when there is none, or one time in four).
+fn token(rng: &mut Rng, b: &mut Vec<u8>, dict: &[&str]) {
+    let t = dict[rng.below(dict.len())].as_bytes();
+    let at = rng.below(b.len() + 1);
+    let start = b[at..]
+        .iter()
+        .position(|c| c.is_ascii_digit())
+        .map(|k| at + k);
+    match start {
+        Some(mut s) if rng.below(4) != 0 => {
+            while s > 0 && numeric(b[s - 1]) {
+                s -= 1;
+            }
+            let end = s + b[s..].iter().take_while(|c| numeric(**c)).count();
+            b.splice(s..end, t.iter().copied());
+        }
+        _ => {
+            b.splice(at..at, t.iter().copied());
+        }
+    }
 }
 
 fn step(rng: &mut Rng, b: &mut Vec<u8>, corpus: &[Vec<u8>]) {
@@ -104,7 +139,7 @@ mod tests {
         let run = |seed| {
             let mut rng = Rng::new(seed);
             (0..2000)
-                .map(|_| mutate(&mut rng, &corpus))
+                .map(|_| mutate(&mut rng, &corpus, &[]))
                 .collect::<Vec<_>>()
         };
         let a = run(5);
@@ -112,5 +147,20 @@ mod tests {
         assert_ne!(a, run(6));
         assert!(a.iter().all(|x| x.len() <= MAX_LEN));
         assert!(a.iter().any(|x| x != &corpus[0] && x != &corpus[1]));
+    }
+
+    #[test]
+    fn tokens_replace_whole_numbers() {
+        let corpus = vec![b"scale = 1.5e-2\n".to_vec()];
+        let mut rng = Rng::new(3);
+        let got: Vec<String> = (0..400)
+            .map(|_| String::from_utf8_lossy(&mutate(&mut rng, &corpus, &["1e308"])).into_owned())
+            .collect();
+        assert!(
+            got.iter().any(|s| s == "scale = 1e308\n"),
+            "{:?}",
+            &got[..20]
+        );
+        assert!(got.iter().all(|s| s.len() <= MAX_LEN));
     }
 }

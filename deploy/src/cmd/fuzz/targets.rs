@@ -20,6 +20,10 @@ pub struct Target {
     pub name: &'static str,
     /// Valid inputs to start from.
     pub seeds: Vec<Vec<u8>>,
+    /// Tokens of the format that mutations put in place of a number or insert (the
+    /// values and names byte flips seldom make: `1e308`, `nan`, `"fixed"`); none for
+    /// a binary format.
+    pub dict: &'static [&'static str],
     /// Decodes one input; the outcome in words.
     pub run: Run,
 }
@@ -35,10 +39,13 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>, String> {
         scenario(),
         trajectory(),
         kernels(),
+        super::arm::urdf(),
+        super::arm::map()?,
+        super::trajectory6::trajectory6(),
     ])
 }
 
-fn outcome<T, E: std::fmt::Display>(r: Result<T, E>) -> String {
+pub fn outcome<T, E: std::fmt::Display>(r: Result<T, E>) -> String {
     r.map_or_else(|e| e.to_string(), |_| "ok".into())
 }
 
@@ -57,6 +64,7 @@ fn blocks() -> Target {
     Target {
         name: "blocks",
         seeds,
+        dict: &[],
         run: Box::new(|b| {
             let rows = b.first().map_or(0, |r| u32::from(r & 0x7f));
             outcome(block::from_planes(b, rows))
@@ -79,6 +87,7 @@ fn records(scratch: &Path) -> Result<Target, String> {
     Ok(Target {
         name: "records",
         seeds,
+        dict: &[],
         run: Box::new(move |b| {
             if std::fs::File::create(&file)
                 .and_then(|mut f| f.write_all(b))
@@ -130,6 +139,7 @@ fn cdr() -> Target {
     Target {
         name: "cdr",
         seeds: vec![joints.to_cdr(), wrench.to_cdr(), array.to_cdr()],
+        dict: &[],
         run: Box::new(|b| {
             [
                 outcome(JointState::from_cdr(b)),
@@ -150,6 +160,7 @@ fn wire() -> Target {
     Target {
         name: "wire",
         seeds: vec![f, b],
+        dict: &[],
         run: Box::new(|b| match tactile_transport::wire::decode(b) {
             Ok(tactile_transport::wire::Frame::Forward(_)) => "forward".into(),
             Ok(tactile_transport::wire::Frame::Backward(_)) => "backward".into(),
@@ -168,6 +179,7 @@ fn attachment() -> Target {
     Target {
         name: "attachment",
         seeds: vec![a.to_bytes().to_vec()],
+        dict: &[],
         run: Box::new(|b| {
             tactile_ros::rmw::Attachment::from_bytes(b).map_or("none".into(), |_| "ok".into())
         }),
@@ -183,6 +195,7 @@ fn scenario() -> Target {
     Target {
         name: "scenario",
         seeds: seeds.iter().map(|s| s.as_bytes().to_vec()).collect(),
+        dict: &[],
         run: Box::new(|b| {
             outcome(tactile_scenario::Scenario::from_toml_str(
                 &String::from_utf8_lossy(b),
@@ -200,6 +213,7 @@ fn trajectory() -> Target {
     Target {
         name: "trajectory",
         seeds: seeds.iter().map(|s| s.as_bytes().to_vec()).collect(),
+        dict: &[],
         run: Box::new(|b| {
             outcome(tactile_master::trajectory::Trajectory::parse(
                 &String::from_utf8_lossy(b),
@@ -232,6 +246,7 @@ fn kernels() -> Target {
     Target {
         name: "kernels",
         seeds: seeds.iter().map(|s| s.as_bytes().to_vec()).collect(),
+        dict: &[],
         run: Box::new(move |b| {
             args.iter()
                 .map(|a| {
