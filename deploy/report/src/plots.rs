@@ -13,8 +13,12 @@ use plotters::prelude::*;
 use std::path::Path;
 use tactile_messages::samples::FLAG_RELEASED;
 
+pub(crate) mod looks;
+mod percentiles;
 mod stretches;
 mod timeplot;
+pub(crate) use looks::{draw_legend, draw_line, draw_markers, look};
+pub use percentiles::percentile_plot;
 use stretches::Stretches;
 pub(crate) use timeplot::tick;
 
@@ -293,7 +297,7 @@ pub fn read_hgrm(text: &str) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Colours of the loops in a percentile plot.
+/// Colours of the series of a plot with several (percentile lines, a sweep's lines).
 pub(crate) const LOOP_COLOURS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -302,90 +306,6 @@ pub(crate) const LOOP_COLOURS: [RGBColor; 6] = [
     RGBColor(255, 127, 14),
     RGBColor(23, 190, 207),
 ];
-
-/// The percentile plot's axes: the largest 1/(1-p), rounded up to a decade (the last
-/// point, p = 1, has no finite one: it is drawn there), and the latency range with
-/// headroom; None without a point.
-fn percentile_extent(series: &[(String, Vec<(f64, f64)>)]) -> Option<(f64, f64, f64)> {
-    let mut x_max = 10.0f64;
-    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    for (_, pts) in series {
-        for &(q, v) in pts {
-            if q < 1.0 {
-                x_max = x_max.max(1.0 / (1.0 - q));
-            }
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
-    }
-    if !lo.is_finite() {
-        return None;
-    }
-    let x_max = 10f64.powf(x_max.log10().ceil());
-    Some((
-        x_max,
-        (lo * 0.8).max(0.01),
-        (hi * 1.25).max(lo * 10.0).max(0.1),
-    ))
-}
-
-/// Latency against percentile as the field draws it (HdrHistogram's plotter): the
-/// percentile on a log axis of 1/(1 - p), so 90 %, 99 %, 99.9 % and 99.99 % are evenly
-/// spaced and the tail is as visible as the body; one line per distribution, each
-/// from its `.hgrm` text; latency on a log axis too, since body and tail lie decades
-/// apart.
-pub fn percentile_plot(
-    path: &Path,
-    title: &str,
-    series: &[(String, Vec<(f64, f64)>)],
-) -> PlotResult {
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let Some((x_max, lo, hi)) = percentile_extent(series) else {
-        return root.present().map_err(err);
-    };
-    // The right margin holds the half of the last tick label ("99.99%") that lies
-    // past the axis's end.
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 20))
-        .margin(10)
-        .margin_right(40)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d((1.0..x_max).log_scale(), (lo..hi).log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("percentile")
-        .y_desc("latency (us)")
-        .x_label_formatter(&|x| {
-            let p = 100.0 * (1.0 - 1.0 / x);
-            format!("{}%", (p * 1000.0).round() / 1000.0)
-        })
-        .draw()
-        .map_err(err)?;
-    for (k, (label, pts)) in series.iter().enumerate() {
-        let colour = LOOP_COLOURS[k % LOOP_COLOURS.len()];
-        let line: Vec<(f64, f64)> = pts
-            .iter()
-            .map(|&(q, v)| (if q < 1.0 { 1.0 / (1.0 - q) } else { x_max }.min(x_max), v))
-            .collect();
-        let style = ShapeStyle::from(colour).stroke_width(2);
-        chart
-            .draw_series(LineSeries::new(line, style))
-            .map_err(err)?
-            .label(label.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
-    root.present().map_err(err)
-}
 
 /// A series: label, colour, whether it is a reference (see `timeplot`), points.
 type Line = (String, RGBColor, bool, Vec<(f64, f64)>);

@@ -1,9 +1,11 @@
 //! `sweep-METRIC.svg`: each metric of a sweep against the first swept key, one line
 //! per value of the second, a marker at every run, and with `--seeds` the 95 %
 //! confidence interval as an error bar. Vector values (`[25,25,25]`) sit at their
-//! elements' mean on a numeric axis; words at their positions 0, 1, 2, ...
+//! elements' mean on a numeric axis; words at their positions 0, 1, 2, ... Where two
+//! lines coincide (controls that agree at a point), both show: each line has its own
+//! colour, dash and marker, the first drawn widest (`plots::looks`).
 
-use crate::plots::{tick, LOOP_COLOURS};
+use crate::plots::{draw_legend, draw_line, draw_markers, look, tick};
 use crate::sweep::{numeric, Axis, FAILED, METRICS};
 use plotters::prelude::*;
 use std::path::Path;
@@ -48,7 +50,7 @@ pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<(), St
                 || name.to_string(),
                 |a| format!("{}={}", a.key, a.values[line]),
             );
-            series.push((label, LOOP_COLOURS[line % LOOP_COLOURS.len()], pts));
+            series.push((label, pts));
         }
         crate::plots::whole_svg(&out.join(format!("sweep-{name}.svg")), |p| {
             plot(p, name, &first.key, &x_desc, &series)
@@ -57,11 +59,12 @@ pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<(), St
     Ok(())
 }
 
-type Series = (String, RGBColor, Vec<(f64, f64, f64)>);
+/// A line's label and its points: x, the mean, the interval's half width.
+type Series = (String, Vec<(f64, f64, f64)>);
 
 /// The ranges the points and their error bars span, padded.
 fn ranges(series: &[Series]) -> Option<((f64, f64), (f64, f64))> {
-    let all = series.iter().flat_map(|s| s.2.iter());
+    let all = series.iter().flat_map(|s| s.1.iter());
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -103,19 +106,12 @@ fn plot(path: &Path, name: &str, key: &str, x_desc: &str, series: &[Series]) -> 
         .x_label_formatter(&tick)
         .draw()
         .map_err(err)?;
-    for (label, colour, pts) in series {
-        let style = ShapeStyle::from(*colour).stroke_width(2);
-        chart
-            .draw_series(LineSeries::new(pts.iter().map(|p| (p.0, p.1)), style))
-            .map_err(err)?
-            .label(label.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-        chart
-            .draw_series(
-                pts.iter()
-                    .map(|p| Circle::new((p.0, p.1), 4, style.filled())),
-            )
-            .map_err(err)?;
+    for (k, (label, pts)) in series.iter().enumerate() {
+        let look = look(k, series.len());
+        let line: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, p.1)).collect();
+        draw_line(&mut chart, line.clone(), &look, label)?;
+        draw_markers(&mut chart, &line, &look)?;
+        let style = look.style();
         chart
             .draw_series(
                 pts.iter()
@@ -124,12 +120,53 @@ fn plot(path: &Path, name: &str, key: &str, x_desc: &str, series: &[Series]) -> 
             )
             .map_err(err)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 0.85)?;
     root.present().map_err(err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plots::looks::svg;
+    use crate::sweep::axis;
+
+    /// Three controls with the same value at every delay: each line is drawn in its
+    /// own colour, the first widest and solid, the later narrower and dashed, each
+    /// with its own marker, so none hides another.
+    #[test]
+    fn lines_that_coincide_all_show() {
+        let axes = [
+            axis("network.forward.delay=[0,0,0],[10,10,10],[50,50,50]").expect("a"),
+            axis("control.kind=none,tdpa,wave").expect("b"),
+        ];
+        let points: Vec<Point> = crate::sweep::combinations(&axes)
+            .into_iter()
+            .map(|c| {
+                let y = 1.0 + c[0] as f64;
+                (c, vec![(Some(y), None); METRICS.len()])
+            })
+            .collect();
+        let dir = tempfile::tempdir().expect("tmp");
+        sweep_plots(dir.path(), &axes, &points).expect("plots");
+        let text = std::fs::read_to_string(dir.path().join("sweep-samples_sent.svg")).expect("svg");
+        let lines = svg::polylines(&text);
+        let hex = |k: usize| {
+            let c = look(k, 3).colour;
+            format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)
+        };
+        let widths: Vec<u32> = (0..3)
+            .map(|k| {
+                let (_, w) = &lines[&hex(k)];
+                assert_eq!(w.len(), 1, "series {k}: {w:?}");
+                w[0].parse().expect("width")
+            })
+            .collect();
+        assert!(widths[0] > widths[1] && widths[1] > widths[2], "{widths:?}");
+        // Dashed: a dash per polyline, many more than the solid line's one (and its
+        // legend's).
+        assert!(lines[&hex(0)].0 <= 2, "{:?}", lines[&hex(0)]);
+        assert!(lines[&hex(1)].0 > 4 && lines[&hex(2)].0 > 4, "{lines:?}");
+        let shapes: Vec<Vec<&str>> = (0..3).map(|k| svg::shapes(&text, &hex(k))).collect();
+        assert_eq!(shapes, [vec!["circle"], vec!["polygon"], vec!["rect"]]);
+    }
 }
