@@ -123,6 +123,8 @@ pub struct SlaveHandler {
     /// view needs a quarter of it).
     last_view: Option<SlaveView>,
     clamps_seen: (u64, u64),
+    /// A URDF arm's failed dynamics periods at the last second's log.
+    failures_seen: u64,
 }
 
 impl std::fmt::Debug for SlaveHandler {
@@ -158,6 +160,7 @@ impl SlaveHandler {
             ),
             last_view: None,
             clamps_seen: (0, 0),
+            failures_seen: 0,
         }
     }
 
@@ -187,6 +190,14 @@ impl Handler for SlaveHandler {
                 "clamped: {} joint torques to the limit and {} IK targets to the workspace in the last second ({} and {} in all)",
                 last.0, last.1, all.0, all.1
             );
+        }
+        let failures = self.slave.arm().map_or(0, |a| a.dynamics_failures());
+        if failures > self.failures_seen {
+            tracing::warn!(
+                "slave.arm: the dynamics failed in {} periods in the last second ({failures} in all): the arm stood still in each",
+                failures - self.failures_seen
+            );
+            self.failures_seen = failures;
         }
     }
 

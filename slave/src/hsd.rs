@@ -147,6 +147,7 @@ impl Slave {
     pub fn hold(&mut self) -> HoldStep {
         if let Some(arm) = self.arm.as_mut() {
             let h = arm.hold(self.t_s, &self.objects);
+            log_first_failure(arm);
             let c = &mut self.counters;
             c.holds += u64::from(h.started);
             c.held_steps += 1;
@@ -386,6 +387,7 @@ impl Slave {
             // The arm's joints are in its own record entry: not three angles.
             let clamps = arm.advance(self.t_s, &self.objects);
             self.counters.torque_clamps += u64::from(clamps);
+            log_first_failure(arm);
             return ([0.0; 3], [0.0; 3], clamps);
         }
         let state = self.dynamics.state;
@@ -485,6 +487,18 @@ impl Slave {
 /// How far from one a received quaternion's norm may be (the sender normalized it;
 /// a wire carries it exactly): anything further is not a rotation and is rejected.
 pub const ROTATION_TOLERANCE: f64 = 1e-6;
+
+/// The arm's first failed dynamics step, logged with its cause (the slave's handler
+/// logs how many more each second): a run whose arm stands still says why.
+fn log_first_failure(arm: &mut UrdfArm) {
+    if let Some(e) = arm.take_failure() {
+        if arm.dynamics_failures() == 1 {
+            tracing::warn!(
+                "slave.arm: the dynamics failed ({e}): the arm stands still while they do"
+            );
+        }
+    }
+}
 
 /// Counts what a URDF arm's IK call did; the flags it sets on h(n).
 fn count_followed(c: &mut SlaveCounters, f: Followed) -> u32 {

@@ -58,6 +58,9 @@ pub struct UrdfArm {
     indexing: Option<Indexing>,
     /// The master's base frame in the arm's (`cfg.rotation`), `None` for none.
     frame: Option<Matrix3<f64>>,
+    /// Periods whose dynamics failed (the arm then stood still), and the last
+    /// failure not yet taken by the slave's log.
+    failures: (u64, Option<String>),
 }
 
 /// Where the master's mapped pose met the robot's reference at a re-engage: the
@@ -166,6 +169,14 @@ impl UrdfArm {
         }
         let dynamics =
             Dynamics::new(&chain, Vector3::from(cfg.gravity)).map_err(|e| e.to_string())?;
+        // One step at home, at rest: dynamics that fail there (a link's mass on its
+        // own joint's axis, nothing to turn) would fail at every step of the run.
+        let zero = vec![0.0; dof];
+        match dynamics.aba(&cfg.home, &zero, &zero) {
+            Ok(a) if a.iter().all(|a| a.is_finite()) => {}
+            Ok(_) => return Err("slave.arm: the dynamics at home are not finite".into()),
+            Err(e) => return Err(format!("slave.arm: at home: {e}")),
+        }
         let ik_cfg = IkConfig {
             max_iterations: cfg.ik.max_iterations as usize,
             orientation_weight: cfg.ik.orientation_weight,
@@ -208,6 +219,7 @@ impl UrdfArm {
             indexing: None,
             frame: (!cfg.rotation.is_identity())
                 .then(|| Matrix3::from_fn(|i, j| cfg.rotation.matrix()[i][j])),
+            failures: (0, None),
         })
     }
 
@@ -456,18 +468,34 @@ impl UrdfArm {
             let drive: Vec<f64> = (0..tau.len())
                 .map(|i| tau[i] + ext[i] - self.chain.dofs[i].damping * self.state.qd[i])
                 .collect();
-            let Ok(acc) = self.dynamics.aba(&self.state.q, &self.state.qd, &drive) else {
-                break;
+            let acc = match self.dynamics.aba(&self.state.q, &self.state.qd, &drive) {
+                Ok(a) if a.iter().all(|a| a.is_finite()) => a,
+                // Never integrate a non-finite state: the joints stop where they are,
+                // and the failure is counted and kept for the slave's log.
+                failed => {
+                    self.state.qd.iter_mut().for_each(|v| *v = 0.0);
+                    self.failures.0 += 1;
+                    self.failures.1 = Some(match failed {
+                        Err(e) => e.to_string(),
+                        Ok(_) => "the joints' accelerations are not finite".into(),
+                    });
+                    break;
+                }
             };
-            if acc.iter().any(|a| !a.is_finite()) {
-                // Never integrate a non-finite state: the joints stop where they are.
-                self.state.qd.iter_mut().for_each(|v| *v = 0.0);
-                break;
-            }
             self.integrate(&acc, h);
             self.state.tau = tau;
         }
         clamped.iter().filter(|c| **c).count() as u32
+    }
+
+    /// Periods whose dynamics failed so far (the arm stood still in each).
+    pub fn dynamics_failures(&self) -> u64 {
+        self.failures.0
+    }
+
+    /// The last failure of the dynamics since this was last called, if any.
+    pub fn take_failure(&mut self) -> Option<String> {
+        self.failures.1.take()
     }
 
     /// The servo's efforts with gravity compensation, clamped to each joint's effort

@@ -437,3 +437,53 @@ fn a_long_chains_joints_are_listed_short() {
     );
     assert!(e.len() < 300, "{} characters", e.len());
 }
+
+/// A one-joint arm: a continuous joint (no position limit stops it) with `damping`.
+fn one_joint(damping: &str, inertia: &str) -> (ArmConfig, String) {
+    let xml = format!(
+        r#"<robot name="r"><link name="base"/>
+        <link name="a"><inertial><mass value="1"/><inertia {inertia}/></inertial></link>
+        <joint name="j" type="continuous"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+        <limit effort="10" velocity="10"/><dynamics damping="{damping}"/></joint></robot>"#
+    );
+    let cfg = ArmConfig {
+        base: "base".into(),
+        tip: "a".into(),
+        home: vec![0.0],
+        kp: vec![10.0],
+        kd: vec![1.0],
+        ..panda_cfg()
+    };
+    (cfg, xml)
+}
+
+/// Issue 51: a dynamics step that failed froze the arm, nothing counted or logged.
+/// A damping the semi-implicit Euler step cannot integrate (the velocity grows by
+/// 1e12 step / inertia each step) fails once the velocity is not finite: counted,
+/// its cause kept for the slave's log (once).
+#[test]
+fn a_failed_dynamics_step_is_counted_and_its_cause_kept() {
+    let (cfg, xml) = one_joint("1e12", r#"ixx="0.01" iyy="0.01" izz="0.01""#);
+    let mut arm = UrdfArm::new(&cfg, &xml, HOME).expect("arm");
+    arm.state.qd[0] = 1.0;
+    for _ in 0..100 {
+        arm.advance(1e-3, &Scene::new(&[]));
+    }
+    assert!(arm.dynamics_failures() > 0, "no failure counted");
+    let e = arm.take_failure().expect("a cause");
+    assert!(e.contains("not finite"), "{e}");
+    assert_eq!(arm.take_failure(), None);
+    assert!(arm.state().qd.iter().all(|v| v.is_finite()));
+}
+
+/// A link whose mass sits on its own joint's axis, with no inertia about it: every
+/// step's dynamics would fail, so the arm is refused at load.
+#[test]
+fn dynamics_that_fail_at_home_are_refused_at_load() {
+    let (cfg, xml) = one_joint("0", r#"ixx="0" iyy="0" izz="0""#);
+    let e = UrdfArm::new(&cfg, &xml, HOME).err().expect("refused");
+    assert!(
+        e.contains("at home") && e.contains("joint `j` has no inertia about its axis"),
+        "{e}"
+    );
+}

@@ -111,12 +111,13 @@ impl Chain {
     /// The chain of `robot` from `base` to `tip`.
     pub fn new(robot: &Robot, base: &str, tip: &str) -> Result<Chain, Error> {
         let err = |p: String| chain_error(base, tip, p);
-        let index = Index::new(robot)?;
+        // Two scans of the links: a link asked for that is not there says so first.
         for l in [base, tip] {
-            if index.link(l).is_none() {
+            if robot.link(l).is_none() {
                 return Err(err(format!("the robot `{}` has no link `{l}`", robot.name)));
             }
         }
+        let index = Index::new(robot)?;
         let path = path(&index, base, tip)?;
         let mut joints = Vec::new();
         // Each link on the chain: its body (None for the base's) and frame in it.
