@@ -428,9 +428,7 @@ fn a_long_chains_joints_are_listed_short() {
         home: vec![0.0],
         ..panda_cfg()
     };
-    let e = UrdfArm::new(&cfg, &xml, HOME)
-        .err()
-        .expect("home has one value");
+    let e = UrdfArm::new(&cfg, &xml, HOME).expect_err("home has one value");
     assert!(
         e.contains("has 300 joints (j1, j2,") && e.contains("j10, ... and 290 more)"),
         "{e}"
@@ -481,7 +479,7 @@ fn a_failed_dynamics_step_is_counted_and_its_cause_kept() {
 #[test]
 fn dynamics_that_fail_at_home_are_refused_at_load() {
     let (cfg, xml) = one_joint("0", r#"ixx="0" iyy="0" izz="0""#);
-    let e = UrdfArm::new(&cfg, &xml, HOME).err().expect("refused");
+    let e = UrdfArm::new(&cfg, &xml, HOME).expect_err("refused");
     assert!(
         e.contains("at home") && e.contains("joint `j` has no inertia about its axis"),
         "{e}"
