@@ -28,6 +28,7 @@ mod pose;
 mod recordings;
 mod records;
 mod ros2;
+mod ros2_inputs;
 mod scheduling;
 mod signals;
 mod slurm;

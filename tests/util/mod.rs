@@ -114,11 +114,11 @@ impl Sandbox {
         output_within(self.command(args), LIMIT)
     }
 
-    /// `tactile run SCENARIO --out OUT --prefix PREFIX -q`; asserts success and that no
-    /// process of the run survives.
-    pub fn run(&self, scenario: &Path, out: &str) -> Output {
+    /// `tactile run SCENARIO --out OUT --prefix PREFIX -q` (OUT relative to the
+    /// sandbox), whatever its outcome.
+    pub fn try_run(&self, scenario: &Path, out: &str) -> Output {
         let out_dir = self.path(out);
-        let o = self.tactile(&[
+        self.tactile(&[
             "run",
             scenario.to_str().expect("utf-8 path"),
             "--out",
@@ -126,7 +126,12 @@ impl Sandbox {
             "--prefix",
             &self.prefix,
             "-q",
-        ]);
+        ])
+    }
+
+    /// [`Sandbox::try_run`]; asserts success and that no process of the run survives.
+    pub fn run(&self, scenario: &Path, out: &str) -> Output {
+        let o = self.try_run(scenario, out);
         assert!(
             o.status.success(),
             "tactile run failed: {}\nstdout:\n{}\nstderr:\n{}",

@@ -19,8 +19,8 @@ mod master;
 mod network;
 mod operator;
 pub mod overrides;
-pub mod shown;
 mod ros;
+pub mod shown;
 mod slave;
 mod validate;
 mod watch;
@@ -173,8 +173,10 @@ impl Scenario {
         s
     }
 
-    /// The paths of every file the scenario reads (a trajectory, recorded networks):
-    /// the one list a run's output copies and a rerun resolves.
+    /// The paths of every file the scenario reads (a trajectory, recorded networks, an
+    /// arm's URDF, a device's gimbal URDF): the one list that `tactile run` checks as
+    /// its inputs, resolves against the scenario's folder and copies into the run's
+    /// `inputs/`, so a file missing here would be read from the wrong folder.
     pub fn input_paths_mut(&mut self) -> Vec<&mut String> {
         let mut v = Vec::new();
         if let Operator::Csv { path, .. } = &mut self.operator {
@@ -183,12 +185,21 @@ impl Scenario {
         if let Some(arm) = &mut self.slave.arm {
             v.push(&mut arm.urdf);
         }
+        if let Some(g) = &mut self.master.ros2.gimbal {
+            v.push(&mut g.urdf);
+        }
         for c in [&mut self.network.forward, &mut self.network.backward] {
             if let Some(r) = &mut c.replay {
                 v.push(&mut r.path);
             }
         }
         v
+    }
+
+    /// The paths of [`Scenario::input_paths_mut`], as written.
+    pub fn input_paths(&self) -> Vec<String> {
+        let mut s = self.clone();
+        s.input_paths_mut().into_iter().map(|p| p.clone()).collect()
     }
 
     /// The scenario with input paths inside `dir` made relative to it: a run's

@@ -63,3 +63,20 @@ fn joint_names_must_differ() {
     let e = d.validate().expect_err("duplicate");
     assert!(e.to_string().contains("master.ros2.joints[2]"), "{e}");
 }
+
+/// A device's gimbal URDF is an input like an arm's: made absolute against the
+/// scenario's folder (never the run's output folder) and listed for the run's
+/// `inputs/` (issue 51: it was left out, and `tactile run` read it from `--out`).
+#[test]
+fn a_gimbal_urdf_is_an_input_resolved_against_the_scenarios_folder() {
+    let text = "[master]\nbackend = \"ros2\"\n[master.ros2]\n\
+                gimbal = { urdf = \"../devices/omni.urdf\", base = \"base\", tip = \"stylus\" }\n";
+    let sc: crate::Scenario = toml::from_str(text).expect("scenario");
+    assert_eq!(sc.input_paths(), vec!["../devices/omni.urdf".to_string()]);
+    let r = sc.resolved(std::path::Path::new("/lab/scenarios"));
+    let g = r.master.ros2.gimbal.as_ref().expect("gimbal");
+    assert_eq!(g.urdf, "/lab/scenarios/../devices/omni.urdf");
+    let back = r.relative_to(std::path::Path::new("/lab/scenarios/.."));
+    let g = back.master.ros2.gimbal.as_ref().expect("gimbal");
+    assert_eq!(g.urdf, "devices/omni.urdf");
+}

@@ -9,7 +9,7 @@ use tactile_messages::Role;
 use tactile_report::write::REPORT_FILES;
 use tactile_runtime::files::{self, same_file};
 use tactile_scenario::overrides::Set;
-use tactile_scenario::{Operator, Scenario};
+use tactile_scenario::Scenario;
 
 /// The paper scenario, built into the executable so `tactile run` works from any folder.
 pub const PAPER_SCENARIO: &str = include_str!("../../scenarios/paper.toml");
@@ -99,20 +99,7 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
             .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     }
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
-    for c in [&scenario.network.forward, &scenario.network.backward] {
-        if let Some(r) = &c.replay {
-            inputs.push(base_dir.join(&r.path));
-        }
-    }
-    if let Operator::Csv { path, .. } = &scenario.operator {
-        inputs.push(base_dir.join(path));
-    }
-    if let Some(arm) = &scenario.slave.arm {
-        inputs.push(base_dir.join(&arm.urdf));
-    }
-    if let Some(g) = &scenario.master.ros2.gimbal {
-        inputs.push(base_dir.join(&g.urdf));
-    }
+    inputs.extend(scenario.input_paths().iter().map(|p| base_dir.join(p)));
     Ok(Loaded {
         scenario,
         base_dir,
