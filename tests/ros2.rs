@@ -165,7 +165,7 @@ fn device_csv(sb: &Sandbox, joints: &[[f64; 4]]) {
 
 /// The stand-in device on `/phantom/...` in ROS domain `domain`, listening on `port`,
 /// playing `device.csv`, with `extra` arguments (junk, silence, its end).
-fn device_standin(sb: &Sandbox, domain: u32, port: u16, extra: &[&str]) -> Child {
+pub(crate) fn device_standin(sb: &Sandbox, domain: u32, port: u16, extra: &[&str]) -> Child {
     let (domain, listen) = (domain.to_string(), format!("tcp/127.0.0.1:{port}"));
     let mut args = vec![
         "device",

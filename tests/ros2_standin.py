@@ -6,7 +6,9 @@ independent of Tactile's, for tests/ros2.rs.
 
   device: publishes sensor_msgs/JointState at 1 kHz along a trajectory (CSV of t and
           the driver's joint values), reads the WrenchStamped forces back; at set
-          times publishes junk, then goes silent. Its clock starts at the first force.
+          times publishes junk, or forged samples (another type hash, no or a short
+          attachment, a joint named twice), then goes silent; with --humble on
+          Humble's key (TypeHashNotSupported). Its clock starts at the first force.
   robot:  follows Float64MultiArray joint commands with first-order dynamics and
           publishes its JointState at 1 kHz.
   viewer: RViz started after the run began: once the run's /tf flows it waits, then
@@ -64,8 +66,11 @@ def dds(ty):
     return f"{pkg}::{kind}::dds_::{name}_"
 
 
-def key(domain, topic, ty):
-    return f"{domain}/{topic.strip('/')}/{dds(ty)}/{TS.hash_rihs01(ty)}"
+HUMBLE = "TypeHashNotSupported"  # Humble's rmw_zenoh: no type hashes
+
+
+def key(domain, topic, ty, hash_=None):
+    return f"{domain}/{topic.strip('/')}/{dds(ty)}/{hash_ or TS.hash_rihs01(ty)}"
 
 
 def ty_of_key(k):
@@ -95,15 +100,15 @@ class Node:
             f"@ros2_lv/{domain}/{self.zid}/0/0/NN/%/%/{name}")]
         self.bad_attachments = []
 
-    def token(self, kind, topic, ty):
+    def token(self, kind, topic, ty, hash_=None):
         k = (f"@ros2_lv/{self.domain}/{self.zid}/0/{self.eid}/{kind}/%/%/{self.name}/"
-             f"{topic.replace('/', '%')}/{dds(ty)}/{TS.hash_rihs01(ty)}/::,10:,:,:,,")
+             f"{topic.replace('/', '%')}/{dds(ty)}/{hash_ or TS.hash_rihs01(ty)}/::,10:,:,:,,")
         self.eid += 1
         self.tokens.append(self.s.liveliness().declare_token(k))
 
-    def publisher(self, topic, ty):
-        self.token("MP", topic, ty)
-        pub = self.s.declare_publisher(key(self.domain, topic, ty))
+    def publisher(self, topic, ty, hash_=None):
+        self.token("MP", topic, ty, hash_)
+        pub = self.s.declare_publisher(key(self.domain, topic, ty, hash_))
         gid = bytes((self.eid * 7 + i) % 256 for i in range(16))
         seq = [0]
 
@@ -253,8 +258,9 @@ def device(a):
             if line.strip() and not line.startswith("t")]
     names = a.names.split(",")
     publish_names = [a.extra_joint] + names[::-1]  # another order, one more joint
-    put_joints = node.publisher(a.joint_topic, JOINT_STATE)
+    put_joints = node.publisher(a.joint_topic, JOINT_STATE, HUMBLE if a.humble else None)
     raw_pub = node.s.declare_publisher(key(a.domain, a.joint_topic, JOINT_STATE))
+    send_forged, forged = forger(node, a, raw_pub, names, publish_names)
     forces = []
     first = {}
 
@@ -307,6 +313,8 @@ def device(a):
         if t0 is not None and a.junk_at <= t and sum(junk.values()) < 4 * a.junk_each:
             send_junk(["bytes", "nan", "missing", "range"][sum(junk.values()) % 4])
         values = interpolate(rows, t)
+        if t0 is not None and send_forged(t, values):
+            return True
         put_joints(joint_state(publish_names, [0.0] + list(values)[::-1]))
         return True
 
@@ -319,6 +327,7 @@ def device(a):
         "forces": forces,
         "silent_from": state["silent_from"],
         "junk": junk,
+        "forged": forged,
         "tokens": state["tokens"],
         "bad_attachments": node.bad_attachments,
         "live": live,
@@ -329,6 +338,47 @@ def device(a):
     with open(a.report, "w") as f:
         json.dump(report, f)
     node.s.close()
+
+
+FORGED = ["hash", "noattach", "short", "dup"]
+
+
+def forger(node, a, raw_pub, names, publish_names):
+    """From --forge-at, --forge-each samples of each FORGED kind, the kinds 1.1 s
+    apart (each the first dropped of its second in the node's log): JointStates whose
+    first joint is 0.5 driver units off the trajectory, on another type hash's key (a
+    valid attachment), on the right key without an attachment or with 20 bytes of
+    one, or naming that joint twice, the wrong value first. After each, 15 ms without
+    a good message, so a forged one taken would be the newest at a tick."""
+    other = node.s.declare_publisher(key(a.domain, a.joint_topic, JOINT_STATE, "RIHS01_" + "0" * 64))
+    forged = {k: 0 for k in FORGED}
+    quiet = {"until": 0.0}
+
+    def send(t, values):
+        if t < quiet["until"]:
+            return True
+        k = int((t - a.forge_at) / 1.1) if t >= a.forge_at else len(FORGED)
+        if k >= len(FORGED) or forged[FORGED[k]] >= a.forge_each:
+            return False
+        kind = FORGED[k]
+        good = [0.0] + list(values)[::-1]  # publish_names' order: names[0] is last
+        bad = good[:-1] + [good[-1] + 0.5]
+        cdr = bytes(TS.serialize_cdr(joint_state(publish_names, bad), JOINT_STATE))
+        att = z_serialize((Int64(1), Int64(time.time_ns()), bytes(16)))
+        if kind == "hash":
+            other.put(cdr, attachment=att)
+        elif kind == "noattach":
+            raw_pub.put(cdr)
+        elif kind == "short":
+            raw_pub.put(cdr, attachment=att.to_bytes()[:20])
+        else:
+            twice = joint_state([names[0]] + publish_names, [bad[-1]] + good)
+            raw_pub.put(bytes(TS.serialize_cdr(twice, JOINT_STATE)), attachment=att)
+        forged[kind] += 1
+        quiet["until"] = t + 0.015
+        return True
+
+    return send, forged
 
 
 def robot(a):
@@ -600,6 +650,10 @@ def main():
     d.add_argument("--junk-at", type=float, default=1e9)
     d.add_argument("--junk-each", type=int, default=0)
     d.add_argument("--silent-at", type=float, default=1e9)
+    d.add_argument("--forge-at", type=float, default=1e9)
+    d.add_argument("--forge-each", type=int, default=0)
+    d.add_argument("--humble", action="store_true",
+                   help="publish the joint states on Humble's key (TypeHashNotSupported)")
     d.add_argument("--end-after", type=float, required=True)
     d.add_argument("--live", action="store_true")
     r = sub.choices["robot"]

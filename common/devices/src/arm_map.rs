@@ -51,7 +51,7 @@ impl ArmJointMap {
 
     /// The chain's joint values from a CDR `JointState`.
     pub fn positions_cdr(&self, cdr: &[u8]) -> Result<Vec<f64>, Reject> {
-        self.positions(&JointState::from_cdr(cdr)?)
+        self.positions(&crate::map::joint_state_cdr(cdr)?)
     }
 
     /// The chain's joint values from a `JointState`, in the chain's order.
@@ -185,6 +185,13 @@ mod tests {
         assert_eq!(
             m.positions(&js),
             Err(Reject::Missing("panda_joint7".into()))
+        );
+        // A joint named twice drops the message (issue 51).
+        js.name.push("panda_joint6".into());
+        js.position.push(0.3);
+        assert_eq!(
+            m.positions_cdr(&js.to_cdr()),
+            Err(Reject::DuplicateJoint("panda_joint6".into()))
         );
     }
 

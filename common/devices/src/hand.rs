@@ -99,7 +99,7 @@ pub const POSE_RANGE: f64 = 2.0;
 /// A joint device's reading from a CDR `JointState`: three joints through `map`, and
 /// with a `gimbal` the orientation.
 pub fn joints_cdr(map: &JointMap, gimbal: Option<&Gimbal>, cdr: &[u8]) -> Result<Hand, Reject> {
-    let js = JointState::from_cdr(cdr)?;
+    let js = crate::map::joint_state_cdr(cdr)?;
     Ok(Hand {
         point: map.angles(&js)?,
         rotation: gimbal.map(|g| g.read(&js)).transpose()?,
@@ -146,9 +146,17 @@ pub fn clutch_cdr(cfg: &ClutchConfig, cdr: &[u8]) -> Result<bool, Reject> {
         }
         ClutchConfig::OmniButton { button, .. } => {
             let b = OmniButtonEvent::from_cdr(cdr)?;
+            for (field, value) in [
+                ("grey_button", b.grey_button),
+                ("white_button", b.white_button),
+            ] {
+                if value != 0 && value != 1 {
+                    return Err(Reject::BadButton { field, value });
+                }
+            }
             Ok(match button {
-                OmniButton::Grey => b.grey_button != 0,
-                OmniButton::White => b.white_button != 0,
+                OmniButton::Grey => b.grey_button == 1,
+                OmniButton::White => b.white_button == 1,
             })
         }
     }

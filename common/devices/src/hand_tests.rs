@@ -134,3 +134,65 @@ fn each_force_message_carries_the_force() {
         );
     }
 }
+
+/// omni_msgs/OmniButtonEvent's buttons are int32, 1 pressed and 0 released: any
+/// other value (7, -1, 2^31 as the int32 it wraps to) is dropped, on either button,
+/// rather than read as pressed (issue 51).
+#[test]
+fn a_button_other_than_0_or_1_is_dropped() {
+    let ev = |grey, white| {
+        OmniButtonEvent {
+            grey_button: grey,
+            white_button: white,
+        }
+        .to_cdr()
+    };
+    let c = ClutchConfig::OmniButton {
+        topic: "/phantom/button".into(),
+        button: OmniButton::Grey,
+    };
+    assert_eq!(clutch_cdr(&c, &ev(0, 1)), Ok(false));
+    for bad in [7, -1, i32::MIN, 2] {
+        assert_eq!(
+            clutch_cdr(&c, &ev(bad, 0)),
+            Err(Reject::BadButton {
+                field: "grey_button",
+                value: bad
+            })
+        );
+        let e = clutch_cdr(&c, &ev(1, bad)).expect_err("white");
+        assert!(e.to_string().contains("white_button is"), "{e}");
+    }
+    // Counted as dropped, the clutch keeping its last good state.
+    let inbox = crate::watch::Inbox::new();
+    inbox.offer(clutch_cdr(&c, &ev(1, 0)), 1);
+    inbox.offer(clutch_cdr(&c, &ev(7, 0)), 2);
+    assert_eq!(inbox.counts(), (2, 1));
+    assert_eq!(inbox.latest().map(|l| (l.value, l.at_ns)), Some((true, 1)));
+}
+
+/// A JointState naming a joint twice is dropped, whichever reader takes it: the
+/// three joints', the gimbal's, an arm's (issue 51).
+#[test]
+fn a_joint_named_twice_is_dropped_by_every_reader() {
+    let map = JointMap::new(
+        ["waist".into(), "shoulder".into(), "elbow".into()],
+        JointMapConfig::default(),
+    );
+    let good = js(&["waist", "shoulder", "elbow"], &[0.0, 0.1, 0.2]).to_cdr();
+    assert!(map.angles_cdr(&good).is_ok());
+    let twice = js(
+        &["waist", "shoulder", "elbow", "waist"],
+        &[0.0, 0.1, 0.2, 0.5],
+    )
+    .to_cdr();
+    let dup = Reject::DuplicateJoint("waist".into());
+    assert_eq!(map.angles_cdr(&twice), Err(dup.clone()));
+    assert_eq!(joints_cdr(&map, None, &twice), Err(dup));
+    // Another joint than the three named, repeated: still not a well-defined state.
+    let other = js(&["yaw", "waist", "shoulder", "elbow", "yaw"], &[0.0; 5]).to_cdr();
+    assert_eq!(
+        map.angles_cdr(&other),
+        Err(Reject::DuplicateJoint("yaw".into()))
+    );
+}

@@ -7,6 +7,7 @@
 //! [`live_view`], behind the `zenoh` feature). The judgements are pure and always
 //! built; the I/O only with Zenoh.
 
+pub mod admit;
 pub mod arm_map;
 pub mod gate;
 pub mod hand;

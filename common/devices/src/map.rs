@@ -36,10 +36,41 @@ pub enum Reject {
     /// A pose that is not one: not finite, or an orientation that is not a rotation.
     #[error("not a pose: {0}")]
     BadPose(String),
+    /// A sample on the topic's name whose key carries another type's hash.
+    #[error(
+        "type hash {0} is not the topic type's (its RIHS01 hash, or Humble's TypeHashNotSupported)"
+    )]
+    WrongType(String),
+    /// A sample without rmw_zenoh's attachment, or with a malformed one.
+    #[error("rmw_zenoh's attachment: {0}")]
+    Attachment(String),
+    /// A `JointState` naming a joint twice: which of its values holds is undefined.
+    #[error("joint {0:?} is named twice")]
+    DuplicateJoint(String),
+    /// A button's value that is neither 0 (released) nor 1 (pressed).
+    #[error("{field} is {value}: a button is 0 or 1")]
+    BadButton {
+        /// The message's field.
+        field: &'static str,
+        /// Its value.
+        value: i32,
+    },
     /// A force in a frame the arm's URDF does not have (it cannot be turned into the
     /// base's).
     #[error("force in frame {0:?}, which is not a link of the arm's URDF")]
     UnknownFrame(String),
+}
+
+/// A CDR `JointState`, decoded, each joint named once (ROS 2 leaves a repeated name
+/// undefined; a driver does not send one).
+pub fn joint_state_cdr(cdr: &[u8]) -> Result<JointState, Reject> {
+    let js = JointState::from_cdr(cdr)?;
+    let mut names: Vec<&str> = js.name.iter().map(String::as_str).collect();
+    names.sort_unstable();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        return Err(Reject::DuplicateJoint(w[0].to_string()));
+    }
+    Ok(js)
 }
 
 /// The position of the joint `name` in a `JointState` (any order, other joints
@@ -72,7 +103,7 @@ impl JointMap {
 
     /// The paper's angles from a CDR `JointState`.
     pub fn angles_cdr(&self, cdr: &[u8]) -> Result<[f64; 3], Reject> {
-        self.angles(&JointState::from_cdr(cdr)?)
+        self.angles(&joint_state_cdr(cdr)?)
     }
 
     /// The paper's angles from a `JointState`: theta = sign raw unit + offset.

@@ -3,14 +3,19 @@
 //! expressions and attachments are rmw_zenoh's (`tactile_ros::rmw`), so ROS 2 tools and
 //! drivers on rmw_zenoh and Tactile's nodes see each other.
 //!
-//! Subscriptions take any type hash (`<domain>/<topic>/<type>/*`): a Jazzy driver's
+//! Subscriptions listen on `<domain>/<topic>/<type>/*` and take a Jazzy driver's
 //! RIHS01 hash and a Humble one's `TypeHashNotSupported` alike, the message layouts
-//! being the same. Publishers use the exact Jazzy key, as Jazzy subscribers expect.
+//! being the same; a sample of any other hash, or without rmw_zenoh's attachment, is
+//! dropped and counted ([`crate::admit`]). Publishers use the exact Jazzy key, as
+//! Jazzy subscribers expect.
 //! Publications do not wait: congestion control `Drop` with no wait before dropping,
 //! like ROS 2 sensor streams.
 
-use crate::RosError;
+use crate::admit::admit;
+use crate::watch::Inbox;
+use crate::{Reject, RosError};
 use std::sync::atomic::{AtomicI64, AtomicU32, Ordering};
+use std::sync::Arc;
 use tactile_ros::rmw::{self, Attachment, EntityKind, NodeId};
 use tactile_scenario::RosConfig;
 use zenoh::liveliness::LivelinessToken;
@@ -204,24 +209,31 @@ impl RosNode {
         Ok(RosLatched { publisher, id })
     }
 
-    /// Calls `on(payload, arrival ns on CLOCK_MONOTONIC)` for every message of `ty` on
-    /// `topic`, from Zenoh's threads.
-    pub fn subscribe(
+    /// Offers `inbox` every message of `ty` on `topic`, from Zenoh's threads, as
+    /// `decode` reads its CDR payload, with its arrival (ns on CLOCK_MONOTONIC); a
+    /// sample of another type hash or without rmw_zenoh's attachment is offered as its
+    /// rejection, never decoded.
+    pub fn subscribe<T: Clone + Send + 'static>(
         &self,
         topic: &str,
-        ty: &str,
-        on: impl Fn(&[u8], u64) + Send + Sync + 'static,
+        ty: &'static str,
+        inbox: &Arc<Inbox<T>>,
+        decode: impl Fn(&[u8]) -> Result<T, Reject> + Send + Sync + 'static,
     ) -> Result<RosSubscription, RosError> {
         let dds = rmw::dds_type(ty).ok_or_else(|| err(topic, format!("bad type {ty}")))?;
         let name = topic.trim_matches('/');
         let key = format!("{}/{name}/{dds}/*", self.id.domain);
         let (_, token) = self.token(EntityKind::Subscription, topic, ty, &rmw::qos_reliable(10))?;
+        let fill = Arc::clone(inbox);
         let sub = self
             .session
             .declare_subscriber(key)
             .callback(move |sample| {
                 let at = tactile_messages::clock::now_ns();
-                on(&sample.payload().to_bytes(), at);
+                let attachment = sample.attachment().map(|a| a.to_bytes());
+                let got = admit(ty, sample.key_expr().as_str(), attachment.as_deref())
+                    .and_then(|()| decode(&sample.payload().to_bytes()));
+                fill.offer(got, at);
             })
             .wait()
             .map_err(|e| err(&format!("subscribing to {topic}"), e))?;

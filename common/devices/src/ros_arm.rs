@@ -61,25 +61,17 @@ impl RosArm {
         let map = ArmJointMap::of(chain);
         let tree = Arc::new(tree);
         let joints = Inbox::new();
-        let fill = Arc::clone(&joints);
         let m = map.clone();
+        let decode = move |cdr: &[u8]| m.positions_cdr(cdr);
         let mut subs =
-            vec![
-                node.subscribe(&cfg.joint_states, JointState::TYPE, move |cdr, at| {
-                    fill.offer(m.positions_cdr(cdr), at);
-                })?,
-            ];
+            vec![node.subscribe(&cfg.joint_states, JointState::TYPE, &joints, decode)?];
         let wrench = if cfg.wrench_topic.is_empty() {
             None
         } else {
             let inbox = Inbox::new();
-            let fill = Arc::clone(&inbox);
             let (t, base) = (Arc::clone(&tree), chain.base.clone());
-            subs.push(
-                node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, move |cdr, at| {
-                    fill.offer(framed_force_cdr(cdr, &t, &base), at);
-                })?,
-            );
+            let decode = move |cdr: &[u8]| framed_force_cdr(cdr, &t, &base);
+            subs.push(node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, &inbox, decode)?);
             Some(inbox)
         };
         let ty = match cfg.command {

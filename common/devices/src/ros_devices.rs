@@ -22,9 +22,8 @@ fn joints_in(
     map: JointMap,
 ) -> Result<(Inbox3, RosSubscription), RosError> {
     let inbox = Inbox::new();
-    let fill = Arc::clone(&inbox);
-    let sub = node.subscribe(topic, JointState::TYPE, move |cdr, at| {
-        fill.offer(map.angles_cdr(cdr), at);
+    let sub = node.subscribe(topic, JointState::TYPE, &inbox, move |cdr| {
+        map.angles_cdr(cdr)
     })?;
     Ok((inbox, sub))
 }
@@ -58,12 +57,7 @@ impl RosRobot {
             None
         } else {
             let inbox = Inbox::new();
-            let fill = Arc::clone(&inbox);
-            subs.push(
-                node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, move |cdr, at| {
-                    fill.offer(force_cdr(cdr), at);
-                })?,
-            );
+            subs.push(node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, &inbox, force_cdr)?);
             Some(inbox)
         };
         Ok(RosRobot {

@@ -52,19 +52,15 @@ impl RosHapticDevice {
     ) -> Result<Self, RosError> {
         let t_s = t_s_ns as f64 * 1e-9;
         let hand = Inbox::new();
-        let fill = Arc::clone(&hand);
         let (topic, sub) = match cfg.input {
             HandInput::Joints => {
                 let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
-                let sub = node.subscribe(&cfg.joint_states, JointState::TYPE, move |cdr, at| {
-                    fill.offer(joints_cdr(&map, gimbal.as_ref(), cdr), at);
-                })?;
+                let decode = move |cdr: &[u8]| joints_cdr(&map, gimbal.as_ref(), cdr);
+                let sub = node.subscribe(&cfg.joint_states, JointState::TYPE, &hand, decode)?;
                 (cfg.joint_states.clone(), sub)
             }
             HandInput::Pose => {
-                let sub = node.subscribe(&cfg.pose_topic, PoseStamped::TYPE, move |cdr, at| {
-                    fill.offer(pose_cdr(cdr), at);
-                })?;
+                let sub = node.subscribe(&cfg.pose_topic, PoseStamped::TYPE, &hand, pose_cdr)?;
                 (cfg.pose_topic.clone(), sub)
             }
         };
@@ -73,11 +69,8 @@ impl RosHapticDevice {
             None => None,
             Some((t, ty)) => {
                 let inbox = Inbox::new();
-                let fill = Arc::clone(&inbox);
                 let c = cfg.clutch.clone();
-                subs.push(node.subscribe(t, ty, move |cdr, at| {
-                    fill.offer(clutch_cdr(&c, cdr), at);
-                })?);
+                subs.push(node.subscribe(t, ty, &inbox, move |cdr| clutch_cdr(&c, cdr))?);
                 Some(inbox)
             }
         };

@@ -70,6 +70,16 @@ pub const TYPE_HASHES: &[(&str, &str)] = &[
     ),
 ];
 
+/// What Humble's rmw_zenoh writes where a type hash goes (Humble has none; its
+/// messages' layouts are Jazzy's).
+pub const HUMBLE_HASH: &str = "TypeHashNotSupported";
+
+/// True if `hash`, the last chunk of a sample's key, is one `ty` is published under:
+/// its RIHS01 hash, or Humble's [`HUMBLE_HASH`].
+pub fn hash_accepted(ty: &str, hash: &str) -> bool {
+    hash == HUMBLE_HASH || type_hash(ty) == Some(hash)
+}
+
 /// The RIHS01 hash of `ty` (`pkg/msg/Type`).
 pub fn type_hash(ty: &str) -> Option<&'static str> {
     TYPE_HASHES.iter().find(|(t, _)| *t == ty).map(|(_, h)| *h)
