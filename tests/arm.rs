@@ -283,3 +283,119 @@ fn a_report_whose_urdf_is_gone_says_so_and_loses_nothing_else() {
         std::fs::read_to_string(sb.path("b").join("joints.csv")).expect("b")
     );
 }
+
+/// example-robot-data's folder of robots (tests/pin_reference.py finds it), or None
+/// when Pinocchio's wheels are not installed.
+fn example_robots() -> Option<PathBuf> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/pin_reference.py");
+    let o = std::process::Command::new("python3")
+        .arg(script)
+        .arg("--robots-dir")
+        .output()
+        .ok()
+        .filter(|o| o.status.success())?;
+    Some(PathBuf::from(String::from_utf8_lossy(&o.stdout).trim()))
+}
+
+/// Issue 51: Kinova's Jaco2 (example-robot-data's kinova.urdf, whose fixed joints
+/// write `<axis xyz="0 0 0">`) was refused; it loads, and on the Panda's press it
+/// follows the master in free space and feels the wall, within its limits.
+#[test]
+fn a_kinova_jaco2_from_example_robot_data_follows_and_presses_the_wall() {
+    let Some(robots) = example_robots() else {
+        return util::cannot(
+            "python3 lacks pinocchio and example-robot-data (tests/requirements.txt)",
+        );
+    };
+    let urdf = robots.join("kinova_description/robots/kinova.urdf");
+    let sb = Sandbox::new("armjaco");
+    let text = panda_text()
+        .replace(
+            panda_urdf().to_str().expect("utf-8"),
+            urdf.to_str().expect("utf-8"),
+        )
+        .replace("base = \"panda_link0\"", "base = \"base\"")
+        .replace("tip = \"panda_hand\"", "tip = \"j2s6s200_end_effector\"")
+        .replace(
+            "home = [0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796, 0.785398]",
+            // Kinova's home pose of the Jaco2 (kinova-ros), radians.
+            "home = [4.80, 2.92, 1.00, 4.19, 1.44, 1.31]",
+        )
+        .replace(
+            "kp = [600.0, 600.0, 600.0, 600.0, 250.0, 150.0, 50.0]",
+            "kp = [200.0, 300.0, 200.0, 50.0, 50.0, 50.0]",
+        )
+        .replace(
+            "kd = [50.0, 50.0, 50.0, 50.0, 30.0, 25.0, 15.0]",
+            "kd = [10.0, 15.0, 10.0, 2.0, 2.0, 2.0]",
+        );
+    let scenario = sb.write("jaco.toml", &text);
+    sb.simulate(&scenario, "a");
+    let trace = sb.trace("a");
+    let (worst, free) = util::free_space_error(&trace, 0);
+    assert!(worst < 1e-3, "tool {worst} m from its target");
+    assert!(free > 1000, "{free} samples in free space");
+    let h3 = column(&trace, "h_3");
+    // Softer gains than the Panda's (the Jaco2's motors give 20 to 80 N m): the
+    // wall's force comes back, 4.9 N here against the Panda's 6.7 N.
+    let h_max = h3.iter().copied().fold(0.0, f64::max);
+    assert!(h_max > 3.0, "largest wall force {h_max} N");
+    eprintln!("jaco2: free space within {worst} m over {free} samples; the wall {h_max} N");
+    let c = &sb.json("a", "summary.json")["slave"]["counters"];
+    assert_eq!(c["ik_clamped"], 0, "{c}");
+    assert_eq!(c["rejected"], 0, "{c}");
+}
+
+/// Issue 51: URDFs that mean nothing physical were taken, and the runs went on
+/// (negative damping pushed the operator at the force limit; a cycle had no root;
+/// an inertia of 1e300 froze the arm; a scale of 1e-300 sent 8e301 N). Each is
+/// refused before anything starts, naming the element and the field.
+#[test]
+fn an_unphysical_urdf_or_scale_is_named_and_nothing_starts() {
+    let sb = Sandbox::new("armunphys");
+    let urdf = std::fs::read_to_string(panda_urdf()).expect("urdf");
+    let cycle = "<joint name=\"back\" type=\"fixed\"><parent link=\"panda_hand\"/><child link=\"panda_link0\"/></joint></robot>";
+    let cases: [(&str, &str, &str); 6] = [
+        (
+            "damping=\"0.003\"",
+            "damping=\"-0.5\"",
+            "joint `panda_joint1`: dynamics damping: -0.5 is negative",
+        ),
+        (
+            "xyz=\"0 0 0.333\"",
+            "xyz=\"0 0 1e308\"",
+            "joint `panda_joint1`: origin xyz: 1e308 m is further than",
+        ),
+        (
+            "<mass value=\"0.629769\"/>",
+            "<mass value=\"1e300\"/>",
+            "link `panda_link0`: mass value: 1e300 kg is outside",
+        ),
+        (
+            "ixx=\"0.70337\"",
+            "ixx=\"-0.70337\"",
+            "link `panda_link1`: inertia: principal moments",
+        ),
+        (
+            "effort=\"87.0\"",
+            "effort=\"0\"",
+            "joint `panda_joint1` has effort 0",
+        ),
+        ("</robot>", cycle, "its joints form a cycle"),
+    ];
+    for (k, (from, to, want)) in cases.iter().enumerate() {
+        assert!(urdf.contains(from), "case {k}: {from}");
+        let bad = sb.write(&format!("bad{k}.urdf"), &urdf.replacen(from, to, 1));
+        let text = panda_text().replace(
+            panda_urdf().to_str().expect("utf-8"),
+            bad.to_str().expect("utf-8"),
+        );
+        sb.assert_refused(k, &text, want);
+    }
+    let scale = panda_text().replace("[slave.arm]", "[slave.arm]\nscale = 1e-300");
+    sb.assert_refused(
+        6,
+        &scale,
+        "field `slave.arm.scale`: 1e-300 is outside [0.001, 100]",
+    );
+}

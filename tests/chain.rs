@@ -1,6 +1,7 @@
 //! tactile-chain against Pinocchio (the `pin` wheel, an independent implementation)
-//! on three arms of example-robot-data read from their own URDFs: the Panda (7
-//! joints, fingers locked), the UR5 (6) and the xArm7 (7). FK and the Jacobian at
+//! on the arms of example-robot-data read from their own URDFs: the Panda (7 joints,
+//! fingers locked), the UR3, UR5 and UR10 (6), the xArm7 (7), Kinova's Jaco2 (6, three
+//! continuous), Unitree's Z1 (6) and the SO-101 (5). FK and the Jacobian at
 //! random configurations to 1e-9, ABA's accelerations to 1e-9 relative, RNEA's
 //! efforts likewise (tests/pin_reference.py makes the reference).
 
@@ -113,14 +114,16 @@ fn check_arm(arm: &Value) -> [f64; 4] {
 }
 
 #[test]
-fn kinematics_and_dynamics_equal_pinocchios_on_the_panda_the_ur5_and_the_xarm7() {
+fn kinematics_and_dynamics_equal_pinocchios_on_every_arm_of_example_robot_data() {
     if !pin_ready() {
         return cannot(
             "python3 lacks pinocchio (pin) and example-robot-data (tests/requirements.txt)",
         );
     }
     let reference = reference();
-    for arm in reference["arms"].as_array().expect("arms") {
+    let arms = reference["arms"].as_array().expect("arms");
+    assert_eq!(arms.len(), 8, "every arm of tests/pin_reference.py");
+    for arm in arms {
         let [fk, jac, aba, rnea] = check_arm(arm);
         let name = &arm["name"];
         eprintln!(

@@ -7,7 +7,8 @@
 //!
 //! Vectors follow Pinocchio's order (`[linear; angular]`), so every figure compares
 //! with it entry by entry; the tests do (tests/chain.rs of the workspace, against
-//! `pin` on the Panda, the UR5 and the xArm7).
+//! `pin` on eight arms of example-robot-data: the Panda, the UR3, UR5 and UR10, the
+//! xArm7, the Jaco2, the Z1 and the SO-101).
 //!
 //! The README follows; its examples run as doctests.
 #![doc = include_str!("../README.md")]
