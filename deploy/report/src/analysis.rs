@@ -364,6 +364,12 @@ impl Analysis {
         }
     }
 
+    /// Rows the tracking error was computed from (those with a step of the slave on
+    /// a finite reference).
+    pub fn tracked(&self) -> u64 {
+        self.tracked
+    }
+
     /// Each node's clock domain (empty where it left no record).
     pub fn domains(&self) -> &[String; 3] {
         &self.domains

@@ -3,248 +3,23 @@
 //! The master's record is the spine: one `Sent` per sample, then an `Answer` or a
 //! `Miss`. The emulator's passages and the slave's steps for the same sample number
 //! are matched to it. Every file is read front to back once, each through a look-ahead
-//! window of [`LATE_WINDOW`] samples (the same window inside which the master matches
-//! late answers), so joining a run of any length takes bounded memory. The records may
+//! window of `LATE_WINDOW` samples (the same window inside which the master matches
+//! late answers; [`crate::source`] says what else it bounds), so joining a run of any
+//! length, or a crafted record of any content, takes bounded memory. The records may
 //! come from one folder or one folder per node, as they would from different hosts.
 
+pub use crate::node_log::{NodeLog, MAX_EVENTS};
+use crate::source::Source;
 use crate::trace::{Stamps, TraceRow};
 use crate::Error;
-use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
-use tactile_messages::samples::{stage, LATE_WINDOW};
+use tactile_messages::samples::stage;
 use tactile_messages::Role;
 use tactile_records::emulator::{Direction, EmulatorTotals, Passage};
 use tactile_records::master::{Answer, MasterSample, MasterTotals, Miss, Sent};
 use tactile_records::slave::{ArmJoints, SlaveSample, SlaveTotals, Step};
-use tactile_records::{record_path, Damage, Record, RecordReader, Start, Totals};
-
-/// Events kept per node in the report; further ones are counted, not kept, so a node
-/// that broke a million times still gives a readable report.
-pub const MAX_EVENTS: usize = 200;
-
-/// What one node's record says about the node (everything but the samples).
-#[derive(Debug, Clone)]
-pub struct NodeLog<C> {
-    /// The record file.
-    pub path: PathBuf,
-    /// One `Start` per segment (a restarted node appends a segment) whose start frame
-    /// was read.
-    pub starts: Vec<Start>,
-    /// Segments whose `Start` frame was lost to damage: their records are kept (they
-    /// follow the last whole start, or open the file).
-    pub starts_lost: u64,
-    /// Run tokens the node joined.
-    pub runs: Vec<u64>,
-    /// Events, as `(sample, what)`, at most [`MAX_EVENTS`].
-    pub events: Vec<(u64, String)>,
-    /// Events not kept.
-    pub events_omitted: u64,
-    /// Last counters of each segment.
-    pub counters: Vec<Totals<C>>,
-    /// How each segment ended: the `Stop` reason, or `None` where the file ends
-    /// without one (the node was killed).
-    pub stops: Vec<Option<String>>,
-    /// Highest sample number in the record.
-    pub last_sample: Option<u64>,
-    /// Stretches of the record that held no whole frame (torn by a kill, corrupted),
-    /// skipped: the first few, where and how long.
-    pub damage: Vec<Damage>,
-    /// Bytes and stretches skipped in all.
-    pub damaged: (u64, u64),
-    /// Sample records that matched no sample of the master (outside the window).
-    pub unjoined: u64,
-}
-
-impl<C> Default for NodeLog<C> {
-    fn default() -> Self {
-        NodeLog {
-            path: PathBuf::new(),
-            starts: Vec::new(),
-            starts_lost: 0,
-            runs: Vec::new(),
-            events: Vec::new(),
-            events_omitted: 0,
-            counters: Vec::new(),
-            stops: Vec::new(),
-            last_sample: None,
-            damage: Vec::new(),
-            damaged: (0, 0),
-            unjoined: 0,
-        }
-    }
-}
-
-impl<C: Clone> NodeLog<C> {
-    fn take<S>(&mut self, r: Record<S, C>) -> Option<S> {
-        if self.stops.is_empty() && !matches!(r, Record::Start(_)) {
-            // The file's first frame was damaged: its records still form a segment.
-            self.starts_lost += 1;
-            self.stops.push(None);
-        }
-        match r {
-            Record::Start(s) => {
-                self.starts.push(s);
-                self.stops.push(None);
-            }
-            Record::Run(t) => {
-                if !self.runs.contains(&t) {
-                    self.runs.push(t);
-                }
-            }
-            Record::Sample(s) => return Some(s),
-            Record::Event(e) => {
-                if self.events.len() < MAX_EVENTS {
-                    self.events.push((e.sample, e.what));
-                } else {
-                    self.events_omitted += 1;
-                }
-            }
-            Record::Counters(c) => {
-                // The last counters of the current segment replace the earlier ones.
-                if self.counters.len() < self.segments() {
-                    self.counters.push(c);
-                } else if let Some(last) = self.counters.last_mut() {
-                    *last = c;
-                }
-            }
-            Record::Stop(s) => {
-                if let Some(last) = self.stops.last_mut() {
-                    *last = Some(s.reason);
-                }
-            }
-            // The reader hands a block's samples out one by one: none comes whole.
-            Record::Samples(_) => {}
-        }
-        None
-    }
-
-    /// Segments in the record: one per start, read or lost.
-    pub fn segments(&self) -> usize {
-        self.stops.len()
-    }
-
-    /// Peak RSS over the segments, kB.
-    pub fn peak_rss_kb(&self) -> u64 {
-        self.counters
-            .iter()
-            .map(|c| c.peak_rss_kb)
-            .max()
-            .unwrap_or(0)
-    }
-
-    /// How the node's record ends, in words.
-    pub fn ending(&self) -> String {
-        let last = self
-            .last_sample
-            .map_or("before any sample".to_string(), |n| {
-                format!("after sample {n}")
-            });
-        match self.stops.last() {
-            None => "no start recorded".into(),
-            Some(Some(reason)) => format!("{reason}, {last}"),
-            Some(None) => {
-                format!("record ends {last} without a stop: the node was killed or crashed")
-            }
-        }
-    }
-}
-
-/// One record file read through a look-ahead window, keyed by sample number.
-struct Source<S, C> {
-    reader: Option<RecordReader<Record<S, C>>>,
-    log: NodeLog<C>,
-    ahead: BTreeMap<u64, Vec<S>>,
-    /// Highest key read so far.
-    front: Option<u64>,
-    key: fn(&S) -> Option<u64>,
-}
-
-impl<S, C: Clone + serde::de::DeserializeOwned> Source<S, C>
-where
-    S: serde::de::DeserializeOwned,
-{
-    fn open(path: Option<PathBuf>, key: fn(&S) -> Option<u64>) -> Result<Self, Error> {
-        let mut log = NodeLog::default();
-        let reader = match path {
-            Some(p) => {
-                log.path = p.clone();
-                Some(RecordReader::open(&p).map_err(|e| Error::BadInput(e.to_string()))?)
-            }
-            None => None,
-        };
-        Ok(Source {
-            reader,
-            log,
-            ahead: BTreeMap::new(),
-            front: None,
-            key,
-        })
-    }
-
-    /// Reads until a record past `n + LATE_WINDOW` is in, or the file ends.
-    fn fill_to(&mut self, n: u64) -> Result<(), Error> {
-        while self.front.is_none_or(|f| f <= n + LATE_WINDOW) {
-            let Some(reader) = self.reader.as_mut() else {
-                return Ok(());
-            };
-            let next = reader
-                .next_record()
-                .map_err(|e| Error::Failed(e.to_string()))?;
-            let Some(rec) = next else {
-                self.close();
-                return Ok(());
-            };
-            if let Some(s) = self.log.take(rec) {
-                if let Some(k) = (self.key)(&s) {
-                    self.front = Some(self.front.map_or(k, |f| f.max(k)));
-                    self.log.last_sample = Some(self.log.last_sample.map_or(k, |l| l.max(k)));
-                    self.ahead.entry(k).or_default().push(s);
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// Stops reading, keeping what the reader skipped as damage.
-    fn close(&mut self) {
-        if let Some(reader) = self.reader.take() {
-            self.log.damage = reader.damage().to_vec();
-            self.log.damaged = reader.damaged();
-        }
-    }
-
-    /// True if records of samples after `n` are waiting (a sample missing from the
-    /// record is a gap, not its end).
-    fn has_after(&self, n: u64) -> bool {
-        self.ahead.keys().next_back().is_some_and(|&k| k > n)
-    }
-
-    /// The log as read so far (a join cut short).
-    fn into_log(mut self) -> NodeLog<C> {
-        self.close();
-        self.log
-    }
-
-    /// The records of sample `n`; records of earlier samples are counted as unjoined.
-    fn take(&mut self, n: u64) -> Result<Vec<S>, Error> {
-        self.fill_to(n)?;
-        while let Some(entry) = self.ahead.first_entry() {
-            if *entry.key() >= n {
-                break;
-            }
-            self.log.unjoined += entry.remove().len() as u64;
-        }
-        Ok(self.ahead.remove(&n).unwrap_or_default())
-    }
-
-    /// Reads the rest of the file (for its events and counters).
-    fn finish(mut self) -> Result<NodeLog<C>, Error> {
-        self.fill_to(u64::MAX - LATE_WINDOW)?;
-        self.log.unjoined += self.ahead.values().map(|v| v.len() as u64).sum::<u64>();
-        Ok(self.log)
-    }
-}
+use tactile_records::{record_path, Record, RecordReader, Start};
 
 /// The three nodes' logs after a join.
 #[derive(Debug, Clone)]
@@ -255,6 +30,9 @@ pub struct Logs {
     pub emulator: NodeLog<EmulatorTotals>,
     /// The slave's (empty if it left no record).
     pub slave: NodeLog<SlaveTotals>,
+    /// A stop request ended the join before this sample: the logs hold what was
+    /// read by then.
+    pub stopped_at: Option<u64>,
 }
 
 /// Finds each role's record in `dirs`: every role at most once, the master's required.
@@ -340,6 +118,30 @@ fn master_key(s: &MasterSample) -> Option<u64> {
     })
 }
 
+/// A sample's rows of the master are all in: its `Sent`, and its answer or miss.
+fn master_whole(rows: &mut dyn Iterator<Item = &MasterSample>) -> bool {
+    let (mut sent, mut answered) = (false, false);
+    for r in rows {
+        match r {
+            MasterSample::Sent(_) => sent = true,
+            MasterSample::Answer(_) | MasterSample::Miss(_) => answered = true,
+        }
+    }
+    sent && answered
+}
+
+/// A sample's passages are all in: one each way.
+fn passages_whole(rows: &mut dyn Iterator<Item = &Passage>) -> bool {
+    let (mut forward, mut backward) = (false, false);
+    for p in rows {
+        match p.dir {
+            Direction::Forward => forward = true,
+            Direction::Backward => backward = true,
+        }
+    }
+    forward && backward
+}
+
 fn passage_key(p: &Passage) -> Option<u64> {
     Some(p.n)
 }
@@ -358,8 +160,16 @@ struct MasterPart {
 }
 
 impl MasterPart {
-    /// The master's entries of a sample, or None if its Sent was lost.
-    fn of(items: &[MasterSample]) -> Option<MasterPart> {
+    /// The master's entries of a sample, or None if its Sent was lost; a second
+    /// `Sent` of one sample, or more than an answer and a miss, is counted in
+    /// `duplicates`, the first kept.
+    fn of(items: &[MasterSample], duplicates: &mut u64) -> Option<MasterPart> {
+        let sents = items
+            .iter()
+            .filter(|x| matches!(x, MasterSample::Sent(_)))
+            .count();
+        let answers = items.len() - sents;
+        *duplicates += (sents.saturating_sub(1) + answers.saturating_sub(2)) as u64;
         let mut part = MasterPart {
             sent: items.iter().find_map(|x| match x {
                 MasterSample::Sent(s) => Some(*s),
@@ -452,68 +262,129 @@ struct Sources {
 }
 
 impl Sources {
-    /// The logs so far (`whole`: read to the end, checking what remains).
-    fn logs(self, whole: bool) -> Result<Logs, Error> {
-        let logs = if whole {
+    /// Opens the records found; sample numbers from `limit` on are no sample of the
+    /// run.
+    fn open(found: [Option<PathBuf>; 3], limit: u64) -> Result<Sources, Error> {
+        let [m, e, s] = found;
+        Ok(Sources {
+            master: Source::open(m, limit, (master_key, master_whole))?,
+            emulator: Source::open(e, limit, (passage_key, passages_whole))?,
+            slave: Source::open(s, limit, (slave_key, |rows| rows.next().is_some()))?,
+        })
+    }
+
+    /// True once a stop request came while a record was read.
+    fn stopped(&self) -> bool {
+        self.master.stopped || self.emulator.stopped || self.slave.stopped
+    }
+
+    /// The logs so far (`whole`: read to the end, checking what remains; a stop
+    /// request then still ends the reading, and the logs say where the join was).
+    fn logs(self, at: u64, whole: bool, stop: &dyn Fn() -> bool) -> Result<Logs, Error> {
+        let mut logs = if whole {
             Logs {
-                master: self.master.finish()?,
-                emulator: self.emulator.finish()?,
-                slave: self.slave.finish()?,
+                master: self.master.finish(stop)?,
+                emulator: self.emulator.finish(stop)?,
+                slave: self.slave.finish(stop)?,
+                stopped_at: None,
             }
         } else {
             Logs {
                 master: self.master.into_log(),
                 emulator: self.emulator.into_log(),
                 slave: self.slave.into_log(),
+                stopped_at: Some(at),
             }
         };
+        if whole && stop() {
+            logs.stopped_at = Some(at);
+        }
         check_one_run(&logs)?;
         Ok(logs)
     }
 }
 
+/// The run's sample count, from the first start found (every node records the
+/// scenario's): no sample of the run is numbered from there on. Without a start
+/// (all lost to damage), none is known and no number is refused.
+fn sample_count(found: &[Option<PathBuf>; 3]) -> Result<u64, Error> {
+    Ok(starts(found)?
+        .iter()
+        .flatten()
+        .map(|s| s.samples)
+        .max()
+        .unwrap_or(u64::MAX))
+}
+
+/// The slave's step of a sample, with a URDF arm's joints; further steps of the same
+/// sample are counted in `duplicates`.
+fn step_of<'a>(
+    steps: &'a [SlaveSample],
+    duplicates: &mut u64,
+) -> (Option<Step>, Option<&'a ArmJoints>) {
+    let mut all = steps.iter().filter_map(|x| match x {
+        SlaveSample::Step(s) => Some((Some(*s), None)),
+        SlaveSample::ArmStep(s, j) => Some((Some(*s), Some(&**j))),
+        SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
+    });
+    let first = all.next().unwrap_or((None, None));
+    *duplicates += all.count() as u64;
+    first
+}
+
+/// Samples joined between two looks at the stop request.
+const STOP_EVERY: u64 = 1024;
+
 /// Joins the records found in `dirs`, handing each sample's row to `each` in order,
 /// with a URDF arm's joints where the slave is one and a 6-DoF master's orientation.
-/// `each` may stop the join early (a stop request): the logs then hold what was read
-/// so far.
+/// `each` may stop the join early: the logs then hold what was read so far.
 pub fn join(
     dirs: &[PathBuf],
+    each: impl FnMut(&TraceRow, Option<&ArmJoints>, Option<[f64; 4]>) -> Result<ControlFlow<()>, Error>,
+) -> Result<Logs, Error> {
+    join_until(dirs, &|| false, each)
+}
+
+/// [`join`], looking at `stop` (a stop request) as it reads, however long a record
+/// makes it read: once it says so, the join ends with what it has, and the logs say
+/// at which sample ([`Logs::stopped_at`]).
+pub fn join_until(
+    dirs: &[PathBuf],
+    stop: &dyn Fn() -> bool,
     mut each: impl FnMut(
         &TraceRow,
         Option<&ArmJoints>,
         Option<[f64; 4]>,
     ) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
-    let [m, e, s] = locate(dirs)?;
-    let mut src = Sources {
-        master: Source::open(m, master_key)?,
-        emulator: Source::open(e, passage_key)?,
-        slave: Source::open(s, slave_key)?,
-    };
-    let mut n = 0u64;
+    let found = locate(dirs)?;
+    let limit = sample_count(&found)?;
+    let mut src = Sources::open(found, limit)?;
+    let (mut n, mut turn) = (0u64, 0u64);
     loop {
-        let Some(part) = MasterPart::of(&src.master.take(n)?) else {
+        turn += 1;
+        let items = src.master.take(n, stop)?;
+        if src.stopped() || (turn % STOP_EVERY == 0 && stop()) {
+            return src.logs(n, false, stop);
+        }
+        let Some(part) = MasterPart::of(&items, &mut src.master.log.duplicates) else {
             // A sample the master's record lost (a damaged stretch): skipped, the
-            // rest joined; past the last one, the end.
-            if src.master.has_after(n) {
-                n += 1;
-                continue;
+            // rest joined from the next sample it holds; past the last one, the end.
+            match src.master.next_after(n) {
+                Some(next) => n = next,
+                None => return src.logs(n, true, stop),
             }
-            return src.logs(true);
+            continue;
         };
-        let passages = src.emulator.take(n)?;
-        let steps = src.slave.take(n)?;
-        let (step, joints) = steps
-            .iter()
-            .find_map(|x| match x {
-                SlaveSample::Step(s) => Some((Some(*s), None)),
-                SlaveSample::ArmStep(s, j) => Some((Some(*s), Some(&**j))),
-                SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
-            })
-            .unwrap_or((None, None));
+        let passages = src.emulator.take(n, stop)?;
+        let steps = src.slave.take(n, stop)?;
+        if src.stopped() {
+            return src.logs(n, false, stop);
+        }
+        let (step, joints) = step_of(&steps, &mut src.slave.log.duplicates);
         let rotation = part.sent.rotation;
         if each(&row(&part, &passages, step.as_ref()), joints, rotation)?.is_break() {
-            return src.logs(false);
+            return src.logs(n, false, stop);
         }
         n += 1;
     }

@@ -1,6 +1,6 @@
 //! The join from records written directly: three hosts' folders with two clock
 //! domains, answers and steps recorded out of order within the look-ahead window, a
-//! record past it, and records of another run.
+//! record past it, one past the run, and records of another run.
 
 use super::*;
 use tactile_messages::samples::Signal;
@@ -118,12 +118,15 @@ fn write_run(root: &Path, slave_run: u64) -> [PathBuf; 3] {
                 .expect("write");
         }
     }
-    let stray = Step {
-        n: N + 5000,
-        ..Step::default()
-    };
-    s.write(&Record::Sample(SlaveSample::Step(stray)))
-        .expect("write");
+    // One step numbered past the run, one of a sample joined long before.
+    for n in [N + 5000, 10] {
+        let stray = Step {
+            n,
+            ..Step::default()
+        };
+        s.write(&Record::Sample(SlaveSample::Step(stray)))
+            .expect("write");
+    }
     dirs
 }
 
@@ -159,10 +162,11 @@ fn records_of_two_clock_domains_join_sample_by_sample_within_the_window() {
     }
     assert_eq!(
         logs.slave.unjoined, 1,
-        "the step past the window joins nothing"
+        "the step of a sample joined before joins nothing"
     );
-    assert_eq!(logs.master.unjoined + logs.emulator.unjoined, 0);
-    assert_eq!(logs.slave.last_sample, Some(N + 5000));
+    assert_eq!(logs.slave.invalid, 1, "the step past the run is no sample");
+    assert_eq!(logs.master.left_out() + logs.emulator.left_out(), 0);
+    assert_eq!(logs.slave.last_sample, Some(N - 1));
 }
 
 #[test]

@@ -108,6 +108,10 @@ pub struct NodeSummary {
     pub ended: String,
     /// Sample records that matched no sample of the master.
     pub unjoined: u64,
+    /// Sample records numbered at or past the run's sample count, dropped.
+    pub invalid: u64,
+    /// Sample records repeating a sample the record already gave, dropped.
+    pub duplicates: u64,
     /// Bytes of its record that held no whole frame (a torn tail, corruption),
     /// skipped; every whole frame around them was read.
     pub damaged_bytes: u64,
@@ -204,6 +208,10 @@ pub struct Summary {
     pub hardware: Option<crate::hardware::HardwareSummary>,
     /// Each node: where it ran, its memory, how its record ends.
     pub nodes: BTreeMap<&'static str, NodeSummary>,
+    /// What the figures leave out: a part of the run they are not computed from
+    /// (rows left out of the join, damaged), or counts of the trace and a node's own
+    /// that disagree. Empty when the figures cover the whole run.
+    pub warnings: Vec<String>,
     /// What happened: processes that died and were restarted, loop breaks, resumes.
     pub events: Vec<String>,
     /// Events left out of `events` (a node keeps at most 200).

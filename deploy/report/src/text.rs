@@ -15,6 +15,10 @@ pub fn render(s: &Summary, out: &Path) -> String {
         "Tactile run {:?}: {:?} at {} Hz, {} arithmetic, {}",
         s.scenario, s.mode, s.rate_hz, s.arithmetic, s.runner
     );
+    // First: a figure below may come from a part of the run only.
+    for w in &s.warnings {
+        let _ = writeln!(t, "warning: {w}");
+    }
     timing(&mut t, s);
     samples(&mut t, s);
     motion(&mut t, s);

@@ -163,6 +163,8 @@ where
         last_sample: log.last_sample,
         ended: log.ending(),
         unjoined: log.unjoined,
+        invalid: log.invalid,
+        duplicates: log.duplicates,
         damaged_bytes: log.damaged.0,
         damaged_stretches: log.damaged.1,
         damage: log.damage.iter().map(|d| [d.offset, d.bytes]).collect(),
@@ -329,6 +331,7 @@ fn summarise(
         emulator,
         slave,
         nodes: nodes(logs),
+        warnings: crate::warnings::warnings(a, logs, scenario.samples, master_totals.counters.sent),
         events: ev,
         events_omitted: omitted,
         failed: launch.failed,
@@ -418,17 +421,29 @@ fn analysis_for(starts: &[Option<Start>; 3]) -> Result<(&'static str, Analysis),
 }
 
 /// Joins the records in `dirs` and writes the report into `out`: summary, trace,
-/// histograms, plots and the scenario as run. Returns the summary.
+/// histograms, plots and the scenario as run. Returns the summary. On any error the
+/// files begun (their partial names) are removed: a folder holds whole files only.
 pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Summary, Error> {
     let (starts, scenario) = recorded(dirs)?;
-    let (runner, mut analysis) = analysis_for(&starts)?;
+    let (runner, analysis) = analysis_for(&starts)?;
     make_out_dir(out)?;
     // Written last: until then the folder holds no summary, so no older one sits beside
     // this report's files if it is cut short.
     remove_if_there(&out.join("summary.json"))?;
+    report_into(dirs, out, launch, &scenario, (runner, analysis)).inspect_err(|_| discard(out))
+}
+
+/// [`write_report`] once the scenario is known and the folder made.
+fn report_into(
+    dirs: &[PathBuf],
+    out: &Path,
+    launch: &Launch,
+    scenario: &Scenario,
+    (runner, mut analysis): (&'static str, Analysis),
+) -> Result<Summary, Error> {
     let t_s = scenario.t_s();
     let mut series = Series::default();
-    let mut streams = Streams::create(out, &scenario, &launch.outputs)?;
+    let mut streams = Streams::create(out, scenario, &launch.outputs)?;
     let warning = streams.warning.clone();
     let stopped = || {
         launch
@@ -437,19 +452,12 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
             .is_some_and(|f| f.load(Ordering::SeqCst))
             || launch.until.is_some_and(|u| Instant::now() >= u)
     };
-    let mut cut_short = None;
-    let logs = join::join(dirs, |row, joints, rotation| {
-        // Looked at every 1024 samples: a clock read per sample would cost.
-        if row.n % 1024 == 0 && stopped() {
-            cut_short = Some(row.n);
-            return Ok(ControlFlow::Break(()));
-        }
+    let logs = join::join_until(dirs, &stopped, |row, joints, rotation| {
         analysis.add(row);
         series.add(row, t_s);
         streams.add(row, joints, rotation)?;
         Ok(ControlFlow::Continue(()))
-    })
-    .inspect_err(|_| discard(out))?;
+    })?;
     streams.finish(out)?;
     analysis.finish();
     figures(out, &analysis, &series)?;
@@ -459,9 +467,9 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
         &out.join("scenario.toml"),
         &scenario.relative_to(&here).to_toml(),
     )?;
-    let mut summary = summarise(&scenario, runner, &analysis, &logs, launch);
+    let mut summary = summarise(scenario, runner, &analysis, &logs, launch);
     summary.events.extend(warning);
-    if let Some(n) = cut_short {
+    if let Some(n) = logs.stopped_at {
         summary.interrupted = true;
         let dirs: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
         summary.events.push(format!(

@@ -1,0 +1,57 @@
+//! What a report must say before its figures are read: where a figure comes from a
+//! part of the run only (a node's rows left out of the join, damaged, numbered past
+//! the run, repeated), and where the trace and a node's own counters disagree. Each is
+//! a line of `warnings` in `summary.json` and a `warning:` line on the terminal.
+
+use crate::analysis::Analysis;
+use crate::join::{Logs, NodeLog};
+use tactile_messages::Role;
+
+/// The warnings of a report from its analysis and the nodes' logs; `samples` is the
+/// run's sample count, `sent` the master's own count of samples sent.
+pub fn warnings(a: &Analysis, logs: &Logs, samples: u64, sent: u64) -> Vec<String> {
+    let mut out = Vec::new();
+    left_out(Role::Master, &logs.master, samples, &mut out);
+    left_out(Role::Emulator, &logs.emulator, samples, &mut out);
+    left_out(Role::Slave, &logs.slave, samples, &mut out);
+    let slave = &logs.slave;
+    let slave_short = !slave.path.as_os_str().is_empty()
+        && (slave.left_out() > 0 || slave.damaged.1 > 0)
+        && a.tracked() < a.rows;
+    if slave_short {
+        out.push(format!(
+            "tracking over {} of {} samples: {} of the slave's rows unjoined, {} invalid, {} duplicates, {} damaged stretches; the slave's columns are empty for the rest",
+            a.tracked(),
+            a.rows,
+            slave.unjoined,
+            slave.invalid,
+            slave.duplicates,
+            slave.damaged.1
+        ));
+    }
+    // A master that stopped wrote its last counters as it ended: they count every
+    // sample it sent (a killed one's are up to a second old, and are not compared).
+    let ended = !logs.master.stops.is_empty() && logs.master.stops.iter().all(Option::is_some);
+    if ended && logs.stopped_at.is_none() && sent != a.rows {
+        out.push(format!(
+            "the trace holds {} samples where the master's own counters say {sent} sent: its record lost or misplaced the rest",
+            a.rows
+        ));
+    }
+    out
+}
+
+/// A node's sample rows the join left out, if any, and why.
+fn left_out<C: Clone>(role: Role, log: &NodeLog<C>, samples: u64, out: &mut Vec<String>) {
+    if log.left_out() == 0 {
+        return;
+    }
+    out.push(format!(
+        "{role}: {} sample rows of {} left out of the join: {} joined no sample of the master (outside its window or out of order), {} numbered past the run's {samples} samples, {} repeated a sample already recorded",
+        log.left_out(),
+        log.path.display(),
+        log.unjoined,
+        log.invalid,
+        log.duplicates
+    ));
+}
