@@ -91,7 +91,10 @@ fn played(t: &Trajectory) -> String {
             if let Some(q) = t.rotation_at(n, t_s) {
                 finite("an orientation", q);
                 let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-                assert!((norm - 1.0).abs() < 1e-9, "sample {n}: orientation {q:?}");
+                // nalgebra's slerp takes sin(h) as sqrt(1 - cos^2 h): between rows
+                // 1e-4 rad apart its result's norm is 1 - 1.9e-9 (the campaign of
+                // docs/12 found it), a rotation to far better than a micrometre.
+                assert!((norm - 1.0).abs() < 1e-6, "sample {n}: orientation {q:?}");
             }
             t.engaged_at(n, t_s);
         }
