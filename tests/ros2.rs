@@ -166,13 +166,18 @@ fn device_csv(sb: &Sandbox, joints: &[[f64; 4]]) {
 /// The stand-in device on `/phantom/...` in ROS domain `domain`, listening on `port`,
 /// playing `device.csv`, with `extra` arguments (junk, silence, its end).
 pub(crate) fn device_standin(sb: &Sandbox, domain: u32, port: u16, extra: &[&str]) -> Child {
-    let (domain, listen) = (domain.to_string(), format!("tcp/127.0.0.1:{port}"));
+    device_standin_on(sb, domain, &format!("tcp/127.0.0.1:{port}"), extra)
+}
+
+/// [`device_standin`] listening on the endpoint `listen`.
+pub(crate) fn device_standin_on(sb: &Sandbox, domain: u32, listen: &str, extra: &[&str]) -> Child {
+    let domain = domain.to_string();
     let mut args = vec![
         "device",
         "--domain",
         &domain,
         "--listen",
-        &listen,
+        listen,
         "--names",
         "waist,shoulder,elbow",
         "--joint-topic",

@@ -83,11 +83,19 @@ def ty_of_key(k):
 class Node:
     """A Zenoh session as an rmw_zenoh node: tokens, publishers with attachments."""
 
-    def __init__(self, name, listen, domain):
+    def __init__(self, name, listen, domain, tls=None):
         c = zenoh.Config()
         c.insert_json5("mode", '"peer"')
         c.insert_json5("scouting/multicast/enabled", "false")
         c.insert_json5("listen/endpoints", json.dumps(listen))
+        if tls:  # mutual TLS as Zenoh's own configuration gives it: CA, certificate, key
+            ca, cert, key = tls.split(",")
+            t = "transport/link/tls"
+            c.insert_json5(f"{t}/root_ca_certificate", json.dumps(ca))
+            for side in ("listen", "connect"):
+                c.insert_json5(f"{t}/{side}_certificate", json.dumps(cert))
+                c.insert_json5(f"{t}/{side}_private_key", json.dumps(key))
+            c.insert_json5(f"{t}/enable_mtls", "true")
         # No shared memory: Tactile's sessions have none, and a stand-in killed at the
         # end of a test would leave its segment in /dev/shm.
         c.insert_json5("transport/shared_memory/enabled", "false")
@@ -253,7 +261,7 @@ def interpolate(rows, t):
 
 
 def device(a):
-    node = Node("touch_standin", a.listen, a.domain)
+    node = Node("touch_standin", a.listen, a.domain, a.tls)
     rows = [[float(x) for x in line.split(",")] for line in open(a.trajectory)
             if line.strip() and not line.startswith("t")]
     names = a.names.split(",")
@@ -643,6 +651,7 @@ def main():
         q.add_argument("--names", required=True)
         q.add_argument("--joint-topic", required=True)
         q.add_argument("--report", required=True)
+        q.add_argument("--tls", default="", help="CA,CERT,KEY (PEM): mutual TLS on tls/ endpoints")
     d = sub.choices["device"]
     d.add_argument("--force-topic", required=True)
     d.add_argument("--trajectory", required=True)

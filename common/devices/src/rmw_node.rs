@@ -18,6 +18,7 @@ use std::sync::atomic::{AtomicI64, AtomicU32, Ordering};
 use std::sync::Arc;
 use tactile_ros::rmw::{self, Attachment, EntityKind, NodeId};
 use tactile_scenario::RosConfig;
+use tactile_transport::zenoh_link::TlsFiles;
 use zenoh::liveliness::LivelinessToken;
 use zenoh::qos::CongestionControl;
 use zenoh::Wait as _;
@@ -33,9 +34,34 @@ pub fn wall_ns() -> u64 {
         .map_or(0, |d| d.as_nanos() as u64)
 }
 
+/// The `[ros.tls]` identity as the loop's Zenoh link takes one, its relative paths
+/// against `base_dir` (the scenario's folder); none without `[ros.tls]`.
+pub fn tls_files(cfg: &RosConfig, base_dir: &std::path::Path) -> Option<TlsFiles> {
+    let t = cfg.tls.as_ref()?;
+    Some(TlsFiles {
+        ca: base_dir.join(&t.ca),
+        cert: base_dir.join(&t.cert),
+        key: base_dir.join(&t.key),
+    })
+}
+
+/// Checks the `[ros.tls]` files before the session opens, as the loop's are checked:
+/// readable, PEM, the key the certificate's, the certificate the CA's; the error
+/// names the field and the file (Zenoh reads them only when a link is made, and would
+/// say nothing).
+pub fn check_tls(cfg: &RosConfig, base_dir: &std::path::Path) -> Result<(), String> {
+    let Some(f) = tls_files(cfg, base_dir) else {
+        return Ok(());
+    };
+    let names = ["ros.tls.ca", "ros.tls.cert", "ros.tls.key"];
+    tactile_transport::tls_files::check_as(&f.ca, &f.cert, &f.key, names)
+}
+
 /// The session's Zenoh configuration: peer mode, the `[ros]` endpoints, no multicast
-/// scouting, otherwise Zenoh's defaults, which rmw_zenoh's router and nodes use (the
-/// loop link's low-latency transport would not connect to them).
+/// scouting, mutual TLS with `[ros.tls]` (the loop link's settings), otherwise Zenoh's
+/// defaults, which rmw_zenoh's router and nodes use (the loop link's low-latency
+/// transport would not connect to them). Relative TLS paths are the working folder's:
+/// a node resolves its scenario first.
 pub fn session_config(cfg: &RosConfig) -> Result<zenoh::Config, RosError> {
     let mut c = zenoh::Config::default();
     let list = |v: &[String]| {
@@ -58,6 +84,9 @@ pub fn session_config(cfg: &RosConfig) -> Result<zenoh::Config, RosError> {
     ] {
         c.insert_json5(key, &value)
             .map_err(|e| err(&format!("ROS 2 Zenoh setting {key} = {value}"), e))?;
+    }
+    if let Some(t) = tls_files(cfg, std::path::Path::new("")) {
+        t.apply(&mut c).map_err(|e| err("ROS 2 TLS (ros.tls)", e))?;
     }
     Ok(c)
 }

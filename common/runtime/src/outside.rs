@@ -35,6 +35,17 @@ pub fn check(sc: &Scenario, role: Role) -> Result<(), NodeError> {
     Ok(())
 }
 
+/// Checks the ROS 2 session's `[ros.tls]` files (relative to `base_dir`) when the run
+/// uses ROS 2: bad input naming the field and the file, before anything starts.
+pub fn check_ros_tls(sc: &Scenario, base_dir: &std::path::Path) -> Result<(), NodeError> {
+    #[cfg(feature = "zenoh")]
+    if ros_in_run(sc) {
+        tactile_devices::rmw_node::check_tls(&sc.ros, base_dir).map_err(NodeError::BadInput)?;
+    }
+    let _ = (sc, base_dir);
+    Ok(())
+}
+
 /// What a node touches besides its link, opened for the run.
 #[derive(Default)]
 pub struct Outside {
@@ -82,7 +93,9 @@ fn open_ros(sc: &Scenario, role: Role, base_dir: &std::path::Path) -> Result<Out
     use tactile_devices::ros_devices::RosRobot;
     use tactile_devices::ros_hand::RosHapticDevice;
     let failed = |e: tactile_devices::RosError| NodeError::Failed(e.to_string());
-    let node = Arc::new(RosNode::open(&sc.ros, &format!("tactile_{role}")).map_err(failed)?);
+    check_ros_tls(sc, base_dir)?;
+    let ros = sc.resolved(base_dir).ros;
+    let node = Arc::new(RosNode::open(&ros, &format!("tactile_{role}")).map_err(failed)?);
     let mut out = Outside::default();
     if role == Role::Master && sc.master.backend == Backend::Ros2 {
         let limit = sc.master.force_limit;

@@ -20,6 +20,7 @@ mod network;
 mod operator;
 pub mod overrides;
 mod ros;
+mod ros_tls;
 pub mod shown;
 mod slave;
 mod validate;
@@ -45,6 +46,7 @@ pub use ros::{
     topic_name, AngleUnit, Backend, ForceMapConfig, JointMapConfig, LiveConfig, RobotCommand,
     RosConfig, RosDeviceConfig, RosRobotConfig, TorqueAbout,
 };
+pub use ros_tls::RosTlsConfig;
 use serde::{Deserialize, Serialize};
 pub use slave::{
     ControllerConfig, DynamicsConfig, Environment, Object, SlaveConfig, MAX_STIFFNESS,
@@ -163,12 +165,20 @@ impl Scenario {
     /// The same scenario with every relative path made absolute against `base_dir`
     /// (the scenario file's folder), so a copy of it runs from any folder.
     pub fn resolved(&self, base_dir: &std::path::Path) -> Scenario {
-        let mut s = self.clone();
-        for path in s.input_paths_mut() {
+        let resolve = |path: &mut String| {
             let p = std::path::Path::new(path.as_str());
             if p.is_relative() {
                 *path = base_dir.join(p).display().to_string();
             }
+        };
+        let mut s = self.clone();
+        s.input_paths_mut().into_iter().for_each(resolve);
+        // The session's TLS files are read where they are, never copied into a run's
+        // inputs/ (a private key has no place in a folder of results).
+        if let Some(t) = &mut s.ros.tls {
+            [&mut t.ca, &mut t.cert, &mut t.key]
+                .into_iter()
+                .for_each(resolve);
         }
         s
     }
@@ -229,7 +239,7 @@ impl Scenario {
         if ros_used {
             w.extend(self.ros.in_clear_to_other_hosts().into_iter().map(|e| {
                 format!(
-                    "ros endpoint {e} leaves this host in clear: joint states, forces and robot commands can be read and forged on that network (Tactile's ROS 2 session has no TLS yet; keep the router on this host, or the network trusted)"
+                    "ros endpoint {e} leaves this host in clear: joint states, forces and robot commands can be read and forged on that network (give [ros.tls] a CA, certificate and key and use tls/ endpoints for mutual TLS, or keep the router on this host, or the network trusted)"
                 )
             }));
         }

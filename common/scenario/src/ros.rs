@@ -28,6 +28,10 @@ pub struct RosConfig {
     pub namespace: String,
     /// The live view: each node's state as ROS 2 topics while it runs.
     pub live: LiveConfig,
+    /// Mutual TLS for the session (`[ros.tls]`); none: in clear, as rmw_zenoh's
+    /// default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tls: Option<crate::ros_tls::RosTlsConfig>,
 }
 
 impl Default for RosConfig {
@@ -38,6 +42,7 @@ impl Default for RosConfig {
             listen: Vec::new(),
             namespace: String::new(),
             live: LiveConfig::default(),
+            tls: None,
         }
     }
 }
@@ -444,6 +449,7 @@ impl RosConfig {
                 })?;
             }
         }
+        crate::ros_tls::validate(self)?;
         let r = self.live.rate_hz;
         if !r.is_finite() || r <= 0.0 || r > rate_hz {
             return Err(invalid(

@@ -280,7 +280,7 @@ impl LinkArgs {
 }
 
 /// A TLS file that can be read: a regular file of at most [`MAX_PEM`] bytes.
-fn readable(f: &std::path::Path, what: &str) -> Result<(), BadOption> {
+pub(crate) fn readable(f: &std::path::Path, what: &str) -> Result<(), BadOption> {
     let meta = std::fs::metadata(f)
         .map_err(|e| BadOption(format!("cannot read {what} {}: {e}", f.display())))?;
     if !meta.is_file() || meta.len() > MAX_PEM {

@@ -10,14 +10,26 @@ use rustls::pki_types::pem::PemObject;
 use rustls::pki_types::{CertificateDer, PrivateKeyDer, UnixTime};
 use std::path::Path;
 
-/// Checks `ca`, `cert` and `key` (PEM) as a node's mutual-TLS identity; the error
-/// names the file and what is wrong with it.
+/// Checks `ca`, `cert` and `key` (PEM) as a node's mutual-TLS identity given by
+/// `--tls-ca`, `--tls-cert` and `--tls-key`; the error names the file and what is
+/// wrong with it.
 pub fn check(ca: &Path, cert: &Path, key: &Path) -> Result<(), String> {
-    let cas = certificates(ca, "--tls-ca")?;
-    let chain = certificates(cert, "--tls-cert")?;
+    check_as(ca, cert, key, ["--tls-ca", "--tls-cert", "--tls-key"])
+}
+
+/// [`check`], the files named in errors as `names` (the CA's, the certificate's, the
+/// key's: options or a scenario's fields); each file first readable, a regular file
+/// of at most 1 MiB.
+pub fn check_as(ca: &Path, cert: &Path, key: &Path, names: [&str; 3]) -> Result<(), String> {
+    let [ca_name, cert_name, key_name] = names;
+    for (f, what) in [(ca, ca_name), (cert, cert_name), (key, key_name)] {
+        crate::options::readable(f, what).map_err(|e| e.0)?;
+    }
+    let cas = certificates(ca, ca_name)?;
+    let chain = certificates(cert, cert_name)?;
     let private = PrivateKeyDer::from_pem_file(key).map_err(|e| {
         format!(
-            "--tls-key {}: no private key in it ({e}): give the PEM key of --tls-cert",
+            "{key_name} {}: no private key in it ({e}): give the PEM key of {cert_name}",
             key.display()
         )
     })?;
@@ -27,7 +39,7 @@ pub fn check(ca: &Path, cert: &Path, key: &Path) -> Result<(), String> {
         .load_private_key(private)
         .map_err(|e| {
             format!(
-                "--tls-key {}: not a key TLS can sign with ({e})",
+                "{key_name} {}: not a key TLS can sign with ({e})",
                 key.display()
             )
         })?;
@@ -35,7 +47,7 @@ pub fn check(ca: &Path, cert: &Path, key: &Path) -> Result<(), String> {
         .keys_match()
         .map_err(|e| {
             format!(
-                "--tls-key {} is not the key of --tls-cert {} ({e}): give the pair made together",
+                "{key_name} {} is not the key of {cert_name} {} ({e}): give the pair made together",
                 key.display(),
                 cert.display()
             )
@@ -44,9 +56,9 @@ pub fn check(ca: &Path, cert: &Path, key: &Path) -> Result<(), String> {
         .iter()
         .map(|c| webpki::anchor_from_trusted_cert(c).map(|a| a.to_owned()))
         .collect::<Result<_, _>>()
-        .map_err(|e| format!("--tls-ca {}: not a CA certificate ({e})", ca.display()))?;
+        .map_err(|e| format!("{ca_name} {}: not a CA certificate ({e})", ca.display()))?;
     let leaf = webpki::EndEntityCert::try_from(&chain[0])
-        .map_err(|e| format!("--tls-cert {}: not a certificate ({e})", cert.display()))?;
+        .map_err(|e| format!("{cert_name} {}: not a certificate ({e})", cert.display()))?;
     leaf.verify_for_usage(
         provider.signature_verification_algorithms.all,
         &anchors,
@@ -58,7 +70,7 @@ pub fn check(ca: &Path, cert: &Path, key: &Path) -> Result<(), String> {
     )
     .map_err(|e| {
         format!(
-            "--tls-cert {} is not valid under --tls-ca {} ({e:?}): a certificate of another CA, expired, or not for client authentication",
+            "{cert_name} {} is not valid under {ca_name} {} ({e:?}): a certificate of another CA, expired, or not for client authentication",
             cert.display(),
             ca.display()
         )

@@ -68,22 +68,33 @@ impl ZenohOptions {
         set(&mut c, "connect/timeout_ms", "-1")?;
         set(&mut c, "connect/exit_on_failure", "false")?;
         if let Some(t) = &self.tls {
-            // Both sides present a certificate of the run's CA (mutual TLS: a listener
-            // refuses a peer without one at the handshake), the server's name is
-            // checked against the address connected to, and no other protocol is
-            // accepted, so nobody joins over plain TCP.
-            let path = |p: &std::path::Path| format!("{:?}", p.display().to_string());
-            let tls = "transport/link/tls";
-            set(&mut c, &format!("{tls}/root_ca_certificate"), &path(&t.ca))?;
-            for side in ["listen", "connect"] {
-                set(&mut c, &format!("{tls}/{side}_certificate"), &path(&t.cert))?;
-                set(&mut c, &format!("{tls}/{side}_private_key"), &path(&t.key))?;
-            }
-            set(&mut c, &format!("{tls}/enable_mtls"), "true")?;
-            set(&mut c, &format!("{tls}/verify_name_on_connect"), "true")?;
-            set(&mut c, "transport/link/protocols", "[\"tls\"]")?;
+            t.apply(&mut c)?;
         }
         Ok(c)
+    }
+}
+
+impl TlsFiles {
+    /// Puts this identity into a Zenoh configuration as mutual TLS: both sides present
+    /// a certificate of the CA (a listener refuses a peer without one at the
+    /// handshake), the server's name is checked against the address connected to, and
+    /// no other protocol is accepted, so nobody joins over plain TCP. The loop's link
+    /// and the ROS 2 session (`[ros.tls]`) both take it from here.
+    pub fn apply(&self, c: &mut zenoh::Config) -> Result<(), LinkError> {
+        let mut set = |key: &str, value: &str| {
+            c.insert_json5(key, value)
+                .map_err(|e| err(&format!("Zenoh setting {key} = {value}"), e))
+        };
+        let path = |p: &std::path::Path| format!("{:?}", p.display().to_string());
+        let tls = "transport/link/tls";
+        set(&format!("{tls}/root_ca_certificate"), &path(&self.ca))?;
+        for side in ["listen", "connect"] {
+            set(&format!("{tls}/{side}_certificate"), &path(&self.cert))?;
+            set(&format!("{tls}/{side}_private_key"), &path(&self.key))?;
+        }
+        set(&format!("{tls}/enable_mtls"), "true")?;
+        set(&format!("{tls}/verify_name_on_connect"), "true")?;
+        set("transport/link/protocols", "[\"tls\"]")
     }
 }
 

@@ -98,6 +98,8 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
         tactile_runtime::outside::gimbal(&scenario, &base_dir)
             .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     }
+    tactile_runtime::outside::check_ros_tls(&scenario, &base_dir)
+        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
     inputs.extend(scenario.input_paths().iter().map(|p| base_dir.join(p)));
     Ok(Loaded {
