@@ -23,7 +23,7 @@ use tactile_records::{Record, RecordReader};
 /// Rows of one sample number a source holds: more than any node writes for one
 /// sample in a segment (the master: a `Sent`, an answer or a miss; the emulator: a
 /// passage each way), with room for a restarted node's second segment.
-pub(crate) const PER_SAMPLE: u32 = 8;
+pub(crate) const PER_SAMPLE: usize = 8;
 
 /// Rows a source holds at most while it looks ahead for a sample's missing rows: the
 /// largest block a writer makes (about 7 MB of the paper arm's rows); a block of a
@@ -44,8 +44,10 @@ const STOP_EVERY: u64 = 4096;
 pub(crate) struct Source<S, C> {
     reader: Option<RecordReader<Record<S, C>>>,
     pub(crate) log: NodeLog<C>,
-    /// The rows held, by sample number and arrival.
-    ahead: BTreeMap<(u64, u32), S>,
+    /// The rows held, by sample number, in the order read.
+    ahead: BTreeMap<u64, Vec<S>>,
+    /// Rows in `ahead`.
+    held: usize,
     /// Highest sample number held so far.
     front: Option<u64>,
     /// Samples below this one were joined: a row of one comes too late.
@@ -84,6 +86,7 @@ where
             reader,
             log,
             ahead: BTreeMap::new(),
+            held: 0,
             front: None,
             floor: 0,
             limit,
@@ -104,8 +107,11 @@ where
         {
             return true;
         }
-        let mut rows = self.ahead.range((n, 0)..=(n, u32::MAX)).map(|(_, s)| s);
-        self.ahead.len() < REORDER_ROWS && !(self.complete)(&mut rows)
+        let whole = self
+            .ahead
+            .get(&n)
+            .is_some_and(|rows| (self.complete)(&mut rows.iter()));
+        self.held < REORDER_ROWS && !whole
     }
 
     /// Reads on for sample `n` (see [`Source::wants`]), or to the file's end.
@@ -145,12 +151,13 @@ where
             self.log.unjoined += 1;
             return;
         }
-        let have = self.ahead.range((k, 0)..=(k, u32::MAX)).count() as u32;
-        if have >= PER_SAMPLE {
+        let rows = self.ahead.entry(k).or_default();
+        if rows.len() >= PER_SAMPLE {
             self.log.duplicates += 1;
             return;
         }
-        self.ahead.insert((k, have), s);
+        rows.push(s);
+        self.held += 1;
         self.front = Some(self.front.map_or(k, |f| f.max(k)));
     }
 
@@ -166,9 +173,9 @@ where
     /// is a gap, not its end: the join goes on from the next one there is).
     pub(crate) fn next_after(&self, n: u64) -> Option<u64> {
         self.ahead
-            .range((n.saturating_add(1), 0)..)
+            .range(n.saturating_add(1)..)
             .next()
-            .map(|((k, _), _)| *k)
+            .map(|(k, _)| *k)
     }
 
     /// The log as read so far (a join cut short).
@@ -182,19 +189,15 @@ where
     pub(crate) fn take(&mut self, n: u64, stop: &dyn Fn() -> bool) -> Result<Vec<S>, Error> {
         self.fill_to(n, stop)?;
         while let Some(entry) = self.ahead.first_entry() {
-            if entry.key().0 >= n {
+            if *entry.key() >= n {
                 break;
             }
-            entry.remove();
-            self.log.unjoined += 1;
+            let stale = entry.remove().len();
+            self.held -= stale;
+            self.log.unjoined += stale as u64;
         }
-        let mut rows = Vec::new();
-        while let Some(entry) = self.ahead.first_entry() {
-            if entry.key().0 != n {
-                break;
-            }
-            rows.push(entry.remove());
-        }
+        let rows = self.ahead.remove(&n).unwrap_or_default();
+        self.held -= rows.len();
         self.floor = self.floor.max(n.saturating_add(1));
         Ok(rows)
     }
@@ -202,15 +205,16 @@ where
     /// Reads the rest of the file (for its events and counters): every sample row
     /// left is counted, none held.
     pub(crate) fn finish(mut self, stop: &dyn Fn() -> bool) -> Result<NodeLog<C>, Error> {
-        self.log.unjoined += self.ahead.len() as u64;
+        self.log.unjoined += self.held as u64;
         self.ahead.clear();
+        self.held = 0;
         self.floor = u64::MAX;
         self.front = None;
         while self.reader.is_some() && !self.stopped {
             self.fill_to(u64::MAX, stop)?;
         }
         // Only a row numbered u64::MAX itself (with no sample count known) is held.
-        self.log.unjoined += self.ahead.len() as u64;
+        self.log.unjoined += self.held as u64;
         self.close();
         Ok(self.log)
     }
