@@ -130,7 +130,10 @@ mod verilate {
     /// (with a warning) when Verilator cannot run outside CI: the crate then builds
     /// without the simulated modules.
     fn verilator_include() -> Option<PathBuf> {
-        match Command::new("verilator").args(["--getenv", "VERILATOR_ROOT"]).output() {
+        match Command::new("verilator")
+            .args(["--getenv", "VERILATOR_ROOT"])
+            .output()
+        {
             Ok(out) if out.status.success() => {
                 Some(PathBuf::from(String::from_utf8_lossy(&out.stdout).trim()).join("include"))
             }
