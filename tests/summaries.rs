@@ -163,3 +163,36 @@ fn replayed(
         + "\n[network.forward.replay]\npath = \"net.csv\"\n";
     (sb.write("s.toml", &text), csv)
 }
+
+/// Issue 51: `--resume` kept a run whose folder held another run's `summary.json`
+/// beside its own right `scenario.toml`. A summary is kept only with the record it
+/// reports (the master's record's length and CRC-32).
+#[test]
+fn resume_keeps_a_summary_only_with_the_records_it_reports() {
+    let sb = Sandbox::new("resume-own");
+    let s = sb.write(
+        "s.toml",
+        &util::wall_delay().replace("samples = 8000", "samples = 300"),
+    );
+    let sweep = |extra: &[&str]| {
+        let mut args = vec!["sweep", s.to_str().expect("utf-8"), "--set", "seed=1,2"];
+        args.extend_from_slice(&["--out", "sw"]);
+        args.extend_from_slice(extra);
+        let o = sb.tactile(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    sweep(&[]);
+    let (own, other) = (
+        sb.path("sw").join("run-0000"),
+        sb.path("sw").join("run-0001"),
+    );
+    std::fs::copy(other.join("summary.json"), own.join("summary.json")).expect("copy");
+    let err = sweep(&["--resume"]);
+    assert!(err.contains("1 runs kept from before"), "{err}");
+    let after = sb.json("sw/run-0000", "summary.json");
+    let theirs = sb.json("sw/run-0001", "summary.json");
+    let digest = |j: &serde_json::Value| j["nodes"]["master"]["digest"].clone();
+    assert_ne!(digest(&after), digest(&theirs), "run-0000 was run again");
+    assert_ne!(after["master"], theirs["master"], "its own figures");
+}

@@ -5,6 +5,7 @@ use crate::analysis::{ClockOffset, Motion, Percentiles};
 use crate::metrics::{Contact, Packets, Passivity, Tracking};
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::path::Path;
 use tactile_records::emulator::EmulatorTotals;
 use tactile_records::master::MasterTotals;
 use tactile_records::slave::SlaveTotals;
@@ -97,6 +98,10 @@ pub struct NodeSummary {
     pub hosts: Vec<String>,
     /// Process id of each segment (more than one: the node was restarted).
     pub pids: Vec<u32>,
+    /// The record's length and CRC-32 as reported (`BYTES:CRC`): what ties a summary
+    /// to its records ([`of_these_records`]; a simulation's starts carry no time, so
+    /// the bytes themselves say which run they are).
+    pub digest: String,
     /// The link it used.
     pub link: String,
     /// Peak resident set size, kB (the largest over its segments).
@@ -220,4 +225,36 @@ pub struct Summary {
     pub failed: bool,
     /// True if SIGINT/SIGTERM cut the run short.
     pub interrupted: bool,
+}
+
+/// A record's length and CRC-32, `BYTES:CRC` (empty if it cannot be read).
+pub fn digest(path: &Path) -> String {
+    use std::io::Read;
+    let Ok(mut f) = std::fs::File::open(path) else {
+        return String::new();
+    };
+    let (mut h, mut bytes, mut buf) = (crc32fast::Hasher::new(), 0u64, vec![0u8; 1 << 16]);
+    loop {
+        match f.read(&mut buf) {
+            Ok(0) => return format!("{bytes}:{:08x}", h.finalize()),
+            Ok(k) => {
+                h.update(&buf[..k]);
+                bytes += k as u64;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(_) => return String::new(),
+        }
+    }
+}
+
+/// True if `summary` (a `summary.json` read back) is the report of the master's
+/// record in `dir` as it is: its length and CRC-32 are those the summary recorded.
+/// A summary copied from another run, or one older than the record (a node appended
+/// to it since), or written before summaries recorded digests, is not.
+pub fn of_these_records(dir: &Path, summary: &serde_json::Value) -> bool {
+    let Ok([Some(master), _, _]) = crate::join::locate(&[dir.to_path_buf()]) else {
+        return false;
+    };
+    let ours = digest(&master);
+    !ours.is_empty() && summary["nodes"]["master"]["digest"].as_str() == Some(ours.as_str())
 }

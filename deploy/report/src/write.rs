@@ -155,6 +155,7 @@ where
         record: log.path.display().to_string(),
         hosts: log.starts.iter().map(|s| s.host.clone()).collect(),
         pids: log.starts.iter().map(|s| s.pid).collect(),
+        digest: crate::summary::digest(&log.path),
         link: log
             .starts
             .first()

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
+use tactile_report::summary::of_these_records;
 use tactile_report::sweep::{describe, values, Axis};
 use tactile_report::write::{TraceFormat, PARQUET_FILE};
 
@@ -105,8 +106,9 @@ pub fn failed(dir: &Path) -> bool {
 }
 
 /// What `--resume` keeps of a folder: a run that ended, did not fail, and ran this
-/// very combination (its `scenario.toml`, input paths aside, is `w`'s scenario), never
-/// another scenario's summary left in the folder; with `--trace`, one that wrote the
+/// very combination (its `scenario.toml`, input paths aside, is `w`'s scenario), its
+/// summary the report of the folder's own record, never another scenario's or
+/// another run's summary left in the folder; with `--trace`, one that wrote the
 /// trace files asked for.
 fn kept(w: &Work, args: &SweepArgs) -> Option<Vec<Option<f64>>> {
     // With --trace, a run kept has the trace files asked for (else it runs again).
@@ -127,7 +129,9 @@ fn kept(w: &Work, args: &SweepArgs) -> Option<Vec<Option<f64>>> {
             p.clear();
         }
     }
-    (theirs == ours && !failed(&w.dir))
+    // The summary must be these records' report, not one copied in from another run.
+    let own = summary(&w.dir).is_some_and(|j| of_these_records(&w.dir, &j));
+    (theirs == ours && own && !failed(&w.dir))
         .then(|| finished(&w.dir))
         .flatten()
 }
