@@ -191,7 +191,7 @@ impl Handler for SlaveHandler {
                 last.0, last.1, all.0, all.1
             );
         }
-        let failures = self.slave.arm().map_or(0, |a| a.dynamics_failures());
+        let failures = t.counters.dynamics_failed;
         if failures > self.failures_seen {
             tracing::warn!(
                 "slave.arm: the dynamics failed in {} periods in the last second ({failures} in all): the arm stood still in each",

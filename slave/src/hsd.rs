@@ -123,6 +123,7 @@ impl Slave {
     pub fn counters(&self) -> SlaveCounters {
         SlaveCounters {
             rtl: self.engine.hardware_clocks(),
+            dynamics_failed: self.arm.as_ref().map_or(0, |a| a.dynamics_failures()),
             ..self.counters
         }
     }

@@ -474,6 +474,25 @@ fn a_failed_dynamics_step_is_counted_and_its_cause_kept() {
     assert!(arm.state().qd.iter().all(|v| v.is_finite()));
 }
 
+/// Issue 51: the failed steps were logged but in no output: the slave's counters
+/// (its record's totals, summary.json's `slave` counters) carry them.
+#[test]
+fn failed_dynamics_steps_reach_the_slaves_counters() {
+    let (cfg, xml) = one_joint("1e12", r#"ixx="0.01" iyy="0.01" izz="0.01""#);
+    let mut arm = UrdfArm::new(&cfg, &xml, HOME).expect("arm");
+    arm.state.qd[0] = 1.0;
+    let mut scenario = tactile_scenario::Scenario::default();
+    scenario.slave.arm = Some(cfg);
+    let mut slave = crate::hsd::Slave::new(&scenario, Some(arm)).expect("slave");
+    assert_eq!(slave.counters().dynamics_failed, 0);
+    for _ in 0..100 {
+        slave.hold();
+    }
+    let failed = slave.counters().dynamics_failed;
+    assert!(failed > 0, "no failure in the counters");
+    assert_eq!(Some(failed), slave.arm().map(UrdfArm::dynamics_failures));
+}
+
 /// A link whose mass sits on its own joint's axis, with no inertia about it: every
 /// step's dynamics would fail, so the arm is refused at load.
 #[test]

@@ -36,6 +36,9 @@ pub struct SlaveCounters {
     pub ik_damped: u64,
     /// Targets outside the arm's workspace box, clamped onto it.
     pub workspace_clamped: u64,
+    /// A URDF arm: periods whose dynamics step failed (not finite, a singular mass
+    /// matrix); the arm stood still in each, so a report must say so.
+    pub dynamics_failed: u64,
     /// `arithmetic = "rtl"`: the clocks IK-HSD, FK-HSD and FBF-HSD spent (zero
     /// otherwise).
     pub rtl: Clocks,

@@ -6,10 +6,18 @@
 use crate::analysis::Analysis;
 use crate::join::{Logs, NodeLog};
 use tactile_messages::Role;
+use tactile_records::slave::SlaveCounters;
 
-/// The warnings of a report from its analysis and the nodes' logs; `samples` is the
-/// run's sample count, `sent` the master's own count of samples sent.
-pub fn warnings(a: &Analysis, logs: &Logs, samples: u64, sent: u64) -> Vec<String> {
+/// The warnings of a report from its analysis, the nodes' logs and the slave's summed
+/// counters; `samples` is the run's sample count, `sent` the master's own count of
+/// samples sent.
+pub fn warnings(
+    a: &Analysis,
+    logs: &Logs,
+    samples: u64,
+    sent: u64,
+    slave_counters: Option<&SlaveCounters>,
+) -> Vec<String> {
     let mut out = Vec::new();
     left_out(Role::Master, &logs.master, samples, &mut out);
     left_out(Role::Emulator, &logs.emulator, samples, &mut out);
@@ -38,7 +46,20 @@ pub fn warnings(a: &Analysis, logs: &Logs, samples: u64, sent: u64) -> Vec<Strin
             a.rows
         ));
     }
+    out.extend(slave_counters.and_then(dynamics_failed));
     out
+}
+
+/// A URDF arm whose dynamics failed in some periods stood still in each: the slave's
+/// columns there are not the arm following, which its tracking and forces do not say.
+/// The first failure's cause is in the slave's log.
+pub fn dynamics_failed(c: &SlaveCounters) -> Option<String> {
+    (c.dynamics_failed > 0).then(|| {
+        format!(
+            "slave.arm: the dynamics failed in {} periods and the arm stood still in each (the slave's log says why): tracking and forces include them",
+            c.dynamics_failed
+        )
+    })
 }
 
 /// A node's sample rows the join left out, if any, and why.
@@ -54,4 +75,22 @@ fn left_out<C: Clone>(role: Role, log: &NodeLog<C>, samples: u64, out: &mut Vec<
         log.invalid,
         log.duplicates
     ));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 51: an arm whose dynamics failed was counted by the slave, and the report
+    /// said nothing of it.
+    #[test]
+    fn an_arm_whose_dynamics_failed_is_warned_of_with_the_count() {
+        assert_eq!(dynamics_failed(&SlaveCounters::default()), None);
+        let c = SlaveCounters {
+            dynamics_failed: 7,
+            ..SlaveCounters::default()
+        };
+        let w = dynamics_failed(&c).expect("a warning");
+        assert!(w.contains("failed in 7 periods"), "{w}");
+    }
 }

@@ -283,6 +283,13 @@ fn summarise(
         &master_totals.counters.rtl,
         &slave.as_ref().map(|s| s.counters.rtl).unwrap_or_default(),
     );
+    let warnings = crate::warnings::warnings(
+        a,
+        logs,
+        scenario.samples,
+        master_totals.counters.sent,
+        slave.as_ref().map(|s| &s.counters),
+    );
     Summary {
         scenario: scenario.name.clone(),
         mode: scenario.mode,
@@ -332,7 +339,7 @@ fn summarise(
         emulator,
         slave,
         nodes: nodes(logs),
-        warnings: crate::warnings::warnings(a, logs, scenario.samples, master_totals.counters.sent),
+        warnings,
         events: ev,
         events_omitted: omitted,
         failed: launch.failed,
