@@ -167,12 +167,11 @@ fn sample_numbers_past_the_run_are_counted_not_walked_to() {
     );
 }
 
-/// A report reading a long record answers SIGTERM at once: exit 130, the report of
-/// what it joined written whole, no partial file left. (Before, the walk to a row
-/// numbered 2^62 never looked at the request.)
-#[test]
-fn a_stop_request_ends_a_report_reading_a_long_record() {
-    let (sb, rec) = crafted("stopread", "master");
+/// Records the report takes long to read, in `bad` of a sandbox named `name`: a
+/// master row numbered 2^62 and 1,500 blocks of one slave row repeated before the
+/// run's own rows.
+fn long_to_read(name: &str) -> Sandbox {
+    let (sb, rec) = crafted(name, "master");
     let mut all = entries::<MasterSample, MasterTotals>(&rec);
     let mut row = first_row(&all);
     if let MasterSample::Sent(s) = &mut row {
@@ -180,7 +179,6 @@ fn a_stop_request_ends_a_report_reading_a_long_record() {
     }
     all.insert(3, Record::Sample(row));
     rewrite(&rec, &all, 100);
-    // The slave's record: a row repeated before the run's own rows, long to read.
     let slave = sb.path("bad").join("slave.rec");
     let all = entries::<SlaveSample, SlaveTotals>(&slave);
     let copy = Record::Sample(first_row(&all));
@@ -194,7 +192,13 @@ fn a_stop_request_ends_a_report_reading_a_long_record() {
         all[..at].iter().chain(copies).chain(&all[at..]),
         COPIES,
     );
-    let child = report(&sb, "bad")
+    sb
+}
+
+/// Runs `cmd`, sends it SIGTERM 0.8 s in and checks it ends within 3 s with exit
+/// 130 and no partial file in `dir`; its output.
+fn stopped_at_once(mut cmd: Command, dir: &Path) -> std::process::Output {
+    let child = cmd
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -205,18 +209,28 @@ fn a_stop_request_ends_a_report_reading_a_long_record() {
     let t = std::time::Instant::now();
     let o = util::wait_within(child, std::time::Duration::from_secs(60));
     let took = t.elapsed();
-    let text = String::from_utf8_lossy(&o.stdout);
     assert_eq!(
         o.status.code(),
         Some(130),
-        "{text}{}",
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     );
     assert!(
         took < std::time::Duration::from_secs(3),
         "took {took:?} after SIGTERM"
     );
-    assert!(partials(&sb.path("bad")).is_empty());
+    assert!(partials(dir).is_empty(), "{:?}", partials(dir));
+    o
+}
+
+/// A report reading a long record answers SIGTERM at once: exit 130, the report of
+/// what it joined written whole, no partial file left. (Before, the walk to a row
+/// numbered 2^62 never looked at the request.)
+#[test]
+fn a_stop_request_ends_a_report_reading_a_long_record() {
+    let sb = long_to_read("stopread");
+    stopped_at_once(report(&sb, "bad"), &sb.path("bad"));
     let s = sb.json("bad", "summary.json");
     assert_eq!(s["interrupted"], true);
     assert!(
@@ -226,6 +240,21 @@ fn a_stop_request_ends_a_report_reading_a_long_record() {
         "{}",
         s["events"]
     );
+}
+
+/// Issue 51: `report --mcap-only` installed no stop handler: SIGTERM killed it and
+/// left run.mcap.partial. It stops as the full report does (exit 130, no partial
+/// file), and writes no run.mcap of part of the run.
+#[test]
+fn a_stop_request_ends_an_mcap_only_report_leaving_no_file() {
+    let sb = long_to_read("stopmcap");
+    let o = stopped_at_once(
+        sb.command(&["report", "bad", "--mcap-only"]),
+        &sb.path("bad"),
+    );
+    assert!(!sb.path("bad").join("run.mcap").exists());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("run.mcap not written"), "{err}");
 }
 
 /// The rows of `trace`'s column `name` that are zero.

@@ -489,27 +489,53 @@ fn report_into(
     Ok(summary)
 }
 
+/// What [`write_mcap`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct McapWritten {
+    /// Samples recorded (joined, where a stop request came).
+    pub samples: u64,
+    /// What the recording leaves out, if anything (an arm whose URDF cannot be read).
+    pub warning: Option<String>,
+    /// A stop request ended the join before this sample: no run.mcap was written (its
+    /// partial file removed; one written before is left as it was).
+    pub stopped_at: Option<u64>,
+}
+
 /// Joins the records in `dirs` and writes only `out/run.mcap` (old records converted
-/// without redoing the report). Returns the number of samples recorded, and what the
-/// recording leaves out, if anything (an arm whose URDF cannot be read).
+/// without redoing the report), looking at `stop` (a stop request) as it reads: a
+/// conversion that stops writes nothing, since a recording of part of the run under
+/// the run's name would pass for all of it.
 pub fn write_mcap(
     dirs: &[PathBuf],
     out: &Path,
     compression: crate::mcap::Compression,
-) -> Result<(u64, Option<String>), Error> {
+    stop: &dyn Fn() -> bool,
+) -> Result<McapWritten, Error> {
     let (_, scenario) = recorded(dirs)?;
     make_out_dir(out)?;
     let (mut rec, warning) =
         run_mcap::create(out, &scenario, compression).map_err(Error::io("writing run.mcap"))?;
 
     let mut samples = 0;
-    join::join(dirs, |row, joints, rotation| {
+    let logs = join::join_until(dirs, stop, |row, joints, rotation| {
         samples += 1;
         rec.add(row, joints, rotation)
             .map_err(Error::io("writing run.mcap"))?;
         Ok(ControlFlow::Continue(()))
     })
     .inspect_err(|_| run_mcap::discard(out))?;
-    run_mcap::commit(rec, out).map_err(Error::io("writing run.mcap"))?;
-    Ok((samples, warning))
+    if logs.stopped_at.is_some() {
+        // Dropped first: its writer would finish the file it is about to lose.
+        drop(rec);
+        run_mcap::discard(out);
+    } else {
+        run_mcap::commit(rec, out)
+            .inspect_err(|_| run_mcap::discard(out))
+            .map_err(Error::io("writing run.mcap"))?;
+    }
+    Ok(McapWritten {
+        samples,
+        warning,
+        stopped_at: logs.stopped_at,
+    })
 }

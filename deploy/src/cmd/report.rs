@@ -4,6 +4,7 @@
 use crate::error::Error;
 use clap::Args;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use tactile_report::join;
 use tactile_report::text::render;
 use tactile_report::write::{write_mcap, write_report, Launch};
@@ -49,19 +50,11 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
     };
     let holder = format!("tactile report (pid {})", std::process::id());
     let _held = tactile_report::out::take(&out, &holder)?;
-    if args.mcap_only {
-        let (samples, warning) = write_mcap(&args.dirs, &out, args.formats.mcap_compression)?;
-        if let Some(w) = warning {
-            crate::noteln!("warning: {w}");
-        }
-        crate::outln!(
-            "wrote {}: {samples} samples",
-            out.join(tactile_report::run_mcap::FILE).display()
-        );
-        return Ok(());
-    }
     let stop =
         tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
+    if args.mcap_only {
+        return mcap_only(args, &out, &stop);
+    }
     let launch = Launch {
         stop: Some(stop),
         outputs: args.formats.outputs(args.no_trace),
@@ -72,5 +65,25 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
     if summary.interrupted {
         return Err(Error::Interrupted);
     }
+    Ok(())
+}
+
+/// `tactile report --mcap-only`: run.mcap alone; a stop request (SIGINT, SIGTERM)
+/// ends it at once with no file written, exit 130.
+fn mcap_only(args: &ReportArgs, out: &Path, stop: &AtomicBool) -> Result<(), Error> {
+    let stopped = || stop.load(Ordering::SeqCst);
+    let w = write_mcap(&args.dirs, out, args.formats.mcap_compression, &stopped)?;
+    let file = out.join(tactile_report::run_mcap::FILE);
+    if let Some(n) = w.stopped_at {
+        crate::noteln!(
+            "stopped at sample {n} by a stop request: {} not written",
+            file.display()
+        );
+        return Err(Error::Interrupted);
+    }
+    if let Some(w) = w.warning {
+        crate::noteln!("warning: {w}");
+    }
+    crate::outln!("wrote {}: {} samples", file.display(), w.samples);
     Ok(())
 }
