@@ -11,6 +11,7 @@ pub mod ends;
 pub mod ipc;
 pub mod memory;
 pub mod options;
+pub mod pem_file;
 pub mod ports;
 pub mod streams;
 #[cfg(feature = "zenoh")]

@@ -92,9 +92,6 @@ pub struct BadOption(pub String);
 pub const NO_ZENOH: &str = "--link zenoh: this build has no Zenoh link; build with \
 `cargo build --release --workspace --features zenoh` (docs/03-across-hosts.md)";
 
-/// Largest TLS file read, bytes.
-const MAX_PEM: u64 = 1 << 20;
-
 impl LinkArgs {
     /// The options as a command line that parses back to them.
     pub fn argv(&self) -> Vec<String> {
@@ -212,7 +209,7 @@ impl LinkArgs {
             ("--tls-key", &self.tls_key),
         ] {
             if let Some(f) = file {
-                readable(f, what)?;
+                crate::pem_file::readable(f, what).map_err(BadOption)?;
             }
         }
         #[cfg(feature = "zenoh")]
@@ -277,21 +274,6 @@ impl LinkArgs {
             ),
         }
     }
-}
-
-/// A TLS file that can be read: a regular file of at most [`MAX_PEM`] bytes.
-pub(crate) fn readable(f: &std::path::Path, what: &str) -> Result<(), BadOption> {
-    let meta = std::fs::metadata(f)
-        .map_err(|e| BadOption(format!("cannot read {what} {}: {e}", f.display())))?;
-    if !meta.is_file() || meta.len() > MAX_PEM {
-        return Err(BadOption(format!(
-            "{what} {}: not a regular file of at most {MAX_PEM} bytes",
-            f.display()
-        )));
-    }
-    std::fs::File::open(f)
-        .map(|_| ())
-        .map_err(|e| BadOption(format!("cannot read {what} {}: {e}", f.display())))
 }
 
 /// Link options as the tests write them.

@@ -23,7 +23,7 @@ pub fn check(ca: &Path, cert: &Path, key: &Path) -> Result<(), String> {
 pub fn check_as(ca: &Path, cert: &Path, key: &Path, names: [&str; 3]) -> Result<(), String> {
     let [ca_name, cert_name, key_name] = names;
     for (f, what) in [(ca, ca_name), (cert, cert_name), (key, key_name)] {
-        crate::options::readable(f, what).map_err(|e| e.0)?;
+        crate::pem_file::readable(f, what)?;
     }
     let cas = certificates(ca, ca_name)?;
     let chain = certificates(cert, cert_name)?;
