@@ -92,13 +92,16 @@ pub fn urdf() -> Target {
 fn unlisted(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut depth = 0usize;
-    for c in text.chars() {
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
         let numeric = c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e');
+        // A sign or a point opens a number when a digit follows it (`-1e0`, `.5`).
+        let opens = matches!(c, '.' | '-' | '+') && chars.peek().is_some_and(char::is_ascii_digit);
         match c {
             '(' => depth += 1,
             ')' if depth > 0 => depth -= 1,
             _ if depth > 0 => {}
-            _ if numeric && (c.is_ascii_digit() || out.ends_with('#')) => {
+            _ if numeric && (c.is_ascii_digit() || opens || out.ends_with('#')) => {
                 if !out.ends_with('#') {
                     out.push('#');
                 }
@@ -385,7 +388,7 @@ mod tests {
     fn listed_names_are_left_out() {
         assert_eq!(
             unlisted("robot `r`: 2 links are no joint's child (a, b(c)): a robot has one root"),
-            "robot `r`: 2 links are no joint's child : a robot has one root"
+            "robot `r`: # links are no joint's child : a robot has one root"
         );
         assert_eq!(
             unlisted("moments -1e0, 0.5e-3 kg"),

@@ -28,23 +28,6 @@ pub struct Target {
     pub run: Run,
 }
 
-/// Every target, seeded; `scratch` is a folder for the record files.
-pub fn all(scratch: &Path) -> Result<Vec<Target>, String> {
-    Ok(vec![
-        records(scratch)?,
-        blocks(),
-        cdr(),
-        wire(),
-        attachment(),
-        scenario(),
-        trajectory(),
-        kernels(),
-        super::arm::urdf(),
-        super::arm::map()?,
-        super::trajectory6::trajectory6(),
-    ])
-}
-
 pub fn outcome<T, E: std::fmt::Display>(r: Result<T, E>) -> String {
     r.map_or_else(|e| e.to_string(), |_| "ok".into())
 }
@@ -52,7 +35,7 @@ pub fn outcome<T, E: std::fmt::Display>(r: Result<T, E>) -> String {
 /// A record's sample block past its checksum (what a crafted record, or another
 /// build's, hands the reader): the planes' layout unpacked, the rows it claims taken
 /// from its first varint so the deeper paths are reached.
-fn blocks() -> Target {
+pub(super) fn blocks() -> Target {
     use tactile_records::block;
     let mut seeds = Vec::new();
     for (rows, len) in [(50usize, 24usize), (7, 9)] {
@@ -73,7 +56,7 @@ fn blocks() -> Target {
 }
 
 /// The three nodes' record files: the reader of each role over the same bytes.
-fn records(scratch: &Path) -> Result<Target, String> {
+pub(super) fn records(scratch: &Path) -> Result<Target, String> {
     let out = scratch.join("seed-run");
     let text = crate::launch::PAPER_SCENARIO.replace("samples = 1200", "samples = 30");
     let scenario = tactile_scenario::Scenario::from_toml_str(&text).map_err(|e| e.to_string())?;
@@ -124,7 +107,7 @@ fn read_all<S: serde::de::DeserializeOwned, C: serde::de::DeserializeOwned>(p: &
 }
 
 /// The ROS 2 messages the nodes take in from drivers.
-fn cdr() -> Target {
+pub(super) fn cdr() -> Target {
     let joints = JointState {
         name: vec!["waist".into(), "shoulder".into(), "elbow".into()],
         position: vec![0.1, -0.2, 0.3],
@@ -152,7 +135,7 @@ fn cdr() -> Target {
 }
 
 /// The loop's samples on UDP and Zenoh.
-fn wire() -> Target {
+pub(super) fn wire() -> Target {
     let mut f = Vec::new();
     let mut b = Vec::new();
     let _ = tactile_transport::wire::encode(&Forward::default(), &mut f);
@@ -170,7 +153,7 @@ fn wire() -> Target {
 }
 
 /// rmw_zenoh's attachment on every ROS 2 sample.
-fn attachment() -> Target {
+pub(super) fn attachment() -> Target {
     let a = tactile_ros::rmw::Attachment {
         seq: 7,
         stamp_ns: 1_700_000_000_000_000_000,
@@ -187,7 +170,7 @@ fn attachment() -> Target {
 }
 
 /// Scenario files.
-fn scenario() -> Target {
+pub(super) fn scenario() -> Target {
     let seeds = [
         crate::launch::PAPER_SCENARIO,
         include_str!("../../../scenarios/wall-delay.toml"),
@@ -205,7 +188,7 @@ fn scenario() -> Target {
 }
 
 /// Operator trajectory files (CSV, timed or not).
-fn trajectory() -> Target {
+pub(super) fn trajectory() -> Target {
     let seeds = [
         "x,y,z\n0.1,0.0,-0.1\n0.11,0.01,-0.12\n",
         "t,x,y,z\n0,0.1,0.0,-0.1\n0.5,0.11,0.01,-0.12\n1.0,0.1,0.0,-0.1\n",
@@ -225,7 +208,7 @@ fn trajectory() -> Target {
 }
 
 /// `tactile kernels` input (CSV on stdin), for each kernel in the hybrid arithmetic.
-fn kernels() -> Target {
+pub(super) fn kernels() -> Target {
     use clap::Parser;
     #[derive(Parser)]
     struct K {
