@@ -6,6 +6,7 @@ use crate::error::Error;
 use crate::spatial::Frame;
 use nalgebra::{Matrix3, Vector3};
 use roxmltree::{Document, Node};
+use tactile_math::shown::Num;
 
 /// xacro's XML namespace.
 const XACRO: &str = "http://www.ros.org/wiki/xacro";
@@ -189,15 +190,6 @@ fn what(n: Node) -> String {
     )
 }
 
-/// A number for an error message: as written when it is of an everyday size, in
-/// exponent form otherwise (1e308 is not 309 digits).
-pub(crate) fn shown(x: f64) -> String {
-    match x == 0.0 || (1e-4..1e9).contains(&x.abs()) {
-        true => format!("{x}"),
-        false => format!("{x:e}"),
-    }
-}
-
 fn named(n: Node) -> Result<String, Error> {
     match n.attribute("name") {
         Some(s) if !s.is_empty() => Ok(s.to_string()),
@@ -260,7 +252,7 @@ fn origin(owner: &Node, holder: Node) -> Result<Frame, Error> {
             "origin xyz",
             format!(
                 "{} m is further than {MAX_LENGTH_M} m: not a robot's link",
-                shown(*x)
+                Num(*x)
             ),
         ));
     }
@@ -285,7 +277,7 @@ fn link(n: Node) -> Result<Link, Error> {
         return Err(bad(
             &n,
             "mass value",
-            format!("{} kg is outside 0 to {MAX_MASS_KG} kg", shown(mass)),
+            format!("{} kg is outside 0 to {MAX_MASS_KG} kg", Num(mass)),
         ));
     }
     let t = child(i, "inertia").ok_or_else(|| bad(&n, "inertial inertia", "missing"))?;
@@ -413,11 +405,7 @@ fn limit(n: &Node, k: JointType) -> Result<Option<Limit>, Error> {
         return Err(bad(
             n,
             "limit",
-            format!(
-                "lower {} is above upper {}",
-                shown(lim.lower),
-                shown(lim.upper)
-            ),
+            format!("lower {} is above upper {}", Num(lim.lower), Num(lim.upper)),
         ));
     }
     if lim.velocity < 0.0 || lim.effort < 0.0 {
@@ -452,7 +440,7 @@ fn damping(n: &Node) -> Result<f64, Error> {
                 &format!("dynamics {attr}"),
                 format!(
                     "{} is negative: it would push the joint, not resist it",
-                    shown(v)
+                    Num(v)
                 ),
             ));
         }

@@ -13,5 +13,6 @@ pub mod engine;
 pub mod geometry;
 pub mod hardware;
 pub mod kernels;
+pub mod shown;
 pub mod validation;
 pub mod vec3;

@@ -2,6 +2,16 @@
 //! the same (`1e308`, not 309 digits; `0.001`, not `1e-3`), a list of names cut to its
 //! first few (`a, b, ... and 9990 more`), so a message stays one readable line
 //! whatever a user's file holds.
+//!
+//! Why here, in the math crate: both crates that word errors about a user's files
+//! need it, `tactile-scenario` (fields beyond their bounds) and `tactile-chain` (a
+//! URDF's values and names), and neither depends on the other. `tactile-math` is
+//! already a dependency of the scenario crate and of every crate that uses the
+//! chain, it is pure (no I/O) and light (serde, thiserror), so the chain depending on
+//! it couples least: making the scenario crate depend on the chain would pull
+//! nalgebra and roxmltree into every node, and a crate of its own for two functions
+//! would be one more crate to build and keep. `tactile_scenario::shown` re-exports
+//! this module.
 
 use std::fmt;
 

@@ -9,6 +9,7 @@
 //! mapped back into the master's frame, so a scenario's objects and stiffnesses keep
 //! their meaning whatever the arm.
 
+use crate::shown::Num;
 use crate::workspace::{self, apply, apply_transpose, FrameRotation, Scale, Workspace};
 use crate::{invalid, positive, ScenarioError};
 use serde::{Deserialize, Serialize};
@@ -317,7 +318,7 @@ impl ArmIkConfig {
         if !(self.velocity_scale > 0.0 && self.velocity_scale <= 1.0) {
             return Err(invalid(
                 "slave.arm.ik.velocity_scale",
-                format!("{} is outside (0, 1]", self.velocity_scale),
+                format!("{} is outside (0, 1]", Num(self.velocity_scale)),
             ));
         }
         Ok(())

@@ -2,6 +2,7 @@
 //! deadband codecs and the predictors, as the scenario sets them (their behaviour is in
 //! `tactile-control`).
 
+use crate::shown::Num;
 use crate::{invalid, positive, ScenarioError};
 use serde::{Deserialize, Serialize};
 
@@ -128,14 +129,14 @@ impl CodecConfig {
         if !self.k.is_finite() || !(0.0..=10.0).contains(&self.k) {
             return Err(invalid(
                 format!("{field}.k"),
-                format!("{} is outside 0..=10", self.k),
+                format!("{} is outside 0..=10", Num(self.k)),
             ));
         }
         for (name, v) in [("floor", self.floor), ("v_ref", self.v_ref)] {
             if !v.is_finite() || v < 0.0 || (name == "v_ref" && v == 0.0) {
                 return Err(invalid(
                     format!("{field}.{name}"),
-                    format!("{v} must be positive"),
+                    format!("{} must be positive", Num(v)),
                 ));
             }
         }
@@ -199,20 +200,20 @@ impl PredictorConfig {
             if !v.is_finite() || v <= 0.0 || v > 1e12 {
                 return Err(invalid(
                     format!("{field}.{name}"),
-                    format!("{v} is outside (0, 1e12]"),
+                    format!("{} is outside (0, 1e12]", Num(v)),
                 ));
             }
         }
         if !self.horizon_s.is_finite() || !(0.0..=10.0).contains(&self.horizon_s) {
             return Err(invalid(
                 format!("{field}.horizon_s"),
-                format!("{} s is outside 0..=10 s", self.horizon_s),
+                format!("{} s is outside 0..=10 s", Num(self.horizon_s)),
             ));
         }
         if !self.max_rate.is_finite() || self.max_rate < 0.0 {
             return Err(invalid(
                 format!("{field}.max_rate"),
-                format!("{} must be non-negative", self.max_rate),
+                format!("{} must be non-negative", Num(self.max_rate)),
             ));
         }
         Ok(())

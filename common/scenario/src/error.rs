@@ -1,6 +1,7 @@
 //! What a scenario that cannot run says: the dotted path of the field and the
 //! problem, and the small range checks every table shares.
 
+use crate::shown::Num;
 use thiserror::Error;
 
 /// A scenario that cannot run, with the dotted path of the offending field.
@@ -29,7 +30,10 @@ pub(crate) fn invalid(field: impl Into<String>, problem: impl Into<String>) -> S
 pub(crate) fn positive(v: f64, field: &str, zero_ok: bool) -> Result<(), ScenarioError> {
     if !v.is_finite() || v < 0.0 || (!zero_ok && v == 0.0) {
         let want = if zero_ok { "non-negative" } else { "positive" };
-        return Err(invalid(field, format!("{v} must be finite and {want}")));
+        return Err(invalid(
+            field,
+            format!("{} must be finite and {want}", Num(v)),
+        ));
     }
     Ok(())
 }
@@ -57,7 +61,7 @@ pub(crate) fn positive3(v: &[f64; 3], field: &str, allow_zero: bool) -> Result<(
             };
             return Err(invalid(
                 format!("{field}[{i}]"),
-                format!("{x} must be {want}"),
+                format!("{} must be {want}", Num(*x)),
             ));
         }
     }
@@ -75,5 +79,22 @@ pub fn one_line(text: &str, e: &toml::de::Error) -> String {
             format!("line {line}, column {column}: {msg}")
         }
         None => msg,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shared checks most fields go through show a huge value short: `{}` of
+    /// -1e308 is 309 digits.
+    #[test]
+    fn a_huge_value_given_to_the_shared_checks_is_shown_short() {
+        let e = format!("{:?}", positive(-1e308, "x", true));
+        assert!(e.contains("-1e308 must be"), "{e}");
+        assert!(e.len() < 120, "{e}");
+        let e = format!("{:?}", positive3(&[1.0, -1e308, 1.0], "v", true));
+        assert!(e.contains("-1e308 must be"), "{e}");
+        assert!(e.len() < 120, "{e}");
     }
 }

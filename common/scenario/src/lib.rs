@@ -21,7 +21,8 @@ mod operator;
 pub mod overrides;
 mod ros;
 mod ros_tls;
-pub mod shown;
+/// Numbers and name lists as error messages show them (defined in `tactile-math`, shared with the URDF chain).
+pub use tactile_math::shown;
 mod slave;
 mod validate;
 mod watch;

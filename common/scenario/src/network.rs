@@ -2,6 +2,7 @@
 //! the netem-class models and replays (their behaviour is in `tactile-netem`; their
 //! settings and ranges are here).
 
+use crate::shown::Num;
 use crate::{invalid, ScenarioError};
 use serde::{Deserialize, Serialize};
 
@@ -144,7 +145,7 @@ impl ChannelConfig {
             if !p.is_finite() || !(0.0..=1.0).contains(&p) {
                 return Err(invalid(
                     format!("{field}.{name}"),
-                    format!("{p} is not a probability in [0, 1]"),
+                    format!("{} is not a probability in [0, 1]", Num(p)),
                 ));
             }
         }
@@ -152,7 +153,10 @@ impl ChannelConfig {
             if !s.is_finite() || *s < 0.0 {
                 return Err(invalid(
                     format!("{field}.noise_std[{i}]"),
-                    format!("{s} must be a finite, non-negative standard deviation"),
+                    format!(
+                        "{} must be a finite, non-negative standard deviation",
+                        Num(*s)
+                    ),
                 ));
             }
         }
@@ -241,7 +245,7 @@ fn probability(v: f64, field: &str) -> Result<(), ScenarioError> {
     if !v.is_finite() || !(0.0..=1.0).contains(&v) {
         return Err(invalid(
             field,
-            format!("{v} is not a probability in [0, 1]"),
+            format!("{} is not a probability in [0, 1]", Num(v)),
         ));
     }
     Ok(())
@@ -258,14 +262,14 @@ impl JitterConfig {
         if !self.jitter.is_finite() || self.jitter < 0.0 || self.jitter > 10_000.0 {
             return Err(invalid(
                 format!("{field}.jitter.jitter"),
-                format!("{} samples is outside 0..=10000", self.jitter),
+                format!("{} samples is outside 0..=10000", Num(self.jitter)),
             ));
         }
         let c = self.correlation;
         if !c.is_finite() || !(0.0..1.0).contains(&c) {
             return Err(invalid(
                 format!("{field}.jitter.correlation"),
-                format!("{c} is outside [0, 1)"),
+                format!("{} is outside [0, 1)", Num(c)),
             ));
         }
         Ok(())

@@ -1,5 +1,6 @@
 //! `[operator]`: what the operator's hand does, a(n).
 
+use crate::shown::Num;
 use crate::{finite3, invalid, ScenarioError};
 use serde::{Deserialize, Serialize};
 
@@ -118,7 +119,7 @@ impl Operator {
                 if !period_s.is_finite() || *period_s <= 0.0 {
                     return Err(invalid(
                         "operator.period_s",
-                        format!("{period_s} must be positive"),
+                        format!("{} must be positive", Num(*period_s)),
                     ));
                 }
                 if !["xy", "yz", "xz"].contains(&plane.as_str()) {
@@ -134,7 +135,7 @@ impl Operator {
                 if !move_s.is_finite() || *move_s <= 0.0 {
                     return Err(invalid(
                         "operator.move_s",
-                        format!("{move_s} must be positive"),
+                        format!("{} must be positive", Num(*move_s)),
                     ));
                 }
             }

@@ -9,6 +9,7 @@
 //! controller; every one of them is to be checked against the driver at hand.
 
 use crate::hand::{ClutchConfig, ForceMessage, GimbalConfig, HandInput};
+use crate::shown::Num;
 use crate::watch::WatchConfig;
 use crate::{finite3, invalid, positive, ScenarioError};
 use serde::{Deserialize, Serialize};
@@ -145,7 +146,7 @@ impl JointMapConfig {
             if *s != 1.0 && *s != -1.0 {
                 return Err(invalid(
                     format!("{field}.sign[{i}]"),
-                    format!("{s} is not 1 or -1"),
+                    format!("{} is not 1 or -1", Num(*s)),
                 ));
             }
         }
@@ -159,7 +160,10 @@ impl JointMapConfig {
                 if x.abs() > MAX_ANGLE_RAD {
                     return Err(invalid(
                         format!("{field}.{name}[{i}]"),
-                        format!("{x} rad is beyond +-{MAX_ANGLE_RAD} rad: no joint turns that far"),
+                        format!(
+                            "{} rad is beyond +-{MAX_ANGLE_RAD} rad: no joint turns that far",
+                            Num(*x)
+                        ),
                     ));
                 }
             }
@@ -168,7 +172,11 @@ impl JointMapConfig {
             if self.min[i] >= self.max[i] {
                 return Err(invalid(
                     format!("{field}.max[{i}]"),
-                    format!("{} rad is not above min {} rad", self.max[i], self.min[i]),
+                    format!(
+                        "{} rad is not above min {} rad",
+                        Num(self.max[i]),
+                        Num(self.min[i])
+                    ),
                 ));
             }
         }
@@ -213,7 +221,7 @@ impl ForceMapConfig {
             if *s != 1.0 && *s != -1.0 {
                 return Err(invalid(
                     format!("{field}.sign[{i}]"),
-                    format!("{s} is not 1 or -1"),
+                    format!("{} is not 1 or -1", Num(*s)),
                 ));
             }
         }
@@ -454,7 +462,7 @@ impl RosConfig {
         if !r.is_finite() || r <= 0.0 || r > rate_hz {
             return Err(invalid(
                 "ros.live.rate_hz",
-                format!("{r} Hz is outside (0, {rate_hz}] (the loop's rate)"),
+                format!("{} Hz is outside (0, {rate_hz}] (the loop's rate)", Num(r)),
             ));
         }
         Ok(())
@@ -477,7 +485,7 @@ impl RosDeviceConfig {
         if !self.ramp_s.is_finite() || !(0.0..=10.0).contains(&self.ramp_s) {
             return Err(invalid(
                 "master.ros2.ramp_s",
-                format!("{} s is outside 0 to 10 s", self.ramp_s),
+                format!("{} s is outside 0 to 10 s", Num(self.ramp_s)),
             ));
         }
         positive(self.max_force_rate, "master.ros2.max_force_rate", false)?;
@@ -510,7 +518,7 @@ impl RosRobotConfig {
             if !t.is_finite() || !(0.0..=1.0).contains(&t) || t == 0.0 {
                 return Err(invalid(
                     "slave.ros2.trajectory_time_s",
-                    format!("{t} s is outside (0, 1] s"),
+                    format!("{} s is outside (0, 1] s", Num(t)),
                 ));
             }
         }

@@ -1,6 +1,7 @@
 //! `[slave]` and `[environment]`: the slave's joint controller and dynamics, and the
 //! objects the tool can touch.
 
+use crate::shown::Num;
 use crate::{finite3, invalid, positive3, ScenarioError};
 use crate::{ArmConfig, Backend, PredictorConfig, RosRobotConfig};
 use serde::{Deserialize, Serialize};
@@ -147,7 +148,7 @@ impl SlaveConfig {
         if !d.step_s.is_finite() || d.step_s < 1e-6 || d.step_s > 0.01 {
             return Err(invalid(
                 "slave.dynamics.step_s",
-                format!("{} s is outside 1 us to 10 ms", d.step_s),
+                format!("{} s is outside 1 us to 10 ms", Num(d.step_s)),
             ));
         }
         self.predictor.validate("slave.predictor")?;
@@ -172,7 +173,10 @@ impl Environment {
                 if *h > MAX_STIFFNESS {
                     return Err(invalid(
                     format!("{f}.stiffness[{i}]"),
-                    format!("{h} N/m is above {MAX_STIFFNESS} N/m, ten times the device's nominal maximum"),
+                    format!(
+                        "{} N/m is above {MAX_STIFFNESS} N/m, ten times the device's nominal maximum",
+                        Num(*h)
+                    ),
                 ));
                 }
             }
@@ -192,7 +196,7 @@ impl Environment {
                     if !radius.is_finite() || *radius <= 0.0 {
                         return Err(invalid(
                             format!("{f}.radius"),
-                            format!("{radius} must be positive"),
+                            format!("{} must be positive", Num(*radius)),
                         ));
                     }
                 }

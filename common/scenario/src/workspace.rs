@@ -9,6 +9,7 @@
 //! loop's values pass through exactly (a product with 1 and sums with 0), so the
 //! defaults leave every run's bytes as they were.
 
+use crate::shown::Num;
 use crate::{invalid, ScenarioError};
 use serde::{Deserialize, Serialize};
 
@@ -25,11 +26,11 @@ fn in_scale_range(s: f64) -> bool {
     s.is_finite() && (SCALE_RANGE.0..=SCALE_RANGE.1).contains(&s)
 }
 
-/// Why a scale is refused: the value (in exponent form, so 1e-300 is not 300 digits)
-/// and the range.
+/// Why a scale is refused: the value (in its shortest form, so 1e-300 is not 300
+/// digits and 100.1 is not `1.001e2`) and the range.
 fn out_of_range(s: f64) -> String {
     let (lo, hi) = SCALE_RANGE;
-    format!("{s:e} is outside [{lo}, {hi}]")
+    format!("{} is outside [{lo}, {hi}]", Num(s))
 }
 
 /// How far from one a configured quaternion's norm may be before it is refused (four
@@ -142,7 +143,7 @@ impl FrameRotation {
                     if !(v.is_finite() && v.abs() <= 360.0) {
                         return Err(invalid(
                             format!("{field}.rpy_deg[{i}]"),
-                            format!("{v} is not an angle within 360 degrees"),
+                            format!("{} is not an angle within 360 degrees", Num(*v)),
                         ));
                     }
                 }
@@ -233,7 +234,11 @@ impl Workspace {
             if !(lo.is_finite() && hi.is_finite() && lo < hi) {
                 return Err(invalid(
                     format!("{field}.min[{k}]"),
-                    format!("{lo} m is not a finite number below max[{k}] = {hi} m"),
+                    format!(
+                        "{} m is not a finite number below max[{k}] = {} m",
+                        Num(lo),
+                        Num(hi)
+                    ),
                 ));
             }
         }
@@ -267,6 +272,13 @@ pub(crate) fn validate(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A scale just past its bound reads as written: `{:e}` showed 100.1 as `1.001e2`.
+    #[test]
+    fn a_scale_out_of_range_reads_as_written() {
+        assert_eq!(out_of_range(100.1), "100.1 is outside [0.001, 100]");
+        assert_eq!(out_of_range(-1e308), "-1e308 is outside [0.001, 100]");
+    }
 
     fn close(a: [f64; 3], b: [f64; 3]) -> bool {
         (0..3).all(|i| (a[i] - b[i]).abs() < 1e-12)
