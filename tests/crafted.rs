@@ -357,3 +357,66 @@ fn swap_rows<S, C>(all: &mut [Record<S, C>], a: usize, b: usize, len: usize) {
         all.swap(at[a + i], at[b + i]);
     }
 }
+
+/// Issue 51: a master record of samples 0 and [`JUMP`] only (its start claiming
+/// them) beside a slave record of every sample between: the slave's source read for
+/// the far sample with its floor still at 1, holding every row between (1.6 kB a
+/// row, memory in proportion to the file). They are counted as read, not held.
+#[test]
+fn a_jump_of_the_masters_spine_holds_no_rows_in_between() {
+    const JUMP: u64 = 400_000;
+    let (sb, rec) = crafted("spinejump", "master");
+    let mut all = entries::<MasterSample, MasterTotals>(&rec);
+    all.retain_mut(|e| match e {
+        Record::Start(s) => {
+            s.samples = JUMP + 1;
+            true
+        }
+        Record::Sample(s) => {
+            let n = match s {
+                MasterSample::Sent(x) => &mut x.n,
+                MasterSample::Answer(x) => &mut x.n,
+                MasterSample::Miss(x) => &mut x.n,
+            };
+            if *n == 1 {
+                *n = JUMP;
+            }
+            *n == 0 || *n == JUMP
+        }
+        _ => true,
+    });
+    rewrite(&rec, &all, 100);
+    let slave = sb.path("bad").join("slave.rec");
+    let all = entries::<SlaveSample, SlaveTotals>(&slave);
+    let row = first_row(&all);
+    let between = (0..JUMP).map(|n| {
+        let mut r = row.clone();
+        if let SlaveSample::Step(s) = &mut r {
+            s.n = n;
+        }
+        Record::Sample(r)
+    });
+    let at = all
+        .iter()
+        .position(|e| matches!(e, Record::Sample(_)))
+        .unwrap_or(0);
+    let rest: Vec<_> = all[at..]
+        .iter()
+        .filter(|e| !matches!(e, Record::Sample(_)))
+        .cloned()
+        .collect();
+    let crafted: Vec<_> = all[..at]
+        .iter()
+        .cloned()
+        .chain(between)
+        .chain(rest)
+        .collect();
+    rewrite(&slave, &crafted, COPIES);
+    let (status, peak_kb) = util::run_measured(report(&sb, "bad"));
+    assert!(status.success(), "{status}");
+    // Held, the rows between took about 640 MB.
+    assert!(peak_kb < 256 * 1024, "peak RSS {peak_kb} kB");
+    let s = sb.json("bad", "summary.json");
+    let node = &s["nodes"]["slave"];
+    assert_eq!(node["unjoined"], JUMP - 1, "{node}");
+}

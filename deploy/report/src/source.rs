@@ -187,6 +187,11 @@ where
     /// The rows of sample `n`; rows of earlier samples are counted as unjoined, and
     /// so is any row of them read from now on.
     pub(crate) fn take(&mut self, n: u64, stop: &dyn Fn() -> bool) -> Result<Vec<S>, Error> {
+        // Raised before reading: when the master's spine jumps far ahead, the rows
+        // between are counted as they are read, not held until this sample is in
+        // (they would be counted unjoined anyway, and held they cost memory in
+        // proportion to the file).
+        self.floor = self.floor.max(n);
         self.fill_to(n, stop)?;
         while let Some(entry) = self.ahead.first_entry() {
             if *entry.key() >= n {
