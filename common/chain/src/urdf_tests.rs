@@ -95,3 +95,15 @@ fn faults_name_the_element_and_the_field() {
         assert!(e.contains(want), "`{e}` should contain `{want}`");
     }
 }
+
+/// A flat body rounded to two digits by a CAD export is taken (refused with a 1e-6
+/// tolerance); one that breaks the triangle inequality, or has a negative moment, is not.
+#[test]
+fn a_rounded_flat_bodys_inertia_is_taken() {
+    let diag = |x: f64, y: f64, z: f64| Matrix3::from_diagonal(&Vector3::new(x, y, z));
+    assert_eq!(physical(&diag(1.2e-5, 1.2e-5, 2.5e-5)), Ok(()));
+    let e = physical(&diag(1.0, 1.0, 3.0)).err().unwrap_or_default();
+    assert!(e.contains("triangle inequality"), "{e}");
+    let e = physical(&diag(-1e-3, 1.0, 1.0)).err().unwrap_or_default();
+    assert!(e.contains("negative"), "{e}");
+}
