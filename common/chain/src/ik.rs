@@ -11,6 +11,17 @@ use crate::error::Error;
 use crate::spatial::{log_rotation, Frame};
 use nalgebra::{DMatrix, DVector, Matrix6xX, SymmetricEigen};
 
+/// The middle of a joint's limits, the default posture (0 where a limit is
+/// infinite). Halved before the sum: `(lower + upper) / 2` overflows to infinity for
+/// finite limits above about 9e307, which a URDF may hold.
+fn midpoint(lower: f64, upper: f64) -> f64 {
+    if lower.is_finite() && upper.is_finite() {
+        lower / 2.0 + upper / 2.0
+    } else {
+        0.0
+    }
+}
+
 /// A target: the tip's pose in the base frame.
 pub type Pose = Frame;
 
@@ -160,13 +171,7 @@ impl Ik {
             None => chain
                 .dofs
                 .iter()
-                .map(|d| {
-                    if d.lower.is_finite() && d.upper.is_finite() {
-                        (d.lower + d.upper) / 2.0
-                    } else {
-                        0.0
-                    }
-                })
+                .map(|d| midpoint(d.lower, d.upper))
                 .collect(),
         };
         Ok(Ik {
@@ -384,5 +389,19 @@ impl Ik {
             *x = a + (*x - a) / over;
         }
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::midpoint;
+
+    /// Huge finite limits have a finite middle: `(lower + upper) / 2` was infinity.
+    #[test]
+    fn huge_limits_have_a_finite_middle() {
+        assert_eq!(midpoint(1e308, 1.5e308), 1.25e308);
+        assert_eq!(midpoint(-1.7e308, 1.7e308), 0.0);
+        assert_eq!(midpoint(-1.0, 3.0), 1.0);
+        assert_eq!(midpoint(f64::NEG_INFINITY, 1.0), 0.0);
     }
 }
