@@ -420,3 +420,36 @@ fn a_jump_of_the_masters_spine_holds_no_rows_in_between() {
     let node = &s["nodes"]["slave"];
     assert_eq!(node["unjoined"], JUMP - 1, "{node}");
 }
+
+/// Issue 51: the sample count was the largest any start claimed, so a slave.rec whose
+/// start says 2^63 lifted it for every node and its row numbered 10^9 was valid again
+/// (the record ended "after sample 1000000000"). The master's start sets it; the
+/// slave's claim is warned of.
+#[test]
+fn a_start_claiming_more_samples_lifts_no_limit() {
+    let (sb, rec) = crafted("startclaim", "slave");
+    let mut all = entries::<SlaveSample, SlaveTotals>(&rec);
+    for e in &mut all {
+        if let Record::Start(s) = e {
+            s.samples = 1 << 63;
+        }
+    }
+    let mut row = first_row(&all);
+    if let SlaveSample::Step(s) = &mut row {
+        s.n = 1_000_000_000;
+    }
+    all.insert(all.len() - 1, Record::Sample(row));
+    rewrite(&rec, &all, 100);
+    let text = reported(&sb);
+    let s = sb.json("bad", "summary.json");
+    let node = &s["nodes"]["slave"];
+    assert_eq!(node["invalid"], 1, "{node}");
+    assert_eq!(node["last_sample"], SAMPLES - 1, "{node}");
+    assert!(
+        text.contains(&format!(
+            "slave: its start claims {} samples where the run's count applied is {SAMPLES}",
+            1u64 << 63
+        )) && text.contains(&format!("1 numbered past the run's {SAMPLES} samples")),
+        "{text}"
+    );
+}

@@ -33,6 +33,11 @@ pub struct Logs {
     /// A stop request ended the join before this sample: the logs hold what was
     /// read by then.
     pub stopped_at: Option<u64>,
+    /// The run's sample count applied: rows numbered from here on were counted
+    /// `invalid` (u64::MAX: no start known, none refused).
+    pub limit: u64,
+    /// Nodes whose start claims another sample count than the one applied.
+    pub disagree: Vec<(Role, u64)>,
 }
 
 /// Finds each role's record in `dirs`: every role at most once, the master's required.
@@ -69,20 +74,18 @@ pub fn locate(dirs: &[PathBuf]) -> Result<[Option<PathBuf>; 3], Error> {
     Ok(found)
 }
 
-/// The first whole `Start` of a record, read without joining (a frame of any role's
+/// The `Start` a record opens with, read without joining (a frame of any role's
 /// record decodes as a `Start` alike: the variant does not depend on the samples'
-/// type). A damaged first frame costs only itself: the next segment's start is taken,
-/// or none if the record holds no other.
+/// type). Only the first whole frame is looked at: nothing precedes a start, and
+/// reading on for a later segment's would read a whole crafted file with no stop
+/// request looked at. A damaged start frame leaves the node's start unknown.
 fn first_start(path: &Path) -> Result<Option<Start>, Error> {
     let mut r = RecordReader::<tactile_records::AnyRecord>::open(path)
         .map_err(|e| Error::BadInput(e.to_string()))?;
-    loop {
-        match r.next_record() {
-            Ok(Some(Record::Start(s))) => return Ok(Some(s)),
-            Ok(Some(_)) => {}
-            Ok(None) => return Ok(None),
-            Err(e) => return Err(Error::BadInput(e.to_string())),
-        }
+    match r.next_record() {
+        Ok(Some(Record::Start(s))) => Ok(Some(s)),
+        Ok(_) => Ok(None),
+        Err(e) => Err(Error::BadInput(e.to_string())),
     }
 }
 
@@ -259,17 +262,21 @@ struct Sources {
     master: Source<MasterSample, MasterTotals>,
     emulator: Source<Passage, EmulatorTotals>,
     slave: Source<SlaveSample, SlaveTotals>,
+    /// The sample count applied, and the starts that claim another.
+    limit: (u64, Vec<(Role, u64)>),
 }
 
 impl Sources {
     /// Opens the records found; sample numbers from `limit` on are no sample of the
     /// run.
-    fn open(found: [Option<PathBuf>; 3], limit: u64) -> Result<Sources, Error> {
+    fn open(found: [Option<PathBuf>; 3], limit: (u64, Vec<(Role, u64)>)) -> Result<Sources, Error> {
         let [m, e, s] = found;
+        let n = limit.0;
         Ok(Sources {
-            master: Source::open(m, limit, (master_key, master_whole))?,
-            emulator: Source::open(e, limit, (passage_key, passages_whole))?,
-            slave: Source::open(s, limit, (slave_key, |rows| rows.next().is_some()))?,
+            limit,
+            master: Source::open(m, n, (master_key, master_whole))?,
+            emulator: Source::open(e, n, (passage_key, passages_whole))?,
+            slave: Source::open(s, n, (slave_key, |rows| rows.next().is_some()))?,
         })
     }
 
@@ -281,12 +288,15 @@ impl Sources {
     /// The logs so far (`whole`: read to the end, checking what remains; a stop
     /// request then still ends the reading, and the logs say where the join was).
     fn logs(self, at: u64, whole: bool, stop: &dyn Fn() -> bool) -> Result<Logs, Error> {
+        let (limit, disagree) = self.limit;
         let mut logs = if whole {
             Logs {
                 master: self.master.finish(stop)?,
                 emulator: self.emulator.finish(stop)?,
                 slave: self.slave.finish(stop)?,
                 stopped_at: None,
+                limit,
+                disagree,
             }
         } else {
             Logs {
@@ -294,6 +304,8 @@ impl Sources {
                 emulator: self.emulator.into_log(),
                 slave: self.slave.into_log(),
                 stopped_at: Some(at),
+                limit,
+                disagree,
             }
         };
         if whole && stop() {
@@ -304,16 +316,23 @@ impl Sources {
     }
 }
 
-/// The run's sample count, from the first start found (every node records the
-/// scenario's): no sample of the run is numbered from there on. Without a start
-/// (all lost to damage), none is known and no number is refused.
-fn sample_count(found: &[Option<PathBuf>; 3]) -> Result<u64, Error> {
-    Ok(starts(found)?
-        .iter()
-        .flatten()
-        .map(|s| s.samples)
-        .max()
-        .unwrap_or(u64::MAX))
+/// The run's sample count: the master's start's (the master sets how many samples
+/// the run has; no node's start may lift it for the others), or where the master's
+/// start was lost the smallest another node claims; without a start none is known and
+/// no number is refused. With it, the nodes whose start claims another count.
+fn sample_count(found: &[Option<PathBuf>; 3]) -> Result<(u64, Vec<(Role, u64)>), Error> {
+    let starts = starts(found)?;
+    let claims: Vec<(Role, u64)> = Role::ALL
+        .into_iter()
+        .zip(&starts)
+        .filter_map(|(role, s)| s.as_ref().map(|s| (role, s.samples)))
+        .collect();
+    let limit = match &starts[0] {
+        Some(m) => m.samples,
+        None => claims.iter().map(|c| c.1).min().unwrap_or(u64::MAX),
+    };
+    let disagree = claims.into_iter().filter(|c| c.1 != limit).collect();
+    Ok((limit, disagree))
 }
 
 /// The slave's step of a sample, with a URDF arm's joints; further steps of the same

@@ -9,16 +9,21 @@ use tactile_messages::Role;
 use tactile_records::slave::SlaveCounters;
 
 /// The warnings of a report from its analysis, the nodes' logs and the slave's summed
-/// counters; `samples` is the run's sample count, `sent` the master's own count of
-/// samples sent.
+/// counters; `sent` is the master's own count of samples sent. A row's number is
+/// checked against the sample count the join applied ([`Logs::limit`]).
 pub fn warnings(
     a: &Analysis,
     logs: &Logs,
-    samples: u64,
     sent: u64,
     slave_counters: Option<&SlaveCounters>,
 ) -> Vec<String> {
     let mut out = Vec::new();
+    let samples = logs.limit;
+    for (role, claimed) in &logs.disagree {
+        out.push(format!(
+            "{role}: its start claims {claimed} samples where the run's count applied is {samples}: rows numbered from {samples} on were counted invalid"
+        ));
+    }
     left_out(Role::Master, &logs.master, samples, &mut out);
     left_out(Role::Emulator, &logs.emulator, samples, &mut out);
     left_out(Role::Slave, &logs.slave, samples, &mut out);

@@ -286,7 +286,6 @@ fn summarise(
     let warnings = crate::warnings::warnings(
         a,
         logs,
-        scenario.samples,
         master_totals.counters.sent,
         slave.as_ref().map(|s| &s.counters),
     );
