@@ -101,9 +101,9 @@ pub fn load_scenario(path: &Path) -> Result<(Scenario, PathBuf), String> {
 /// is not says how paths are resolved and how to copy a scenario elsewhere: a copy of
 /// a shipped scenario keeps its relative paths, which then point nowhere.
 pub fn inputs_present(scenario: &Scenario, base_dir: &Path) -> Result<(), String> {
-    for p in scenario.clone().input_paths_mut() {
-        let full = base_dir.join(p.as_str());
-        if full.exists() || Path::new(p.as_str()).is_absolute() {
+    for p in scenario.input_paths() {
+        let full = base_dir.join(&p);
+        if full.exists() || Path::new(&p).is_absolute() {
             continue;
         }
         return Err(format!(
