@@ -347,8 +347,10 @@ fn check_touch_run(sb: &Sandbox, r: &serde_json::Value, d: &serde_json::Value) {
         "h {h_end} N, MuJoCo's force at the loop's end {f_end} N"
     );
     let last = last_force(d);
+    let s = sb.json("out", "summary.json");
+    matches_the_loops_force(&s, last[3], h[1][end], "the Touch's z");
     assert!(
-        (last[3] - h[1][end]).abs() < 0.05 && last[1].abs() < 0.2 * last[3],
+        last[1].abs() < 0.2 * last[3] && last[2].abs() < 0.2 * last[3],
         "the Touch's last force {last:?}"
     );
     eprintln!(
@@ -367,6 +369,28 @@ fn check_touch_run(sb: &Sandbox, r: &serde_json::Value, d: &serde_json::Value) {
 
 /// The last force a device stand-in received before the end's zero (which must come:
 /// the run leaves the device rendering nothing), `[t, fx, fy, fz]`.
+/// The device's last force on one axis, `got`, against the loop's last force on that
+/// axis, `want`: the same within 0.05 N when the gate ramped the force up only once
+/// (at the start); after a restart (the device or the loop lost for a moment, as on a
+/// loaded machine) the force may end part way up its ramp, so then it only has to
+/// point the same way and be no larger.
+fn matches_the_loops_force(s: &serde_json::Value, got: f64, want: f64, what: &str) {
+    let device = &s["master"]["device"];
+    let (ramps, losses) = (num(&device["ramps"]), num(&device["losses"]));
+    if ramps == 1.0 && losses == 0.0 {
+        assert!(
+            (got - want).abs() < 0.05,
+            "{what}: {got} N for the loop's {want} N"
+        );
+    } else {
+        eprintln!("{ramps} ramps, {losses} losses: {what} {got} N for the loop's {want} N");
+        assert!(
+            got * want > 0.0 && got.abs() <= want.abs() + 0.05,
+            "{what}: {got} N for the loop's {want} N after {ramps} ramps, {losses} losses"
+        );
+    }
+}
+
 fn last_force(d: &serde_json::Value) -> Vec<f64> {
     let forces: Vec<Vec<f64>> = d["forces"]
         .as_array()
@@ -502,10 +526,7 @@ timeout_ms = 300.0
     assert!(h1[end] < -0.5, "h_1 at the end {}", h1[end]);
     let last = last_force(&d);
     assert_eq!(last.len(), 4, "t and three forces: {last:?}");
-    assert!(
-        (last[1] - h1[end]).abs() < 0.05,
-        "the device's last force {last:?}"
-    );
+    matches_the_loops_force(&s, last[1], h1[end], "the device's x");
     eprintln!(
         "Force Dimension -> Panda: {} free-space samples within {:.2} mm and {:.3} degrees at the median; {:.2} N at the device",
         moves.len(),
