@@ -151,7 +151,7 @@ fn a_bad_arm_is_named_and_nothing_starts() {
         (
             "[slave.arm]",
             "[slave]\nbackend = \"ros2\"\n[slave.ros2]\njoints = [\"a\", \"b\", \"c\"]\n[slave.arm]",
-            "field `slave.ros2.joints`: with [slave.arm] the arm's URDF gives the joints",
+            "field `slave.ros2.joints`: is for the paper's 3-DoF arm only; with [slave.arm] the arm's joints are its URDF's",
         ),
         (
             "[slave.arm]",

@@ -768,3 +768,69 @@ fn an_out_that_is_a_file_a_key_swept_twice_and_options_that_do_nothing_are_refus
         Some("not a folder")
     );
 }
+
+/// The shipped UR5 over ROS 2, its URDF by absolute path, with `extra` put into its
+/// `[slave.ros2]`.
+fn ur5_over_ros2(extra: &str) -> String {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let text =
+        std::fs::read_to_string(format!("{root}/scenarios/ur5-ros2.toml")).expect("ur5-ros2");
+    text.replace("../robots/", &format!("{root}/robots/"))
+        .replacen("[slave.ros2]\n", &format!("[slave.ros2]\n{extra}\n"), 1)
+}
+
+/// A 6-joint robot over ROS 2 is configured by its `[slave.arm]` alone (issue 52): the
+/// shipped UR5 checks, and the scenario `check` prints holds none of the paper arm's
+/// three-element keys (it printed `joints = ["joint1", "joint2", "joint3"]`, a
+/// three-joint `max_velocity` and maps for the six-joint arm) and checks again as
+/// printed.
+#[test]
+fn a_six_joint_robot_over_ros2_checks_with_its_urdf_alone() {
+    let sb = Sandbox::new("ur5-ros2-check");
+    let path = sb.write("ur5.toml", &ur5_over_ros2(""));
+    let o = sb.tactile(&["check", path.to_str().expect("utf-8")]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let printed = text(&o.stdout);
+    let table: toml::Table = printed.parse().expect("check prints TOML");
+    let ros2 = &table["slave"]["ros2"];
+    assert_eq!(ros2["command"].as_str(), Some("trajectory"), "{ros2}");
+    for key in ["joints", "map", "max_velocity", "wrench_map"] {
+        assert!(ros2.get(key).is_none(), "`{key}` printed:\n{ros2}");
+    }
+    let again = sb.write("printed.toml", &printed);
+    let o = sb.tactile(&["check", again.to_str().expect("utf-8")]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+}
+
+/// Beside `[slave.arm]` each of the paper arm's three-element keys is refused by its
+/// name, even at its default value (which passed before issue 52), with what to
+/// write instead: exit 2, nothing started.
+#[test]
+fn the_paper_arms_ros2_keys_beside_an_arm_are_refused_with_what_to_write() {
+    let sb = Sandbox::new("ur5-ros2-old-keys");
+    let defaults = [
+        "joints = [\"joint1\", \"joint2\", \"joint3\"]",
+        "max_velocity = [2.0, 2.0, 2.0]",
+        "map = { unit = \"rad\" }",
+        "wrench_map = { axes = [0, 1, 2] }",
+    ];
+    let wants: Vec<String> = defaults
+        .iter()
+        .map(|d| {
+            let key = d.split(' ').next().unwrap_or_default();
+            format!("field `slave.ros2.{key}`: is for the paper's 3-DoF arm only; with [slave.arm]")
+        })
+        .collect();
+    let cases: Vec<(&str, String, Vec<&str>)> = defaults
+        .iter()
+        .zip(&wants)
+        .map(|(d, want)| {
+            (
+                "old-key.toml",
+                ur5_over_ros2(d),
+                vec![want.as_str(), "delete"],
+            )
+        })
+        .collect();
+    assert_all_refused(&sb, &cases);
+}

@@ -50,7 +50,7 @@ impl RosRobot {
     /// Subscribes to the joint states (and the wrench) and declares the command
     /// publisher.
     pub fn open(node: &Arc<RosNode>, cfg: &RosRobotConfig, t_s_ns: u64) -> Result<Self, RosError> {
-        let map = JointMap::new(cfg.joints.clone(), cfg.map.clone());
+        let map = JointMap::new(cfg.paper_joints(), cfg.paper_map());
         let (joints, sub) = joints_in(node, &cfg.joint_states, map.clone())?;
         let mut subs = vec![sub];
         let wrench = if cfg.wrench_topic.is_empty() {
@@ -69,10 +69,14 @@ impl RosRobot {
             gate: {
                 let (lo, hi) = map.raw_range();
                 let t_s = t_s_ns as f64 * 1e-9;
-                JointGate::new(lo, hi, map.raw_step(cfg.max_velocity.map(|v| v * t_s)))
+                JointGate::new(
+                    lo,
+                    hi,
+                    map.raw_step(cfg.paper_max_velocity().map(|v| v * t_s)),
+                )
             },
             map,
-            wrench_map: cfg.wrench_map.clone(),
+            wrench_map: cfg.paper_wrench_map(),
             watch: Watch::new(&cfg.watch, t_s_ns),
             topic: cfg.joint_states.clone(),
             last_tick_ns: 0,

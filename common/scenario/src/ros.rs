@@ -141,7 +141,7 @@ impl Default for JointMapConfig {
 }
 
 impl JointMapConfig {
-    fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+    pub(crate) fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         for (i, s) in self.sign.iter().enumerate() {
             if *s != 1.0 && *s != -1.0 {
                 return Err(invalid(
@@ -206,7 +206,7 @@ impl Default for ForceMapConfig {
 }
 
 impl ForceMapConfig {
-    fn validate(&self, field: &str) -> Result<(), ScenarioError> {
+    pub(crate) fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         let mut seen = [false; 3];
         for (i, a) in self.axes.iter().enumerate() {
             if *a > 2 || seen[*a] {
@@ -244,7 +244,7 @@ impl ForceMapConfig {
 }
 
 /// Checks three joint names: non-empty and distinct.
-fn joint_names(names: &[String; 3], field: &str) -> Result<(), ScenarioError> {
+pub(crate) fn joint_names(names: &[String; 3], field: &str) -> Result<(), ScenarioError> {
     for (i, n) in names.iter().enumerate() {
         if n.is_empty() || names[..i].contains(n) {
             return Err(invalid(
@@ -314,91 +314,6 @@ impl Default for RosDeviceConfig {
             gimbal: None,
             clutch: ClutchConfig::default(),
             force_message: ForceMessage::default(),
-        }
-    }
-}
-
-/// The message a robot's controller takes its references in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum RobotCommand {
-    /// `std_msgs/msg/Float64MultiArray`, the joints in order: a forward position
-    /// controller's `commands` (`/<controller>/commands`).
-    #[default]
-    Positions,
-    /// `trajectory_msgs/msg/JointTrajectory` of one point, the joints by name: a
-    /// joint_trajectory_controller's `/<controller>/joint_trajectory` (UR's
-    /// scaled_joint_trajectory_controller, Franka's fr3_arm_controller, Kinova's,
-    /// xArm's). Only with `[slave.arm]`.
-    Trajectory,
-    /// `geometry_msgs/msg/PoseStamped` of the tool in the arm's base link (its
-    /// `frame_id`), stamped with the wall clock: for stacks that do their own IK and
-    /// safety, MoveIt Servo's `/servo_node/pose_target_cmds` and FZI
-    /// cartesian_controllers' `<controller>/target_frame`. The pose is the FK of the
-    /// joints the gate passed. Only with `[slave.arm]`.
-    Pose,
-}
-
-/// `[slave.ros2]`: a robot arm through ros2_control.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct RosRobotConfig {
-    /// The robot's `sensor_msgs/msg/JointState` topic: theta^SD.
-    pub joint_states: String,
-    /// Names of the joints moving as theta_1, theta_2, theta_3, and the order of the
-    /// commands.
-    pub joints: [String; 3],
-    /// The robot's joint conventions.
-    pub map: JointMapConfig,
-    /// Where the joint references go: `std_msgs/msg/Float64MultiArray` for a forward
-    /// position controller, in the driver's unit.
-    pub command_topic: String,
-    /// A force-torque sensor's `geometry_msgs/msg/WrenchStamped` (newtons, in the
-    /// robot's base frame); empty: the force comes from the environment model.
-    pub wrench_topic: String,
-    /// The paper's axes in the sensor's frame.
-    pub wrench_map: ForceMapConfig,
-    /// Staleness and loss.
-    pub watch: WatchConfig,
-    /// The fastest each joint may be commanded to move, rad/s (the paper's angles): a
-    /// command's step per period is cut to it.
-    pub max_velocity: [f64; 3],
-    /// The message the controller takes (`positions` or `trajectory`).
-    pub command: RobotCommand,
-    /// A trajectory point's `time_from_start`, s (default: one period).
-    pub trajectory_time_s: Option<f64>,
-    /// With `[slave.arm]`: the point the wrench's torque is about, `frame` (the
-    /// message frame's origin, as a sensor measures it) or `tool` (the tool, in the
-    /// frame's axes: Franka's `external_wrench_in_base_frame`, about its stiffness
-    /// frame, given in the base).
-    pub wrench_torque: TorqueAbout,
-}
-
-/// Where a wrench's torque is taken about.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum TorqueAbout {
-    /// The origin of the message's frame.
-    #[default]
-    Frame,
-    /// The arm's tool (its URDF tip).
-    Tool,
-}
-
-impl Default for RosRobotConfig {
-    fn default() -> Self {
-        RosRobotConfig {
-            joint_states: "/joint_states".into(),
-            joints: ["joint1".into(), "joint2".into(), "joint3".into()],
-            map: JointMapConfig::default(),
-            command_topic: "/forward_position_controller/commands".into(),
-            wrench_topic: String::new(),
-            wrench_map: ForceMapConfig::default(),
-            watch: WatchConfig::default(),
-            max_velocity: [2.0; 3],
-            command: RobotCommand::Positions,
-            trajectory_time_s: None,
-            wrench_torque: TorqueAbout::Frame,
         }
     }
 }
@@ -497,72 +412,6 @@ impl RosDeviceConfig {
             topic_name,
         )?;
         self.watch.validate("master.ros2.watch")
-    }
-}
-
-impl RosRobotConfig {
-    /// Checks the ranges; errors name `slave.ros2.*`.
-    pub fn validate(&self) -> Result<(), ScenarioError> {
-        topic_name(&self.joint_states, "slave.ros2.joint_states")?;
-        joint_names(&self.joints, "slave.ros2.joints")?;
-        self.map.validate("slave.ros2.map")?;
-        topic_name(&self.command_topic, "slave.ros2.command_topic")?;
-        if !self.wrench_topic.is_empty() {
-            topic_name(&self.wrench_topic, "slave.ros2.wrench_topic")?;
-        }
-        self.wrench_map.validate("slave.ros2.wrench_map")?;
-        for (i, v) in self.max_velocity.iter().enumerate() {
-            positive(*v, &format!("slave.ros2.max_velocity[{i}]"), false)?;
-        }
-        if let Some(t) = self.trajectory_time_s {
-            if !t.is_finite() || !(0.0..=1.0).contains(&t) || t == 0.0 {
-                return Err(invalid(
-                    "slave.ros2.trajectory_time_s",
-                    format!("{} s is outside (0, 1] s", Num(t)),
-                ));
-            }
-        }
-        self.watch.validate("slave.ros2.watch")
-    }
-
-    /// With `[slave.arm]` the arm's URDF names its joints, their limits and speeds:
-    /// the paper arm's three-joint fields must be left as they are.
-    pub fn validate_for_arm(&self) -> Result<(), ScenarioError> {
-        let d = RosRobotConfig::default();
-        let unused = [
-            ("joints", self.joints != d.joints),
-            ("map", self.map != d.map),
-            ("max_velocity", self.max_velocity != d.max_velocity),
-            ("wrench_map", self.wrench_map != d.wrench_map),
-        ];
-        for (field, set) in unused {
-            if set {
-                return Err(invalid(
-                    format!("slave.ros2.{field}"),
-                    "with [slave.arm] the arm's URDF gives the joints (by name), their limits and speeds, and a wrench is turned through its chain: leave it out",
-                ));
-            }
-        }
-        Ok(())
-    }
-}
-
-impl RobotCommand {
-    /// Checks the command fits the arm: a trajectory names joints and a pose needs
-    /// the chain's FK, which only an arm from its URDF has.
-    pub fn validate(self, arm: bool) -> Result<(), ScenarioError> {
-        let name = match self {
-            RobotCommand::Positions => return Ok(()),
-            RobotCommand::Trajectory => "trajectory",
-            RobotCommand::Pose => "pose",
-        };
-        if !arm {
-            return Err(invalid(
-                "slave.ros2.command",
-                format!("\"{name}\" needs [slave.arm] (its URDF names the joints and the tool); the paper's three joints take \"positions\""),
-            ));
-        }
-        Ok(())
     }
 }
 

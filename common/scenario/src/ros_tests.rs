@@ -1,5 +1,6 @@
 //! The ROS 2 tables' unit tests (beside the module, which they would double).
 use super::*;
+use crate::{RobotCommand, RosRobotConfig, Scenario};
 
 #[test]
 fn a_trajectory_command_needs_an_arm_from_its_urdf() {
@@ -79,4 +80,105 @@ fn a_gimbal_urdf_is_an_input_resolved_against_the_scenarios_folder() {
     let back = r.relative_to(std::path::Path::new("/lab/scenarios/.."));
     let g = back.master.ros2.gimbal.as_ref().expect("gimbal");
     assert_eq!(g.urdf, "devices/omni.urdf");
+}
+
+/// A 6-joint arm over ROS 2, `[slave.arm]` and `[slave.ros2]` with `extra` in it.
+fn arm_over_ros(extra: &str) -> String {
+    format!(
+        "[slave]\nbackend = \"ros2\"\n[slave.ros2]\ncommand = \"trajectory\"\n{extra}\n\
+         [slave.arm]\nurdf = \"ur5.urdf\"\nbase = \"base_link\"\ntip = \"tool0\"\n\
+         home = [0.0, -1.2, 1.6, -1.97, -1.5708, 0.0]\nkp = [1.0, 1.0, 1.0, 1.0, 1.0, 1.0]\n\
+         kd = [0.1, 0.1, 0.1, 0.1, 0.1, 0.1]\n"
+    )
+}
+
+/// The paper arm's three-element keys beside `[slave.arm]` are refused by name even
+/// when their value is the default (issue 52: a default value passed unnoticed), and
+/// the error says what to write instead.
+#[test]
+fn a_paper_arm_key_beside_an_arm_is_refused_by_name_at_any_value() {
+    Scenario::from_toml_str(&arm_over_ros("")).expect("[slave.arm] alone");
+    let cases = [
+        (
+            "joints = [\"joint1\", \"joint2\", \"joint3\"]",
+            "joints",
+            "delete `joints`",
+        ),
+        (
+            "max_velocity = [2.0, 2.0, 2.0]",
+            "max_velocity",
+            "<limit velocity>",
+        ),
+        ("map = { unit = \"rad\" }", "map", "delete [slave.ros2.map]"),
+        (
+            "wrench_map = { axes = [0, 1, 2] }",
+            "wrench_map",
+            "frame_id",
+        ),
+    ];
+    for (extra, field, instead) in cases {
+        let e = Scenario::from_toml_str(&arm_over_ros(extra)).expect_err(field);
+        let text = e.to_string();
+        assert!(
+            text.starts_with(&format!(
+                "field `slave.ros2.{field}`: is for the paper's 3-DoF arm only"
+            )),
+            "{text}"
+        );
+        assert!(text.contains(instead), "{text}");
+    }
+    // Whatever the backend: with an arm the keys never apply.
+    let simulated =
+        arm_over_ros("max_velocity = [1.0, 1.0, 1.0]").replace("\"ros2\"", "\"simulated\"");
+    let e = Scenario::from_toml_str(&simulated).expect_err("simulated");
+    assert!(e.to_string().contains("slave.ros2.max_velocity"), "{e}");
+}
+
+/// The paper's arm keeps its keys: given ones are used and written back, absent ones
+/// take the paper arm's defaults and are not written.
+#[test]
+fn the_paper_arm_keeps_its_three_joint_keys() {
+    let text = "[slave]\nbackend = \"ros2\"\n[slave.ros2]\njoints = [\"a\", \"b\", \"c\"]\n\
+                max_velocity = [1.0, 2.0, 3.0]\n";
+    let sc = Scenario::from_toml_str(text).expect("paper arm");
+    let r = &sc.slave.ros2;
+    assert_eq!(r.paper_joints(), ["a", "b", "c"].map(String::from));
+    assert_eq!(r.paper_max_velocity(), [1.0, 2.0, 3.0]);
+    assert_eq!(Scenario::from_toml_str(&sc.to_toml()).expect("again"), sc);
+    let d = RosRobotConfig::default();
+    assert_eq!(
+        d.paper_joints(),
+        ["joint1", "joint2", "joint3"].map(String::from)
+    );
+    assert_eq!(d.paper_max_velocity(), [crate::PAPER_MAX_VELOCITY; 3]);
+    let written: toml::Table = Scenario::default().to_toml().parse().expect("toml");
+    let slave_ros2 = &written["slave"]["ros2"];
+    for key in ["joints", "map", "max_velocity", "wrench_map"] {
+        assert!(slave_ros2.get(key).is_none(), "{key} written: {slave_ros2}");
+    }
+}
+
+/// A record of an arm made before issue 52 holds the paper arm's four keys at their
+/// defaults (every key was written): it still reads, as the same scenario without
+/// them, while a scenario file with them, or a record with another value, is refused.
+#[test]
+fn an_old_record_of_an_arm_reads_without_the_paper_arms_defaults() {
+    let old = "joints = [\"joint1\", \"joint2\", \"joint3\"]\n\
+               max_velocity = [2.0, 2.0, 2.0]\n\
+               map = { sign = [1.0, 1.0, 1.0], offset = [0.0, 0.0, 0.0], unit = \"rad\", \
+               min = [-3.141592653589793, -3.141592653589793, -3.141592653589793], \
+               max = [3.141592653589793, 3.141592653589793, 3.141592653589793], \
+               elbow_after_shoulder = false }\n\
+               wrench_map = { axes = [0, 1, 2], sign = [1.0, 1.0, 1.0] }";
+    let want = Scenario::from_toml_str(&arm_over_ros("")).expect("arm alone");
+    assert!(Scenario::from_toml_str(&arm_over_ros(old)).is_err());
+    let read = Scenario::from_recorded_toml(&arm_over_ros(old)).expect("old record");
+    assert_eq!(read, want);
+    let other = arm_over_ros("max_velocity = [1.0, 2.0, 2.0]");
+    let e = Scenario::from_recorded_toml(&other).expect_err("not what was written");
+    assert!(e.to_string().contains("slave.ros2.max_velocity"), "{e}");
+    // The paper's arm keeps whatever it recorded.
+    let paper = "[slave]\nbackend = \"ros2\"\n[slave.ros2]\nmax_velocity = [2.0, 2.0, 2.0]\n";
+    let read = Scenario::from_recorded_toml(paper).expect("paper");
+    assert_eq!(read.slave.ros2.max_velocity, Some([2.0; 3]));
 }

@@ -154,12 +154,8 @@ impl SlaveConfig {
         self.predictor.validate("slave.predictor")?;
         if let Some(arm) = &self.arm {
             arm.validate()?;
-            if self.backend == Backend::Ros2 {
-                self.ros2.validate_for_arm()?;
-            }
         }
-        self.ros2.command.validate(self.arm.is_some())?;
-        self.ros2.validate()
+        self.ros2.validate(self.arm.is_some())
     }
 }
 

@@ -368,7 +368,7 @@ fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
         )));
     };
     let from = found[k].clone().unwrap_or_default();
-    let scenario = Scenario::from_toml_str(&start.scenario_toml).map_err(|e| {
+    let scenario = Scenario::from_recorded_toml(&start.scenario_toml).map_err(|e| {
         Error::BadInput(format!(
             "{}: the scenario recorded is not valid: {e}",
             from.display()

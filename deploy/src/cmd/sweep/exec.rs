@@ -92,7 +92,11 @@ pub fn finished(dir: &Path) -> Option<Vec<Option<f64>>> {
 /// The seed the run in `dir` used, from its `scenario.toml`.
 pub fn seed_of(dir: &Path) -> Option<u64> {
     let text = std::fs::read_to_string(dir.join("scenario.toml")).ok()?;
-    Some(tactile_scenario::Scenario::from_toml_str(&text).ok()?.seed)
+    Some(
+        tactile_scenario::Scenario::from_recorded_toml(&text)
+            .ok()?
+            .seed,
+    )
 }
 
 fn summary(dir: &Path) -> Option<serde_json::Value> {
@@ -122,7 +126,7 @@ fn kept(w: &Work, args: &SweepArgs) -> Option<Vec<Option<f64>>> {
         }
     }
     let text = std::fs::read_to_string(w.dir.join("scenario.toml")).ok()?;
-    let mut theirs = tactile_scenario::Scenario::from_toml_str(&text).ok()?;
+    let mut theirs = tactile_scenario::Scenario::from_recorded_toml(&text).ok()?;
     let mut ours = w.loaded.scenario.clone();
     for s in [&mut theirs, &mut ours] {
         for p in s.input_paths_mut() {
