@@ -265,3 +265,62 @@ fn a_replayed_trace_reproduces_its_delays_and_losses() {
     );
     assert!(!sb.path("x").exists());
 }
+
+/// The paper at 100 Hz (lockstep) with a network given in samples, and the same given
+/// in milliseconds (`delay_ms`, `schedule_ms`, `jitter_ms`).
+fn paper_network(forward: &str, jitter: &str, backward: &str) -> String {
+    tactile::launch::PAPER_SCENARIO
+        .replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        .replacen("delay = [0, 0, 0]", forward, 1)
+        .replacen("delay = [0, 0, 0]", backward, 1)
+        + "\n[network.forward.jitter]\ndistribution = \"normal\"\n"
+        + jitter
+        + "\n"
+}
+
+/// Times in milliseconds are the samples they are at the scenario's rate: `check`
+/// shows both units, the run's trace is the sample form's byte for byte, and both
+/// forms of one time, or a time between samples, are refused naming the field.
+#[test]
+fn times_in_ms_run_as_their_samples_and_check_shows_both() {
+    let sb = Sandbox::new("ms");
+    let samples = sb.write(
+        "samples.toml",
+        &paper_network(
+            "delay = [5, 5, 5]\nschedule = [[0, 5, 5, 5], [600, 2, 3, 4]]",
+            "jitter = 2.0",
+            "delay = [3, 3, 3]",
+        ),
+    );
+    let ms = sb.write(
+        "ms.toml",
+        &paper_network(
+            "delay_ms = 50\nschedule_ms = [[0, 50], [6000, 20, 30, 40]]",
+            "jitter_ms = 20",
+            "delay_ms = [30, 30, 30]",
+        ),
+    );
+    let o = sb.tactile(&["check", ms.to_str().expect("utf-8")]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    for want in [
+        "# network.forward: delay 5 samples (50 ms at 100 Hz); jitter 2 samples (20 ms), normal, correlation 0; schedule from sample 0 (0 ms) delay 5 samples (50 ms), from sample 600 (6000 ms) delay [2, 3, 4] samples ([20, 30, 40] ms)",
+        "# network.backward: delay 3 samples (30 ms at 100 Hz)",
+    ] {
+        assert!(err.lines().any(|l| l == want), "{want:?} not in\n{err}");
+    }
+    sb.simulate(&samples, "samples");
+    sb.simulate(&ms, "ms");
+    assert!(
+        sb.trace("samples") == sb.trace("ms"),
+        "the ms run's trace differs from the samples run's"
+    );
+    let both = paper_network("delay = [5, 5, 5]\ndelay_ms = 50", "jitter = 2.0", "");
+    sb.assert_refused(
+        0,
+        &both,
+        "`network.forward.delay_ms`: and `network.forward.delay` are both set",
+    );
+    let between = paper_network("delay_ms = 15", "jitter = 2.0", "");
+    sb.assert_refused(1, &between, "15 ms is 1.5 samples at 100 Hz");
+}

@@ -242,6 +242,31 @@ pub fn mean_ci95(v: &[f64]) -> Option<(f64, Option<f64>)> {
     Some((mean, Some(t95(n - 1) * (var / n as f64).sqrt())))
 }
 
+/// The unit of a swept key, for a plot's labels: `ms` for the milliseconds keys
+/// (`delay_ms`, `schedule_ms[1][0]`, `jitter.jitter_ms`, any `_ms`), `samples` for
+/// their twins that count samples (`delay`, `schedule`, `jitter.jitter`, any
+/// `_samples`); `None` for the rest. A `delay` of 10 and a `delay_ms` of 10 are ten
+/// times apart at 100 Hz, and a plot must say which it shows.
+pub fn unit(key: &str) -> Option<&'static str> {
+    let last = key.rsplit('.').next().unwrap_or(key);
+    let name = last.split('[').next().unwrap_or(last);
+    let samples = tactile_scenario::units::TWINS
+        .iter()
+        .any(|&(s, _)| s == name && (s != "jitter" || key.ends_with("jitter.jitter")));
+    if name.ends_with("_ms") {
+        Some("ms")
+    } else if samples || name.ends_with("_samples") {
+        Some("samples")
+    } else {
+        None
+    }
+}
+
+/// A swept key with its unit, as a plot labels it: `network.forward.delay_ms (ms)`.
+pub fn labelled(key: &str) -> String {
+    unit(key).map_or_else(|| key.to_string(), |u| format!("{key} ({u})"))
+}
+
 /// A swept value as a number for a plot's axis: the number itself, or a vector's
 /// elements' mean (`[25,25,25]` is 25); `None` for words.
 pub fn numeric(value: &str) -> Option<f64> {
@@ -270,6 +295,44 @@ fn csv_field(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A time key's plot label says its unit; other keys none.
+    #[test]
+    fn swept_time_keys_are_labelled_with_their_unit() {
+        for (key, want) in [
+            ("network.forward.delay_ms", "network.forward.delay_ms (ms)"),
+            ("network.forward.delay", "network.forward.delay (samples)"),
+            (
+                "network.backward.delay[0]",
+                "network.backward.delay[0] (samples)",
+            ),
+            (
+                "network.forward.schedule_ms[1][0]",
+                "network.forward.schedule_ms[1][0] (ms)",
+            ),
+            (
+                "network.forward.schedule",
+                "network.forward.schedule (samples)",
+            ),
+            (
+                "network.forward.jitter.jitter",
+                "network.forward.jitter.jitter (samples)",
+            ),
+            (
+                "network.forward.jitter.jitter_ms",
+                "network.forward.jitter.jitter_ms (ms)",
+            ),
+            (
+                "faults.peer_timeout_samples",
+                "faults.peer_timeout_samples (samples)",
+            ),
+            ("network.forward.jitter", "network.forward.jitter"),
+            ("control.kind", "control.kind"),
+            ("network.forward.loss", "network.forward.loss"),
+        ] {
+            assert_eq!(labelled(key), want);
+        }
+    }
 
     #[test]
     fn a_failed_run_is_one_in_its_column_and_a_whole_run_zero() {

@@ -6,7 +6,7 @@
 //! colour, dash and marker, the first drawn widest (`plots::looks`).
 
 use crate::plots::{draw_legend, draw_line, draw_markers, look, tick};
-use crate::sweep::{numeric, Axis, FAILED, METRICS};
+use crate::sweep::{labelled, numeric, unit, Axis, FAILED, METRICS};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -25,10 +25,11 @@ pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<(), St
     };
     let nums: Option<Vec<f64>> = first.values.iter().map(|v| numeric(v)).collect();
     let x_of = |i: usize| nums.as_ref().map_or(i as f64, |n| n[i]);
+    // The axis says the unit of a time key (samples or ms, ten times apart at 100 Hz).
     let x_desc = if nums.is_some() {
-        first.key.clone()
+        labelled(&first.key)
     } else {
-        format!("{} (0: {})", first.key, first.values.join(", "))
+        format!("{} (0: {})", labelled(&first.key), first.values.join(", "))
     };
     let lines = axes.get(1).map_or(1, |a| a.values.len());
     for (m, (name, _)) in METRICS.iter().enumerate() {
@@ -48,7 +49,10 @@ pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<(), St
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             let label = axes.get(1).map_or_else(
                 || name.to_string(),
-                |a| format!("{}={}", a.key, a.values[line]),
+                |a| {
+                    let unit = unit(&a.key).map_or_else(String::new, |u| format!(" {u}"));
+                    format!("{}={}{unit}", a.key, a.values[line])
+                },
             );
             series.push((label, pts));
         }
@@ -130,16 +134,12 @@ mod tests {
     use crate::plots::looks::svg;
     use crate::sweep::axis;
 
-    /// Three controls with the same value at every delay: each line is drawn in its
-    /// own colour, the first widest and solid, the later narrower and dashed, each
-    /// with its own marker, so none hides another.
-    #[test]
-    fn lines_that_coincide_all_show() {
-        let axes = [
-            axis("network.forward.delay=[0,0,0],[10,10,10],[50,50,50]").expect("a"),
-            axis("control.kind=none,tdpa,wave").expect("b"),
-        ];
-        let points: Vec<Point> = crate::sweep::combinations(&axes)
+    /// The plot of `samples_sent` over the axes `a` and `b` (`KEY=V1,V2,...`), every
+    /// metric 1 + the first axis's index (the same for every value of the second: its
+    /// lines coincide).
+    fn samples_sent(a: &str, b: &str) -> String {
+        let axes = &[axis(a).expect("a"), axis(b).expect("b")];
+        let points: Vec<Point> = crate::sweep::combinations(axes)
             .into_iter()
             .map(|c| {
                 let y = 1.0 + c[0] as f64;
@@ -147,8 +147,38 @@ mod tests {
             })
             .collect();
         let dir = tempfile::tempdir().expect("tmp");
-        sweep_plots(dir.path(), &axes, &points).expect("plots");
-        let text = std::fs::read_to_string(dir.path().join("sweep-samples_sent.svg")).expect("svg");
+        sweep_plots(dir.path(), axes, &points).expect("plots");
+        std::fs::read_to_string(dir.path().join("sweep-samples_sent.svg")).expect("svg")
+    }
+
+    /// A swept time key's axis and a second key's legend say their units.
+    #[test]
+    fn a_swept_time_is_labelled_in_its_unit() {
+        let text = samples_sent(
+            "network.forward.delay_ms=0,50,100",
+            "network.backward.delay=[0,0,0],[5,5,5]",
+        );
+        // plotters writes each text on a line of its own.
+        for want in [
+            "network.forward.delay_ms (ms)",
+            "network.backward.delay=[5,5,5] samples",
+        ] {
+            assert!(
+                text.lines().any(|l| l.trim() == want),
+                "{want} not in the plot"
+            );
+        }
+    }
+
+    /// Three controls with the same value at every delay: each line is drawn in its
+    /// own colour, the first widest and solid, the later narrower and dashed, each
+    /// with its own marker, so none hides another.
+    #[test]
+    fn lines_that_coincide_all_show() {
+        let text = samples_sent(
+            "network.forward.delay=[0,0,0],[10,10,10],[50,50,50]",
+            "control.kind=none,tdpa,wave",
+        );
         let lines = svg::polylines(&text);
         let hex = |k: usize| {
             let c = look(k, 3).colour;

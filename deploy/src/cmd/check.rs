@@ -63,6 +63,17 @@ pub fn report(s: &Scenario) -> Vec<String> {
             duration(s.samples as f64 / LOCKSTEP_PER_S)
         ),
     });
+    // Each direction's times in samples and in ms: a delay written in one unit is
+    // read back in the other before anything runs.
+    for (name, c) in [
+        ("forward", &s.network.forward),
+        ("backward", &s.network.backward),
+    ] {
+        v.push(format!(
+            "# {}",
+            tactile_scenario::units::describe(name, c, s.rate_hz)
+        ));
+    }
     let sizes: Vec<String> = PER_SAMPLE
         .iter()
         .map(|(f, b)| format!("{f} {}", bytes(b * s.samples as f64)))
