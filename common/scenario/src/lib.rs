@@ -25,6 +25,7 @@ mod ros_tls;
 /// Numbers and name lists as error messages show them (defined in `tactile-math`, shared with the URDF chain).
 pub use tactile_math::shown;
 mod slave;
+pub mod units;
 mod validate;
 mod watch;
 pub use watch::WatchConfig;
@@ -153,13 +154,25 @@ impl Scenario {
         }
     }
 
-    /// Parses TOML and validates every range.
+    /// Parses TOML, converts the `_ms` keys into samples ([`units`]) and validates
+    /// every range.
     pub fn from_toml_str(text: &str) -> Result<Scenario, ScenarioError> {
-        let s: Scenario =
-            toml::from_str(text).map_err(|e| ScenarioError::Parse(one_line(text, &e)))?;
-        if let (Ok(written), Ok(parsed)) = (text.parse::<toml::Value>(), toml::Value::try_from(&s))
-        {
-            lengths::check(&written, &parsed)?;
+        let mut written = text.parse::<toml::Value>().ok();
+        let converted = match &mut written {
+            Some(w) => units::to_samples(w)?,
+            None => false,
+        };
+        let s: Scenario = match (&written, converted) {
+            // The converted table has no positions in the text: its errors name the
+            // key only.
+            (Some(w), true) => w.clone().try_into().map_err(|e: toml::de::Error| {
+                let words: Vec<&str> = e.message().split_whitespace().collect();
+                ScenarioError::Parse(words.join(" "))
+            })?,
+            _ => toml::from_str(text).map_err(|e| ScenarioError::Parse(one_line(text, &e)))?,
+        };
+        if let (Some(written), Ok(parsed)) = (&written, toml::Value::try_from(&s)) {
+            lengths::check(written, &parsed)?;
         }
         s.validate()?;
         Ok(s)

@@ -121,6 +121,11 @@ fn put(table: &mut Table, path: &[Step], value: Value) -> Result<(), String> {
         return Err("the path must start with a key".into());
     };
     if rest.is_empty() {
+        // A time given in one unit replaces the file's in the other (`delay_ms` the
+        // file's `delay`): both would be refused, and the --set is the newer word.
+        if let Some(twin) = crate::units::twin(first) {
+            table.remove(twin);
+        }
         table.insert(first.clone(), value);
         return Ok(());
     }

@@ -3,15 +3,22 @@
 
 use crate::*;
 
+/// The sampling rate, 100 Hz to 10 kHz (also checked before `_ms` keys are
+/// converted at it).
+pub(crate) fn check_rate(rate_hz: f64) -> Result<(), ScenarioError> {
+    if !rate_hz.is_finite() || !(100.0..=10_000.0).contains(&rate_hz) {
+        return Err(invalid(
+            "rate_hz",
+            format!("{rate_hz} Hz is outside 100..=10000 Hz"),
+        ));
+    }
+    Ok(())
+}
+
 impl Scenario {
     /// Checks every value is in range; the error names the field.
     pub fn validate(&self) -> Result<(), ScenarioError> {
-        if !self.rate_hz.is_finite() || !(100.0..=10_000.0).contains(&self.rate_hz) {
-            return Err(invalid(
-                "rate_hz",
-                format!("{} Hz is outside 100..=10000 Hz", self.rate_hz),
-            ));
-        }
+        check_rate(self.rate_hz)?;
         if self.samples == 0 || self.samples > 100_000_000 {
             return Err(invalid(
                 "samples",
