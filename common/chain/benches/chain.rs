@@ -1,12 +1,13 @@
 //! Time per call of the chain's kernels on a 7-joint arm (the Panda) and a 6-joint
-//! one (the UR5): FK, the Jacobian, RNEA, ABA, and the IK following a moving target
-//! as a slave does every period (the paper gives each side 37.5 us).
+//! one (the UR5): FK, the Jacobian, RNEA, ABA (allocating, and into a workspace made
+//! once), and the IK following a moving target as a slave does every period (the
+//! paper gives each side 37.5 us).
 //!
 //! Run with `cargo bench -p tactile-chain --bench chain`.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::{Matrix6xX, Vector3};
-use tactile_chain::dynamics::EARTH;
+use tactile_chain::dynamics::{Workspace, EARTH};
 use tactile_chain::{Chain, Dynamics, Ik, IkConfig};
 
 const PANDA: &str = include_str!("../../../deploy/robots/panda.urdf");
@@ -42,6 +43,16 @@ fn bench(c: &mut Criterion) {
         });
         g.bench_function(BenchmarkId::new("aba", name), |b| {
             b.iter(|| dynamics.aba(black_box(&q), &zero, &zero))
+        });
+        // The same two with a workspace made once, as a simulation's inner loop calls
+        // them: the difference is the allocations.
+        let mut ws = Workspace::new(&arm);
+        let mut out = vec![0.0; q.len()];
+        g.bench_function(BenchmarkId::new("rnea_into", name), |b| {
+            b.iter(|| dynamics.rnea_into(&mut ws, black_box(&q), &zero, &zero, &mut out))
+        });
+        g.bench_function(BenchmarkId::new("aba_into", name), |b| {
+            b.iter(|| dynamics.aba_into(&mut ws, black_box(&q), &zero, &zero, &mut out))
         });
         // The target circles 5 cm around the start at 1 Hz, sampled at 1 kHz: each
         // call starts from the last one's answer, as the slave's does.

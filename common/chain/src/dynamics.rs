@@ -61,13 +61,15 @@ impl Dynamics {
         self.chain.check_len(what, v)
     }
 
-    /// Each body's transform from its parent's coordinates, at `q`.
-    fn transforms(&self, q: &[f64]) -> Vec<Matrix6<f64>> {
-        self.chain
-            .joints
-            .iter()
-            .map(|j| j.frame(q[j.dof]).motion_to_child())
-            .collect()
+    /// Each body's transform from its parent's coordinates, at `q`, into `x`.
+    fn transforms(&self, q: &[f64], x: &mut Vec<Matrix6<f64>>) {
+        x.clear();
+        x.extend(
+            self.chain
+                .joints
+                .iter()
+                .map(|j| j.frame(q[j.dof]).motion_to_child()),
+        );
     }
 
     /// The base's acceleration that stands for gravity.
@@ -78,13 +80,30 @@ impl Dynamics {
 
     /// Joint efforts that give accelerations `qdd` at `q`, `qd`: `M qdd + C qd + g`.
     pub fn rnea(&self, q: &[f64], qd: &[f64], qdd: &[f64]) -> Result<Vec<f64>, Error> {
+        let mut tau = vec![0.0; qdd.len()];
+        self.rnea_into(&mut Workspace::new(&self.chain), q, qd, qdd, &mut tau)?;
+        Ok(tau)
+    }
+
+    /// [`Dynamics::rnea`] into `tau`, its scratch in `ws`: no allocation once `ws` has
+    /// grown to the chain (as it is made by [`Workspace::new`]).
+    pub fn rnea_into(
+        &self,
+        ws: &mut Workspace,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        tau: &mut [f64],
+    ) -> Result<(), Error> {
         self.check("q", q)?;
         self.check("qd", qd)?;
         self.check("qdd", qdd)?;
-        let x = self.transforms(q);
+        self.check("tau", tau)?;
+        self.transforms(q, &mut ws.x);
+        let (x, f) = (&ws.x, &mut ws.pa);
         let n = x.len();
         let (mut v, mut a) = (Vector6::zeros(), self.a0());
-        let mut f = Vec::with_capacity(n);
+        f.clear();
         for i in 0..n {
             let s = &self.s[i];
             let vj = s * qd[i];
@@ -93,7 +112,6 @@ impl Dynamics {
             let body = &self.chain.joints[i].body;
             f.push(body * a + force_cross(&v, &(body * v)));
         }
-        let mut tau = vec![0.0; n];
         for i in (0..n).rev() {
             tau[i] = self.s[i].dot(&f[i]);
             if i > 0 {
@@ -101,27 +119,75 @@ impl Dynamics {
                 f[i - 1] += up;
             }
         }
-        Ok(tau)
+        Ok(())
     }
 
     /// The efforts that hold the arm still at `q` against gravity.
     pub fn gravity_torques(&self, q: &[f64]) -> Result<Vec<f64>, Error> {
-        let z = vec![0.0; q.len()];
-        self.rnea(q, &z, &z)
+        let mut tau = vec![0.0; q.len()];
+        self.gravity_torques_into(&mut Workspace::new(&self.chain), q, &mut tau)?;
+        Ok(tau)
+    }
+
+    /// [`Dynamics::gravity_torques`] into `tau`, its scratch in `ws`.
+    pub fn gravity_torques_into(
+        &self,
+        ws: &mut Workspace,
+        q: &[f64],
+        tau: &mut [f64],
+    ) -> Result<(), Error> {
+        // Taken out of `ws` for the call (an empty `Vec` allocates nothing) and put back.
+        let mut z = std::mem::take(&mut ws.zeros);
+        z.clear();
+        z.resize(q.len(), 0.0);
+        let r = self.rnea_into(ws, q, &z, &z, tau);
+        ws.zeros = z;
+        r
     }
 
     /// Joint accelerations under efforts `tau` at `q`, `qd`.
     pub fn aba(&self, q: &[f64], qd: &[f64], tau: &[f64]) -> Result<Vec<f64>, Error> {
+        let mut qdd = vec![0.0; tau.len()];
+        self.aba_into(&mut Workspace::new(&self.chain), q, qd, tau, &mut qdd)?;
+        Ok(qdd)
+    }
+
+    /// [`Dynamics::aba`] into `qdd`, its scratch in `ws`: no allocation once `ws` has
+    /// grown to the chain (as it is made by [`Workspace::new`]).
+    pub fn aba_into(
+        &self,
+        ws: &mut Workspace,
+        q: &[f64],
+        qd: &[f64],
+        tau: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<(), Error> {
         self.check("q", q)?;
         self.check("qd", qd)?;
         self.check("tau", tau)?;
-        let x = self.transforms(q);
-        let n = x.len();
-        let mut c = Vec::with_capacity(n);
-        let mut ia: Vec<Matrix6<f64>> = Vec::with_capacity(n);
-        let mut pa: Vec<Vector6<f64>> = Vec::with_capacity(n);
+        self.check("qdd", qdd)?;
+        self.transforms(q, &mut ws.x);
+        self.aba_outward(ws, qd);
+        self.aba_inward(ws, tau)?;
+        let Workspace { x, c, u, d, uu, .. } = ws;
+        let mut a = self.a0();
+        for i in 0..x.len() {
+            let ap = x[i] * a + c[i];
+            qdd[i] = (uu[i] - u[i].dot(&ap)) / d[i];
+            a = ap + self.s[i] * qdd[i];
+        }
+        Ok(())
+    }
+
+    /// The ABA's first pass, base to tip: velocities' bias accelerations `c`, each
+    /// body's own inertia `ia` and bias force `pa`.
+    fn aba_outward(&self, ws: &mut Workspace, qd: &[f64]) {
+        let Workspace { x, c, ia, pa, .. } = ws;
+        c.clear();
+        ia.clear();
+        pa.clear();
         let mut v = Vector6::zeros();
-        for i in 0..n {
+        for i in 0..x.len() {
             let vj = self.s[i] * qd[i];
             v = x[i] * v + vj;
             c.push(motion_cross(&v) * vj);
@@ -129,7 +195,28 @@ impl Dynamics {
             ia.push(body);
             pa.push(force_cross(&v, &(body * v)));
         }
-        let (mut u, mut d, mut uu) = (vec![Vector6::zeros(); n], vec![0.0; n], vec![0.0; n]);
+    }
+
+    /// The ABA's second pass, tip to base: articulated inertias and bias forces
+    /// folded into each parent, and each joint's `u`, `d`, `uu`.
+    fn aba_inward(&self, ws: &mut Workspace, tau: &[f64]) -> Result<(), Error> {
+        let Workspace {
+            x,
+            c,
+            ia,
+            pa,
+            u,
+            d,
+            uu,
+            ..
+        } = ws;
+        let n = x.len();
+        for v in [&mut *d, &mut *uu] {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+        u.clear();
+        u.resize(n, Vector6::zeros());
         for i in (0..n).rev() {
             let s = &self.s[i];
             u[i] = ia[i] * s;
@@ -148,14 +235,46 @@ impl Dynamics {
                 pa[i - 1] += x[i].transpose() * pai;
             }
         }
-        let mut a = self.a0();
-        let mut qdd = vec![0.0; n];
-        for i in 0..n {
-            let ap = x[i] * a + c[i];
-            qdd[i] = (uu[i] - u[i].dot(&ap)) / d[i];
-            a = ap + self.s[i] * qdd[i];
+        Ok(())
+    }
+}
+
+/// The dynamics' scratch memory (Pinocchio's `Data` beside its `Model`, which
+/// [`Dynamics`] is): made once for a chain, it lets [`Dynamics::aba_into`] and
+/// [`Dynamics::rnea_into`] run in a simulation's inner loop without allocating.
+/// Any workspace serves any chain; one made for another grows on its first use.
+#[derive(Debug, Clone, Default)]
+pub struct Workspace {
+    /// Each body's motion transform from its parent.
+    x: Vec<Matrix6<f64>>,
+    /// Velocity-product accelerations (ABA).
+    c: Vec<Vector6<f64>>,
+    /// Articulated inertias (ABA).
+    ia: Vec<Matrix6<f64>>,
+    /// Bias forces (ABA); the bodies' forces (RNEA).
+    pa: Vec<Vector6<f64>>,
+    /// `IA s`, `s^T IA s` and `tau - s^T pA` per joint (ABA).
+    u: Vec<Vector6<f64>>,
+    d: Vec<f64>,
+    uu: Vec<f64>,
+    /// Zero velocities and accelerations (gravity torques).
+    zeros: Vec<f64>,
+}
+
+impl Workspace {
+    /// A workspace sized for `chain`: its first use allocates nothing either.
+    pub fn new(chain: &Chain) -> Workspace {
+        let n = chain.joints.len();
+        Workspace {
+            x: Vec::with_capacity(n),
+            c: Vec::with_capacity(n),
+            ia: Vec::with_capacity(n),
+            pa: Vec::with_capacity(n),
+            u: Vec::with_capacity(n),
+            d: Vec::with_capacity(n),
+            uu: Vec::with_capacity(n),
+            zeros: Vec::with_capacity(chain.dof()),
         }
-        Ok(qdd)
     }
 }
 
@@ -230,5 +349,41 @@ mod tests {
         }
         let ok = r#"<limit lower="-1" upper="1" effort="5" velocity="1"/>"#;
         Dynamics::new(&one_joint("revolute", ok), EARTH).expect("a motor of 5 N m");
+    }
+
+    /// Issue 52: the workspace versions give the allocating ones' numbers bit for bit,
+    /// from a workspace that served another chain (its stale contents unused).
+    #[test]
+    fn the_workspace_versions_give_the_same_bits_from_a_used_workspace() {
+        let xml = include_str!("../../../deploy/robots/panda.urdf");
+        let panda = Chain::from_urdf(xml, "panda_link0", "panda_hand").expect("panda");
+        let dynamics = Dynamics::new(&panda, EARTH).expect("dynamics");
+        let ok = r#"<limit lower="-1" upper="1" effort="5" velocity="1"/>"#;
+        let one = Dynamics::new(&one_joint("revolute", ok), EARTH).expect("one joint");
+        let mut ws = Workspace::new(&panda);
+        let q = [0.3, -0.7, 0.2, -2.1, 0.4, 1.6, 0.9];
+        let qd = [0.5, -0.4, 0.3, 0.2, -0.6, 0.7, -0.1];
+        let tau = [1.0, -2.0, 3.0, -4.0, 0.5, -0.5, 0.25];
+        let mut out = [0.0; 7];
+        for _ in 0..2 {
+            dynamics
+                .aba_into(&mut ws, &q, &qd, &tau, &mut out)
+                .expect("aba");
+            assert_eq!(out.to_vec(), dynamics.aba(&q, &qd, &tau).expect("aba"));
+            dynamics
+                .rnea_into(&mut ws, &q, &qd, &tau, &mut out)
+                .expect("rnea");
+            assert_eq!(out.to_vec(), dynamics.rnea(&q, &qd, &tau).expect("rnea"));
+            dynamics
+                .gravity_torques_into(&mut ws, &q, &mut out)
+                .expect("g");
+            assert_eq!(out.to_vec(), dynamics.gravity_torques(&q).expect("g"));
+            // A bigger chain's leftovers, then the Panda again.
+            let mut small = [0.0];
+            one.aba_into(&mut ws, &[0.1], &[0.2], &[0.3], &mut small)
+                .expect("aba");
+        }
+        let e = dynamics.aba_into(&mut ws, &q, &qd, &tau, &mut [0.0; 6]);
+        assert!(e.expect_err("six outputs").to_string().contains("qdd"));
     }
 }

@@ -8,17 +8,29 @@ impl Chain {
     /// Each moving joint's frame in the base, and the tip's, at joint values `q`.
     pub fn frames(&self, q: &[f64]) -> (Vec<Frame>, Frame) {
         let mut out = Vec::with_capacity(self.joints.len());
+        let tip = self.frames_into(q, &mut out);
+        (out, tip)
+    }
+
+    /// [`Chain::frames`] into `out` (cleared first): no allocation once it has room.
+    pub fn frames_into(&self, q: &[f64], out: &mut Vec<Frame>) -> Frame {
+        out.clear();
+        self.walk(q, |f| out.push(f))
+    }
+
+    /// The tip's pose in the base at joint values `q` (allocates nothing).
+    pub fn fk(&self, q: &[f64]) -> Frame {
+        self.walk(q, |_| {})
+    }
+
+    /// Each moving joint's frame in the base to `each`, base to tip; the tip's back.
+    fn walk(&self, q: &[f64], mut each: impl FnMut(Frame)) -> Frame {
         let mut f = Frame::IDENTITY;
         for j in &self.joints {
             f = f.then(&j.frame(j.position(q)));
-            out.push(f);
+            each(f);
         }
-        (out, f.then(&self.tip_frame))
-    }
-
-    /// The tip's pose in the base at joint values `q`.
-    pub fn fk(&self, q: &[f64]) -> Frame {
-        self.frames(q).1
+        f.then(&self.tip_frame)
     }
 
     /// The tip's pose and its geometric Jacobian: column `k` is the tip's velocity
@@ -26,9 +38,20 @@ impl Chain {
     /// degree of freedom `k` (Pinocchio's `LOCAL_WORLD_ALIGNED` of the tip frame, for a
     /// base at the world's origin). A mimic joint adds its multiple to its leader's.
     pub fn jacobian(&self, q: &[f64], jac: &mut Matrix6xX<f64>) -> Frame {
-        let (frames, tip) = self.frames(q);
+        self.jacobian_with(q, jac, &mut Vec::with_capacity(self.joints.len()))
+    }
+
+    /// [`Chain::jacobian`] with the joints' frames kept in `frames`: no allocation
+    /// once it has room for them.
+    pub fn jacobian_with(
+        &self,
+        q: &[f64],
+        jac: &mut Matrix6xX<f64>,
+        frames: &mut Vec<Frame>,
+    ) -> Frame {
+        let tip = self.frames_into(q, frames);
         jac.fill(0.0);
-        for (j, f) in self.joints.iter().zip(&frames) {
+        for (j, f) in self.joints.iter().zip(frames.iter()) {
             let z: Vector3<f64> = f.r * j.axis.into_inner();
             let (lin, ang) = match j.kind {
                 Kind::Revolute => (z.cross(&(tip.p - f.p)), z),
