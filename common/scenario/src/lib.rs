@@ -163,11 +163,16 @@ impl Scenario {
             None => false,
         };
         let s: Scenario = match (&written, converted) {
-            // The converted table has no positions in the text: its errors name the
-            // key only.
+            // The converted table has no positions in the text; where the text as
+            // written fails the same way (the error is not an `_ms` key's), its error,
+            // with the line and column, is the one shown.
             (Some(w), true) => w.clone().try_into().map_err(|e: toml::de::Error| {
-                let words: Vec<&str> = e.message().split_whitespace().collect();
-                ScenarioError::Parse(words.join(" "))
+                ScenarioError::Parse(match toml::from_str::<Scenario>(text) {
+                    Err(as_written) if as_written.message() == e.message() => {
+                        one_line(text, &as_written)
+                    }
+                    _ => e.message().split_whitespace().collect::<Vec<_>>().join(" "),
+                })
             })?,
             _ => toml::from_str(text).map_err(|e| ScenarioError::Parse(one_line(text, &e)))?,
         };

@@ -12,9 +12,9 @@
 //! same run without a word). A jitter's spread is fractional in samples already.
 
 use crate::error::{invalid, ScenarioError};
+use crate::network::ChannelConfig;
 use crate::network::MAX_DELAY_SAMPLES;
 use crate::shown::{listed, Num};
-use crate::ChannelConfig;
 use toml::{Table, Value};
 
 /// The keys that say one quantity in two units, samples then milliseconds: giving
