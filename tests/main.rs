@@ -36,4 +36,5 @@ mod signals;
 mod slurm;
 mod summaries;
 mod sweep;
+mod task_space;
 mod trajectories;

@@ -359,6 +359,8 @@ fn joints(arm: &UrdfArm, torque: [f64; 3], master: Option<[f64; 4]>) -> ArmJoint
         torque,
         target_rotation: arm.target_rotation(),
         tool_rotation: arm.tool_rotation(),
+        target_position: arm.target_position(),
+        tool_position: arm.tool_in_base(),
         released: arm.released(),
         master_rotation: master.unwrap_or([0.0, 0.0, 0.0, 1.0]),
         offset,

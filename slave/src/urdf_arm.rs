@@ -276,6 +276,12 @@ impl UrdfArm {
         quaternion(&(self.reference.0.r * self.home_tool.r.transpose()))
     }
 
+    /// The position reference in the base frame, m: the last target (mapped, offset,
+    /// clamped into the box), or what the robot holds while released or silent.
+    pub fn target_position(&self) -> [f64; 3] {
+        self.reference.0.p.into()
+    }
+
     /// The clutch's offsets captured at the last engage: position (m, base frame) and
     /// orientation `[x, y, z, w]`; zero and the identity before the first release.
     pub fn offsets(&self) -> ([f64; 3], [f64; 4]) {

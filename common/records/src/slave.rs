@@ -115,6 +115,14 @@ pub struct ArmJoints {
     pub target_rotation: [f64; 4],
     /// The tool's orientation (FK of the joints) relative to its home, `[x, y, z, w]`.
     pub tool_rotation: [f64; 4],
+    /// The tool's position target in the arm's base frame, m: the master's position
+    /// through the map, moved by the clutch's offset and clamped into the workspace
+    /// box; while released, the reference the robot holds. What the report's
+    /// task-space tracking error measures the tool against (the step's `reference`
+    /// is v(n) in the master's frame, which knows neither offsets nor box).
+    pub target_position: [f64; 3],
+    /// The tool's position (FK of the joints) in the arm's base frame, m.
+    pub tool_position: [f64; 3],
     /// The 6-DoF master's orientation the arm follows (relative to the operator's
     /// home, about the master base's axes), as last accepted; the identity for a 3-DoF
     /// master.

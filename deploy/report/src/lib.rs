@@ -2,7 +2,7 @@
 //! what `tactile report` does: [`join`] streams the nodes' records (one host's folder
 //! or several) and joins them by sequence number into [`trace::TraceRow`]s;
 //! [`analysis`] and [`metrics`] fold the rows into latency histograms and the loop's
-//! figures; [`summary`] says it in JSON and [`text`] on the terminal; [`plots`] draws it; [`run_mcap`]
+//! figures, [`task_space`] a URDF arm's in its base frame; [`summary`] says it in JSON and [`text`] on the terminal; [`plots`] draws it; [`run_mcap`]
 //! writes it as ROS 2 messages in MCAP ([`mcap`]) for the robotics viewers, a URDF slave drawn as [`arm_scene`] says; [`write`]
 //! puts the report's files in a folder ([`out`]: one process at a time, each file whole); [`sweep`] tabulates many runs' summaries.
 
@@ -25,6 +25,7 @@ mod streams;
 pub mod summary;
 pub mod sweep;
 pub mod sweep_plots;
+pub mod task_space;
 pub mod text;
 pub mod trace;
 pub mod warnings;

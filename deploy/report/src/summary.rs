@@ -195,6 +195,11 @@ pub struct Summary {
     pub tracking: Tracking,
     /// How deep the tool went.
     pub contact: Contact,
+    /// A URDF arm: the tool against its target after the master's workspace map, in
+    /// the arm's base frame, the clutch's releases, the robot's force before
+    /// `force_scale`; absent for the paper's arm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub task_space: Option<crate::task_space::TaskSpace>,
     /// The channel's passivity observers, the energy the control dissipated, and the
     /// drift of the slave's reference.
     pub passivity: Passivity,

@@ -104,24 +104,36 @@ fn samples(t: &mut String, s: &Summary) {
 fn motion(t: &mut String, s: &Summary) {
     let m = &s.master;
     let mo = &m.motion;
+    match &s.task_space {
+        Some(ts) => task_space(t, ts),
+        None => {
+            let _ = writeln!(
+                t,
+                "tracking error (slave tool against the v(n) it was sent): rms {}, max {}",
+                mm(mo.tracking_rms_m),
+                mm(mo.tracking_max_m)
+            );
+        }
+    }
+    // h(n) is the environment's force as sent; a URDF arm's is the robot's scaled.
+    let sent = match &s.task_space {
+        Some(ts) => format!(
+            "h(n) sent max {:.3} N (the robot's {:.3} N times force_scale {})",
+            mo.force_max_n, ts.robot_force_max_n, ts.force_scale
+        ),
+        None => format!("environment's force h(n) max {:.3} N", mo.force_max_n),
+    };
     let _ = writeln!(
         t,
-        "tracking error (slave tool against the v(n) it was sent): rms {}, max {}",
-        mm(mo.tracking_rms_m),
-        mm(mo.tracking_max_m)
-    );
-    let _ = writeln!(
-        t,
-        "forces: {} samples in contact, slave max {:.3} N, felt rms {} max {:.3} N, master torque max {:.4} N m",
+        "forces: {} samples in contact, {sent}, felt rms {} max {:.3} N, master torque max {:.4} N m",
         mo.contact_samples,
-        mo.force_max_n,
         mo.felt_rms_n.map_or("n/a".to_string(), |f| format!("{f:.3} N")),
         mo.felt_max_n,
         mo.tau_max_nm
     );
     let _ = writeln!(
         t,
-        "bilateral ({} hand, control {}): position rms {} against the delay-shifted handle, force rms {}, penetration max {:.2} mm",
+        "bilateral ({} hand, control {}): position rms {} against the delay-shifted handle, force tracking error rms {} (felt against the environment's force it came from), penetration max {:.2} mm",
         match s.hand {
             tactile_scenario::HandMode::Position => "position",
             tactile_scenario::HandMode::Impedance => "impedance",
@@ -140,6 +152,31 @@ fn motion(t: &mut String, s: &Summary) {
         s.packets.forward,
         s.packets.backward
     );
+}
+
+/// A URDF arm's tracking in its base frame, and the clutch's releases.
+fn task_space(t: &mut String, ts: &crate::task_space::TaskSpace) {
+    let mm3 = |v: Option<f64>| v.map_or("n/a".to_string(), |x| format!("{:.3} mm", x * 1e3));
+    let deg = |v: Option<f64>| v.map_or("n/a".to_string(), |x| format!("{x:.3} deg"));
+    let _ = writeln!(
+        t,
+        "tracking error (tool against its target after the map, base frame, {} engaged samples): position rms {}, max {}; orientation rms {}, max {}",
+        ts.engaged_samples,
+        mm3(ts.position_rms_m),
+        mm3(ts.position_max_m),
+        deg(ts.rotation_rms_deg),
+        deg(ts.rotation_max_deg)
+    );
+    if ts.released_samples > 0 {
+        let _ = writeln!(
+            t,
+            "clutch: released {} samples ({:.3} s), {} engages; released samples are left out of the tracking error: the robot held within {} of its reference",
+            ts.released_samples,
+            ts.released_s,
+            ts.engages,
+            mm3(ts.held_max_m)
+        );
+    }
 }
 
 /// What the network and each side counted.

@@ -319,6 +319,7 @@ fn summarise(
         control: scenario.control.kind.name(),
         tracking: a.bilateral.tracking,
         contact: a.bilateral.contact,
+        task_space: None,
         passivity: a.bilateral.passivity,
         packets: Packets {
             forward: master_totals.counters.packets_sent,
@@ -459,8 +460,12 @@ fn report_into(
             .is_some_and(|f| f.load(Ordering::SeqCst))
             || launch.until.is_some_and(|u| Instant::now() >= u)
     };
+    let mut task = crate::task_space::TaskSpaceSums::of(scenario);
     let logs = join::join_until(dirs, &stopped, |row, joints, rotation| {
         analysis.add(row);
+        if let (Some(t), Some(j)) = (task.as_mut(), joints) {
+            t.add(row, j);
+        }
         series.add(row, t_s);
         streams.add(row, joints, rotation)?;
         Ok(ControlFlow::Continue(()))
@@ -475,6 +480,7 @@ fn report_into(
         &scenario.relative_to(&here).to_toml(),
     )?;
     let mut summary = summarise(scenario, runner, &analysis, &logs, launch);
+    summary.task_space = task.map(|t| t.finish());
     summary.events.extend(warning);
     if let Some(n) = logs.stopped_at {
         summary.interrupted = true;
