@@ -377,4 +377,8 @@ fn reach_report(text: &str, s: &serde_json::Value) {
         text.contains("clutch: released 2400 samples (2.400 s), 2 engages"),
         "{text}"
     );
+    assert!(
+        text.contains("handle (the master's frame, the clutch's offsets and releases included)"),
+        "{text}"
+    );
 }

@@ -133,13 +133,19 @@ fn motion(t: &mut String, s: &Summary) {
     );
     let _ = writeln!(
         t,
-        "bilateral ({} hand, control {}): position rms {} against the delay-shifted handle, force tracking error rms {} (felt against the environment's force it came from), penetration max {:.2} mm",
+        "bilateral ({} hand, control {}): position rms {} against the delay-shifted handle{}, force tracking error rms {} (felt against the environment's force it came from), penetration max {:.2} mm",
         match s.hand {
             tactile_scenario::HandMode::Position => "position",
             tactile_scenario::HandMode::Impedance => "impedance",
         },
         s.control,
         mm(s.tracking.position_rms_m),
+        // The handle knows no clutch: its distance from the tool grows with each
+        // release, which the task-space line above leaves out.
+        match &s.task_space {
+            Some(ts) if ts.released_samples > 0 => " (the master's frame, the clutch's offsets and releases included)",
+            _ => "",
+        },
         s.tracking.force_rms_n.map_or("n/a".to_string(), |f| format!("{f:.3} N")),
         s.contact.max_penetration_m * 1e3
     );
