@@ -803,25 +803,29 @@ fn a_six_joint_robot_over_ros2_checks_with_its_urdf_alone() {
 }
 
 /// Beside `[slave.arm]` each of the paper arm's three-element keys is refused by its
-/// name, even at its default value (which passed before issue 52), with what to
-/// write instead: exit 2, nothing started.
+/// name, even at its default value (which passed before issue 52) or with the arm's
+/// six joint names (told it takes three before), with what to write instead: exit 2,
+/// nothing started.
 #[test]
 fn the_paper_arms_ros2_keys_beside_an_arm_are_refused_with_what_to_write() {
     let sb = Sandbox::new("ur5-ros2-old-keys");
-    let defaults = [
+    let written = [
         "joints = [\"joint1\", \"joint2\", \"joint3\"]",
         "max_velocity = [2.0, 2.0, 2.0]",
         "map = { unit = \"rad\" }",
         "wrench_map = { axes = [0, 1, 2] }",
+        // The UR5's own six names: not "it takes 3".
+        "joints = [\"shoulder_pan_joint\", \"shoulder_lift_joint\", \"elbow_joint\", \
+         \"wrist_1_joint\", \"wrist_2_joint\", \"wrist_3_joint\"]",
     ];
-    let wants: Vec<String> = defaults
+    let wants: Vec<String> = written
         .iter()
         .map(|d| {
             let key = d.split(' ').next().unwrap_or_default();
             format!("field `slave.ros2.{key}`: is for the paper's 3-DoF arm only; with [slave.arm]")
         })
         .collect();
-    let cases: Vec<(&str, String, Vec<&str>)> = defaults
+    let cases: Vec<(&str, String, Vec<&str>)> = written
         .iter()
         .zip(&wants)
         .map(|(d, want)| {

@@ -177,6 +177,7 @@ impl Scenario {
             _ => toml::from_str(text).map_err(|e| ScenarioError::Parse(one_line(text, &e)))?,
         };
         if let (Some(written), Ok(parsed)) = (&written, toml::Value::try_from(&s)) {
+            ros_robot::refuse_written(written)?;
             lengths::check(written, &parsed)?;
         }
         s.validate()?;

@@ -181,19 +181,38 @@ impl RosRobotConfig {
     /// The first of the paper arm's three-element keys that is given, refused by
     /// name whatever its value, with what to write instead.
     fn refuse_paper_keys(&self) -> Result<(), ScenarioError> {
-        let given = [
+        refuse_given([
             self.joints.is_some(),
             self.map.is_some(),
             self.max_velocity.is_some(),
             self.wrench_map.is_some(),
-        ];
-        match WITH_ARM.iter().zip(given).find(|(_, set)| *set) {
-            Some(((field, instead), _)) => Err(invalid(
-                format!("slave.ros2.{field}"),
-                format!("is for the paper's 3-DoF arm only; with [slave.arm] {instead}"),
-            )),
-            None => Ok(()),
-        }
+        ])
+    }
+}
+
+/// The paper arm's keys in the scenario as written, beside `[slave.arm]`: refused
+/// before the arrays' lengths are compared, so that six joint names for a UR5 are told
+/// what to write instead, not that `joints` takes three.
+pub(crate) fn refuse_written(written: &toml::Value) -> Result<(), ScenarioError> {
+    let slave = written.get("slave");
+    let (Some(_), Some(ros2)) = (
+        slave.and_then(|s| s.get("arm")),
+        slave.and_then(|s| s.get("ros2")),
+    ) else {
+        return Ok(());
+    };
+    refuse_given(WITH_ARM.map(|(key, _)| ros2.get(key).is_some()))
+}
+
+/// The first key of [`WITH_ARM`] that `given` marks, as an error with what to write
+/// instead.
+fn refuse_given(given: [bool; 4]) -> Result<(), ScenarioError> {
+    match WITH_ARM.iter().zip(given).find(|(_, set)| *set) {
+        Some(((field, instead), _)) => Err(invalid(
+            format!("slave.ros2.{field}"),
+            format!("is for the paper's 3-DoF arm only; with [slave.arm] {instead}"),
+        )),
+        None => Ok(()),
     }
 }
 

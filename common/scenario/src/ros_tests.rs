@@ -127,6 +127,10 @@ fn a_paper_arm_key_beside_an_arm_is_refused_by_name_at_any_value() {
         );
         assert!(text.contains(instead), "{text}");
     }
+    // Six names for a UR5's six joints: told what to write, not that it takes three.
+    let six = "joints = [\"a\", \"b\", \"c\", \"d\", \"e\", \"f\"]";
+    let e = Scenario::from_toml_str(&arm_over_ros(six)).expect_err("six names");
+    assert!(e.to_string().contains("delete `joints`"), "{e}");
     // Whatever the backend: with an arm the keys never apply.
     let simulated =
         arm_over_ros("max_velocity = [1.0, 1.0, 1.0]").replace("\"ros2\"", "\"simulated\"");
