@@ -2,8 +2,9 @@
 //! prismatic joints, fixed joints folded, mimic joints followed), its forward
 //! kinematics and geometric Jacobian, a damped least-squares IK with joint and
 //! velocity limits and a null-space posture term, and its rigid-body dynamics (the
-//! recursive Newton-Euler and articulated-body algorithms). Pure math, no I/O: the
-//! nodes read the file, this crate reads the text.
+//! recursive Newton-Euler and articulated-body algorithms). Pure math, but for one
+//! function: [`file::read`], the one reading of a URDF file (a size cap, the file
+//! named in every error), which every reader of an arm goes through.
 //!
 //! Vectors follow Pinocchio's order (`[linear; angular]`), so every figure compares
 //! with it entry by entry; the tests do (tests/chain.rs of the workspace, against
@@ -16,6 +17,7 @@
 pub mod chain;
 pub mod dynamics;
 mod error;
+pub mod file;
 pub mod ik;
 pub mod kinematics;
 pub mod spatial;
@@ -26,6 +28,7 @@ pub mod urdf;
 pub use chain::{Chain, Dof};
 pub use dynamics::Dynamics;
 pub use error::Error;
+pub use file::{UrdfFile, MAX_URDF_BYTES};
 pub use ik::{Ik, IkConfig, IkStats, IkStep, Pose};
 pub use spatial::Frame;
 pub use tree::Tree;
