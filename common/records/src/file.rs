@@ -260,6 +260,27 @@ pub fn runs_in(path: &Path) -> Vec<u64> {
     runs
 }
 
+/// How many rows the whole sample blocks of a record hold, counted from the blocks'
+/// headers without unpacking them; 0 if the file cannot be read. How far a node that
+/// is still writing has got, in rows rather than bytes (a block's size depends on its
+/// compression and on the node's block length, its row count does not). A row is one
+/// of the role's sample entries: the slave writes one a sample, the master two (c(n)
+/// sent, then q(n) come back or missed).
+pub fn rows_in(path: &Path) -> u64 {
+    let Ok(mut frames) = Frames::open(path) else {
+        return 0;
+    };
+    let mut n = 0;
+    while let Ok(true) = frames.next_frame() {
+        let decoded =
+            bincode::serde::decode_from_slice::<Record<(), ()>, _>(&frames.body, config());
+        if let Ok((Record::Samples(b), _)) = decoded {
+            n += u64::from(b.samples);
+        }
+    }
+    n
+}
+
 /// Reads a record file back, record by record, in bounded memory: damaged stretches
 /// are skipped and reported in [`RecordReader::damage`], never the whole file.
 pub struct RecordReader<T> {

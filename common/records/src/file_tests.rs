@@ -147,6 +147,28 @@ fn samples_come_back_in_order_with_the_entries_between_them() {
 }
 
 #[test]
+fn rows_in_counts_the_whole_blocks_written_so_far() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("x.rec");
+    assert_eq!(rows_in(&path), 0, "no file yet");
+    write_samples(&path, 1000, 30);
+    assert_eq!(
+        rows_in(&path),
+        1000,
+        "events between the blocks are not samples"
+    );
+    // Three blocks of 30, the last torn (a node still writing it): not counted.
+    write_samples(&path, 90, 30);
+    let len = std::fs::metadata(&path).expect("meta").len();
+    let f = std::fs::OpenOptions::new()
+        .write(true)
+        .open(&path)
+        .expect("open");
+    f.set_len(len - 5).expect("cut");
+    assert_eq!(rows_in(&path), 60);
+}
+
+#[test]
 fn a_corrupted_block_costs_its_samples_and_no_others() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("x.rec");
