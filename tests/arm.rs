@@ -167,11 +167,7 @@ fn a_bad_arm_is_named_and_nothing_starts() {
 
 /// True if python3 has the readers tests/mcap_arm_check.py needs.
 fn mcap_readers() -> bool {
-    let probe = "import mcap, mcap_ros2, yourdfpy, numpy";
-    std::process::Command::new("python3")
-        .args(["-c", probe])
-        .output()
-        .is_ok_and(|o| o.status.success())
+    util::python_has("mcap, mcap_ros2, yourdfpy, numpy")
 }
 
 /// tests/mcap_arm_check.py on the report in `out`: its output.

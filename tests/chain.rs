@@ -13,10 +13,7 @@ use tactile_chain::dynamics::Dynamics;
 use tactile_chain::Chain;
 
 fn pin_ready() -> bool {
-    Command::new("python3")
-        .args(["-c", "import pinocchio"])
-        .output()
-        .is_ok_and(|o| o.status.success())
+    crate::util::python_has("pinocchio")
 }
 
 fn reference() -> Value {

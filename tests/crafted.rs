@@ -195,17 +195,23 @@ fn long_to_read(name: &str) -> Sandbox {
     sb
 }
 
-/// Runs `cmd`, sends it SIGTERM 0.8 s in and checks it ends within 3 s with exit
-/// 130 and no partial file in `dir`; its output.
+/// Runs `cmd`, sends it SIGTERM once it answers one (its stop handler in place, just
+/// before it reads the records) and checks it ends within 3 s with exit 130 and no
+/// partial file in `dir`; its output.
 fn stopped_at_once(mut cmd: Command, dir: &Path) -> std::process::Output {
     let child = cmd
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
         .expect("report");
-    std::thread::sleep(std::time::Duration::from_millis(800));
+    let term = rustix::process::Signal::TERM;
+    util::wait_for(
+        "the stop handler",
+        std::time::Duration::from_secs(30),
+        || util::catches(child.id(), term),
+    );
     let pid = rustix::process::Pid::from_child(&child);
-    rustix::process::kill_process(pid, rustix::process::Signal::TERM).expect("SIGTERM");
+    rustix::process::kill_process(pid, term).expect("SIGTERM");
     let t = std::time::Instant::now();
     let o = util::wait_within(child, std::time::Duration::from_secs(60));
     let took = t.elapsed();

@@ -10,7 +10,7 @@ use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
 use tactile_report::trace::signal_columns;
 use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber};
 use tactile_transport::{Publish, Subscribe};
-use util::{cannot, column, Sandbox};
+use util::{cannot, column, finish, pid_of, Sandbox};
 
 fn spawn_run(sb: &Sandbox, scenario: &std::path::Path, out: &str) -> Child {
     sb.command(&["run", scenario.to_str().expect("utf-8"), "--out"])
@@ -22,10 +22,6 @@ fn spawn_run(sb: &Sandbox, scenario: &std::path::Path, out: &str) -> Child {
         .expect("start tactile run")
 }
 
-fn pid_of(sb: &Sandbox, role: &str) -> Option<i32> {
-    util::pid_of(&sb.prefix, role)
-}
-
 /// Sends `signal`; a process already gone is fine (nodes stop by themselves when their
 /// launcher dies).
 fn kill(pid: i32, signal: rustix::process::Signal) {
@@ -33,24 +29,13 @@ fn kill(pid: i32, signal: rustix::process::Signal) {
     let _ = rustix::process::kill_process(pid, signal);
 }
 
-/// Waits until the master of the run into `out` has recorded `bytes` (about 57 a sample at
-/// 1 kHz in blocks of 50 ms: 1,500 samples are 85 kB), then kills `role` with SIGKILL.
-fn kill_mid_run(sb: &Sandbox, out: &str, role: &str, bytes: u64) {
+/// Waits until the master of the run into `out` has recorded `samples`, then kills
+/// `role` with SIGKILL.
+fn kill_mid_run(sb: &Sandbox, out: &str, role: &str, samples: u64) {
     let rec = sb.path(out).join("master.rec");
-    util::wait_for("the run got going", Duration::from_secs(30), || {
-        std::fs::metadata(&rec).is_ok_and(|m| m.len() >= bytes)
-    });
-    let pid = pid_of(sb, role).unwrap_or_else(|| panic!("no {role} running"));
+    util::wait_for_rows(&rec, util::MASTER_ROWS * samples, Duration::from_secs(30));
+    let pid = pid_of(&sb.prefix, role).unwrap_or_else(|| panic!("no {role} running"));
     kill(pid, rustix::process::Signal::KILL);
-}
-
-fn finish(child: Child) -> (Option<i32>, String, String) {
-    let o = util::wait_within(child, util::LIMIT);
-    (
-        o.status.code(),
-        String::from_utf8_lossy(&o.stdout).to_string(),
-        String::from_utf8_lossy(&o.stderr).to_string(),
-    )
 }
 
 /// Kills `role` mid-run; the launcher restarts it and the loop must break, command
@@ -59,14 +44,10 @@ fn peer_dies_and_the_loop_resumes(role: &str) {
     let sb = Sandbox::new(role);
     let scenario = sb.write("s.toml", &util::paper_1khz(4000));
     let child = spawn_run(&sb, &scenario, "run");
-    kill_mid_run(&sb, "run", role, 85_000);
-    let (code, stdout, stderr) = finish(child);
+    kill_mid_run(&sb, "run", role, 1_500);
+    let (code, stderr) = finish(child);
     sb.assert_no_leftover_processes();
-    assert_eq!(
-        code,
-        Some(1),
-        "a run with a dead process fails\n{stdout}\n{stderr}"
-    );
+    assert_eq!(code, Some(1), "a run with a dead process fails\n{stderr}");
     assert!(
         stderr.contains(&format!("{role} was killed by signal 9")),
         "{stderr}"
@@ -145,16 +126,14 @@ fn lockstep_drops_and_stalls_change_nothing() {
     let scenario = sb.write("s.toml", &text);
     let child = spawn_run(&sb, &scenario, "run");
     let rec = sb.path("run").join("master.rec");
-    for (role, bytes) in [("emulator", 57_000), ("master", 230_000)] {
-        util::wait_for("the run got going", Duration::from_secs(30), || {
-            std::fs::metadata(&rec).is_ok_and(|m| m.len() >= bytes)
-        });
-        let pid = pid_of(&sb, role).unwrap_or_else(|| panic!("no {role} running"));
+    for (role, samples) in [("emulator", 1_000), ("master", 4_000)] {
+        util::wait_for_rows(&rec, util::MASTER_ROWS * samples, Duration::from_secs(30));
+        let pid = pid_of(&sb.prefix, role).unwrap_or_else(|| panic!("no {role} running"));
         kill(pid, rustix::process::Signal::STOP);
         std::thread::sleep(Duration::from_millis(300));
         kill(pid, rustix::process::Signal::CONT);
     }
-    let (code, _, stderr) = finish(child);
+    let (code, stderr) = finish(child);
     assert_eq!(code, Some(0), "{stderr}");
     sb.assert_no_leftover_processes();
     sb.simulate(&scenario, "sim");
@@ -183,8 +162,8 @@ fn master_killed_the_slave_holds_and_the_launcher_fails_cleanly() {
     let sb = Sandbox::new("master");
     let scenario = sb.write("s.toml", &util::paper_1khz(5000));
     let child = spawn_run(&sb, &scenario, "run");
-    kill_mid_run(&sb, "run", "master", 85_000);
-    let (code, _stdout, stderr) = finish(child);
+    kill_mid_run(&sb, "run", "master", 1_500);
+    let (code, stderr) = finish(child);
     sb.assert_no_leftover_processes();
     assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("master was killed by signal 9"), "{stderr}");
@@ -205,15 +184,13 @@ fn sigterm_to_the_launcher_stops_everything_and_writes_the_report() {
     let sb = Sandbox::new("sigterm");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let child = spawn_run(&sb, &scenario, "run");
-    // Once the loop has run for a while (its slave has recorded about a second).
+    // Once the loop has run for a while (its slave has recorded a second).
     let rec = sb.path("run").join("slave.rec");
-    util::wait_for("the loop runs", Duration::from_secs(20), || {
-        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 300_000)
-    });
+    util::wait_for_rows(&rec, 1_000, Duration::from_secs(20));
     kill(child.id() as i32, rustix::process::Signal::TERM);
-    let (code, stdout, stderr) = finish(child);
+    let (code, stderr) = finish(child);
     sb.assert_no_leftover_processes();
-    assert_eq!(code, Some(130), "{stdout}\n{stderr}");
+    assert_eq!(code, Some(130), "{stderr}");
     let s = sb.json("run", "summary.json");
     assert_eq!(s["interrupted"], true);
     let sent = s["samples_sent"].as_u64().expect("sent");
@@ -227,13 +204,13 @@ fn a_new_run_after_a_crash_starts_cleanly() {
     let sb = Sandbox::new("crash");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
     let child = spawn_run(&sb, &scenario, "first");
-    kill_mid_run(&sb, "first", "master", 28_000);
+    kill_mid_run(&sb, "first", "master", 500);
     // Kill the launcher first, so nobody cleans up, then every process of the run.
     let launcher = child.id() as i32;
     let (m, e, s) = (
-        pid_of(&sb, "master"),
-        pid_of(&sb, "emulator"),
-        pid_of(&sb, "slave"),
+        pid_of(&sb.prefix, "master"),
+        pid_of(&sb.prefix, "emulator"),
+        pid_of(&sb.prefix, "slave"),
     );
     kill(launcher, rustix::process::Signal::KILL);
     for pid in [m, e, s].into_iter().flatten() {
@@ -243,7 +220,7 @@ fn a_new_run_after_a_crash_starts_cleanly() {
     util::wait_for("the killed nodes are gone", Duration::from_secs(10), || {
         ["master", "emulator", "slave"]
             .iter()
-            .all(|r| pid_of(&sb, r).is_none())
+            .all(|r| pid_of(&sb.prefix, r).is_none())
     });
     sb.assert_no_leftover_processes();
     // Stale shared memory of the crashed run is still there; the same prefix must work.
@@ -452,7 +429,7 @@ fn a_full_disk_names_the_nodes_that_died_of_it() {
         .stderr(Stdio::piped())
         .spawn()
         .expect("start tactile run");
-    let (code, _, err) = finish(child);
+    let (code, err) = finish(child);
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("No space left on device"), "{err}");
     assert!(

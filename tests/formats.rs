@@ -7,12 +7,9 @@
 use crate::util::{self, cannot, Sandbox};
 use std::process::Command;
 
-/// True if python3 has Arrow and pandas.
+/// True if python3 has Arrow, pandas and the MCAP readers.
 fn python_ready() -> bool {
-    Command::new("python3")
-        .args(["-c", "import pyarrow, pandas, mcap, rosbags"])
-        .output()
-        .is_ok_and(|o| o.status.success())
+    util::python_has("pyarrow, pandas, mcap, rosbags")
 }
 
 /// Runs a checker script, asserts success and that it said `said`.

@@ -10,10 +10,10 @@
 #![cfg(feature = "zenoh")]
 
 use crate::ros2::{
-    any_arm_standin, floats, free_port, listening, mujoco_ready, one_at_a_time, python_ready,
-    report, MUJOCO_PANDA, PANDA_JOINTS, PANDA_READY,
+    any_arm_standin, floats, listening, mujoco_ready, one_at_a_time, python_ready, report,
+    MUJOCO_PANDA, PANDA_JOINTS, PANDA_READY,
 };
-use crate::util::{self, cannot, num, Sandbox};
+use crate::util::{self, cannot, free_port, num, Sandbox};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use std::process::Child;
 

@@ -13,7 +13,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
 use tactile_report::trace::signal_columns;
-use util::{column, node_dir, Sandbox};
+use util::{column, finish_ok, free_port, node_dir, Sandbox};
 
 /// Two hosts: network namespaces made for the test, removed on drop.
 struct Hosts {
@@ -62,32 +62,16 @@ fn spawn(mut c: Command, sb: &Sandbox) -> Child {
         .expect("start node")
 }
 
-fn finish(child: Child, name: &str) {
-    let o = util::wait_within(child, util::LIMIT);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{name}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
-
 /// Waits for the master, emulator and slave (each must complete) and returns the
 /// summary of `tactile report` over their folders (a-master, b-emulator, b-slave).
 fn report_of(sb: &Sandbox, nodes: [Child; 3]) -> serde_json::Value {
     for (child, name) in nodes.into_iter().zip(["master", "emulator", "slave"]) {
-        finish(child, name);
+        finish_ok(child, name);
     }
     let dirs = ["a-master", "b-emulator", "b-slave"];
     let o = sb.tactile(&["report", dirs[0], dirs[1], dirs[2], "--out", "report"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     sb.json("report", "summary.json")
-}
-
-/// A free TCP port on loopback.
-fn free_port() -> u16 {
-    let l = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
-    l.local_addr().expect("addr").port()
 }
 
 /// Master on host A; emulator and slave on host B, the emulator joined to the master
@@ -226,14 +210,7 @@ fn the_slave_host_node_killed_breaks_the_loop_and_it_resumes_after_restart() {
     ];
     let mut slave = spawn(hosts.on(1, "tactile-slave", &slave_args), &sb);
     let rec = sb.path("s").join("slave.rec");
-    let start = Instant::now();
-    while std::fs::metadata(&rec).map_or(0, |m| m.len()) < 150_000 {
-        assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "the slave never got going"
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    util::wait_for_rows(&rec, 2_000, Duration::from_secs(30));
     slave.kill().expect("SIGKILL the slave");
     let _ = slave.wait();
     // The master notices: the loop breaks before the slave is back.
@@ -244,8 +221,8 @@ fn the_slave_host_node_killed_breaks_the_loop_and_it_resumes_after_restart() {
     let mut again = slave_args.to_vec();
     again.push("--append");
     let slave = spawn(hosts.on(1, "tactile-slave", &again), &sb);
-    finish(master, "master");
-    finish(slave, "slave");
+    finish_ok(master, "master");
+    finish_ok(slave, "slave");
     let o = sb.tactile(&["report", "m", "s", "--out", "report"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let sum = sb.json("report", "summary.json");
@@ -359,14 +336,7 @@ fn garbage_truncated_and_other_version_payloads_are_counted_and_dropped() {
     // Once the run is going, a stranger on the same Zenoh network sends junk at every
     // stream of the run, one session per node (peers do not route for each other).
     let rec = sb.path("m").join("master.rec");
-    let start = Instant::now();
-    while std::fs::metadata(&rec).map_or(0, |m| m.len()) < 20_000 {
-        assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "the run never started"
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    util::wait_for_rows(&rec, util::MASTER_ROWS * 300, Duration::from_secs(30));
     let sessions: Vec<tactile_transport::zenoh_link::zenoh::Session> = at
         .iter()
         .map(|e| {
@@ -407,9 +377,9 @@ fn garbage_truncated_and_other_version_payloads_are_counted_and_dropped() {
         }
         std::thread::sleep(Duration::from_millis(5 + round % 3));
     }
-    finish(master, "master");
-    finish(emulator, "emulator");
-    finish(slave, "slave");
+    finish_ok(master, "master");
+    finish_ok(emulator, "emulator");
+    finish_ok(slave, "slave");
     let o = sb.tactile(&["report", "m", "e", "s", "--out", "report"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let sum = sb.json("report", "summary.json");
@@ -457,18 +427,16 @@ fn garbage_datagrams_at_a_udp_node_are_counted_and_dropped() {
     let socket = std::net::UdpSocket::bind("127.0.0.1:0").expect("bind");
     // The run is going (the slave answers) before the junk goes out.
     let rec = sb.path("m").join("master.rec");
-    util::wait_for("the run got going", Duration::from_secs(30), || {
-        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 20_000)
-    });
+    util::wait_for_rows(&rec, util::MASTER_ROWS * 300, Duration::from_secs(30));
     for _ in 0..50 {
         for b in bad_payloads() {
             let _ = socket.send_to(&b, ("127.0.0.1", ports.ports[2]));
         }
         std::thread::sleep(Duration::from_millis(5));
     }
-    finish(master, "master");
-    finish(emulator, "emulator");
-    finish(slave, "slave");
+    finish_ok(master, "master");
+    finish_ok(emulator, "emulator");
+    finish_ok(slave, "slave");
     let o = sb.tactile(&["report", "m", "e", "s", "--out", "report"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let sum = sb.json("report", "summary.json");
@@ -535,9 +503,7 @@ fn mutual_tls_admits_the_run_and_refuses_strangers() {
     let emulator = spawn(hosts.on(1, "tactile-emulator", &e), &sb);
     let master = spawn(hosts.on(0, "tactile-master", &m), &sb);
     let rec = sb.path("a-master").join("master.rec");
-    util::wait_for("the loop runs over TLS", Duration::from_secs(30), || {
-        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 200_000)
-    });
+    util::wait_for_rows(&rec, util::MASTER_ROWS * 3_000, Duration::from_secs(30));
     // Strangers on host B, under other prefixes (the run's are locked): one with a
     // certificate of another CA, one in clear.
     let rogue = tactile::launch::pki::args(&rogue_pki);

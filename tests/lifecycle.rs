@@ -67,9 +67,7 @@ fn a_node_that_dies_past_its_restarts_ends_the_run_as_failed() {
         util::pid_of(&sb.prefix, "slave").is_some()
     });
     let slave = util::pid_of(&sb.prefix, "slave").expect("slave");
-    wait_for("the slave records", Duration::from_secs(20), || {
-        std::fs::metadata(out.join("slave.rec")).is_ok_and(|m| m.len() > 50_000)
-    });
+    util::wait_for_rows(&out.join("slave.rec"), 800, Duration::from_secs(20));
     let pid = rustix::process::Pid::from_raw(slave).expect("pid");
     let _ = rustix::process::kill_process(pid, rustix::process::Signal::KILL);
     let o = util::wait_within(child, util::LIMIT);
@@ -112,9 +110,9 @@ fn a_restarted_nodes_counters_are_summed_over_its_segments() {
     let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
     let slave = start_node(&sb, "slave", &scenario, "s", &[]);
     let rec = sb.path("s").join("slave.rec");
-    // Past a second (about 64 bytes a sample at 1 kHz), so the first segment has
-    // written its counters.
-    kill_once_recorded(slave, &rec, 110_000);
+    // Past a second of samples at 1 kHz, so the first segment has written its
+    // counters (every second).
+    kill_once_recorded(slave, &rec, 1_500);
     let slave = start_node(&sb, "slave", &scenario, "s", &["--append"]);
     for (role, child) in [("master", master), ("emulator", emulator), ("slave", slave)] {
         let (code, err) = finish(child);
@@ -188,12 +186,8 @@ fn an_output_folder_holds_one_run_at_a_time() {
         .spawn()
         .expect("first run");
     let rec = out.join("slave.rec");
-    util::wait_for(
-        "the first run's slave records",
-        Duration::from_secs(30),
-        || std::fs::metadata(&rec).is_ok_and(|m| m.len() > 10_000),
-    );
-    let before = std::fs::metadata(&rec).expect("record").len();
+    util::wait_for_rows(&rec, 150, Duration::from_secs(30));
+    let before = tactile_records::rows_in(&rec);
     let second = sb.tactile(&[
         "run",
         scenario.to_str().expect("utf-8"),
@@ -209,7 +203,10 @@ fn an_output_folder_holds_one_run_at_a_time() {
     );
     let report = sb.tactile(&["report", out.to_str().expect("utf-8")]);
     assert_eq!(report.status.code(), Some(2), "{report:?}");
-    assert!(std::fs::metadata(&rec).expect("record kept").len() >= before);
+    assert!(
+        tactile_records::rows_in(&rec) >= before,
+        "the record is kept"
+    );
     let done = util::wait_within(first, Duration::from_secs(60));
     assert!(
         done.status.success(),
@@ -229,18 +226,16 @@ fn an_output_folder_holds_one_run_at_a_time() {
 }
 
 /// `tactile run` into `run` (with `extra`), its slave stopped by SIGSTOP once its
-/// record holds `bytes`; the run's output.
+/// record holds `samples`; the run's output.
 fn freeze_the_slave(
     sb: &Sandbox,
     scenario: &Path,
     extra: &[&str],
-    bytes: u64,
+    samples: u64,
 ) -> std::process::Output {
     let out = sb.path("run");
     let child = run_without_restarts(sb, scenario, &out, extra);
-    wait_for("the slave records", Duration::from_secs(20), || {
-        std::fs::metadata(out.join("slave.rec")).is_ok_and(|m| m.len() > bytes)
-    });
+    util::wait_for_rows(&out.join("slave.rec"), samples, Duration::from_secs(20));
     let slave = util::pid_of(&sb.prefix, "slave").expect("slave");
     let pid = rustix::process::Pid::from_raw(slave).expect("pid");
     rustix::process::kill_process(pid, rustix::process::Signal::STOP).expect("SIGSTOP");
@@ -253,7 +248,7 @@ fn freeze_the_slave(
 fn a_frozen_node_fails_the_run_after_the_stall_limit() {
     let sb = Sandbox::new("frozen");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
-    let o = freeze_the_slave(&sb, &scenario, &["--stall-s", "1.5"], 50_000);
+    let o = freeze_the_slave(&sb, &scenario, &["--stall-s", "1.5"], 800);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     let s = sb.json("run", "summary.json");
@@ -277,7 +272,7 @@ fn a_frozen_node_fails_the_run_after_the_stall_limit() {
 fn a_node_still_frozen_when_the_run_ends_fails_it() {
     let sb = Sandbox::new("frozenend");
     let scenario = sb.write("s.toml", &util::paper_1khz(3000));
-    let o = freeze_the_slave(&sb, &scenario, &[], 20_000);
+    let o = freeze_the_slave(&sb, &scenario, &[], 300);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(

@@ -123,7 +123,7 @@ fn a_killed_slave_leaves_every_sample_it_took_in_its_record() {
     let emulator = start_node(&sb, "emulator", &scenario, "e", &[]);
     let slave = start_node(&sb, "slave", &scenario, "s", &[]);
     // Kill the slave (SIGKILL: no chance to flush anything) once it is well under way.
-    kill_once_recorded(slave, &sb.path("s").join("slave.rec"), 20_000);
+    kill_once_recorded(slave, &sb.path("s").join("slave.rec"), 300);
     // The master breaks, runs to its end with zero torque; the emulator follows it.
     let (code, err) = finish(master);
     assert_eq!(code, Some(0), "{err}");
@@ -228,18 +228,13 @@ fn nodes_stop_within_a_second_when_the_launcher_is_killed() {
         .stderr(Stdio::null())
         .spawn()
         .expect("start");
-    let start = Instant::now();
-    while ["master", "emulator", "slave"]
-        .iter()
-        .any(|r| pid_of(&sb.prefix, r).is_none())
-    {
-        assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "nodes did not start"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    std::thread::sleep(Duration::from_millis(500));
+    // The loop runs (its samples reach the slave's record), so every node is past its
+    // start-up when the launcher dies.
+    util::wait_for_rows(
+        &sb.path("run").join("slave.rec"),
+        200,
+        Duration::from_secs(20),
+    );
     launcher.kill().expect("SIGKILL the launcher");
     let _ = launcher.wait();
     let killed = Instant::now();
@@ -328,11 +323,9 @@ fn a_prefix_in_use_is_refused_and_names_its_holder() {
         .stderr(Stdio::null())
         .spawn()
         .expect("start");
-    let start = Instant::now();
-    while pid_of(&sb.prefix, "master").is_none() {
-        assert!(start.elapsed() < Duration::from_secs(20));
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    util::wait_for("the first run's master", Duration::from_secs(20), || {
+        pid_of(&sb.prefix, "master").is_some()
+    });
     let o = sb.tactile(&[
         "run",
         "s.toml",

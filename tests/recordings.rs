@@ -10,11 +10,7 @@ use std::process::{Command, Stdio};
 
 /// True if python3 has the readers the check needs.
 fn python_ready() -> bool {
-    let probe = "import mcap, mcap_ros2, rosbags, yourdfpy";
-    Command::new("python3")
-        .args(["-c", probe])
-        .output()
-        .is_ok_and(|o| o.status.success())
+    util::python_has("mcap, mcap_ros2, rosbags, yourdfpy")
 }
 
 /// The kernels' FK (f64) at three poses, as the checker's `--fk` JSON.

@@ -4,8 +4,7 @@
 //! real node processes between them. Each test has its own ports and ROS domain.
 #![cfg(feature = "zenoh")]
 
-use crate::util::{self, cannot, num, Sandbox};
-use std::net::TcpListener;
+use crate::util::{self, cannot, free_port, num, Sandbox};
 use std::process::{Child, Command, Stdio};
 
 /// Held by the tests whose stand-ins run at 1 kHz in Python (and MuJoCo): one at a
@@ -21,15 +20,7 @@ pub(crate) fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
 
 /// True if python3 has eclipse-zenoh and rosbags.
 pub(crate) fn python_ready() -> bool {
-    Command::new("python3")
-        .args(["-c", "import zenoh, zenoh.ext, rosbags, numpy"])
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
-pub(crate) fn free_port() -> u16 {
-    let l = TcpListener::bind("127.0.0.1:0").expect("bind");
-    l.local_addr().expect("addr").port()
+    util::python_has("zenoh, zenoh.ext, rosbags, numpy")
 }
 
 /// Waits until a stand-in listens on `port` (Zenoh retries a refused connection only
@@ -676,13 +667,10 @@ fn a_run_stopped_by_sigint_leaves_no_force_and_the_robot_holding() {
         .spawn()
         .expect("tactile run");
     let rec = out.join("master.rec");
-    util::wait_for(
-        "the master's record",
-        std::time::Duration::from_secs(60),
-        || std::fs::metadata(&rec).is_ok_and(|m| m.len() > 0),
-    );
-    // Into the hold against the wall, at the end of the 4 s move.
-    std::thread::sleep(std::time::Duration::from_secs(6));
+    // Into the hold against the wall: 6 s of the loop at 100 Hz, past the end of the
+    // 4 s move and before the device's stand-in ends, 8 s after its first force.
+    let rows = util::MASTER_ROWS * 600;
+    util::wait_for_rows(&rec, rows, std::time::Duration::from_secs(60));
     let pid = rustix::process::Pid::from_raw(child.id() as i32).expect("pid");
     let _ = rustix::process::kill_process(pid, rustix::process::Signal::INT);
     let (code, err) = util::finish(child);
@@ -1213,11 +1201,7 @@ fn a_viewer_started_late_still_gets_the_arms_description_and_fixed_frames() {
 
 /// True if python3 also has Pinocchio (tests/servo_ik.py).
 pub(crate) fn pinocchio_ready() -> bool {
-    python_ready()
-        && Command::new("python3")
-            .args(["-c", "import pinocchio"])
-            .output()
-            .is_ok_and(|o| o.status.success())
+    python_ready() && util::python_has("pinocchio")
 }
 
 /// The same arm through a stack that does its own IK and safety (MoveIt Servo's pose
@@ -1308,11 +1292,7 @@ pub(crate) const MUJOCO_PANDA: [&str; 10] = [
 ];
 
 pub(crate) fn mujoco_ready() -> bool {
-    python_ready()
-        && Command::new("python3")
-            .args(["-c", "import mujoco"])
-            .output()
-            .is_ok_and(|o| o.status.success())
+    python_ready() && util::python_has("mujoco")
 }
 
 /// A Panda simulated by MuJoCo (its own URDF import, dynamics and soft contact) under a

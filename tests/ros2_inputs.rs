@@ -4,8 +4,8 @@
 //! counted, against the independent stand-in of tests/ros2_standin.py.
 #![cfg(feature = "zenoh")]
 
-use crate::ros2::{free_port, listening, python_ready, report};
-use crate::util::{self, cannot, num, Sandbox};
+use crate::ros2::{listening, python_ready, report};
+use crate::util::{self, cannot, free_port, num, Sandbox};
 
 /// A Touch with its gimbal (`gimbal` the URDF's path as written) over ROS 2 on
 /// `port` in `domain`, driving the Panda simulated (`root`: the deploy folder).

@@ -4,8 +4,8 @@
 //! tests make them (`tactile::launch::pki`); and the files refused, named, when bad.
 #![cfg(feature = "zenoh")]
 
-use crate::ros2::{device_standin_on, free_port, listening, python_ready, report};
-use crate::util::{cannot, num, Sandbox};
+use crate::ros2::{device_standin_on, listening, python_ready, report};
+use crate::util::{cannot, free_port, num, Sandbox};
 use std::path::PathBuf;
 
 /// A CA and a node certificate for 127.0.0.1 in `sb/dir`, or None without openssl.

@@ -30,9 +30,7 @@ fn sigint_stops_an_in_process_run_with_a_report_of_what_ran() {
         .spawn()
         .expect("start");
     let rec = sb.path("run").join("master.rec");
-    wait_for("the run's records grow", Duration::from_secs(30), || {
-        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 1_000_000)
-    });
+    util::wait_for_rows(&rec, util::MASTER_ROWS * 15_000, Duration::from_secs(30));
     let asked = Instant::now();
     signal(child.id() as i32, rustix::process::Signal::INT);
     let (code, err) = finish(child);
@@ -135,9 +133,7 @@ fn ctrl_c_to_the_process_group_is_a_stop_not_a_failure() {
         .spawn()
         .expect("start");
     let rec = sb.path("run").join("slave.rec");
-    wait_for("the loop runs", Duration::from_secs(20), || {
-        std::fs::metadata(&rec).is_ok_and(|m| m.len() > 100_000)
-    });
+    util::wait_for_rows(&rec, 1_500, Duration::from_secs(20));
     let group = rustix::process::Pid::from_raw(child.id() as i32).expect("pid");
     let _ = rustix::process::kill_process_group(group, rustix::process::Signal::INT);
     let (code, err) = finish(child);
@@ -205,9 +201,7 @@ fn sigterm_to_any_node_is_the_same_stop() {
             .spawn()
             .expect("start");
         let rec = sb.path("run").join("slave.rec");
-        wait_for("the loop runs", Duration::from_secs(20), || {
-            std::fs::metadata(&rec).is_ok_and(|m| m.len() > 100_000)
-        });
+        util::wait_for_rows(&rec, 1_500, Duration::from_secs(20));
         let pid = util::pid_of(&sb.prefix, role).unwrap_or_else(|| panic!("no {role}"));
         signal(pid, rustix::process::Signal::TERM);
         let (code, err) = finish(child);

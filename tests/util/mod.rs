@@ -4,6 +4,10 @@
 
 #![allow(dead_code)]
 
+pub mod ports;
+
+pub use ports::free_port;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -335,17 +339,26 @@ pub fn finish(child: std::process::Child) -> (Option<i32>, String) {
     )
 }
 
-/// Kills `node` with SIGKILL (no chance to flush anything) once its record `rec` has
-/// grown past `bytes`, and waits for it.
-pub fn kill_once_recorded(node: std::process::Child, rec: &Path, bytes: u64) {
-    let start = std::time::Instant::now();
-    while std::fs::metadata(rec).map_or(0, |m| m.len()) < bytes {
-        assert!(
-            start.elapsed() < std::time::Duration::from_secs(20),
-            "the node never got going"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+/// Waits for a node that must complete: fails the test naming it and with its stderr
+/// if it exits otherwise.
+pub fn finish_ok(child: std::process::Child, name: &str) {
+    let (code, err) = finish(child);
+    assert_eq!(code, Some(0), "{name}: {err}");
+}
+
+/// True if python3 can import `modules` (a comma-separated list, as `import` takes
+/// it): the tests with independent readers and stand-ins skip without them.
+pub fn python_has(modules: &str) -> bool {
+    Command::new("python3")
+        .args(["-c", &format!("import {modules}")])
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Kills `node` with SIGKILL (no chance to flush anything) once its record `rec` holds
+/// `rows`, and waits for it.
+pub fn kill_once_recorded(node: std::process::Child, rec: &Path, rows: u64) {
+    wait_for_rows(rec, rows, std::time::Duration::from_secs(20));
     let pid = rustix::process::Pid::from_raw(node.id() as i32).expect("pid");
     let _ = rustix::process::kill_process(pid, rustix::process::Signal::KILL);
     let (code, _) = finish(node);
@@ -360,6 +373,34 @@ pub fn wait_for(what: &str, limit: std::time::Duration, mut ready: impl FnMut() 
         assert!(start.elapsed() < limit, "{what}: not within {limit:?}");
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
+}
+
+/// Rows the master records a sample: c(n) sent, then q(n) come back or missed (the
+/// slave records one).
+pub const MASTER_ROWS: u64 = 2;
+
+/// Waits until the record `rec` holds `n` sample rows in whole blocks, failing the
+/// test after `limit`: a run's progress read from its record's content (the records
+/// crate's count), not its size, which moves with the record's format, compression
+/// and block length.
+pub fn wait_for_rows(rec: &Path, n: u64, limit: std::time::Duration) {
+    let what = format!("{} holds {n} sample rows", rec.display());
+    wait_for(&what, limit, || tactile_records::rows_in(rec) >= n);
+}
+
+/// True once process `pid` has a handler of its own for `signal` (the kernel's
+/// `SigCgt` mask in /proc): the moment a stop request is something it answers, which
+/// a test waits for instead of sleeping.
+pub fn catches(pid: u32, signal: rustix::process::Signal) -> bool {
+    let Ok(status) = std::fs::read_to_string(format!("/proc/{pid}/status")) else {
+        return false;
+    };
+    let caught = status
+        .lines()
+        .find_map(|l| l.strip_prefix("SigCgt:"))
+        .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+        .unwrap_or(0);
+    (caught >> (signal.as_raw() - 1)) & 1 == 1
 }
 
 /// A test that cannot check what it must here (no root for namespaces, SCHED_FIFO
