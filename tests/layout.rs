@@ -1,6 +1,7 @@
 //! The workspace draws the architecture, and keeps drawing it: no module imports a
 //! module that imports it back, no source file outgrows a read, and the crates that
-//! must not depend on each other do not (`cargo tree -e normal`).
+//! must not depend on each other do not (`cargo tree -e normal`); the Verilog ships in
+//! the crate that compiles it.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -308,4 +309,56 @@ fn only_the_driver_speaks_the_protocol() {
             }
         }
     }
+}
+
+/// The paths a file's `include_str!`/`include_bytes!` name, resolved from its folder.
+fn included(file: &Path) -> Vec<PathBuf> {
+    let text = std::fs::read_to_string(file).expect("readable");
+    let mut out = Vec::new();
+    for macro_ in ["include_str!(\"", "include_bytes!(\""] {
+        for (at, _) in text.match_indices(macro_) {
+            let rest = &text[at + macro_.len()..];
+            let path = &rest[..rest.find('"').expect("closing quote")];
+            out.push(file.parent().expect("folder").join(path));
+        }
+    }
+    out
+}
+
+/// The Verilog lives beside the crate that carries and compiles it, so the crate's
+/// package (`cargo package` takes the crate's folder alone) builds on its own: every
+/// file `tactile-rtl` includes is inside `common/rtl/`.
+#[test]
+fn the_verilog_ships_with_the_crate_that_compiles_it() {
+    let krate = root()
+        .join("common/rtl")
+        .canonicalize()
+        .expect("common/rtl");
+    let mut files = Vec::new();
+    rust_files(&krate.join("src"), &mut files);
+    files.push(krate.join("build.rs"));
+    let mut outside = Vec::new();
+    let mut verilog = 0;
+    for f in &files {
+        for p in included(f) {
+            let p = p
+                .canonicalize()
+                .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            verilog += usize::from(p.extension().is_some_and(|x| x == "v" || x == "vh"));
+            if !p.starts_with(&krate) {
+                outside.push(format!("{} includes {}", f.display(), p.display()));
+            }
+        }
+    }
+    assert!(verilog >= 25, "{verilog} Verilog files included");
+    assert!(
+        outside.is_empty(),
+        "included from outside the crate:\n{}",
+        outside.join("\n")
+    );
+    let build = std::fs::read_to_string(krate.join("build.rs")).expect("build.rs");
+    assert!(
+        build.contains("rerun-if-changed=hdl\""),
+        "build.rs watches hdl/"
+    );
 }

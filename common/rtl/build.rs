@@ -15,7 +15,7 @@
 //! CI installs it and must not pass without the hardware.
 
 fn main() {
-    println!("cargo:rerun-if-changed=../../deploy/hdl");
+    println!("cargo:rerun-if-changed=hdl");
     println!("cargo:rerun-if-changed=src/glue.cpp");
     println!("cargo:rerun-if-changed=src/text.rs");
     println!("cargo:rerun-if-env-changed=CI");

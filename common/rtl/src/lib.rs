@@ -1,6 +1,6 @@
 //! The paper's hardware as RTL.
 //!
-//! - [`text`]: the hand-written Verilog (`deploy/hdl/`) and its generated parameters,
+//! - [`text`]: the hand-written Verilog (`common/rtl/hdl/`) and its generated parameters,
 //!   from the model; `tactile hdl` writes them, co-simulates and synthesizes them.
 //! - [`engine`]: the kernels' [`Engine`] for any arithmetic, `rtl` included: with the
 //!   feature `verilator`, the modules FK, KFF, FBF and IK are compiled by Verilator

@@ -1,4 +1,5 @@
-//! The RTL's text: the hand-written Verilog (`deploy/hdl/`) and the two generated
+//! The RTL's text: the hand-written Verilog (`hdl/`, beside this crate's sources: it
+//! packages with the crate that compiles it) and the two generated
 //! parameter files, `tfb_params.vh` (a format's CORDIC constants) and `kin_params.vh`
 //! (the modules' constants for a geometry), both computed by the model
 //! (`tactile-math`) so the hardware and the model share every number.
@@ -12,58 +13,34 @@ use tactile_math::cordic::Rounding;
 use tactile_math::geometry::{Geometry, Lengths};
 use tactile_math::kernels::IkConstants;
 
-/// The hand-written, parameterized RTL (deploy/hdl), carried in the binary so that
+/// The hand-written, parameterized RTL (`common/rtl/hdl/`), carried in the binary so that
 /// `tactile hdl` works from any folder.
 pub const SOURCES: [(&str, &str); 25] = [
-    ("tfb_fp.vh", include_str!("../../../deploy/hdl/tfb_fp.vh")),
-    (
-        "tfb_delay.v",
-        include_str!("../../../deploy/hdl/tfb_delay.v"),
-    ),
-    (
-        "tfb_stage.v",
-        include_str!("../../../deploy/hdl/tfb_stage.v"),
-    ),
-    (
-        "tfb_sincos.v",
-        include_str!("../../../deploy/hdl/tfb_sincos.v"),
-    ),
-    (
-        "tfb_vector.v",
-        include_str!("../../../deploy/hdl/tfb_vector.v"),
-    ),
-    (
-        "tfb_atan2.v",
-        include_str!("../../../deploy/hdl/tfb_atan2.v"),
-    ),
-    (
-        "tfb_sqrt1m.v",
-        include_str!("../../../deploy/hdl/tfb_sqrt1m.v"),
-    ),
-    ("tfb_acos.v", include_str!("../../../deploy/hdl/tfb_acos.v")),
-    ("tfb_top.v", include_str!("../../../deploy/hdl/tfb_top.v")),
-    ("tb_tfb.v", include_str!("../../../deploy/hdl/tb_tfb.v")),
-    ("f32_lat.vh", include_str!("../../../deploy/hdl/f32_lat.vh")),
-    ("f32_fn.vh", include_str!("../../../deploy/hdl/f32_fn.vh")),
-    (
-        "f32_round.vh",
-        include_str!("../../../deploy/hdl/f32_round.vh"),
-    ),
-    ("f32_add.v", include_str!("../../../deploy/hdl/f32_add.v")),
-    ("f32_mul.v", include_str!("../../../deploy/hdl/f32_mul.v")),
-    ("f32_div.v", include_str!("../../../deploy/hdl/f32_div.v")),
-    ("f32_sqrt.v", include_str!("../../../deploy/hdl/f32_sqrt.v")),
-    ("tb_f32.v", include_str!("../../../deploy/hdl/tb_f32.v")),
-    (
-        "kin_sincos3.v",
-        include_str!("../../../deploy/hdl/kin_sincos3.v"),
-    ),
-    ("kin_fk.v", include_str!("../../../deploy/hdl/kin_fk.v")),
-    ("kin_kff.v", include_str!("../../../deploy/hdl/kin_kff.v")),
-    ("kin_fbf.v", include_str!("../../../deploy/hdl/kin_fbf.v")),
-    ("kin_ik.v", include_str!("../../../deploy/hdl/kin_ik.v")),
-    ("kin_top.v", include_str!("../../../deploy/hdl/kin_top.v")),
-    ("tb_kin.v", include_str!("../../../deploy/hdl/tb_kin.v")),
+    ("tfb_fp.vh", include_str!("../hdl/tfb_fp.vh")),
+    ("tfb_delay.v", include_str!("../hdl/tfb_delay.v")),
+    ("tfb_stage.v", include_str!("../hdl/tfb_stage.v")),
+    ("tfb_sincos.v", include_str!("../hdl/tfb_sincos.v")),
+    ("tfb_vector.v", include_str!("../hdl/tfb_vector.v")),
+    ("tfb_atan2.v", include_str!("../hdl/tfb_atan2.v")),
+    ("tfb_sqrt1m.v", include_str!("../hdl/tfb_sqrt1m.v")),
+    ("tfb_acos.v", include_str!("../hdl/tfb_acos.v")),
+    ("tfb_top.v", include_str!("../hdl/tfb_top.v")),
+    ("tb_tfb.v", include_str!("../hdl/tb_tfb.v")),
+    ("f32_lat.vh", include_str!("../hdl/f32_lat.vh")),
+    ("f32_fn.vh", include_str!("../hdl/f32_fn.vh")),
+    ("f32_round.vh", include_str!("../hdl/f32_round.vh")),
+    ("f32_add.v", include_str!("../hdl/f32_add.v")),
+    ("f32_mul.v", include_str!("../hdl/f32_mul.v")),
+    ("f32_div.v", include_str!("../hdl/f32_div.v")),
+    ("f32_sqrt.v", include_str!("../hdl/f32_sqrt.v")),
+    ("tb_f32.v", include_str!("../hdl/tb_f32.v")),
+    ("kin_sincos3.v", include_str!("../hdl/kin_sincos3.v")),
+    ("kin_fk.v", include_str!("../hdl/kin_fk.v")),
+    ("kin_kff.v", include_str!("../hdl/kin_kff.v")),
+    ("kin_fbf.v", include_str!("../hdl/kin_fbf.v")),
+    ("kin_ik.v", include_str!("../hdl/kin_ik.v")),
+    ("kin_top.v", include_str!("../hdl/kin_top.v")),
+    ("tb_kin.v", include_str!("../hdl/tb_kin.v")),
 ];
 
 /// The modules of the hardware, in compile order: the TFB's, the f32 units, the

@@ -1,4 +1,4 @@
-//! What the TFB's RTL (`deploy/hdl/`) takes from this model: the quantised constants
+//! What the TFB's RTL (`common/rtl/hdl/`) takes from this model: the quantised constants
 //! of a format, the range reduction done in integers, and each function's values at
 //! the stage boundaries. The Verilog parameters and the co-simulation's test vectors
 //! are made here, from the same [`Cordic`] the kernels use, so the hardware and the
