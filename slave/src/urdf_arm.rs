@@ -21,15 +21,15 @@
 //! arm's tool as it is (the objects are the master frame's, so a wall keeps its place
 //! and stiffness for the operator whatever the arm).
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Matrix6xX, Vector3, Vector6};
+use nalgebra::{Matrix3, Vector3, Vector6};
 use std::path::Path;
 pub use tactile_chain::spatial::{quaternion, rotation_matrix};
 use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
 use tactile_math::arith::StdTrig;
 use tactile_scenario::shown::{listed, Num};
-use tactile_scenario::{ArmConfig, ArmServo, Scenario};
+use tactile_scenario::{ArmConfig, Scenario};
 
-use crate::environment::{deepest_contact, Scene};
+use crate::environment::Scene;
 use tactile_math::kernels;
 
 /// Largest URDF file read, bytes (the Panda's is 15 kB; meshes are separate files).
@@ -45,7 +45,8 @@ pub struct UrdfArm {
     home_tool: Frame,
     master_home: [f64; 3],
     state: ArmState,
-    jac: Matrix6xX<f64>,
+    /// The integration's buffers, made once.
+    scratch: sim::Scratch,
     /// The joints held since input went silent, if it is.
     held: Option<Vec<f64>>,
     /// The tool's pose reference and its velocity `[linear; angular]` in the base
@@ -205,7 +206,7 @@ impl UrdfArm {
             tau: vec![0.0; dof],
         };
         Ok(UrdfArm {
-            jac: Matrix6xX::zeros(dof),
+            scratch: sim::Scratch::new(&chain),
             chain,
             ik,
             dynamics,
@@ -462,38 +463,6 @@ impl UrdfArm {
         self.held = None;
     }
 
-    /// Integrates the arm over `dt` under its servo, pushed by whatever the tool
-    /// touches among `objects`. Returns how many joints hit their effort limit.
-    pub fn advance(&mut self, dt: f64, objects: &Scene) -> u32 {
-        let steps = (dt / self.cfg.step_s).ceil().max(1.0) as u32;
-        let h = dt / f64::from(steps);
-        let mut clamped = vec![false; self.chain.dof()];
-        for _ in 0..steps {
-            let tau = self.servo(&mut clamped);
-            let ext = self.contact_torques(objects);
-            let drive: Vec<f64> = (0..tau.len())
-                .map(|i| tau[i] + ext[i] - self.chain.dofs[i].damping * self.state.qd[i])
-                .collect();
-            let acc = match self.dynamics.aba(&self.state.q, &self.state.qd, &drive) {
-                Ok(a) if a.iter().all(|a| a.is_finite()) => a,
-                // Never integrate a non-finite state: the joints stop where they are,
-                // and the failure is counted and kept for the slave's log.
-                failed => {
-                    self.state.qd.iter_mut().for_each(|v| *v = 0.0);
-                    self.failures.0 += 1;
-                    self.failures.1 = Some(match failed {
-                        Err(e) => e.to_string(),
-                        Ok(_) => "the joints' accelerations are not finite".into(),
-                    });
-                    break;
-                }
-            };
-            self.integrate(&acc, h);
-            self.state.tau = tau;
-        }
-        clamped.iter().filter(|c| **c).count() as u32
-    }
-
     /// Periods whose dynamics failed so far (the arm stood still in each).
     pub fn dynamics_failures(&self) -> u64 {
         self.failures.0
@@ -503,96 +472,10 @@ impl UrdfArm {
     pub fn take_failure(&mut self) -> Option<String> {
         self.failures.1.take()
     }
-
-    /// The servo's efforts with gravity compensation, clamped to each joint's effort
-    /// limit: the joint PD, or the Cartesian impedance.
-    fn servo(&mut self, clamped: &mut [bool]) -> Vec<f64> {
-        let g = self
-            .dynamics
-            .gravity_torques(&self.state.q)
-            .unwrap_or_else(|_| vec![0.0; self.chain.dof()]);
-        let drive = match self.cfg.servo {
-            ArmServo::Joint => None,
-            ArmServo::Cartesian => Some(self.impedance()),
-        };
-        let s = &self.state;
-        (0..g.len())
-            .map(|i| {
-                let u = match &drive {
-                    None => {
-                        self.cfg.kp[i] * (s.q_ref[i] - s.q[i])
-                            + self.cfg.kd[i] * (s.qd_ref[i] - s.qd[i])
-                            + g[i]
-                    }
-                    Some(d) => d[i] + g[i],
-                };
-                let limit = self.chain.dofs[i].effort;
-                let t = u.clamp(-limit, limit);
-                clamped[i] |= t != u;
-                t
-            })
-            .collect()
-    }
-
-    /// The Cartesian impedance without gravity: `J^T (K e - D (v - v_ref))` toward the
-    /// pose reference, and in the null space of the task (`I - J^T J^+T`, `J^+` damped)
-    /// a PD toward the IK's references, so a redundant arm keeps its posture.
-    fn impedance(&mut self) -> Vec<f64> {
-        let n = self.chain.dof();
-        let tip = self.chain.jacobian(&self.state.q, &mut self.jac);
-        let (r, v_ref) = &self.reference;
-        let e_p = r.p - tip.p;
-        let e_r = tactile_chain::spatial::log_rotation(&(r.r * tip.r.transpose()));
-        let qd = DVector::from_column_slice(&self.state.qd);
-        let v = &self.jac * &qd;
-        let c = &self.cfg.cartesian;
-        let (k, d) = (c.stiffness, c.damping());
-        let e = [e_p.x, e_p.y, e_p.z, e_r.x, e_r.y, e_r.z];
-        let w = Vector6::from_fn(|i, _| k[i] * e[i] - d[i] * (v[i] - v_ref[i]));
-        let task = self.jac.transpose() * w;
-        // J^+ = J^T (J J^T + lambda^2 I)^-1: damped, so a singular pose stays finite.
-        let jjt: Matrix6<f64> = &self.jac * self.jac.transpose() + Matrix6::identity() * 1e-6;
-        let inv = jjt.try_inverse().unwrap_or_else(Matrix6::zeros);
-        let pinv = self.jac.transpose() * inv;
-        let null = DMatrix::identity(n, n) - self.jac.transpose() * pinv.transpose();
-        let kn = c.nullspace_stiffness;
-        let dn = 2.0 * kn.sqrt();
-        let s = &self.state;
-        let posture = DVector::from_fn(n, |i, _| kn * (s.q_ref[i] - s.q[i]) - dn * s.qd[i]);
-        let tau = task + null * posture;
-        tau.iter().copied().collect()
-    }
-
-    /// The contact force at the tool (the environment's, evaluated in the master's
-    /// frame) as joint efforts: J_v^T f.
-    fn contact_torques(&mut self, objects: &Scene) -> Vec<f64> {
-        let tip = self.chain.jacobian(&self.state.q, &mut self.jac);
-        let tool = self.to_master(&tip.p);
-        let Some(c) = deepest_contact(objects, tool) else {
-            return vec![0.0; self.chain.dof()];
-        };
-        let f = Vector3::from(
-            self.cfg
-                .force_to_robot(kernels::fbf(c.surface, tool, c.stiffness)),
-        );
-        (0..self.chain.dof())
-            .map(|i| self.jac.fixed_view::<3, 1>(0, i).dot(&f))
-            .collect()
-    }
-
-    /// Semi-implicit Euler; a joint that reaches its limit stops there.
-    fn integrate(&mut self, acc: &[f64], h: f64) {
-        let s = &mut self.state;
-        for (i, d) in self.chain.dofs.iter().enumerate() {
-            s.qd[i] += h * acc[i];
-            s.q[i] += h * s.qd[i];
-            if s.q[i] < d.lower || s.q[i] > d.upper {
-                s.q[i] = s.q[i].clamp(d.lower, d.upper);
-                s.qd[i] = 0.0;
-            }
-        }
-    }
 }
+
+#[path = "urdf_arm_sim.rs"]
+mod sim;
 
 #[cfg(test)]
 #[path = "urdf_arm_tests.rs"]

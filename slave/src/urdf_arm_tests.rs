@@ -2,7 +2,9 @@
 use super::*;
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
-use tactile_scenario::{ArmIkConfig, CartesianConfig, FrameRotation, Object, Scale, Workspace};
+use tactile_scenario::{
+    ArmIkConfig, ArmServo, CartesianConfig, FrameRotation, Object, Scale, Workspace,
+};
 
 fn panda_xml() -> String {
     let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../deploy/robots/panda.urdf");
@@ -60,10 +62,9 @@ fn gravity_compensation_holds_the_arm_at_home() {
 fn at_rest_the_servo_gives_the_gravity_torques() {
     // At home with no error the servo's effort is the gravity torque itself (RNEA),
     // far from zero: without it the arm would sag.
-    let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    let arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
     let g = arm.dynamics.gravity_torques(&panda_cfg().home).expect("g");
-    let mut clamped = vec![false; 7];
-    let tau = arm.servo(&mut clamped);
+    let tau = arm.servo_now();
     assert_eq!(tau, g);
     assert!(g[1].abs() > 1.0, "{g:?}");
 }
