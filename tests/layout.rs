@@ -285,6 +285,15 @@ fn the_crates_depend_as_the_architecture_says() {
         let t = tree(low);
         assert!(!has(&t, "tactile-runtime"), "{low} depends on the runtime");
     }
+    // The nodes own their peripherals: the runtime drives them through
+    // tactile-peripheral's traits and knows no device, arm or gimbal.
+    let runtime = tree("tactile-runtime");
+    for node_side in ["tactile-devices", "tactile-chain"] {
+        assert!(
+            !has(&runtime, node_side),
+            "tactile-runtime depends on {node_side}"
+        );
+    }
 }
 
 /// The per-sample protocol is the driver's alone: no node crate names the pacer, the

@@ -4,14 +4,16 @@
 use crate::handler::MasterHandler;
 use crate::hmd::Master;
 use crate::operator::OperatorSource;
+use crate::peripherals;
 use clap::Parser;
 use std::process::ExitCode;
 use std::time::Duration;
 use tactile_messages::Role;
 use tactile_runtime::args::{exit, parse, LinkKind, NodeArgs, NodeError};
 use tactile_runtime::exit::EXIT_CODES_HELP;
-use tactile_runtime::program::Program;
+use tactile_runtime::program::{Opened, Program};
 use tactile_runtime::start::Links;
+use tactile_scenario::Backend;
 
 /// tactile-master: the operator's side (OP, MD, HMD). Sends c(n), takes q(n) back,
 /// commands the master device's torques, and records every sample.
@@ -71,14 +73,24 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     for w in source.warnings(sc.samples, sc.t_s()) {
         tracing::warn!("{w}");
     }
+    // The gimbal's URDF read and checked before anything starts: bad input (exit 2).
+    let gimbal = match sc.master.backend {
+        Backend::Ros2 => peripherals::gimbal(sc, &program.prepared().base_dir)
+            .map_err(|e| NodeError::BadInput(format!("{}: {e}", a.scenario.display())))?,
+        Backend::Simulated => None,
+    };
     let timeout = Duration::from_secs_f64(cli.startup_timeout_s.min(1e6));
     program.lead(
         timeout,
-        Box::new(move |p, outside| {
+        Box::new(move |p| {
+            let opened = peripherals::open(&p.scenario, &p.base_dir, gimbal)?;
             let master =
                 Master::new(&p.scenario, source).map_err(|e| NodeError::Failed(e.to_string()))?;
             let timeout = p.scenario.faults.peer_timeout_samples;
-            Ok(MasterHandler::new(master, outside.haptic.take(), timeout))
+            Ok(Opened {
+                handler: MasterHandler::new(master, opened.device, timeout),
+                live: opened.live,
+            })
         }),
     )
 }

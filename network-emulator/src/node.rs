@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use tactile_messages::Role;
 use tactile_runtime::args::{exit, parse, LinkKind, NodeArgs, NodeError};
 use tactile_runtime::exit::EXIT_CODES_HELP;
-use tactile_runtime::program::Program;
+use tactile_runtime::program::{Opened, Program};
 use tactile_runtime::start::Links;
 
 /// tactile-emulator: the network between master and slave. Delays, perturbs, drops
@@ -47,10 +47,10 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let program = Program::prepare(Role::Emulator, a, links)?;
     let replays = crate::replay::load(program.scenario(), &program.prepared().base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: {e}", a.scenario.display())))?;
-    program.follow(Box::new(move |p, _| {
-        Ok(EmulatorHandler::new(Emulator::with_replays(
+    program.follow(Box::new(move |p| {
+        Ok(Opened::alone(EmulatorHandler::new(Emulator::with_replays(
             &p.scenario,
             replays,
-        )))
+        ))))
     }))
 }

@@ -1,14 +1,15 @@
 //! The `tactile-slave` program (HSD): its command line and its run.
 
-use crate::handler::{RealRobot, SlaveHandler};
+use crate::handler::SlaveHandler;
 use crate::hsd::Slave;
+use crate::peripherals;
 use crate::urdf_arm::UrdfArm;
 use clap::Parser;
 use std::process::ExitCode;
 use tactile_messages::Role;
 use tactile_runtime::args::{exit, parse, NodeArgs, NodeError};
 use tactile_runtime::exit::EXIT_CODES_HELP;
-use tactile_runtime::program::Program;
+use tactile_runtime::program::{Opened, Program};
 use tactile_runtime::start::Links;
 
 /// tactile-slave: the remote side (HSD, SD, ENV). Follows v(n) with the slave arm,
@@ -42,16 +43,21 @@ pub fn main() -> ExitCode {
 pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let a = &cli.node;
     let program = Program::prepare(Role::Slave, a, Links::all(a.link.link))?;
-    // Read and checked before anything starts: a bad URDF is bad input (exit 2).
-    let arm = UrdfArm::of_scenario(program.scenario(), &program.prepared().base_dir)
-        .map_err(NodeError::BadInput)?;
-    program.follow(Box::new(move |p, outside| {
+    // Read and checked before anything starts: a bad URDF is bad input (exit 2). Read
+    // and parsed once: the simulated arm, the robot over ROS 2 and the live view take
+    // its model.
+    let (sc, base_dir) = (program.scenario(), &program.prepared().base_dir);
+    let urdf = UrdfArm::read_urdf(sc, base_dir).map_err(NodeError::BadInput)?;
+    let arm = match &urdf {
+        Some(u) => UrdfArm::of_urdf(sc, u).map_err(NodeError::BadInput)?,
+        None => None,
+    };
+    program.follow(Box::new(move |p| {
+        let opened = peripherals::open(&p.scenario, &p.base_dir, urdf.as_ref())?;
         let slave = Slave::new(&p.scenario, arm).map_err(|e| NodeError::Failed(e.to_string()))?;
-        let robot = match (outside.robot.take(), outside.arm_robot.take()) {
-            (Some(r), _) => Some(RealRobot::Paper(r)),
-            (None, Some(r)) => Some(RealRobot::Arm(r)),
-            (None, None) => None,
-        };
-        Ok(SlaveHandler::new(slave, &p.scenario, robot))
+        Ok(Opened {
+            handler: SlaveHandler::new(slave, &p.scenario, opened.robot),
+            live: opened.live,
+        })
     }))
 }

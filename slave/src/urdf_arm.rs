@@ -22,18 +22,12 @@
 //! and stiffness for the operator whatever the arm).
 
 use nalgebra::{Matrix3, Vector3, Vector6};
-use std::path::Path;
 pub use tactile_chain::spatial::{quaternion, rotation_matrix};
-use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
-use tactile_math::arith::StdTrig;
+use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig, Robot};
 use tactile_scenario::shown::{listed, Num};
-use tactile_scenario::{ArmConfig, Scenario};
+use tactile_scenario::ArmConfig;
 
 use crate::environment::Scene;
-use tactile_math::kernels;
-
-/// Largest URDF file read, bytes (the Panda's is 15 kB; meshes are separate files).
-pub const MAX_URDF_BYTES: u64 = 16 << 20;
 
 /// The simulated arm and its references.
 #[derive(Debug, Clone)]
@@ -121,30 +115,17 @@ pub struct Holding {
 }
 
 impl UrdfArm {
-    /// The scenario's `[slave.arm]`, its URDF read (relative to `base_dir`) and
-    /// checked; `None` without one (the paper's arm).
-    pub fn of_scenario(scenario: &Scenario, base_dir: &Path) -> Result<Option<Self>, String> {
-        let Some(cfg) = &scenario.slave.arm else {
-            return Ok(None);
-        };
-        let geometry = scenario.device.geometry().map_err(|e| e.to_string())?;
-        // The paper arm's tool at zero angles: where the master starts.
-        let home = kernels::fk(&geometry.lengths(), &StdTrig, [0.0; 3]);
-        UrdfArm::load(cfg, base_dir, home).map(Some)
-    }
-
-    /// Reads the URDF named by `cfg` (relative to `base_dir`) and makes the arm.
-    pub fn load(cfg: &ArmConfig, base_dir: &Path, master_home: [f64; 3]) -> Result<Self, String> {
-        let path = base_dir.join(&cfg.urdf);
-        let xml = tactile_runtime::files::read_text(&path, "URDF", MAX_URDF_BYTES)?;
-        UrdfArm::new(cfg, &xml, master_home)
-            .map_err(|e| format!("slave.arm: {}: {e}", path.display()))
-    }
-
     /// The arm of `cfg` from the URDF text `xml`, at rest at its home posture;
     /// `master_home` is the master's position that maps onto the tool's home pose.
     pub fn new(cfg: &ArmConfig, xml: &str, master_home: [f64; 3]) -> Result<Self, String> {
-        let chain = Chain::from_urdf(xml, &cfg.base, &cfg.tip).map_err(|e| e.to_string())?;
+        let robot = Robot::parse(xml).map_err(|e| e.to_string())?;
+        UrdfArm::of_robot(cfg, &robot, master_home)
+    }
+
+    /// The arm of `cfg` from its URDF's model `robot` (parsed once), at rest at its
+    /// home posture; `master_home` as for [`UrdfArm::new`].
+    pub fn of_robot(cfg: &ArmConfig, robot: &Robot, master_home: [f64; 3]) -> Result<Self, String> {
+        let chain = Chain::new(robot, &cfg.base, &cfg.tip).map_err(|e| e.to_string())?;
         let dof = chain.dof();
         for (field, v) in [("home", &cfg.home), ("kp", &cfg.kp), ("kd", &cfg.kd)] {
             if v.len() != dof {

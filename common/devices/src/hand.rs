@@ -48,7 +48,19 @@ impl Gimbal {
     /// The gimbal of the URDF text `xml` from `base` to `tip`, its base turned by
     /// `frame` into the master's.
     pub fn new(xml: &str, base: &str, tip: &str, frame: &FrameRotation) -> Result<Gimbal, String> {
-        let chain = Chain::from_urdf(xml, base, tip).map_err(|e| e.to_string())?;
+        let robot = tactile_chain::Robot::parse(xml).map_err(|e| e.to_string())?;
+        Gimbal::of_robot(&robot, base, tip, frame)
+    }
+
+    /// The gimbal of the URDF model `robot` (read once by the master,
+    /// [`tactile_chain::file::read`]) from `base` to `tip`, its base turned by `frame`.
+    pub fn of_robot(
+        robot: &tactile_chain::Robot,
+        base: &str,
+        tip: &str,
+        frame: &FrameRotation,
+    ) -> Result<Gimbal, String> {
+        let chain = Chain::new(robot, base, tip).map_err(|e| e.to_string())?;
         let names = chain.dofs.iter().map(|d| d.name.clone()).collect();
         let m = frame.matrix();
         Ok(Gimbal {

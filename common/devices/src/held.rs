@@ -2,7 +2,7 @@
 //! holds through staleness and loss and the events it records, and the once-a-second
 //! log line. Shared by the master and the slave.
 
-use crate::{Change, DeviceCounters, Reading, Reject};
+use crate::{Change, Reading};
 
 /// A device's angles as a loop holds them: the last good ones (held while the device
 /// is stale or lost) and whether it is lost now. `V`: three angles, or an arm's
@@ -48,25 +48,7 @@ impl<V> Held<V> {
     }
 }
 
-/// Logs, at most once a second (call it when the counters are due), the stale and
-/// lost ticks of `who` since the last call and what it sent that was dropped.
-pub fn log_second(
-    who: &str,
-    seen: &mut DeviceCounters,
-    now: &DeviceCounters,
-    reject: Option<Reject>,
-) {
-    if now.stale != seen.stale || now.lost != seen.lost || now.rejected != seen.rejected {
-        tracing::warn!(
-            "{who} in the last second: {} stale and {} lost ticks, {} messages dropped{}",
-            now.stale - seen.stale,
-            now.lost - seen.lost,
-            now.rejected - seen.rejected,
-            reject.map_or(String::new(), |r| format!(" (first: {r})"))
-        );
-    }
-    *seen = *now;
-}
+pub use tactile_peripheral::log_second;
 
 #[cfg(test)]
 mod tests {

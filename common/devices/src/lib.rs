@@ -4,7 +4,8 @@
 //! loop holds through staleness and loss ([`held`]); over ROS 2 on rmw_zenoh (the
 //! node's session [`rmw_node`], the device [`ros_hand`], the robots [`ros_devices`]
 //! and [`ros_arm`], and the live view
-//! [`live_view`], behind the `zenoh` feature). The judgements are pure and always
+//! [`live_view`], behind the `zenoh` feature; what the nodes share opening them,
+//! [`ros_side`]). The judgements are pure and always
 //! built; the I/O only with Zenoh.
 
 pub mod admit;
@@ -25,31 +26,13 @@ pub mod ros_arm;
 pub mod ros_devices;
 #[cfg(feature = "zenoh")]
 pub mod ros_hand;
+pub mod ros_side;
 pub mod watch;
 
 pub use map::{JointMap, Reject};
+pub use tactile_peripheral::{LiveSink, Peripheral};
 pub use tactile_records::device::DeviceCounters;
 pub use watch::{Change, Reading};
-
-/// A device or robot as the loop's driver sees it, whatever it is: whether it has
-/// been heard from, what it delivered, and what it sent that was dropped.
-pub trait Peripheral {
-    /// `device` or `robot`, for messages.
-    fn kind(&self) -> &'static str;
-    /// True once a good message has come.
-    fn heard(&self) -> bool;
-    /// What it delivered and how it was judged.
-    fn counters(&self) -> DeviceCounters;
-    /// The first message dropped since the last call, for the log.
-    fn take_reject(&self) -> Option<Reject>;
-    /// Where it is read from, for messages.
-    fn describe(&self) -> String;
-    /// Why nothing can come yet, if the way to it is not even open (the ROS 2 session
-    /// reached no router or peer); None once it is, or where there is no such way.
-    fn unreached(&self) -> Option<String> {
-        None
-    }
-}
 
 /// A real master device, as the master's loop uses it: the handle in (three joints,
 /// or a pose; with an orientation and a clutch on a 6-DoF device), force out.
@@ -94,15 +77,6 @@ pub trait Robot<V = [f64; 3]>: Peripheral {
     /// Leaves the robot holding: its own last angles commanded, sent so they arrive.
     /// True if it was sent to a listening controller.
     fn release(&mut self) -> bool;
-}
-
-/// Where a loop hands its state for the live view: takes it only every k-th sample,
-/// and never blocks.
-pub trait LiveSink<S> {
-    /// True if sample `n` is one the live view publishes.
-    fn due(&self, n: u64) -> bool;
-    /// Hands the state over (dropped and counted if the publisher is behind).
-    fn offer(&mut self, state: S);
 }
 
 /// A ROS 2 session, publisher or subscription that could not be made, with what was

@@ -6,60 +6,7 @@
 use tactile_ros::msg::{Decode, JointState, WrenchStamped};
 use tactile_scenario::JointMapConfig;
 
-/// Why a message was dropped.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum Reject {
-    /// Not a well-formed message of the topic's type.
-    #[error("not a well-formed message: {0}")]
-    Malformed(#[from] tactile_ros::CdrError),
-    /// A named joint is not in the message (or has no position).
-    #[error("joint {0:?} is missing")]
-    Missing(String),
-    /// A value is NaN or infinite.
-    #[error("joint {0:?} is not finite")]
-    NotFinite(String),
-    /// A value outside the configured range.
-    #[error("joint {joint:?} at {value} rad is outside {min}..={max}")]
-    OutOfRange {
-        /// The joint.
-        joint: String,
-        /// Its angle, rad (the paper's convention).
-        value: f64,
-        /// Smallest accepted.
-        min: f64,
-        /// Largest accepted.
-        max: f64,
-    },
-    /// A force that is NaN or infinite.
-    #[error("force is not finite")]
-    ForceNotFinite,
-    /// A pose that is not one: not finite, or an orientation that is not a rotation.
-    #[error("not a pose: {0}")]
-    BadPose(String),
-    /// A sample on the topic's name whose key carries another type's hash.
-    #[error(
-        "type hash {0} is not the topic type's (its RIHS01 hash, or Humble's TypeHashNotSupported)"
-    )]
-    WrongType(String),
-    /// A sample without rmw_zenoh's attachment, or with a malformed one.
-    #[error("rmw_zenoh's attachment: {0}")]
-    Attachment(String),
-    /// A `JointState` naming a joint twice: which of its values holds is undefined.
-    #[error("joint {0:?} is named twice")]
-    DuplicateJoint(String),
-    /// A button's value that is neither 0 (released) nor 1 (pressed).
-    #[error("{field} is {value}: a button is 0 or 1")]
-    BadButton {
-        /// The message's field.
-        field: &'static str,
-        /// Its value.
-        value: i32,
-    },
-    /// A force in a frame the arm's URDF does not have (it cannot be turned into the
-    /// base's).
-    #[error("force in frame {0:?}, which is not a link of the arm's URDF")]
-    UnknownFrame(String),
-}
+pub use tactile_peripheral::Reject;
 
 /// A CDR `JointState`, decoded, each joint named once (ROS 2 leaves a repeated name
 /// undefined; a driver does not send one).

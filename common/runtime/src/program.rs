@@ -1,18 +1,20 @@
 //! A node program from its checks to its exit: the three node programs are each this,
 //! with their own handler. [`Program::prepare`] checks everything a user controls
 //! before anything starts (bad input: exit 2); [`Program::follow`] and
-//! [`Program::lead`] start the record, open the node's ends and its ROS 2 side, make
-//! the handler and run the driver; every failure after the record started is in it.
+//! [`Program::lead`] start the record, open the node's ends, have the node open its own
+//! peripherals (device, robot, live view) and make its handler, and run the driver;
+//! every failure after the record started is in it.
 
 use crate::args::{NodeArgs, NodeError};
 use crate::driver::follow::Follow;
 use crate::driver::lead::{Lead, LeadOptions};
 use crate::driver::{Failure, Follower, Handler, Leader, Link, OnTransports, Timing};
-use crate::outside::Outside;
 use crate::start::{new_run_token, prepare, start_record, Links, Prepared};
 use std::time::Duration;
 use tactile_messages::Role;
+use tactile_peripheral::LiveSink;
 use tactile_records::{Events, Recorder};
+use tactile_ros::view::SampleView;
 use tactile_scenario::Scenario;
 
 /// A node program that passed its checks.
@@ -24,8 +26,40 @@ pub struct Program {
     prepared: Prepared,
 }
 
-/// What a node's handler is made from.
-pub type Make<'a, H> = Box<dyn FnOnce(&Prepared, &mut Outside) -> Result<H, NodeError> + 'a>;
+/// A node's live view, as the driver takes it.
+pub type Live = Box<dyn LiveSink<SampleView>>;
+
+/// What a node hands its driver: its handler (holding the device or robot the node
+/// opened, if any) and its live view. The node opens them (it knows its arm or
+/// gimbal); the runtime only drives them, through `tactile-peripheral`'s traits.
+pub struct Opened<H> {
+    /// The node's handler.
+    pub handler: H,
+    /// The live view, when `[ros.live]` asks for one.
+    pub live: Option<Live>,
+}
+
+impl<H> std::fmt::Debug for Opened<H> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Opened")
+            .field("live", &self.live.is_some())
+            .finish_non_exhaustive()
+    }
+}
+
+impl<H> Opened<H> {
+    /// A handler without a live view.
+    pub fn alone(handler: H) -> Opened<H> {
+        Opened {
+            handler,
+            live: None,
+        }
+    }
+}
+
+/// What a node's handler is made from, once the record started and its ends are
+/// open: a failure here is recorded.
+pub type Make<'a, H> = Box<dyn FnOnce(&Prepared) -> Result<Opened<H>, NodeError> + 'a>;
 
 impl Program {
     /// Checks the arguments, the scenario and the prefix, takes the role's lock,
@@ -66,12 +100,13 @@ impl Program {
         Ok(rec)
     }
 
-    /// The node's ends, its ROS 2 side and its handler; a failure is recorded.
+    /// The node's ends, and its handler and live view as the node opened them; a
+    /// failure is recorded.
     fn open<H: Handler>(
         &self,
         rec: &mut Recorder<H::Sample, H::Totals>,
         make: Make<'_, H>,
-    ) -> Result<(Link, Outside, H), NodeError> {
+    ) -> Result<(Link, Opened<H>), NodeError> {
         let opened = (|| {
             let links = self.links;
             let ports = tactile_transport::ports::open(
@@ -81,10 +116,8 @@ impl Program {
                 links.direct,
             )
             .map_err(|e| NodeError::Failed(e.to_string()))?;
-            let mut outside =
-                Outside::open(&self.prepared.scenario, self.role, &self.prepared.base_dir)?;
-            let h = make(&self.prepared, &mut outside)?;
-            Ok((Link::new(ports, self.prepared.spin), outside, h))
+            let opened = make(&self.prepared)?;
+            Ok((Link::new(ports, self.prepared.spin), opened))
         })();
         if let Err(e) = &opened {
             let _ = rec.event(0, &format!("failed: {e}"));
@@ -106,8 +139,8 @@ impl Program {
     pub fn follow<H: Follower>(self, make: Make<'_, H>) -> Result<bool, NodeError> {
         let ended = (|| {
             let mut rec = self.record::<H>()?;
-            let (link, outside, h) = self.open(&mut rec, make)?;
-            Follow::new(h, link, rec, self.timing(), outside.live)
+            let (link, o) = self.open(&mut rec, make)?;
+            Follow::new(o.handler, link, rec, self.timing(), o.live)
                 .run(&mut OnTransports)
                 .map_err(failed)
         })();
@@ -137,7 +170,7 @@ impl Program {
     ) -> Result<bool, NodeError> {
         let ended = (|| {
             let mut rec = self.record::<H>()?;
-            let (link, outside, h) = self.open(&mut rec, make)?;
+            let (link, o) = self.open(&mut rec, make)?;
             let opts = LeadOptions {
                 run: new_run_token(),
                 samples: self.prepared.scenario.samples,
@@ -149,7 +182,7 @@ impl Program {
                 answer_timeout: Duration::from_secs(1),
                 timing: self.timing(),
             };
-            Lead::new(h, link, rec, opts, outside.live)
+            Lead::new(o.handler, link, rec, opts, o.live)
                 .run(&mut OnTransports)
                 .map_err(failed)
         })();

@@ -14,9 +14,6 @@ use tactile_math::kernels;
 use tactile_ros::arm::{self, Link, WORLD};
 use tactile_scenario::{ArmConfig, Object, Scenario};
 
-/// The largest URDF a report reads (the nodes' limit).
-const MAX_URDF_BYTES: u64 = 16 << 20;
-
 /// The joint that stands the robot in the world.
 pub const MOUNT: &str = "slave_mount";
 
@@ -42,25 +39,37 @@ impl ArmScene {
         let Some(cfg) = &scenario.slave.arm else {
             return Ok(None);
         };
-        let path = std::path::Path::new(&cfg.urdf);
-        let xml = read(path)?;
+        // The nodes' one reader of a URDF: the same cap and messages.
+        let urdf = tactile_chain::file::read(std::path::Path::new(&cfg.urdf))
+            .map_err(|e| format!("slave.arm: {e}"))?;
         let g = scenario.device.geometry().map_err(|e| e.to_string())?;
-        ArmScene::new(cfg, &xml, &g)
+        ArmScene::of_robot(cfg, &urdf.text, &urdf.robot, &g)
             .map(Some)
-            .map_err(|e| format!("slave.arm: {}: {e}", path.display()))
+            .map_err(|e| format!("slave.arm: {}: {e}", urdf.path.display()))
     }
 
     /// The arm of `cfg` from its URDF text `xml`, beside the master of geometry `g`.
     pub fn new(cfg: &ArmConfig, xml: &str, g: &Geometry) -> Result<ArmScene, String> {
         let robot = Robot::parse(xml).map_err(|e| e.to_string())?;
-        let chain = Chain::new(&robot, &cfg.base, &cfg.tip).map_err(|e| e.to_string())?;
-        let tree = Tree::new(&robot).map_err(|e| e.to_string())?;
+        ArmScene::of_robot(cfg, xml, &robot, g)
+    }
+
+    /// The arm of `cfg` from its URDF's text `xml` and its model `robot` (parsed
+    /// once), beside the master of geometry `g`.
+    pub fn of_robot(
+        cfg: &ArmConfig,
+        xml: &str,
+        robot: &Robot,
+        g: &Geometry,
+    ) -> Result<ArmScene, String> {
+        let chain = Chain::new(robot, &cfg.base, &cfg.tip).map_err(|e| e.to_string())?;
+        let tree = Tree::new(robot).map_err(|e| e.to_string())?;
         let names: Vec<String> = chain.dofs.iter().map(|d| d.name.clone()).collect();
         let home_tool = chain.fk(&cfg.home).p.into();
         let master_home = kernels::fk(&g.lengths(), &StdTrig, [0.0; 3]);
         let mut description = tactile_ros::urdf::urdf_open(g, &["master"]);
         let ours = names_in(&robot_of(&description)?);
-        let theirs = names_in(&robot);
+        let theirs = names_in(robot);
         if let Some(clash) = theirs.iter().find(|n| *n != WORLD && ours.contains(n)) {
             return Err(format!(
                 "the URDF names `{clash}`, as the master's drawing does: rename it"
@@ -184,15 +193,6 @@ impl ArmScene {
         let len = v.iter().map(|x| x * x).sum::<f64>().sqrt();
         v.map(|x| x / len)
     }
-}
-
-fn read(path: &std::path::Path) -> Result<String, String> {
-    let what = |e: &dyn std::fmt::Display| format!("slave.arm: URDF {}: {e}", path.display());
-    let len = std::fs::metadata(path).map_err(|e| what(&e))?.len();
-    if len > MAX_URDF_BYTES {
-        return Err(what(&format!("{len} bytes, more than {MAX_URDF_BYTES}")));
-    }
-    std::fs::read_to_string(path).map_err(|e| what(&e))
 }
 
 fn robot_of(open: &str) -> Result<Robot, String> {

@@ -95,11 +95,13 @@ pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error>
     tactile_slave::urdf_arm::UrdfArm::of_scenario(&scenario, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     if scenario.master.backend == tactile_scenario::Backend::Ros2 {
-        tactile_runtime::outside::gimbal(&scenario, &base_dir)
+        tactile_master::peripherals::gimbal(&scenario, &base_dir)
             .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     }
-    tactile_runtime::outside::check_ros_tls(&scenario, &base_dir)
-        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    if tactile_runtime::outside::ros_in_run(&scenario) {
+        tactile_devices::ros_side::check_tls(&scenario.ros, &base_dir)
+            .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    }
     let mut inputs: Vec<PathBuf> = path.map(Path::to_path_buf).into_iter().collect();
     inputs.extend(scenario.input_paths().iter().map(|p| base_dir.join(p)));
     Ok(Loaded {

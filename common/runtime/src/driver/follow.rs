@@ -9,10 +9,10 @@ use super::link::{Arrival, Block, Idle, Link};
 use super::{Counts, Failure, Follower, Io, Reply, Timing};
 use crate::pace::Pacer;
 use std::time::{Duration, Instant};
-use tactile_devices::{DeviceCounters, LiveSink};
 use tactile_messages::samples::{
     stage, Backward, Forward, FLAG_DROPPED, FLAG_END, FLAG_PROBE, FLAG_WAITING,
 };
+use tactile_peripheral::{DeviceCounters, LiveSink};
 use tactile_records::{Events, Recorder};
 
 /// The run this node serves: learned from the master's first sample (probe or data);

@@ -9,11 +9,11 @@ use super::link::{Arrival, Block, Idle, Link};
 use super::waits::{Notes, Waited};
 use super::{Counts, Failure, Io, Leader, Timing};
 use std::time::{Duration, Instant};
-use tactile_devices::{DeviceCounters, LiveSink};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{
     stage, Backward, Forward, FLAG_DROPPED, FLAG_END, FLAG_PROBE, FLAG_WAITING, LATE_WINDOW,
 };
+use tactile_peripheral::{DeviceCounters, LiveSink};
 use tactile_records::{Events, Recorder};
 
 /// Samples waiting for their answer: the last [`LATE_WINDOW`] sent, each answered or

@@ -21,9 +21,9 @@ pub mod waits;
 pub use link::{Arrival, Block, Idle, Link, OnTransports};
 
 use std::time::Duration;
-use tactile_devices::Peripheral;
 use tactile_messages::clock::now_ns;
 use tactile_messages::samples::{Backward, Forward};
+use tactile_peripheral::Peripheral;
 use tactile_records::{Events, Recorder, WriteError};
 use tactile_transport::{LinkError, PortStats};
 
@@ -191,12 +191,12 @@ pub(crate) fn each_second<H: Handler>(
     rec: &mut Recorder<H::Sample, H::Totals>,
     handler: &mut H,
     counts: &Counts,
-    device_seen: &mut tactile_devices::DeviceCounters,
+    device_seen: &mut tactile_peripheral::DeviceCounters,
 ) -> Result<(), Failure> {
     let totals = handler.totals(counts);
     handler.log_second(&totals);
     if let Some(p) = handler.peripheral() {
-        tactile_devices::held::log_second(p.kind(), device_seen, &p.counters(), p.take_reject());
+        tactile_peripheral::log_second(p.kind(), device_seen, &p.counters(), p.take_reject());
     }
     rec.counters(totals, crate::sys::max_rss_kb())?;
     Ok(())

@@ -128,7 +128,7 @@ impl Default for Delivered {
 
 impl Delivered {
     /// Looks at `p`'s counters if a second passed, and logs what changed.
-    pub fn tick(&mut self, p: &dyn tactile_devices::Peripheral) {
+    pub fn tick(&mut self, p: &dyn tactile_peripheral::Peripheral) {
         if Instant::now() < self.next {
             return;
         }
@@ -168,7 +168,7 @@ impl Delivered {
 
     /// What to say when nothing came from `p`: the session reached nobody, or (it did)
     /// the driver's side to check.
-    pub fn nothing_came(&self, p: &dyn tactile_devices::Peripheral) -> String {
+    pub fn nothing_came(&self, p: &dyn tactile_peripheral::Peripheral) -> String {
         match p.unreached() {
             Some(why) => format!(": {why}"),
             None => ": the session reached a router or a peer; is the driver running, with the same ROS_DOMAIN_ID, publishing on that topic?".into(),
