@@ -4,23 +4,12 @@
 
 use crate::util;
 
-use std::process::{Child, Stdio};
 use std::time::Duration;
 use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
 use tactile_report::trace::signal_columns;
 use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber};
 use tactile_transport::{Publish, Subscribe};
 use util::{cannot, column, finish, pid_of, Sandbox};
-
-fn spawn_run(sb: &Sandbox, scenario: &std::path::Path, out: &str) -> Child {
-    sb.command(&["run", scenario.to_str().expect("utf-8"), "--out"])
-        .arg(sb.path(out))
-        .args(["--prefix", &sb.prefix, "-q"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start tactile run")
-}
 
 /// Sends `signal`; a process already gone is fine (nodes stop by themselves when their
 /// launcher dies).
@@ -43,7 +32,7 @@ fn kill_mid_run(sb: &Sandbox, out: &str, role: &str, samples: u64) {
 fn peer_dies_and_the_loop_resumes(role: &str) {
     let sb = Sandbox::new(role);
     let scenario = sb.write("s.toml", &util::paper_1khz(4000));
-    let child = spawn_run(&sb, &scenario, "run");
+    let child = sb.spawn_run(&scenario, "run", &[]);
     kill_mid_run(&sb, "run", role, 1_500);
     let (code, stderr) = finish(child);
     sb.assert_no_leftover_processes();
@@ -124,7 +113,7 @@ fn lockstep_drops_and_stalls_change_nothing() {
         .replace("[network.forward]\n", "[network.forward]\nloss = 0.05\n")
         .replace("[network.backward]\n", "[network.backward]\nloss = 0.05\n");
     let scenario = sb.write("s.toml", &text);
-    let child = spawn_run(&sb, &scenario, "run");
+    let child = sb.spawn_run(&scenario, "run", &[]);
     let rec = sb.path("run").join("master.rec");
     for (role, samples) in [("emulator", 1_000), ("master", 4_000)] {
         util::wait_for_rows(&rec, util::MASTER_ROWS * samples, Duration::from_secs(30));
@@ -161,7 +150,7 @@ fn emulator_killed_the_master_zeroes_torque_and_resumes_after_restart() {
 fn master_killed_the_slave_holds_and_the_launcher_fails_cleanly() {
     let sb = Sandbox::new("master");
     let scenario = sb.write("s.toml", &util::paper_1khz(5000));
-    let child = spawn_run(&sb, &scenario, "run");
+    let child = sb.spawn_run(&scenario, "run", &[]);
     kill_mid_run(&sb, "run", "master", 1_500);
     let (code, stderr) = finish(child);
     sb.assert_no_leftover_processes();
@@ -183,7 +172,7 @@ fn master_killed_the_slave_holds_and_the_launcher_fails_cleanly() {
 fn sigterm_to_the_launcher_stops_everything_and_writes_the_report() {
     let sb = Sandbox::new("sigterm");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
-    let child = spawn_run(&sb, &scenario, "run");
+    let child = sb.spawn_run(&scenario, "run", &[]);
     // Once the loop has run for a while (its slave has recorded a second).
     let rec = sb.path("run").join("slave.rec");
     util::wait_for_rows(&rec, 1_000, Duration::from_secs(20));
@@ -203,7 +192,7 @@ fn sigterm_to_the_launcher_stops_everything_and_writes_the_report() {
 fn a_new_run_after_a_crash_starts_cleanly() {
     let sb = Sandbox::new("crash");
     let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
-    let child = spawn_run(&sb, &scenario, "first");
+    let child = sb.spawn_run(&scenario, "first", &[]);
     kill_mid_run(&sb, "first", "master", 500);
     // Kill the launcher first, so nobody cleans up, then every process of the run.
     let launcher = child.id() as i32;
@@ -421,14 +410,7 @@ fn a_full_disk_names_the_nodes_that_died_of_it() {
         return;
     }
     let _unmount = Unmount(disk.clone());
-    let child = sb
-        .command(&["run", scenario.to_str().expect("utf-8"), "--out"])
-        .arg(disk.join("run"))
-        .args(["--prefix", &sb.prefix, "-q", "--max-restarts", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start tactile run");
+    let child = sb.spawn_run(&scenario, disk.join("run"), &["--max-restarts", "0"]);
     let (code, err) = finish(child);
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("No space left on device"), "{err}");

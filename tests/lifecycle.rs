@@ -47,14 +47,7 @@ fn run_without_restarts(
     out: &Path,
     extra: &[&str],
 ) -> std::process::Child {
-    sb.command(&["run", scenario.to_str().expect("utf-8"), "--out"])
-        .arg(out)
-        .args(["--prefix", &sb.prefix, "-q", "--max-restarts", "0"])
-        .args(extra)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("start")
+    sb.spawn_run(scenario, out, &[&["--max-restarts", "0"], extra].concat())
 }
 
 #[test]
@@ -172,19 +165,7 @@ fn an_output_folder_holds_one_run_at_a_time() {
     let sb = Sandbox::new("oneout");
     let scenario = sb.write("s.toml", &util::paper_1khz(3000));
     let out = sb.path("out");
-    let mut first = sb.command(&[
-        "run",
-        scenario.to_str().expect("utf-8"),
-        "--out",
-        out.to_str().expect("utf-8"),
-        "--prefix",
-        &sb.prefix,
-        "-q",
-    ]);
-    let first = first
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .expect("first run");
+    let first = sb.spawn_run(&scenario, &out, &[]);
     let rec = out.join("slave.rec");
     util::wait_for_rows(&rec, 150, Duration::from_secs(30));
     let before = tactile_records::rows_in(&rec);

@@ -214,20 +214,7 @@ fn a_long_run_keeps_every_node_in_bounded_memory() {
 fn nodes_stop_within_a_second_when_the_launcher_is_killed() {
     let sb = Sandbox::new("orphans");
     let scenario = sb.write("s.toml", &util::paper_1khz(60_000));
-    let mut launcher = sb
-        .command(&[
-            "run",
-            scenario.to_str().expect("utf-8"),
-            "--out",
-            "run",
-            "--prefix",
-            &sb.prefix,
-            "-q",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("start");
+    let mut launcher = sb.spawn_run(&scenario, "run", &[]);
     // The loop runs (its samples reach the slave's record), so every node is past its
     // start-up when the launcher dies.
     util::wait_for_rows(

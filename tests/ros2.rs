@@ -651,22 +651,8 @@ fn a_run_stopped_by_sigint_leaves_no_force_and_the_robot_holding() {
     );
     listening(ports[0]);
     listening(ports[1]);
-    let out = sb.path("out");
-    let child = sb
-        .command(&[
-            "run",
-            scenario.to_str().expect("utf-8"),
-            "--out",
-            out.to_str().expect("utf-8"),
-            "--prefix",
-            &sb.prefix,
-            "-q",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("tactile run");
-    let rec = out.join("master.rec");
+    let child = sb.spawn_run(&scenario, "out", &[]);
+    let rec = sb.path("out").join("master.rec");
     // Into the hold against the wall: 6 s of the loop at 100 Hz, past the end of the
     // 4 s move and before the device's stand-in ends, 8 s after its first force.
     let rows = util::MASTER_ROWS * 600;

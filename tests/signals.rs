@@ -193,13 +193,7 @@ fn sigterm_to_any_node_is_the_same_stop() {
     for role in ["master", "emulator", "slave"] {
         let sb = Sandbox::new(&format!("sigterm{role}"));
         let scenario = sb.write("s.toml", &util::paper_1khz(20_000));
-        let child = sb
-            .command(&["run", scenario.to_str().expect("utf-8"), "--out", "run"])
-            .args(["--prefix", &sb.prefix, "-q"])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("start");
+        let child = sb.spawn_run(&scenario, "run", &[]);
         let rec = sb.path("run").join("slave.rec");
         util::wait_for_rows(&rec, 1_500, Duration::from_secs(20));
         let pid = util::pid_of(&sb.prefix, role).unwrap_or_else(|| panic!("no {role}"));

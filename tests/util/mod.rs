@@ -133,6 +133,26 @@ impl Sandbox {
         ])
     }
 
+    /// `tactile run SCENARIO --out OUT --prefix PREFIX -q EXTRA...` started, not waited
+    /// for (OUT relative to the sandbox), its output piped: for the tests that act on a
+    /// run while it goes (signals, kills, a second run beside it).
+    pub fn spawn_run(
+        &self,
+        scenario: &Path,
+        out: impl AsRef<Path>,
+        extra: &[&str],
+    ) -> std::process::Child {
+        self.command(&["run", scenario.to_str().expect("utf-8 path"), "--out"])
+            .arg(self.dir.path().join(out))
+            .args(["--prefix", &self.prefix, "-q"])
+            .args(extra)
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("start tactile run")
+    }
+
     /// [`Sandbox::try_run`]; asserts success and that no process of the run survives.
     pub fn run(&self, scenario: &Path, out: &str) -> Output {
         let o = self.try_run(scenario, out);
