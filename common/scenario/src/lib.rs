@@ -162,22 +162,16 @@ impl Scenario {
             Some(w) => units::to_samples(w)?,
             None => false,
         };
+        if let Some(w) = &written {
+            // By name, before the types: `max_velocity = 2.0` beside an arm is told
+            // what to write instead, not that it takes an array of three.
+            ros_robot::refuse_written(w)?;
+        }
         let s: Scenario = match (&written, converted) {
-            // The converted table has no positions in the text; where the text as
-            // written fails the same way (the error is not an `_ms` key's), its error,
-            // with the line and column, is the one shown.
-            (Some(w), true) => w.clone().try_into().map_err(|e: toml::de::Error| {
-                ScenarioError::Parse(match toml::from_str::<Scenario>(text) {
-                    Err(as_written) if as_written.message() == e.message() => {
-                        one_line(text, &as_written)
-                    }
-                    _ => e.message().split_whitespace().collect::<Vec<_>>().join(" "),
-                })
-            })?,
+            (Some(w), true) => units::parse_converted(text, w)?,
             _ => toml::from_str(text).map_err(|e| ScenarioError::Parse(one_line(text, &e)))?,
         };
         if let (Some(written), Ok(parsed)) = (&written, toml::Value::try_from(&s)) {
-            ros_robot::refuse_written(written)?;
             lengths::check(written, &parsed)?;
         }
         s.validate()?;

@@ -11,10 +11,11 @@
 //! the value and the two nearest that are (rounding would make two swept values the
 //! same run without a word). A jitter's spread is fractional in samples already.
 
-use crate::error::{invalid, ScenarioError};
+use crate::error::{invalid, one_line, ScenarioError};
 use crate::network::ChannelConfig;
 use crate::network::MAX_DELAY_SAMPLES;
 use crate::shown::{listed, Num};
+use crate::Scenario;
 use toml::{Table, Value};
 
 /// The keys that say one quantity in two units, samples then milliseconds: giving
@@ -40,6 +41,14 @@ const WHOLE: f64 = 1e-6;
 
 /// The largest jitter spread accepted, samples (as `JitterConfig::validate`).
 const MAX_JITTER_SAMPLES: f64 = 10_000.0;
+
+/// The largest schedule start accepted in ms, samples: the sample form's start has
+/// no cap of its own, and up to 2^53 an f64 counts whole samples exactly.
+const MAX_START_SAMPLES: i64 = 1 << 53;
+
+/// How far a time in ms may be from a whole sample and still be it: `check` shows ms
+/// rounded to the microsecond.
+const HALF_MICROSECOND: f64 = 0.0005 * (1.0 + 1e-9);
 
 /// Rewrites every `_ms` key of `[network.forward]` and `[network.backward]` into its
 /// sample form in `doc`, at the scenario's `rate_hz`; true if it changed anything.
@@ -132,32 +141,34 @@ impl Rate {
         Ok(x)
     }
 
-    /// A delay or a start in milliseconds as whole samples, at most
-    /// [`MAX_DELAY_SAMPLES`].
-    fn samples(&self, v: &Value, field: &str) -> Result<i64, ScenarioError> {
+    /// A delay or a start in milliseconds as whole samples, at most `limit` (a
+    /// delay's [`MAX_DELAY_SAMPLES`], a start's [`MAX_START_SAMPLES`]). A value within
+    /// half a microsecond of a whole sample is that sample: `check` shows times to
+    /// the microsecond (one sample at 300 Hz is 3.333 ms), and what it shows reads
+    /// back; two values that close cannot mean two different runs.
+    fn samples(&self, v: &Value, field: &str, limit: i64) -> Result<i64, ScenarioError> {
         let ms = self.ms(v, field)?;
         let n = ms * self.hz / 1000.0;
-        let limit = MAX_DELAY_SAMPLES as f64;
-        if n > limit {
+        if n > limit as f64 {
             return Err(invalid(
                 field,
                 format!(
-                    "{} ms is {} samples at {} Hz, beyond {MAX_DELAY_SAMPLES}",
-                    Num(ms),
-                    Num(n),
+                    "{} ms is {} samples at {} Hz, beyond {limit}",
+                    units_ms(ms),
+                    count(n),
                     Num(self.hz)
                 ),
             ));
         }
+        let step = 1000.0 / self.hz;
         let whole = n.round();
-        if (n - whole).abs() > WHOLE {
-            let step = 1000.0 / self.hz;
+        if (n - whole).abs() > WHOLE && (ms - whole * step).abs() > HALF_MICROSECOND {
             let (lo, hi) = (n.floor() * step, n.ceil() * step);
             return Err(invalid(
                 field,
                 format!(
-                    "{} ms is {} samples at {} Hz; a channel delays by whole samples ({} ms each): give {} or {} ms, or the delay in samples",
-                    Num(ms), Num(n), Num(self.hz), Num(step), Num(lo), Num(hi)
+                    "{} ms is {} samples at {} Hz; a channel delays by whole samples ({} ms each): give {} or {} ms, or the time in samples (a whole number of samples works at any rate)",
+                    units_ms(ms), count(n), Num(self.hz), units_ms(step), units_ms(lo), units_ms(hi)
                 ),
             ));
         }
@@ -170,7 +181,7 @@ impl Rate {
             Value::Array(a) if a.len() == 3 => {
                 let mut d = [0; 3];
                 for (i, x) in a.iter().enumerate() {
-                    d[i] = self.samples(x, &format!("{field}[{i}]"))?;
+                    d[i] = self.samples(x, &format!("{field}[{i}]"), MAX_DELAY_SAMPLES)?;
                 }
                 Ok(d)
             }
@@ -181,7 +192,7 @@ impl Rate {
                     a.len()
                 ),
             )),
-            x => Ok([self.samples(x, field)?; 3]),
+            x => Ok([self.samples(x, field, MAX_DELAY_SAMPLES)?; 3]),
         }
     }
 
@@ -203,7 +214,7 @@ impl Rate {
                 Some([from, dx, dy, dz]) => [from, dx, dy, dz],
                 _ => return Err(invalid(f, "a row is [from_ms, d] or [from_ms, dx, dy, dz]")),
             };
-            let from = self.samples(r[0], &format!("{f}[0]"))?;
+            let from = self.samples(r[0], &format!("{f}[0]"), MAX_START_SAMPLES)?;
             if from <= last {
                 return Err(invalid(
                     f,
@@ -215,7 +226,11 @@ impl Rate {
             let mut e = vec![Value::Integer(from)];
             for (i, d) in r[1..].iter().enumerate() {
                 let at = if one { 1 } else { i + 1 };
-                e.push(Value::Integer(self.samples(d, &format!("{f}[{at}]"))?));
+                e.push(Value::Integer(self.samples(
+                    d,
+                    &format!("{f}[{at}]"),
+                    MAX_DELAY_SAMPLES,
+                )?));
             }
             out.push(Value::Array(e));
         }
@@ -231,8 +246,8 @@ impl Rate {
                 field,
                 format!(
                     "{} ms is {} samples at {} Hz, beyond {}",
-                    Num(ms),
-                    Num(n),
+                    units_ms(ms),
+                    count(n),
                     Num(self.hz),
                     Num(MAX_JITTER_SAMPLES)
                 ),
@@ -242,10 +257,75 @@ impl Rate {
     }
 }
 
-/// A number of milliseconds as `check` shows it: to the microsecond, shortest form
-/// (one sample at 300 Hz is 3.333 ms, not 3.3333333333333335).
+/// The scenario whose `_ms` keys `converted` holds in samples, read the way a file
+/// without them is (`toml::from_str` on its text), so the same mistakes get the same
+/// messages: an over-long array is trimmed here and named by `lengths::check`, where
+/// `Value::try_into` would refuse it without a field. The converted text's positions
+/// are not the user's: where the text as written fails the same way, its line and
+/// column are shown, else the field the mistake is in.
+pub(crate) fn parse_converted(text: &str, converted: &Value) -> Result<Scenario, ScenarioError> {
+    let again = toml::to_string(converted).map_err(|e| {
+        ScenarioError::Parse(format!(
+            "writing the scenario with its _ms keys in samples: {e}"
+        ))
+    })?;
+    toml::from_str(&again).map_err(|e: toml::de::Error| {
+        ScenarioError::Parse(match toml::from_str::<Scenario>(text) {
+            Err(as_written) if as_written.message() == e.message() => one_line(text, &as_written),
+            _ => field_of(&again, &e),
+        })
+    })
+}
+
+/// `e`'s message with the dotted path of the key its span is on in `text` (a text
+/// `toml::to_string` wrote: a `[table]` header, then one `key = value` a line).
+fn field_of(text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+    let Some(span) = e.span() else {
+        return msg;
+    };
+    let before = &text[..span.start.min(text.len())];
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let line = text[line_start..].lines().next().unwrap_or_default();
+    let header = |l: &str| {
+        let l = l.trim();
+        l.starts_with('[')
+            .then(|| l.trim_matches(|c| c == '[' || c == ']').to_string())
+    };
+    if let Some(h) = header(line) {
+        return format!("table `{h}`: {msg}");
+    }
+    let key = line.split_once('=').map_or("", |(k, _)| k).trim();
+    let table = before[..line_start].lines().rev().find_map(header);
+    match table {
+        Some(t) => format!("field `{t}.{key}`: {msg}"),
+        None => format!("field `{key}`: {msg}"),
+    }
+}
+
+/// A number of milliseconds as `check` and the messages show it: to the
+/// microsecond, shortest form (one sample at 300 Hz is 3.333 ms, not
+/// 3.3333333333333335).
 fn ms(x: f64) -> Num {
     Num((x * 1000.0).round() / 1000.0)
+}
+
+/// A time in ms as a message shows it: as [`ms`] unless that would show a small
+/// non-zero value as 0 (a user's 1e-7 ms is shown as they wrote it).
+fn units_ms(x: f64) -> Num {
+    match ms(x) {
+        Num(0.0) if x != 0.0 => Num(x),
+        m => m,
+    }
+}
+
+/// A sample count as a message shows it: to a thousandth of a sample (11 ms at
+/// 100 Hz is 1.1 samples, not 1.1000000000000003).
+fn count(n: f64) -> Num {
+    match Num((n * 1000.0).round() / 1000.0) {
+        Num(0.0) if n != 0.0 => Num(n),
+        c => c,
+    }
 }
 
 /// One channel's times in both units, for `tactile check`: `network.forward: delay

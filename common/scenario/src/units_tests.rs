@@ -187,3 +187,69 @@ fn check_shows_each_time_in_samples_and_in_ms() {
         "network.backward: delay [1, 2, 3] samples ([3.333, 6.667, 10] ms at 300 Hz)"
     );
 }
+
+/// An `_ms` key does not change how the rest is read: an over-long array is named by
+/// its field (as without one), a wrong type names its key (review of issue 52, 1).
+#[test]
+fn a_mistake_beside_an_ms_key_is_named_as_without_it() {
+    for (text, needles) in [
+        (
+            "[network.forward]\ndelay_ms = 100\nnoise_std = [0.001, 0.001, 0.001, 0.001]\n",
+            &["network.forward.noise_std", "has 4 elements; it takes 3"][..],
+        ),
+        (
+            "[network.forward]\ndelay_ms = 100\nloss = \"high\"\n",
+            &["network.forward.loss", "invalid type: string \"high\""],
+        ),
+        (
+            "[network.forward]\ndelay_ms = 100\n[network.backward]\nloss = \"high\"\n",
+            &["network.backward.loss", "invalid type"],
+        ),
+    ] {
+        refused(text, needles);
+    }
+}
+
+/// A schedule's start in ms is a sample count like the sample form's, which has no
+/// delay cap: 2,000 s at 100 Hz is sample 200,000 (review of issue 52, 2).
+#[test]
+fn a_schedule_start_in_ms_is_not_capped_as_a_delay() {
+    same(
+        "[network.forward]\nschedule_ms = [[0, 10], [2000000, 20]]\n",
+        "[network.forward]\nschedule = [[0, 1, 1, 1], [200000, 2, 2, 2]]\n",
+    );
+    refused(
+        "[network.forward]\nschedule_ms = [[1e300, 10]]\n",
+        &["network.forward.schedule_ms[0][0]", "beyond"],
+    );
+    refused(
+        "[network.forward]\nschedule_ms = [[0, 1e12]]\n",
+        &["network.forward.schedule_ms[0][1]", "beyond 100000"],
+    );
+}
+
+/// What `check` prints at a rate that does not divide 1000 reads back: one sample at
+/// 300 Hz is shown 3.333 ms, and `delay_ms = 3.333` is that sample; a value between
+/// samples is told short numbers (review of issue 52, 8).
+#[test]
+fn a_time_printed_to_the_microsecond_reads_back_as_its_sample() {
+    same(
+        "rate_hz = 300\n[network.forward]\ndelay_ms = [3.333, 6.667, 10]\n",
+        "rate_hz = 300\n[network.forward]\ndelay = [1, 2, 3]\n",
+    );
+    same(
+        "rate_hz = 7000\n[network.forward]\nschedule_ms = [[0.143, 0.286]]\n",
+        "rate_hz = 7000\n[network.forward]\nschedule = [[1, 2, 2, 2]]\n",
+    );
+    let e = read("rate_hz = 300\n[network.forward]\ndelay_ms = 3.33\n")
+        .expect_err("between samples")
+        .to_string();
+    assert!(e.contains("give 0 or 3.333 ms"), "{e}");
+    assert!(e.contains("0.999 samples"), "{e}");
+    assert!(e.contains("whole number of samples"), "{e}");
+    assert!(!e.contains("3333333"), "{e}");
+    let e = read("[network.forward]\ndelay_ms = 11\n")
+        .expect_err("1.1")
+        .to_string();
+    assert!(e.contains("11 ms is 1.1 samples"), "{e}");
+}
