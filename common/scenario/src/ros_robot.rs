@@ -238,10 +238,13 @@ impl RobotCommand {
 impl crate::Scenario {
     /// A scenario as a record or a run folder holds it: as
     /// [`Scenario::from_toml_str`](crate::Scenario::from_toml_str), except that the
-    /// paper arm's four keys at their defaults beside `[slave.arm]` are dropped, not
-    /// refused. Tactile before issue 52 wrote every key, those four included, into
-    /// the scenario it recorded (a non-default value was refused then), so its records
-    /// of an arm still report; a scenario file a user writes gets no such leniency.
+    /// paper arm's four `[slave.ros2]` keys beside `[slave.arm]` are dropped, not
+    /// refused, at their defaults, or at any value when the slave's backend is not
+    /// ros2 (there they never had an effect). Tactile before issue 52 wrote every key,
+    /// those four included, into the scenario it recorded, so its run folders still
+    /// read (a sweep resumes over them); its records of format 15 are refused by the
+    /// record reader on their format, not here. A scenario file a user writes gets no
+    /// such leniency.
     pub fn from_recorded_toml(text: &str) -> Result<crate::Scenario, ScenarioError> {
         if let Ok(mut table) = text.parse::<toml::Table>() {
             if drop_written_defaults(&mut table) {
@@ -255,7 +258,8 @@ impl crate::Scenario {
 }
 
 /// Drops from `[slave.ros2]` each paper-arm key equal to what the old writer put
-/// there, if there is a `[slave.arm]`; true if it dropped one.
+/// there (any value if the backend is not ros2), if there is a `[slave.arm]`; true
+/// if it dropped one.
 fn drop_written_defaults(table: &mut toml::Table) -> bool {
     let Some(slave) = table.get_mut("slave").and_then(|v| v.as_table_mut()) else {
         return false;
@@ -263,6 +267,7 @@ fn drop_written_defaults(table: &mut toml::Table) -> bool {
     if !slave.contains_key("arm") {
         return false;
     }
+    let ros_backend = slave.get("backend").and_then(toml::Value::as_str) == Some("ros2");
     let Some(ros2) = slave.get_mut("ros2").and_then(|v| v.as_table_mut()) else {
         return false;
     };
@@ -278,7 +283,9 @@ fn drop_written_defaults(table: &mut toml::Table) -> bool {
     ];
     let mut dropped = false;
     for (key, value) in written {
-        if value.is_ok_and(|v| ros2.get(key) == Some(&v)) {
+        if ros2.contains_key(key)
+            && (!ros_backend || value.is_ok_and(|v| ros2.get(key) == Some(&v)))
+        {
             ros2.remove(key);
             dropped = true;
         }

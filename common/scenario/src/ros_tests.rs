@@ -186,3 +186,31 @@ fn an_old_record_of_an_arm_reads_without_the_paper_arms_defaults() {
     let read = Scenario::from_recorded_toml(paper).expect("paper");
     assert_eq!(read.slave.ros2.max_velocity, Some([2.0; 3]));
 }
+
+/// A paper-arm key beside `[slave.arm]` is refused by name whatever its shape, and
+/// whether or not the scenario has an `_ms` key (review of issue 52, 1 and 4).
+#[test]
+fn a_paper_arm_key_is_refused_by_name_before_its_type_is_read() {
+    let e = Scenario::from_toml_str(&arm_over_ros("max_velocity = 2.0")).expect_err("2.0");
+    assert!(e.to_string().contains("slave.ros2.max_velocity"), "{e}");
+    assert!(e.to_string().contains("paper's 3-DoF arm only"), "{e}");
+    let six = "joints = [\"a\", \"b\", \"c\", \"d\", \"e\", \"f\"]";
+    let with_ms = format!("{}[network.forward]\ndelay_ms = 100\n", arm_over_ros(six));
+    let e = Scenario::from_toml_str(&with_ms).expect_err("six names");
+    assert!(e.to_string().contains("delete `joints`"), "{e}");
+}
+
+/// A recorded arm whose backend is not ROS 2 never used the paper arm's ROS keys:
+/// all four are dropped whatever their value (review of issue 52, 5).
+#[test]
+fn a_recorded_simulated_arm_drops_the_paper_arms_ros_keys() {
+    let simulated = |extra: &str| arm_over_ros(extra).replace("\"ros2\"", "\"simulated\"");
+    let want = Scenario::from_toml_str(&simulated("")).expect("arm alone");
+    let old = simulated(
+        "max_velocity = [1.0, 2.0, 2.0]\njoints = [\"a\", \"b\", \"c\"]\n\
+         wrench_map = { axes = [2, 1, 0] }\nmap = { unit = \"deg\" }",
+    );
+    let read = Scenario::from_recorded_toml(&old).expect("old simulated record");
+    assert_eq!(read, want);
+    assert!(Scenario::from_toml_str(&old).is_err());
+}
