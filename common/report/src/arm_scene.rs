@@ -253,11 +253,11 @@ fn link(parent: &str, child: &str, f: &Frame) -> Link {
 mod tests {
     use super::*;
 
-    const PANDA: &str = include_str!("../../robots/panda.urdf");
+    const PANDA: &str = include_str!("../../../deploy/robots/panda.urdf");
 
     /// The shipped Panda scenario's arm, at `scale`.
     fn cfg(scale: f64) -> ArmConfig {
-        let text = include_str!("../../scenarios/panda.toml");
+        let text = include_str!("../../../deploy/scenarios/panda.toml");
         let s = Scenario::from_toml_str(text).expect("the shipped scenario");
         ArmConfig {
             scale: tactile_scenario::Scale::Uniform(scale),
