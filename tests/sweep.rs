@@ -128,6 +128,37 @@ fn a_bad_value_anywhere_in_a_sweep_stops_it_before_any_run() {
     assert!(!sb.path("sw").exists(), "nothing ran");
 }
 
+/// One time set twice in its two units (`delay` and `delay_ms`) is refused naming
+/// both, exit 2, nothing run: a run kept the last silently, a sweep ran its
+/// combinations as duplicates (issue 52 review, 3).
+#[test]
+fn one_time_set_in_both_units_is_refused_before_any_run() {
+    let sb = Sandbox::new("twinset");
+    let s = sb.write("s.toml", &scenario(100));
+    let s = s.to_str().expect("utf-8");
+    let refused = |cmd: &str, extra: &[&str], a: &str, b: &str| {
+        let out = format!("{cmd}-out");
+        let mut args = vec![cmd, s, "--out", out.as_str(), "--set", a, "--set", b];
+        args.extend_from_slice(extra);
+        let o = sb.tactile(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        let named = err.contains(a) && err.contains(b) && err.contains("two units");
+        assert!(named, "{err}");
+        assert!(!sb.path(&out).exists(), "nothing ran");
+    };
+    let (a, b) = (
+        "network.forward.delay=[5,5,5]",
+        "network.forward.delay_ms=10",
+    );
+    refused("run", &["--in-process"], a, b);
+    let (a, b) = (
+        "network.forward.delay=[1,1,1],[2,2,2]",
+        "network.forward.delay_ms=10,20",
+    );
+    refused("sweep", &[], a, b);
+}
+
 /// `tactile sweep` over the paper scenario with two axes (3 x 2 = 6 combinations),
 /// extra arguments, into `out`; asserts success.
 fn sweep(sb: &Sandbox, out: &str, extra: &[&str]) -> std::process::Output {

@@ -106,6 +106,10 @@ pub fn apply(text: &str, sets: &[Set]) -> Result<String, String> {
     if sets.is_empty() {
         return Ok(text.to_string());
     }
+    let keys: Vec<String> = sets.iter().map(Set::key).collect();
+    if let Some((a, b)) = twins(&keys) {
+        return Err(twice(&sets[a].text, &sets[b].text));
+    }
     let mut table: Table = text.parse().map_err(|e: toml::de::Error| {
         format!("the scenario is not TOML: {}", e.message().trim_end())
     })?;
@@ -113,6 +117,32 @@ pub fn apply(text: &str, sets: &[Set]) -> Result<String, String> {
         put(&mut table, &s.path, s.value.clone()).map_err(|e| format!("--set {}: {e}", s.text))?;
     }
     toml::to_string(&table).map_err(|e| format!("encoding the scenario: {e}"))
+}
+
+/// The first two of `keys` that say one time in two units at one place
+/// (`network.forward.delay` and `network.forward.delay_ms`), by index, earlier first.
+/// A `--set` replaces the file's twin, so two such sets would silently keep the
+/// last: `tactile run` and `tactile sweep` refuse them.
+pub fn twins(keys: &[String]) -> Option<(usize, usize)> {
+    fn split(k: &str) -> (&str, &str) {
+        let k = k.trim();
+        k.rsplit_once('.').unwrap_or(("", k))
+    }
+    (0..keys.len()).find_map(|b| {
+        let (pb, kb) = split(&keys[b]);
+        keys[..b]
+            .iter()
+            .position(|a| {
+                let (pa, ka) = split(a);
+                pa == pb && crate::units::twin(ka) == Some(kb)
+            })
+            .map(|a| (a, b))
+    })
+}
+
+/// The message for two `--set`s of one time in two units.
+pub fn twice(a: &str, b: &str) -> String {
+    format!("--set {a} and --set {b} give one time in two units: give it once, in milliseconds (_ms) or in samples")
 }
 
 /// Puts `value` at `path` in `table`, making the tables on the way that do not exist.
@@ -123,6 +153,8 @@ fn put(table: &mut Table, path: &[Step], value: Value) -> Result<(), String> {
     if rest.is_empty() {
         // A time given in one unit replaces the file's in the other (`delay_ms` the
         // file's `delay`): both would be refused, and the --set is the newer word.
+        // Two sets of one time are refused before (`twins`), so only the file's
+        // twin is ever removed here.
         if let Some(twin) = crate::units::twin(first) {
             table.remove(twin);
         }

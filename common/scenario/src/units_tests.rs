@@ -253,3 +253,27 @@ fn a_time_printed_to_the_microsecond_reads_back_as_its_sample() {
         .to_string();
     assert!(e.contains("11 ms is 1.1 samples"), "{e}");
 }
+
+/// Two `--set`s of one time in its two units are refused naming both; a set in one
+/// unit still replaces the file's other (review of issue 52, 3).
+#[test]
+fn two_sets_of_one_time_in_two_units_are_refused() {
+    let file = "[network.forward]\ndelay = [1, 1, 1]\n";
+    let sets = [
+        Set::parse("network.forward.delay=[5,5,5]").expect("set"),
+        Set::parse("network.forward.delay_ms=10").expect("set"),
+    ];
+    let e = apply(file, &sets).expect_err("twins");
+    assert!(
+        e.contains("network.forward.delay=[5,5,5]") && e.contains("network.forward.delay_ms=10"),
+        "{e}"
+    );
+    // Not twins: another channel, or another key.
+    let other = [
+        Set::parse("network.forward.delay=[5,5,5]").expect("set"),
+        Set::parse("network.backward.delay_ms=10").expect("set"),
+        Set::parse("network.backward.jitter.jitter_ms=10").expect("set"),
+    ];
+    let s = read(&apply(file, &other).expect("apply")).expect("valid");
+    assert_eq!(s.network.backward.delay, [1; 3]);
+}

@@ -265,6 +265,12 @@ pub fn parse_axes(sets: &[String]) -> Result<Vec<Axis>, Error> {
             )));
         }
     }
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    if let Some((a, b)) = tactile_scenario::overrides::twins(&keys) {
+        return Err(Error::BadInput(tactile_scenario::overrides::twice(
+            &sets[a], &sets[b],
+        )));
+    }
     let count = axes
         .iter()
         .try_fold(1usize, |n, a| n.checked_mul(a.values.len()))
