@@ -6,6 +6,7 @@
 
 pub mod ports;
 
+#[cfg(feature = "zenoh")]
 pub use ports::free_port;
 
 use std::path::{Path, PathBuf};
