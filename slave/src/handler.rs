@@ -5,14 +5,13 @@
 //! the protocol.
 
 use crate::hsd::{Measured, Slave};
-use crate::urdf_arm::UrdfArm;
-use std::sync::Arc;
 use std::time::Duration;
 use tactile_devices::held::Held;
 use tactile_devices::{Peripheral, Robot};
+use tactile_math::joints::Joints;
 use tactile_messages::samples::{Backward, Forward};
-use tactile_records::slave::{ArmJoints, SlaveCounters, SlaveSample, SlaveTotals};
-use tactile_ros::view::{ArmSample, SampleView, SlaveView};
+use tactile_records::slave::{SlaveCounters, SlaveSample, SlaveTotals};
+use tactile_ros::view::{SampleView, SlaveView};
 use tactile_runtime::driver::{changed, Counts, Failure, Follower, Handler, Io, Reply};
 use tactile_scenario::Scenario;
 
@@ -24,40 +23,19 @@ pub fn hold_timeout(scenario: &Scenario) -> Duration {
     t.max(Duration::from_millis(50))
 }
 
-/// A real robot: the paper's three joints, or an arm from its URDF.
-pub enum RealRobot {
-    /// Three joints shaped like the paper's arm.
-    Paper(Box<dyn Robot>),
-    /// An arm of `[slave.arm]`, its joints by the URDF's names.
-    Arm(Box<dyn Robot<Vec<f64>>>),
-}
-
-impl std::fmt::Debug for RealRobot {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            RealRobot::Paper(r) => write!(f, "Paper({})", r.describe()),
-            RealRobot::Arm(r) => write!(f, "Arm({})", r.describe()),
-        }
-    }
-}
-
 /// A real robot as the loop holds it.
-struct Hardware<V> {
-    robot: Box<dyn Robot<V>>,
+struct Hardware {
+    robot: Box<dyn Robot>,
     /// Its joints as the loop holds them.
-    held: Held<V>,
+    held: Held<Joints>,
     /// What it was last commanded (held while it is lost).
-    commanded: Option<V>,
+    commanded: Option<Joints>,
     /// The reference of the step just taken, commanded once h(n) is on its way.
-    due: Option<V>,
+    due: Option<Joints>,
 }
 
-/// What a robot gave for one tick: its joints, its force sensor's force (`None`
-/// without one) and the torque that came with it.
-type Reading<V> = (V, Option<[f64; 3]>, [f64; 3]);
-
-impl<V: Clone + Default> Hardware<V> {
-    fn new(robot: Box<dyn Robot<V>>) -> Self {
+impl Hardware {
+    fn new(robot: Box<dyn Robot>) -> Self {
         Hardware {
             robot,
             held: Held::default(),
@@ -68,23 +46,26 @@ impl<V: Clone + Default> Hardware<V> {
 
     /// Reads the robot for this tick (its joints, its force sensor's force and
     /// torque); says so in the record when it is lost or back.
-    fn read(&mut self, n: u64, io: &mut Io) -> Result<Reading<V>, Failure> {
+    fn read(&mut self, n: u64, io: &mut Io) -> Result<(Measured, [f64; 3]), Failure> {
         let who = self.robot.describe();
         let judged = self.robot.read(io.now());
         let meanwhile = "holding its last safe reference";
         if let Some(what) = self.held.take(judged, ("robot", &who), meanwhile) {
             io.event(n, &what)?;
         }
-        let force = self.robot.force(io.now());
-        Ok((self.held.theta.clone(), force, self.robot.torque()))
+        let measured = Measured {
+            joints: self.held.theta,
+            force: self.robot.force(io.now()),
+        };
+        Ok((measured, self.robot.torque()))
     }
 
     /// Commands `reference`, or, while the robot is lost, the last reference it had.
-    fn command(&mut self, reference: V) {
+    fn command(&mut self, reference: Joints) {
         if !self.held.lost {
             self.commanded = Some(reference);
         }
-        if let Some(c) = self.commanded.clone() {
+        if let Some(c) = self.commanded {
             self.robot.command(c, tactile_messages::clock::now_ns());
         }
     }
@@ -103,20 +84,12 @@ impl<V: Clone + Default> Hardware<V> {
     }
 }
 
-/// The real robot the handler drives, if any.
-enum Robots {
-    None,
-    Paper(Hardware<[f64; 3]>),
-    Arm(Hardware<Vec<f64>>),
-}
-
 /// The slave's handler: its state machine, the real robot if there is one, and what
 /// it keeps between the driver's calls.
 pub struct SlaveHandler {
     slave: Slave,
-    robot: Robots,
-    /// A URDF arm's base link and joint names, for the live view.
-    arm_names: Option<(Arc<str>, Arc<[String]>)>,
+    /// The real robot, if there is one (else the arm is simulated).
+    robot: Option<Hardware>,
     holding: bool,
     idle: (Duration, Duration),
     /// The last step's state for the live view (a step's record is 368 bytes; the
@@ -139,20 +112,10 @@ impl std::fmt::Debug for SlaveHandler {
 impl SlaveHandler {
     /// The handler of `slave` for `scenario`, with a real robot (`None`: the
     /// simulated arm).
-    pub fn new(slave: Slave, scenario: &Scenario, robot: Option<RealRobot>) -> Self {
-        let arm_names = slave.arm().map(|a| {
-            let c = a.chain();
-            let names: Vec<String> = c.dofs.iter().map(|d| d.name.clone()).collect();
-            (Arc::from(c.base.as_str()), Arc::from(names))
-        });
+    pub fn new(slave: Slave, scenario: &Scenario, robot: Option<Box<dyn Robot>>) -> Self {
         SlaveHandler {
             slave,
-            arm_names,
-            robot: match robot {
-                None => Robots::None,
-                Some(RealRobot::Paper(r)) => Robots::Paper(Hardware::new(r)),
-                Some(RealRobot::Arm(r)) => Robots::Arm(Hardware::new(r)),
-            },
+            robot: robot.map(Hardware::new),
             holding: false,
             idle: (
                 hold_timeout(scenario),
@@ -202,41 +165,16 @@ impl Handler for SlaveHandler {
     }
 
     fn peripheral(&self) -> Option<&dyn Peripheral> {
-        match &self.robot {
-            Robots::None => None,
-            Robots::Paper(h) => Some(h.robot.as_ref() as &dyn Peripheral),
-            Robots::Arm(h) => Some(h.robot.as_ref() as &dyn Peripheral),
-        }
+        let h = self.robot.as_ref()?;
+        Some(h.robot.as_ref() as &dyn Peripheral)
     }
 
     fn release(&mut self) -> Option<String> {
-        match &mut self.robot {
-            Robots::None => None,
-            Robots::Paper(h) => Some(h.release()),
-            Robots::Arm(h) => Some(h.release()),
-        }
+        self.robot.as_mut().map(Hardware::release)
     }
 
     fn live(&self) -> Option<SampleView> {
-        let s = self.last_view?;
-        if let (Some(arm), Some((base, names))) = (self.slave.arm(), &self.arm_names) {
-            let a = arm.state();
-            return Some(SampleView {
-                arm: Some(ArmSample {
-                    base: Arc::clone(base),
-                    names: Arc::clone(names),
-                    q: a.q.clone(),
-                    effort: a.tau.clone(),
-                    tool: arm.tool_in_base(),
-                    force: s.force,
-                }),
-                ..SampleView::default()
-            });
-        }
-        Some(SampleView {
-            slave: Some(s),
-            ..SampleView::default()
-        })
+        Some(self.slave.arm().live(self.last_view?))
     }
 }
 
@@ -251,22 +189,13 @@ impl Follower for SlaveHandler {
             self.holding = false;
             io.event(v.seq, "input back: following the master again")?;
         }
-        match &mut self.robot {
-            Robots::None => {}
-            Robots::Paper(hw) => {
-                let (theta, force, _) = hw.read(v.seq, io)?;
-                self.slave.measure(Measured { theta, force });
-            }
-            Robots::Arm(hw) => {
-                let (q, force, torque) = hw.read(v.seq, io)?;
-                self.slave.measure_arm(q, force, torque);
-            }
+        if let Some(hw) = &mut self.robot {
+            let (measured, torque) = hw.read(v.seq, io)?;
+            self.slave.measure(measured, torque);
         }
         let step = self.slave.step(v, &mut out.backward);
-        match &mut self.robot {
-            Robots::None => {}
-            Robots::Paper(hw) => hw.due = Some(step.theta_ref),
-            Robots::Arm(hw) => hw.due = self.slave.arm_state().map(|a| a.q_ref.clone()),
+        if let Some(hw) = &mut self.robot {
+            hw.due = Some(self.slave.arm().reference());
         }
         self.last_view = Some(SlaveView {
             theta: step.theta,
@@ -276,12 +205,12 @@ impl Follower for SlaveHandler {
             force: step.force,
         });
         let torque = out.backward.as_ref().map_or([0.0; 3], |h| h.torque);
-        out.record = Some(match self.slave.arm() {
-            Some(a) => {
-                SlaveSample::ArmStep(step, Box::new(joints(a, torque, self.slave.rotation())))
-            }
-            None => SlaveSample::Step(step),
-        });
+        out.record = Some(
+            match self.slave.arm().joints(torque, self.slave.rotation()) {
+                Some(joints) => SlaveSample::ArmStep(step, joints),
+                None => SlaveSample::Step(step),
+            },
+        );
         Ok(())
     }
 
@@ -296,17 +225,9 @@ impl Follower for SlaveHandler {
     }
 
     fn after(&mut self, _: &mut Io) {
-        match &mut self.robot {
-            Robots::None => {}
-            Robots::Paper(hw) => {
-                if let Some(r) = hw.due.take() {
-                    hw.command(r);
-                }
-            }
-            Robots::Arm(hw) => {
-                if let Some(r) = hw.due.take() {
-                    hw.command(r);
-                }
+        if let Some(hw) = &mut self.robot {
+            if let Some(r) = hw.due.take() {
+                hw.command(r);
             }
         }
     }
@@ -323,47 +244,19 @@ impl Follower for SlaveHandler {
             io.event(last, "input silent: holding position")?;
         }
         let held = match &mut self.robot {
-            Robots::None => self.slave.hold(),
-            Robots::Paper(hw) => {
-                let (theta, ..) = hw.read(last, io)?;
-                let held = self.slave.hold_measured(theta);
-                hw.command(held.theta_ref);
-                held
-            }
-            Robots::Arm(hw) => {
-                let (q, ..) = hw.read(last, io)?;
-                let held = self.slave.hold_measured_arm(&q);
-                if let Some(a) = self.slave.arm_state() {
-                    hw.command(a.q_ref.clone());
-                }
+            None => self.slave.hold(None),
+            Some(hw) => {
+                let (measured, _) = hw.read(last, io)?;
+                let held = self.slave.hold(Some(&measured.joints));
+                hw.command(self.slave.arm().reference());
                 held
             }
         };
-        Ok(Some(match self.slave.arm() {
-            Some(a) => {
-                SlaveSample::ArmHold(held, Box::new(joints(a, [0.0; 3], self.slave.rotation())))
-            }
-            None => SlaveSample::Hold(held),
-        }))
-    }
-}
-
-/// A URDF arm's joints and tool orientation as its record holds them.
-fn joints(arm: &UrdfArm, torque: [f64; 3], master: Option<[f64; 4]>) -> ArmJoints {
-    let a = arm.state();
-    let (offset, offset_rotation) = arm.offsets();
-    ArmJoints {
-        q_ref: a.q_ref.clone(),
-        q: a.q.clone(),
-        tau: a.tau.clone(),
-        torque,
-        target_rotation: arm.target_rotation(),
-        tool_rotation: arm.tool_rotation(),
-        target_position: arm.target_position(),
-        tool_position: arm.tool_in_base(),
-        released: arm.released(),
-        master_rotation: master.unwrap_or([0.0, 0.0, 0.0, 1.0]),
-        offset,
-        offset_rotation,
+        Ok(Some(
+            match self.slave.arm().joints([0.0; 3], self.slave.rotation()) {
+                Some(joints) => SlaveSample::ArmHold(held, joints),
+                None => SlaveSample::Hold(held),
+            },
+        ))
     }
 }

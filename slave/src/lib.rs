@@ -1,7 +1,7 @@
-//! The slave side of the loop (the paper's HSD, SD and ENV): the simulated arm's
-//! controller and joint dynamics ([`arm`]), its environment ([`environment`]), the HSD
-//! kernels as a pure state machine ([`hsd`]), any arm from its URDF in place of the
-//! paper's ([`urdf_arm`]), what the slave does with each sample the
+//! The slave side of the loop (the paper's HSD, SD and ENV): the slave's arm as one
+//! trait ([`slave_arm`]) that the paper's arm ([`paper_arm`]: its controller and joint
+//! dynamics in [`arm`]) and any arm from its URDF ([`urdf_arm`]) implement, its
+//! environment ([`environment`]), the step as a pure state machine ([`hsd`]), what the slave does with each sample the
 //! loop's driver hands it ([`handler`]), the arm's URDF read once and the real robot
 //! and live view it opens for its driver ([`peripherals`]), and its program
 //! ([`node`]). The same handler
@@ -12,5 +12,7 @@ pub mod environment;
 pub mod handler;
 pub mod hsd;
 pub mod node;
+pub mod paper_arm;
 pub mod peripherals;
+pub mod slave_arm;
 pub mod urdf_arm;

@@ -48,10 +48,7 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     // its model.
     let (sc, base_dir) = (program.scenario(), &program.prepared().base_dir);
     let urdf = UrdfArm::read_urdf(sc, base_dir).map_err(NodeError::BadInput)?;
-    let arm = match &urdf {
-        Some(u) => UrdfArm::of_urdf(sc, u).map_err(NodeError::BadInput)?,
-        None => None,
-    };
+    let arm = peripherals::of_scenario(sc, urdf.as_ref()).map_err(NodeError::BadInput)?;
     program.follow(Box::new(move |p| {
         let opened = peripherals::open(&p.scenario, &p.base_dir, urdf.as_ref())?;
         let slave = Slave::new(&p.scenario, arm).map_err(|e| NodeError::Failed(e.to_string()))?;

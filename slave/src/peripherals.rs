@@ -4,10 +4,12 @@
 //! "ros2"`: the paper-shaped robot or the arm) and the live view's arm; the live view
 //! itself (`[ros.live]`). The runtime knows no arm; it drives what the slave hands it.
 
-use crate::handler::RealRobot;
+use crate::paper_arm::PaperArm;
+use crate::slave_arm::SlaveArm;
 use crate::urdf_arm::UrdfArm;
 use std::path::Path;
 use tactile_chain::UrdfFile;
+use tactile_devices::Robot;
 use tactile_math::arith::StdTrig;
 use tactile_math::kernels;
 use tactile_runtime::args::NodeError;
@@ -51,11 +53,35 @@ impl UrdfArm {
     }
 }
 
+/// The scenario's arm: its `[slave.arm]` from the URDF as read (`urdf`, relative
+/// paths already resolved), or the paper's.
+pub fn of_scenario(
+    scenario: &Scenario,
+    urdf: Option<&UrdfFile>,
+) -> Result<Box<dyn SlaveArm>, String> {
+    match (&scenario.slave.arm, urdf) {
+        (None, _) => Ok(Box::new(
+            PaperArm::new(scenario).map_err(|e| e.to_string())?,
+        )),
+        (Some(_), Some(urdf)) => match UrdfArm::of_urdf(scenario, urdf)? {
+            Some(arm) => Ok(Box::new(arm)),
+            None => Err("slave.arm: not in the scenario".into()),
+        },
+        (Some(_), None) => Err("slave.arm: its URDF was not read".into()),
+    }
+}
+
+/// The scenario's arm, its URDF (if any) read relative to `base_dir`.
+pub fn read_arm(scenario: &Scenario, base_dir: &Path) -> Result<Box<dyn SlaveArm>, String> {
+    let urdf = UrdfArm::read_urdf(scenario, base_dir)?;
+    of_scenario(scenario, urdf.as_ref())
+}
+
 /// What the slave opened: its real robot (None: simulated) and its live view.
 #[derive(Default)]
 pub struct Peripherals {
     /// The real robot, over ROS 2.
-    pub robot: Option<RealRobot>,
+    pub robot: Option<Box<dyn Robot>>,
     /// The live view.
     pub live: Option<Live>,
 }
@@ -63,7 +89,7 @@ pub struct Peripherals {
 impl std::fmt::Debug for Peripherals {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Peripherals")
-            .field("robot", &self.robot)
+            .field("robot", &self.robot.as_ref().map(|r| r.describe()))
             .field("live", &self.live.is_some())
             .finish()
     }
@@ -92,12 +118,12 @@ pub fn open(
     let mut out = Peripherals::default();
     let mut live_arm = None;
     match (sc.slave.backend, urdf) {
-        (Backend::Ros2, Some(urdf)) => out.robot = Some(RealRobot::Arm(ros_arm(&node, sc, urdf)?)),
+        (Backend::Ros2, Some(urdf)) => out.robot = Some(ros_arm(&node, sc, urdf)?),
         (Backend::Ros2, None) => {
             let r =
                 tactile_devices::ros_devices::RosRobot::open(&node, &sc.slave.ros2, sc.t_s_ns())
                     .map_err(failed)?;
-            out.robot = Some(RealRobot::Paper(Box::new(r)));
+            out.robot = Some(Box::new(r));
         }
         (Backend::Simulated, Some(urdf)) => {
             let tree = tactile_chain::Tree::new(&urdf.robot).map_err(|e| arm_error(urdf, &e))?;
@@ -121,7 +147,7 @@ fn ros_arm(
     node: &std::sync::Arc<tactile_devices::rmw_node::RosNode>,
     sc: &Scenario,
     urdf: &UrdfFile,
-) -> Result<Box<dyn tactile_devices::Robot<Vec<f64>>>, NodeError> {
+) -> Result<Box<dyn Robot>, NodeError> {
     use tactile_chain::{Chain, Tree};
     let Some(arm) = &sc.slave.arm else {
         return Err(NodeError::Failed("no [slave.arm] for its URDF".into()));

@@ -28,6 +28,8 @@ use tactile_scenario::shown::{listed, Num};
 use tactile_scenario::ArmConfig;
 
 use crate::environment::Scene;
+use std::sync::Arc;
+use tactile_math::joints::MAX_JOINTS;
 
 /// The simulated arm and its references.
 #[derive(Debug, Clone)]
@@ -56,6 +58,8 @@ pub struct UrdfArm {
     /// Periods whose dynamics failed (the arm then stood still), and the last
     /// failure not yet taken by the slave's log.
     failures: (u64, Option<String>),
+    /// The base link and the joints' names, as the live view shares them.
+    live_names: (Arc<str>, Arc<[String]>),
 }
 
 /// Where the master's mapped pose met the robot's reference at a re-engage: the
@@ -138,6 +142,12 @@ impl UrdfArm {
                 ));
             }
         }
+        if dof > MAX_JOINTS {
+            return Err(format!(
+                "the chain from `{}` to `{}` has {dof} joints; an arm may have at most {MAX_JOINTS}",
+                cfg.base, cfg.tip
+            ));
+        }
         for (d, q) in chain.dofs.iter().zip(&cfg.home) {
             if *q < d.lower || *q > d.upper {
                 return Err(format!(
@@ -188,7 +198,6 @@ impl UrdfArm {
         };
         Ok(UrdfArm {
             scratch: sim::Scratch::new(&chain),
-            chain,
             ik,
             dynamics,
             cfg: cfg.clone(),
@@ -202,7 +211,17 @@ impl UrdfArm {
             frame: (!cfg.rotation.is_identity())
                 .then(|| Matrix3::from_fn(|i, j| cfg.rotation.matrix()[i][j])),
             failures: (0, None),
+            live_names: (
+                Arc::from(chain.base.as_str()),
+                chain.dofs.iter().map(|d| d.name.clone()).collect(),
+            ),
+            chain,
         })
+    }
+
+    /// The base link and the joints' names, shared with the live view.
+    pub fn live_names(&self) -> &(Arc<str>, Arc<[String]>) {
+        &self.live_names
     }
 
     /// The joints now.
@@ -457,6 +476,9 @@ impl UrdfArm {
 
 #[path = "urdf_arm_sim.rs"]
 mod sim;
+
+#[path = "urdf_arm_slave.rs"]
+mod slave;
 
 #[cfg(test)]
 #[path = "urdf_arm_tests.rs"]

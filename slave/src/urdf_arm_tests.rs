@@ -409,12 +409,10 @@ fn a_turned_reengage_continues_from_the_held_orientation() {
     assert!((0..4).all(|k| (tool[k] - want[k]).abs() < 1e-3), "{tool:?}");
 }
 
-/// A chain of 300 joints and a `home` of one value: the error listed every joint's
-/// name on one line (10,000 of them for a 10,000-joint chain); it names the first ten.
-#[test]
-fn a_long_chains_joints_are_listed_short() {
+/// A URDF of `n` revolute joints in a row, from `l0` to `l{n}`.
+fn long_chain(n: usize) -> String {
     let mut xml = String::from("<robot name=\"long\"><link name=\"l0\"/>");
-    for k in 1..=300 {
+    for k in 1..=n {
         xml += &format!(
             "<link name=\"l{k}\"><inertial><mass value=\"0.1\"/><inertia ixx=\"1e-3\" ixy=\"0\" ixz=\"0\" iyy=\"1e-3\" iyz=\"0\" izz=\"1e-3\"/></inertial></link>\
              <joint name=\"j{k}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{k}\"/>\
@@ -423,6 +421,14 @@ fn a_long_chains_joints_are_listed_short() {
         );
     }
     xml += "</robot>";
+    xml
+}
+
+/// A chain of 300 joints and a `home` of one value: the error listed every joint's
+/// name on one line (10,000 of them for a 10,000-joint chain); it names the first ten.
+#[test]
+fn a_long_chains_joints_are_listed_short() {
+    let xml = long_chain(300);
     let cfg = ArmConfig {
         base: "l0".into(),
         tip: "l300".into(),
@@ -435,6 +441,23 @@ fn a_long_chains_joints_are_listed_short() {
         "{e}"
     );
     assert!(e.len() < 300, "{} characters", e.len());
+}
+
+/// An arm carries its joints inline (no heap per sample): a chain longer than that
+/// is refused at load, naming the limit.
+#[test]
+fn a_chain_of_more_joints_than_an_arm_holds_is_refused() {
+    let xml = long_chain(17);
+    let cfg = ArmConfig {
+        base: "l0".into(),
+        tip: "l17".into(),
+        home: vec![0.0; 17],
+        kp: vec![1.0; 17],
+        kd: vec![0.1; 17],
+        ..panda_cfg()
+    };
+    let e = UrdfArm::new(&cfg, &xml, HOME).expect_err("17 joints");
+    assert!(e.contains("has 17 joints; an arm may have at most 16"), "{e}");
 }
 
 /// A one-joint arm: a continuous joint (no position limit stops it) with `damping`.
@@ -484,14 +507,14 @@ fn failed_dynamics_steps_reach_the_slaves_counters() {
     arm.state.qd[0] = 1.0;
     let mut scenario = tactile_scenario::Scenario::default();
     scenario.slave.arm = Some(cfg);
-    let mut slave = crate::hsd::Slave::new(&scenario, Some(arm)).expect("slave");
+    let mut slave = crate::hsd::Slave::new(&scenario, Box::new(arm)).expect("slave");
     assert_eq!(slave.counters().dynamics_failed, 0);
     for _ in 0..100 {
-        slave.hold();
+        slave.hold(None);
     }
     let failed = slave.counters().dynamics_failed;
     assert!(failed > 0, "no failure in the counters");
-    assert_eq!(Some(failed), slave.arm().map(UrdfArm::dynamics_failures));
+    assert_eq!(failed, 100);
 }
 
 /// A link whose mass sits on its own joint's axis, with no inertia about it: every

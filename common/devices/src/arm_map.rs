@@ -7,6 +7,7 @@
 
 use crate::map::Reject;
 use tactile_chain::{Chain, Frame, Tree};
+use tactile_math::joints::{Joints, TooManyJoints};
 use tactile_ros::msg::{Decode, JointState, WrenchStamped};
 use tactile_scenario::TorqueAbout;
 
@@ -23,40 +24,40 @@ pub const DEFAULT_VELOCITY: f64 = 2.0;
 pub struct ArmJointMap {
     /// The chain's joint names, in its order (the commands' order).
     pub names: Vec<String>,
-    lower: Vec<f64>,
-    upper: Vec<f64>,
-    velocity: Vec<f64>,
+    lower: Joints,
+    upper: Joints,
+    velocity: Joints,
 }
 
 impl ArmJointMap {
-    /// The joints of `chain`.
-    pub fn of(chain: &Chain) -> ArmJointMap {
-        ArmJointMap {
+    /// The joints of `chain`, if it has no more than a [`Joints`] holds.
+    pub fn of(chain: &Chain) -> Result<ArmJointMap, TooManyJoints> {
+        let each = |f: fn(&tactile_chain::Dof) -> f64| {
+            let v: Vec<f64> = chain.dofs.iter().map(f).collect();
+            Joints::from_slice(&v)
+        };
+        Ok(ArmJointMap {
             names: chain.dofs.iter().map(|d| d.name.clone()).collect(),
-            lower: chain.dofs.iter().map(|d| d.lower).collect(),
-            upper: chain.dofs.iter().map(|d| d.upper).collect(),
-            velocity: chain
-                .dofs
-                .iter()
-                .map(|d| {
-                    if d.velocity.is_finite() {
-                        d.velocity
-                    } else {
-                        DEFAULT_VELOCITY
-                    }
-                })
-                .collect(),
-        }
+            lower: each(|d| d.lower)?,
+            upper: each(|d| d.upper)?,
+            velocity: each(|d| {
+                if d.velocity.is_finite() {
+                    d.velocity
+                } else {
+                    DEFAULT_VELOCITY
+                }
+            })?,
+        })
     }
 
     /// The chain's joint values from a CDR `JointState`.
-    pub fn positions_cdr(&self, cdr: &[u8]) -> Result<Vec<f64>, Reject> {
+    pub fn positions_cdr(&self, cdr: &[u8]) -> Result<Joints, Reject> {
         self.positions(&crate::map::joint_state_cdr(cdr)?)
     }
 
     /// The chain's joint values from a `JointState`, in the chain's order.
-    pub fn positions(&self, js: &JointState) -> Result<Vec<f64>, Reject> {
-        let mut q = Vec::with_capacity(self.names.len());
+    pub fn positions(&self, js: &JointState) -> Result<Joints, Reject> {
+        let mut q = self.lower;
         for (i, name) in self.names.iter().enumerate() {
             let v = crate::map::position_of(js, name)?;
             let (min, max) = (self.lower[i] - LIMIT_MARGIN, self.upper[i] + LIMIT_MARGIN);
@@ -68,16 +69,17 @@ impl ArmJointMap {
                     max,
                 });
             }
-            q.push(v);
+            q[i] = v;
         }
         Ok(q)
     }
 
     /// The gate's range (the URDF's limits) and largest step in `t_s` seconds (its
     /// velocity limits).
-    pub fn gate(&self, t_s: f64) -> crate::gate::JointGate<Vec<f64>> {
-        let step = self.velocity.iter().map(|v| v * t_s).collect();
-        crate::gate::JointGate::new(self.lower.clone(), self.upper.clone(), step)
+    pub fn gate(&self, t_s: f64) -> crate::gate::JointGate<Joints> {
+        let mut step = self.velocity;
+        step.iter_mut().for_each(|v| *v *= t_s);
+        crate::gate::JointGate::new(self.lower, self.upper, step)
     }
 }
 
@@ -157,7 +159,7 @@ mod tests {
     #[test]
     fn joints_are_read_by_name_in_any_order_and_checked() {
         let (chain, _) = panda();
-        let m = ArmJointMap::of(&chain);
+        let m = ArmJointMap::of(&chain).expect("seven joints");
         let mut names: Vec<String> = m.names.iter().rev().cloned().collect();
         names.push("panda_finger_joint1".into());
         let mut js = JointState {
@@ -168,7 +170,7 @@ mod tests {
         };
         assert_eq!(
             m.positions_cdr(&js.to_cdr()),
-            Ok(vec![0.2, -0.5, 0.0, -1.5, 0.0, 1.0, 0.1])
+            Ok(Joints::from_slice(&[0.2, -0.5, 0.0, -1.5, 0.0, 1.0, 0.1]).expect("seven"))
         );
         js.position[3] = 0.5; // panda_joint4 is in [-3.0718, -0.0698]
         assert!(
@@ -198,7 +200,7 @@ mod tests {
     #[test]
     fn a_wrench_in_the_hand_turns_into_the_base() {
         let (chain, tree) = panda();
-        let names = ArmJointMap::of(&chain).names;
+        let names = ArmJointMap::of(&chain).expect("seven joints").names;
         // The shipped Panda scenario's home: franka_ros' ready pose.
         let sc = include_str!("../../../deploy/scenarios/panda.toml");
         let sc = tactile_scenario::Scenario::from_toml_str(sc).expect("scenario");

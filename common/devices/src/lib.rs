@@ -30,6 +30,7 @@ pub mod ros_side;
 pub mod watch;
 
 pub use map::{JointMap, Reject};
+pub use tactile_math::joints::Joints;
 pub use tactile_peripheral::{LiveSink, Peripheral};
 pub use tactile_records::device::DeviceCounters;
 pub use watch::{Change, Reading};
@@ -57,11 +58,11 @@ pub trait HapticDevice: Peripheral {
 }
 
 /// A real slave robot, as the slave's loop uses it: joint references out, joint
-/// angles and (when it has a sensor) the contact force in. `V` is the joints' values:
-/// the paper arm's three angles, or an arm's joints from its URDF (`Vec<f64>`).
-pub trait Robot<V = [f64; 3]>: Peripheral {
-    /// The joints' newest angles at this tick, judged.
-    fn read(&mut self, now_ns: u64) -> (Reading<V>, Change);
+/// values and (when it has a sensor) the contact force in. Its joints are the arm's
+/// (the paper's three angles, or an arm's from its URDF, in its order and units).
+pub trait Robot: Peripheral {
+    /// The joints' newest values at this tick, judged.
+    fn read(&mut self, now_ns: u64) -> (Reading<Joints>, Change);
     /// The contact force at this tick, N in the paper's frame (an arm's: its base's
     /// axes), if the robot has a force sensor (else the environment model gives it);
     /// zero when the sensor's newest reading is older than the timeout.
@@ -73,7 +74,7 @@ pub trait Robot<V = [f64; 3]>: Peripheral {
     }
     /// Sends the joint references (rad in the paper's convention; an arm's in its
     /// URDF's), through the gate.
-    fn command(&mut self, reference: V, now_ns: u64);
+    fn command(&mut self, reference: Joints, now_ns: u64);
     /// Leaves the robot holding: its own last angles commanded, sent so they arrive.
     /// True if it was sent to a listening controller.
     fn release(&mut self) -> bool;

@@ -12,7 +12,7 @@ use crate::gate::JointGate;
 use crate::rmw_node::{wall_ns, RosNode, RosPublisher, RosSubscription};
 use crate::ros_devices::{hold_at, released};
 use crate::watch::{Inbox, Watch};
-use crate::{Change, Reading, Robot, RosError};
+use crate::{Change, Joints, Reading, Robot, RosError};
 use std::sync::Arc;
 use tactile_chain::{Chain, Tree};
 use tactile_ros::msg::{
@@ -25,7 +25,7 @@ use tactile_scenario::{RobotCommand, RosRobotConfig};
 #[derive(Debug)]
 pub struct RosArm {
     node: Arc<RosNode>,
-    joints: Arc<Inbox<Vec<f64>>>,
+    joints: Arc<Inbox<Joints>>,
     wrench: Option<Arc<Inbox<FramedForce>>>,
     _subs: Vec<RosSubscription>,
     command: RosPublisher,
@@ -41,7 +41,7 @@ pub struct RosArm {
     torque: [f64; 3],
     /// The point the wrench's torque is about.
     torque_about: tactile_scenario::TorqueAbout,
-    gate: JointGate<Vec<f64>>,
+    gate: JointGate<Joints>,
     watch: Watch,
     topic: String,
     last_tick_ns: u64,
@@ -58,7 +58,7 @@ impl RosArm {
         t_s_ns: u64,
     ) -> Result<Self, RosError> {
         let t_s = t_s_ns as f64 * 1e-9;
-        let map = ArmJointMap::of(chain);
+        let map = ArmJointMap::of(chain).map_err(|e| RosError::new("the arm's joints", e))?;
         let tree = Arc::new(tree);
         let joints = Inbox::new();
         let m = map.clone();
@@ -104,14 +104,14 @@ impl RosArm {
     /// The command message for joint values `q` (which passed the gate): a pose
     /// command's is the tool's pose at `q`, so it is reachable and moves no joint
     /// faster than the gate lets it.
-    fn message(&self, q: Vec<f64>) -> Vec<u8> {
+    fn message(&self, q: Joints) -> Vec<u8> {
         match self.kind {
-            RobotCommand::Positions => Float64MultiArray { data: q }.to_cdr(),
+            RobotCommand::Positions => Float64MultiArray { data: q.to_vec() }.to_cdr(),
             RobotCommand::Trajectory => JointTrajectory {
                 // A zero stamp: the controller starts the point on receipt.
                 header: Header::at(0, ""),
                 joint_names: self.map.names.clone(),
-                positions: q,
+                positions: q.to_vec(),
                 velocities: Vec::new(),
                 time_from_start: self.point_time,
             }
@@ -131,8 +131,8 @@ impl RosArm {
 
 crate::ros_devices::robot_peripheral!(RosArm);
 
-impl Robot<Vec<f64>> for RosArm {
-    fn read(&mut self, now_ns: u64) -> (Reading<Vec<f64>>, Change) {
+impl Robot for RosArm {
+    fn read(&mut self, now_ns: u64) -> (Reading<Joints>, Change) {
         self.watch.judge(self.joints.latest(), now_ns)
     }
 
@@ -173,7 +173,7 @@ impl Robot<Vec<f64>> for RosArm {
         self.torque
     }
 
-    fn command(&mut self, reference: Vec<f64>, now_ns: u64) {
+    fn command(&mut self, reference: Joints, now_ns: u64) {
         self.last_tick_ns = now_ns;
         if let Some(l) = self.joints.latest() {
             self.gate.start_at(l.value);

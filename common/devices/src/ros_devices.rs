@@ -8,7 +8,7 @@ use crate::map::force_cdr;
 use crate::rmw_node::{RosNode, RosPublisher, RosSubscription};
 use crate::watch::{Inbox, Latest, Watch};
 use crate::RosError;
-use crate::{Change, JointMap, Reading, Robot};
+use crate::{Change, JointMap, Joints, Reading, Robot};
 use std::sync::Arc;
 use tactile_ros::msg::{Float64MultiArray, JointState, Message, WrenchStamped};
 use tactile_scenario::RosRobotConfig;
@@ -125,8 +125,9 @@ pub(crate) use robot_peripheral;
 robot_peripheral!(RosRobot);
 
 impl Robot for RosRobot {
-    fn read(&mut self, now_ns: u64) -> (Reading<[f64; 3]>, Change) {
-        self.watch.judge(self.joints.latest(), now_ns)
+    fn read(&mut self, now_ns: u64) -> (Reading<Joints>, Change) {
+        let (reading, change) = self.watch.judge(self.joints.latest(), now_ns);
+        (reading.map(Joints::from), change)
     }
 
     fn force(&mut self, now_ns: u64) -> Option<[f64; 3]> {
@@ -135,7 +136,8 @@ impl Robot for RosRobot {
         Some(self.wrench_map.to_paper(f))
     }
 
-    fn command(&mut self, theta_ref: [f64; 3], now_ns: u64) {
+    fn command(&mut self, theta_ref: Joints, now_ns: u64) {
+        let theta_ref = theta_ref.to_array3();
         self.last_tick_ns = now_ns;
         if let Some(l) = self.joints.latest() {
             self.gate.start_at(self.map.raw(l.value));

@@ -94,6 +94,17 @@ pub enum Reading<T> {
     Lost,
 }
 
+impl<T> Reading<T> {
+    /// The same judgement of `f` of the value.
+    pub fn map<U>(self, f: impl FnOnce(T) -> U) -> Reading<U> {
+        match self {
+            Reading::Fresh(t) => Reading::Fresh(f(t)),
+            Reading::Stale(t) => Reading::Stale(f(t)),
+            Reading::Lost => Reading::Lost,
+        }
+    }
+}
+
 /// Judges each tick's sample and counts the judgements.
 #[derive(Debug, Clone)]
 pub struct Watch {

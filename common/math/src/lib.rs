@@ -12,6 +12,7 @@ pub mod cordic;
 pub mod engine;
 pub mod geometry;
 pub mod hardware;
+pub mod joints;
 pub mod kernels;
 pub mod shown;
 pub mod validation;

@@ -24,7 +24,6 @@ use tactile_runtime::driver::{in_process, Link, Timing};
 use tactile_scenario::Scenario;
 use tactile_slave::handler::SlaveHandler;
 use tactile_slave::hsd::Slave;
-use tactile_slave::urdf_arm::UrdfArm;
 
 /// The run token of a simulation (there is no master process to choose one).
 pub const SIM_RUN: u64 = 1;
@@ -81,7 +80,7 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<bool
     let replays =
         tactile_network_emulator::replay::load(scenario, base_dir).map_err(Error::BadInput)?;
     let emulator = EmulatorHandler::new(Emulator::with_replays(scenario, replays));
-    let arm = UrdfArm::of_scenario(scenario, base_dir).map_err(Error::BadInput)?;
+    let arm = tactile_slave::peripherals::read_arm(scenario, base_dir).map_err(Error::BadInput)?;
     let slave = SlaveHandler::new(Slave::new(scenario, arm).map_err(bad)?, scenario, None);
     let timing = Timing::Simulated {
         t_s_ns: scenario.t_s_ns(),

@@ -1,0 +1,92 @@
+//! The slave's arm, whichever it is: the paper's three joints
+//! ([`crate::paper_arm::PaperArm`], its HSD kernels in the scenario's arithmetic) or
+//! any serial arm from its URDF ([`crate::urdf_arm::UrdfArm`]), simulated or a real robot's measured joints. The slave's step
+//! ([`crate::hsd::Slave`]) is written once against this trait: it follows the
+//! channel's target, moves (or is measured), holds while the input is silent, and
+//! says where its tool is and what force the operator is to feel.
+
+use crate::environment::Scene;
+use tactile_math::joints::Joints;
+use tactile_records::slave::{ArmJoints, HoldStep, SlaveCounters};
+use tactile_ros::view::{SampleView, SlaveView};
+
+/// What one period's motion gave the step's record: the paper's three angles, their
+/// reference, their torques (zero for an arm whose joints are in their own record entry) and the
+/// torque clamps.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Moved {
+    /// The joints' reference theta_ref, rad (the paper's arm's).
+    pub theta_ref: [f64; 3],
+    /// Joint angles theta^SD, rad (the paper's arm's).
+    pub theta: [f64; 3],
+    /// The joint controller's torques, N m (the paper's arm's).
+    pub torque: [f64; 3],
+    /// Joint efforts clamped to their limits this period.
+    pub clamps: u32,
+}
+
+/// The slave's arm. Positions and forces are in the master's frame, as the loop
+/// carries them; each arm maps them into its own.
+pub trait SlaveArm: std::fmt::Debug + Send {
+    /// IK toward the channel's `position` (and a 6-DoF master's `rotation`); while the
+    /// operator's clutch is `released`, the references hold. Counts what the IK did
+    /// into `c`; returns the flags it sets on h(n).
+    fn follow(
+        &mut self,
+        position: [f64; 3],
+        rotation: Option<[f64; 4]>,
+        released: bool,
+        dt: f64,
+        c: &mut SlaveCounters,
+    ) -> u32;
+
+    /// One period of `dt` s: a real robot's `measured` joints are the arm's (its own controller
+    /// follows the reference); without, the simulated joints move under the servo,
+    /// pushed back by what the tool touches in `objects`.
+    fn advance(
+        &mut self,
+        measured: Option<&Joints>,
+        objects: &Scene,
+        dt: f64,
+        c: &mut SlaveCounters,
+    ) -> Moved;
+
+    /// One period with no input: the arm holds where it was when the input went
+    /// silent (measured or simulated, as [`SlaveArm::advance`]); counted into `c`.
+    fn hold(
+        &mut self,
+        measured: Option<&Joints>,
+        objects: &Scene,
+        dt: f64,
+        c: &mut SlaveCounters,
+    ) -> HoldStep;
+
+    /// Input is back: the next silence holds where the arm is then.
+    fn end_hold(&mut self);
+
+    /// The tool, m in the master's frame: as the HSD's FK computes it (the paper's
+    /// arithmetic) and as it is (f64), which the environment sees.
+    fn tool(&self) -> ([f64; 3], [f64; 3]);
+
+    /// FBF: the force of a contact at `surface` of `stiffness` (N/m per axis) on the
+    /// tool at `tool`,
+    /// as the operator is to feel it.
+    fn contact_force(&self, surface: [f64; 3], tool: [f64; 3], stiffness: [f64; 3]) -> [f64; 3];
+
+    /// A force-torque sensor's force or torque (the arm's base's axes) as the
+    /// operator is to feel it.
+    fn felt(&self, f: [f64; 3]) -> [f64; 3];
+
+    /// The joint references a real robot is commanded.
+    fn reference(&self) -> Joints;
+
+    /// `c` with what the arm counts itself (the hardware's clocks, failed dynamics).
+    fn counters(&self, c: SlaveCounters) -> SlaveCounters;
+
+    /// The record's entry of an arm with joints of its own (`None`: the paper's, whose
+    /// angles are the step's): `torque` is h(n)'s, `master` the orientation followed.
+    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> Option<Box<ArmJoints>>;
+
+    /// The live view's sample of the step `view`.
+    fn live(&self, view: SlaveView) -> SampleView;
+}
