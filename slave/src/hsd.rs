@@ -5,12 +5,12 @@
 //! program and in the in-process simulation alike, so both compute identical values.
 //!
 //! One step: the channel's control (the received position itself, or TDPA's or the
-//! wave's reference) -> CPD (pass-through) -> IK-HSD -> JPD (pass-through) -> FCS (PID)
-//! -> SD joint dynamics over t_s, with the contact force of the environment acting on
-//! the joints -> FK-HSD -> ENV nearest surface point -> FBF-HSD -> the control's value
-//! to send back (the force, or the backward wave).
-//! The HSD kernels (IK, FK, FBF) run in the scenario's arithmetic; the physical world
-//! (the device's true tool position and the contact force on it) is f64.
+//! wave's reference) -> CPD (pass-through) -> the arm's IK (IK-HSD for the paper's arm)
+//! -> JPD (pass-through) -> the arm's servo and dynamics over t_s (FCS and SD), or a
+//! real robot's measured joints -> the arm's FK -> ENV nearest surface point -> FBF ->
+//! the control's value to send back (the force, or the backward wave). The arm is
+//! one trait ([`crate::slave_arm::SlaveArm`]); the paper's runs its kernels in the
+//! scenario's arithmetic, the physical world (the true tool, the contact) in f64.
 
 use crate::environment::{deepest_contact, Scene};
 use crate::slave_arm::SlaveArm;
@@ -53,8 +53,8 @@ pub struct Slave {
 pub struct Measured {
     /// Its joints, in the arm's order and units.
     pub joints: Joints,
-    /// Contact force from a force-torque sensor, N in the arm's base's axes (None:
-    /// the environment model).
+    /// Contact force from a force-torque sensor, N (None: the environment model): the
+    /// paper's robot's in the paper's frame, a URDF arm's in its base's axes.
     pub force: Option<[f64; 3]>,
 }
 
@@ -110,7 +110,7 @@ impl Slave {
 
     /// A real robot's reading for the next step: its joints (SD is the robot, FCS its
     /// own controller, which is commanded the step's reference), its force sensor's
-    /// force and the torque about the tool, in the arm's base's axes.
+    /// force and the torque about the tool (see [`Measured::force`] for their frame).
     pub fn measure(&mut self, m: Measured, torque: [f64; 3]) {
         self.measured = Some(m);
         self.measured_torque = torque;

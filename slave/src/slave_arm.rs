@@ -51,8 +51,9 @@ pub trait SlaveArm: std::fmt::Debug + Send {
         c: &mut SlaveCounters,
     ) -> Moved;
 
-    /// One period with no input: the arm holds where it was when the input went
-    /// silent (measured or simulated, as [`SlaveArm::advance`]); counted into `c`.
+    /// One period with no input: simulated, the arm holds where it was when the input
+    /// went silent; a real robot (`measured`) is commanded the reference it had then.
+    /// Counted into `c`.
     fn hold(
         &mut self,
         measured: Option<&Joints>,
@@ -73,8 +74,8 @@ pub trait SlaveArm: std::fmt::Debug + Send {
     /// as the operator is to feel it.
     fn contact_force(&self, surface: [f64; 3], tool: [f64; 3], stiffness: [f64; 3]) -> [f64; 3];
 
-    /// A force-torque sensor's force or torque (the arm's base's axes) as the
-    /// operator is to feel it.
+    /// A force-torque sensor's force or torque (the paper's robot's in the paper's
+    /// frame, a URDF arm's in its base's axes) as the operator is to feel it.
     fn felt(&self, f: [f64; 3]) -> [f64; 3];
 
     /// The joint references a real robot is commanded.

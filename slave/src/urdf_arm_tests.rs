@@ -457,7 +457,10 @@ fn a_chain_of_more_joints_than_an_arm_holds_is_refused() {
         ..panda_cfg()
     };
     let e = UrdfArm::new(&cfg, &xml, HOME).expect_err("17 joints");
-    assert!(e.contains("has 17 joints; an arm may have at most 16"), "{e}");
+    assert!(
+        e.contains("has 17 joints; an arm may have at most 16"),
+        "{e}"
+    );
 }
 
 /// A one-joint arm: a continuous joint (no position limit stops it) with `damping`.

@@ -13,7 +13,7 @@
 //! would leave the robot stuck until the target came back near it.
 
 /// What the gate did with one value: three joints or a force (`[f64; 3]`), or an
-/// arm's joints (`Vec<f64>`).
+/// arm's joints (`tactile_math::joints::Joints`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Passed<V = [f64; 3]> {
     /// Let through as it was.
@@ -35,7 +35,7 @@ impl<V> Passed<V> {
 }
 
 /// A robot's joint commands, in the driver's unit: three joints (`[f64; 3]`, the
-/// paper's arm) or any number (`Vec<f64>`, an arm from its URDF).
+/// paper's arm) or any number (`Joints`, an arm from its URDF).
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointGate<V = [f64; 3]> {
     lo: V,
