@@ -297,7 +297,8 @@ fn the_crates_depend_as_the_architecture_says() {
 }
 
 /// The per-sample protocol is the driver's alone: no node crate names the pacer, the
-/// run filter, the probe or end-of-run flags, or the record's once-a-second counters.
+/// run filter, a control message (probe, end, waiting, dropped) or its flags, or the
+/// record's once-a-second counters.
 #[test]
 fn only_the_driver_speaks_the_protocol() {
     let words = [
@@ -305,6 +306,9 @@ fn only_the_driver_speaks_the_protocol() {
         "RunFilter",
         "FLAG_END",
         "FLAG_PROBE",
+        "FLAG_WAITING",
+        "FLAG_DROPPED",
+        "Control::",
         "recv_paced",
         "counters_due",
     ];

@@ -50,6 +50,23 @@ pub mod stage {
     ];
 }
 
+// The flags fall in three groups, each bit in one ([`Control::FLAGS`],
+// [`PAYLOAD_FLAGS`], [`NOTE_FLAGS`]): the run's control messages (probe, end, waiting,
+// dropped; made and read through [`Control`] only); what the payload is or how the
+// network treated it, which a receiver acts on (substituted, unsent, corrupted, pose,
+// released); and notes of what the node that set them did, for the trace (IK clamped,
+// rejected, contact, held, peer lost, clamped).
+
+/// What a sample's payload is or how the network treated it: its receiver acts on
+/// these.
+pub const PAYLOAD_FLAGS: u32 =
+    FLAG_SUBSTITUTED | FLAG_UNSENT | FLAG_CORRUPTED | FLAG_POSE | FLAG_RELEASED;
+
+/// Notes of what the node that set them did with the sample, for the trace: no
+/// receiver acts on them.
+pub const NOTE_FLAGS: u32 =
+    FLAG_IK_CLAMPED | FLAG_REJECTED | FLAG_CONTACT | FLAG_HELD | FLAG_PEER_LOST | FLAG_CLAMPED;
+
 /// Flag: a value stood in for one the channel did not have (start-up of a delay, gap).
 pub const FLAG_SUBSTITUTED: u32 = 1;
 /// Flag: the slave's IK target was outside the workspace (clamped).
@@ -210,3 +227,127 @@ impl OfRun for Backward {
 /// within it; an answer older than this counts as unexpected. Bounded, so memory does
 /// not grow with the run's length.
 pub const LATE_WINDOW: u64 = 1024;
+
+/// The run's control messages, as a kind: what a sample is when it carries no data.
+/// On the wire each is its `FLAG_*` bits in [`Signal::flags`] (the layout is
+/// unchanged); a program makes and reads them only through this type
+/// ([`Forward::control`], [`Backward::control`], [`Forward::control_kind`],
+/// [`Backward::control_kind`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Control {
+    /// A start-up probe: passes every process untouched and comes back to the master
+    /// ([`FLAG_PROBE`]).
+    Probe,
+    /// A probe's echo from the end of the chain, which is there but still waits for
+    /// its robot ([`FLAG_PROBE`] and [`FLAG_WAITING`]).
+    Waiting,
+    /// The run is over: each process passes it on and exits ([`FLAG_END`]).
+    End,
+    /// Lockstep, backward: the emulator dropped sample `seq` on purpose, no answer
+    /// comes ([`FLAG_DROPPED`]).
+    Dropped,
+}
+
+impl Control {
+    /// The flags that make a sample a control message.
+    pub const FLAGS: u32 = FLAG_PROBE | FLAG_WAITING | FLAG_END | FLAG_DROPPED;
+
+    /// Its bits on the wire.
+    pub fn flags(self) -> u32 {
+        match self {
+            Control::Probe => FLAG_PROBE,
+            Control::Waiting => FLAG_PROBE | FLAG_WAITING,
+            Control::End => FLAG_END,
+            Control::Dropped => FLAG_DROPPED,
+        }
+    }
+
+    /// The control message that `flags` make, if any: the end first (a run that
+    /// ends, ends), then a waiting echo, a probe, a drop.
+    pub fn of(flags: u32) -> Option<Control> {
+        if flags & FLAG_END != 0 {
+            Some(Control::End)
+        } else if flags & FLAG_WAITING != 0 {
+            Some(Control::Waiting)
+        } else if flags & FLAG_PROBE != 0 {
+            Some(Control::Probe)
+        } else if flags & FLAG_DROPPED != 0 {
+            Some(Control::Dropped)
+        } else {
+            None
+        }
+    }
+
+    /// True for a probe or its echo, which the chain passes on untouched.
+    pub fn is_probe(self) -> bool {
+        matches!(self, Control::Probe | Control::Waiting)
+    }
+}
+
+impl Forward {
+    /// The control message `kind` of run `run`, numbered `seq` (a probe's count).
+    pub fn control(kind: Control, run: u64, seq: u64) -> Forward {
+        let mut f = Forward {
+            seq,
+            run,
+            ..Forward::default()
+        };
+        f.signal.flags = kind.flags();
+        f
+    }
+
+    /// What control message this is, if it is one.
+    pub fn control_kind(&self) -> Option<Control> {
+        Control::of(self.signal.flags)
+    }
+}
+
+impl Backward {
+    /// The control message `kind` of run `run`, about sample `seq` (a probe's echo,
+    /// a dropped sample's notice).
+    pub fn control(kind: Control, run: u64, seq: u64) -> Backward {
+        let mut b = Backward {
+            seq,
+            run,
+            ..Backward::default()
+        };
+        b.signal.flags = kind.flags();
+        b
+    }
+
+    /// What control message this is, if it is one.
+    pub fn control_kind(&self) -> Option<Control> {
+        Control::of(self.signal.flags)
+    }
+}
+
+#[cfg(test)]
+mod control_tests {
+    use super::*;
+
+    #[test]
+    fn each_control_reads_back_as_itself_and_data_as_none() {
+        for k in [
+            Control::Probe,
+            Control::Waiting,
+            Control::End,
+            Control::Dropped,
+        ] {
+            assert_eq!(Forward::control(k, 7, 3).control_kind(), Some(k));
+            let b = Backward::control(k, 7, 3);
+            assert_eq!((b.control_kind(), b.run, b.seq), (Some(k), 7, 3));
+            assert_eq!(k.flags() & !Control::FLAGS, 0);
+        }
+        let mut data = Forward::default();
+        data.signal.flags = !Control::FLAGS;
+        assert_eq!(data.control_kind(), None);
+        assert!(Control::Waiting.is_probe() && !Control::End.is_probe());
+    }
+
+    #[test]
+    fn every_flag_is_in_exactly_one_group() {
+        let groups = [Control::FLAGS, PAYLOAD_FLAGS, NOTE_FLAGS];
+        assert_eq!(groups.iter().fold(0, |a, g| a | g), (1 << 15) - 1);
+        assert_eq!(groups.iter().map(|g| g.count_ones()).sum::<u32>(), 15);
+    }
+}

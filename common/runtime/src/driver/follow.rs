@@ -9,9 +9,7 @@ use super::link::{Arrival, Block, Idle, Link};
 use super::{Counts, Failure, Follower, Io, Reply, Timing};
 use crate::pace::Pacer;
 use std::time::{Duration, Instant};
-use tactile_messages::samples::{
-    stage, Backward, Forward, FLAG_DROPPED, FLAG_END, FLAG_PROBE, FLAG_WAITING,
-};
+use tactile_messages::samples::{stage, Backward, Control, Forward};
 use tactile_peripheral::{DeviceCounters, LiveSink};
 use tactile_records::{Events, Recorder};
 
@@ -252,9 +250,11 @@ impl<H: Follower> Follow<H> {
             self.rec.run(t)?;
         }
         match a {
-            Arrival::Forward(c) if c.signal.flags & (FLAG_PROBE | FLAG_END) != 0 => self.control(c),
-            Arrival::Forward(c) => self.forward(c, waiting).map(|()| Flow::Continue),
-            Arrival::Backward(h) if h.signal.flags & FLAG_PROBE != 0 => {
+            Arrival::Forward(c) => match c.control_kind() {
+                None | Some(Control::Dropped) => self.forward(c, waiting).map(|()| Flow::Continue),
+                Some(_) => self.control(c),
+            },
+            Arrival::Backward(h) if h.control_kind().is_some_and(Control::is_probe) => {
                 self.link.send_backward(h, true)?;
                 Ok(Flow::Continue)
             }
@@ -267,16 +267,11 @@ impl<H: Follower> Follow<H> {
     fn control(&mut self, c: &Forward) -> Result<Flow, Failure> {
         if self.place == Place::Middle {
             self.link.send_forward(c, true)?;
-        } else if c.signal.flags & FLAG_PROBE != 0 {
-            let mut echo = Backward {
-                seq: c.seq,
-                run: c.run,
-                ..Backward::default()
-            };
-            echo.signal.flags = FLAG_PROBE;
+        } else if c.control_kind().is_some_and(Control::is_probe) {
+            let echo = Backward::control(Control::Probe, c.run, c.seq);
             self.link.send_backward(&echo, true)?;
         }
-        if c.signal.flags & FLAG_END != 0 {
+        if c.control_kind() == Some(Control::End) {
             Events::event(&mut self.rec, self.last_seq, "end of run from the master")?;
             return Ok(Flow::End);
         }
@@ -353,13 +348,7 @@ impl<H: Follower> Follow<H> {
         if timing != Timing::Lockstep {
             return Ok(());
         }
-        let mut notice = Backward {
-            seq,
-            run,
-            ..Backward::default()
-        };
-        notice.signal.flags = FLAG_DROPPED;
-        link.send_backward(&notice, true)?;
+        link.send_backward(&Backward::control(Control::Dropped, run, seq), true)?;
         Ok(())
     }
 
@@ -454,7 +443,7 @@ impl<H: Follower> Follow<H> {
 }
 
 /// While the end of the chain waits for its robot: each probe of a run it may join
-/// is echoed with [`FLAG_WAITING`]; anything else is left (no data comes before the
+/// is echoed with [`Control::Waiting`]; anything else is left (no data comes before the
 /// master has its answer).
 fn answer_waiting(
     link: &mut Link,
@@ -465,15 +454,10 @@ fn answer_waiting(
     while let Some(a) = link.poll()? {
         if let Arrival::Forward(c) = a {
             if place == Place::End
-                && c.signal.flags & FLAG_PROBE != 0
+                && c.control_kind() == Some(Control::Probe)
                 && filter.admit(c.run, joined)
             {
-                let mut echo = Backward {
-                    seq: c.seq,
-                    run: c.run,
-                    ..Backward::default()
-                };
-                echo.signal.flags = FLAG_PROBE | FLAG_WAITING;
+                let echo = Backward::control(Control::Waiting, c.run, c.seq);
                 link.send_backward(&echo, true)?;
             }
         }

@@ -10,9 +10,7 @@ use super::waits::{Notes, Waited};
 use super::{Counts, Failure, Io, Leader, Timing};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
-use tactile_messages::samples::{
-    stage, Backward, Forward, FLAG_DROPPED, FLAG_END, FLAG_PROBE, FLAG_WAITING, LATE_WINDOW,
-};
+use tactile_messages::samples::{stage, Backward, Control, Forward, LATE_WINDOW};
 use tactile_peripheral::{DeviceCounters, LiveSink};
 use tactile_records::{Events, Recorder};
 
@@ -217,19 +215,14 @@ impl<H: Leader> Lead<H> {
                     )
                 }));
             }
-            let mut p = Forward {
-                seq: k,
-                run: self.opts.run,
-                ..Forward::default()
-            };
-            p.signal.flags = FLAG_PROBE;
+            let p = Forward::control(Control::Probe, self.opts.run, k);
             self.link.send_forward(&p, true)?;
             k += 1;
             let deadline = Instant::now() + Duration::from_millis(20);
             loop {
                 match self.link.wait(deadline, block)? {
                     Ok(super::Arrival::Backward(b))
-                        if b.signal.flags & FLAG_WAITING != 0 && b.run == self.opts.run =>
+                        if b.control_kind() == Some(Control::Waiting) && b.run == self.opts.run =>
                     {
                         if !robot_wait {
                             robot_wait = true;
@@ -241,7 +234,7 @@ impl<H: Leader> Lead<H> {
                         }
                     }
                     Ok(super::Arrival::Backward(b))
-                        if b.signal.flags & FLAG_PROBE != 0 && b.run == self.opts.run =>
+                        if b.control_kind() == Some(Control::Probe) && b.run == self.opts.run =>
                     {
                         self.rec
                             .event(0, "peers found: the emulator and slave answer")?;
@@ -338,7 +331,7 @@ impl<H: Leader> Lead<H> {
                     let Arrival::Backward(q) = slot else {
                         continue;
                     };
-                    if q.signal.flags & FLAG_DROPPED != 0 {
+                    if q.control_kind() == Some(Control::Dropped) {
                         // The emulator dropped sample n: no answer comes.
                         if q.run == self.opts.run && q.seq == n {
                             self.miss(n, origin)?;
@@ -369,7 +362,7 @@ impl<H: Leader> Lead<H> {
         origin: u64,
     ) -> Result<Option<u64>, Failure> {
         q.stamps[stage::MASTER_RECV] = self.opts.timing.stamp();
-        if q.signal.flags & (FLAG_PROBE | FLAG_DROPPED) != 0 {
+        if q.control_kind().is_some() {
             return Ok(None);
         }
         if q.run != self.opts.run {
@@ -416,11 +409,7 @@ impl<H: Leader> Lead<H> {
         while let Ok(Arrival::Backward(mut q)) = self.link.wait(grace, block)? {
             self.absorb(&mut q, last, 0)?;
         }
-        let mut end = Forward {
-            run: self.opts.run,
-            ..Forward::default()
-        };
-        end.signal.flags = FLAG_END;
+        let end = Forward::control(Control::End, self.opts.run, 0);
         self.link.send_forward(&end, true)?;
         let reason = if completed {
             "completed"

@@ -6,7 +6,7 @@ use crate::launch::Supervision;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use tactile_messages::clock::{now_ns, sleep_until_ns};
-use tactile_messages::samples::{Forward, FLAG_END, FLAG_PROBE};
+use tactile_messages::samples::{Control, Forward};
 use tactile_report::analysis::Latency;
 use tactile_runtime::driver::{Arrival, Failure, Idle, Link, OnTransports};
 use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber, IpcWake};
@@ -36,9 +36,9 @@ pub fn echo(prefix: &str, spin: Duration) -> Result<(), Failure> {
     loop {
         let deadline = Instant::now() + Duration::from_secs(3600);
         match link.wait(deadline, &mut OnTransports)? {
-            Ok(Arrival::Forward(f)) if f.signal.flags & FLAG_END != 0 => return Ok(()),
+            Ok(Arrival::Forward(f)) if f.control_kind() == Some(Control::End) => return Ok(()),
             Ok(Arrival::Forward(f)) => {
-                link.send_forward(&f, f.signal.flags & FLAG_PROBE != 0)?;
+                link.send_forward(&f, f.control_kind().is_some())?;
             }
             Ok(Arrival::Backward(_)) | Err(Idle::Timeout) => {}
             Err(Idle::Stop) => return Ok(()),
@@ -91,8 +91,7 @@ fn fail(e: impl Into<Failure>) -> Error {
 fn find_echo(link: &mut Link) -> Result<(), Error> {
     let start = Instant::now();
     loop {
-        let mut p = Forward::default();
-        p.signal.flags = FLAG_PROBE;
+        let p = Forward::control(Control::Probe, 0, 0);
         link.send_forward(&p, true).map_err(fail)?;
         let until = Instant::now() + Duration::from_millis(20);
         if link.wait(until, &mut OnTransports).map_err(fail)?.is_ok() {
@@ -140,8 +139,7 @@ fn ping(link: &mut Link, rate: f64, n: u64) -> Result<(Latency, u64), Error> {
             }
         }
     }
-    let mut end = Forward::default();
-    end.signal.flags = FLAG_END;
+    let end = Forward::control(Control::End, 0, 0);
     link.send_forward(&end, true).map_err(fail)?;
     Ok((lat, misses))
 }
