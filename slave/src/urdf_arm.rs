@@ -29,7 +29,7 @@ use tactile_scenario::ArmConfig;
 
 use crate::environment::Scene;
 use std::sync::Arc;
-use tactile_math::joints::MAX_JOINTS;
+use tactile_math::joints::{Joints, MAX_JOINTS};
 
 /// The simulated arm and its references.
 #[derive(Debug, Clone)]
@@ -44,7 +44,7 @@ pub struct UrdfArm {
     /// The integration's buffers, made once.
     scratch: sim::Scratch,
     /// The joints held since input went silent, if it is.
-    held: Option<Vec<f64>>,
+    held: Option<Joints>,
     /// The tool's pose reference and its velocity `[linear; angular]` in the base
     /// frame (the Cartesian servo's).
     reference: (Frame, Vector6<f64>),
@@ -71,21 +71,22 @@ struct Indexing {
     dr: Matrix3<f64>,
 }
 
-/// The arm's joints after a step: references, angles, velocities, efforts.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// The arm's joints after a step: references, angles, velocities, efforts (inline:
+/// copying them costs no allocation).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ArmState {
     /// The IK's joint references, rad or m.
-    pub q_ref: Vec<f64>,
+    pub q_ref: Joints,
     /// The references' velocity over the last period (the servo's feedforward), rad/s
     /// or m/s.
-    pub qd_ref: Vec<f64>,
+    pub qd_ref: Joints,
     /// Joint values, rad or m.
-    pub q: Vec<f64>,
+    pub q: Joints,
     /// Joint velocities, rad/s or m/s.
-    pub qd: Vec<f64>,
+    pub qd: Joints,
     /// The PD's efforts (with gravity compensation) at the step's last integration
     /// step, after the effort limits, N m or N.
-    pub tau: Vec<f64>,
+    pub tau: Joints,
 }
 
 /// What one IK call did, for the slave's flags and counters.
@@ -189,12 +190,17 @@ impl UrdfArm {
                 ));
             }
         }
+        let too_many = |e: tactile_math::joints::TooManyJoints| e.to_string();
+        let (home, zeros) = (
+            Joints::from_slice(&cfg.home).map_err(too_many)?,
+            Joints::zeros(dof).map_err(too_many)?,
+        );
         let state = ArmState {
-            q_ref: cfg.home.clone(),
-            qd_ref: vec![0.0; dof],
-            q: cfg.home.clone(),
-            qd: vec![0.0; dof],
-            tau: vec![0.0; dof],
+            q_ref: home,
+            qd_ref: zeros,
+            q: home,
+            qd: zeros,
+            tau: zeros,
         };
         Ok(UrdfArm {
             scratch: sim::Scratch::new(&chain),
@@ -382,11 +388,11 @@ impl UrdfArm {
                     .qd_ref
                     .iter_mut()
                     .zip(&s.q)
-                    .zip(&self.state.q_ref)
+                    .zip(self.state.q_ref.iter())
                 {
                     *v = (new - old) / dt;
                 }
-                self.state.q_ref = s.q;
+                self.state.q_ref.copy_from_slice(&s.q);
                 Followed {
                     unreachable: s.unreachable,
                     joint_limited: s.clamped,
@@ -408,7 +414,8 @@ impl UrdfArm {
     /// when the input went silent, the arm integrated as in [`UrdfArm::advance`].
     pub fn hold(&mut self, dt: f64, objects: &Scene) -> Holding {
         let started = self.held.is_none();
-        let from = self.held.get_or_insert_with(|| self.state.q.clone());
+        let q = self.state.q;
+        let from = self.held.get_or_insert(q);
         self.state.q_ref.copy_from_slice(from);
         self.state.qd_ref.iter_mut().for_each(|v| *v = 0.0);
         let held = self.chain.fk(&self.state.q_ref);
@@ -433,7 +440,7 @@ impl UrdfArm {
         if q.len() != s.q.len() {
             return;
         }
-        for ((v, new), old) in s.qd.iter_mut().zip(q).zip(&s.q) {
+        for ((v, new), old) in s.qd.iter_mut().zip(q).zip(s.q.iter()) {
             *v = (new - old) / dt;
         }
         s.q.copy_from_slice(q);
@@ -444,7 +451,8 @@ impl UrdfArm {
     /// reference it had when the input went silent.
     pub fn hold_measured(&mut self, q: &[f64], dt: f64) -> Holding {
         let started = self.held.is_none();
-        let from = self.held.get_or_insert_with(|| self.state.q_ref.clone());
+        let q_ref = self.state.q_ref;
+        let from = self.held.get_or_insert(q_ref);
         self.state.q_ref.copy_from_slice(from);
         self.state.qd_ref.iter_mut().for_each(|v| *v = 0.0);
         self.set_measured(q, dt);

@@ -95,8 +95,7 @@ impl SlaveArm for UrdfArm {
     }
 
     fn reference(&self) -> Joints {
-        // The chain's joints were counted against what a Joints holds at load.
-        Joints::from_slice(&self.state().q_ref).unwrap_or_default()
+        self.state().q_ref
     }
 
     fn counters(&self, c: SlaveCounters) -> SlaveCounters {
@@ -110,9 +109,9 @@ impl SlaveArm for UrdfArm {
         let a = self.state();
         let (offset, offset_rotation) = self.offsets();
         Some(Box::new(ArmJoints {
-            q_ref: a.q_ref.clone(),
-            q: a.q.clone(),
-            tau: a.tau.clone(),
+            q_ref: a.q_ref,
+            q: a.q,
+            tau: a.tau,
             torque,
             target_rotation: self.target_rotation(),
             tool_rotation: self.tool_rotation(),
@@ -132,8 +131,8 @@ impl SlaveArm for UrdfArm {
             arm: Some(ArmSample {
                 base: Arc::clone(base),
                 names: Arc::clone(names),
-                q: a.q.clone(),
-                effort: a.tau.clone(),
+                q: a.q.to_vec(),
+                effort: a.tau.to_vec(),
                 tool: self.tool_in_base(),
                 force: view.force,
             }),

@@ -245,7 +245,7 @@ fn a_hold_keeps_the_joints_where_the_input_went_silent() {
         arm.advance(1e-3, &Scene::new(&[]));
     }
     // Still moving when the input stops: the servo brings it back to where it was.
-    let at_silence = arm.state().q.clone();
+    let at_silence = arm.state().q;
     let first = arm.hold(1e-3, &Scene::new(&[]));
     assert!(first.started);
     let mut last = first;
@@ -335,7 +335,7 @@ fn the_clutch_holds_the_references_and_reengages_without_a_step() {
         arm.follow(away, None, 1e-3);
         arm.advance(1e-3, &Scene::new(&[]));
     }
-    let held = arm.state().q_ref.clone();
+    let held = arm.state().q_ref;
     for _ in 0..200 {
         arm.release();
         arm.advance(1e-3, &Scene::new(&[]));
@@ -386,7 +386,7 @@ fn a_turned_reengage_continues_from_the_held_orientation() {
         arm.advance(1e-3, &Scene::new(&[]));
     }
     // Engaged with the hand turned elsewhere (30 degrees about x): no step.
-    let before = arm.state().q_ref.clone();
+    let before = arm.state().q_ref;
     arm.follow(HOME, Some(about(0, 30.0)), 1e-3);
     let step = arm
         .state()

@@ -4,6 +4,9 @@
 //! robot, the robot's gate and the record all carry it, and copying it costs no heap,
 //! so a sample's joints move through the loop without an allocation.
 
+use serde::de::{Deserializer, SeqAccess, Visitor};
+use serde::ser::{SerializeSeq, Serializer};
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::ops::{Deref, DerefMut};
 
@@ -78,6 +81,14 @@ impl DerefMut for Joints {
     }
 }
 
+impl<'a> IntoIterator for &'a Joints {
+    type Item = &'a f64;
+    type IntoIter = std::slice::Iter<'a, f64>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
 impl AsRef<[f64]> for Joints {
     fn as_ref(&self) -> &[f64] {
         self
@@ -87,6 +98,47 @@ impl AsRef<[f64]> for Joints {
 impl AsMut<[f64]> for Joints {
     fn as_mut(&mut self) -> &mut [f64] {
         self
+    }
+}
+
+/// Written as a sequence, as a `Vec<f64>` is: a record's bytes are the same either way.
+impl Serialize for Joints {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut seq = s.serialize_seq(Some(self.len()))?;
+        for v in self.iter() {
+            seq.serialize_element(v)?;
+        }
+        seq.end()
+    }
+}
+
+/// Read as a sequence of at most [`MAX_JOINTS`] numbers; a longer one is refused.
+impl<'de> Deserialize<'de> for Joints {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Joints, D::Error> {
+        d.deserialize_seq(JointsVisitor)
+    }
+}
+
+struct JointsVisitor;
+
+impl<'de> Visitor<'de> for JointsVisitor {
+    type Value = Joints;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "at most {MAX_JOINTS} joint values")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Joints, A::Error> {
+        let mut j = Joints::default();
+        while let Some(v) = seq.next_element::<f64>()? {
+            let n = usize::from(j.len);
+            if n == MAX_JOINTS {
+                return Err(serde::de::Error::invalid_length(n + 1, &self));
+            }
+            j.values[n] = v;
+            j.len += 1;
+        }
+        Ok(j)
     }
 }
 
@@ -111,5 +163,17 @@ mod tests {
         assert_eq!(Joints::zeros(MAX_JOINTS).expect("max").len(), MAX_JOINTS);
         assert_eq!(Joints::zeros(MAX_JOINTS + 1), Err(TooManyJoints(17)));
         assert_eq!(Joints::default().len(), 0);
+    }
+
+    #[test]
+    fn it_is_written_as_a_vec_is_and_a_longer_one_is_refused() {
+        let q = Joints::from_slice(&[0.5, -1.0, 2.0]).expect("three");
+        let as_vec = toml::Value::try_from(vec![0.5, -1.0, 2.0]).expect("vec");
+        assert_eq!(toml::Value::try_from(q).expect("joints"), as_vec);
+        let back: Joints = as_vec.try_into().expect("read back");
+        assert_eq!(back, q);
+        let long = toml::Value::try_from(vec![0.0; MAX_JOINTS + 1]).expect("vec");
+        let e = Joints::deserialize(long).expect_err("too long");
+        assert!(e.to_string().contains("at most 16 joint values"), "{e}");
     }
 }

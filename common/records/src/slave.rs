@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 use tactile_math::hardware::Clocks;
+use tactile_math::joints::Joints;
 use tactile_messages::samples::Signal;
 use tactile_messages::stream::{InboxStats, OutboxStats};
 
@@ -101,11 +102,11 @@ pub struct HoldStep {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ArmJoints {
     /// The IK's joint references, rad or m.
-    pub q_ref: Vec<f64>,
+    pub q_ref: Joints,
     /// Joint values, rad or m.
-    pub q: Vec<f64>,
+    pub q: Joints,
     /// Efforts the servo applied, N m or N.
-    pub tau: Vec<f64>,
+    pub tau: Joints,
     /// h(n)'s torque about the tool in the base's axes (a real arm's sensor's; zero
     /// for the simulated point contact), N m.
     pub torque: [f64; 3],

@@ -36,7 +36,12 @@ pub fn header(dof: usize) -> String {
 /// Appends sample `n`'s row (with newline) to `line`.
 pub fn row(line: &mut String, n: u64, j: &ArmJoints) {
     let _ = write!(line, "{n}");
-    let values = j.q_ref.iter().chain(&j.q).chain(&j.tau).chain(&j.torque);
+    let values = j
+        .q_ref
+        .iter()
+        .chain(j.q.iter())
+        .chain(j.tau.iter())
+        .chain(&j.torque);
     let turns = j.target_rotation.iter().chain(&j.tool_rotation);
     let map = j
         .master_rotation
@@ -72,6 +77,7 @@ pub fn angle_deg(a: [f64; 4], b: [f64; 4]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tactile_math::joints::Joints;
 
     #[test]
     fn the_angle_between_orientations_is_the_turn_between_them() {
@@ -95,9 +101,9 @@ mod tests {
     #[test]
     fn a_row_has_as_many_cells_as_the_header() {
         let j = ArmJoints {
-            q_ref: vec![0.1; 7],
-            q: vec![0.2; 7],
-            tau: vec![0.3; 7],
+            q_ref: Joints::from_slice(&[0.1; 7]).expect("seven"),
+            q: Joints::from_slice(&[0.2; 7]).expect("seven"),
+            tau: Joints::from_slice(&[0.3; 7]).expect("seven"),
             torque: [0.0; 3],
             target_rotation: [0.0, 0.0, 0.0, 1.0],
             tool_rotation: [0.0, 0.0, 0.0, 1.0],

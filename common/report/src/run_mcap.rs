@@ -167,7 +167,7 @@ impl<W: Write> Recording<W> {
                 names: &scene.names,
                 q,
                 velocity: Some(&arm_velocity),
-                effort: joints.map_or(&[][..], |j| &j.tau),
+                effort: joints.map_or(&[][..], |j| &j.tau[..]),
                 tool: scene.to_robot(row.tool),
                 force: row.h,
             }
@@ -188,7 +188,7 @@ impl<W: Write> Recording<W> {
         let Some(j) = joints.filter(|j| j.q.len() == q.len()) else {
             return vec![0.0; q.len()];
         };
-        q.clone_from(&j.q);
+        q.copy_from_slice(&j.q);
         let v = match prev.as_ref() {
             Some((m, before)) if n > *m => {
                 let dt = (n - m) as f64 * t_s;
