@@ -276,10 +276,8 @@ impl Master {
     ) {
         self.handle = c;
         self.control.measure(moved);
-        *f = Forward {
-            seq: n,
-            ..Forward::default()
-        };
+        // The envelope (number, run, stamps) is the driver's.
+        *f = Forward::default();
         f.signal.value = self.control.transmit(c);
         f.signal.energy = self.control.energy();
         let speed = tactile_math::vec3::norm(self.control.velocity());
@@ -291,7 +289,6 @@ impl Master {
         f.signal.sent_seq = [n; 3];
         f.signal.origin_seq = [n; 3];
         f.signal.origin_ns = [now_ns; 3];
-        f.stamps[stage::MASTER_TICK] = now_ns;
         self.counters.sent += 1;
         *sent = Sent {
             n,

@@ -116,9 +116,9 @@ impl Slave {
         self.measured_torque = torque;
     }
 
-    /// One sample: v(n) in, h(n) into `h`, and the step's record. Stamps are copied
-    /// from `v`; the edge sets its own. h(n) is filled where it lies (a follower's
-    /// reply): returned, it was copied twice a sample on its way there.
+    /// One sample: v(n) in, h(n)'s payload into `h` (the driver writes its number,
+    /// run and stamps), and the step's record. h(n) is filled where it lies (a
+    /// follower's reply): returned, it was copied twice a sample on its way there.
     pub fn step(&mut self, v: &Forward, h: &mut Option<Backward>) -> Step {
         self.counters.steps += 1;
         self.arm.end_hold();
@@ -253,11 +253,8 @@ impl Slave {
     ) {
         self.last_force = force;
         let oldest = (0..3).min_by_key(|&i| v.signal.origin_seq[i]).unwrap_or(0);
-        let out = h.insert(Backward {
-            seq: v.seq,
-            stamps: v.stamps,
-            ..Backward::default()
-        });
+        // The envelope (number, run, stamps) is the driver's.
+        let out = h.insert(Backward::default());
         out.signal.value = self.control.transmit(force);
         out.signal.energy = self.control.energy();
         out.signal.sent_seq = [v.seq; 3];

@@ -310,7 +310,9 @@ impl<H: Follower> Follow<H> {
             Self::dropped(&mut self.link, self.timing, c.seq, c.run)?;
         }
         if let Some(h) = &mut reply.backward {
-            h.run = c.run;
+            // The envelope is the driver's: an answer to c carries its number, run
+            // and stamps so far; the handler wrote the payload.
+            (h.seq, h.run, h.stamps) = (c.seq, c.run, c.stamps);
             h.stamps[bwd_send] = self.timing.stamp();
             sent |= self.link.send_backward(h, false)?;
         }

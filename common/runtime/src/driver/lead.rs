@@ -289,7 +289,10 @@ impl<H: Leader> Lead<H> {
         let mut io = Io::new(&mut self.rec, origin, &timing, &dead);
         let c = &mut self.forward;
         self.handler.tick(n, origin, &mut io, c)?;
-        c.run = self.opts.run;
+        // The envelope is the driver's: the handler wrote the payload.
+        (c.seq, c.run) = (n, self.opts.run);
+        c.stamps = [0; stage::COUNT];
+        c.stamps[stage::MASTER_TICK] = origin;
         c.stamps[stage::MASTER_SEND] = timing.stamp();
         self.link.send_forward(c, false)?;
         self.window.send(n);
