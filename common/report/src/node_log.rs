@@ -135,19 +135,53 @@ impl<C: Clone> NodeLog<C> {
             .unwrap_or(0)
     }
 
-    /// How the node's record ends, in words.
-    pub fn ending(&self) -> String {
+    /// How the node's record ends, in words. `cut_short`: a stop request ended the
+    /// reading at that sample, so a stop not seen may lie further on in the record.
+    pub fn ending(&self, cut_short: Option<u64>) -> String {
         let last = self
             .last_sample
             .map_or("before any sample".to_string(), |n| {
                 format!("after sample {n}")
             });
-        match self.stops.last() {
-            None => "no start recorded".into(),
-            Some(Some(reason)) => format!("{reason}, {last}"),
-            Some(None) => {
+        match (self.stops.last(), cut_short) {
+            (None, _) => "no start recorded".into(),
+            (Some(Some(reason)), _) => format!("{reason}, {last}"),
+            (Some(None), Some(n)) => format!(
+                "not read to its end: the report was cut short at sample {n} by a stop request"
+            ),
+            (Some(None), None) => {
                 format!("record ends {last} without a stop: the node was killed or crashed")
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A record read to its end without a stop is a killed node; one whose reading a
+    /// stop request cut short says only that (its stop may lie further on).
+    #[test]
+    fn a_missing_stop_is_a_kill_only_when_the_record_was_read_to_its_end() {
+        let log = NodeLog::<()> {
+            stops: vec![None],
+            last_sample: Some(14_334),
+            ..NodeLog::default()
+        };
+        assert_eq!(
+            log.ending(None),
+            "record ends after sample 14334 without a stop: the node was killed or crashed"
+        );
+        assert_eq!(
+            log.ending(Some(9_000)),
+            "not read to its end: the report was cut short at sample 9000 by a stop request"
+        );
+        let stopped = NodeLog::<()> {
+            stops: vec![Some("interrupted".into())],
+            last_sample: Some(3),
+            ..NodeLog::default()
+        };
+        assert_eq!(stopped.ending(Some(2)), "interrupted, after sample 3");
     }
 }

@@ -144,7 +144,9 @@ fn summed<C: Serialize + DeserializeOwned + Clone>(log: &NodeLog<C>) -> Option<C
     serde_json::from_value(acc).ok().or(Some(first))
 }
 
-fn node_summary<C>(log: &NodeLog<C>) -> Option<NodeSummary>
+/// A node's line of the summary; `cut_short`: a stop request ended the join at that
+/// sample, so a record may hold more than was read.
+fn node_summary<C>(log: &NodeLog<C>, cut_short: Option<u64>) -> Option<NodeSummary>
 where
     C: Clone,
 {
@@ -162,7 +164,7 @@ where
             .map_or_else(|| "unknown (start lost)".into(), |s| s.link.clone()),
         peak_rss_kb: log.peak_rss_kb(),
         last_sample: log.last_sample,
-        ended: log.ending(),
+        ended: log.ending(cut_short),
         unjoined: log.unjoined,
         invalid: log.invalid,
         duplicates: log.duplicates,
@@ -238,9 +240,12 @@ fn channels(
 /// Each node that left a record, summarised.
 fn nodes(logs: &Logs) -> BTreeMap<&'static str, NodeSummary> {
     [
-        (Role::Master, node_summary(&logs.master)),
-        (Role::Emulator, node_summary(&logs.emulator)),
-        (Role::Slave, node_summary(&logs.slave)),
+        (Role::Master, node_summary(&logs.master, logs.stopped_at)),
+        (
+            Role::Emulator,
+            node_summary(&logs.emulator, logs.stopped_at),
+        ),
+        (Role::Slave, node_summary(&logs.slave, logs.stopped_at)),
     ]
     .into_iter()
     .filter_map(|(role, n)| Some((role.name(), n?)))
