@@ -53,12 +53,11 @@ pub mod stage {
 // The flags fall in three groups, each bit in one ([`Control::FLAGS`],
 // [`PAYLOAD_FLAGS`], [`NOTE_FLAGS`]): the run's control messages (probe, end, waiting,
 // dropped; made and read through [`Control`] only); what the payload is or how the
-// network treated it, which a receiver acts on (substituted, unsent, corrupted, pose,
-// released); and notes of what the node that set them did, for the trace (IK clamped,
+// network treated it (substituted, unsent, corrupted, pose, released); and notes of what the node that set them did, for the trace (IK clamped,
 // rejected, contact, held, peer lost, clamped).
 
-/// What a sample's payload is or how the network treated it: its receiver acts on
-/// these.
+/// What a sample's payload is (unsent, a pose, the clutch released) or how the
+/// network treated it (substituted, corrupted): part of what it carries.
 pub const PAYLOAD_FLAGS: u32 =
     FLAG_SUBSTITUTED | FLAG_UNSENT | FLAG_CORRUPTED | FLAG_POSE | FLAG_RELEASED;
 

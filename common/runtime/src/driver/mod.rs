@@ -268,7 +268,8 @@ impl<S> Default for Reply<S> {
 /// A node that takes what comes and passes it on: the emulator, the slave.
 pub trait Follower: Handler {
     /// A forward sample (c(n), v(n)), stamped at its arrival: what it makes of it
-    /// into `out`, which comes empty.
+    /// into `out`, which comes empty. An answer in `out.backward` is the payload: the
+    /// driver gives it the number, run and stamps of `s`.
     fn forward(
         &mut self,
         s: &Forward,
@@ -300,9 +301,10 @@ pub trait Follower: Handler {
 
 /// The node that makes the samples and waits for their answers: the master.
 pub trait Leader: Handler {
-    /// Sample n, at its instant `origin_ns`: c(n) to send, into `c`, which holds the
+    /// Sample n, at its instant `origin_ns`: c(n)'s payload, into `c`, which holds the
     /// sample before it and must be written whole (its loop keeps it: a sample is
-    /// hundreds of bytes, copied through each `Result` when returned).
+    /// hundreds of bytes, copied through each `Result` when returned); the driver then
+    /// writes the envelope (number n, run, stamps from `origin_ns`).
     fn tick(&mut self, n: u64, origin_ns: u64, io: &mut Io, c: &mut Forward)
         -> Result<(), Failure>;
     /// c(n) as it went out (stamped): the record of it.
