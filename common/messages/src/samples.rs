@@ -70,7 +70,10 @@ pub const NOTE_FLAGS: u32 =
 pub const FLAG_SUBSTITUTED: u32 = 1;
 /// Flag: the slave's IK target was outside the workspace (clamped).
 pub const FLAG_IK_CLAMPED: u32 = 2;
-/// Flag: a received value was NaN or infinite and was rejected.
+/// Flag (note): the node that set it rejected a value it received (not finite, a jump
+/// its predictor finds implausible, a rotation not of norm one) and went on from its
+/// estimate; the slave sets it on its step and h(n), the master on its effect. Never
+/// on a value as received.
 pub const FLAG_REJECTED: u32 = 4;
 /// Flag: the tool is in contact with an object.
 pub const FLAG_CONTACT: u32 = 8;

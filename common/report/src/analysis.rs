@@ -320,9 +320,10 @@ impl Analysis {
         if row.contact_object >= 0 {
             m.contact_samples += 1;
         }
-        // Tracking against what the slave was asked to reach; a rejected (non-finite)
-        // reference asked nothing.
-        if row.stepped && row.flags_f & FLAG_REJECTED == 0 && row.v.iter().all(|x| x.is_finite()) {
+        // Tracking against what the slave was asked to reach; a v(n) the slave rejected
+        // (implausible or not finite: its own flag, which v(n) never carries) asked
+        // nothing.
+        if row.stepped && row.flags_s & FLAG_REJECTED == 0 && row.v.iter().all(|x| x.is_finite()) {
             // The control's reference: v(n) itself without control, what TDPA or the
             // wave made of it otherwise (a wave is not a position).
             let d = distance(row.tool, row.reference);
@@ -436,4 +437,29 @@ pub fn us_header() -> String {
         "{:<24} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10}",
         "latency (us)", "count", "p50", "p90", "p99", "p99.9", "max"
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tracking error leaves out a step whose v(n) the slave rejected: the slave's
+    /// own flag says so (v(n) as received never carries it).
+    #[test]
+    fn a_step_the_slave_rejected_is_not_in_the_tracking_error() {
+        let mut a = Analysis::new(false, Default::default());
+        for n in 0..4u64 {
+            let mut r = TraceRow {
+                n,
+                stepped: true,
+                contact_object: -1,
+                ..TraceRow::default()
+            };
+            if n == 2 {
+                (r.tool, r.flags_s) = ([0.5, 0.0, 0.0], FLAG_REJECTED);
+            }
+            a.add(&r);
+        }
+        assert_eq!(a.tracked(), 3);
+    }
 }

@@ -231,7 +231,7 @@ fn fill_passages(r: &mut TraceRow, passages: &[Passage]) {
 
 /// The slave's columns of a sample.
 fn fill_step(r: &mut TraceRow, s: &Step) {
-    r.stepped = true;
+    (r.stepped, r.flags_s) = (true, s.flags);
     (r.v, r.delay_f, r.flags_f) = (s.received.value, s.received.delay_samples, s.received.flags);
     (r.theta_ref, r.reference) = (s.theta_ref, s.reference);
     (r.observer_s, r.port_net_s, r.dissipated_s) = (s.observer, s.port_net_j, s.dissipated_j);

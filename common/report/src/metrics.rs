@@ -168,8 +168,9 @@ impl Bilateral {
             let depth = distance(row.surface, row.tool);
             self.contact.max_penetration_m = self.contact.max_penetration_m.max(depth);
         }
-        // A corrupted or rejected v(n) asked the slave nothing: it held.
-        if row.flags_f & (FLAG_CORRUPTED | FLAG_REJECTED) != 0 {
+        // A corrupted v(n) (the channel's flag) or one the slave rejected (its own)
+        // asked the slave nothing: it held.
+        if row.flags_f & FLAG_CORRUPTED != 0 || row.flags_s & FLAG_REJECTED != 0 {
             return;
         }
         // The master's handle where each value of v(n) left it; for a value the
@@ -284,5 +285,36 @@ mod tests {
         }
         b.finish();
         assert_eq!(b.contact.force_swing_n, 0.25);
+    }
+
+    /// A v(n) the slave rejected is flagged on the slave's step, never on v(n) as it
+    /// arrived: the step's flag is the one that keeps it out of the tracking error.
+    #[test]
+    fn a_step_the_slave_rejected_is_not_tracked() {
+        let run = |flag_on_step: bool| {
+            let mut b = Bilateral::default();
+            for n in 0..6u64 {
+                let mut r = row(n);
+                if n == 4 {
+                    // The slave held where the rejected value would have sent it 1 m off.
+                    r.tool = [1.0, 0.0, 0.0];
+                    if flag_on_step {
+                        r.flags_s = FLAG_REJECTED;
+                    } else {
+                        r.flags_f = FLAG_REJECTED;
+                    }
+                }
+                b.add(&r);
+            }
+            b.finish();
+            b.tracking
+        };
+        let skipped = run(true);
+        assert_eq!(skipped.position_samples, 5);
+        assert_eq!(skipped.position_rms_m, Some(0.0));
+        // The same bit on v(n) as received means nothing: that sample is tracked.
+        let tracked = run(false);
+        assert_eq!(tracked.position_samples, 6);
+        assert!(tracked.position_rms_m.is_some_and(|e| e > 0.4));
     }
 }
