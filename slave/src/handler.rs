@@ -46,7 +46,7 @@ impl Hardware {
 
     /// Reads the robot for this tick (its joints, its force sensor's force and
     /// torque); says so in the record when it is lost or back.
-    fn read(&mut self, n: u64, io: &mut Io) -> Result<(Measured, [f64; 3]), Failure> {
+    fn read(&mut self, n: u64, io: &mut Io) -> Result<Measured, Failure> {
         let who = self.robot.describe();
         let judged = self.robot.read(io.now());
         let meanwhile = "holding its last safe reference";
@@ -56,8 +56,9 @@ impl Hardware {
         let measured = Measured {
             joints: self.held.theta,
             force: self.robot.force(io.now()),
+            torque: self.robot.torque(),
         };
-        Ok((measured, self.robot.torque()))
+        Ok(measured)
     }
 
     /// Commands `reference`, or, while the robot is lost, the last reference it had.
@@ -190,8 +191,8 @@ impl Follower for SlaveHandler {
             io.event(v.seq, "input back: following the master again")?;
         }
         if let Some(hw) = &mut self.robot {
-            let (measured, torque) = hw.read(v.seq, io)?;
-            self.slave.measure(measured, torque);
+            let measured = hw.read(v.seq, io)?;
+            self.slave.measure(measured);
         }
         let step = self.slave.step(v, &mut out.backward);
         if let Some(hw) = &mut self.robot {
@@ -246,7 +247,7 @@ impl Follower for SlaveHandler {
         let held = match &mut self.robot {
             None => self.slave.hold(None),
             Some(hw) => {
-                let (measured, _) = hw.read(last, io)?;
+                let measured = hw.read(last, io)?;
                 let held = self.slave.hold(Some(&measured.joints));
                 hw.command(self.slave.arm().reference());
                 held

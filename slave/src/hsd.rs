@@ -44,8 +44,6 @@ pub struct Slave {
     measured: Option<Measured>,
     /// A 6-DoF master's last accepted orientation (held while none valid comes).
     rotation: Option<[f64; 4]>,
-    /// A real arm's measured torque about the tool for the next step, N m.
-    measured_torque: [f64; 3],
 }
 
 /// What a real robot measured for one step.
@@ -56,6 +54,9 @@ pub struct Measured {
     /// Contact force from a force-torque sensor, N (None: the environment model): the
     /// paper's robot's in the paper's frame, a URDF arm's in its base's axes.
     pub force: Option<[f64; 3]>,
+    /// The torque about the tool from the same sensor, in the force's axes, N m (zero
+    /// without one): a 6-DoF sample is answered with this wrench.
+    pub torque: [f64; 3],
 }
 
 impl Slave {
@@ -86,7 +87,6 @@ impl Slave {
             counters: SlaveCounters::default(),
             measured: None,
             rotation: None,
-            measured_torque: [0.0; 3],
         })
     }
 
@@ -111,9 +111,8 @@ impl Slave {
     /// A real robot's reading for the next step: its joints (SD is the robot, FCS its
     /// own controller, which is commanded the step's reference), its force sensor's
     /// force and the torque about the tool (see [`Measured::force`] for their frame).
-    pub fn measure(&mut self, m: Measured, torque: [f64; 3]) {
+    pub fn measure(&mut self, m: Measured) {
         self.measured = Some(m);
-        self.measured_torque = torque;
     }
 
     /// One sample: v(n) in, h(n)'s payload into `h` (the driver writes its number,
@@ -130,7 +129,8 @@ impl Slave {
             .advance(joints, &self.objects, self.t_s, &mut self.counters);
         let (tool, force, surface, contact_object) =
             self.sense(measured.and_then(|m| m.force), &mut flags);
-        self.reply(v, force, tool, flags, h);
+        let torque = measured.map_or([0.0; 3], |m| m.torque);
+        self.reply(v, (force, torque), tool, flags, h);
         Step {
             n: v.seq,
             received: v.signal,
@@ -242,11 +242,12 @@ impl Slave {
     }
 
     /// h(n) into `h`: the control's value of the force, through the codec, with the
-    /// provenance of the oldest position value it used.
+    /// provenance of the oldest position value it used; `wrench`: the force and a real
+    /// arm's measured torque about the tool (zero for the simulated point contact).
     fn reply(
         &mut self,
         v: &Forward,
-        force: [f64; 3],
+        (force, torque): ([f64; 3], [f64; 3]),
         tool: [f64; 3],
         flags: u32,
         h: &mut Option<Backward>,
@@ -269,9 +270,7 @@ impl Slave {
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
         out.signal.delay_samples = [v.signal.delay_samples[oldest]; 3];
         out.signal.flags |= flags;
-        // A 6-DoF sample is answered with a wrench: a real arm's measured torque about
-        // the tool; the torque of the simulated point contact at the tool is zero.
-        let torque = std::mem::take(&mut self.measured_torque);
+        // A 6-DoF sample is answered with a wrench.
         out.torque = self.arm.felt(torque);
         out.signal.flags |= v.signal.flags & FLAG_POSE;
     }
