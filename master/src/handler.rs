@@ -4,7 +4,7 @@
 //! does not come, and what goes back to a real device. The driver owns the pacing,
 //! the waits and the protocol; [`Master`] owns the signals.
 
-use crate::hmd::Master;
+use crate::hmd::{Input, Master, Reading};
 use tactile_devices::held::Held;
 use tactile_devices::{Change, HapticDevice, Peripheral};
 use tactile_messages::samples::{stage, Backward, Forward};
@@ -149,8 +149,8 @@ impl Leader for MasterHandler {
         io: &mut Io,
         c: &mut Forward,
     ) -> Result<(), Failure> {
-        match self.device.as_deref_mut() {
-            None => self.master.forward(n, origin_ns, (c, &mut self.sent)),
+        let input = match self.device.as_deref_mut() {
+            None => Input::Simulated,
             Some(d) => {
                 let who = d.describe();
                 let judged = d.read(io.now());
@@ -167,17 +167,15 @@ impl Leader for MasterHandler {
                 // A lost device's clutch is released: the robot holds until the
                 // device is back and the button says engaged.
                 let clutch = d.clutch().map(|c| c && !self.held.lost);
-                let hand = self.held.taken.then_some(self.held.theta);
-                self.master.forward_measured(
-                    n,
-                    origin_ns,
-                    hand,
-                    d.input(),
+                Input::Device(Reading {
+                    hand: self.held.taken.then_some(self.held.theta),
+                    kind: d.input(),
                     clutch,
-                    (c, &mut self.sent),
-                );
+                })
             }
-        }
+        };
+        self.master
+            .forward(n, origin_ns, input, (c, &mut self.sent));
         Ok(())
     }
 

@@ -1,7 +1,9 @@
 //! The master side's per-sample logic (OP + MD + HMD) as a pure state machine.
 //!
-//! [`Master::forward`] turns sample n of the operator's motion into c(n): the master
-//! device's joint encoders b(n) (the MD model), then FK-HMD. [`Master::backward`] turns
+//! [`Master::forward`] turns sample n of the master's [`Input`] into c(n): the
+//! simulated operator's or a real device's joints b(n) (the MD model), then FK-HMD, or
+//! a pose device's position; a 6-DoF input's orientation and clutch with it, the same
+//! for every kind. [`Master::backward`] turns
 //! a received q(n) into joint torques p(n) = J(b)^T q (KFF-HMD). Each gives the
 //! sample for the wire and the master's record of it. The process edge and the
 //! in-process simulation call the same functions.
@@ -26,6 +28,29 @@ use tactile_messages::samples::{
 use tactile_records::master::{Answer, Effect, MasterCounters, Miss, Sent};
 use tactile_scenario::ControlKind;
 use tactile_scenario::{HandInput, HandMode, MasterConfig, Scenario, ScenarioError};
+
+/// The master's input at one sample: the kinds of one master device. Every kind
+/// gives the handle's position (through joints or directly) and, if it is 6-DoF, an
+/// orientation and a clutch; [`Master::forward`] takes them all the same way.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Input {
+    /// The scenario's operator: a simulated hand (ideal or impedance) on the simulated
+    /// three-joint device, following the trajectory (its orientation and clutch too).
+    Simulated,
+    /// A real device: the paper's three joints, a gimbal, or a pose device.
+    Device(Reading),
+}
+
+/// A real device's reading as the loop holds it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reading {
+    /// Joints or pose (`None` until the device has given one).
+    pub hand: Option<Hand>,
+    /// What `hand.point` holds: three joint angles or a position.
+    pub kind: HandInput,
+    /// The clutch, engaged or not (`None`: the device has none).
+    pub clutch: Option<bool>,
+}
 
 /// The master: operator source, device model and HMD kernels.
 #[derive(Debug)]
@@ -148,26 +173,47 @@ impl Master {
         }
     }
 
-    /// Sample n forward: operator a(n) -> MD encoders b(n) -> FK-HMD c(n), written
-    /// with its record into `out` (filled where they lie: returned, they were copied
-    /// at each call on the way out, a dozen copies a sample).
-    /// `now_ns` is the tick time; it becomes the origin timestamp of all three values.
-    pub fn forward(&mut self, n: u64, now_ns: u64, out: (&mut Forward, &mut Sent)) {
+    /// Sample n forward from the master's input, whichever kind it is: b(n) (the
+    /// simulated hand's device, a device's three joints) or a pose device's position,
+    /// then FK-HMD c(n), written with its record into `out` (filled where they lie:
+    /// returned, they were copied at each call on the way out, a dozen copies a
+    /// sample). A 6-DoF input's orientation and clutch go onto c(n) the same way for
+    /// every kind. `now_ns` is the tick time; it becomes the origin timestamp of all
+    /// three values.
+    pub fn forward(&mut self, n: u64, now_ns: u64, input: Input, out: (&mut Forward, &mut Sent)) {
+        let (f, sent) = out;
+        let pose = match input {
+            Input::Simulated => self.simulated(n, now_ns, (&mut *f, &mut *sent)),
+            Input::Device(reading) => self.measured(n, now_ns, reading, (&mut *f, &mut *sent)),
+        };
+        if let Some((r, engaged)) = pose {
+            self.turn(f, sent, r, engaged);
+        }
+    }
+
+    /// The simulated operator's sample n: a(n) -> MD encoders b(n) -> c(n); its
+    /// orientation and clutch if the trajectory is 6-DoF.
+    fn simulated(
+        &mut self,
+        n: u64,
+        now_ns: u64,
+        out: (&mut Forward, &mut Sent),
+    ) -> Option<([f64; 4], bool)> {
         let (target, hand_force) = match self.held.is_some() {
             false => (self.ideal_hand(n), [0.0; 3]),
             true => self.impedance_hand(n),
         };
-        let (f, sent) = out;
-        self.encode(n, now_ns, target, hand_force, (&mut *f, &mut *sent));
-        if self.source.six_dof() {
-            let t = n as f64 * self.t_s;
-            let r = self.source.rotation(n, self.t_s).unwrap_or(IDENTITY);
-            let r = match &self.approach {
-                Some(a) => a.apply_rotation(r, t),
-                None => r,
-            };
-            self.turn(f, sent, r, self.source.engaged(n, self.t_s));
+        self.encode(n, now_ns, target, hand_force, out);
+        if !self.source.six_dof() {
+            return None;
         }
+        let t = n as f64 * self.t_s;
+        let r = self.source.rotation(n, self.t_s).unwrap_or(IDENTITY);
+        let r = match &self.approach {
+            Some(a) => a.apply_rotation(r, t),
+            None => r,
+        };
+        Some((r, self.source.engaged(n, self.t_s)))
     }
 
     /// A 6-DoF sample's orientation `r` and clutch onto c(n) and its record; released,
@@ -183,25 +229,22 @@ impl Master {
         }
     }
 
-    /// Sample n forward from a real device's reading (the operator's hand is the real
-    /// one, so the target is where the handle is): b(n) = three joints as measured, or
-    /// a pose device's position moved so that its first reading is the devices' home.
-    /// A 6-DoF device's orientation goes relative to its first reading (the operator's
-    /// home, as a trajectory's), with its clutch (`None`: none, always engaged).
-    /// `hand` is `None` until the device has given a reading: the handle is then taken
-    /// to be at home, unturned (no origin is captured from it). Into `out`, as
-    /// [`Master::forward`].
-    pub fn forward_measured(
+    /// A real device's sample n (the operator's hand is the real one, so the target is
+    /// where the handle is): b(n) = three joints as measured, or a pose device's
+    /// position moved so that its first reading is the devices' home. A 6-DoF device's
+    /// orientation goes relative to its first reading (the operator's home, as a
+    /// trajectory's), with its clutch (`None`: none, always engaged). Until the device
+    /// has given a reading the handle is taken to be at home, unturned (no origin is
+    /// captured from it).
+    fn measured(
         &mut self,
         n: u64,
         now_ns: u64,
-        hand: Option<Hand>,
-        input: HandInput,
-        clutch: Option<bool>,
-        out: (&mut Forward, &mut Sent),
-    ) {
-        self.pose_input = input == HandInput::Pose;
-        let (hand, origin) = match hand {
+        reading: Reading,
+        (f, sent): (&mut Forward, &mut Sent),
+    ) -> Option<([f64; 4], bool)> {
+        self.pose_input = reading.kind == HandInput::Pose;
+        let (hand, origin) = match reading.hand {
             Some(h) => (h, *self.origin.get_or_insert(h)),
             None => {
                 let home = Hand {
@@ -211,12 +254,11 @@ impl Master {
                 (home, home)
             }
         };
-        let (f, sent) = out;
-        match input {
+        match reading.kind {
             HandInput::Joints => {
                 self.theta_md = hand.point;
                 let handle = self.truth.fk(hand.point);
-                self.encode(n, now_ns, handle, [0.0; 3], (&mut *f, &mut *sent));
+                self.encode(n, now_ns, handle, [0.0; 3], (f, sent));
             }
             HandInput::Pose => {
                 let c = [0, 1, 2].map(|k| self.home[k] + hand.point[k] - origin.point[k]);
@@ -224,16 +266,17 @@ impl Master {
                     0 => [0.0; 3],
                     _ => [0, 1, 2].map(|k| c[k] - self.handle[k]),
                 };
-                self.encode_at(n, now_ns, (c, c, [0.0; 3]), moved, (&mut *f, &mut *sent));
+                self.encode_at(n, now_ns, (c, c, [0.0; 3]), moved, (f, sent));
             }
         }
-        if hand.rotation.is_some() || clutch.is_some() {
-            let r = match (hand.rotation, origin.rotation) {
-                (Some(q), Some(q0)) => relative(q, q0),
-                _ => IDENTITY,
-            };
-            self.turn(f, sent, r, clutch.unwrap_or(true));
+        if hand.rotation.is_none() && reading.clutch.is_none() {
+            return None;
         }
+        let r = match (hand.rotation, origin.rotation) {
+            (Some(q), Some(q0)) => relative(q, q0),
+            _ => IDENTITY,
+        };
+        Some((r, reading.clutch.unwrap_or(true)))
     }
 
     /// The torques commanded now, N m.

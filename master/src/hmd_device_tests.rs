@@ -12,7 +12,7 @@ fn master(spring: f64) -> Master {
     Master::new(&sc, source).expect("master")
 }
 
-/// [`Master::forward_measured`]'s c(n) and record, returned.
+/// [`Master::forward`]'s c(n) and record from a device's reading, returned.
 fn measured(
     m: &mut Master,
     n: u64,
@@ -22,7 +22,12 @@ fn measured(
     clutch: Option<bool>,
 ) -> (Forward, Sent) {
     let (mut f, mut sent) = (Forward::default(), Sent::default());
-    m.forward_measured(n, now_ns, hand, input, clutch, (&mut f, &mut sent));
+    let reading = Reading {
+        hand,
+        kind: input,
+        clutch,
+    };
+    m.forward(n, now_ns, Input::Device(reading), (&mut f, &mut sent));
     (f, sent)
 }
 
@@ -225,7 +230,12 @@ fn kept_slots_hold_each_sample_as_fresh_ones_would() {
     ];
     for (n, (hand, input, clutch)) in steps.into_iter().enumerate() {
         let n = n as u64;
-        kept.forward_measured(n, n, hand, input, clutch, (&mut f, &mut sent));
+        let reading = Reading {
+            hand,
+            kind: input,
+            clutch,
+        };
+        kept.forward(n, n, Input::Device(reading), (&mut f, &mut sent));
         let want = measured(&mut fresh, n, n, hand, input, clutch);
         assert_eq!((f, sent), want, "sample {n}");
         kept.backward(&answer(n, [0.5, 0.0, 0.0]));

@@ -15,7 +15,7 @@ fn targets(operator: Operator, hand: HandMode, samples: u64) -> Vec<[f64; 3]> {
     let (mut f, mut sent) = (Forward::default(), Sent::default());
     (0..samples)
         .map(|n| {
-            m.forward(n, 0, (&mut f, &mut sent));
+            m.forward(n, 0, Input::Simulated, (&mut f, &mut sent));
             sent.target
         })
         .collect()
