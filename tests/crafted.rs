@@ -168,7 +168,7 @@ fn sample_numbers_past_the_run_are_counted_not_walked_to() {
 }
 
 /// Records the report takes long to read, in `bad` of a sandbox named `name`: a
-/// master row numbered 2^62 and 1,500 blocks of one slave row repeated before the
+/// master row numbered 2^62 and 400 blocks of one slave row repeated before the
 /// run's own rows.
 fn long_to_read(name: &str) -> Sandbox {
     let (sb, rec) = crafted(name, "master");
@@ -186,7 +186,7 @@ fn long_to_read(name: &str) -> Sandbox {
         .iter()
         .position(|e| matches!(e, Record::Sample(_)))
         .unwrap_or(0);
-    let copies = std::iter::repeat_n(&copy, 1500 * COPIES);
+    let copies = std::iter::repeat_n(&copy, 400 * COPIES);
     rewrite(
         &slave,
         all[..at].iter().chain(copies).chain(&all[at..]),
