@@ -59,6 +59,10 @@ mod verilate {
         let Some(include) = verilator_include() else {
             return;
         };
+        if linting_only() {
+            println!("cargo:rustc-cfg=tactile_rtl_sim");
+            return;
+        }
         for top in TOPS {
             verilate(&rtl, &out, top);
         }
@@ -89,6 +93,19 @@ mod verilate {
         println!("cargo:rustc-link-lib=pthread");
         println!("cargo:rustc-link-lib=atomic");
         println!("cargo:rustc-cfg=tactile_rtl_sim");
+    }
+
+    /// True under `cargo clippy`, which checks and links nothing: the models' C++ (about
+    /// 85 s of CI's two cores, and the test build compiles it again) is left out, and
+    /// the simulation's Rust is still linted under its cfg. Cargo gives a build script
+    /// the workspace's wrapper, which cargo-clippy sets to clippy-driver.
+    fn linting_only() -> bool {
+        println!("cargo:rerun-if-env-changed=RUSTC_WORKSPACE_WRAPPER");
+        std::env::var_os("RUSTC_WORKSPACE_WRAPPER").is_some_and(|w| {
+            Path::new(&w)
+                .file_stem()
+                .is_some_and(|s| s.to_string_lossy().starts_with("clippy-driver"))
+        })
     }
 
     /// The RTL's files for the format and geometry asked for, into `dir`.
