@@ -8,6 +8,9 @@
 //! scenario asks for another is refused with these variables named.
 
 //!
+//! Under `cargo clippy`, which links nothing, the models' C++ is not compiled (the
+//! cfg is still set, so the simulation's Rust is linted).
+//!
 //! Without Verilator on `PATH` the crate still builds (a new user's `cargo test
 //! --workspace --all-features` needs only Rust): the build script warns, leaves out
 //! the cfg `tactile_rtl_sim`, and `arithmetic = "rtl"` is refused at run time naming

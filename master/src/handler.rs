@@ -4,7 +4,7 @@
 //! does not come, and what goes back to a real device. The driver owns the pacing,
 //! the waits and the protocol; [`Master`] owns the signals.
 
-use crate::hmd::{Input, Master, Reading};
+use crate::hmd::{DeviceReading, Input, Master};
 use tactile_devices::held::Held;
 use tactile_devices::{Change, HapticDevice, Peripheral};
 use tactile_messages::samples::{stage, Backward, Forward};
@@ -167,7 +167,7 @@ impl Leader for MasterHandler {
                 // A lost device's clutch is released: the robot holds until the
                 // device is back and the button says engaged.
                 let clutch = d.clutch().map(|c| c && !self.held.lost);
-                Input::Device(Reading {
+                Input::Device(DeviceReading {
                     hand: self.held.taken.then_some(self.held.theta),
                     kind: d.input(),
                     clutch,

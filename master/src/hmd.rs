@@ -29,21 +29,23 @@ use tactile_records::master::{Answer, Effect, MasterCounters, Miss, Sent};
 use tactile_scenario::ControlKind;
 use tactile_scenario::{HandInput, HandMode, MasterConfig, Scenario, ScenarioError};
 
-/// The master's input at one sample: the kinds of one master device. Every kind
-/// gives the handle's position (through joints or directly) and, if it is 6-DoF, an
-/// orientation and a clutch; [`Master::forward`] takes them all the same way.
+/// The master's input at one sample: the kinds of one master device. The simulated
+/// operator gives a target the simulated hand moves the handle to; a device gives the
+/// handle itself (three joints, or a position); either, if it is 6-DoF, an orientation
+/// and a clutch, which [`Master::forward`] takes the same way for every kind.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Input {
     /// The scenario's operator: a simulated hand (ideal or impedance) on the simulated
     /// three-joint device, following the trajectory (its orientation and clutch too).
     Simulated,
-    /// A real device: the paper's three joints, a gimbal, or a pose device.
-    Device(Reading),
+    /// A real device: three joints (the paper's, or a gimbal's arm with its
+    /// orientation) or a pose device.
+    Device(DeviceReading),
 }
 
 /// A real device's reading as the loop holds it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Reading {
+pub struct DeviceReading {
     /// Joints or pose (`None` until the device has given one).
     pub hand: Option<Hand>,
     /// What `hand.point` holds: three joint angles or a position.
@@ -174,8 +176,8 @@ impl Master {
     }
 
     /// Sample n forward from the master's input, whichever kind it is: b(n) (the
-    /// simulated hand's device, a device's three joints) or a pose device's position,
-    /// then FK-HMD c(n), written with its record into `out` (filled where they lie:
+    /// simulated hand's device, a device's three joints) through FK-HMD, or a pose
+    /// device's position, as c(n), written with its record into `out` (filled where they lie:
     /// returned, they were copied at each call on the way out, a dozen copies a
     /// sample). A 6-DoF input's orientation and clutch go onto c(n) the same way for
     /// every kind. `now_ns` is the tick time; it becomes the origin timestamp of all
@@ -240,7 +242,7 @@ impl Master {
         &mut self,
         n: u64,
         now_ns: u64,
-        reading: Reading,
+        reading: DeviceReading,
         (f, sent): (&mut Forward, &mut Sent),
     ) -> Option<([f64; 4], bool)> {
         self.pose_input = reading.kind == HandInput::Pose;

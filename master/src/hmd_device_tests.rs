@@ -22,7 +22,7 @@ fn measured(
     clutch: Option<bool>,
 ) -> (Forward, Sent) {
     let (mut f, mut sent) = (Forward::default(), Sent::default());
-    let reading = Reading {
+    let reading = DeviceReading {
         hand,
         kind: input,
         clutch,
@@ -230,7 +230,7 @@ fn kept_slots_hold_each_sample_as_fresh_ones_would() {
     ];
     for (n, (hand, input, clutch)) in steps.into_iter().enumerate() {
         let n = n as u64;
-        let reading = Reading {
+        let reading = DeviceReading {
             hand,
             kind: input,
             clutch,

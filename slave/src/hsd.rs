@@ -242,8 +242,8 @@ impl Slave {
     }
 
     /// h(n) into `h`: the control's value of the force, through the codec, with the
-    /// provenance of the oldest position value it used; `wrench`: the force and a real
-    /// arm's measured torque about the tool (zero for the simulated point contact).
+    /// provenance of the oldest position value it used; with the force, a real arm's
+    /// measured torque about the tool (zero for the simulated point contact).
     fn reply(
         &mut self,
         v: &Forward,

@@ -73,7 +73,8 @@ pub const FLAG_IK_CLAMPED: u32 = 2;
 /// Flag (note): the node that set it rejected a value it received (not finite, a jump
 /// its predictor finds implausible, a rotation not of norm one) and went on from its
 /// estimate; the slave sets it on its step and h(n), the master on its effect. Never
-/// on a value as received.
+/// on v(n) as received; on q(n) as received it is the slave's note about the v(n) it
+/// stepped on, not about q(n).
 pub const FLAG_REJECTED: u32 = 4;
 /// Flag: the tool is in contact with an object.
 pub const FLAG_CONTACT: u32 = 8;

@@ -320,9 +320,10 @@ impl Analysis {
         if row.contact_object >= 0 {
             m.contact_samples += 1;
         }
-        // Tracking against what the slave was asked to reach; a v(n) the slave rejected
-        // (implausible or not finite: its own flag, which v(n) never carries) asked
-        // nothing.
+        // Tracking against what the slave was asked to reach; a step that rejected what
+        // it received (a position implausible or not finite, or a 6-DoF sample's
+        // orientation: the slave's own flag, which v(n) never carries) went on from the
+        // slave's estimate, not from v(n), and is left out.
         if row.stepped && row.flags_s & FLAG_REJECTED == 0 && row.v.iter().all(|x| x.is_finite()) {
             // The control's reference: v(n) itself without control, what TDPA or the
             // wave made of it otherwise (a wave is not a position).

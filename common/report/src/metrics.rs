@@ -168,8 +168,9 @@ impl Bilateral {
             let depth = distance(row.surface, row.tool);
             self.contact.max_penetration_m = self.contact.max_penetration_m.max(depth);
         }
-        // A corrupted v(n) (the channel's flag) or one the slave rejected (its own)
-        // asked the slave nothing: it held.
+        // A corrupted v(n) (the channel's flag) or a step that rejected what it received
+        // (the slave's own flag: a position, or a 6-DoF sample's orientation) went on
+        // from the slave's estimate, not from the master's handle: left out.
         if row.flags_f & FLAG_CORRUPTED != 0 || row.flags_s & FLAG_REJECTED != 0 {
             return;
         }

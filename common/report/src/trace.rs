@@ -159,9 +159,8 @@ macro_rules! trace_row {
             /// True if the slave recorded a step on v(n) (not a trace column: it says
             /// whether the slave's columns hold data).
             pub stepped: bool,
-            /// The slave's own flags for its step (h(n)'s as it left the slave: rejected,
-            /// contact, clamped); not a trace column: q(n)'s are `flags_b`, and h(n)
-            /// may not come back.
+            /// The slave's note flags for its step (rejected, contact, IK clamped); not a
+            /// trace column: q(n)'s are `flags_b`, and h(n) may not come back.
             pub flags_s: u32,
         }
 
