@@ -5,7 +5,7 @@
 use crate::util;
 
 use std::time::Duration;
-use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
+use tactile_messages::samples::{Flags, Forward};
 use tactile_report::trace::signal_columns;
 use tactile_transport::ipc::{self, IpcPublisher, IpcSubscriber};
 use tactile_transport::{Publish, Subscribe};
@@ -68,7 +68,7 @@ fn peer_dies_and_the_loop_resumes(role: &str) {
         .map(|j| column(&trace, &format!("tau_{j}")))
         .collect();
     let lost: Vec<usize> = (0..flags.len())
-        .filter(|&n| flags[n] as u32 & FLAG_PEER_LOST != 0)
+        .filter(|&n| Flags::from_bits(flags[n] as u32).intersects(Flags::PEER_LOST))
         .collect();
     assert!(!lost.is_empty());
     for &n in &lost {

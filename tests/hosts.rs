@@ -11,7 +11,7 @@ use crate::util;
 
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
-use tactile_messages::samples::{Forward, FLAG_PEER_LOST};
+use tactile_messages::samples::{Flags, Forward};
 use tactile_report::trace::signal_columns;
 use util::{column, finish_ok, free_port, node_dir, Sandbox};
 
@@ -239,7 +239,7 @@ fn the_slave_host_node_killed_breaks_the_loop_and_it_resumes_after_restart() {
     let flags = column(&trace, "flags_m");
     let received = column(&trace, "received");
     let first = (0..flags.len())
-        .find(|&n| flags[n] as u32 & FLAG_PEER_LOST != 0)
+        .find(|&n| Flags::from_bits(flags[n] as u32).intersects(Flags::PEER_LOST))
         .expect("a break");
     assert_eq!(received[first - 10], 1.0);
     assert!(received[first - 9..=first].iter().all(|r| *r == 0.0));

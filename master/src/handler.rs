@@ -206,8 +206,8 @@ impl Leader for MasterHandler {
             round_trip_ns: a.round_trip_ns as i64,
             overhead_ns: a.overhead_ns,
             delay_backward: a.q.delay_samples,
-            flags_backward: a.q.flags,
-            flags_master: a.effect.flags,
+            flags_backward: a.q.flags.bits(),
+            flags_master: a.effect.flags.bits(),
             observer_master: a.effect.observer,
             ..SampleTiming::default()
         };

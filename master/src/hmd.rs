@@ -21,10 +21,7 @@ use tactile_control::passivity::{MasterForce, MasterSide};
 use tactile_devices::hand::Hand;
 use tactile_math::engine::Engine;
 use tactile_math::kernels::IkStatus;
-use tactile_messages::samples::{
-    stage, Backward, Forward, FLAG_CLAMPED, FLAG_HELD, FLAG_PEER_LOST, FLAG_POSE, FLAG_REJECTED,
-    FLAG_RELEASED, FLAG_SUBSTITUTED, FLAG_UNSENT,
-};
+use tactile_messages::samples::{stage, Backward, Flags, Forward};
 use tactile_records::master::{Answer, Effect, MasterCounters, Miss, Sent};
 use tactile_scenario::ControlKind;
 use tactile_scenario::{HandInput, HandMode, MasterConfig, Scenario, ScenarioError};
@@ -222,11 +219,11 @@ impl Master {
     /// the operator feels the clutch spring instead of the robot.
     fn turn(&mut self, f: &mut Forward, sent: &mut Sent, r: [f64; 4], engaged: bool) {
         f.rotation = r;
-        f.signal.flags |= FLAG_POSE;
+        f.signal.flags |= Flags::POSE;
         sent.rotation = Some(r);
         self.released = !engaged;
         if self.released {
-            f.signal.flags |= FLAG_RELEASED;
+            f.signal.flags |= Flags::RELEASED;
             sent.released = true;
         }
     }
@@ -329,7 +326,7 @@ impl Master {
         if self.codec.send(f.signal.value, speed) {
             self.counters.packets_sent += 1;
         } else {
-            f.signal.flags |= FLAG_UNSENT;
+            f.signal.flags |= Flags::UNSENT;
         }
         f.signal.sent_seq = [n; 3];
         f.signal.origin_seq = [n; 3];
@@ -434,11 +431,14 @@ impl Master {
             self.counters.resumes += 1;
         }
         self.silent = 0;
-        let mut flags = 0;
+        let mut flags = Flags::NONE;
         // CPD/JPD-HMD: a value not sent or not new (the channel held it) is filled by
         // the predictor; one that is not physically possible (not finite, too large,
         // too fast) is rejected and filled likewise, never reaching a torque.
-        let new = q.signal.flags & (FLAG_UNSENT | FLAG_SUBSTITUTED) == 0;
+        let new = !q
+            .signal
+            .flags
+            .intersects(Flags::UNSENT | Flags::SUBSTITUTED);
         let fresh = (new || !self.predictor.has_value()).then(|| {
             let at = q.signal.sent_seq.iter().copied().min().unwrap_or(q.seq);
             (at, q.signal.value)
@@ -450,13 +450,13 @@ impl Master {
         };
         if let Estimate::Rejected(_) = est {
             self.counters.rejected += 1;
-            flags |= FLAG_REJECTED;
+            flags |= Flags::REJECTED;
         }
         let out = self
             .control
             .receive(est.value(), energy, self.limits.force_limit);
         if self.command(&out) {
-            flags |= FLAG_CLAMPED;
+            flags |= Flags::CLAMPED;
         }
         self.answer(q, flags, &out)
     }
@@ -495,7 +495,7 @@ impl Master {
         [0, 1, 2].map(|i| (k * (self.home[i] - self.handle[i])).clamp(-limit, limit))
     }
 
-    fn answer(&self, q: &Backward, flags: u32, out: &MasterForce) -> Answer {
+    fn answer(&self, q: &Backward, flags: Flags, out: &MasterForce) -> Answer {
         Answer {
             n: q.seq,
             q: q.signal,
@@ -508,7 +508,7 @@ impl Master {
     }
 
     /// What was commanded, and the books after it.
-    fn effect(&self, flags: u32, out: &MasterForce) -> Effect {
+    fn effect(&self, flags: Flags, out: &MasterForce) -> Effect {
         Effect {
             tau: self.last_tau,
             felt: self.last_felt,
@@ -533,7 +533,7 @@ impl Master {
             let out = self.control.release();
             self.last_tau = [0.0; 3];
             self.last_felt = [0.0; 3];
-            (FLAG_PEER_LOST, out)
+            (Flags::PEER_LOST, out)
         } else {
             self.counters.held_samples += 1;
             let guess = self.predictor.estimate(n, None).value();
@@ -541,7 +541,7 @@ impl Master {
                 .control
                 .receive(guess, [0.0; 3], self.limits.force_limit);
             self.command(&out);
-            (FLAG_HELD, out)
+            (Flags::HELD, out)
         };
         Miss {
             n,

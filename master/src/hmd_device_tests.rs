@@ -52,7 +52,10 @@ fn a_pose_device_starts_at_home_and_turns_from_its_first_reading() {
     let (f, sent) = measured(&mut m, 0, 0, Some(first), HandInput::Pose, None);
     assert_eq!(f.signal.value, home());
     assert_eq!(f.rotation, IDENTITY);
-    assert_eq!(f.signal.flags & (FLAG_POSE | FLAG_RELEASED), FLAG_POSE);
+    assert_eq!(
+        f.signal.flags & (Flags::POSE | Flags::RELEASED),
+        Flags::POSE
+    );
     assert_eq!(sent.handle, home());
     let later = Hand {
         point: [0.31, -0.1, 0.03],
@@ -129,7 +132,7 @@ fn a_3dof_device_without_a_clutch_sends_what_it_always_did() {
         rotation: None,
     };
     let (f, sent) = measured(&mut m, 0, 0, Some(hand), HandInput::Joints, None);
-    assert_eq!(f.signal.flags & FLAG_POSE, 0);
+    assert!(!f.signal.flags.intersects(Flags::POSE));
     assert_eq!(sent.theta_md, theta);
     let truth = tactile_math::kernels::fk(
         &tactile_math::geometry::Geometry::PAPER.lengths(),
@@ -165,7 +168,7 @@ fn released_the_hand_feels_the_spring_not_the_robot() {
         assert_eq!(m.felt(), [1.0, 0.5, 0.0], "engaged: the robot's force");
         // Released 2 cm to the right of where it started.
         let (f, sent) = measured(&mut m, 1, 1, Some(at(0.02)), HandInput::Pose, Some(false));
-        assert_ne!(f.signal.flags & FLAG_RELEASED, 0);
+        assert!(f.signal.flags.intersects(Flags::RELEASED));
         assert!(sent.released);
         m.backward(&answer(1, [1.0, 0.5, 0.0]));
         let felt = m.felt();
@@ -241,6 +244,6 @@ fn kept_slots_hold_each_sample_as_fresh_ones_would() {
         kept.backward(&answer(n, [0.5, 0.0, 0.0]));
         fresh.backward(&answer(n, [0.5, 0.0, 0.0]));
     }
-    assert_eq!(f.signal.flags & FLAG_RELEASED, 0);
+    assert!(!f.signal.flags.intersects(Flags::RELEASED));
     assert!(!sent.released);
 }

@@ -11,15 +11,12 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tactile_messages::samples::{
-    Backward, Forward, Signal, FLAG_CORRUPTED, FLAG_POSE, FLAG_RELEASED, FLAG_SUBSTITUTED,
-    FLAG_UNSENT,
-};
+use tactile_messages::samples::{Backward, Flags, Forward, Signal};
 
 /// The flags that belong to a sample's packet and arrive with it, not with the sample
 /// that triggers the emulator's output: the clutch (released at the pose it was
 /// released at, however late that pose arrives).
-const CARRIED: u32 = FLAG_RELEASED;
+const CARRIED: Flags = Flags::RELEASED;
 use tactile_netem::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
 use tactile_netem::{Loss, Replay};
 use tactile_records::emulator::{Direction, EmulatorCounters, Fate, Passage};
@@ -102,7 +99,7 @@ fn apply(s: &mut Signal, e: &tactile_netem::channel::Emitted) {
         s.delay_samples[i] = e.values[i].delay_samples;
     }
     if e.substituted {
-        s.flags |= FLAG_SUBSTITUTED;
+        s.flags |= Flags::SUBSTITUTED;
     }
 }
 
@@ -153,7 +150,7 @@ impl Emulator {
         );
         let k = &mut self.counters;
         k.forward += 1;
-        k.forward_substituted += u64::from(out.signal.flags & FLAG_SUBSTITUTED != 0);
+        k.forward_substituted += u64::from(out.signal.flags.intersects(Flags::SUBSTITUTED));
         k.forward_corrupted += u64::from(fate == Fate::Corrupt);
         k.forward_dropped += u64::from(fate == Fate::Drop);
         k.forward_packets_lost += u64::from(lost);
@@ -163,7 +160,7 @@ impl Emulator {
             n: c.seq,
             input: c.signal.value,
             out: out.signal,
-            rotational: (c.signal.flags & FLAG_POSE != 0).then_some(out.rotation),
+            rotational: (c.signal.flags.intersects(Flags::POSE)).then_some(out.rotation),
             noise,
             jitter,
             lost,
@@ -195,7 +192,7 @@ impl Emulator {
         out.torque = [torque[0], torque[1], torque[2]];
         let k = &mut self.counters;
         k.backward += 1;
-        k.backward_substituted += u64::from(out.signal.flags & FLAG_SUBSTITUTED != 0);
+        k.backward_substituted += u64::from(out.signal.flags.intersects(Flags::SUBSTITUTED));
         k.backward_corrupted += u64::from(fate == Fate::Corrupt);
         k.backward_dropped += u64::from(fate == Fate::Drop);
         k.backward_packets_lost += u64::from(lost);
@@ -205,7 +202,7 @@ impl Emulator {
             n: h.seq,
             input: h.signal.value,
             out: out.signal,
-            rotational: (h.signal.flags & FLAG_POSE != 0).then_some(torque),
+            rotational: (h.signal.flags.intersects(Flags::POSE)).then_some(torque),
             noise,
             jitter,
             lost,
@@ -233,21 +230,21 @@ fn pass(
     // model loses (netem's loss is of packets: the receiver still ticks and fills the
     // sample from what it has); `loss` instead drops the whole sample (the receiver
     // gets nothing). What leaves is what the network delivers at this sample.
-    let unsent = signal.flags & FLAG_UNSENT != 0;
+    let unsent = signal.flags.intersects(Flags::UNSENT);
     let model_lost = faults.packet_lost() && !unsent;
-    let rest = (*extra, signal.flags & CARRIED);
+    let rest = (*extra, (signal.flags & CARRIED).bits());
     let e = channel.push_packet(seq, values(signal), rest, !unsent && !model_lost);
-    signal.flags &= !FLAG_UNSENT;
+    signal.flags.remove(Flags::UNSENT);
     apply(signal, &e);
     *extra = e.extra.0;
-    signal.flags = (signal.flags & !CARRIED) | (e.extra.1 & CARRIED);
+    signal.flags = signal.flags.without(CARRIED) | (Flags::from_bits(e.extra.1) & CARRIED);
     let fate = faults.fate();
     if fate == Fate::Corrupt {
         signal.value = [f64::NAN; 3];
-        if signal.flags & FLAG_POSE != 0 {
+        if signal.flags.intersects(Flags::POSE) {
             *extra = [f64::NAN; 4];
         }
-        signal.flags |= FLAG_CORRUPTED;
+        signal.flags |= Flags::CORRUPTED;
     }
     (fate, e.noise, e.jitter, e.lost || model_lost, e.duplicated)
 }

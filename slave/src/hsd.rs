@@ -20,10 +20,7 @@ use tactile_math::arith::StdTrig;
 use tactile_math::joints::Joints;
 use tactile_math::kernels;
 use tactile_math::vec3::distance;
-use tactile_messages::samples::{
-    Backward, Forward, FLAG_CONTACT, FLAG_POSE, FLAG_REJECTED, FLAG_RELEASED, FLAG_SUBSTITUTED,
-    FLAG_UNSENT,
-};
+use tactile_messages::samples::{Backward, Flags, Forward};
 use tactile_records::slave::{HoldStep, SlaveCounters, Step};
 use tactile_scenario::{Scenario, ScenarioError};
 
@@ -155,9 +152,12 @@ impl Slave {
     /// one that is not physically possible (not finite, too large, too fast) is
     /// rejected and filled likewise, never reaching the control, IK or a torque.
     /// Returns the flags so far, the observer and the energy dissipated.
-    fn follow(&mut self, v: &Forward) -> (u32, [f64; 3], f64) {
-        let mut flags = 0;
-        let new = v.signal.flags & (FLAG_UNSENT | FLAG_SUBSTITUTED) == 0;
+    fn follow(&mut self, v: &Forward) -> (Flags, [f64; 3], f64) {
+        let mut flags = Flags::NONE;
+        let new = !v
+            .signal
+            .flags
+            .intersects(Flags::UNSENT | Flags::SUBSTITUTED);
         let fresh = (new || !self.predictor.has_value()).then(|| {
             let at = v.signal.sent_seq.iter().copied().min().unwrap_or(v.seq);
             (at, v.signal.value)
@@ -168,7 +168,7 @@ impl Slave {
             _ => [0.0; 3],
         };
         if let Estimate::Rejected(_) = est {
-            flags |= FLAG_REJECTED;
+            flags |= Flags::REJECTED;
             self.counters.rejected += 1;
         }
         if !self.predictor.has_value() {
@@ -176,7 +176,7 @@ impl Slave {
         }
         let r = self.control.receive(est.value(), energy, self.last_force);
         self.accept_rotation(v, &mut flags);
-        let released = v.signal.flags & FLAG_RELEASED != 0;
+        let released = v.signal.flags.intersects(Flags::RELEASED);
         flags |= self.arm.follow(
             r.position,
             self.rotation,
@@ -190,17 +190,20 @@ impl Slave {
     /// A 6-DoF sample's orientation, if it is a rotation (finite, of norm one within
     /// [`ROTATION_TOLERANCE`]): taken, normalized; otherwise rejected and counted,
     /// and the last one held.
-    fn accept_rotation(&mut self, v: &Forward, flags: &mut u32) {
-        if v.signal.flags & FLAG_POSE == 0 {
+    fn accept_rotation(&mut self, v: &Forward, flags: &mut Flags) {
+        if !v.signal.flags.intersects(Flags::POSE) {
             return;
         }
         let q = v.rotation;
         let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
         if norm.is_finite() && (norm - 1.0).abs() <= ROTATION_TOLERANCE {
             self.rotation = Some(q.map(|x| x / norm));
-        } else if *flags & FLAG_REJECTED == 0 {
-            *flags |= FLAG_REJECTED;
-            self.counters.rejected += 1;
+        } else {
+            // A sample counts once, whether its position was rejected too or not.
+            if !flags.intersects(Flags::REJECTED) {
+                self.counters.rejected += 1;
+            }
+            *flags |= Flags::ROTATION_REJECTED;
         }
     }
 
@@ -215,7 +218,7 @@ impl Slave {
     fn sense(
         &mut self,
         sensor: Option<[f64; 3]>,
-        flags: &mut u32,
+        flags: &mut Flags,
     ) -> ([f64; 3], [f64; 3], [f64; 3], u32) {
         let (tool, truth) = self.arm.tool();
         let contact = deepest_contact(&self.objects, truth);
@@ -225,13 +228,13 @@ impl Slave {
                 // arm's is in its base's axes: turned into the master's and scaled.
                 let f = self.arm.felt(f);
                 if f.iter().any(|x| *x != 0.0) {
-                    *flags |= FLAG_CONTACT;
+                    *flags |= Flags::CONTACT;
                     self.counters.contact_steps += 1;
                 }
                 (f, [0.0; 3], u32::MAX)
             }
             (None, Some(c)) => {
-                *flags |= FLAG_CONTACT;
+                *flags |= Flags::CONTACT;
                 self.counters.contact_steps += 1;
                 let f = self.arm.contact_force(c.surface, tool, c.stiffness);
                 (f, c.surface, c.object as u32)
@@ -249,7 +252,7 @@ impl Slave {
         v: &Forward,
         (force, torque): ([f64; 3], [f64; 3]),
         tool: [f64; 3],
-        flags: u32,
+        flags: Flags,
         h: &mut Option<Backward>,
     ) {
         self.last_force = force;
@@ -264,7 +267,7 @@ impl Slave {
         if self.codec.send(out.signal.value, speed) {
             self.counters.packets_sent += 1;
         } else {
-            out.signal.flags |= FLAG_UNSENT;
+            out.signal.flags |= Flags::UNSENT;
         }
         out.signal.origin_seq = [v.signal.origin_seq[oldest]; 3];
         out.signal.origin_ns = [v.signal.origin_ns[oldest]; 3];
@@ -272,7 +275,7 @@ impl Slave {
         out.signal.flags |= flags;
         // A 6-DoF sample is answered with a wrench.
         out.torque = self.arm.felt(torque);
-        out.signal.flags |= v.signal.flags & FLAG_POSE;
+        out.signal.flags |= v.signal.flags & Flags::POSE;
     }
 }
 

@@ -11,7 +11,7 @@ use tactile_math::geometry::Lengths;
 use tactile_math::joints::Joints;
 use tactile_math::kernels::{self, IkStatus};
 use tactile_math::vec3::distance;
-use tactile_messages::samples::{FLAG_IK_CLAMPED, FLAG_REJECTED};
+use tactile_messages::samples::Flags;
 use tactile_records::slave::{ArmJoints, HoldStep, SlaveCounters};
 use tactile_ros::view::{SampleView, SlaveView};
 use tactile_scenario::{Scenario, ScenarioError};
@@ -90,17 +90,17 @@ impl SlaveArm for PaperArm {
         _: bool,
         _: f64,
         c: &mut SlaveCounters,
-    ) -> u32 {
+    ) -> Flags {
         let ik = self.engine.ik(position);
         let flags = match ik.status {
-            IkStatus::Reachable => 0,
+            IkStatus::Reachable => Flags::NONE,
             IkStatus::Clamped => {
                 c.ik_clamped += 1;
-                FLAG_IK_CLAMPED
+                Flags::IK_CLAMPED
             }
             IkStatus::Invalid => {
                 c.rejected += 1;
-                FLAG_REJECTED
+                Flags::REJECTED
             }
         };
         if ik.status != IkStatus::Invalid {

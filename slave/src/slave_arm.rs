@@ -7,6 +7,7 @@
 
 use crate::environment::Scene;
 use tactile_math::joints::Joints;
+use tactile_messages::samples::Flags;
 use tactile_records::slave::{ArmJoints, HoldStep, SlaveCounters};
 use tactile_ros::view::{SampleView, SlaveView};
 
@@ -38,7 +39,7 @@ pub trait SlaveArm: std::fmt::Debug + Send {
         released: bool,
         dt: f64,
         c: &mut SlaveCounters,
-    ) -> u32;
+    ) -> Flags;
 
     /// One period of `dt` s: a real robot's `measured` joints are the arm's (its own controller
     /// follows the reference); without, the simulated joints move under the servo,

@@ -8,7 +8,7 @@ use crate::slave_arm::{Moved, SlaveArm};
 use std::sync::Arc;
 use tactile_math::joints::Joints;
 use tactile_math::kernels;
-use tactile_messages::samples::{FLAG_IK_CLAMPED, FLAG_REJECTED};
+use tactile_messages::samples::Flags;
 use tactile_records::slave::{ArmJoints, HoldStep, SlaveCounters};
 use tactile_ros::view::{ArmSample, SampleView, SlaveView};
 
@@ -20,10 +20,10 @@ impl SlaveArm for UrdfArm {
         released: bool,
         dt: f64,
         c: &mut SlaveCounters,
-    ) -> u32 {
+    ) -> Flags {
         if released {
             self.release();
-            return 0;
+            return Flags::NONE;
         }
         count_followed(c, UrdfArm::follow(self, position, rotation, dt))
     }
@@ -154,21 +154,21 @@ fn log_first_failure(arm: &mut UrdfArm) {
 }
 
 /// Counts what a URDF arm's IK call did; the flags it sets on h(n).
-fn count_followed(c: &mut SlaveCounters, f: super::Followed) -> u32 {
+fn count_followed(c: &mut SlaveCounters, f: super::Followed) -> Flags {
     c.ik_joint_limited += u64::from(f.joint_limited);
     c.ik_velocity_limited += u64::from(f.velocity_limited);
     c.ik_damped += u64::from(f.damped);
-    let mut flags = 0;
+    let mut flags = Flags::NONE;
     if f.unreachable {
-        flags |= FLAG_IK_CLAMPED;
+        flags |= Flags::IK_CLAMPED;
         c.ik_clamped += 1;
     }
     if f.refused {
-        flags |= FLAG_REJECTED;
+        flags |= Flags::REJECTED;
         c.rejected += 1;
     }
     if f.workspace_clamped {
-        flags |= FLAG_IK_CLAMPED;
+        flags |= Flags::IK_CLAMPED;
         c.workspace_clamped += 1;
     }
     flags

@@ -531,3 +531,44 @@ fn dynamics_that_fail_at_home_are_refused_at_load() {
         "{e}"
     );
 }
+
+/// A 6-DoF sample whose orientation is no rotation is the slave's
+/// `ROTATION_REJECTED`, not `REJECTED`: its position was still followed, so the
+/// position's tracking errors keep the step. A sample rejected on both counts is
+/// counted once.
+#[test]
+fn a_rejected_orientation_is_told_apart_from_a_rejected_position() {
+    use tactile_messages::samples::{Flags, Forward, Signal};
+    let arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
+    let mut scenario = tactile_scenario::Scenario::default();
+    scenario.slave.arm = Some(panda_cfg());
+    let mut slave = crate::hsd::Slave::new(&scenario, Box::new(arm)).expect("slave");
+    let pose = |seq: u64, value: [f64; 3], rotation: [f64; 4]| Forward {
+        seq,
+        signal: Signal {
+            value,
+            sent_seq: [seq; 3],
+            flags: Flags::POSE,
+            ..Signal::default()
+        },
+        rotation,
+        ..Forward::default()
+    };
+    let (turn, not_a_turn) = ([0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 2.0]);
+    let mut h = None;
+    let good = slave.step(&pose(0, HOME, turn), &mut h).flags;
+    assert!(!good.intersects(Flags::REJECTED | Flags::ROTATION_REJECTED));
+    let turned = slave.step(&pose(1, HOME, not_a_turn), &mut h).flags;
+    assert!(turned.contains(Flags::ROTATION_REJECTED), "{turned:?}");
+    assert!(!turned.intersects(Flags::REJECTED), "{turned:?}");
+    assert_eq!(slave.rotation(), Some(turn), "the last rotation is held");
+    assert_eq!(slave.counters().rejected, 1);
+    let both = slave
+        .step(&pose(2, [f64::NAN; 3], not_a_turn), &mut h)
+        .flags;
+    assert!(
+        both.contains(Flags::REJECTED | Flags::ROTATION_REJECTED),
+        "{both:?}"
+    );
+    assert_eq!(slave.counters().rejected, 2, "one sample, counted once");
+}

@@ -14,7 +14,7 @@
 //! device's home (the workspace's origin for the hand), forces as they are.
 //!
 //! A sample not sent still crosses the processes as the loop's clock, flagged
-//! `FLAG_UNSENT`: the network (the emulator's channel) carries no packet for it, and
+//! `Flags::UNSENT`: the network (the emulator's channel) carries no packet for it, and
 //! the receiver fills it with its predictor, exactly as for a packet that is late.
 
 use tactile_math::vec3::{distance, norm};

@@ -4,6 +4,7 @@
 //! counts; the three roles; and the monotonic clock every stamp is read from.
 
 pub mod clock;
+pub mod flags;
 pub mod role;
 pub mod samples;
 pub mod stream;

@@ -10,6 +10,8 @@
 use iceoryx2::prelude::ZeroCopySend;
 use serde::{Deserialize, Serialize};
 
+pub use crate::flags::{Control, Flags};
+
 /// Stages a sample passes, in order; indices into `stamps`.
 pub mod stage {
     /// Sample n's instant: its scheduled tick in realtime (so a late wake-up counts as
@@ -49,67 +51,6 @@ pub mod stage {
         "master_done",
     ];
 }
-
-// The flags fall in three groups, each bit in one ([`Control::FLAGS`],
-// [`PAYLOAD_FLAGS`], [`NOTE_FLAGS`]): the run's control messages (probe, end, waiting,
-// dropped; made and read through [`Control`] only); what the payload is or how the
-// network treated it (substituted, unsent, corrupted, pose, released); and notes of what the node that set them did, for the trace (IK clamped,
-// rejected, contact, held, peer lost, clamped).
-
-/// What a sample's payload is (unsent, a pose, the clutch released) or how the
-/// network treated it (substituted, corrupted): part of what it carries.
-pub const PAYLOAD_FLAGS: u32 =
-    FLAG_SUBSTITUTED | FLAG_UNSENT | FLAG_CORRUPTED | FLAG_POSE | FLAG_RELEASED;
-
-/// Notes of what the node that set them did with the sample, for the trace: no
-/// receiver acts on them.
-pub const NOTE_FLAGS: u32 =
-    FLAG_IK_CLAMPED | FLAG_REJECTED | FLAG_CONTACT | FLAG_HELD | FLAG_PEER_LOST | FLAG_CLAMPED;
-
-/// Flag: a value stood in for one the channel did not have (start-up of a delay, gap).
-pub const FLAG_SUBSTITUTED: u32 = 1;
-/// Flag: the slave's IK target was outside the workspace (clamped).
-pub const FLAG_IK_CLAMPED: u32 = 2;
-/// Flag (note): the node that set it rejected a value it received (not finite, a jump
-/// its predictor finds implausible, a rotation not of norm one) and went on from its
-/// estimate; the slave sets it on its step and h(n), the master on its effect. Never
-/// on v(n) as received; on q(n) as received it is the slave's note about the v(n) it
-/// stepped on, not about q(n).
-pub const FLAG_REJECTED: u32 = 4;
-/// Flag: the tool is in contact with an object.
-pub const FLAG_CONTACT: u32 = 8;
-/// Flag: a start-up probe; passes every process untouched and comes back to the master.
-pub const FLAG_PROBE: u32 = 16;
-/// Flag: the run is over; each process passes it on and exits.
-pub const FLAG_END: u32 = 32;
-/// Flag (trace): no answer this sample; the master held its last torque.
-pub const FLAG_HELD: u32 = 64;
-/// Flag (trace): the loop is broken (a peer is silent past the timeout); zero torque.
-pub const FLAG_PEER_LOST: u32 = 128;
-/// Flag: a value was corrupted to NaN on purpose by the emulator (fault injection).
-pub const FLAG_CORRUPTED: u32 = 256;
-/// Flag: a force or torque was clamped to the device's limit.
-pub const FLAG_CLAMPED: u32 = 512;
-/// Flag: the sender's codec did not send this sample (deadband): it crosses the
-/// processes as the loop's clock only, no packet crosses the network for it, and the
-/// receiver fills it with its predictor.
-pub const FLAG_UNSENT: u32 = 1024;
-/// Flag: on a probe's echo, the node at the end of the chain is there but still
-/// waits for its robot, so the master can say what it waits for.
-pub const FLAG_WAITING: u32 = 2048;
-/// Flag: lockstep only, a notice from the emulator to the master that sample `seq`
-/// was dropped on purpose (the loss model): no answer to it comes, so the master
-/// counts the miss at once, as the in-process run does, instead of waiting out a
-/// timeout whose firing would depend on the machine's load.
-pub const FLAG_DROPPED: u32 = 4096;
-/// Flag: a 6-DoF sample. Forward, c(n) carries an orientation in
-/// [`Forward::rotation`]; backward, h(n) carries a torque in [`Backward::torque`].
-/// Never set in the paper's 3-DoF runs, whose samples carry positions and forces only.
-pub const FLAG_POSE: u32 = 8192;
-/// Flag (forward): the operator has released the clutch; the robot holds where it is
-/// and, at the next engaged sample, takes the master's pose from there (its offsets
-/// captured again), so it never jumps.
-pub const FLAG_RELEASED: u32 = 16384;
 
 /// A sample that carries a per-hop publish counter.
 pub trait Sequenced {
@@ -158,8 +99,9 @@ pub struct Signal {
     pub origin_ns: [u64; 3],
     /// Delay injected on purpose along the path so far, samples.
     pub delay_samples: [u32; 3],
-    /// `FLAG_*` bits.
-    pub flags: u32,
+    /// What the payload is, how the network treated it, a control message or a
+    /// node's notes ([`Flags`]).
+    pub flags: Flags,
 }
 
 /// Forward stream: c(n) from the master, v(n) from the emulator. Carries only what the
@@ -178,7 +120,7 @@ pub struct Forward {
     pub run: u64,
     /// Tool position.
     pub signal: Signal,
-    /// With `FLAG_POSE`: the tool's orientation relative to the operator's home, in the
+    /// With [`Flags::POSE`]: the tool's orientation relative to the operator's home, in the
     /// master's frame, as a unit quaternion `[x, y, z, w]` (ROS order). It crosses the
     /// network in the position's packet (delayed with it, never noised).
     pub rotation: [f64; 4],
@@ -200,7 +142,7 @@ pub struct Backward {
     /// Contact force.
     pub signal: Signal,
     /// The contact torque about the tool, in the master's frame, N m: what a real
-    /// arm's wrench sensor measured, zero for a point contact; flagged `FLAG_POSE` in
+    /// arm's wrench sensor measured, zero for a point contact; flagged [`Flags::POSE`] in
     /// a 6-DoF run. It crosses the network in the force's packet.
     pub torque: [f64; 3],
     /// Stamps of the triggering forward sample, then the backward stages.
@@ -230,62 +172,6 @@ impl OfRun for Backward {
 /// within it; an answer older than this counts as unexpected. Bounded, so memory does
 /// not grow with the run's length.
 pub const LATE_WINDOW: u64 = 1024;
-
-/// The run's control messages, as a kind: what a sample is when it carries no data.
-/// On the wire each is its `FLAG_*` bits in [`Signal::flags`] (the layout is
-/// unchanged); a program makes and reads them only through this type
-/// ([`Forward::control`], [`Backward::control`], [`Forward::control_kind`],
-/// [`Backward::control_kind`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Control {
-    /// A start-up probe: passes every process untouched and comes back to the master
-    /// ([`FLAG_PROBE`]).
-    Probe,
-    /// A probe's echo from the end of the chain, which is there but still waits for
-    /// its robot ([`FLAG_PROBE`] and [`FLAG_WAITING`]).
-    Waiting,
-    /// The run is over: each process passes it on and exits ([`FLAG_END`]).
-    End,
-    /// Lockstep, backward: the emulator dropped sample `seq` on purpose, no answer
-    /// comes ([`FLAG_DROPPED`]).
-    Dropped,
-}
-
-impl Control {
-    /// The flags that make a sample a control message.
-    pub const FLAGS: u32 = FLAG_PROBE | FLAG_WAITING | FLAG_END | FLAG_DROPPED;
-
-    /// Its bits on the wire.
-    pub fn flags(self) -> u32 {
-        match self {
-            Control::Probe => FLAG_PROBE,
-            Control::Waiting => FLAG_PROBE | FLAG_WAITING,
-            Control::End => FLAG_END,
-            Control::Dropped => FLAG_DROPPED,
-        }
-    }
-
-    /// The control message that `flags` make, if any: the end first (a run that
-    /// ends, ends), then a waiting echo, a probe, a drop.
-    pub fn of(flags: u32) -> Option<Control> {
-        if flags & FLAG_END != 0 {
-            Some(Control::End)
-        } else if flags & FLAG_WAITING != 0 {
-            Some(Control::Waiting)
-        } else if flags & FLAG_PROBE != 0 {
-            Some(Control::Probe)
-        } else if flags & FLAG_DROPPED != 0 {
-            Some(Control::Dropped)
-        } else {
-            None
-        }
-    }
-
-    /// True for a probe or its echo, which the chain passes on untouched.
-    pub fn is_probe(self) -> bool {
-        matches!(self, Control::Probe | Control::Waiting)
-    }
-}
 
 impl Forward {
     /// The control message `kind` of run `run`, numbered `seq` (a probe's count).
@@ -339,18 +225,11 @@ mod control_tests {
             assert_eq!(Forward::control(k, 7, 3).control_kind(), Some(k));
             let b = Backward::control(k, 7, 3);
             assert_eq!((b.control_kind(), b.run, b.seq), (Some(k), 7, 3));
-            assert_eq!(k.flags() & !Control::FLAGS, 0);
+            assert!(k.flags().without(Flags::CONTROL).is_empty());
         }
         let mut data = Forward::default();
-        data.signal.flags = !Control::FLAGS;
+        data.signal.flags = Flags::from_bits(!0).without(Flags::CONTROL);
         assert_eq!(data.control_kind(), None);
         assert!(Control::Waiting.is_probe() && !Control::End.is_probe());
-    }
-
-    #[test]
-    fn every_flag_is_in_exactly_one_group() {
-        let groups = [Control::FLAGS, PAYLOAD_FLAGS, NOTE_FLAGS];
-        assert_eq!(groups.iter().fold(0, |a, g| a | g), (1 << 15) - 1);
-        assert_eq!(groups.iter().map(|g| g.count_ones()).sum::<u32>(), 15);
     }
 }

@@ -4,7 +4,7 @@
 use crate::device::DeviceCounters;
 use serde::{Deserialize, Serialize};
 use tactile_math::hardware::Clocks;
-use tactile_messages::samples::{stage, Signal};
+use tactile_messages::samples::{stage, Flags, Signal};
 use tactile_messages::stream::{InboxStats, OutboxStats};
 
 /// What the master counted over a run.
@@ -70,9 +70,8 @@ pub struct Effect {
     pub tau: [f64; 3],
     /// The force the operator feels, N.
     pub felt: [f64; 3],
-    /// `FLAG_*` bits of the master: clamped, rejected; `FLAG_HELD` or `FLAG_PEER_LOST`
-    /// after a miss.
-    pub flags: u32,
+    /// The master's notes: clamped, rejected; held or peer lost after a miss.
+    pub flags: Flags,
     /// The master's passivity observer per axis after this sample, J.
     pub observer: [f64; 3],
     /// Energy the master's port has put into the channel minus what it took out, all

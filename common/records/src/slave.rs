@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 use tactile_math::hardware::Clocks;
 use tactile_math::joints::Joints;
-use tactile_messages::samples::Signal;
+use tactile_messages::samples::{Flags, Signal};
 use tactile_messages::stream::{InboxStats, OutboxStats};
 
 /// What the slave counted over a run.
@@ -78,8 +78,8 @@ pub struct Step {
     pub clamps: u32,
     /// Object index in contact, or u32::MAX.
     pub contact_object: u32,
-    /// `FLAG_*` bits of h(n).
-    pub flags: u32,
+    /// The flags of h(n): the slave's notes on its step, and h(n)'s payload's.
+    pub flags: Flags,
 }
 
 /// One step of holding position while the input is silent.

@@ -12,7 +12,7 @@ use hdrhistogram::Histogram;
 use serde::Serialize;
 use std::fmt::Write as _;
 use tactile_math::vec3::{distance, norm};
-use tactile_messages::samples::{stage, FLAG_REJECTED, FLAG_SUBSTITUTED};
+use tactile_messages::samples::{stage, Flags};
 use tactile_messages::Role;
 
 /// Percentiles of one latency distribution, nanoseconds.
@@ -324,7 +324,10 @@ impl Analysis {
         // it received (a position implausible or not finite, or a 6-DoF sample's
         // orientation: the slave's own flag, which v(n) never carries) went on from the
         // slave's estimate, not from v(n), and is left out.
-        if row.stepped && row.flags_s & FLAG_REJECTED == 0 && row.v.iter().all(|x| x.is_finite()) {
+        if row.stepped
+            && !row.flags_s.intersects(Flags::REJECTED)
+            && row.v.iter().all(|x| x.is_finite())
+        {
             // The control's reference: v(n) itself without control, what TDPA or the
             // wave made of it otherwise (a wave is not a position).
             let d = distance(row.tool, row.reference);
@@ -342,7 +345,7 @@ impl Analysis {
         let felt = norm(row.felt);
         self.felt_sq += felt * felt;
         m.felt_max_n = m.felt_max_n.max(felt);
-        if (row.flags_b | row.flags_f) & FLAG_SUBSTITUTED == 0 {
+        if !(row.flags_b | row.flags_f).intersects(Flags::SUBSTITUTED) {
             self.round_trip.record(row.round_trip_ns as i64);
             self.overhead.record(row.overhead_ns);
             let oldest = row.q_origin.iter().copied().min().unwrap_or(row.n);
@@ -457,7 +460,7 @@ mod tests {
                 ..TraceRow::default()
             };
             if n == 2 {
-                (r.tool, r.flags_s) = ([0.5, 0.0, 0.0], FLAG_REJECTED);
+                (r.tool, r.flags_s) = ([0.5, 0.0, 0.0], Flags::REJECTED);
             }
             a.add(&r);
         }

@@ -7,7 +7,7 @@
 use crate::trace::TraceRow;
 use serde::Serialize;
 use tactile_math::vec3::{distance, norm};
-use tactile_messages::samples::{FLAG_CORRUPTED, FLAG_REJECTED, FLAG_SUBSTITUTED, LATE_WINDOW};
+use tactile_messages::samples::{Flags, LATE_WINDOW};
 
 /// `tracking` in summary.json.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -136,8 +136,11 @@ impl Bilateral {
         // A force the master rejected was never felt as such; one the channel held (or
         // that was not sent) is compared with the environment where a fresh one would
         // have come from: holding costs what the environment did meanwhile.
-        if row.received && row.flags_m & FLAG_REJECTED == 0 && row.flags_b & FLAG_CORRUPTED == 0 {
-            if row.flags_b & FLAG_SUBSTITUTED == 0 {
+        if row.received
+            && !row.flags_m.intersects(Flags::REJECTED)
+            && !row.flags_b.intersects(Flags::CORRUPTED)
+        {
+            if !row.flags_b.intersects(Flags::SUBSTITUTED) {
                 self.backward_lag = Some([0, 1, 2].map(|i| row.n.saturating_sub(row.q_from[i])));
             }
             let from = self
@@ -171,13 +174,13 @@ impl Bilateral {
         // A corrupted v(n) (the channel's flag) or a step that rejected what it received
         // (the slave's own flag: a position, or a 6-DoF sample's orientation) went on
         // from the slave's estimate, not from the master's handle: left out.
-        if row.flags_f & FLAG_CORRUPTED != 0 || row.flags_s & FLAG_REJECTED != 0 {
+        if row.flags_f.intersects(Flags::CORRUPTED) || row.flags_s.intersects(Flags::REJECTED) {
             return;
         }
         // The master's handle where each value of v(n) left it; for a value the
         // channel held (or that was not sent), where a fresh one would have left it:
         // holding costs what the master did meanwhile.
-        if row.flags_f & FLAG_SUBSTITUTED == 0 {
+        if !row.flags_f.intersects(Flags::SUBSTITUTED) {
             self.forward_lag = Some(row.delay_f.map(u64::from));
         }
         let Some(lag) = self.forward_lag else {
@@ -253,7 +256,7 @@ mod tests {
             r.port_net_s = 0.5e-3 * n as f64;
             r.dissipated_s = 1e-4;
             if n < 3 {
-                r.flags_f = FLAG_SUBSTITUTED;
+                r.flags_f = Flags::SUBSTITUTED;
             }
             b.add(&r);
         }
@@ -300,9 +303,9 @@ mod tests {
                     // The slave held where the rejected value would have sent it 1 m off.
                     r.tool = [1.0, 0.0, 0.0];
                     if flag_on_step {
-                        r.flags_s = FLAG_REJECTED;
+                        r.flags_s = Flags::REJECTED;
                     } else {
-                        r.flags_f = FLAG_REJECTED;
+                        r.flags_f = Flags::REJECTED;
                     }
                 }
                 b.add(&r);

@@ -11,7 +11,7 @@ use crate::analysis::Latency;
 use crate::trace::TraceRow;
 use plotters::prelude::*;
 use std::path::Path;
-use tactile_messages::samples::FLAG_RELEASED;
+use tactile_messages::samples::Flags;
 
 pub(crate) mod looks;
 mod percentiles;
@@ -129,7 +129,7 @@ impl Series {
     /// Adds one row at its time.
     pub fn add(&mut self, row: &TraceRow, t_s: f64) {
         let t = row.n as f64 * t_s;
-        if row.flags_f & FLAG_RELEASED != 0 {
+        if row.flags_f.intersects(Flags::RELEASED) {
             self.released.mark(t, t_s);
         }
         let low = |w: [f64; 3]| w.iter().copied().fold(f64::INFINITY, f64::min);
@@ -349,7 +349,11 @@ mod tests {
         for n in 0..200_000u64 {
             let row = TraceRow {
                 n,
-                flags_f: if n % 2 == 0 { FLAG_RELEASED } else { 0 },
+                flags_f: if n % 2 == 0 {
+                    Flags::RELEASED
+                } else {
+                    Flags::NONE
+                },
                 ..TraceRow::default()
             };
             s.add(&row, 1e-3);

@@ -286,9 +286,9 @@ fn timing(row: &TraceRow) -> SampleTiming {
         overhead_ns: row.overhead_ns,
         delay_forward: row.delay_f,
         delay_backward: row.delay_b,
-        flags_forward: row.flags_f,
-        flags_backward: row.flags_b,
-        flags_master: row.flags_m,
+        flags_forward: row.flags_f.bits(),
+        flags_backward: row.flags_b.bits(),
+        flags_master: row.flags_m.bits(),
         observer_master: row.observer_m,
         observer_slave: row.observer_s,
     }

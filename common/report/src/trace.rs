@@ -11,7 +11,7 @@
 
 use crate::columns::{Columns, Kind};
 use std::fmt::Write;
-use tactile_messages::samples::stage;
+use tactile_messages::samples::{stage, Flags};
 
 /// Name of the first timing column; everything from here on is wall-clock dependent.
 pub const FIRST_TIMING_COLUMN: &str = "round_trip_ns";
@@ -49,6 +49,22 @@ macro_rules! integer_cells {
 }
 
 integer_cells!(u64 => U64, i64, i64; u32 => U32, i32, i32; i64 => I64, i64, i64);
+
+/// Flags as their number.
+impl Cells for Flags {
+    fn names(field: &str, h: &mut String) {
+        u32::names(field, h);
+    }
+    fn cells(&self, line: &mut String, t0: u64) {
+        self.bits().cells(line, t0);
+    }
+    fn kinds(field: &str, k: &mut Vec<(String, Kind)>) {
+        u32::kinds(field, k);
+    }
+    fn push(&self, cols: &mut Columns, t0: u64) {
+        self.bits().push(cols, t0);
+    }
+}
 
 impl Cells for bool {
     fn names(field: &str, h: &mut String) {
@@ -161,7 +177,7 @@ macro_rules! trace_row {
             pub stepped: bool,
             /// The slave's note flags for its step (rejected, contact, IK clamped); not a
             /// trace column: q(n)'s are `flags_b`, and h(n) may not come back.
-            pub flags_s: u32,
+            pub flags_s: Flags,
         }
 
         /// The header line (without newline).
@@ -252,11 +268,11 @@ trace_row! {
     /// round trip in samples.
     q_origin: [u64; 3],
     /// Flags of v(n) as received.
-    flags_f: u32,
+    flags_f: Flags,
     /// Flags of q(n) as received.
-    flags_b: u32,
+    flags_b: Flags,
     /// The master's flags for this sample (held, peer lost, clamped, rejected).
-    flags_m: u32,
+    flags_m: Flags,
     /// Object in contact, or -1.
     contact_object: i64,
     /// Energy the master's control dissipated this sample, J.
