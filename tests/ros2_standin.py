@@ -127,32 +127,37 @@ class Node:
 
         return put
 
-    def subscribe(self, topic, ty, on):
-        """Calls on(message, arrival time) for each sample, checking its attachment."""
+    def subscribe(self, topic, ty, on, sent=False):
+        """Calls on(message, arrival time) for each sample, checking its attachment;
+        with `sent`, on(message, arrival time, the publisher's send time in ns from its
+        attachment, or None)."""
         self.token("MS", topic, ty)
         last = {}
 
         def cb(sample):
-            self.check(str(sample.key_expr), sample.attachment, last)
+            stamp = self.check(str(sample.key_expr), sample.attachment, last)
             try:
                 msg = TS.deserialize_cdr(sample.payload.to_bytes(), ty)
             except Exception as e:  # noqa: BLE001 - reported, never fatal
                 self.bad_attachments.append(f"{topic}: undecodable payload: {e}")
                 return
-            on(msg, time.monotonic())
+            if sent:
+                on(msg, time.monotonic(), stamp)
+            else:
+                on(msg, time.monotonic())
 
         return self.s.declare_subscriber(f"{self.domain}/{topic.strip('/')}/{dds(ty)}/*", cb)
 
     def check(self, k, att, last):
         """rmw_zenoh's attachment: seq from 1 rising by one per publisher, a recent
-        timestamp, a 16-byte gid."""
+        timestamp, a 16-byte gid. Returns its timestamp (ns), or None."""
         if att is None:
             self.bad_attachments.append(f"{k}: no attachment")
-            return
+            return None
         raw = att.to_bytes()
         if len(raw) != 33:
             self.bad_attachments.append(f"{k}: attachment of {len(raw)} bytes")
-            return
+            return None
         seq, stamp, gid = z_deserialize(tuple[Int64, Int64, bytes], att)
         seq, stamp = int(seq), int(stamp)
         if len(gid) != 16 or abs(stamp - time.time_ns()) > 5e9:
@@ -161,6 +166,7 @@ class Node:
         if (prev is None and seq < 1) or (prev is not None and seq <= prev):
             self.bad_attachments.append(f"{k}: seq {seq} after {prev}")
         last[gid] = seq
+        return stamp
 
     def tokens_seen(self):
         replies = self.s.liveliness().get("@ros2_lv/**", timeout=2.0)
@@ -493,8 +499,12 @@ def arm(a):
         rep["point_times"].add(pt.time_from_start.sec * 10**9 + pt.time_from_start.nanosec)
         take([by_name[j] for j in names])
 
-    def on_pose(msg, _t):
-        why = servo.check(msg, time.time_ns())
+    def on_pose(msg, _t, sent_ns):
+        # Servo measures a command's age when it takes it. This stand-in, starved by a
+        # suite that loads both cores, may take it 100 ms late; the age is measured at
+        # the moment the sample left Tactile (its rmw attachment's stamp, on the same
+        # clock), which is what the stamp promises. Without one, on arrival.
+        why = servo.check(msg, sent_ns if sent_ns is not None else time.time_ns())
         if why:
             rep["bad_commands"].append(why)
             return
@@ -506,7 +516,7 @@ def arm(a):
         from servo_ik import ServoIk  # beside this script
         servo = ServoIk(a.ik_urdf, names, a.tool, a.pose_frame)
         rep["poses"] = []
-        sub = node.subscribe(a.command_topic, POSE, on_pose)
+        sub = node.subscribe(a.command_topic, POSE, on_pose, sent=True)
     elif a.command_type == "trajectory":
         sub = node.subscribe(a.command_topic, TRAJECTORY, on_trajectory)
     else:
