@@ -94,22 +94,26 @@ fn engaged_stretches(released: &[f64]) -> Vec<(usize, usize)> {
 /// stopped (see [`following`]'s `settled`), with no window at all.
 const LAG: usize = 200;
 
-/// Over each engaged stretch (from 50 samples after the engage, free space only: no
-/// force back), how far the robot's tool moved from where the map says: its move
-/// since the engage against `S R` times the master's (m, the robot's frame), and its
-/// turn against the master's turn carried by the map (degrees). Returns both, sorted.
-/// How the robot followed the master's mapped motion in free space, in its engaged
-/// stretches: `moves` and `turns` (sorted) against the nearest of the master's last
-/// [`LAG`] samples; `settled`, the move's error with no window at all, at the end of
-/// each stretch the hand ended still (unmoved for `LAG` samples) out of contact. A
-/// window forgives a late robot, and also a short scale along a straight stroke; the
-/// settled error forgives neither.
+/// How long the hand must have been still at a stretch's end for its `settled` error:
+/// 0.1 s at 1 kHz (the shortest still spell of the tests' trajectories is 0.2 s).
+const STILL: usize = 100;
+
+/// How the robot followed the master's mapped motion: see [`following`].
 struct Following {
     moves: Vec<f64>,
     turns: Vec<f64>,
     settled: Vec<f64>,
 }
 
+/// Over each engaged stretch (from 50 samples after the engage, free space only: no
+/// force back), how far the robot's tool moved from where the map says: its move
+/// since the engage against `S R` times the master's (m, the robot's frame), and its
+/// turn against the master's turn carried by the map (degrees), each against the
+/// nearest of the master's last [`LAG`] samples (`moves`, `turns`, sorted); and
+/// `settled`, the move's error with no window at all, at the end of each stretch the
+/// hand ended still (unmoved for [`STILL`] samples) out of contact. A window forgives
+/// a late robot, and also a short scale along a straight stroke; the settled error
+/// forgives neither.
 fn following(trace: &str, joints: &str, scale: f64, r: &Matrix3<f64>) -> Following {
     let col = |c: &str| util::column(trace, c);
     let v = [1, 2, 3].map(|i| col(&format!("v_{i}")));
@@ -132,7 +136,7 @@ fn following(trace: &str, joints: &str, scale: f64, r: &Matrix3<f64>) -> Followi
         let tool_e = fk(e);
         let error =
             |n: usize, m: usize| (fk(n).p - tool_e.p - scale * r * (at(&v, m) - at(&v, e))).norm();
-        let still = end >= e + LAG && (end - LAG..=end).all(|m| at(&v, m) == at(&v, end));
+        let still = end >= e + STILL && (end - STILL..=end).all(|m| at(&v, m) == at(&v, end));
         if still && h.iter().all(|c| c[end] == 0.0) {
             settled.push(error(end, end));
         }
@@ -142,7 +146,7 @@ fn following(trace: &str, joints: &str, scale: f64, r: &Matrix3<f64>) -> Followi
             }
             // Since the engage: the robot's move against S R times the master's, its
             // turn against the master's turn carried by R; the nearest of the
-            // master's last 50 samples (a stand-in starved by the suite follows the
+            // master's last LAG samples (a stand-in starved by the suite follows the
             // same path late: this measures the map, not the stand-in's timing).
             let tool = fk(n);
             let lagged = n.saturating_sub(LAG).max(e)..=n;

@@ -297,9 +297,8 @@ fn the_crates_depend_as_the_architecture_says() {
 }
 
 /// The per-sample protocol is the driver's alone: no node crate names the pacer, the
-/// run filter, a control message (probe, end, waiting, dropped; their bits are private
-/// to `tactile-messages`, so only `Control` makes them), or the record's
-/// once-a-second counters.
+/// run filter, a control message (probe, end, waiting, dropped; their bits have no
+/// public name, `Control` makes them), or the record's once-a-second counters.
 #[test]
 fn only_the_driver_speaks_the_protocol() {
     let words = [

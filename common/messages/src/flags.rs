@@ -1,8 +1,8 @@
 //! The bits a sample carries in [`Signal::flags`](crate::samples::Signal::flags), as a
 //! type. They fall in three groups, each bit in exactly one:
 //!
-//! - the run's control messages (probe, end, waiting, dropped), made and read only
-//!   through [`Control`], so their bits are private to this crate;
+//! - the run's control messages (probe, end, waiting, dropped), made and read
+//!   through [`Control`]: their bits have no public name;
 //! - the payload's: what a sample carries or how the network treated it
 //!   ([`Flags::PAYLOAD`]: substituted, unsent, corrupted, pose, released);
 //! - notes of what the node that set them did, for the trace ([`Flags::NOTES`]: IK
@@ -54,7 +54,8 @@ impl Flags {
     /// Note: the slave's IK target was outside the workspace (clamped).
     pub const IK_CLAMPED: Flags = Flags(2);
     /// Note: the node that set it rejected a position or force it received (not
-    /// finite, a jump its predictor finds implausible) and went on from its estimate;
+    /// finite, a jump its predictor finds implausible; at the slave, also a target its
+    /// IK refuses) and went on from its estimate;
     /// the slave sets it on its step and h(n), the master on its effect. Never on v(n)
     /// as received; on q(n) as received it is the slave's note about the v(n) it
     /// stepped on, not about q(n). An orientation rejected is
@@ -78,7 +79,8 @@ impl Flags {
     pub const CLAMPED: Flags = Flags(512);
     /// Payload: the sender's codec did not send this sample (deadband): it crosses the
     /// processes as the loop's clock only, no packet crosses the network for it, and
-    /// the receiver fills it with its predictor.
+    /// the receiver fills it with its predictor. The emulator clears it on the way
+    /// (the receiver sees [`Flags::SUBSTITUTED`]), so no trace row carries it.
     pub const UNSENT: Flags = Flags(1024);
     /// Control: a probe's echo from a node that still waits for its robot
     /// ([`Control::Waiting`]).
@@ -86,12 +88,13 @@ impl Flags {
     /// Control: lockstep only, the emulator dropped sample `seq` on purpose
     /// ([`Control::Dropped`]).
     pub(crate) const DROPPED: Flags = Flags(4096);
-    /// Payload: a 6-DoF sample. Forward, c(n) carries an orientation in
+    /// Payload, set by the master (and copied by the slave onto h(n)): a 6-DoF
+    /// sample. Forward, c(n) carries an orientation in
     /// [`Forward::rotation`](crate::samples::Forward::rotation); backward, h(n) carries a torque in
     /// [`Backward::torque`](crate::samples::Backward::torque). Never set in the paper's 3-DoF runs, whose samples carry
     /// positions and forces only.
     pub const POSE: Flags = Flags(8192);
-    /// Payload (forward): the operator has released the clutch; the robot holds where
+    /// Payload (forward), set by the master: the operator has released the clutch; the robot holds where
     /// it is and, at the next engaged sample, takes the master's pose from there (its
     /// offsets captured again), so it never jumps.
     pub const RELEASED: Flags = Flags(16384);

@@ -15,7 +15,8 @@ pub struct SlaveCounters {
     /// Targets outside the workspace: IK clamped.
     pub ik_clamped: u64,
     /// Samples not physically possible (not finite, too large, too fast, out of
-    /// order), rejected and filled by the predictor; or outside the workspace (IK).
+    /// order), rejected and filled by the predictor; or outside the workspace (IK);
+    /// or whose orientation is no rotation. A sample counts once.
     pub rejected: u64,
     /// Joint torque clamps (one per joint per step).
     pub torque_clamps: u64,

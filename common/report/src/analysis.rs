@@ -320,10 +320,11 @@ impl Analysis {
         if row.contact_object >= 0 {
             m.contact_samples += 1;
         }
-        // Tracking against what the slave was asked to reach; a step that rejected what
-        // it received (a position implausible or not finite, or a 6-DoF sample's
-        // orientation: the slave's own flag, which v(n) never carries) went on from the
-        // slave's estimate, not from v(n), and is left out.
+        // Tracking against what the slave was asked to reach; a step that rejected the
+        // position it received (implausible, not finite, refused by the IK: the slave's
+        // own flag, which v(n) never carries) went on from the slave's estimate, not
+        // from v(n), and is left out. A rejected orientation alone (ROTATION_REJECTED)
+        // is kept: the position was followed.
         if row.stepped
             && !row.flags_s.intersects(Flags::REJECTED)
             && row.v.iter().all(|x| x.is_finite())

@@ -171,9 +171,10 @@ impl Bilateral {
             let depth = distance(row.surface, row.tool);
             self.contact.max_penetration_m = self.contact.max_penetration_m.max(depth);
         }
-        // A corrupted v(n) (the channel's flag) or a step that rejected what it received
-        // (the slave's own flag: a position, or a 6-DoF sample's orientation) went on
-        // from the slave's estimate, not from the master's handle: left out.
+        // A corrupted v(n) (the channel's flag) or a step that rejected the position it
+        // received (the slave's own flag) went on from the slave's estimate, not from
+        // the master's handle: left out. A rejected orientation alone
+        // (ROTATION_REJECTED) is kept: the position was followed.
         if row.flags_f.intersects(Flags::CORRUPTED) || row.flags_s.intersects(Flags::REJECTED) {
             return;
         }

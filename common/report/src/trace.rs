@@ -175,7 +175,8 @@ macro_rules! trace_row {
             /// True if the slave recorded a step on v(n) (not a trace column: it says
             /// whether the slave's columns hold data).
             pub stepped: bool,
-            /// The slave's note flags for its step (rejected, contact, IK clamped); not a
+            /// The slave's note flags for its step (rejected, rotation rejected, contact,
+            /// IK clamped); not a
             /// trace column: q(n)'s are `flags_b`, and h(n) may not come back.
             pub flags_s: Flags,
         }

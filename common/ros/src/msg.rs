@@ -437,7 +437,8 @@ pub struct SampleTiming {
     pub delay_forward: [u32; 3],
     /// Delay injected into q(n) per axis, samples.
     pub delay_backward: [u32; 3],
-    /// Flags of v(n) as the slave received it (1024: not sent, the deadband held it).
+    /// Flags of v(n) as the slave received it (1: substituted, the channel held a
+    /// value: a gap, a deadband, a delay's start-up).
     pub flags_forward: u32,
     /// Flags of q(n) as the master received it.
     pub flags_backward: u32,
