@@ -26,6 +26,7 @@ mod logs;
 mod loop_processes;
 mod nodes;
 mod pose;
+mod python;
 mod recordings;
 mod records;
 mod ros2;

@@ -21,6 +21,16 @@ pub fn stop_flag() -> std::io::Result<Arc<AtomicBool>> {
     Ok(Arc::clone(STOP.get_or_init(|| stop)))
 }
 
+/// Forgets a stop request that was answered: for a library whose caller goes on after
+/// one (the Python package, where a Ctrl-C ends one run and the notebook goes on), so
+/// the next run does not stop at once. The command never calls it: there a request
+/// ends the process.
+pub fn clear_stop() {
+    if let Some(f) = STOP.get() {
+        f.store(false, std::sync::atomic::Ordering::SeqCst);
+    }
+}
+
 /// True once SIGINT or SIGTERM arrived (false if no flag was ever installed), whether
 /// the node's handler caught it or iceoryx2's (which takes the signals over once the
 /// process maps its shared memory: see `tactile_transport::ipc`); the latter is

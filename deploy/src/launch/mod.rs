@@ -12,7 +12,9 @@ pub mod stall;
 pub mod supervise;
 
 pub use links::Links;
-pub use scenario::{load_scenario, parse_sets, prepare_out, Loaded, PAPER_SCENARIO};
+pub use scenario::{
+    load_scenario, load_source, parse_sets, prepare_out, Loaded, Source, PAPER_SCENARIO,
+};
 pub use supervise::run_processes;
 
 use std::time::Duration;

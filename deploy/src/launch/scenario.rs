@@ -32,19 +32,45 @@ pub struct Loaded {
 /// Reads and validates a scenario; `None` is the built-in paper scenario. A trajectory
 /// file is read too, so a bad one stops the run before anything starts.
 pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error> {
-    let (text, base_dir, name) = match path {
-        None => (
-            PAPER_SCENARIO.to_string(),
-            std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
-            "deploy/scenarios/paper.toml (built in)".to_string(),
-        ),
-        Some(p) => (
-            files::read_text(p, "scenario", files::MAX_SCENARIO_BYTES).map_err(Error::BadInput)?,
-            files::base_dir(p),
-            p.display().to_string(),
-        ),
+    let source = match path {
+        None => Source {
+            text: PAPER_SCENARIO.to_string(),
+            base_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+            name: "deploy/scenarios/paper.toml (built in)".to_string(),
+            path: None,
+        },
+        Some(p) => Source {
+            text: files::read_text(p, "scenario", files::MAX_SCENARIO_BYTES)
+                .map_err(Error::BadInput)?,
+            base_dir: files::base_dir(p),
+            name: p.display().to_string(),
+            path: Some(p.to_path_buf()),
+        },
     };
-    let text = tactile_scenario::overrides::apply(&text, sets)
+    load_source(&source, sets)
+}
+
+/// A scenario's text and where it came from, before `--set`s and validation.
+#[derive(Debug, Clone)]
+pub struct Source {
+    /// The TOML.
+    pub text: String,
+    /// Folder its relative paths are resolved against.
+    pub base_dir: PathBuf,
+    /// How errors name it (its path, or what it is).
+    pub name: String,
+    /// Its file, if it has one (a run must never overwrite it).
+    pub path: Option<PathBuf>,
+}
+
+/// [`load_scenario`] for a scenario's text from anywhere (a file, the Python API).
+pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
+    let (base_dir, name, path) = (
+        source.base_dir.clone(),
+        &source.name,
+        source.path.as_deref(),
+    );
+    let text = tactile_scenario::overrides::apply(&source.text, sets)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     let with = if sets.is_empty() {
         String::new()

@@ -1,0 +1,16 @@
+"""Type stubs of tactile._native, the package's compiled half (deploy/python/src/lib.rs)."""
+from typing import List, Optional, Tuple
+
+PAPER_SCENARIO: str
+
+class ScenarioError(ValueError):
+    """A scenario, a --set or an input the command would refuse (exit status 2)."""
+
+class RunError(RuntimeError):
+    """A run or a report that failed (exit status 1)."""
+
+def check(text: str, base_dir: str, name: str, path: Optional[str],
+          sets: List[str]) -> Tuple[str, List[str]]: ...
+def run(text: str, base_dir: str, name: str, path: Optional[str], sets: List[str],
+        out: str, trace_format: str) -> bool: ...
+def report(dirs: List[str], out: str, trace_format: str) -> None: ...
