@@ -26,7 +26,6 @@ mod logs;
 mod loop_processes;
 mod nodes;
 mod pose;
-mod python;
 mod recordings;
 mod records;
 mod ros2;

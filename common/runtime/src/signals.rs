@@ -21,13 +21,28 @@ pub fn stop_flag() -> std::io::Result<Arc<AtomicBool>> {
     Ok(Arc::clone(STOP.get_or_init(|| stop)))
 }
 
+/// For a library inside another program that handles the signals itself (the Python
+/// package: Python's SIGINT handler raises KeyboardInterrupt, and SIGTERM must still
+/// end the interpreter): the process's stop flag, made without handlers of its own if
+/// none were installed yet, so [`stop_flag`] hands out this flag and installs nothing.
+/// The caller sets it with [`request_stop`] when its own handling says so.
+pub fn handled_by_caller() -> Arc<AtomicBool> {
+    Arc::clone(STOP.get_or_init(|| Arc::new(AtomicBool::new(false))))
+}
+
+/// Asks every loop of the process to stop after the sample in hand, as SIGINT does
+/// (for a caller that handles the signals itself: [`handled_by_caller`]).
+pub fn request_stop() {
+    handled_by_caller().store(true, Ordering::SeqCst);
+}
+
 /// Forgets a stop request that was answered: for a library whose caller goes on after
 /// one (the Python package, where a Ctrl-C ends one run and the notebook goes on), so
 /// the next run does not stop at once. The command never calls it: there a request
 /// ends the process.
 pub fn clear_stop() {
     if let Some(f) = STOP.get() {
-        f.store(false, std::sync::atomic::Ordering::SeqCst);
+        f.store(false, Ordering::SeqCst);
     }
 }
 

@@ -1,28 +1,37 @@
 //! `tactile._native`: the Python package's compiled half. It calls the libraries the
-//! `tactile` command calls (the scenario's loading and checks, the in-process run,
-//! the report), with no subprocess and no second copy of the loop; the package's
-//! Python half (`python/tactile/__init__.py`) gives them their Python shape (a
-//! `Scenario` value, a `Run` whose tables are pyarrow's).
+//! `tactile` command calls (the scenario's reading, loading and checks, the
+//! in-process run, the report), with no subprocess and no second copy of the loop;
+//! the package's Python half (`python/tactile/__init__.py`) gives them their Python
+//! shape (a `Scenario` value, a `Run` whose tables are pyarrow's).
 //!
 //! Every function takes a scenario as its source (text, the folder its relative
 //! paths are resolved against, its name for errors, its file if any) and its `--set`s
 //! as the command takes them, so a scenario is checked, resolved and run exactly as
-//! `tactile check` and `tactile run --in-process` do. A run releases the GIL while it
-//! computes.
+//! `tactile check` and `tactile run --in-process` do.
+//!
+//! Signals stay Python's: the module installs no handler (a SIGTERM still ends the
+//! interpreter, a Ctrl-C raises KeyboardInterrupt wherever Python is). A run computes
+//! on a thread of its own while the caller's thread waits with the GIL released,
+//! looking at Python's signals every [`SIGNAL_POLL`]; a KeyboardInterrupt there asks
+//! the run to stop after the sample in hand, as SIGINT asks the command, and is raised
+//! once the report of what ran is written.
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
 use tactile::error::Error;
 use tactile::launch::{load_source, parse_sets, Loaded, Outputs, Source};
 use tactile_report::write::{write_report, Launch};
+use tactile_runtime::files;
+use tactile_runtime::signals;
 
 create_exception!(
     _native,
     ScenarioError,
     PyValueError,
-    "A scenario, a --set or an input file the command would refuse (exit status 2); the message is the command's, naming the field."
+    "A scenario, a --set or an input the command would refuse (exit status 2); the message is the command's, naming the field."
 );
 create_exception!(
     _native,
@@ -31,12 +40,17 @@ create_exception!(
     "A run or a report that failed (exit status 1); the message is the command's."
 );
 
-/// The command's error as the Python exception of its kind.
+/// How often a waiting call looks at Python's signals: a Ctrl-C is answered within
+/// this (plus the sample in hand).
+const SIGNAL_POLL: Duration = Duration::from_millis(20);
+
+/// The command's error as the Python exception of its exit status: 2 (bad input)
+/// ScenarioError, 130 KeyboardInterrupt, else RunError.
 fn to_py(e: Error) -> PyErr {
-    match e {
-        Error::BadInput(m) => ScenarioError::new_err(m),
-        Error::Interrupted => pyo3::exceptions::PyKeyboardInterrupt::new_err(e.to_string()),
-        other => RunError::new_err(other.to_string()),
+    match e.exit_code() {
+        2 => ScenarioError::new_err(e.to_string()),
+        130 => PyKeyboardInterrupt::new_err(e.to_string()),
+        _ => RunError::new_err(e.to_string()),
     }
 }
 
@@ -52,6 +66,57 @@ fn source(text: String, base_dir: &str, name: String, path: Option<&str>) -> Sou
 
 fn load(src: &Source, sets: &[String]) -> Result<Loaded, Error> {
     load_source(src, &parse_sets(sets)?)
+}
+
+/// Runs `work` on a thread of its own while this thread waits, the GIL released,
+/// looking at Python's signals: a KeyboardInterrupt (or whatever the caller's handler
+/// raises) asks `work` to stop and is returned once `work` has ended.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T, Error> + Send,
+) -> PyResult<T> {
+    use std::sync::mpsc::{channel, RecvTimeoutError};
+    let (ended, end) = channel::<()>();
+    std::thread::scope(|s| {
+        let handle = s.spawn(move || {
+            let done = work();
+            let _ = ended.send(());
+            done
+        });
+        let mut raised: Option<PyErr> = None;
+        let mut end = end;
+        loop {
+            // Woken at once when the work ends (or panics: the sender is dropped). The
+            // receiver goes along and back: it may be sent, not shared.
+            let (got, back) = py.detach(move || (end.recv_timeout(SIGNAL_POLL), end));
+            end = back;
+            if !matches!(got, Err(RecvTimeoutError::Timeout)) {
+                break;
+            }
+            if raised.is_none() {
+                if let Err(e) = py.check_signals() {
+                    signals::request_stop();
+                    raised = Some(e);
+                }
+            }
+        }
+        let done = handle
+            .join()
+            .map_err(|_| RunError::new_err("the run panicked; its records say how far it got"))?;
+        match raised {
+            Some(e) => Err(e),
+            None => done.map_err(to_py),
+        }
+    })
+}
+
+/// A scenario file read as the command reads it (its size cap, UTF-8): its text, the
+/// folder its relative paths are resolved against, its name.
+#[pyfunction]
+fn read_scenario(path: PathBuf) -> PyResult<(String, PathBuf, String)> {
+    let text = files::read_text(&path, "scenario", files::MAX_SCENARIO_BYTES)
+        .map_err(|e| to_py(Error::BadInput(e)))?;
+    Ok((text, files::base_dir(&path), path.display().to_string()))
 }
 
 /// `tactile check`: the scenario as it would run (every default filled in, the sets
@@ -74,10 +139,9 @@ fn check(
 }
 
 /// `tactile run --in-process` into `out`, the trace as `trace_format` (csv, parquet,
-/// both). Returns whether the run completed (False: failed). A stop request (SIGINT:
-/// Ctrl-C in a terminal or a notebook's interrupt; SIGTERM) ends it after the sample
-/// in hand, as it ends the command, and raises KeyboardInterrupt once the report of
-/// what ran is written; the next run starts with no request.
+/// both). Returns whether the run completed (False: failed). A KeyboardInterrupt
+/// while it runs ends it after the sample in hand and is raised once the report of
+/// what ran is written (marked `interrupted`); the next run starts afresh.
 #[pyfunction]
 #[pyo3(signature = (text, base_dir, name, path, sets, out, trace_format))]
 #[allow(clippy::too_many_arguments)] // the source's four parts, as everywhere here
@@ -93,48 +157,56 @@ fn run(
 ) -> PyResult<bool> {
     let outputs = outputs(trace_format)?;
     let src = source(text, base_dir, name, path);
-    let summary = py
-        .detach(|| {
-            // A Ctrl-C answered by an earlier run (its KeyboardInterrupt) is over.
-            tactile_runtime::signals::clear_stop();
-            let loaded = load(&src, &sets)?;
-            tactile::launch::sim::run_in_process(&loaded, &out, &outputs)
-        })
-        .map_err(to_py)?;
+    signals::handled_by_caller();
+    signals::clear_stop();
+    let summary = interruptible(py, || {
+        let loaded = load(&src, &sets)?;
+        tactile::launch::sim::run_in_process(&loaded, &out, &outputs)
+    })?;
     if summary.interrupted {
-        return Err(interrupted(py));
+        return Err(to_py(Error::Interrupted));
     }
     Ok(!summary.failed)
 }
 
-/// The error a stopped run raises. Python's own SIGINT handler saw the signal too
-/// (the run's handler chains to it), so its KeyboardInterrupt is pending: it is taken
-/// now, once, else it would interrupt the caller's `except` a second time. A handler
-/// of the caller's that raises something else has its way.
-fn interrupted(py: Python<'_>) -> PyErr {
-    match py.check_signals() {
-        Err(e) if !e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) => e,
-        _ => to_py(Error::Interrupted),
-    }
+/// `tactile report DIR... [--out OUT]`: the report of the records in `dirs` (a run's
+/// folder, or one folder per node) written into `out` (None: beside the master's
+/// record, as the command does), the trace as `trace_format`. Returns the folder.
+#[pyfunction]
+#[pyo3(signature = (dirs, out, trace_format))]
+fn report(
+    py: Python<'_>,
+    dirs: Vec<PathBuf>,
+    out: Option<PathBuf>,
+    trace_format: &str,
+) -> PyResult<PathBuf> {
+    let outputs = outputs(trace_format)?;
+    signals::handled_by_caller();
+    signals::clear_stop();
+    let written = interruptible(py, || {
+        let out = match out {
+            Some(o) => o,
+            None => tactile::cmd::report::default_out(&dirs)?,
+        };
+        write_into(&dirs, &out, outputs)?;
+        Ok(out)
+    })?;
+    Ok(written)
 }
 
-/// `tactile report DIR... --out OUT`: the report of the records in `dirs` (a run's
-/// folder, or one folder per node) written into `out`, the trace as `trace_format`.
-#[pyfunction]
-fn report(py: Python<'_>, dirs: Vec<PathBuf>, out: PathBuf, trace_format: &str) -> PyResult<()> {
-    let outputs = outputs(trace_format)?;
-    py.detach(|| -> Result<(), Error> {
-        tactile_runtime::signals::clear_stop();
-        let holder = format!("tactile report from Python (pid {})", std::process::id());
-        let _held = tactile_report::out::take(&out, &holder)?;
-        let launch = Launch {
-            outputs,
-            ..Launch::default()
-        };
-        write_report(&dirs, &out, &launch)?;
-        Ok(())
-    })
-    .map_err(to_py)
+fn write_into(dirs: &[PathBuf], out: &Path, outputs: Outputs) -> Result<(), Error> {
+    let holder = format!("tactile report from Python (pid {})", std::process::id());
+    let _held = tactile_report::out::take(out, &holder)?;
+    let launch = Launch {
+        outputs,
+        stop: Some(signals::handled_by_caller()),
+        ..Launch::default()
+    };
+    let summary = write_report(dirs, out, &launch)?;
+    if summary.interrupted {
+        return Err(Error::Interrupted);
+    }
+    Ok(())
 }
 
 /// The outputs of a run or report from Python: its trace as `trace_format`.
@@ -151,6 +223,9 @@ fn outputs(trace_format: &str) -> PyResult<Outputs> {
 /// The module.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // Before anything could install the command's handlers: signals stay Python's.
+    signals::handled_by_caller();
+    m.add_function(wrap_pyfunction!(read_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;

@@ -31,6 +31,16 @@ pub struct ReportArgs {
     pub formats: super::formats::FormatArgs,
 }
 
+/// Where a report of the records in `dirs` goes without `--out`: beside the master's
+/// record (the run's folder; with one folder per node, the master's).
+pub fn default_out(dirs: &[PathBuf]) -> Result<PathBuf, Error> {
+    let [master, _, _] = join::locate(dirs)?;
+    Ok(master
+        .as_deref()
+        .and_then(Path::parent)
+        .map_or_else(|| PathBuf::from("."), Path::to_path_buf))
+}
+
 /// `tactile report DIR... [--out OUT]`.
 pub fn main(args: &ReportArgs) -> Result<(), Error> {
     args.formats
@@ -40,13 +50,9 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
             "--trace-format with --mcap-only: only run.mcap is written".into(),
         ));
     }
-    let [master, _, _] = join::locate(&args.dirs)?;
     let out = match &args.out {
         Some(o) => o.clone(),
-        None => master
-            .as_deref()
-            .and_then(Path::parent)
-            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+        None => default_out(&args.dirs)?,
     };
     let holder = format!("tactile report (pid {})", std::process::id());
     let _held = tactile_report::out::take(&out, &holder)?;

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import os
 import tempfile
 from pathlib import Path
@@ -29,18 +30,35 @@ __all__ = ["Scenario", "Run", "run", "report", "ScenarioError", "RunError"]
 PathLike = Union[str, "os.PathLike[str]"]
 
 
+def _toml_string(s: str) -> str:
+    """A TOML basic string: quotes, backslashes and control characters escaped,
+    everything else as it is (JSON's escapes would split a character outside the BMP
+    into surrogates, which TOML refuses)."""
+    out = []
+    for ch in s:
+        if ch in '"\\':
+            out.append("\\" + ch)
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
+
+
 def _toml_value(key: str, v: Any) -> str:
-    """A Python value as the TOML literal `--set KEY=VALUE` takes."""
-    if isinstance(v, bool):
+    """A Python value (NumPy's scalars too) as the TOML literal `--set KEY=VALUE`
+    takes."""
+    if isinstance(v, bool) or getattr(getattr(v, "dtype", None), "kind", None) == "b":
         return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if not math.isfinite(v):
-            raise ScenarioError(f"--set {key}: {v} is not a finite number")
-        return repr(v)
+    if isinstance(v, numbers.Integral):
+        return str(int(v))
+    if isinstance(v, numbers.Real):
+        x = float(v)
+        if not math.isfinite(x):
+            raise ScenarioError(f"--set {key}: {x} is not a finite number")
+        return repr(x)
     if isinstance(v, str):
-        return json.dumps(v)  # a TOML basic string: quotes and escapes as JSON's
+        return _toml_string(v)
     if isinstance(v, (list, tuple)):
         return "[" + ",".join(_toml_value(key, x) for x in v) + "]"
     raise ScenarioError(f"--set {key}: a {type(v).__name__} is no TOML value "
@@ -63,13 +81,10 @@ class Scenario:
 
     @classmethod
     def load(cls, path: PathLike) -> "Scenario":
-        """The scenario in file `path` (relative paths in it are read beside it)."""
-        p = Path(path)
-        try:
-            text = p.read_text()
-        except OSError as e:
-            raise ScenarioError(f"{p}: {e.strerror or e}") from None
-        return cls(text, p.resolve().parent, str(p), p)
+        """The scenario in file `path`, read as the command reads it (UTF-8, at most
+        1 MiB; the same errors); relative paths in it are read beside it."""
+        text, base_dir, name = _native.read_scenario(os.fspath(path))
+        return cls(text, base_dir, name, path)
 
     @classmethod
     def from_toml(cls, text: str, base_dir: PathLike = ".") -> "Scenario":
@@ -156,33 +171,36 @@ class Run:
 def run(scenario: Scenario, out: Optional[PathLike] = None,
         trace_format: str = "parquet") -> Run:
     """Runs `scenario` in this process, as `tactile run --in-process` does, into
-    folder `out` (None: a temporary folder, read into memory and removed). The GIL is
-    released while it runs. Bad input raises ScenarioError; a failed run RunError
-    after its report is read."""
+    folder `out` (None: a temporary folder, read into memory and removed, with it the
+    report of a run that failed or was interrupted). The GIL is released while it
+    runs. Bad input raises ScenarioError; a failed run RunError after its report is
+    read; Ctrl-C stops the run after the sample in hand and raises
+    KeyboardInterrupt once its report is written."""
     if out is None:
         with tempfile.TemporaryDirectory(prefix="tactile-run-") as tmp:
-            r = _run_into(scenario, Path(tmp) / "run", trace_format)
+            r = _run_into(scenario, Path(tmp) / "run", trace_format, kept=False)
             r.out = None
             return r
-    return _run_into(scenario, Path(out), trace_format)
+    return _run_into(scenario, Path(out), trace_format, kept=True)
 
 
-def _run_into(scenario: Scenario, out: Path, trace_format: str) -> Run:
+def _run_into(scenario: Scenario, out: Path, trace_format: str, kept: bool) -> Run:
     completed = _native.run(*scenario._source(), os.fspath(out), trace_format)
     r = Run.read(out, completed)
     if not completed:
         events = "; ".join(r.summary.get("events", [])[:1])
-        raise RunError(f"the run failed: {events} (its report is in {out})")
+        where = f"its report is in {out}" if kept else "give out= to keep its report"
+        raise RunError(f"the run failed: {events} ({where})")
     return r
 
 
 def report(*dirs: PathLike, out: Optional[PathLike] = None,
            trace_format: str = "parquet") -> Run:
     """The report of the records in `dirs` (a run's folder, or one folder per node),
-    written as `tactile report` writes it into `out` (default: the first folder), and
-    read back."""
+    written as `tactile report` writes it into `out` (default, as the command's: the
+    folder of the master's record), and read back."""
     if not dirs:
         raise ScenarioError("report: give a run's folder, or one folder per node")
-    target = Path(out) if out is not None else Path(dirs[0])
-    _native.report([os.fspath(d) for d in dirs], os.fspath(target), trace_format)
+    target = _native.report([os.fspath(d) for d in dirs],
+                            None if out is None else os.fspath(out), trace_format)
     return Run.read(target)

@@ -1,4 +1,5 @@
 """Type stubs of tactile._native, the package's compiled half (deploy/python/src/lib.rs)."""
+from pathlib import Path
 from typing import List, Optional, Tuple
 
 PAPER_SCENARIO: str
@@ -9,8 +10,9 @@ class ScenarioError(ValueError):
 class RunError(RuntimeError):
     """A run or a report that failed (exit status 1)."""
 
+def read_scenario(path: str) -> Tuple[str, Path, str]: ...
 def check(text: str, base_dir: str, name: str, path: Optional[str],
           sets: List[str]) -> Tuple[str, List[str]]: ...
 def run(text: str, base_dir: str, name: str, path: Optional[str], sets: List[str],
         out: str, trace_format: str) -> bool: ...
-def report(dirs: List[str], out: str, trace_format: str) -> None: ...
+def report(dirs: List[str], out: Optional[str], trace_format: str) -> Path: ...
