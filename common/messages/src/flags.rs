@@ -137,11 +137,6 @@ impl Flags {
         self.0 == 0
     }
 
-    /// Sets the flags of `other`.
-    pub fn insert(&mut self, other: Flags) {
-        self.0 |= other.0;
-    }
-
     /// Clears the flags of `other`.
     pub fn remove(&mut self, other: Flags) {
         self.0 &= !other.0;
@@ -283,7 +278,7 @@ mod tests {
         let f = Flags::POSE | Flags::RELEASED | Flags::from_bits(1 << 20);
         assert_eq!(format!("{f:?}"), "Flags(POSE | RELEASED | 0x100000)");
         let mut g = Flags::NONE;
-        g.insert(Flags::REJECTED | Flags::CONTACT);
+        g |= Flags::REJECTED | Flags::CONTACT;
         g.remove(Flags::CONTACT);
         assert!(g.contains(Flags::REJECTED) && !g.intersects(Flags::CONTACT));
     }

@@ -76,7 +76,7 @@ fn interruptible<T: Send>(
     work: impl FnOnce() -> Result<T, Error> + Send,
 ) -> PyResult<T> {
     use std::sync::mpsc::{channel, RecvTimeoutError};
-    let (ended, end) = channel::<()>();
+    let (ended, mut end) = channel::<()>();
     std::thread::scope(|s| {
         let handle = s.spawn(move || {
             let done = work();
@@ -84,7 +84,6 @@ fn interruptible<T: Send>(
             done
         });
         let mut raised: Option<PyErr> = None;
-        let mut end = end;
         loop {
             // Woken at once when the work ends (or panics: the sender is dropped). The
             // receiver goes along and back: it may be sent, not shared.
@@ -139,7 +138,7 @@ fn check(
 }
 
 /// `tactile run --in-process` into `out`, the trace as `trace_format` (csv, parquet,
-/// both). Returns whether the run completed (False: failed). A KeyboardInterrupt
+/// both); whether it completed is its summary's (`failed`). A KeyboardInterrupt
 /// while it runs ends it after the sample in hand and is raised once the report of
 /// what ran is written (marked `interrupted`); the next run starts afresh.
 #[pyfunction]
@@ -154,10 +153,9 @@ fn run(
     sets: Vec<String>,
     out: PathBuf,
     trace_format: &str,
-) -> PyResult<bool> {
+) -> PyResult<()> {
     let outputs = outputs(trace_format)?;
     let src = source(text, base_dir, name, path);
-    signals::handled_by_caller();
     signals::clear_stop();
     let summary = interruptible(py, || {
         let loaded = load(&src, &sets)?;
@@ -166,7 +164,7 @@ fn run(
     if summary.interrupted {
         return Err(to_py(Error::Interrupted));
     }
-    Ok(!summary.failed)
+    Ok(())
 }
 
 /// `tactile report DIR... [--out OUT]`: the report of the records in `dirs` (a run's
@@ -181,17 +179,15 @@ fn report(
     trace_format: &str,
 ) -> PyResult<PathBuf> {
     let outputs = outputs(trace_format)?;
-    signals::handled_by_caller();
     signals::clear_stop();
-    let written = interruptible(py, || {
+    interruptible(py, || {
         let out = match out {
             Some(o) => o,
             None => tactile::cmd::report::default_out(&dirs)?,
         };
         write_into(&dirs, &out, outputs)?;
         Ok(out)
-    })?;
-    Ok(written)
+    })
 }
 
 fn write_into(dirs: &[PathBuf], out: &Path, outputs: Outputs) -> Result<(), Error> {

@@ -142,8 +142,9 @@ class Run:
         self.completed = completed
 
     @classmethod
-    def read(cls, folder: PathLike, completed: Optional[bool] = None) -> "Run":
-        """The report in `folder` (summary.json, the trace, joints.csv)."""
+    def read(cls, folder: PathLike) -> "Run":
+        """The report in `folder` (summary.json, the trace, joints.csv); `completed`
+        is the summary's (not `failed`)."""
         d = Path(folder)
         try:
             summary = json.loads((d / "summary.json").read_text())
@@ -160,8 +161,7 @@ class Run:
         if (d / "joints.csv").exists():
             import pyarrow.csv as pc
             joints = pc.read_csv(d / "joints.csv")
-        done = not summary.get("failed", False) if completed is None else completed
-        return cls(d, summary, trace, joints, done)
+        return cls(d, summary, trace, joints, not summary.get("failed", False))
 
     def __repr__(self) -> str:
         rt = (self.summary.get("round_trip_ns") or {}).get("p50")
@@ -185,9 +185,9 @@ def run(scenario: Scenario, out: Optional[PathLike] = None,
 
 
 def _run_into(scenario: Scenario, out: Path, trace_format: str, kept: bool) -> Run:
-    completed = _native.run(*scenario._source(), os.fspath(out), trace_format)
-    r = Run.read(out, completed)
-    if not completed:
+    _native.run(*scenario._source(), os.fspath(out), trace_format)
+    r = Run.read(out)
+    if not r.completed:
         events = "; ".join(r.summary.get("events", [])[:1])
         where = f"its report is in {out}" if kept else "give out= to keep its report"
         raise RunError(f"the run failed: {events} ({where})")
