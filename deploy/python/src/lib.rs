@@ -21,6 +21,8 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
+use tactile::cmd::formats::FormatArgs;
+use tactile::cmd::sweep::{Base, Progress, SweepArgs};
 use tactile::error::Error;
 use tactile::launch::{load_source, parse_sets, Loaded, Outputs, Source};
 use tactile_report::write::{write_report, Launch};
@@ -68,35 +70,59 @@ fn load(src: &Source, sets: &[String]) -> Result<Loaded, Error> {
     load_source(src, &parse_sets(sets)?)
 }
 
+/// What a computing thread tells the waiting one.
+enum Told<E> {
+    /// Something for the caller's Python code (a sweep's progress).
+    Event(E),
+    /// The work is done.
+    Ended,
+}
+
 /// Runs `work` on a thread of its own while this thread waits, the GIL released,
 /// looking at Python's signals: a KeyboardInterrupt (or whatever the caller's handler
-/// raises) asks `work` to stop and is returned once `work` has ended.
-fn interruptible<T: Send>(
+/// raises) asks `work` to stop and is returned once `work` has ended. What `work`
+/// tells (its first argument) is handed to `on_event` on this thread, with the GIL;
+/// an exception there stops the work as a KeyboardInterrupt does.
+fn interruptible<T: Send, E: Send>(
     py: Python<'_>,
-    work: impl FnOnce() -> Result<T, Error> + Send,
+    work: impl FnOnce(&(dyn Fn(E) + Sync)) -> Result<T, Error> + Send,
+    mut on_event: impl FnMut(Python<'_>, E) -> PyResult<()>,
 ) -> PyResult<T> {
     use std::sync::mpsc::{channel, RecvTimeoutError};
-    let (ended, mut end) = channel::<()>();
+    let (tell, mut told) = channel::<Told<E>>();
     std::thread::scope(|s| {
         let handle = s.spawn(move || {
-            let done = work();
-            let _ = ended.send(());
+            let event = |e| {
+                let _ = tell.send(Told::Event(e));
+            };
+            let done = work(&event);
+            let _ = tell.send(Told::Ended);
             done
         });
         let mut raised: Option<PyErr> = None;
-        loop {
-            // Woken at once when the work ends (or panics: the sender is dropped). The
-            // receiver goes along and back: it may be sent, not shared.
-            let (got, back) = py.detach(move || (end.recv_timeout(SIGNAL_POLL), end));
-            end = back;
-            if !matches!(got, Err(RecvTimeoutError::Timeout)) {
-                break;
-            }
+        let stop = |e: PyErr, raised: &mut Option<PyErr>| {
             if raised.is_none() {
-                if let Err(e) = py.check_signals() {
-                    signals::request_stop();
-                    raised = Some(e);
+                signals::request_stop();
+                *raised = Some(e);
+            }
+        };
+        loop {
+            // Woken at once when the work tells or ends (or panics: the sender is
+            // dropped). The receiver goes along and back: it may be sent, not shared.
+            let (got, back) = py.detach(move || (told.recv_timeout(SIGNAL_POLL), told));
+            told = back;
+            match got {
+                Ok(Told::Event(e)) if raised.is_none() => {
+                    if let Err(err) = on_event(py, e) {
+                        stop(err, &mut raised);
+                    }
                 }
+                Ok(Told::Event(_)) => {}
+                Ok(Told::Ended) | Err(RecvTimeoutError::Disconnected) => break,
+                Err(RecvTimeoutError::Timeout) => {}
+            }
+            if let Err(e) = py.check_signals() {
+                stop(e, &mut raised);
             }
         }
         let done = handle
@@ -107,6 +133,11 @@ fn interruptible<T: Send>(
             None => done.map_err(to_py),
         }
     })
+}
+
+/// [`interruptible`] for work that tells nothing.
+fn waiting<T: Send>(py: Python<'_>, work: impl FnOnce() -> Result<T, Error> + Send) -> PyResult<T> {
+    interruptible(py, |_: &(dyn Fn(()) + Sync)| work(), |_, ()| Ok(()))
 }
 
 /// A scenario file read as the command reads it (its size cap, UTF-8): its text, the
@@ -157,7 +188,7 @@ fn run(
     let outputs = outputs(trace_format)?;
     let src = source(text, base_dir, name, path);
     signals::clear_stop();
-    let summary = interruptible(py, || {
+    let summary = waiting(py, || {
         let loaded = load(&src, &sets)?;
         tactile::launch::sim::run_in_process(&loaded, &out, &outputs)
     })?;
@@ -165,6 +196,65 @@ fn run(
         return Err(to_py(Error::Interrupted));
     }
     Ok(())
+}
+
+/// `tactile sweep` of the source with `sets` applied (the swept keys' values win),
+/// over the `swept` axes (`KEY=V1,V2,...` as `--set` takes them), `seeds` seeds each,
+/// `jobs` runs at once (None: the CPUs), into `out`; with `trace`, every run's trace
+/// as `trace_format`; with `resume`, the runs already in `out` are kept. After each
+/// run, `progress(ended, total, run, what)` is called with the GIL (an exception
+/// there stops the sweep). Returns the runs it ran; the tables are in `out`.
+#[pyfunction]
+#[pyo3(signature = (text, base_dir, name, path, sets, swept, seeds, jobs, out, trace, trace_format, resume, progress))]
+#[allow(clippy::too_many_arguments)] // the source's four parts and the sweep's options
+fn sweep(
+    py: Python<'_>,
+    text: String,
+    base_dir: &str,
+    name: String,
+    path: Option<&str>,
+    sets: Vec<String>,
+    swept: Vec<String>,
+    seeds: usize,
+    jobs: Option<usize>,
+    out: PathBuf,
+    trace: bool,
+    trace_format: &str,
+    resume: bool,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<usize> {
+    let args = SweepArgs {
+        scenario: None,
+        set: swept,
+        out,
+        processes: false,
+        trace,
+        formats: FormatArgs {
+            trace_format: outputs(trace_format)?.trace_format,
+            mcap_compression: Default::default(),
+        },
+        jobs,
+        seeds,
+        resume,
+        shard: None,
+        quiet: true,
+        merge: Vec::new(),
+    };
+    let base = Base {
+        source: source(text, base_dir, name, path),
+        sets,
+    };
+    signals::clear_stop();
+    interruptible(
+        py,
+        |tell: &(dyn Fn(Progress) + Sync)| {
+            tactile::cmd::sweep::sweep(&base, &args, &|p: &Progress| tell(p.clone()))
+        },
+        |py, p: Progress| match &progress {
+            Some(f) => f.call1(py, (p.ended, p.total, p.run, p.what)).map(drop),
+            None => Ok(()),
+        },
+    )
 }
 
 /// `tactile report DIR... [--out OUT]`: the report of the records in `dirs` (a run's
@@ -180,7 +270,7 @@ fn report(
 ) -> PyResult<PathBuf> {
     let outputs = outputs(trace_format)?;
     signals::clear_stop();
-    interruptible(py, || {
+    waiting(py, || {
         let out = match out {
             Some(o) => o,
             None => tactile::cmd::report::default_out(&dirs)?,
@@ -224,6 +314,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
     m.add("RunError", m.py().get_type::<RunError>())?;

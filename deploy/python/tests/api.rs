@@ -1,6 +1,6 @@
 //! The Python package against the command: the module Cargo built for this test (the
 //! crate's cdylib, beside this test's executable) laid out as maturin lays it out
-//! beside the package's Python half, then `tests/api.py` checks it against the
+//! beside the package's Python half, then pytest runs `tests/` against the
 //! `tactile` binary: the same errors for the same bad input, the same resolved
 //! scenario, a run's summary and trace equal to `tactile run --in-process`'s, a run
 //! kept in memory, an arm's joints, the GIL released while a run computes, and a
@@ -51,8 +51,8 @@ fn package(site: &Path, module: &Path) {
 
 #[test]
 fn the_python_package_runs_what_the_command_runs() {
-    if !python_has("pyarrow") {
-        return cannot("python3 lacks pyarrow");
+    if !python_has("pyarrow, pandas, pytest") {
+        return cannot("python3 lacks pyarrow, pandas or pytest (tests/requirements.txt)");
     }
     let (deps, profile) = folders();
     let module = deps.join("lib_native.so");
@@ -72,18 +72,20 @@ fn the_python_package_runs_what_the_command_runs() {
     std::fs::create_dir_all(&work).expect("work folder");
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let o = Command::new("python3")
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/api.py"))
-        .arg(&tactile)
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider", "--basetemp"])
         .arg(&work)
-        .arg(&root)
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests"))
         .env("PYTHONPATH", &site)
+        .env("TACTILE_BIN", &tactile)
+        .env("TACTILE_ROOT", &root)
         .output()
         .expect("python3");
     let text =
         String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "api.py: {text}");
+    assert!(o.status.success(), "pytest: {text}");
+    // Every test ran: none skipped, none deselected.
     assert!(
-        text.contains("ok ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs"),
+        text.contains(" passed") && !text.contains("skipped"),
         "{text}"
     );
 }

@@ -33,19 +33,8 @@ pub struct Loaded {
 /// file is read too, so a bad one stops the run before anything starts.
 pub fn load_scenario(path: Option<&Path>, sets: &[Set]) -> Result<Loaded, Error> {
     let source = match path {
-        None => Source {
-            text: PAPER_SCENARIO.to_string(),
-            base_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
-            name: "deploy/scenarios/paper.toml (built in)".to_string(),
-            path: None,
-        },
-        Some(p) => Source {
-            text: files::read_text(p, "scenario", files::MAX_SCENARIO_BYTES)
-                .map_err(Error::BadInput)?,
-            base_dir: files::base_dir(p),
-            name: p.display().to_string(),
-            path: Some(p.to_path_buf()),
-        },
+        None => Source::paper(),
+        Some(p) => Source::file(p)?,
     };
     load_source(&source, sets)
 }
@@ -61,6 +50,30 @@ pub struct Source {
     pub name: String,
     /// Its file, if it has one (a run must never overwrite it).
     pub path: Option<PathBuf>,
+}
+
+impl Source {
+    /// The built-in paper scenario, its relative paths read from the working folder.
+    pub fn paper() -> Self {
+        Source {
+            text: PAPER_SCENARIO.to_string(),
+            base_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+            name: "deploy/scenarios/paper.toml (built in)".to_string(),
+            path: None,
+        }
+    }
+
+    /// The scenario file `path`, read as every command reads it (UTF-8, at most
+    /// [`files::MAX_SCENARIO_BYTES`]); its relative paths are read beside it.
+    pub fn file(path: &Path) -> Result<Self, Error> {
+        Ok(Source {
+            text: files::read_text(path, "scenario", files::MAX_SCENARIO_BYTES)
+                .map_err(Error::BadInput)?,
+            base_dir: files::base_dir(path),
+            name: path.display().to_string(),
+            path: Some(path.to_path_buf()),
+        })
+    }
 }
 
 /// [`load_scenario`] for a scenario's text from anywhere (a file, the Python API).

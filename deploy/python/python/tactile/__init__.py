@@ -9,23 +9,29 @@ command (no subprocess, no second copy of the loop).
     run = tactile.run(sc, out="runs/a")
     run.summary["round_trip_ns"]["p50"]
     run.trace                        # pyarrow.Table, trace.parquet's columns
+    df = tactile.sweep(sc, {"network.forward.delay_ms": [0, 10, 50],
+                            "control.kind": ["none", "tdpa"]}, seeds=3)
 
 A run's folder is the command's: `tactile report` and every tool read it the same.
 """
 from __future__ import annotations
 
+import csv
+import itertools
 import json
 import math
 import numbers
 import os
+import sys
 import tempfile
+import time
 from pathlib import Path
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 from . import _native
 from ._native import RunError, ScenarioError
 
-__all__ = ["Scenario", "Run", "run", "report", "ScenarioError", "RunError"]
+__all__ = ["Scenario", "Run", "run", "sweep", "report", "ScenarioError", "RunError"]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -204,3 +210,134 @@ def report(*dirs: PathLike, out: Optional[PathLike] = None,
     target = _native.report([os.fspath(d) for d in dirs],
                             None if out is None else os.fspath(out), trace_format)
     return Run.read(target)
+
+
+Progress = Callable[[int, int, str, str], Any]
+
+
+def _axis(key: Any, values: Any) -> tuple:
+    """One swept key and its values as the command's `--set KEY=V1,V2,...`."""
+    if not isinstance(key, str) or not key.strip():
+        raise ScenarioError(f"sweep: {key!r}: a swept key is a scenario key, a string")
+    if isinstance(values, (str, bytes)) or not isinstance(values, Sequence) or not values:
+        raise ScenarioError(f"sweep: {key}: give its values as a non-empty list "
+                            f"(a list of lists for a list-valued key)")
+    return key, list(values), f"{key}=" + ",".join(_toml_value(key, v) for v in values)
+
+
+def _terminal_progress() -> Progress:
+    """The command's progress line, on standard error."""
+    start = time.monotonic()
+
+    def mmss(s: float) -> str:
+        return f"{int(s // 60)}:{int(s % 60):02d}"
+
+    def say(ended: int, total: int, run: str, what: str) -> None:
+        elapsed = time.monotonic() - start
+        left = elapsed / ended * (total - ended)
+        print(f"tactile sweep: {ended}/{total} runs, {mmss(elapsed)} elapsed, "
+              f"about {mmss(left)} left ({run}: {what})", file=sys.stderr, flush=True)
+    return say
+
+
+def _progress(progress: Union[bool, Progress, None]) -> tuple:
+    """The callback for `progress`, and what to close after: a tqdm bar (its
+    notebook widget in Jupyter) if tqdm is installed, else the command's line."""
+    if progress is False:
+        return None, None
+    if callable(progress):
+        return progress, None
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        return _terminal_progress(), None
+    bar = tqdm(desc="tactile sweep", unit="run")
+
+    def update(ended: int, total: int, run: str, what: str) -> None:
+        bar.total = total
+        bar.set_postfix_str(f"{run}: {what}", refresh=False)
+        bar.update(ended - bar.n)
+    return update, bar
+
+
+def sweep(scenario: Scenario, grid: Mapping[str, Sequence[Any]], seeds: int = 1,
+          jobs: Optional[int] = None, out: Optional[PathLike] = None, trace: bool = False,
+          trace_format: str = "parquet", resume: bool = False,
+          progress: Union[bool, Progress, None] = None) -> "pandas.DataFrame":
+    """Runs `scenario` once for every combination of `grid`'s values (each key a
+    scenario key as `with_set` takes it, its values a list; the first key varies
+    slowest), each over `seeds` seeds, `jobs` runs at once (None: the CPUs), as
+    `tactile sweep` does, into folder `out` (None: a temporary folder, removed). The
+    GIL is released while it runs.
+
+    Returns a pandas.DataFrame, one row per run in the grid's order: `run` (its
+    folder's name), `combination`, one column per swept key holding the values as
+    given (numbers, strings, lists), `seed` (as the run used it), every metric of
+    `sweep.csv`, and `folder` (the run's folder; None with out=None). The columns are
+    the same whatever `seeds`. `out` holds the command's files: sweep.csv (these
+    rows), sweep-summary.csv (mean and 95 % interval per combination), a plot per
+    metric, one folder per run.
+
+    `trace` writes every run's trace (as `trace_format`); `resume` keeps the runs `out`
+    already holds. `progress`: None shows a tqdm bar if tqdm is installed, else the
+    command's line on standard error; False nothing; a callable is called as
+    `progress(ended, total, run, what)` after each run (an exception there stops the
+    sweep). Bad input raises ScenarioError before any run starts; a failed run
+    RunError once the tables are written; Ctrl-C stops the sweep after the runs in
+    hand and raises KeyboardInterrupt once the tables of the runs that ended are
+    written (`resume=True` runs the rest)."""
+    if not isinstance(grid, Mapping) or not grid:
+        raise ScenarioError("sweep: give the swept keys as a dict {KEY: [V1, V2, ...]}")
+    axes = [_axis(k, v) for k, v in grid.items()]
+    if isinstance(seeds, bool) or not isinstance(seeds, numbers.Integral):
+        raise ScenarioError(f"sweep: seeds={seeds!r}: give a whole number")
+    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, numbers.Integral)
+                             or jobs < 0):
+        raise ScenarioError(f"sweep: jobs={jobs!r}: give a whole number, or None")
+    import pandas  # before any run: a missing pandas is said at once
+    if out is None:
+        with tempfile.TemporaryDirectory(prefix="tactile-sweep-") as tmp:
+            df = _sweep_into(scenario, axes, int(seeds), jobs, Path(tmp) / "sweep",
+                             trace, trace_format, resume, progress)
+            df["folder"] = None
+            return df
+    return _sweep_into(scenario, axes, int(seeds), jobs, Path(out), trace, trace_format,
+                       resume, progress)
+
+
+def _sweep_into(scenario: Scenario, axes: list, seeds: int, jobs: Optional[int], out: Path,
+                trace: bool, trace_format: str, resume: bool,
+                progress: Union[bool, Progress, None]) -> "pandas.DataFrame":
+    tell, bar = _progress(progress)
+    try:
+        _native.sweep(*scenario._source(), [a[2] for a in axes], seeds,
+                      None if jobs is None else int(jobs), os.fspath(out), trace,
+                      trace_format, resume, tell)
+    finally:
+        if bar is not None:
+            bar.close()
+    return _table(out, axes)
+
+
+def _table(out: Path, axes: list) -> "pandas.DataFrame":
+    """`out/sweep.csv` with each swept key's column holding the values as given,
+    looked up by the run's combination (the grid's order, the first key slowest)."""
+    import pandas
+    keys = [a[0] for a in axes]
+    as_text = {k: str for k in keys if k != "seed"}
+    df = pandas.read_csv(out / "sweep.csv", dtype=as_text, keep_default_na=False,
+                         na_values={c: [""] for c in _metric_columns(out)})
+    combos = list(itertools.product(*(a[1] for a in axes)))
+    for j, key in enumerate(keys):
+        if key != "seed":
+            df[key] = pandas.Series([combos[k][j] for k in df["combination"]],
+                                    index=df.index, dtype=object)
+    df["folder"] = [os.fspath(out.resolve() / r) for r in df["run"]]
+    return df
+
+
+def _metric_columns(out: Path) -> list:
+    """sweep.csv's columns after `seed`: the metrics (an empty cell is no value)."""
+    with open(out / "sweep.csv", encoding="utf-8", newline="") as f:
+        header = next(csv.reader(f))
+    return header[header.index("seed") + 1:]

@@ -1,6 +1,6 @@
 """Type stubs of tactile._native, the package's compiled half (deploy/python/src/lib.rs)."""
 from pathlib import Path
-from typing import List, Optional, Tuple
+from typing import Any, Callable, List, Optional, Tuple
 
 PAPER_SCENARIO: str
 
@@ -16,3 +16,7 @@ def check(text: str, base_dir: str, name: str, path: Optional[str],
 def run(text: str, base_dir: str, name: str, path: Optional[str], sets: List[str],
         out: str, trace_format: str) -> None: ...
 def report(dirs: List[str], out: Optional[str], trace_format: str) -> Path: ...
+def sweep(text: str, base_dir: str, name: str, path: Optional[str], sets: List[str],
+          swept: List[str], seeds: int, jobs: Optional[int], out: str, trace: bool,
+          trace_format: str, resume: bool,
+          progress: Optional[Callable[[int, int, str, str], Any]]) -> int: ...

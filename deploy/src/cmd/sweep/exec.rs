@@ -2,13 +2,13 @@
 //! folder, progress with an estimate of the time left, and `--resume` keeping the
 //! runs that already ended.
 
-use super::{run_dir, sets_of, SweepArgs};
+use super::{run_dir, sets_of, Base, SweepArgs};
 use crate::error::Error;
-use crate::launch::{self, load_scenario, Loaded};
+use crate::launch::{self, load_source, parse_sets, Loaded};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use tactile_report::summary::of_these_records;
 use tactile_report::sweep::{describe, values, Axis};
 use tactile_report::write::{TraceFormat, PARQUET_FILE};
@@ -42,18 +42,20 @@ impl Work {
 
 /// Every run of combinations `mine`, its scenario loaded and checked.
 pub fn plan(
-    scenario: &Path,
+    base: &Base,
     axes: &[Axis],
     combos: &[Vec<usize>],
     mine: &[usize],
     args: &SweepArgs,
 ) -> Result<Vec<Work>, Error> {
-    let base = load_scenario(Some(scenario), &[])?.scenario.seed;
+    let base_sets = parse_sets(&base.sets)?;
+    let first = load_source(&base.source, &base_sets)?.scenario.seed;
     let mut work = Vec::with_capacity(mine.len() * args.seeds);
     for &k in mine {
         for s in 0..args.seeds {
-            let seed = (args.seeds > 1).then(|| base.wrapping_add(s as u64));
-            let loaded = load_scenario(Some(scenario), &sets_of(axes, &combos[k], seed)?)?;
+            let seed = (args.seeds > 1).then(|| first.wrapping_add(s as u64));
+            let sets = sets_of(&base_sets, axes, &combos[k], seed)?;
+            let loaded = load_source(&base.source, &sets)?;
             let mut what = describe(axes, &combos[k]);
             let dir = run_dir(&args.out, k, s, args.seeds);
             let mut columns: Vec<(String, String)> = axes
@@ -146,6 +148,7 @@ pub fn run_all(
     work: &[Work],
     jobs: usize,
     args: &SweepArgs,
+    progress: &(dyn Fn(&Progress) + Sync),
 ) -> Result<Vec<Option<Vec<Option<f64>>>>, Error> {
     let stop =
         tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
@@ -190,9 +193,13 @@ pub fn run_all(
                     }
                 }
                 let n = ended.fetch_add(1, Ordering::SeqCst) + 1;
-                if !args.quiet {
-                    progress(n, todo.len(), start, w);
-                }
+                progress(&Progress {
+                    ended: n,
+                    total: todo.len(),
+                    elapsed: start.elapsed(),
+                    run: w.name(),
+                    what: w.what.clone(),
+                });
             });
         }
     });
@@ -206,18 +213,37 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-/// `tactile sweep: 12/40 runs, 0:31 elapsed, about 1:12 left (run-0011: ...)`.
-fn progress(n: usize, total: usize, start: Instant, w: &Work) {
-    let elapsed = start.elapsed().as_secs_f64();
-    let left = elapsed / n as f64 * (total - n) as f64;
-    let mmss = |s: f64| format!("{}:{:02}", (s / 60.0) as u64, (s % 60.0) as u64);
-    crate::noteln!(
-        "tactile sweep: {n}/{total} runs, {} elapsed, about {} left ({}: {})",
-        mmss(elapsed),
-        mmss(left),
-        w.name(),
-        w.what
-    );
+/// A run of the sweep ended: what a progress bar or line shows.
+#[derive(Debug, Clone)]
+pub struct Progress {
+    /// Runs ended so far, this one included (not counting those `--resume` kept).
+    pub ended: usize,
+    /// Runs this sweep runs (not counting those `--resume` kept).
+    pub total: usize,
+    /// Since the first run started.
+    pub elapsed: Duration,
+    /// The run's folder's name, `run-0011`.
+    pub run: String,
+    /// Its combination, `KEY=VALUE ...`.
+    pub what: String,
+}
+
+impl Progress {
+    /// `tactile sweep: 12/40 runs, 0:31 elapsed, about 1:12 left (run-0011: ...)`.
+    pub fn say(&self) {
+        let elapsed = self.elapsed.as_secs_f64();
+        let left = elapsed / self.ended as f64 * (self.total - self.ended) as f64;
+        let mmss = |s: f64| format!("{}:{:02}", (s / 60.0) as u64, (s % 60.0) as u64);
+        crate::noteln!(
+            "tactile sweep: {}/{} runs, {} elapsed, about {} left ({}: {})",
+            self.ended,
+            self.total,
+            mmss(elapsed),
+            mmss(left),
+            self.run,
+            self.what
+        );
+    }
 }
 
 /// `tactile sweep: run-0003 stopped before it ended (KEY=VALUE ...)`.

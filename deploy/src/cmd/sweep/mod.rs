@@ -21,7 +21,9 @@ mod table;
 mod traces;
 
 use crate::error::Error;
+use crate::launch::Source;
 use clap::Args;
+pub use exec::Progress;
 use std::path::{Path, PathBuf};
 use tactile_report::sweep::{axis, combinations, Axis};
 use tactile_scenario::overrides::Set;
@@ -164,6 +166,42 @@ fn warn_once(work: &[exec::Work]) {
     }
 }
 
+/// What a sweep starts every run from: a scenario's source and the `--set`s applied
+/// to it before the swept ones (none from the command; a Python `Scenario`'s
+/// `with_set`s). A swept key given here too takes the swept value.
+#[derive(Debug, Clone)]
+pub struct Base {
+    /// The scenario's text and where it came from.
+    pub source: Source,
+    /// `KEY=VALUE` sets applied before each run's swept values.
+    pub sets: Vec<String>,
+}
+
+impl Base {
+    /// The scenario file `path`, read as `tactile run` reads it, with no sets.
+    pub fn file(path: &Path) -> Result<Self, Error> {
+        Ok(Base {
+            source: Source::file(path)?,
+            sets: Vec::new(),
+        })
+    }
+
+    /// FNV-1a of the text (then of each set, a newline before each), hex: what
+    /// `--resume` and `--merge` compare. With no sets, the file's bytes' hash alone,
+    /// as `sweep.json` has always recorded it.
+    fn hash(&self) -> String {
+        let mut bytes = self.source.text.as_bytes().to_vec();
+        for s in &self.sets {
+            bytes.push(b'\n');
+            bytes.extend_from_slice(s.as_bytes());
+        }
+        let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
+        });
+        format!("{h:016x}")
+    }
+}
+
 /// `tactile sweep`.
 pub fn main(args: &SweepArgs) -> Result<(), Error> {
     args.formats.refuse_unless(
@@ -177,14 +215,39 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         .scenario
         .as_deref()
         .ok_or_else(|| Error::BadInput("a scenario file is needed".into()))?;
+    let runs = sweep(&Base::file(scenario)?, args, &|p: &Progress| {
+        if !args.quiet {
+            p.say();
+        }
+    })?;
+    crate::outln!(
+        "tactile sweep: {runs} runs{}; sweep.csv and one plot per metric in {}",
+        args.shard
+            .as_deref()
+            .map_or_else(String::new, |s| format!(" (shard {s})")),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Runs the sweep `args` asks for (its scenario file aside: `base` is what every
+/// run starts from) into `args.out`, telling `progress` as each run ends; the runs
+/// it ran. Every run's scenario is checked before the first starts, so a bad value
+/// is bad input with nothing run. The tables are written even when a run fails or a
+/// stop request cuts the sweep short (then the error says so).
+pub fn sweep(
+    base: &Base,
+    args: &SweepArgs,
+    progress: &(dyn Fn(&Progress) + Sync),
+) -> Result<usize, Error> {
     let axes = parse_axes(&args.set)?;
     let combos = combinations(&axes);
     check_size(args, &axes, combos.len())?;
     let shard = args.shard.as_deref().map(parse_shard).transpose()?;
     let jobs = jobs(args)?;
     let spec = Spec {
-        scenario: scenario.display().to_string(),
-        scenario_hash: file_hash(scenario)?,
+        scenario: base.source.name.clone(),
+        scenario_hash: base.hash(),
         sets: args.set.clone(),
         seeds: args.seeds,
         combinations: combos.len(),
@@ -193,15 +256,13 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
     let mine: Vec<usize> = (0..combos.len())
         .filter(|k| shard.is_none_or(|(s, n)| k % n == s - 1))
         .collect();
-    // Every run's scenario is checked before the first starts, so a bad value is bad
-    // input (exit 2) with nothing run.
-    let work = exec::plan(scenario, &axes, &combos, &mine, args)?;
+    let work = exec::plan(base, &axes, &combos, &mine, args)?;
     warn_once(&work);
     let holder = format!("tactile sweep (pid {})", std::process::id());
     let _held = tactile_report::out::take(&args.out, &holder)?;
     table::check_resume(&args.out, &spec, args.resume)?;
     table::write_spec(&args.out, &spec)?;
-    let done = exec::run_all(&work, jobs, args);
+    let done = exec::run_all(&work, jobs, args, progress);
     // Even after a failure: the dataset then holds the runs that ended, no stale ones.
     traces::gather(&args.out, work.iter().map(|w| w.dir.as_path()))?;
     let done = done?;
@@ -242,13 +303,7 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
             failed.join(", ")
         )));
     }
-    crate::outln!(
-        "tactile sweep: {} runs{}; sweep.csv and one plot per metric in {}",
-        work.len(),
-        shard.map_or_else(String::new, |(k, n)| format!(" (shard {k}/{n})")),
-        args.out.display()
-    );
-    Ok(())
+    Ok(work.len())
 }
 
 /// The axes of `--set`s, each key once.
@@ -299,24 +354,16 @@ fn parse_shard(s: &str) -> Result<(usize, usize), Error> {
     Ok((k, n))
 }
 
-/// FNV-1a of a file's bytes, hex.
-fn file_hash(path: &Path) -> Result<String, Error> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        Error::BadInput(format!("{}: cannot read the scenario: {e}", path.display()))
-    })?;
-    let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
-    });
-    Ok(format!("{h:016x}"))
-}
-
-/// The `--set`s of one run: the combination's values, and its seed when seeds vary.
-fn sets_of(axes: &[Axis], combo: &[usize], seed: Option<u64>) -> Result<Vec<Set>, Error> {
-    let mut sets: Vec<Set> = axes
-        .iter()
-        .zip(combo)
-        .map(|(a, &i)| a.sets[i].clone())
-        .collect();
+/// The `--set`s of one run: the base's, then the combination's values, then its seed
+/// when seeds vary (later sets of a key win).
+fn sets_of(
+    base: &[Set],
+    axes: &[Axis],
+    combo: &[usize],
+    seed: Option<u64>,
+) -> Result<Vec<Set>, Error> {
+    let mut sets = base.to_vec();
+    sets.extend(axes.iter().zip(combo).map(|(a, &i)| a.sets[i].clone()));
     if let Some(s) = seed {
         sets.push(Set::parse(&format!("seed={s}")).map_err(Error::BadInput)?);
     }

@@ -1,7 +1,8 @@
-"""The Python package against the command (tests/api.rs runs this with the built
-module on PYTHONPATH): the same errors, the same summary and trace, the GIL released
-while a run computes, Ctrl-C. Usage: api.py TACTILE_BINARY WORK_DIR REPO_ROOT."""
+"""The Python package against the command (api.rs runs pytest here with the built
+module on PYTHONPATH, TACTILE_BIN and TACTILE_ROOT set): the same errors, the same
+summary and trace, the GIL released while a run computes, Ctrl-C."""
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -13,16 +14,23 @@ import pyarrow.parquet as pq
 
 import tactile
 
-tactile_bin, work, root = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
-paper = root / "deploy" / "scenarios" / "paper.toml"
-panda = root / "deploy" / "scenarios" / "panda.toml"
+import pytest
+
+ROOT = Path(os.environ["TACTILE_ROOT"])
+paper = ROOT / "deploy" / "scenarios" / "paper.toml"
+panda = ROOT / "deploy" / "scenarios" / "panda.toml"
 
 
 def cli(*args):
-    return subprocess.run([tactile_bin, *args], capture_output=True, text=True)
+    return subprocess.run([os.environ["TACTILE_BIN"], *args], capture_output=True, text=True)
 
 
-def bad_input_is_the_commands_error():
+@pytest.fixture
+def work(tmp_path):
+    return tmp_path
+
+
+def test_bad_input_is_the_commands_error(work):
     sc = tactile.Scenario.load(paper)
     for key, value, text, names in [
             ("samples", -3, "-3", "samples=-3"),
@@ -57,7 +65,7 @@ def bad_input_is_the_commands_error():
     assert 'name = "wall \U0001F600"' in named, named
 
 
-def sets_are_the_commands():
+def test_sets_are_the_commands():
     sc = tactile.Scenario.load(paper).with_set(
         {"samples": 300, "control.kind": "tdpa", "network.forward.delay_ms": 50,
          "network.forward.noise_std": [0.0, 0.0, 0.0]})
@@ -70,7 +78,7 @@ def sets_are_the_commands():
     assert any("50 ms" in n for n in notes), notes
 
 
-def a_run_is_the_commands_run():
+def test_a_run_is_the_commands_run(work):
     sc = tactile.Scenario.load(paper).with_set({"samples": 400, "control.kind": "tdpa"})
     r = tactile.run(sc, out=work / "py")
     c = cli("run", str(paper), "--in-process", "-q", "--set", "samples=400",
@@ -94,7 +102,7 @@ def a_run_is_the_commands_run():
     assert tactile.report(work / "py").out == work / "py"
 
 
-def in_memory_and_an_arm():
+def test_in_memory_and_an_arm():
     sc = tactile.Scenario.load(panda).with_set({"samples": 300})
     r = tactile.run(sc)
     assert r.out is None and r.completed
@@ -103,7 +111,7 @@ def in_memory_and_an_arm():
     assert "q_1" in r.joints.column_names and r.summary["task_space"] is not None
 
 
-def the_gil_is_released_while_it_runs():
+def test_the_gil_is_released_while_it_runs():
     sc = tactile.Scenario.paper().with_set({"samples": 40_000})
     done, failed = threading.Event(), []
 
@@ -148,7 +156,7 @@ time.sleep(60)
 """
 
 
-def ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs():
+def test_ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs(work):
     """SIGINT (a terminal's Ctrl-C, a notebook's interrupt) ends a run as it ends the
     command: KeyboardInterrupt, the report of what ran written and marked; again after
     Python's handler is installed anew (as a notebook's kernel does); the next run
@@ -179,9 +187,3 @@ def ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs():
             p.wait()
 
 
-for test in [bad_input_is_the_commands_error, sets_are_the_commands,
-             a_run_is_the_commands_run, in_memory_and_an_arm,
-             the_gil_is_released_while_it_runs,
-             ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs]:
-    test()
-    print(f"ok {test.__name__}", flush=True)

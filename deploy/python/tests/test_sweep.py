@@ -1,0 +1,106 @@
+"""tactile.sweep against the command's sweep: the wall-delay study of docs/05 equals
+deploy/results/wall-delay/sweep.csv, the table's columns and types, the sets a
+Scenario carries, bad input before any run, progress, and a progress callback's
+exception stopping the sweep with the runs that ended kept."""
+import os
+import subprocess
+from pathlib import Path
+
+import pandas
+import pytest
+
+import tactile
+
+ROOT = Path(os.environ["TACTILE_ROOT"])
+WALL = ROOT / "deploy" / "scenarios" / "wall-delay.toml"
+PAPER = ROOT / "deploy" / "scenarios" / "paper.toml"
+DELAYS_MS = [0, 10, 50, 100, 200]
+KINDS = ["none", "tdpa", "wave"]
+
+
+def test_the_wall_delay_sweep_equals_the_commands_table(tmp_path):
+    sc = tactile.Scenario.load(WALL)
+    df = tactile.sweep(sc, {"network.forward.delay_ms": DELAYS_MS, "control.kind": KINDS,
+                            "network.backward.delay_ms": [0]}, out=tmp_path / "s",
+                       progress=False)
+    ref = pandas.read_csv(ROOT / "deploy" / "results" / "wall-delay" / "sweep.csv")
+    assert len(df) == len(ref) == 15
+    metrics = list(ref.columns[ref.columns.get_loc("seed"):])
+    pandas.testing.assert_frame_equal(df[metrics], ref[metrics], check_exact=True)
+    assert list(df["network.forward.delay_ms"]) == [d for d in DELAYS_MS for _ in KINDS]
+    assert list(df["control.kind"]) == KINDS * len(DELAYS_MS)
+    assert list(df["run"]) == list(ref["run"])
+    assert df["folder"].map(lambda f: (Path(f) / "summary.json").is_file()).all()
+
+
+def test_columns_are_the_same_whatever_the_seeds_and_keep_python_types(tmp_path):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 200})
+    grid = {"network.forward.delay": [[0, 0, 0], [5, 5, 5]], "control.kind": ["none", "tdpa"]}
+    one = tactile.sweep(sc, grid, out=tmp_path / "one", progress=False)
+    two = tactile.sweep(sc, grid, seeds=2, jobs=1, out=tmp_path / "two", progress=False)
+    assert list(one.columns) == list(two.columns)
+    assert list(one.columns[:5]) == ["run", "combination", "network.forward.delay",
+                                     "control.kind", "seed"]
+    assert one.columns[-1] == "folder"
+    assert len(one) == 4 and len(two) == 8
+    assert two["network.forward.delay"].iloc[-1] == [5, 5, 5]
+    assert isinstance(two["control.kind"].iloc[0], str)
+    first = int(one["seed"].iloc[0])
+    assert sorted(set(two["seed"])) == [first, first + 1]
+    # The Scenario's own sets are every run's: 200 samples each.
+    assert (one["samples_sent"] == 200).all() and (two["samples_sent"] == 200).all()
+    # The long table is sweep.csv, and sweep-summary.csv holds the means.
+    assert (tmp_path / "two" / "sweep-summary.csv").is_file()
+
+
+def test_a_swept_key_replaces_the_scenarios_set_of_it(tmp_path):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 999})
+    df = tactile.sweep(sc, {"samples": [100, 150]}, progress=False)
+    assert list(df["samples_sent"]) == [100, 150]
+    assert df["folder"].isna().all()
+
+
+def test_bad_input_runs_nothing(tmp_path):
+    sc = tactile.Scenario.load(PAPER)
+    out = tmp_path / "bad"
+    cases = [({"control.kind": ["none", "nope"]}, "unknown variant `nope`"),
+             ({"control.kind": "tdpa"}, "control.kind: give its values as a non-empty list"),
+             ({"control.kind": []}, "non-empty list"),
+             ({}, "give the swept keys"),
+             ({"no.such": [1]}, "unknown field `no`")]
+    for grid, said in cases:
+        with pytest.raises(tactile.ScenarioError, match=said.replace("`", ".")):
+            tactile.sweep(sc, grid, out=out, progress=False)
+        assert not (out / "run-0000").exists()
+    with pytest.raises(tactile.ScenarioError, match="--seeds 0"):
+        tactile.sweep(sc, {"samples": [10]}, seeds=0, out=out, progress=False)
+    # The command says the same of the same value.
+    c = subprocess.run([os.environ["TACTILE_BIN"], "sweep", str(PAPER), "--set",
+                        "control.kind=none,nope", "--out", str(out)],
+                       capture_output=True, text=True)
+    assert c.returncode == 2 and "unknown variant `nope`" in c.stderr, c.stderr
+
+
+def test_progress_is_told_and_an_exception_there_stops_the_sweep(tmp_path, capsys):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 100})
+    seen = []
+    tactile.sweep(sc, {"samples": [100, 110, 120]}, jobs=1, out=tmp_path / "a",
+                  progress=lambda ended, total, run, what: seen.append((ended, total, run, what)))
+    assert [s[:3] for s in seen] == [(1, 3, "run-0000"), (2, 3, "run-0001"), (3, 3, "run-0002")]
+    assert seen[0][3] == "samples=100"
+
+    class Enough(Exception):
+        pass
+
+    def stop(ended, total, run, what):
+        raise Enough(run)
+
+    with pytest.raises(Enough, match="run-0000"):
+        tactile.sweep(sc, {"samples": [100, 110, 120]}, jobs=1, out=tmp_path / "b",
+                      progress=stop)
+    rows = pandas.read_csv(tmp_path / "b" / "sweep.csv")
+    assert list(rows["run"]) == ["run-0000"]
+    # Without tqdm, the command's line on standard error; with it, a bar there.
+    tactile.sweep(sc, {"samples": [100]}, out=tmp_path / "c")
+    err = capsys.readouterr().err
+    assert "1/1" in err, err
