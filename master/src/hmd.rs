@@ -14,9 +14,9 @@
 //! ([`MasterSide`]) decides what is sent for c(n) and which force comes of q(n).
 //! Either hand reaches the trajectory from the devices' home along [`Approach`].
 
-use crate::operator::{Approach, OperatorSource, Target, IDENTITY};
+use crate::operator::{Approach, Operate, OperatorSource, Scripted, Target, IDENTITY};
 use crate::simulated::HeldDevice;
-use tactile_control::codec::{Deadband, Estimate, Predictor};
+use tactile_control::codec::{Deadband, Estimate, Guess, Predictor};
 use tactile_control::passivity::{MasterForce, MasterSide};
 use tactile_devices::hand::Hand;
 use tactile_math::engine::Engine;
@@ -58,6 +58,8 @@ pub struct Master {
     /// The physical master device: f64 kernels (encoders read the true angles).
     truth: Engine,
     source: OperatorSource,
+    /// An operator from outside in place of `source`'s targets (the Python API).
+    scripted: Option<Scripted>,
     t_s: f64,
     t_s_ns: u64,
     theta_md: [f64; 3],
@@ -133,6 +135,7 @@ impl Master {
             truth: Engine::new(tactile_math::arith::ArithKind::F64, geometry, cordic)
                 .map_err(|e| no_engine(e.into()))?,
             source,
+            scripted: None,
             t_s: scenario.t_s(),
             t_s_ns: scenario.t_s_ns(),
             theta_md: [0.0; 3],
@@ -162,6 +165,28 @@ impl Master {
             handle: home,
             pose_input: false,
         })
+    }
+
+    /// Takes the simulated hand's targets from `operate` instead of the scenario's
+    /// operator (whose orientation and clutch are then refused: `operate` gives
+    /// positions). The approach from home always runs, since the first target is not
+    /// known before the run. Call before the first sample.
+    pub fn set_operator(&mut self, operate: Box<dyn Operate>) -> Result<(), ScenarioError> {
+        if self.source.six_dof() {
+            return Err(ScenarioError::Invalid {
+                field: "operator".into(),
+                problem: "its trajectory has an orientation or a clutch (6-DoF), but a scripted operator gives positions only: give a 3-DoF operator".into(),
+            });
+        }
+        self.approach = Approach::from_home(self.home, self.limits.hand.approach_s);
+        self.scripted = Some(Scripted::new(operate, self.home));
+        Ok(())
+    }
+
+    /// Fills gaps in h(n) with `guess` instead of the predictor's kind
+    /// (`[master.predictor]`'s acceptance and horizon still hold).
+    pub fn set_predictor(&mut self, guess: Box<dyn Guess>) {
+        self.predictor.set_guess(guess);
     }
 
     /// Counters so far.
@@ -360,8 +385,11 @@ impl Master {
 
     /// What the hand means to do at sample n: the trajectory, blended in from the
     /// devices' home over the approach (both hands, so neither starts with a jump).
-    fn target(&self, n: u64) -> Target {
-        let a = self.source.target(n, self.t_s);
+    fn target(&mut self, n: u64) -> Target {
+        let a = match &mut self.scripted {
+            Some(s) => s.target(n, self.t_s, self.last_felt),
+            None => self.source.target(n, self.t_s),
+        };
         match &self.approach {
             Some(approach) => approach.apply(a, n as f64 * self.t_s),
             None => a,
@@ -369,7 +397,7 @@ impl Master {
     }
 
     /// The impedance hand's intended position at sample n.
-    fn intended(&self, n: u64) -> [f64; 3] {
+    fn intended(&mut self, n: u64) -> [f64; 3] {
         match self.target(n) {
             Target::Joints(theta) => self.truth.fk(theta),
             Target::Position(p) => p,

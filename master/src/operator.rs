@@ -28,6 +28,48 @@ pub enum Target {
     Position([f64; 3]),
 }
 
+/// An operator written outside this crate (a Python function, through the Python
+/// API): called once a sample, in a run's order, so it may keep state (a human model,
+/// a scripted reaction to what the hand feels).
+pub trait Operate: Send {
+    /// Where the hand means the handle to be at sample `n` (time `t`, s), given the
+    /// force it felt at the sample before (N, zero at first): a position, m. `None`
+    /// holds the last target (the implementation says why, and stops the run).
+    fn target(&mut self, n: u64, t: f64, felt: [f64; 3]) -> Option<[f64; 3]>;
+}
+
+/// An [`Operate`] in the master's loop: its targets, a missing or non-finite one
+/// replaced by the last (the devices' home before the first).
+pub struct Scripted {
+    operate: Box<dyn Operate>,
+    last: [f64; 3],
+}
+
+impl std::fmt::Debug for Scripted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Scripted {{ last: {:?} }}", self.last)
+    }
+}
+
+impl Scripted {
+    /// `operate`, starting from `home`.
+    pub fn new(operate: Box<dyn Operate>, home: [f64; 3]) -> Self {
+        Scripted {
+            operate,
+            last: home,
+        }
+    }
+
+    /// The target at sample `n`, period `t_s`, the hand having felt `felt`.
+    pub fn target(&mut self, n: u64, t_s: f64, felt: [f64; 3]) -> Target {
+        match self.operate.target(n, n as f64 * t_s, felt) {
+            Some(p) if p.iter().all(|x| x.is_finite()) => self.last = p,
+            _ => {}
+        }
+        Target::Position(self.last)
+    }
+}
+
 /// A ready trajectory.
 #[derive(Debug, Clone, PartialEq)]
 pub enum OperatorSource {
@@ -107,6 +149,12 @@ impl Approach {
         let s = min_jerk(t / self.seconds);
         let q = UnitQuaternion::identity().slerp(&unit(r), s);
         [q.i, q.j, q.k, q.w]
+    }
+
+    /// The approach for a target not known before the run (a [`Scripted`]
+    /// operator's), or `None` for a zero duration.
+    pub fn from_home(home: [f64; 3], seconds: f64) -> Option<Approach> {
+        (seconds > 0.0).then_some(Approach { home, seconds })
     }
 
     /// See [`Approach::apply_rotation`]; positions and joints.

@@ -14,7 +14,7 @@
 
 use crate::environment::{deepest_contact, Scene};
 use crate::slave_arm::SlaveArm;
-use tactile_control::codec::{Deadband, Estimate, Predictor};
+use tactile_control::codec::{Deadband, Estimate, Guess, Predictor};
 use tactile_control::passivity::SlaveSide;
 use tactile_math::arith::StdTrig;
 use tactile_math::joints::Joints;
@@ -85,6 +85,12 @@ impl Slave {
             measured: None,
             rotation: None,
         })
+    }
+
+    /// Fills gaps in v(n) with `guess` instead of the predictor's kind
+    /// (`[slave.predictor]`'s acceptance and horizon still hold).
+    pub fn set_predictor(&mut self, guess: Box<dyn Guess>) {
+        self.predictor.set_guess(guess);
     }
 
     /// Counters so far.

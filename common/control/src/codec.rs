@@ -94,8 +94,53 @@ impl Estimate {
     }
 }
 
+/// Most accepted values a [`Guess`] is shown, oldest first: enough for any
+/// polynomial or filter over the last tens of milliseconds at 1 kHz, and a bound on
+/// the memory a long run holds.
+pub const HISTORY: usize = 64;
+
+/// A guess made outside this crate (a Python function, through the Python API), in
+/// place of the predictor's kind's. The predictor still decides what is accepted
+/// (finite, physically possible), when a guess is needed and how far ahead
+/// (`horizon_s`); a guess that is `None` or not finite holds the last value, as the
+/// kinds' do.
+pub trait Guess: Send {
+    /// The value at the sender's sample `to`, for the receiver's sample `n`, from
+    /// `history`: the values accepted so far, `(sender's sample, value)`, oldest first,
+    /// the last [`HISTORY`] of them (never empty).
+    fn guess(&mut self, n: u64, to: u64, history: &[(u64, [f64; 3])]) -> Option<[f64; 3]>;
+}
+
+/// A [`Guess`] and the history it is shown.
+struct Custom {
+    guess: Box<dyn Guess>,
+    history: std::collections::VecDeque<(u64, [f64; 3])>,
+}
+
+impl std::fmt::Debug for Custom {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Custom {{ history: {} values }}", self.history.len())
+    }
+}
+
+impl Custom {
+    /// `at`'s value accepted: the last one replaced if it is of the same sample (the
+    /// real value of a sample the channel first stood in for), else appended.
+    fn accept(&mut self, at: u64, v: [f64; 3]) {
+        match self.history.back_mut() {
+            Some(last) if last.0 == at => *last = (at, v),
+            _ => {
+                if self.history.len() == HISTORY {
+                    self.history.pop_front();
+                }
+                self.history.push_back((at, v));
+            }
+        }
+    }
+}
+
 /// A receiver's predictor over three axes; time is the sender's sample number.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Predictor {
     cfg: PredictorConfig,
     t_s: f64,
@@ -104,6 +149,7 @@ pub struct Predictor {
     before: Option<(u64, [f64; 3])>,
     arrived_at: u64,
     kalman: [Kalman; 3],
+    custom: Option<Custom>,
 }
 
 /// A constant-velocity Kalman filter on one axis.
@@ -181,7 +227,17 @@ impl Predictor {
             before: None,
             arrived_at: 0,
             kalman: [Kalman::default(); 3],
+            custom: None,
         }
+    }
+
+    /// Guesses with `guess` from now on, in place of the kind's (its history
+    /// starts empty: call before the first sample).
+    pub fn set_guess(&mut self, guess: Box<dyn Guess>) {
+        self.custom = Some(Custom {
+            guess,
+            history: std::collections::VecDeque::with_capacity(HISTORY),
+        });
     }
 
     /// True once a value has been accepted.
@@ -217,6 +273,9 @@ impl Predictor {
         self.last = None;
         self.before = None;
         self.kalman = [Kalman::default(); 3];
+        if let Some(c) = &mut self.custom {
+            c.history.clear();
+        }
     }
 
     /// Finite, no larger than `max_rate` allows over a second, and no faster from the
@@ -244,6 +303,9 @@ impl Predictor {
     }
 
     fn accept(&mut self, at: u64, v: [f64; 3]) {
+        if let Some(c) = &mut self.custom {
+            c.accept(at, v);
+        }
         if self.last.is_some_and(|(t, _)| t == at) {
             // The real value of a sample the channel first stood in for replaces it.
             self.last = Some((at, v));
@@ -272,12 +334,20 @@ impl Predictor {
 
     /// The guess for the receiver's sample `n`: the sender's signal at its sample
     /// number of the last value plus the samples since that value arrived.
-    fn predict(&self, n: u64) -> [f64; 3] {
+    fn predict(&mut self, n: u64) -> [f64; 3] {
         let Some((t1, x1)) = self.last else {
             return [0.0; 3];
         };
         let horizon = (self.cfg.horizon_s / self.t_s).round() as u64;
-        let n = t1 + n.saturating_sub(self.arrived_at).min(horizon);
+        let to = t1 + n.saturating_sub(self.arrived_at).min(horizon);
+        if let Some(c) = &mut self.custom {
+            let history = c.history.make_contiguous();
+            return match c.guess.guess(n, to, history) {
+                Some(g) if g.iter().all(|x| x.is_finite()) => g,
+                _ => x1,
+            };
+        }
+        let n = to;
         let guess = match self.cfg.kind {
             PredictorKind::Hold => x1,
             PredictorKind::Linear => match self.before {
@@ -405,5 +475,60 @@ mod tests {
             p.estimate(3, Some((3, [0.1001; 3]))),
             Estimate::Fresh([0.1001; 3])
         );
+    }
+
+    /// Each call's `(n, to, history)`.
+    type Seen = std::sync::Arc<std::sync::Mutex<Vec<(u64, u64, Vec<(u64, [f64; 3])>)>>>;
+
+    /// A guess that records what it was shown and answers with a fixed value, or
+    /// nothing.
+    struct Shown {
+        seen: Seen,
+        answer: Option<[f64; 3]>,
+    }
+
+    impl Guess for Shown {
+        fn guess(&mut self, n: u64, to: u64, history: &[(u64, [f64; 3])]) -> Option<[f64; 3]> {
+            self.seen
+                .lock()
+                .expect("not poisoned")
+                .push((n, to, history.to_vec()));
+            self.answer
+        }
+    }
+
+    fn shown(answer: Option<[f64; 3]>) -> (Predictor, Seen) {
+        let seen = std::sync::Arc::default();
+        let mut p = predictor(PredictorKind::Linear);
+        p.set_guess(Box::new(Shown {
+            seen: std::sync::Arc::clone(&seen),
+            answer,
+        }));
+        (p, seen)
+    }
+
+    #[test]
+    fn a_guess_from_outside_sees_a_bounded_history_and_is_checked() {
+        let (mut p, seen) = shown(Some([0.5; 3]));
+        // More values than the history holds, each accepted, then a gap.
+        for k in 0..100u64 {
+            let v = [k as f64 * 1e-5; 3];
+            assert_eq!(p.estimate(k, Some((k, v))), Estimate::Fresh(v));
+        }
+        // The real value of sample 99 replaces the one the channel stood in for.
+        p.estimate(100, Some((99, [2e-3; 3])));
+        assert_eq!(p.estimate(101, None), Estimate::Predicted([0.5; 3]));
+        let seen = seen.lock().expect("not poisoned");
+        let (n, to, history) = &seen[0];
+        assert_eq!((*n, *to), (101, 100));
+        assert_eq!(history.len(), HISTORY);
+        assert_eq!(history[0].0, 100 - HISTORY as u64);
+        assert_eq!(history[HISTORY - 1], (99, [2e-3; 3]));
+        // Nothing, or a value not finite, holds the last one.
+        for answer in [None, Some([f64::NAN, 0.0, 0.0])] {
+            let (mut p, _) = shown(answer);
+            p.estimate(0, Some((0, [0.1; 3])));
+            assert_eq!(p.estimate(1, None), Estimate::Predicted([0.1; 3]));
+        }
     }
 }

@@ -16,6 +16,9 @@
 //! the run to stop after the sample in hand, as SIGINT asks the command, and is raised
 //! once the report of what ran is written.
 
+mod hooks;
+
+use hooks::Raised;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -169,11 +172,13 @@ fn check(
 }
 
 /// `tactile run --in-process` into `out`, the trace as `trace_format` (csv, parquet,
-/// both); whether it completed is its summary's (`failed`). A KeyboardInterrupt
-/// while it runs ends it after the sample in hand and is raised once the report of
-/// what ran is written (marked `interrupted`); the next run starts afresh.
+/// both), with the Python callables given in its loop (see [`hooks`]); whether it
+/// completed is its summary's (`failed`). A KeyboardInterrupt while it runs ends it
+/// after the sample in hand and is raised once the report of what ran is written
+/// (marked `interrupted`); so is the first exception a callable raised. The next run
+/// starts afresh.
 #[pyfunction]
-#[pyo3(signature = (text, base_dir, name, path, sets, out, trace_format))]
+#[pyo3(signature = (text, base_dir, name, path, sets, out, trace_format, operator, backward_predictor, forward_predictor))]
 #[allow(clippy::too_many_arguments)] // the source's four parts, as everywhere here
 fn run(
     py: Python<'_>,
@@ -184,15 +189,23 @@ fn run(
     sets: Vec<String>,
     out: PathBuf,
     trace_format: &str,
+    operator: Option<Py<PyAny>>,
+    backward_predictor: Option<Py<PyAny>>,
+    forward_predictor: Option<Py<PyAny>>,
 ) -> PyResult<()> {
     let outputs = outputs(trace_format)?;
     let src = source(text, base_dir, name, path);
+    let raised = Raised::default();
+    let hooks = hooks::hooks([operator, backward_predictor, forward_predictor], &raised);
     signals::clear_stop();
     let summary = waiting(py, || {
         let loaded = load(&src, &sets)?;
-        tactile::launch::sim::run_in_process(&loaded, &out, &outputs)
-    })?;
-    if summary.interrupted {
+        tactile::launch::sim::run_in_process(&loaded, &out, &outputs, hooks)
+    });
+    if let Some(e) = hooks::take(&raised) {
+        return Err(e);
+    }
+    if summary?.interrupted {
         return Err(to_py(Error::Interrupted));
     }
     Ok(())

@@ -83,7 +83,12 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
         crate::noteln!("tactile: warning: {w}");
     }
     let summary = if args.in_process {
-        launch::sim::run_in_process(&loaded, &args.out, &args.formats.outputs(args.no_trace))?
+        launch::sim::run_in_process(
+            &loaded,
+            &args.out,
+            &args.formats.outputs(args.no_trace),
+            Default::default(),
+        )?
     } else {
         launch::clean_stale_runs();
         let link = Links::on_this_host(if args.udp { LinkKind::Udp } else { args.link })?;

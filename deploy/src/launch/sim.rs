@@ -10,9 +10,10 @@
 
 use crate::error::Error;
 use std::path::Path;
+use tactile_control::codec::Guess;
 use tactile_master::handler::MasterHandler;
 use tactile_master::hmd::Master;
-use tactile_master::operator::OperatorSource;
+use tactile_master::operator::{Operate, OperatorSource};
 use tactile_messages::Role;
 use tactile_network_emulator::emulator::Emulator;
 use tactile_network_emulator::handler::EmulatorHandler;
@@ -24,6 +25,30 @@ use tactile_runtime::driver::{in_process, Link, Timing};
 use tactile_scenario::Scenario;
 use tactile_slave::handler::SlaveHandler;
 use tactile_slave::hsd::Slave;
+
+/// Code from outside the scenario in the loop of an in-process run (the Python API's
+/// callables): each in place of its part of the scenario. Only in-process: a callable
+/// lives in the caller's process, and its time is not the loop's.
+#[derive(Default)]
+pub struct Hooks {
+    /// The simulated hand's targets, in place of `[operator]`'s.
+    pub operator: Option<Box<dyn Operate>>,
+    /// The master's guess of h(n) for a sample missing or late, in place of
+    /// `[master.predictor]`'s kind.
+    pub backward_predictor: Option<Box<dyn Guess>>,
+    /// The slave's guess of v(n), in place of `[slave.predictor]`'s kind.
+    pub forward_predictor: Option<Box<dyn Guess>>,
+}
+
+impl std::fmt::Debug for Hooks {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Hooks")
+            .field("operator", &self.operator.is_some())
+            .field("backward_predictor", &self.backward_predictor.is_some())
+            .field("forward_predictor", &self.forward_predictor.is_some())
+            .finish()
+    }
+}
 
 /// The run token of a simulation (there is no master process to choose one).
 pub const SIM_RUN: u64 = 1;
@@ -67,21 +92,33 @@ fn record<S: serde::Serialize, C: serde::Serialize>(
 /// resolves a trajectory file's path. A stop request (SIGINT, SIGTERM) ends it after
 /// the sample in hand, its records closed as `interrupted`; returns whether it ran
 /// to the end.
-pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<bool, Error> {
+pub fn simulate(
+    scenario: &Scenario,
+    base_dir: &Path,
+    out: &Path,
+    hooks: Hooks,
+) -> Result<bool, Error> {
     tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     let source = OperatorSource::load(&scenario.operator, base_dir)
         .map_err(|e| Error::BadInput(e.to_string()))?;
     let bad = |e: tactile_scenario::ScenarioError| Error::BadInput(e.to_string());
-    let master = MasterHandler::new(
-        Master::new(scenario, source).map_err(bad)?,
-        None,
-        scenario.faults.peer_timeout_samples,
-    );
+    let mut master = Master::new(scenario, source).map_err(bad)?;
+    if let Some(op) = hooks.operator {
+        master.set_operator(op).map_err(bad)?;
+    }
+    if let Some(g) = hooks.backward_predictor {
+        master.set_predictor(g);
+    }
+    let master = MasterHandler::new(master, None, scenario.faults.peer_timeout_samples);
     let replays =
         tactile_network_emulator::replay::load(scenario, base_dir).map_err(Error::BadInput)?;
     let emulator = EmulatorHandler::new(Emulator::with_replays(scenario, replays));
     let arm = tactile_slave::peripherals::read_arm(scenario, base_dir).map_err(Error::BadInput)?;
-    let slave = SlaveHandler::new(Slave::new(scenario, arm).map_err(bad)?, scenario, None);
+    let mut slave = Slave::new(scenario, arm).map_err(bad)?;
+    if let Some(g) = hooks.forward_predictor {
+        slave.set_predictor(g);
+    }
+    let slave = SlaveHandler::new(slave, scenario, None);
     let timing = Timing::Simulated {
         t_s_ns: scenario.t_s_ns(),
     };
@@ -119,12 +156,14 @@ pub fn simulate(scenario: &Scenario, base_dir: &Path, out: &Path) -> Result<bool
 }
 
 /// A run in-process into `out`, as `tactile run --in-process` and each run of a sweep
-/// do it: the folder made ready (inputs copied in), the simulation, its report (cut
-/// short and marked so if a stop request ended the simulation).
+/// do it: the folder made ready (inputs copied in), the simulation (with `hooks` in
+/// its loop), its report (cut short and marked so if a stop request ended the
+/// simulation).
 pub fn run_in_process(
     loaded: &super::Loaded,
     out: &Path,
     outputs: &super::Outputs,
+    hooks: Hooks,
 ) -> Result<tactile_report::summary::Summary, Error> {
     if tactile_runtime::outside::ros_in_run(&loaded.scenario) {
         return Err(Error::BadInput(
@@ -132,7 +171,7 @@ pub fn run_in_process(
         ));
     }
     let (bundled, _held) = super::prepare_out(out, loaded)?;
-    let completed = simulate(&bundled.scenario, &bundled.base_dir, out)?;
+    let completed = simulate(&bundled.scenario, &bundled.base_dir, out, hooks)?;
     let launch = tactile_report::write::Launch {
         stop: tactile_runtime::signals::stop_flag().ok(),
         outputs: outputs.clone(),

@@ -31,9 +31,17 @@ from typing import Any, Callable, Mapping, Optional, Sequence, Union
 from . import _native
 from ._native import RunError, ScenarioError
 
-__all__ = ["Scenario", "Run", "run", "sweep", "report", "ScenarioError", "RunError"]
+__all__ = ["Scenario", "Run", "run", "sweep", "report", "ScenarioError", "RunError",
+           "CallbackError"]
 
 PathLike = Union[str, "os.PathLike[str]"]
+
+
+class CallbackError(RunError):
+    """A Python callable in a run's loop raised or gave a value the run cannot take
+    (not three finite numbers); the message names the callable and the sample, the
+    callable's own exception is the cause. The run stopped after that sample and its
+    report (marked interrupted) was written."""
 
 
 def _toml_string(s: str) -> str:
@@ -174,24 +182,108 @@ class Run:
         return f"<tactile.Run {self.out or '(in memory)'} completed={self.completed} round_trip_p50_ns={rt}>"
 
 
-def run(scenario: Scenario, out: Optional[PathLike] = None,
-        trace_format: str = "parquet") -> Run:
+Operator = Callable[[int, float, "numpy.ndarray"], Any]
+Predictor = Callable[[int, int, "numpy.ndarray"], Any]
+
+
+def _three(r: Any, what: str, n: int) -> tuple:
+    """A callable's result as three finite floats, or CallbackError naming the sample."""
+    import numpy as np
+    try:
+        a = np.asarray(r, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise CallbackError(f"{what} at sample {n}: gave {r!r}, not three numbers ({e})") from None
+    if a.shape != (3,):
+        raise CallbackError(f"{what} at sample {n}: gave an array of shape {a.shape}, "
+                            "not three numbers (shape (3,))")
+    if not np.isfinite(a).all():
+        raise CallbackError(f"{what} at sample {n}: gave {a.tolist()}, not finite")
+    return float(a[0]), float(a[1]), float(a[2])
+
+
+def _raised(what: str, n: int, e: Exception) -> CallbackError:
+    return CallbackError(f"{what} at sample {n}: {type(e).__name__}: {e}")
+
+
+def _operator(f: Operator) -> Callable:
+    """The operator as the loop calls it: (n, t, fx, fy, fz) -> three floats."""
+    import numpy as np
+
+    def call(n: int, t: float, fx: float, fy: float, fz: float) -> tuple:
+        try:
+            r = f(n, t, np.array((fx, fy, fz)))
+        except Exception as e:
+            raise _raised("operator", n, e) from e
+        return _three(r, "operator", n)
+    return call
+
+
+def _predictor(f: Predictor, what: str) -> Callable:
+    """A predictor as the loop calls it: (n, to, history's bytes) -> three floats;
+    the history a read-only (k, 4) array, rows [sample, x, y, z], oldest first."""
+    import numpy as np
+
+    def call(n: int, to: int, raw: bytes) -> tuple:
+        history = np.frombuffer(raw, dtype=np.float64).reshape(-1, 4)
+        try:
+            r = f(n, to, history)
+        except Exception as e:
+            raise _raised(what, n, e) from e
+        return _three(r, what, n)
+    return call
+
+
+def _hook(f: Any, wrap: Callable, name: str, *args: str) -> Optional[Callable]:
+    if f is None:
+        return None
+    if not callable(f):
+        raise ScenarioError(f"{name}: give a function, not a {type(f).__name__}")
+    return wrap(f, *args)
+
+
+def run(scenario: Scenario, out: Optional[PathLike] = None, trace_format: str = "parquet",
+        operator: Optional[Operator] = None,
+        backward_predictor: Optional[Predictor] = None,
+        forward_predictor: Optional[Predictor] = None) -> Run:
     """Runs `scenario` in this process, as `tactile run --in-process` does, into
     folder `out` (None: a temporary folder, read into memory and removed, with it the
     report of a run that failed or was interrupted). The GIL is released while it
-    runs. Bad input raises ScenarioError; a failed run RunError after its report is
-    read; Ctrl-C stops the run after the sample in hand and raises
-    KeyboardInterrupt once its report is written."""
+    runs, except while a callable below runs. Bad input raises ScenarioError; a failed
+    run RunError after its report is read; Ctrl-C stops the run after the sample in
+    hand and raises KeyboardInterrupt once its report is written.
+
+    Python in the loop, each called on the run's thread when the loop needs it:
+
+    - `operator(n, t, felt)`: the simulated hand's target at sample n (time t, s),
+      given `felt`, the force (N, a (3,) array) the hand was made to feel at the sample
+      before; returns the handle's position (m, three numbers), in place of the
+      scenario's `[operator]` (which must be 3-DoF). The hand (`[master.hand]`) and
+      its approach from home move the handle there, as with a built-in operator.
+    - `backward_predictor(n, to, history)`: the master's guess of the slave's force
+      h for its sample n (missing, late, not sent or rejected), at the slave's sample
+      `to`, from `history`, the values accepted so far (a read-only (k, 4) array, rows
+      `[sample, x, y, z]`, oldest first, at most 64); in place of
+      `[master.predictor]`'s kind, whose acceptance checks and `horizon_s` still hold.
+    - `forward_predictor(n, to, history)`: the slave's guess of the master's position
+      v, likewise, in place of `[slave.predictor]`'s kind.
+
+    A callable that raises, or returns anything but three finite numbers, stops the
+    run after that sample; CallbackError, naming the callable and the sample, is
+    raised once the report is written."""
+    hooks = (_hook(operator, _operator, "operator"),
+             _hook(backward_predictor, _predictor, "backward_predictor", "backward predictor"),
+             _hook(forward_predictor, _predictor, "forward_predictor", "forward predictor"))
     if out is None:
         with tempfile.TemporaryDirectory(prefix="tactile-run-") as tmp:
-            r = _run_into(scenario, Path(tmp) / "run", trace_format, kept=False)
+            r = _run_into(scenario, Path(tmp) / "run", trace_format, hooks, kept=False)
             r.out = None
             return r
-    return _run_into(scenario, Path(out), trace_format, kept=True)
+    return _run_into(scenario, Path(out), trace_format, hooks, kept=True)
 
 
-def _run_into(scenario: Scenario, out: Path, trace_format: str, kept: bool) -> Run:
-    _native.run(*scenario._source(), os.fspath(out), trace_format)
+def _run_into(scenario: Scenario, out: Path, trace_format: str, hooks: tuple,
+              kept: bool) -> Run:
+    _native.run(*scenario._source(), os.fspath(out), trace_format, *hooks)
     r = Run.read(out)
     if not r.completed:
         events = "; ".join(r.summary.get("events", [])[:1])

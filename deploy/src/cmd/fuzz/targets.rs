@@ -61,7 +61,8 @@ pub(super) fn records(scratch: &Path) -> Result<Target, String> {
     let text = crate::launch::PAPER_SCENARIO.replace("samples = 1200", "samples = 30");
     let scenario = tactile_scenario::Scenario::from_toml_str(&text).map_err(|e| e.to_string())?;
     std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
-    crate::launch::sim::simulate(&scenario, scratch, &out).map_err(|e| e.to_string())?;
+    crate::launch::sim::simulate(&scenario, scratch, &out, Default::default())
+        .map_err(|e| e.to_string())?;
     let seeds = ["master", "emulator", "slave"]
         .iter()
         .map(|r| std::fs::read(out.join(format!("{r}.rec"))).map_err(|e| e.to_string()))

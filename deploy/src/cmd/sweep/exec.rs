@@ -268,7 +268,7 @@ fn run_one(w: &Work, args: &SweepArgs) -> Result<Option<Vec<Option<f64>>>, Error
         let sup = launch::sweep_supervision(outputs);
         launch::run_processes(l, &w.dir, &sup)?
     } else {
-        launch::sim::run_in_process(l, &w.dir, &outputs)?
+        launch::sim::run_in_process(l, &w.dir, &outputs, Default::default())?
     };
     if summary.interrupted {
         return Ok(None);

@@ -1,0 +1,111 @@
+//! Python callables in the loop of an in-process run: the operator and the two
+//! predictors, each called once a sample it is needed at, on the run's thread, with
+//! the GIL taken for the call. The package's Python half wraps the user's function so
+//! that what reaches here is already checked (three finite numbers) and an exception
+//! names the sample; an exception, kept in [`Raised`], asks the run to stop after the
+//! sample in hand and is raised once the run has ended, and no callable of the run is
+//! called after it.
+
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use std::sync::{Arc, Mutex};
+use tactile::launch::sim::Hooks;
+use tactile_control::codec::{Guess, HISTORY};
+use tactile_master::operator::Operate;
+use tactile_runtime::signals;
+
+/// The first exception a run's callables raised, kept until the run has ended.
+pub type Raised = Arc<Mutex<Option<PyErr>>>;
+
+/// The exception kept, if any.
+pub fn take(raised: &Raised) -> Option<PyErr> {
+    raised.lock().unwrap_or_else(|p| p.into_inner()).take()
+}
+
+/// One of the run's callables (the Python half's wrapper, which returns three
+/// floats or raises).
+struct Callable {
+    f: Py<PyAny>,
+    raised: Raised,
+}
+
+impl Callable {
+    /// `f(args)` as three numbers; `None` once any of the run's callables raised
+    /// (this one now: its exception is kept and the run asked to stop).
+    fn call<A>(&self, args: A) -> Option<[f64; 3]>
+    where
+        A: for<'py> pyo3::call::PyCallArgs<'py>,
+    {
+        if self.lock().is_some() {
+            return None;
+        }
+        // The lock is not held over the call: the GIL is taken there.
+        let got = Python::attach(|py| {
+            self.f
+                .call1(py, args)
+                .and_then(|r| r.extract::<(f64, f64, f64)>(py))
+        });
+        match got {
+            Ok((x, y, z)) => Some([x, y, z]),
+            Err(e) => {
+                self.lock().get_or_insert(e);
+                signals::request_stop();
+                None
+            }
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Option<PyErr>> {
+        self.raised.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+/// The operator: `f(n, t, fx, fy, fz)`, the force the hand felt as its last three.
+struct Operator(Callable);
+
+impl Operate for Operator {
+    fn target(&mut self, n: u64, t: f64, felt: [f64; 3]) -> Option<[f64; 3]> {
+        self.0.call((n, t, felt[0], felt[1], felt[2]))
+    }
+}
+
+/// A predictor: `f(n, to, history)`, the history as the bytes of a (k, 4) float64
+/// array, rows `[sample, x, y, z]`, oldest first.
+struct Predictor {
+    call: Callable,
+    bytes: Vec<u8>,
+}
+
+impl Guess for Predictor {
+    fn guess(&mut self, n: u64, to: u64, history: &[(u64, [f64; 3])]) -> Option<[f64; 3]> {
+        self.bytes.clear();
+        for (at, v) in history {
+            for x in [*at as f64, v[0], v[1], v[2]] {
+                self.bytes.extend_from_slice(&x.to_ne_bytes());
+            }
+        }
+        let raw = Python::attach(|py| PyBytes::new(py, &self.bytes).unbind());
+        self.call.call((n, to, raw))
+    }
+}
+
+/// The hooks for `[operator, backward predictor, forward predictor]`, each the
+/// Python half's wrapper or None, sharing `raised`.
+pub fn hooks(f: [Option<Py<PyAny>>; 3], raised: &Raised) -> Hooks {
+    let [operator, backward, forward] = f;
+    let callable = |f: Py<PyAny>| Callable {
+        f,
+        raised: Arc::clone(raised),
+    };
+    let predictor = |f: Py<PyAny>| -> Box<dyn Guess> {
+        Box::new(Predictor {
+            call: callable(f),
+            bytes: Vec::with_capacity(HISTORY * 4 * 8),
+        })
+    };
+    Hooks {
+        operator: operator.map(|f| Box::new(Operator(callable(f))) as Box<dyn Operate>),
+        backward_predictor: backward.map(predictor),
+        forward_predictor: forward.map(predictor),
+    }
+}

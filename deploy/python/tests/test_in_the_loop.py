@@ -1,0 +1,145 @@
+"""Python in the loop of an in-process run: a predictor written in Python equal to the
+built-in one gives a byte-identical trace (both channels, with a lossy network and
+deadband codecs, so the predictors fill thousands of samples); so does an operator
+equal to the built-in circle; the operator is called once a sample in order with the
+force felt at the sample before; a bad result or an exception stops the run and is
+raised naming the callable and the sample, the report kept."""
+import filecmp
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+import tactile
+
+ROOT = Path(os.environ["TACTILE_ROOT"])
+PAPER = ROOT / "deploy" / "scenarios" / "paper.toml"
+WALL = ROOT / "deploy" / "scenarios" / "wall-delay.toml"
+LOSSY = {"codec.forward.kind": "deadband", "codec.backward.kind": "deadband",
+         "network.forward.loss": 0.05, "network.backward.loss": 0.05}
+
+
+def hold(n, to, history):
+    return history[-1, 1:]
+
+
+def linear(n, to, history):
+    """The built-in `linear`: on from the last two values accepted."""
+    t1, x1 = history[-1, 0], history[-1, 1:]
+    if len(history) < 2:
+        return x1
+    t0, x0 = history[-2, 0], history[-2, 1:]
+    if not (to > t1 > t0):
+        return x1
+    return x1 + (to - t1) / (t1 - t0) * (x1 - x0)
+
+
+@pytest.mark.parametrize("kind,guess", [("linear", linear), ("hold", hold)])
+def test_a_predictor_in_python_equal_to_the_built_in_gives_the_same_trace(tmp_path, kind,
+                                                                          guess):
+    sc = tactile.Scenario.load(PAPER).with_set(
+        {**LOSSY, "slave.predictor.kind": kind, "master.predictor.kind": kind})
+    calls = {"backward": 0, "forward": 0}
+    shapes = set()
+
+    def counted(side):
+        def f(n, to, history):
+            calls[side] += 1
+            shapes.add(history.shape[1])
+            assert not history.flags.writeable and len(history) <= 64
+            assert history[-1, 0] <= to
+            return guess(n, to, history)
+        return f
+
+    tactile.run(sc, out=tmp_path / "built-in", trace_format="csv")
+    tactile.run(sc, out=tmp_path / "python", trace_format="csv",
+                backward_predictor=counted("backward"), forward_predictor=counted("forward"))
+    assert filecmp.cmp(tmp_path / "built-in" / "trace.csv", tmp_path / "python" / "trace.csv",
+                       shallow=False)
+    assert calls["backward"] > 500 and calls["forward"] > 500, calls
+    assert shapes == {4}
+    # A predictor that guesses otherwise changes the run: the hook is in the loop.
+    tactile.run(sc, out=tmp_path / "zero", trace_format="csv",
+                forward_predictor=lambda n, to, h: np.zeros(3))
+    assert not filecmp.cmp(tmp_path / "built-in" / "trace.csv",
+                           tmp_path / "zero" / "trace.csv", shallow=False)
+
+
+def circle_scenario(base):
+    toml = base.to_toml()
+    assert '[operator]\nkind = "paper"' in toml
+    return tactile.Scenario.from_toml(toml.replace(
+        '[operator]\nkind = "paper"',
+        '[operator]\nkind = "circle"\ncenter = [0.0, 0.15, 0.05]\nradius = 0.03\nperiod_s = 2.0'))
+
+
+def test_an_operator_in_python_equal_to_the_circle_gives_the_same_trace(tmp_path):
+    base = tactile.Scenario.load(PAPER).with_set({"samples": 1500})
+
+    def circle(n, t, felt):
+        w = 2.0 * math.pi * t / 2.0
+        return (0.0 + 0.03 * math.cos(w), 0.15 + 0.03 * math.sin(w), 0.05)
+
+    tactile.run(circle_scenario(base), out=tmp_path / "built-in", trace_format="csv")
+    tactile.run(base, out=tmp_path / "python", trace_format="csv", operator=circle)
+    assert filecmp.cmp(tmp_path / "built-in" / "trace.csv", tmp_path / "python" / "trace.csv",
+                       shallow=False)
+
+
+def test_the_operator_is_called_each_sample_with_the_force_felt_before():
+    sc = tactile.Scenario.load(WALL).with_set({"samples": 1500})
+    seen = []
+
+    def press(n, t, felt):
+        seen.append((n, t, felt.copy()))
+        return np.array([0.0, -0.11, -0.035 - 0.04 * min(t / 0.5, 1.0)])
+
+    r = tactile.run(sc, operator=press)
+    assert [s[0] for s in seen] == list(range(1500))
+    assert all(t == n * 0.001 for n, t, _ in seen)
+    felt = np.column_stack([r.trace.column(f"felt_{i}").to_numpy() for i in (1, 2, 3)])
+    got = np.array([s[2] for s in seen])
+    assert (got[0] == 0).all()
+    np.testing.assert_array_equal(got[1:], felt[:-1])
+    assert np.abs(felt).max() > 1.0, "the wall was never felt"
+
+
+def test_a_bad_result_or_an_exception_stops_the_run_naming_the_sample(tmp_path):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 1000})
+    here = (0.0, 0.15, 0.05)
+    cases = [
+        ("nan", lambda n, t, f: (math.nan, 0.0, 0.0) if n == 300 else here,
+         r"operator at sample 300: gave \[nan, 0.0, 0.0\], not finite"),
+        ("shape", lambda n, t, f: (1.0, 2.0) if n == 40 else here,
+         r"operator at sample 40: gave an array of shape \(2,\)"),
+        ("text", lambda n, t, f: "up" if n == 7 else here, "operator at sample 7: gave 'up'"),
+        ("raises", lambda n, t, f: 1 / (n - 12) and here,
+         "operator at sample 12: ZeroDivisionError"),
+    ]
+    for name, op, said in cases:
+        out = tmp_path / name
+        with pytest.raises(tactile.CallbackError, match=said) as e:
+            tactile.run(sc, out=out, operator=op)
+        summary = json.loads((out / "summary.json").read_text())
+        assert summary["interrupted"] is True
+        stopped_at = int(said.split("sample ")[1].split(":")[0])
+        assert stopped_at < summary["samples_sent"] <= stopped_at + 3, summary["samples_sent"]
+    assert isinstance(e.value.__cause__, ZeroDivisionError)
+    lossy = tactile.Scenario.load(PAPER).with_set(LOSSY)
+    with pytest.raises(tactile.CallbackError, match=r"forward predictor at sample \d+: gave"):
+        tactile.run(lossy, forward_predictor=lambda n, to, h: [math.inf] * 3)
+    # The next run runs whole: the stop the callable asked for is not left behind.
+    assert tactile.run(sc, operator=lambda n, t, f: here).completed
+
+
+def test_what_cannot_take_a_callable_is_refused(tmp_path):
+    sc = tactile.Scenario.load(PAPER)
+    with pytest.raises(tactile.ScenarioError, match="operator: give a function"):
+        tactile.run(sc, operator=[0.0, 0.1, 0.0])
+    pose = tactile.Scenario.load(ROOT / "deploy" / "scenarios" / "panda-pose.toml")
+    with pytest.raises(tactile.ScenarioError, match="a scripted operator gives positions"):
+        tactile.run(pose, out=tmp_path / "pose", operator=lambda n, t, f: (0.0, 0.0, 0.0))
