@@ -172,7 +172,7 @@ fn check(
 }
 
 /// `tactile run --in-process` into `out`, the trace as `trace_format` (csv, parquet,
-/// both), with the Python callables given in its loop (see [`hooks`]); whether it
+/// both; None: `--no-trace`), with the Python callables given in its loop (see [`hooks`]); whether it
 /// completed is its summary's (`failed`). A KeyboardInterrupt while it runs ends it
 /// after the sample in hand and is raised once the report of what ran is written
 /// (marked `interrupted`); so is the first exception a callable raised. The next run
@@ -188,7 +188,7 @@ fn run(
     path: Option<&str>,
     sets: Vec<String>,
     out: PathBuf,
-    trace_format: &str,
+    trace_format: Option<&str>,
     operator: Option<Py<PyAny>>,
     backward_predictor: Option<Py<PyAny>>,
     forward_predictor: Option<Py<PyAny>>,
@@ -243,7 +243,7 @@ fn sweep(
         processes: false,
         trace,
         formats: FormatArgs {
-            trace_format: outputs(trace_format)?.trace_format,
+            trace_format: outputs(Some(trace_format))?.trace_format,
             mcap_compression: Default::default(),
         },
         jobs,
@@ -281,7 +281,7 @@ fn report(
     out: Option<PathBuf>,
     trace_format: &str,
 ) -> PyResult<PathBuf> {
-    let outputs = outputs(trace_format)?;
+    let outputs = outputs(Some(trace_format))?;
     signals::clear_stop();
     waiting(py, || {
         let out = match out {
@@ -308,9 +308,16 @@ fn write_into(dirs: &[PathBuf], out: &Path, outputs: Outputs) -> Result<(), Erro
     Ok(())
 }
 
-/// The outputs of a run or report from Python: its trace as `trace_format`.
-fn outputs(trace_format: &str) -> PyResult<Outputs> {
-    let trace_format = trace_format
+/// The outputs of a run or report from Python: its trace as `trace_format`, or no
+/// trace and no recording for None (the command's `--no-trace`).
+fn outputs(trace_format: Option<&str>) -> PyResult<Outputs> {
+    let Some(format) = trace_format else {
+        return Ok(Outputs {
+            no_trace: true,
+            ..Outputs::default()
+        });
+    };
+    let trace_format = format
         .parse()
         .map_err(|e: String| ScenarioError::new_err(format!("trace_format: {e}")))?;
     Ok(Outputs {

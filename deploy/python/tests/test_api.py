@@ -111,6 +111,15 @@ def test_in_memory_and_an_arm():
     assert "q_1" in r.joints.column_names and r.summary["task_space"] is not None
 
 
+def test_no_trace_is_the_commands_no_trace(work):
+    sc = tactile.Scenario.paper().with_set({"samples": 200})
+    r = tactile.run(sc, out=work / "bare", trace_format=None)
+    assert r.trace is None and r.summary["samples_sent"] == 200
+    assert not any((work / "bare" / f).exists() for f in ["trace.parquet", "trace.csv", "run.mcap"])
+    with pytest.raises(tactile.ScenarioError, match="trace_format"):
+        tactile.run(sc, trace_format="xlsx")
+
+
 def test_the_gil_is_released_while_it_runs():
     sc = tactile.Scenario.paper().with_set({"samples": 40_000})
     done, failed = threading.Event(), []

@@ -241,7 +241,8 @@ def _hook(f: Any, wrap: Callable, name: str, *args: str) -> Optional[Callable]:
     return wrap(f, *args)
 
 
-def run(scenario: Scenario, out: Optional[PathLike] = None, trace_format: str = "parquet",
+def run(scenario: Scenario, out: Optional[PathLike] = None,
+        trace_format: Optional[str] = "parquet",
         operator: Optional[Operator] = None,
         backward_predictor: Optional[Predictor] = None,
         forward_predictor: Optional[Predictor] = None) -> Run:
@@ -250,7 +251,9 @@ def run(scenario: Scenario, out: Optional[PathLike] = None, trace_format: str = 
     report of a run that failed or was interrupted). The GIL is released while it
     runs, except while a callable below runs. Bad input raises ScenarioError; a failed
     run RunError after its report is read; Ctrl-C stops the run after the sample in
-    hand and raises KeyboardInterrupt once its report is written.
+    hand and raises KeyboardInterrupt once its report is written. `trace_format` is
+    the command's `--trace-format` (parquet, csv, both); None writes no trace and no
+    recording, as `--no-trace` (then `Run.trace` is None).
 
     Python in the loop, each called on the run's thread when the loop needs it:
 
@@ -281,7 +284,7 @@ def run(scenario: Scenario, out: Optional[PathLike] = None, trace_format: str = 
     return _run_into(scenario, Path(out), trace_format, hooks, kept=True)
 
 
-def _run_into(scenario: Scenario, out: Path, trace_format: str, hooks: tuple,
+def _run_into(scenario: Scenario, out: Path, trace_format: Optional[str], hooks: tuple,
               kept: bool) -> Run:
     _native.run(*scenario._source(), os.fspath(out), trace_format, *hooks)
     r = Run.read(out)
