@@ -104,3 +104,45 @@ def test_progress_is_told_and_an_exception_there_stops_the_sweep(tmp_path, capsy
     tactile.sweep(sc, {"samples": [100]}, out=tmp_path / "c")
     err = capsys.readouterr().err
     assert "1/1" in err, err
+
+
+INTERRUPTED = """
+import sys, tactile
+sc = tactile.Scenario.paper().with_set({"samples": 5000})
+def told(ended, total, run, what):
+    print("ended", run, flush=True)
+try:
+    tactile.sweep(sc, {"seed": list(range(1, 60))}, jobs=1, out=sys.argv[1], progress=told)
+except KeyboardInterrupt:
+    print("KeyboardInterrupt", flush=True)
+"""
+
+
+def test_ctrl_c_stops_a_sweep_keeping_the_runs_that_ended(tmp_path):
+    """SIGINT to the interpreter stops a sweep as it stops the command: the run in
+    hand ends early, the tables of the runs that ended are written, then
+    KeyboardInterrupt; resume=True runs the rest."""
+    import signal
+    import sys
+    out = tmp_path / "stopped"
+    p = subprocess.Popen([sys.executable, "-c", INTERRUPTED, str(out)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert p.stdout.readline().strip() == "ended run-0000", p.stderr.read()
+        p.send_signal(signal.SIGINT)
+        lines = [line.strip() for line in p.stdout]
+        p.wait(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    assert lines and lines[-1] == "KeyboardInterrupt", (lines, p.stderr.read())
+    rows = pandas.read_csv(out / "sweep.csv")
+    ended = [line.split()[1] for line in lines[:-1]]
+    assert list(rows["run"]) == ["run-0000"] + ended and len(rows) < 59
+    assert "stopped by a signal" in p.stderr.read()
+    # The rest, resumed: every run, the ones kept from before unchanged.
+    sc = tactile.Scenario.paper().with_set({"samples": 5000})
+    df = tactile.sweep(sc, {"seed": list(range(1, 60))}, out=out, resume=True, progress=False)
+    assert len(df) == 59 and list(df["seed"]) == list(range(1, 60))
+    assert (df["samples_sent"] == 5000).all()
