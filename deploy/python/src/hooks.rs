@@ -2,17 +2,18 @@
 //! predictors, each called once a sample it is needed at, on the run's thread, with
 //! the GIL taken for the call. The package's Python half wraps the user's function so
 //! that what reaches here is already checked (three finite numbers) and an exception
-//! names the sample; an exception, kept in [`Raised`], asks the run to stop after the
-//! sample in hand and is raised once the run has ended, and no callable of the run is
-//! called after it.
+//! names the sample; an exception, kept in [`Raised`], asks this run alone to stop
+//! after the sample in hand (`Hooks::halt`, not the process's stop request, which
+//! would stop every run of the process) and is raised once the run has ended; no
+//! callable of the run is called after it.
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use tactile::launch::sim::Hooks;
 use tactile_control::codec::{Guess, HISTORY};
 use tactile_master::operator::Operate;
-use tactile_runtime::signals;
 
 /// The first exception a run's callables raised, kept until the run has ended.
 pub type Raised = Arc<Mutex<Option<PyErr>>>;
@@ -27,12 +28,14 @@ pub fn take(raised: &Raised) -> Option<PyErr> {
 struct Callable {
     f: Py<PyAny>,
     raised: Raised,
+    /// The run's own stop request (`Hooks::halt`).
+    halt: Arc<AtomicBool>,
 }
 
 impl Callable {
     /// `f(args)` as three numbers; `None` once any of the run's callables raised
     /// (this one now: its exception is kept and the run asked to stop).
-    fn call<A>(&self, args: A) -> Option<[f64; 3]>
+    fn call<A>(&self, args: impl FnOnce(Python<'_>) -> A) -> Option<[f64; 3]>
     where
         A: for<'py> pyo3::call::PyCallArgs<'py>,
     {
@@ -42,14 +45,14 @@ impl Callable {
         // The lock is not held over the call: the GIL is taken there.
         let got = Python::attach(|py| {
             self.f
-                .call1(py, args)
+                .call1(py, args(py))
                 .and_then(|r| r.extract::<(f64, f64, f64)>(py))
         });
         match got {
             Ok((x, y, z)) => Some([x, y, z]),
             Err(e) => {
                 self.lock().get_or_insert(e);
-                signals::request_stop();
+                self.halt.store(true, Ordering::SeqCst);
                 None
             }
         }
@@ -65,7 +68,7 @@ struct Operator(Callable);
 
 impl Operate for Operator {
     fn target(&mut self, n: u64, t: f64, felt: [f64; 3]) -> Option<[f64; 3]> {
-        self.0.call((n, t, felt[0], felt[1], felt[2]))
+        self.0.call(|_| (n, t, felt[0], felt[1], felt[2]))
     }
 }
 
@@ -84,8 +87,9 @@ impl Guess for Predictor {
                 self.bytes.extend_from_slice(&x.to_ne_bytes());
             }
         }
-        let raw = Python::attach(|py| PyBytes::new(py, &self.bytes).unbind());
-        self.call.call((n, to, raw))
+        let bytes = &self.bytes;
+        self.call
+            .call(|py| (n, to, PyBytes::new(py, bytes).unbind()))
     }
 }
 
@@ -93,9 +97,11 @@ impl Guess for Predictor {
 /// Python half's wrapper or None, sharing `raised`.
 pub fn hooks(f: [Option<Py<PyAny>>; 3], raised: &Raised) -> Hooks {
     let [operator, backward, forward] = f;
+    let halt = Arc::new(AtomicBool::new(false));
     let callable = |f: Py<PyAny>| Callable {
         f,
         raised: Arc::clone(raised),
+        halt: Arc::clone(&halt),
     };
     let predictor = |f: Py<PyAny>| -> Box<dyn Guess> {
         Box::new(Predictor {
@@ -107,5 +113,6 @@ pub fn hooks(f: [Option<Py<PyAny>>; 3], raised: &Raised) -> Hooks {
         operator: operator.map(|f| Box::new(Operator(callable(f))) as Box<dyn Operate>),
         backward_predictor: backward.map(predictor),
         forward_predictor: forward.map(predictor),
+        halt: Arc::clone(&halt),
     }
 }

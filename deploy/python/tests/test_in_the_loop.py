@@ -62,11 +62,17 @@ def test_a_predictor_in_python_equal_to_the_built_in_gives_the_same_trace(tmp_pa
                        shallow=False)
     assert calls["backward"] > 500 and calls["forward"] > 500, calls
     assert shapes == {4}
-    # A predictor that guesses otherwise changes the run: the hook is in the loop.
-    tactile.run(sc, out=tmp_path / "zero", trace_format="csv",
-                forward_predictor=lambda n, to, h: np.zeros(3))
-    assert not filecmp.cmp(tmp_path / "built-in" / "trace.csv",
-                           tmp_path / "zero" / "trace.csv", shallow=False)
+    # A predictor that guesses otherwise changes the run, on either side: the hooks
+    # are in the loop.
+    for side in ["forward_predictor", "backward_predictor"]:
+        r = tactile.run(sc, out=tmp_path / side, trace_format="csv",
+                        **{side: lambda n, to, h: np.zeros(3)})
+        assert not filecmp.cmp(tmp_path / "built-in" / "trace.csv",
+                               tmp_path / side / "trace.csv", shallow=False), side
+        # The report says a hook stood in for the scenario's predictor.
+        assert any("predictor was a hook" in e for e in r.summary["events"]), r.summary
+    builtin = json.loads((tmp_path / "built-in" / "summary.json").read_text())
+    assert not any("hook" in e for e in builtin["events"])
 
 
 def circle_scenario(base):
@@ -143,3 +149,28 @@ def test_what_cannot_take_a_callable_is_refused(tmp_path):
     pose = tactile.Scenario.load(ROOT / "deploy" / "scenarios" / "panda-pose.toml")
     with pytest.raises(tactile.ScenarioError, match="a scripted operator gives positions"):
         tactile.run(pose, out=tmp_path / "pose", operator=lambda n, t, f: (0.0, 0.0, 0.0))
+    # Refused before anything is made.
+    assert not (tmp_path / "pose").exists()
+
+
+def test_a_failing_callable_stops_its_own_run_only(tmp_path):
+    """The stop a callable's error asks for is its run's: a run in another thread
+    goes on to its end, and an error at the last sample still marks the run
+    interrupted with its whole report."""
+    import threading
+    long = tactile.Scenario.paper().with_set({"samples": 30_000})
+    other = {}
+
+    def beside():
+        other["run"] = tactile.run(long, trace_format=None)
+
+    t = threading.Thread(target=beside)
+    t.start()
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 400})
+    here = (0.0, 0.15, 0.05)
+    with pytest.raises(tactile.CallbackError, match="operator at sample 399"):
+        tactile.run(sc, out=tmp_path / "last", operator=lambda n, t, f: None if n == 399 else here)
+    t.join()
+    assert other["run"].completed and other["run"].summary["samples_sent"] == 30_000
+    summary = json.loads((tmp_path / "last" / "summary.json").read_text())
+    assert summary["interrupted"] is True and summary["samples_sent"] == 400

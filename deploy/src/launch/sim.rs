@@ -10,6 +10,8 @@
 
 use crate::error::Error;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use tactile_control::codec::Guess;
 use tactile_master::handler::MasterHandler;
 use tactile_master::hmd::Master;
@@ -38,6 +40,44 @@ pub struct Hooks {
     pub backward_predictor: Option<Box<dyn Guess>>,
     /// The slave's guess of v(n), in place of `[slave.predictor]`'s kind.
     pub forward_predictor: Option<Box<dyn Guess>>,
+    /// Set by a hook that failed: the run stops after the sample in hand, its report
+    /// marked interrupted. The run's own, not the process's stop request, so other
+    /// runs of the process go on and this run's report is written whole.
+    pub halt: Arc<AtomicBool>,
+}
+
+impl Hooks {
+    /// What the report says of the hooks in the loop (`summary.json`'s events), so
+    /// the run's folder does not pass them off as its scenario's parts.
+    fn events(&self) -> Vec<String> {
+        [
+            (self.operator.is_some(), "the operator", "[operator]"),
+            (self.backward_predictor.is_some(), "the master's predictor", "[master.predictor]'s kind"),
+            (self.forward_predictor.is_some(), "the slave's predictor", "[slave.predictor]'s kind"),
+        ]
+        .into_iter()
+        .filter(|(set, _, _)| *set)
+        .map(|(_, what, instead)| {
+            format!("{what} was a hook from outside the scenario (the Python API) in place of {instead}: scenario.toml alone does not repeat this run")
+        })
+        .collect()
+    }
+
+    /// A hook the scenario cannot take, refused before anything is made: an operator
+    /// hook gives positions, so the scenario's operator must be 3-DoF.
+    fn check(&self, loaded: &super::Loaded) -> Result<(), Error> {
+        if self.operator.is_none() {
+            return Ok(());
+        }
+        let source = OperatorSource::load(&loaded.scenario.operator, &loaded.base_dir)
+            .map_err(|e| Error::BadInput(e.to_string()))?;
+        if source.six_dof() {
+            return Err(Error::BadInput(
+                "operator: its trajectory has an orientation or a clutch (6-DoF), but a scripted operator gives positions only: give a 3-DoF operator".into(),
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl std::fmt::Debug for Hooks {
@@ -46,6 +86,7 @@ impl std::fmt::Debug for Hooks {
             .field("operator", &self.operator.is_some())
             .field("backward_predictor", &self.backward_predictor.is_some())
             .field("forward_predictor", &self.forward_predictor.is_some())
+            .field("halt", &self.halt)
             .finish()
     }
 }
@@ -102,6 +143,7 @@ pub fn simulate(
     let source = OperatorSource::load(&scenario.operator, base_dir)
         .map_err(|e| Error::BadInput(e.to_string()))?;
     let bad = |e: tactile_scenario::ScenarioError| Error::BadInput(e.to_string());
+    let halt = Arc::clone(&hooks.halt);
     let mut master = Master::new(scenario, source).map_err(bad)?;
     if let Some(op) = hooks.operator {
         master.set_operator(op).map_err(bad)?;
@@ -137,7 +179,8 @@ pub fn simulate(
         record(Role::Master, scenario, base_dir, out)?,
         opts,
         None,
-    );
+    )
+    .halt_on(halt);
     let emu = Follow::new(
         emulator,
         link(ep),
@@ -170,17 +213,28 @@ pub fn run_in_process(
             "an in-process run simulates both devices and has no live view: a ros2 backend or ros.live needs the node programs (tactile run without --in-process)".into(),
         ));
     }
+    hooks.check(loaded)?;
     let (bundled, _held) = super::prepare_out(out, loaded)?;
+    let halt = Arc::clone(&hooks.halt);
+    let events = hooks.events();
     let completed = simulate(&bundled.scenario, &bundled.base_dir, out, hooks)?;
+    // A hook that failed at the last sample stopped nothing, but its sample was not
+    // the hook's: the run is not whole either way.
+    let halted = halt.load(Ordering::SeqCst);
     let launch = tactile_report::write::Launch {
         stop: tactile_runtime::signals::stop_flag().ok(),
         outputs: outputs.clone(),
+        events,
         ..Default::default()
     };
-    let launch = if completed {
-        launch
-    } else {
-        launch.interrupted()
+    let launch = match (completed, halted) {
+        (true, false) => launch,
+        // The run's own stop: no signal hurries the report, which is written whole.
+        (_, true) => tactile_report::write::Launch {
+            interrupted: true,
+            ..launch
+        },
+        (false, false) => launch.interrupted(),
     };
     Ok(tactile_report::write::write_report(
         std::slice::from_ref(&out.to_path_buf()),

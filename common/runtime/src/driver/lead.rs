@@ -94,6 +94,8 @@ pub struct Lead<H: Leader> {
     slot: Option<Box<Arrival>>,
     /// The record of the answer in hand, kept from answer to answer.
     record: Option<H::Sample>,
+    /// This run's own stop request, beside the process's (see [`Lead::halt_on`]).
+    halt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl<H: Leader> std::fmt::Debug for Lead<H> {
@@ -127,7 +129,16 @@ impl<H: Leader> Lead<H> {
             forward: Forward::default(),
             slot: None,
             record: None,
+            halt: None,
         }
+    }
+
+    /// Also stops after the sample in hand once `halt` is set: a stop request of this
+    /// run alone (a Python callable in its loop that failed), where the process's
+    /// (a signal) would stop every run and every report of the process.
+    pub fn halt_on(mut self, halt: std::sync::Arc<std::sync::atomic::AtomicBool>) -> Self {
+        self.halt = Some(halt);
+        self
     }
 
     /// Runs until every sample was sent (true) or a stop request (false); every way it
@@ -279,7 +290,11 @@ impl<H: Leader> Lead<H> {
     /// Sends sample n and waits for its answer until its deadline; false if a stop
     /// request came.
     fn sample(&mut self, n: u64, t0: u64, block: &mut dyn Block) -> Result<bool, Failure> {
-        if crate::signals::stop_requested() {
+        let halted = self
+            .halt
+            .as_ref()
+            .is_some_and(|h| h.load(std::sync::atomic::Ordering::SeqCst));
+        if halted || crate::signals::stop_requested() {
             return Ok(false);
         }
         let (origin, deadline) = self.instant(n, t0);

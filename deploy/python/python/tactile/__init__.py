@@ -299,7 +299,8 @@ def _run_into(scenario: Scenario, out: Path, trace_format: Optional[str], hooks:
     _native.run(*scenario._source(), os.fspath(out), trace_format, *hooks)
     r = Run.read(out)
     if not r.completed:
-        events = "; ".join(r.summary.get("events", [])[:1])
+        said = [e for e in r.summary.get("events", []) if "(the Python API)" not in e]
+        events = "; ".join(said[:1])
         where = f"its report is in {out}" if kept else "give out= to keep its report"
         raise RunError(f"the run failed: {events} ({where})")
     return r
@@ -321,13 +322,21 @@ Progress = Callable[[int, int, str, str], Any]
 
 
 def _axis(key: Any, values: Any) -> tuple:
-    """One swept key and its values as the command's `--set KEY=V1,V2,...`."""
+    """One swept key and its values (any non-string iterable: a list, a tuple, a
+    NumPy array) as the command's `--set KEY=V1,V2,...`."""
     if not isinstance(key, str) or not key.strip():
         raise ScenarioError(f"sweep: {key!r}: a swept key is a scenario key, a string")
-    if isinstance(values, (str, bytes)) or not isinstance(values, Sequence) or not values:
+    key = key.strip()
+    try:
+        values = [] if isinstance(values, (str, bytes)) else list(values)
+    except TypeError:
+        values = []
+    if not values:
         raise ScenarioError(f"sweep: {key}: give its values as a non-empty list "
                             f"(a list of lists for a list-valued key)")
-    return key, list(values), f"{key}=" + ",".join(_toml_value(key, v) for v in values)
+    values = [v.tolist() if hasattr(v, "tolist") and getattr(v, "ndim", 0) > 0 else v
+              for v in values]
+    return key, values, f"{key}=" + ",".join(_toml_value(key, v) for v in values)
 
 
 def _terminal_progress() -> Progress:
@@ -361,13 +370,13 @@ def _progress(progress: Union[bool, Progress, None]) -> tuple:
     def update(ended: int, total: int, run: str, what: str) -> None:
         bar.total = total
         bar.set_postfix_str(f"{run}: {what}", refresh=False)
-        bar.update(ended - bar.n)
+        bar.update(max(0, ended - bar.n))
     return update, bar
 
 
 def sweep(scenario: Scenario, grid: Mapping[str, Sequence[Any]], seeds: int = 1,
           jobs: Optional[int] = None, out: Optional[PathLike] = None, trace: bool = False,
-          trace_format: str = "parquet", resume: bool = False,
+          trace_format: Optional[str] = "parquet", resume: bool = False,
           progress: Union[bool, Progress, None] = None) -> "pandas.DataFrame":
     """Runs `scenario` once for every combination of `grid`'s values (each key a
     scenario key as `with_set` takes it, its values a list; the first key varies
@@ -383,8 +392,8 @@ def sweep(scenario: Scenario, grid: Mapping[str, Sequence[Any]], seeds: int = 1,
     rows), sweep-summary.csv (mean and 95 % interval per combination), a plot per
     metric, one folder per run.
 
-    `trace` writes every run's trace (as `trace_format`); `resume` keeps the runs `out`
-    already holds. `progress`: None shows a tqdm bar if tqdm is installed, else the
+    `trace` writes every run's trace (as `trace_format`; None is no trace, as
+    `trace=False`); `resume` keeps the runs `out` already holds. `progress`: None shows a tqdm bar if tqdm is installed, else the
     command's line on standard error; False nothing; a callable is called as
     `progress(ended, total, run, what)` after each run (an exception there stops the
     sweep). Bad input raises ScenarioError before any run starts; a failed run
@@ -394,12 +403,14 @@ def sweep(scenario: Scenario, grid: Mapping[str, Sequence[Any]], seeds: int = 1,
     if not isinstance(grid, Mapping) or not grid:
         raise ScenarioError("sweep: give the swept keys as a dict {KEY: [V1, V2, ...]}")
     axes = [_axis(k, v) for k, v in grid.items()]
-    if isinstance(seeds, bool) or not isinstance(seeds, numbers.Integral):
-        raise ScenarioError(f"sweep: seeds={seeds!r}: give a whole number")
+    if isinstance(seeds, bool) or not isinstance(seeds, numbers.Integral) or seeds < 0:
+        raise ScenarioError(f"sweep: seeds={seeds!r}: give 1 to 1000")
     if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, numbers.Integral)
                              or jobs < 0):
         raise ScenarioError(f"sweep: jobs={jobs!r}: give a whole number, or None")
     import pandas  # before any run: a missing pandas is said at once
+    if trace_format is None:
+        trace, trace_format = False, "parquet"
     if out is None:
         with tempfile.TemporaryDirectory(prefix="tactile-sweep-") as tmp:
             df = _sweep_into(scenario, axes, int(seeds), jobs, Path(tmp) / "sweep",

@@ -167,7 +167,7 @@ pub fn run_all(
         );
     }
     let next = AtomicUsize::new(0);
-    let ended = AtomicUsize::new(0);
+    let ended = Mutex::new(0usize);
     let failed: Mutex<Option<Error>> = Mutex::new(None);
     let abort = AtomicBool::new(false);
     let start = Instant::now();
@@ -192,9 +192,11 @@ pub fn run_all(
                         break;
                     }
                 }
-                let n = ended.fetch_add(1, Ordering::SeqCst) + 1;
+                // Counted and told under one lock, so the counts are told in order.
+                let mut n = lock(&ended);
+                *n += 1;
                 progress(&Progress {
-                    ended: n,
+                    ended: *n,
                     total: todo.len(),
                     elapsed: start.elapsed(),
                     run: w.name(),

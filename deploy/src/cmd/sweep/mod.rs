@@ -168,7 +168,8 @@ fn warn_once(work: &[exec::Work]) {
 
 /// What a sweep starts every run from: a scenario's source and the `--set`s applied
 /// to it before the swept ones (none from the command; a Python `Scenario`'s
-/// `with_set`s). A swept key given here too takes the swept value.
+/// `with_set`s). A swept key given here too (or its twin in the other unit) takes the
+/// swept value.
 #[derive(Debug, Clone)]
 pub struct Base {
     /// The scenario's text and where it came from.
@@ -186,13 +187,13 @@ impl Base {
         })
     }
 
-    /// FNV-1a of the text (then of each set, a newline before each), hex: what
+    /// FNV-1a of the text (then of each set, a NUL before each), hex: what
     /// `--resume` and `--merge` compare. With no sets, the file's bytes' hash alone,
     /// as `sweep.json` has always recorded it.
     fn hash(&self) -> String {
         let mut bytes = self.source.text.as_bytes().to_vec();
         for s in &self.sets {
-            bytes.push(b'\n');
+            bytes.push(0);
             bytes.extend_from_slice(s.as_bytes());
         }
         let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
@@ -233,8 +234,9 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
 /// Runs the sweep `args` asks for (its scenario file aside: `base` is what every
 /// run starts from) into `args.out`, telling `progress` as each run ends; the runs
 /// it ran. Every run's scenario is checked before the first starts, so a bad value
-/// is bad input with nothing run. The tables are written even when a run fails or a
-/// stop request cuts the sweep short (then the error says so).
+/// is bad input with nothing run. The tables are written even when a run's summary
+/// says it failed or a stop request cuts the sweep short (then the error says so); a
+/// run that could not be run at all ends the sweep with its error.
 pub fn sweep(
     base: &Base,
     args: &SweepArgs,
@@ -354,15 +356,22 @@ fn parse_shard(s: &str) -> Result<(usize, usize), Error> {
     Ok((k, n))
 }
 
-/// The `--set`s of one run: the base's, then the combination's values, then its seed
-/// when seeds vary (later sets of a key win).
+/// The `--set`s of one run: the base's but those of a swept key (or of its twin in
+/// the other unit: `delay_ms` for `delay`), then the combination's values, then its
+/// seed when seeds vary.
 fn sets_of(
     base: &[Set],
     axes: &[Axis],
     combo: &[usize],
     seed: Option<u64>,
 ) -> Result<Vec<Set>, Error> {
-    let mut sets = base.to_vec();
+    let swept = |b: &Set| {
+        axes.iter().any(|a| {
+            let keys = [b.key(), a.key.clone()];
+            keys[0] == keys[1] || tactile_scenario::overrides::twins(&keys).is_some()
+        })
+    };
+    let mut sets: Vec<Set> = base.iter().filter(|b| !swept(b)).cloned().collect();
     sets.extend(axes.iter().zip(combo).map(|(a, &i)| a.sets[i].clone()));
     if let Some(s) = seed {
         sets.push(Set::parse(&format!("seed={s}")).map_err(Error::BadInput)?);
