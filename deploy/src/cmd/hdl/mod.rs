@@ -1,12 +1,14 @@
 //! `tactile hdl`: the TFB as RTL. Writes the Verilog with a format's parameters,
 //! the model's test vectors, runs the co-simulation (Icarus Verilog) and the
-//! synthesis (Yosys, Virtex-6) that hold the RTL against the model
+//! synthesis (Yosys, Virtex-6) that hold the RTL against the model, and the modules'
+//! timing from a real place and route (Yosys and nextpnr, ECP5)
 //! (docs/09-the-hardware.md).
 
 mod kin;
 mod params;
 mod sim;
 mod synth;
+mod timing;
 mod units;
 mod vectors;
 
@@ -63,6 +65,9 @@ pub enum HdlCommand {
     Cosim(sim::CosimArgs),
     /// Synthesize each function with Yosys for Virtex-6 and print its resources.
     Synth(synth::SynthArgs),
+    /// Place and route each of the paper's modules on an ECP5 (Yosys, nextpnr-ecp5):
+    /// its clock rate, its latency in ns, its cells, beside the paper's Virtex-6.
+    Timing(timing::TimingArgs),
 }
 
 /// A block of the hardware: a TFB function, an f32 unit or one of the paper's modules.
@@ -263,5 +268,6 @@ pub fn main(args: &HdlArgs) -> Result<(), Error> {
         } => write_vectors((*function, *count, *seed), out.as_deref(), datapath),
         HdlCommand::Cosim(a) => sim::cosim_main(a),
         HdlCommand::Synth(a) => synth::synth_main(a),
+        HdlCommand::Timing(a) => timing::timing_main(a),
     }
 }
