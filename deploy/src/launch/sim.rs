@@ -217,9 +217,9 @@ pub fn run_in_process(
     let (bundled, _held) = super::prepare_out(out, loaded)?;
     let halt = Arc::clone(&hooks.halt);
     let events = hooks.events();
+    // A hook that failed at the last sample stopped nothing, but the master's loop
+    // says the run did not complete (`Lead::halt_on`).
     let completed = simulate(&bundled.scenario, &bundled.base_dir, out, hooks)?;
-    // A hook that failed at the last sample stopped nothing, but its sample was not
-    // the hook's: the run is not whole either way.
     let halted = halt.load(Ordering::SeqCst);
     let launch = tactile_report::write::Launch {
         stop: tactile_runtime::signals::stop_flag().ok(),
@@ -228,12 +228,18 @@ pub fn run_in_process(
         ..Default::default()
     };
     let launch = match (completed, halted) {
-        (true, false) => launch,
+        (true, _) => launch,
         // The run's own stop: no signal hurries the report, which is written whole.
-        (_, true) => tactile_report::write::Launch {
-            interrupted: true,
-            ..launch
-        },
+        (false, true) => {
+            let mut launch = tactile_report::write::Launch {
+                interrupted: true,
+                ..launch
+            };
+            launch
+                .events
+                .push("stopped after the sample in hand: a hook from outside the scenario (the Python API) failed".into());
+            launch
+        }
         (false, false) => launch.interrupted(),
     };
     Ok(tactile_report::write::write_report(

@@ -133,6 +133,13 @@ impl<H: Leader> Lead<H> {
         }
     }
 
+    /// True once this run's own stop request is set.
+    fn halted(&self) -> bool {
+        self.halt
+            .as_ref()
+            .is_some_and(|h| h.load(std::sync::atomic::Ordering::SeqCst))
+    }
+
     /// Also stops after the sample in hand once `halt` is set: a stop request of this
     /// run alone (a Python callable in its loop that failed), where the process's
     /// (a signal) would stop every run and every report of the process.
@@ -166,6 +173,9 @@ impl<H: Leader> Lead<H> {
             }
             self.counters_if_due()?;
         }
+        // A halt asked for during the last sample: that sample was not the run's own
+        // either, so the records must not say it completed.
+        completed &= !self.halted();
         self.end(block, completed)?;
         Ok(completed)
     }
@@ -290,11 +300,7 @@ impl<H: Leader> Lead<H> {
     /// Sends sample n and waits for its answer until its deadline; false if a stop
     /// request came.
     fn sample(&mut self, n: u64, t0: u64, block: &mut dyn Block) -> Result<bool, Failure> {
-        let halted = self
-            .halt
-            .as_ref()
-            .is_some_and(|h| h.load(std::sync::atomic::Ordering::SeqCst));
-        if halted || crate::signals::stop_requested() {
+        if self.halted() || crate::signals::stop_requested() {
             return Ok(false);
         }
         let (origin, deadline) = self.instant(n, t0);

