@@ -48,7 +48,15 @@ fn the_rtl_matches_the_model_bit_for_bit_in_six_formats() {
     for (word, frac) in [("16", "13"), ("24", "21"), ("32", "29")] {
         for rounding in ["nearest", "truncate"] {
             let args = ["--word", word, "--frac", frac, "--rounding", rounding];
-            let only = ["--function", "sincos,atan2,acos", "--count", "6000"];
+            // The formats in the pipeline every other one is checked against below.
+            let only = [
+                "--function",
+                "sincos,atan2,acos",
+                "--count",
+                "6000",
+                "--pipeline",
+                "sample",
+            ];
             let (ok, r, text) = cosim(&sb, &[&args[..], &only[..]].concat());
             assert!(ok, "[s{word}.{frac}] {rounding}:\n{text}");
             assert_eq!(r.len(), 3, "three functions:\n{text}");
@@ -74,14 +82,15 @@ fn a_wrong_rtl_is_caught_by_the_same_test() {
             "--function",
             "sincos,atan2,acos",
             "--count",
-            "2000",
+            "1000",
             "--define",
             mutant,
         ];
         let (ok, r, text) = cosim(&sb, &args);
         assert!(!ok, "{mutant} passed:\n{text}");
         assert!(text.contains("outputs differ from the model"), "{text}");
-        assert_eq!(r.len(), 3, "{text}");
+        // Three functions in each of the three pipelines: each catches it.
+        assert_eq!(r.len(), 9, "{text}");
         for (f, vectors, mismatches) in r {
             assert!(
                 mismatches > vectors / 20,
@@ -150,6 +159,8 @@ fn a_relative_keep_folder_is_taken_from_the_current_one() {
         "add",
         "--count",
         "50",
+        "--pipeline",
+        "unit",
     ]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(

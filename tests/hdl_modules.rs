@@ -5,6 +5,7 @@
 
 use crate::hdl::{cosim, have, synth_row};
 use crate::util::{cannot, Sandbox};
+use tactile_rtl::text::Block;
 
 #[test]
 fn the_f32_units_are_ieee_round_to_nearest_even_bit_for_bit() {
@@ -12,7 +13,14 @@ fn the_f32_units_are_ieee_round_to_nearest_even_bit_for_bit() {
         return cannot("iverilog is not installed");
     }
     let sb = Sandbox::new("hdl-units");
-    let args = ["--function", "add,sub,mul,div,sqrt", "--count", "40000"];
+    let args = [
+        "--function",
+        "add,sub,mul,div,sqrt",
+        "--count",
+        "40000",
+        "--pipeline",
+        "sample",
+    ];
     let (ok, r, text) = cosim(&sb, &args);
     assert!(ok, "{text}");
     assert_eq!(r.len(), 5, "{text}");
@@ -30,7 +38,13 @@ fn the_modules_match_the_model_bit_for_bit_in_three_formats() {
         return cannot("iverilog is not installed");
     }
     let sb = Sandbox::new("hdl-modules");
-    for (word, frac) in [("16", "13"), ("24", "21"), ("32", "29")] {
+    // Every pipeline for the paper's format, the deepest and the shallowest for the
+    // others (the registers do not depend on the format).
+    for (word, frac, pipelines, rows) in [
+        ("16", "13", "sample,unit,module", 12),
+        ("24", "21", "sample,module", 8),
+        ("32", "29", "sample,module", 8),
+    ] {
         let args = [
             "--function",
             "fk,kff,fbf,ik",
@@ -40,15 +54,59 @@ fn the_modules_match_the_model_bit_for_bit_in_three_formats() {
             word,
             "--frac",
             frac,
+            "--pipeline",
+            pipelines,
         ];
         let (ok, r, text) = cosim(&sb, &args);
         assert!(ok, "[s{word}.{frac}]:\n{text}");
-        assert_eq!(r.len(), 4, "{text}");
+        assert_eq!(r.len(), rows, "{text}");
         for (f, vectors, mismatches) in r {
             // The paper's validation run (1,200 samples) and the 2,000 others.
             assert!(vectors > 3_000, "{f}: {vectors}");
             assert_eq!(mismatches, 0, "{f} [s{word}.{frac}]:\n{text}");
         }
+    }
+}
+
+/// Every block in every pipeline configuration gives the model's bits, and takes the
+/// clocks its formula says (the testbenches measure them; `tactile hdl cosim` fails on
+/// a difference): the deepest pipeline's docs/09 latencies, one f32 operation or TFB
+/// function a clock, and one clock a module in the paper's architecture.
+#[test]
+fn every_pipeline_gives_the_same_bits_in_its_own_clocks() {
+    if !have("iverilog") {
+        return cannot("iverilog is not installed");
+    }
+    let sb = Sandbox::new("hdl-pipelines");
+    let (ok, r, text) = cosim(&sb, &["--count", "1000"]);
+    assert!(ok, "{text}");
+    assert_eq!(r.len(), 12 * 3, "{text}");
+    assert!(r.iter().all(|(_, v, m)| *v > 1000 && *m == 0), "{text}");
+    let clocks = |f: &str, p: &str| -> Option<u32> {
+        text.lines()
+            .find(|l| l.starts_with(&format!("{f} ")) && l.contains(&format!("pipeline {p} ")))?
+            .split("(latency ")
+            .nth(1)?
+            .split_whitespace()
+            .next()?
+            .parse()
+            .ok()
+    };
+    for (f, sample, unit, module) in [
+        ("fk", 35, 5, 1),
+        ("kff", 43, 7, 1),
+        ("fbf", 8, 2, 1),
+        ("ik", 175, 14, 1),
+        ("mul", 4, 1, 0),
+        ("div", 28, 1, 0),
+        ("acos", 51, 2, 0),
+    ] {
+        let got = ["sample", "unit", "module"].map(|p| clocks(f, p));
+        assert_eq!(
+            got,
+            [Some(sample), Some(unit), Some(module)],
+            "{f}:\n{text}"
+        );
     }
 }
 
@@ -59,22 +117,25 @@ fn a_unit_that_truncates_is_caught() {
     }
     let sb = Sandbox::new("hdl-unit-mutant");
     // F32_MUTANT_ROUND: every unit truncates where it must round to nearest even.
+    // In each pipeline (the default: all three).
     for unit in ["add", "mul", "div", "sqrt"] {
         let args = [
             "--function",
             unit,
             "--count",
-            "2000",
+            "1000",
             "--define",
             "F32_MUTANT_ROUND",
         ];
         let (ok, r, text) = cosim(&sb, &args);
         assert!(!ok, "{unit} passed truncating:\n{text}");
-        let (_, vectors, mismatches) = r[0];
-        assert!(
-            mismatches > vectors / 10,
-            "{unit}: only {mismatches} of {vectors}"
-        );
+        assert_eq!(r.len(), 3, "{text}");
+        for (_, vectors, mismatches) in r {
+            assert!(
+                mismatches > vectors / 10,
+                "{unit}: only {mismatches} of {vectors}"
+            );
+        }
     }
 }
 
@@ -86,16 +147,19 @@ fn a_wrong_module_is_caught_by_the_same_test() {
     let sb = Sandbox::new("hdl-kin-mutant");
     for module in ["fk", "kff", "fbf", "ik"] {
         let define = format!("KIN_MUTANT_{}", module.to_uppercase());
-        let args = ["--function", module, "--count", "1000", "--define", &define];
+        let args = ["--function", module, "--count", "500", "--define", &define];
         let (ok, r, text) = cosim(&sb, &args);
         assert!(!ok, "{define} passed:\n{text}");
         assert!(text.contains("outputs differ from the model"), "{text}");
-        let (_, vectors, mismatches) = r[0];
-        // Rounding-level mistakes: a few percent of the vectors at least.
-        assert!(
-            mismatches > vectors / 100,
-            "{define}: only {mismatches} of {vectors}"
-        );
+        // Caught in each of the three pipelines.
+        assert_eq!(r.len(), 3, "{text}");
+        for (_, vectors, mismatches) in r {
+            // Rounding-level mistakes: a few percent of the vectors at least.
+            assert!(
+                mismatches > vectors / 100,
+                "{define}: only {mismatches} of {vectors}"
+            );
+        }
     }
 }
 
@@ -243,17 +307,19 @@ fn the_rtl_in_the_loop_gives_the_hybrid_models_trace_byte_for_byte() {
     )
     .expect("json");
     let m = &summary["hardware"]["modules"];
+    let p = tactile_rtl::built_pipeline();
+    let lat = |b| p.latency(b, 14);
     for (name, clocks, calls) in [
-        ("FK-HMD", 35, 1200),
-        ("IK-HSD", 175, 1200),
-        ("FK-HSD", 35, 1200),
-        ("FBF-HSD", 8, 812),
+        ("FK-HMD", lat(Block::Fk), 1200),
+        ("IK-HSD", lat(Block::Ik), 1200),
+        ("FK-HSD", lat(Block::Fk), 1200),
+        ("FBF-HSD", lat(Block::Fbf), 812),
     ] {
         assert_eq!(m[name]["min"], clocks, "{name}: {m}");
         assert_eq!(m[name]["max"], clocks, "{name}: {m}");
         assert_eq!(m[name]["calls"], calls, "{name}: {m}");
     }
-    assert_eq!(m["KFF-HMD"]["min"], 43);
+    assert_eq!(m["KFF-HMD"]["min"], lat(Block::Kff));
     assert_eq!(summary["hardware"]["faults"], 0);
     let hybrid_summary =
         std::fs::read_to_string(sb.path("hybrid").join("summary.json")).expect("summary");

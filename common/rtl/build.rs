@@ -6,6 +6,11 @@
 //! `TACTILE_RTL_ROUNDING` (`nearest`, `truncate`) and `TACTILE_RTL_DEVICE` (`paper`,
 //! `omni`); by default the paper's `[s16.13]`, nearest, and its geometry. A run whose
 //! scenario asks for another is refused with these variables named.
+//!
+//! The pipeline: `TACTILE_RTL_PIPELINE` (`sample`, `unit`, `module`), by default
+//! `module`, the paper's architecture: a sample takes one clock of each module, so the
+//! simulator evaluates each module's logic once a sample (the deeper pipelines give the
+//! same bits in more clocks, each evaluating the whole module again).
 
 //!
 //! Under `cargo clippy`, which links nothing, the models' C++ is not compiled (the
@@ -126,6 +131,12 @@ mod verilate {
                 "TACTILE_RTL_ROUNDING: {other:?} is not nearest or truncate"
             )),
         };
+        let pipe = env("TACTILE_RTL_PIPELINE", "module");
+        let pipeline = text::Pipeline::from_name(&pipe).unwrap_or_else(|| {
+            fail(format!(
+                "TACTILE_RTL_PIPELINE: {pipe:?} is not sample, unit or module"
+            ))
+        });
         let device = env("TACTILE_RTL_DEVICE", "paper");
         let geometry = Geometry::preset(&device).unwrap_or_else(|| {
             fail(format!(
@@ -141,7 +152,7 @@ mod verilate {
             fail(format!("no RTL for [s{word}.{frac}]: its range reduction differs from the model's at {a:e}"));
         }
         std::fs::create_dir_all(dir).unwrap_or_else(|e| fail(format!("{}: {e}", dir.display())));
-        for (name, text) in text::files(&constants, &geometry) {
+        for (name, text) in text::files(&constants, &geometry, pipeline) {
             std::fs::write(dir.join(name), text).unwrap_or_else(|e| fail(format!("{name}: {e}")));
         }
     }

@@ -6,7 +6,9 @@
 // One new a, b per clock; r appears LATENCY clocks later (LATENCY register stages
 // from ports a, b to port r). No reset: pure datapath.
 //
-// Stage map (LATENCY = 4 = F32_ADD_LAT in f32_lat.vh):
+// Stage map (LATENCY = F32_ADD_LAT in f32_lat.vh: 4 when every stage is a register,
+// pipeline "sample"; the last stage is the unit's output register, `UNIT_REG, the
+// others `STAGE_REG, each a register or a wire as pipe.vh says):
 //   1  unpack; order the operands by magnitude, x = larger, y = smaller;
 //      exponent difference; specials (NaN, inf)
 //   2  align y to x (right shift keeping guard, round and sticky bits), add or
@@ -26,9 +28,9 @@ module f32_add #(
     input  wire [31:0] b,            // f32 bits
     output reg  [31:0] r             // f32 bits of a + b (a - b)
 );
-localparam LATENCY = 4;
 localparam [31:0] QNAN = 32'h7FC00000;
 
+`include "pipe.vh"
 `include "f32_round.vh"
 
 // Leading-zero count of a 28-bit word (28 when zero).
@@ -68,7 +70,7 @@ reg         sg1, sub1, nan1, inf1;
 reg  [7:0]  e1;
 reg  [4:0]  d1;
 reg  [23:0] mx1, my1;
-always @(posedge clk) begin
+`STAGE_REG begin
     sg1  <= x[31];                                  // sign of the larger: of the result
     sub1 <= a[31] ^ bb[31];                         // effective subtraction
     nan1 <= a_nan | b_nan | (a_inf & b_inf & (a[31] ^ bb[31]));
@@ -90,7 +92,7 @@ wire [27:0] sum = sub1 ? {1'b0, xal} - {1'b0, yal} : {1'b0, xal} + {1'b0, yal};
 reg  [27:0] s2;
 reg  [7:0]  e2;
 reg         sg2, nan2, inf2;
-always @(posedge clk) begin
+`STAGE_REG begin
     s2   <= sum;
     e2   <= e1;
     // An exact zero is +0 from a subtraction (x + (-x)); from an addition both
@@ -109,7 +111,7 @@ wire [7:0] sh  = ({3'd0, lz} > e2) ? e2 : {3'd0, lz};
 reg  [27:0] n3;
 reg  [8:0]  e3;
 reg         sg3, nan3, inf3;
-always @(posedge clk) begin
+`STAGE_REG begin
     n3   <= s2 << sh[4:0];                          // sh <= 28
     e3   <= {1'b0, e2} + 9'd1 - {1'b0, sh};         // 1..255
     sg3  <= sg2;
@@ -119,7 +121,7 @@ end
 
 // ---------------------------------------------------------------- stage 4
 wire [30:0] mag = rnd_pack({1'b0, e3}, n3[27:4], n3[3], |n3[2:0]);
-always @(posedge clk)
+`UNIT_REG
     r <= nan3 ? QNAN : inf3 ? {sg3, 31'h7F800000} : {sg3, mag};
 
 endmodule

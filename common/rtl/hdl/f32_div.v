@@ -7,7 +7,9 @@
 // One new a, b per clock; r appears LATENCY clocks later (LATENCY register stages
 // from ports a, b to port r). No reset: pure datapath.
 //
-// Stage map (LATENCY = 28 = F32_DIV_LAT in f32_lat.vh):
+// Stage map (LATENCY = F32_DIV_LAT in f32_lat.vh: 28 when every stage is a register,
+// pipeline "sample"; the last stage is the unit's output register, `UNIT_REG, the
+// others `STAGE_REG, each a register or a wire as pipe.vh says):
 //   1      unpack; normalize subnormal significands (leading one to bit 23);
 //          exponent difference; specials (NaN, inf, zero)
 //   2      pre-scale: if ma < mb use 2 ma (exponent - 1) so the quotient is in [1, 2)
@@ -21,10 +23,10 @@ module f32_div (
     input  wire [31:0] b,            // f32 bits, divisor
     output reg  [31:0] r             // f32 bits of a / b
 );
-localparam LATENCY = 28;
 localparam NQ      = 25;             // quotient bits: 24 significant + guard
 localparam [31:0] QNAN = 32'h7FC00000;
 
+`include "pipe.vh"
 `include "f32_round.vh"
 
 // ---------------------------------------------------------------- stage 1
@@ -52,7 +54,7 @@ reg  [23:0] ma1, mb1;
 reg  [9:0]  e1;
 reg         sg1;
 reg  [1:0]  spc1;
-always @(posedge clk) begin
+`STAGE_REG begin
     ma1  <= ma << lza;
     mb1  <= mb << lzb;
     e1   <= ea - eb + 10'd127;                      // -149..403
@@ -68,7 +70,7 @@ wire        lt1 = (ma1 < mb1);
 reg  [24:0] rem2;                                   // partial remainder, < 2 mb
 reg  [23:0] dv2;                                    // divisor
 reg  [12:0] sd2;                                    // {special, sign, exponent}
-always @(posedge clk) begin
+`STAGE_REG begin
     rem2 <= lt1 ? {ma1, 1'b0} : {1'b0, ma1};
     dv2  <= mb1;
     sd2  <= {spc1, sg1, e1 - {9'd0, lt1}};          // e: -150..403
@@ -78,10 +80,10 @@ end
 // Restoring division, one quotient bit a stage: with R < 2D, the bit is R >= D;
 // then R := 2 (R - bit D) < 2D again.
 // Flat buses between stages (slice k = output register of digit stage k).
-reg [25*NQ-1:0] q_rem;                              // partial remainder (< 2^25)
-reg [24*NQ-1:0] q_dv;                               // divisor
-reg [25*NQ-1:0] q_quo;                              // quotient bits so far
-reg [13*NQ-1:0] q_side;                             // {special, sign, exponent}
+reg [25*NQ-1:0] q_rem /*verilator split_var*/;                              // partial remainder (< 2^25)
+reg [24*NQ-1:0] q_dv /*verilator split_var*/;                               // divisor
+reg [25*NQ-1:0] q_quo /*verilator split_var*/;                              // quotient bits so far
+reg [13*NQ-1:0] q_side /*verilator split_var*/;                             // {special, sign, exponent}
 
 genvar k;
 generate
@@ -104,7 +106,7 @@ generate
         wire        ge  = (rem_i >= {1'b0, dv_i});
         wire [24:0] dif = rem_i - {1'b0, dv_i};      // < D when ge
         wire [24:0] nr  = ge ? dif : rem_i;          // < D < 2^24
-        always @(posedge clk) begin
+        `STAGE_REG begin
             q_rem [25*k +: 25] <= {nr[23:0], 1'b0};
             q_dv  [24*k +: 24] <= dv_i;
             q_quo [25*k +: 25] <= {quo_i[23:0], ge};
@@ -131,7 +133,7 @@ wire [24:0] dq   = qf >> shq;
 wire        lost = |(qf & ~({25{1'b1}} << shq));    // bits shifted out
 wire [9:0]  epq  = subq ? 10'd1 : (eq > 10'd255) ? 10'd255 : eq;   // 255: overflow
 wire [30:0] mag  = rnd_pack(epq, dq[24:1], dq[0], qst | lost);
-always @(posedge clk)
+`UNIT_REG
     r <= (spcq == 2'd3) ? QNAN :
          (spcq == 2'd2) ? {sgq, 31'h7F800000} :
          (spcq == 2'd1) ? {sgq, 31'd0} :

@@ -7,7 +7,9 @@
 // One new a, b per clock; r appears LATENCY clocks later (LATENCY register stages
 // from ports a, b to port r). No reset: pure datapath.
 //
-// Stage map (LATENCY = 4 = F32_MUL_LAT in f32_lat.vh):
+// Stage map (LATENCY = F32_MUL_LAT in f32_lat.vh: 4 when every stage is a register,
+// pipeline "sample"; the last stage is the unit's output register, `UNIT_REG, the
+// others `STAGE_REG, each a register or a wire as pipe.vh says):
 //   1  unpack; normalize subnormal significands (leading one to bit 23, the
 //      exponent goes below 1); exponent sum; specials (NaN, inf, zero)
 //   2  24x24 significand product (plain `*` on registered operands: DSP48E1s)
@@ -20,9 +22,9 @@ module f32_mul (
     input  wire [31:0] b,            // f32 bits
     output reg  [31:0] r             // f32 bits of a * b
 );
-localparam LATENCY = 4;
 localparam [31:0] QNAN = 32'h7FC00000;
 
+`include "pipe.vh"
 `include "f32_round.vh"
 
 // ---------------------------------------------------------------- stage 1
@@ -44,7 +46,7 @@ wire        b_zero = (b[30:0] == 31'd0);
 reg  [23:0] ma1, mb1;
 reg  [9:0]  e1;
 reg         sg1, nan1, inf1, zero1;
-always @(posedge clk) begin
+`STAGE_REG begin
     ma1   <= ma << lza;                             // zero stays zero (flagged)
     mb1   <= mb << lzb;
     e1    <= ea + eb - 10'd127;                     // -171..381
@@ -59,7 +61,7 @@ end
 reg  [47:0] p2, p3;
 reg  [9:0]  e2, e3;
 reg         sg2, nan2, inf2, zero2, sg3, nan3, inf3, zero3;
-always @(posedge clk) begin
+`STAGE_REG begin
     p2 <= ma1 * mb1;
     p3 <= p2;
     {e2, sg2, nan2, inf2, zero2} <= {e1, sg1, nan1, inf1, zero1};
@@ -80,7 +82,7 @@ wire [47:0] d4   = n4 >> sh4;
 wire        lost = |(n4 & ~({48{1'b1}} << sh4));    // bits shifted out
 wire [9:0]  ep4  = sub4 ? 10'd1 : (e4 > 10'd255) ? 10'd255 : e4;   // 255: overflow
 wire [30:0] mag  = rnd_pack(ep4, d4[47:24], d4[23], (|d4[22:0]) | lost);
-always @(posedge clk)
+`UNIT_REG
     r <= nan3  ? QNAN :
          inf3  ? {sg3, 31'h7F800000} :
          zero3 ? {sg3, 31'd0} :

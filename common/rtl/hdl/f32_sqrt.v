@@ -6,7 +6,9 @@
 // One new a per clock; r appears LATENCY clocks later (LATENCY register stages
 // from port a to port r). No reset: pure datapath.
 //
-// Stage map (LATENCY = 28 = F32_SQRT_LAT in f32_lat.vh):
+// Stage map (LATENCY = F32_SQRT_LAT in f32_lat.vh: 28 when every stage is a register,
+// pipeline "sample"; the last stage is the unit's output register, `UNIT_REG, the
+// others `STAGE_REG, each a register or a wire as pipe.vh says):
 //   1      unpack; normalize a subnormal significand (leading one to bit 23);
 //          specials (NaN, inf, zero)
 //   2      make the exponent even, form the 50-bit radicand, halve the exponent
@@ -21,7 +23,6 @@ module f32_sqrt (
     input  wire [31:0] a,            // f32 bits
     output reg  [31:0] r             // f32 bits of sqrt(a)
 );
-localparam LATENCY = 28;
 localparam NQ      = 25;             // root bits: 24 significant + guard
 localparam [31:0] QNAN = 32'h7FC00000;
 
@@ -45,6 +46,7 @@ function [30:0] rnd_root;
     end
 endfunction
 
+`include "pipe.vh"
 `include "f32_round.vh"
 
 // ---------------------------------------------------------------- stage 1
@@ -64,7 +66,7 @@ reg  [23:0] m1;
 reg  [9:0]  e1;
 reg  [1:0]  spc1;
 reg         sg1;
-always @(posedge clk) begin
+`STAGE_REG begin
     m1   <= ma << lza;
     e1   <= {2'b00, (a[30:23] == 8'd0) ? 8'd1 : a[30:23]} - {5'd0, lza};
     spc1 <= spc;
@@ -79,17 +81,17 @@ end
 wire [9:0] e127 = e1 + 10'd127;
 reg  [49:0] rad2;
 reg  [10:0] sd2;                                    // {special, sign, exponent}
-always @(posedge clk) begin
+`STAGE_REG begin
     rad2 <= e1[0] ? {1'b0, m1, 25'd0} : {m1, 26'd0};
     sd2  <= {spc1, sg1, e127[8:1]};
 end
 
 // ---------------------------------------------------------------- stages 3-27
 // Flat buses between stages (slice k = output register of digit stage k).
-reg [50*NQ-1:0] q_rad;                              // radicand, consumed 2 bits/stage
-reg [26*NQ-1:0] q_rem;                              // partial remainder (< 2^26)
-reg [25*NQ-1:0] q_root;                             // partial root
-reg [11*NQ-1:0] q_side;                             // {special, sign, exponent}
+reg [50*NQ-1:0] q_rad /*verilator split_var*/;                              // radicand, consumed 2 bits/stage
+reg [26*NQ-1:0] q_rem /*verilator split_var*/;                              // partial remainder (< 2^26)
+reg [25*NQ-1:0] q_root /*verilator split_var*/;                             // partial root
+reg [11*NQ-1:0] q_side /*verilator split_var*/;                             // {special, sign, exponent}
 
 genvar k;
 generate
@@ -114,7 +116,7 @@ generate
         wire [27:0] trial = {1'b0, root_i, 2'b01};
         wire        ge    = (rsh >= trial);
         wire [27:0] dif   = rsh - trial;
-        always @(posedge clk) begin
+        `STAGE_REG begin
             q_rad [50*k +: 50] <= {rad_i[47:0], 2'b00};
             q_rem [26*k +: 26] <= ge ? dif[25:0] : rsh[25:0];
             q_root[25*k +: 25] <= {root_i[23:0], ge};
@@ -129,7 +131,7 @@ wire [24:0] qf   = q_root[25*(NQ-1) +: 25];
 wire        qst  = |q_rem[26*(NQ-1) +: 26];
 wire [10:0] qsd  = q_side[11*(NQ-1) +: 11];
 wire [30:0] mag  = rnd_root(qsd[7:0], qf[24:1], qf[0], qst);
-always @(posedge clk)
+`UNIT_REG
     r <= (qsd[10:9] == 2'd3) ? QNAN :
          (qsd[10:9] == 2'd2) ? 32'h7F800000 :
          (qsd[10:9] == 2'd1) ? {qsd[8], 31'd0} :

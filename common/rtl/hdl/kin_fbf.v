@@ -8,7 +8,11 @@
 //   0 .. ADD                d_i = o_i - e_i           (3 f32_add, SUB)   h delayed ADD
 //   ADD .. ADD+MUL          F_i = h_i * d_i           (3 f32_mul)        d delayed MUL (dbg)
 //
-//   LATENCY = F32_ADD_LAT + F32_MUL_LAT
+//   LATENCY = F32_ADD_LAT + F32_MUL_LAT (+ PIPE_M)
+//
+// In the paper's architecture (pipe.vh's PIPE_M = 1: no register inside any unit) every
+// output passes one register more, so that a sample takes one clock, of a period as
+// long as the whole datapath.
 //
 // dbg = {d1, d2, d3}, lined up with f1..f3.
 // KIN_MUTANT_FBF: the distributed form F = h*o - h*e (a plausible rewrite that rounds
@@ -28,7 +32,7 @@ module kin_fbf (
     `include "f32_lat.vh"
     `include "f32_fn.vh"
 
-    localparam integer LATENCY = F32_ADD_LAT + F32_MUL_LAT;
+    localparam integer LATENCY = F32_ADD_LAT + F32_MUL_LAT + PIPE_M;
 
     wire [95:0] o = {o1, o2, o3};
     wire [95:0] e = {e1, e2, e3};
@@ -53,9 +57,9 @@ module kin_fbf (
         end
     endgenerate
     tfb_delay #(.W(96), .N(F32_ADD_LAT)) d_h (.clk(clk), .d(h), .q(h_d));
-    tfb_delay #(.W(96), .N(F32_MUL_LAT)) d_d (.clk(clk), .d(d), .q(d_out));
+    tfb_delay #(.W(96), .N(F32_MUL_LAT + PIPE_M)) d_d (.clk(clk), .d(d), .q(d_out));
+    tfb_delay #(.W(96), .N(PIPE_M)) d_f (.clk(clk), .d(f), .q({f1, f2, f3}));
     tfb_delay #(.W(1), .N(LATENCY)) d_valid (.clk(clk), .d(in_valid), .q(out_valid));
 
-    assign {f1, f2, f3} = f;
     assign dbg = d_out;
 endmodule

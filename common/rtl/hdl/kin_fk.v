@@ -20,7 +20,11 @@
 //   SC+2MUL+ADD .. +ADD     z = w - L4                                     (f32_add)
 //   x = -m (a sign flip) delayed ADD, y delayed MUL, to meet z.
 //
-//   LATENCY = (ITER + 5) + 2 F32_MUL_LAT + 2 F32_ADD_LAT
+//   LATENCY = (ITER + 5) + 2 F32_MUL_LAT + 2 F32_ADD_LAT (+ PIPE_M)
+//
+// In the paper's architecture (pipe.vh's PIPE_M = 1: no register inside any unit) every
+// output passes one register more, so that a sample takes one clock, of a period as
+// long as the whole datapath.
 //
 // err: OR of the three TFBs' range_err (an angle with |angle| >= 3 pi, inf or NaN; the
 // outputs are then NaN), lined up with the outputs. dbg = {s1, c1, s2, c2, s3, c3}
@@ -40,10 +44,10 @@ module kin_fk (
     `include "f32_lat.vh"
     `include "f32_fn.vh"
 
-    localparam integer SC = ITER + 5;                  // tfb_sincos's LATENCY
+    localparam integer SC = `TFB_SINCOS_LAT(ITER);     // tfb_sincos's LATENCY
     localparam integer MUL = F32_MUL_LAT;
     localparam integer ADD = F32_ADD_LAT;
-    localparam integer LATENCY = SC + 2 * MUL + 2 * ADD;
+    localparam integer LATENCY = SC + 2 * MUL + 2 * ADD + PIPE_M;
 
     // ---- 0 .. SC: the three TFBs ----
     wire [31:0] s1, c1, s2, c2, s3, c3;
@@ -89,13 +93,13 @@ module kin_fk (
 
     // ---- line up ----
     wire [31:0] xm_d, yo_d;
-    tfb_delay #(.W(32), .N(ADD)) d_x (.clk(clk), .d(xm), .q(xm_d));
-    tfb_delay #(.W(32), .N(MUL)) d_y (.clk(clk), .d(yo), .q(yo_d));
+    tfb_delay #(.W(32), .N(ADD + PIPE_M)) d_x (.clk(clk), .d(xm), .q(xm_d));
+    tfb_delay #(.W(32), .N(MUL + PIPE_M)) d_y (.clk(clk), .d(yo), .q(yo_d));
+    tfb_delay #(.W(32), .N(PIPE_M)) d_z (.clk(clk), .d(zo), .q(z));
     assign x = f32_neg(xm_d);
     assign y = yo_d;
-    assign z = zo;
-    tfb_delay #(.W(1), .N(2 * MUL + 2 * ADD)) d_err (.clk(clk), .d(rng), .q(err));
-    tfb_delay #(.W(192), .N(2 * MUL + 2 * ADD)) d_dbg (
+    tfb_delay #(.W(1), .N(LATENCY - SC)) d_err (.clk(clk), .d(rng), .q(err));
+    tfb_delay #(.W(192), .N(LATENCY - SC)) d_dbg (
         .clk(clk), .d({s1, c1, s2, c2, s3, c3}), .q(dbg));
     tfb_delay #(.W(1), .N(LATENCY)) d_valid (.clk(clk), .d(in_valid), .q(out_valid));
 endmodule

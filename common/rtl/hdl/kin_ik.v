@@ -48,7 +48,11 @@
 //   theta1 = -atan delayed to the end, theta2 delayed 2 ADD; the invalid flag and
 //   the clamp flags delayed to the end, where they select the outputs.
 //
-//   LATENCY = 6 ADD + 3 MUL + 2 DIV + SQRT + AC + 4
+// In the paper's architecture (pipe.vh's PIPE_M = 1: no register inside any unit) every
+// output passes one register more, so that a sample takes one clock, of a period as
+// long as the whole datapath.
+//
+//   LATENCY = 6 ADD + 3 MUL + 2 DIV + SQRT + AC + 4 (+ PIPE_M)
 //           = (ITER + 41) + 6 F32_ADD_LAT + 3 F32_MUL_LAT + 2 F32_DIV_LAT + F32_SQRT_LAT
 //
 // dbg = {xs, ys, zs, atan, rr2, big_r, r2, r, cg, gamma, beta, ca, alpha} (xs in the
@@ -74,23 +78,24 @@ module kin_ik (
     localparam integer MUL = F32_MUL_LAT;
     localparam integer DIV = F32_DIV_LAT;
     localparam integer SQRT = F32_SQRT_LAT;
-    localparam integer AT = ITER + 4;                  // tfb_atan2's LATENCY
-    localparam integer AC = 33 + ITER + 4;             // tfb_acos's LATENCY
+    localparam integer AT = `TFB_VECTOR_LAT(ITER);     // tfb_atan2's LATENCY
+    localparam integer AC = `TFB_ACOS_LAT(ITER);       // tfb_acos's LATENCY
     localparam integer T_A = ADD;
-    localparam integer T_F = T_A + 2;
+    localparam integer T_F = T_A + 2 * PIPE_S;
     localparam integer T_K = T_F + DIV;
     localparam integer T_M = T_K + MUL;
-    localparam integer T_S = T_M + 1;
+    localparam integer T_S = T_M + PIPE_S;
     localparam integer T_RR = T_S + MUL + ADD;
     localparam integer T_R2 = T_RR + ADD;
     localparam integer T_BR = T_RR + SQRT;
     localparam integer T_R = T_R2 + SQRT;
     localparam integer T_CG = T_R + MUL + DIV;
     localparam integer T_CA = T_R2 + ADD + DIV;
-    localparam integer T_C = T_CG + 1;
+    localparam integer T_C = T_CG + PIPE_S;
     localparam integer T_G = T_C + AC;
     localparam integer T_B = T_BR + AT;
-    localparam integer LATENCY = T_G + 3 * ADD;
+    localparam integer T_END = T_G + 3 * ADD;
+    localparam integer LATENCY = T_END + PIPE_M;
     localparam [31:0] ZERO = 32'h0000_0000;
     localparam [31:0] ONE = 32'h3F80_0000;
     localparam [31:0] M_ONE = 32'hBF80_0000;
@@ -114,7 +119,7 @@ module kin_ik (
 
     // ---- T_A .. T_F: far = max_of(max_of(|x|, |yl|), |zl|) ----
     reg [31:0] m1, zl_abs1, far;
-    always @(posedge clk) begin
+    `STAGE_REG begin
         m1 <= f32_gt(f32_abs(yl), f32_abs(xa)) ? f32_abs(yl) : f32_abs(xa);
         zl_abs1 <= f32_abs(zl);
         far <= f32_gt(zl_abs1, m1) ? zl_abs1 : m1;
@@ -133,7 +138,7 @@ module kin_ik (
     tfb_delay #(.W(96), .N(MUL)) d_xyz_s (.clk(clk), .d({xa_m, yl_m, zl_m}), .q({xa_s, yl_s, zl_s}));
     reg [31:0] xs, ys, zs;
     reg        big_s;
-    always @(posedge clk) begin
+    `STAGE_REG begin
         xs <= big_m ? xk : xa_s;
         ys <= big_m ? yk : yl_s;
         zs <= big_m ? zk : zl_s;
@@ -211,7 +216,7 @@ module kin_ik (
     wire [32:0] ca_u = clamp_unit(ca_q_d);
     reg  [31:0] cg, ca;
     reg         flag_c;
-    always @(posedge clk) begin
+    `STAGE_REG begin
         cg <= cg_u[31:0];
         ca <= ca_u[31:0];
         flag_c <= cg_u[32] | ca_u[32] | (!rpos && L1_NE_L2 != 0);
@@ -235,18 +240,19 @@ module kin_ik (
     );
 
     // ---- T_G .. LATENCY: theta2, theta3 ----
-    wire [31:0] beta_g, alpha_d, th2, th3a, th3;
+    wire [31:0] beta_g, alpha_d, th2, th3a, th3_c, th3;
     tfb_delay #(.W(32), .N(T_G - T_B)) d_beta (.clk(clk), .d(beta), .q(beta_g));
     f32_add            a_th2 (.clk(clk), .a(gamma), .b(beta_g), .r(th2));
     tfb_delay #(.W(32), .N(ADD)) d_alpha (.clk(clk), .d(alpha), .q(alpha_d));
     f32_add            a_th3a (.clk(clk), .a(th2), .b(alpha_d), .r(th3a));
-    f32_add #(.SUB(1)) a_th3 (.clk(clk), .a(th3a), .b(HALF_PI), .r(th3));
+    f32_add #(.SUB(1)) a_th3 (.clk(clk), .a(th3a), .b(HALF_PI), .r(th3_c));
+    tfb_delay #(.W(32), .N(PIPE_M)) d_th3 (.clk(clk), .d(th3_c), .q(th3));
 
     // ---- the outputs: invalid and clamp flags select ----
     wire [31:0] atan_o, th2_o;
     wire inv_o, big_o, flag_o;
     tfb_delay #(.W(32), .N(LATENCY - T_S - AT)) d_th1 (.clk(clk), .d(atan), .q(atan_o));
-    tfb_delay #(.W(32), .N(2 * ADD)) d_th2 (.clk(clk), .d(th2), .q(th2_o));
+    tfb_delay #(.W(32), .N(2 * ADD + PIPE_M)) d_th2 (.clk(clk), .d(th2), .q(th2_o));
     tfb_delay #(.W(1), .N(LATENCY)) d_inv (.clk(clk), .d(inv0), .q(inv_o));
     tfb_delay #(.W(1), .N(LATENCY - T_S)) d_bigo (.clk(clk), .d(big_s), .q(big_o));
     tfb_delay #(.W(1), .N(LATENCY - T_C)) d_flag (.clk(clk), .d(flag_c), .q(flag_o));

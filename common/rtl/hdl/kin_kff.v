@@ -26,7 +26,11 @@
 //   JT+MUL .. +ADD          J[0][i]*f1 + J[1][i]*f2                     (3 f32_add)
 //   JT+MUL+ADD .. +ADD      ... + J[2][i]*f3       J[2][i]*f3 delayed ADD (3 f32_add)
 //
-//   LATENCY = (ITER + 5) + 3 F32_MUL_LAT + 3 F32_ADD_LAT
+//   LATENCY = (ITER + 5) + 3 F32_MUL_LAT + 3 F32_ADD_LAT (+ PIPE_M)
+//
+// In the paper's architecture (pipe.vh's PIPE_M = 1: no register inside any unit) every
+// output passes one register more, so that a sample takes one clock, of a period as
+// long as the whole datapath.
 //
 // err: OR of the three TFBs' range_err, lined up with the outputs. dbg = {s1, c1, s2,
 // c2, s3, c3, j11, j12, j13, j21, j22, j23, j31, j32, j33} (s1 in the top 32 bits),
@@ -48,11 +52,11 @@ module kin_kff (
     `include "f32_lat.vh"
     `include "f32_fn.vh"
 
-    localparam integer SC = ITER + 5;                  // tfb_sincos's LATENCY
+    localparam integer SC = `TFB_SINCOS_LAT(ITER);     // tfb_sincos's LATENCY
     localparam integer MUL = F32_MUL_LAT;
     localparam integer ADD = F32_ADD_LAT;
     localparam integer JT = SC + 2 * MUL + ADD;        // the Jacobian is ready
-    localparam integer LATENCY = SC + 3 * MUL + 3 * ADD;
+    localparam integer LATENCY = SC + 3 * MUL + 3 * ADD + PIPE_M;
     localparam [31:0] ZERO = 32'h0000_0000;
 
     // ---- 0 .. SC: the three TFBs ----
@@ -116,25 +120,27 @@ module kin_kff (
     f32_mul m_p33 (.clk(clk), .a(j33_d), .b(f3_d), .r(p33));
 
     // ---- JT+MUL ..: the two sums of each tau ----
-    wire [31:0] q1, q2, q3, w1, w2, w3;
+    wire [31:0] q1, q2, q3, w1, w2, w3, tau1_c, tau2_c, tau3_c;
 `ifdef KIN_MUTANT_KFF
     // mutant: J[0][i]*f1 + (J[1][i]*f2 + J[2][i]*f3)
     f32_add a_q1 (.clk(clk), .a(p21), .b(p31), .r(q1));
     f32_add a_q2 (.clk(clk), .a(p22), .b(p32), .r(q2));
     f32_add a_q3 (.clk(clk), .a(p23), .b(p33), .r(q3));
     tfb_delay #(.W(96), .N(ADD)) d_w (.clk(clk), .d({p11, p12, p13}), .q({w1, w2, w3}));
-    f32_add a_t1 (.clk(clk), .a(w1), .b(q1), .r(tau1));
-    f32_add a_t2 (.clk(clk), .a(w2), .b(q2), .r(tau2));
-    f32_add a_t3 (.clk(clk), .a(w3), .b(q3), .r(tau3));
+    f32_add a_t1 (.clk(clk), .a(w1), .b(q1), .r(tau1_c));
+    f32_add a_t2 (.clk(clk), .a(w2), .b(q2), .r(tau2_c));
+    f32_add a_t3 (.clk(clk), .a(w3), .b(q3), .r(tau3_c));
 `else
     f32_add a_q1 (.clk(clk), .a(p11), .b(p21), .r(q1));
     f32_add a_q2 (.clk(clk), .a(p12), .b(p22), .r(q2));
     f32_add a_q3 (.clk(clk), .a(p13), .b(p23), .r(q3));
     tfb_delay #(.W(96), .N(ADD)) d_w (.clk(clk), .d({p31, p32, p33}), .q({w1, w2, w3}));
-    f32_add a_t1 (.clk(clk), .a(q1), .b(w1), .r(tau1));
-    f32_add a_t2 (.clk(clk), .a(q2), .b(w2), .r(tau2));
-    f32_add a_t3 (.clk(clk), .a(q3), .b(w3), .r(tau3));
+    f32_add a_t1 (.clk(clk), .a(q1), .b(w1), .r(tau1_c));
+    f32_add a_t2 (.clk(clk), .a(q2), .b(w2), .r(tau2_c));
+    f32_add a_t3 (.clk(clk), .a(q3), .b(w3), .r(tau3_c));
 `endif
+    tfb_delay #(.W(96), .N(PIPE_M)) d_tau (
+        .clk(clk), .d({tau1_c, tau2_c, tau3_c}), .q({tau1, tau2, tau3}));
 
     // ---- line up the flags and taps ----
     tfb_delay #(.W(1), .N(LATENCY - SC)) d_err (.clk(clk), .d(rng), .q(err));

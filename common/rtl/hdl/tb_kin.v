@@ -52,6 +52,7 @@ module tb;
     reg [63:0] mem [0:`MAXWORDS-1];
     reg [1023:0] path, dump_path;
     integer dump;
+    integer latency = -1;   // clocks from the first input to the first output
     integer count, n_in, n_out, bad, cycles, i, j, nf;
     reg clk = 1'b0;
     reg in_valid = 1'b0;
@@ -154,6 +155,12 @@ module tb;
     end
     always #5 clk = ~clk;
 
+    // The first input is driven at the edge where cycles == 0 and enters the first
+    // register at the next; the first output is seen one edge after it is registered.
+    always @(posedge clk)
+        if (out_valid && latency < 0)
+            latency = cycles - 1;
+
     always @(posedge clk) begin
         cycles <= cycles + 1;
         if (n_in < count) begin
@@ -200,7 +207,7 @@ module tb;
             n_out = n_out + 1;
             if (n_out == count) begin
                 if (dump != 0) $fclose(dump);
-                $display("kin-cosim: %s vectors=%0d mismatches=%0d", `MOD_NAME, count, bad);
+                $display("kin-cosim: %s vectors=%0d mismatches=%0d latency=%0d", `MOD_NAME, count, bad, latency);
                 $finish;
             end
         end

@@ -22,6 +22,7 @@ module tb;
 `endif
     reg [63:0] mem [0:`MAXWORDS-1];
     reg [1023:0] path;
+    integer latency = -1;   // clocks from the first input to the first output
     integer count, n_in, n_out, bad, cycles;
     reg clk = 1'b0;
     reg in_valid = 1'b0;
@@ -45,6 +46,12 @@ module tb;
         cycles = 0;
     end
     always #5 clk = ~clk;
+
+    // The first input is driven at the edge where cycles == 0 and enters the first
+    // register at the next; the first output is seen one edge after it is registered.
+    always @(posedge clk)
+        if (out_valid && latency < 0)
+            latency = cycles - 1;
 
     always @(posedge clk) begin
         cycles <= cycles + 1;
@@ -73,7 +80,7 @@ module tb;
             end
             n_out <= n_out + 1;
             if (n_out + 1 == count) begin
-                $display("tfb-cosim: %s vectors=%0d mismatches=%0d", `FUNC_NAME, count, bad);
+                $display("tfb-cosim: %s vectors=%0d mismatches=%0d latency=%0d", `FUNC_NAME, count, bad, latency);
                 $finish;
             end
         end

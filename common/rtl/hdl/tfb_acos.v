@@ -1,7 +1,8 @@
 // TFB acos(a): bit for bit the hybrid model's `Cordic::acos`, every f32 input. The
 // model computes acos(a) = atan2(sqrt((1 - a)(1 + a)), a) with a clamped to [-1, 1]
 // and the root in f32; here the f32 front end (tfb_sqrt1m, 33 clocks) feeds the
-// vectoring block (tfb_vector with its clamp at 0). LATENCY = 33 + ITER + 4 clocks.
+// vectoring block (tfb_vector with its clamp at 0). LATENCY = 33 + ITER + 4 clocks with
+// every stage a register (TFB_ACOS_LAT in f32_lat.vh).
 module tfb_acos #(
     parameter integer WORD = 16,
     parameter integer FRAC = 13,
@@ -22,8 +23,9 @@ module tfb_acos #(
     output wire [WORD-1:0] dbg_y,
     output wire [WORD-1:0] dbg_z
 );
-    localparam integer FRONT = 33;                 // tfb_sqrt1m's LATENCY
-    localparam integer LATENCY = FRONT + ITER + 4;
+    `include "f32_lat.vh"
+    localparam integer FRONT = `TFB_SQRT1M_LAT;
+    localparam integer LATENCY = `TFB_ACOS_LAT(ITER);
     wire nan = a[30:23] == 8'hFF && a[22:0] != 23'd0;
     wire [31:0] root, clamped;
     wire nan_f, valid_f;
@@ -39,7 +41,7 @@ module tfb_acos #(
     );
     generate
         if (DEBUG != 0) begin : taps
-            tfb_delay #(.W(32), .N(ITER + 4)) d_root (.clk(clk), .d(root), .q(dbg_root));
+            tfb_delay #(.W(32), .N(`TFB_VECTOR_LAT(ITER))) d_root (.clk(clk), .d(root), .q(dbg_root));
         end else begin : no_taps
             assign dbg_root = 32'd0;
         end

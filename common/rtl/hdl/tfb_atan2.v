@@ -1,6 +1,7 @@
 // TFB atan2(y, x): bit for bit the hybrid model's `Cordic::atan2`, every f32 input
 // (infinities become +-1 and the other input a signed zero, as the model's
-// `sanitize` does; NaN in gives NaN out). LATENCY = ITER + 4 clocks (tfb_vector).
+// `sanitize` does; NaN in gives NaN out). LATENCY = ITER + 4 clocks (tfb_vector)
+// with every stage a register (TFB_VECTOR_LAT in f32_lat.vh).
 module tfb_atan2 #(
     parameter integer WORD = 16,
     parameter integer FRAC = 13,
@@ -21,7 +22,8 @@ module tfb_atan2 #(
     output wire [WORD-1:0] dbg_y,
     output wire [WORD-1:0] dbg_z
 );
-    localparam integer LATENCY = ITER + 4;
+    `include "f32_lat.vh"
+    localparam integer LATENCY = `TFB_VECTOR_LAT(ITER);
     wire x_inf = x[30:0] == 31'h7F80_0000;
     wire y_inf = y[30:0] == 31'h7F80_0000;
     wire nan = x[30:23] == 8'hFF && !x_inf || y[30:23] == 8'hFF && !y_inf;

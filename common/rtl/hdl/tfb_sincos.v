@@ -1,7 +1,9 @@
 // TFB, rotation mode: sin and cos of an f32 angle, bit for bit the hybrid model's
 // `Cordic::sin_cos` (tactile-math, cordic/datapath.rs) for |angle| < 3 pi.
 //
-// One sample a clock, LATENCY = ITER + 5 clocks:
+// One sample a clock, LATENCY = ITER + 5 clocks with every stage a register (pipeline
+// "sample"; the output register is the unit's, `UNIT_REG, the others `STAGE_REG: see
+// pipe.vh and TFB_SINCOS_LAT in f32_lat.vh):
 //   1    F2FP, part 1: unpack the f32, A = floor(angle 2^(FRAC+GUARD)), pick the
 //        turn k (|angle| > pi: k = +-1); range_err for |angle| >= 3 pi, inf, NaN
 //   2    F2FP, part 2: code = floor((A - k 2pi 2^(FRAC+GUARD) + h) / 2^GUARD)
@@ -44,8 +46,9 @@ module tfb_sincos #(
 );
     localparam integer FP2F_W = WORD;
     `include "tfb_fp.vh"
+    `include "f32_lat.vh"
 
-    localparam integer LATENCY = ITER + 5;
+    localparam integer LATENCY = `TFB_SINCOS_LAT(ITER);
     // |A| < 3 pi 2^(FRAC+GUARD) < 2^(FRAC+GUARD+4), a sign, one bit of headroom.
     localparam integer RW = FRAC + GUARD + 6;
     localparam [RW-1:0] TWO_PI_R = TWO_PI[RW-1:0];
@@ -81,7 +84,7 @@ module tfb_sincos #(
     end
     reg signed [RW-1:0] a1;
     reg                 kpos1, kneg1, err1;
-    always @(posedge clk) begin
+    `STAGE_REG begin
         a1 <= sgn ? -$signed(t + st) : $signed(t);   // floor, also below the lsb
         kpos1 <= !sgn && angle[30:0] >= PI_UP[30:0];
         kneg1 <= sgn && angle[30:0] >= PI_UP[30:0];
@@ -92,14 +95,14 @@ module tfb_sincos #(
     wire signed [RW-1:0] w = a1 - (kpos1 ? $signed(TWO_PI_R) : 0)
                               + (kneg1 ? $signed(TWO_PI_R) : 0) + $signed(HALF_R);
     reg signed [WORD-1:0] code2;
-    always @(posedge clk) code2 <= w[GUARD +: WORD];
+    `STAGE_REG code2 <= w[GUARD +: WORD];
 
     // ---- 3: quadrant fold ----
     wire up = code2 > HALF_PI_W;
     wire down = code2 < -HALF_PI_W;
     reg signed [WORD-1:0] z3;
     reg                   flip3;
-    always @(posedge clk) begin
+    `STAGE_REG begin
         z3 <= code2 - (up ? PI_W : 0) + (down ? PI_W : 0);
         flip3 <= up | down;
     end
@@ -123,7 +126,7 @@ module tfb_sincos #(
         end
     endgenerate
     wire flip_n;
-    tfb_delay #(.W(1), .N(ITER)) d_flip (.clk(clk), .d(flip3), .q(flip_n));
+    tfb_delay #(.W(1), .N(ITER * PIPE_S)) d_flip (.clk(clk), .d(flip3), .q(flip_n));
 
     // ---- sign and saturation ----
     wire signed [WORD-1:0] xf = xw[ITER];
@@ -131,16 +134,16 @@ module tfb_sincos #(
     wire signed [WORD:0] s_neg = flip_n ? -yf : yf;   // one more bit: -(-2^(W-1))
     wire signed [WORD:0] c_neg = flip_n ? -xf : xf;
     reg  signed [WORD-1:0] s_c, c_c;
-    always @(posedge clk) begin
+    `STAGE_REG begin
         s_c <= s_neg > ONE ? ONE : (s_neg < -ONE ? -ONE : s_neg[WORD-1:0]);
         c_c <= c_neg > ONE ? ONE : (c_neg < -ONE ? -ONE : c_neg[WORD-1:0]);
     end
 
     // ---- FP2F ----
     wire err_n;
-    tfb_delay #(.W(1), .N(ITER + 3)) d_err (.clk(clk), .d(err1), .q(err_n));
+    tfb_delay #(.W(1), .N((ITER + 3) * PIPE_S)) d_err (.clk(clk), .d(err1), .q(err_n));
     reg err_o;
-    always @(posedge clk) begin
+    `UNIT_REG begin
         sin_out <= err_n ? 32'h7FC0_0000 : fp2f(s_c, FRAC + 1);
         cos_out <= err_n ? 32'h7FC0_0000 : fp2f(c_c, FRAC + 1);
         err_o <= err_n;
@@ -150,9 +153,9 @@ module tfb_sincos #(
 
     generate
         if (DEBUG != 0) begin : taps
-            tfb_delay #(.W(WORD), .N(LATENCY - 2)) d_code (.clk(clk), .d(code2), .q(dbg_code));
-            tfb_delay #(.W(WORD + 1), .N(LATENCY - 3)) d_fold (.clk(clk), .d({flip3, z3}), .q({dbg_flip, dbg_folded}));
-            tfb_delay #(.W(2 * WORD), .N(1)) d_sc (.clk(clk), .d({s_c, c_c}), .q({dbg_sin, dbg_cos}));
+            tfb_delay #(.W(WORD), .N((ITER + 2) * PIPE_S + PIPE_U)) d_code (.clk(clk), .d(code2), .q(dbg_code));
+            tfb_delay #(.W(WORD + 1), .N((ITER + 1) * PIPE_S + PIPE_U)) d_fold (.clk(clk), .d({flip3, z3}), .q({dbg_flip, dbg_folded}));
+            tfb_delay #(.W(2 * WORD), .N(PIPE_U)) d_sc (.clk(clk), .d({s_c, c_c}), .q({dbg_sin, dbg_cos}));
         end else begin : no_taps
             assign dbg_code = {WORD{1'b0}};
             assign dbg_folded = {WORD{1'b0}};

@@ -6,7 +6,9 @@
 // One new a per clock; s and a_clamp appear LATENCY clocks later (LATENCY
 // register stages from port a to ports s / a_clamp). No reset: pure datapath.
 //
-// Stage map (LATENCY = 33):
+// Stage map (LATENCY = TFB_SQRT1M_LAT in f32_lat.vh: 33 with every stage a register,
+// pipeline "sample"; stage 33 is the output register, `UNIT_REG, the others
+// `STAGE_REG, each a register or a wire as pipe.vh says):
 //   1      clamp
 //   2-4    u = fl(1-a), v = fl(1+a): exact fixed-point add, normalize, round
 //   5-7    p = fl(u*v): operand->product reg, product pipe reg (DSP MREG/PREG), round
@@ -18,7 +20,7 @@ module tfb_sqrt1m (
     output reg  [31:0] s,        // f32 bits of sqrt((1-a)(1+a))
     output reg  [31:0] a_clamp   // f32 bits of clamp(a,-1,1), aligned with s
 );
-localparam LATENCY = 33;         // clocks from a to s / a_clamp
+`include "f32_lat.vh"
 localparam NQ      = 25;         // sqrt digit stages (24 significant bits + guard)
 
 // Round-to-nearest-even of a 24-bit significand (hidden bit set) with guard g
@@ -51,7 +53,7 @@ endfunction
 // Clamp: |a| >= 1 (exponent >= 127, includes inf) becomes +-1.0; else a
 // unchanged (so -0.0 stays -0.0).
 reg [31:0] c1;
-always @(posedge clk)
+`STAGE_REG
     c1 <= (a[30:23] >= 8'd127) ? {a[31], 8'd127, 23'd0} : a;
 
 // ---------------------------------------------------------------- stage 2
@@ -67,7 +69,7 @@ wire [50:0] one   = {2'b01, 49'd0};
 wire [50:0] c1_sp = one + {1'b0, c1_x};          // 1 + |a|, <= 2
 wire [50:0] c1_sm = one - {1'b0, c1_x};          // 1 - |a|, >= 0 (|a| <= 1)
 reg  [50:0] su2, sv2;
-always @(posedge clk) begin
+`STAGE_REG begin
     su2 <= c1[31] ? c1_sp : c1_sm;               // 1 - a
     sv2 <= c1[31] ? c1_sm : c1_sp;               // 1 + a
 end
@@ -79,7 +81,7 @@ wire [5:0] lzv = lzc51(sv2);
 reg  [50:0] nu3, nv3;
 reg  [7:0]  eu3, ev3;
 reg         zu3, zv3;
-always @(posedge clk) begin
+`STAGE_REG begin
     nu3 <= su2 << lzu;
     nv3 <= sv2 << lzv;
     eu3 <= 8'd128 - {2'b00, lzu};
@@ -92,7 +94,7 @@ end
 // Round u and v to 24 bits (sum is exact, so guard/sticky are exact).
 reg [31:0] u4, v4;                               // {exp, significand}
 reg        zu4, zv4;
-always @(posedge clk) begin
+`STAGE_REG begin
     u4  <= rne(eu3, nu3[50:27], nu3[26], |nu3[25:0]);
     v4  <= rne(ev3, nv3[50:27], nv3[26], |nv3[25:0]);
     zu4 <= zu3;
@@ -104,7 +106,7 @@ end
 reg [47:0] pm5, pm6;
 reg [8:0]  pe5, pe6;                             // eu + ev - 127
 reg        pz5, pz6;
-always @(posedge clk) begin
+`STAGE_REG begin
     pm5 <= u4[23:0] * v4[23:0];
     pe5 <= {1'b0, u4[31:24]} + {1'b0, v4[31:24]} - 9'd127;
     pz5 <= zu4 | zv4;
@@ -117,7 +119,7 @@ end
 // Normalize product (in [2^46, 2^48)) and round.
 reg [31:0] p7;                                   // {exp, significand}
 reg        pz7;
-always @(posedge clk) begin
+`STAGE_REG begin
     p7  <= pm6[47] ? rne(pe6[7:0] + 8'd1, pm6[47:24], pm6[23], |pm6[22:0])
                    : rne(pe6[7:0],        pm6[46:23], pm6[22], |pm6[21:0]);
     pz7 <= pz6;
@@ -133,10 +135,10 @@ wire [49:0] r0_rad = p7_e[0] ? {1'b0, p7[23:0], 25'd0} : {p7[23:0], 26'd0};
 wire [8:0]  r0_exp = ({1'b0, p7_e} + 9'd126 + {8'd0, p7_e[0]}) >> 1;
 
 // Flat buses between stages (slice k = output register of digit stage k).
-reg [50*NQ-1:0] q_rad;                           // radicand, consumed 2 bits/stage
-reg [26*NQ-1:0] q_rem;                           // partial remainder (< 2^26)
-reg [25*NQ-1:0] q_root;                          // partial root
-reg [9*NQ-1:0]  q_side;                          // {zero, result exponent}
+reg [50*NQ-1:0] q_rad /*verilator split_var*/;                           // radicand, consumed 2 bits/stage
+reg [26*NQ-1:0] q_rem /*verilator split_var*/;                           // partial remainder (< 2^26)
+reg [25*NQ-1:0] q_root /*verilator split_var*/;                          // partial root
+reg [9*NQ-1:0]  q_side /*verilator split_var*/;                          // {zero, result exponent}
 
 genvar k;
 generate
@@ -161,7 +163,7 @@ generate
         wire [27:0] trial = {1'b0, root_i, 2'b01};
         wire        ge    = (rsh >= trial);
         wire [27:0] dif   = rsh - trial;
-        always @(posedge clk) begin
+        `STAGE_REG begin
             q_rad [50*k +: 50] <= {rad_i[47:0], 2'b00};
             q_rem [26*k +: 26] <= ge ? dif[25:0] : rsh[25:0];
             q_root[25*k +: 25] <= {root_i[23:0], ge};
@@ -176,15 +178,13 @@ wire [24:0] qf   = q_root[25*(NQ-1) +: 25];
 wire        qst  = |q_rem[26*(NQ-1) +: 26];
 wire [8:0]  qsd  = q_side[9*(NQ-1) +: 9];
 wire [31:0] qr   = rne(qsd[7:0], qf[24:1], qf[0], qst);
-always @(posedge clk)
+`UNIT_REG
     s <= qsd[8] ? 32'd0 : {1'b0, qr[31:24], qr[22:0]};
 
-// a_clamp: c1 delayed to line up with s (LATENCY-2 pipe regs + output reg).
-localparam ND = LATENCY - 2;
-reg [32*ND-1:0] ac_dly;
-always @(posedge clk) begin
-    ac_dly  <= {ac_dly[32*(ND-1)-1:0], c1};
-    a_clamp <= ac_dly[32*ND-1 -: 32];
-end
+// a_clamp: c1 delayed to line up with s (stages 2-32, then the output register).
+wire [31:0] ac_dly;
+tfb_delay #(.W(32), .N(31 * PIPE_S)) d_ac (.clk(clk), .d(c1), .q(ac_dly));
+`UNIT_REG
+    a_clamp <= ac_dly;
 
 endmodule

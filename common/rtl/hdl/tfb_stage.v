@@ -1,4 +1,5 @@
-// One CORDIC iteration i, one clock: both modes, every register WORD bits.
+// One CORDIC iteration i, one clock (a `STAGE_REG: a wire when pipe.vh says so): both
+// modes, every register WORD bits.
 // sigma = +1 turns (x, y) counter-clockwise by atan(2^-i) and takes the angle off z:
 //   x' = x - sigma ((y + b) >>> i),  y' = y + sigma ((x + b) >>> i),  z' = z - sigma a_i
 // with b = 2^(i-1) for round-half-up shifts (NEAREST, i >= 1), else 0. Rotation mode
@@ -30,11 +31,12 @@ module tfb_stage #(
 `else
     localparam integer B = (NEAREST != 0 && SH > 0) ? (1 << (SH - 1)) : 0;
 `endif
+`include "pipe.vh"
     wire signed [WORD-1:0] xs = (x + B) >>> SH;
     wire signed [WORD-1:0] ys = (y + B) >>> SH;
     wire signed [WORD-1:0] a = ATAN_I[WORD-1:0];
     wire ccw = VECTORING != 0 ? y[WORD-1] : !z[WORD-1];
-    always @(posedge clk) begin
+    `STAGE_REG begin
         if (ccw) begin
             xn <= x - ys;
             yn <= y + xs;

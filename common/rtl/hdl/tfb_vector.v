@@ -1,7 +1,9 @@
 // TFB, vectoring mode: the angle of (x, y), bit for bit the hybrid model's vectoring
 // (`Cordic::atan2`, and with ACOS = 1 the back end of `Cordic::acos`).
 //
-// One sample a clock, LATENCY = ITER + 4 clocks:
+// One sample a clock, LATENCY = ITER + 4 clocks with every stage a register (pipeline
+// "sample"; the output register is the unit's, `UNIT_REG, the others `STAGE_REG: see
+// pipe.vh and TFB_VECTOR_LAT in f32_lat.vh):
 //   1    F2FP: both inputs scaled by one power of two so that max(|x|, |y|) is in
 //        [0.5, 1) (an exponent subtraction), then floor(v 2^FRAC + h) each
 //   2    half-plane fold: x < 0 negates both, z starts at +-pi by y's sign bit
@@ -34,8 +36,9 @@ module tfb_vector #(
 );
     localparam integer FP2F_W = WORD;
     `include "tfb_fp.vh"
+    `include "f32_lat.vh"
 
-    localparam integer LATENCY = ITER + 4;
+    localparam integer LATENCY = `TFB_VECTOR_LAT(ITER);
     // Both positive and below 2^(WORD-1): one zero bit on top makes them signed.
     localparam signed [WORD:0] PI_W = {1'b0, PI_Q[WORD-1:0]};
     localparam signed [WORD:0] PI_FLOOR_W = {1'b0, PI_FLOOR[WORD-1:0]};
@@ -77,7 +80,7 @@ module tfb_vector #(
         emax = ex > ey ? ex : ey;
         if (emax < -149) emax = -149;
     end
-    always @(posedge clk) begin
+    `STAGE_REG begin
         xc1 <= f2fp(x[31], f32_sig(x), ex - emax + FRAC - 23);
         yc1 <= f2fp(y[31], f32_sig(y), ey - emax + FRAC - 23);
         ysgn1 <= y[31];
@@ -88,7 +91,7 @@ module tfb_vector #(
     reg signed [WORD-1:0] x2, y2;
     reg signed [WORD:0]   z0_2;
     reg zero2;
-    always @(posedge clk) begin
+    `STAGE_REG begin
         x2 <= xc1[WORD-1] ? -xc1 : xc1;
         y2 <= xc1[WORD-1] ? -yc1 : yc1;
         z0_2 <= xc1[WORD-1] ? (ysgn1 ? -PI_W : PI_W) : 0;
@@ -115,13 +118,13 @@ module tfb_vector #(
     endgenerate
     wire signed [WORD:0] z0_n;
     wire zero_n;
-    tfb_delay #(.W(WORD + 2), .N(ITER)) d_z0 (.clk(clk), .d({zero2, z0_2}), .q({zero_n, z0_n}));
+    tfb_delay #(.W(WORD + 2), .N(ITER * PIPE_S)) d_z0 (.clk(clk), .d({zero2, z0_2}), .q({zero_n, z0_n}));
 
     // ---- offset, saturation ----
     wire signed [WORD-1:0] zf = zw[ITER];
     wire signed [WORD+1:0] sum = zf + z0_n;
     reg  signed [WORD-1:0] zc;
-    always @(posedge clk) begin
+    `STAGE_REG begin
         if (zero_n || (ACOS != 0 && sum < 0))
             zc <= {WORD{1'b0}};
         else if (sum > PI_FLOOR_W)
@@ -134,15 +137,15 @@ module tfb_vector #(
 
     // ---- FP2F ----
     wire nan_n;
-    tfb_delay #(.W(1), .N(ITER + 2)) d_nan (.clk(clk), .d(nan1), .q(nan_n));
-    always @(posedge clk)
+    tfb_delay #(.W(1), .N((ITER + 2) * PIPE_S)) d_nan (.clk(clk), .d(nan1), .q(nan_n));
+    `UNIT_REG
         angle <= nan_n ? 32'h7FC0_0000 : fp2f(zc, FRAC);
     tfb_delay #(.W(1), .N(LATENCY)) d_valid (.clk(clk), .d(in_valid), .q(out_valid));
 
     generate
         if (DEBUG != 0) begin : taps
-            tfb_delay #(.W(2 * WORD), .N(LATENCY - 1)) d_xy (.clk(clk), .d({xc1, yc1}), .q({dbg_x, dbg_y}));
-            tfb_delay #(.W(WORD), .N(1)) d_zc (.clk(clk), .d(zc), .q(dbg_z));
+            tfb_delay #(.W(2 * WORD), .N((ITER + 2) * PIPE_S + PIPE_U)) d_xy (.clk(clk), .d({xc1, yc1}), .q({dbg_x, dbg_y}));
+            tfb_delay #(.W(WORD), .N(PIPE_U)) d_zc (.clk(clk), .d(zc), .q(dbg_z));
         end else begin : no_taps
             assign dbg_x = {WORD{1'b0}};
             assign dbg_y = {WORD{1'b0}};

@@ -14,7 +14,7 @@ pub mod text;
 mod sim;
 
 #[cfg(tactile_rtl_sim)]
-pub use sim::{Rtl, BUILT_FOR};
+pub use sim::{built_pipeline, Rtl, BUILT_FOR};
 
 use tactile_math::arith::ArithKind;
 use tactile_math::cordic::CordicConfig;

@@ -6,7 +6,7 @@
 // lengths fixed by glue.cpp, and a pointer owned by `Rtl` alone.
 #![allow(unsafe_code)]
 
-use crate::text::{kin_params_vh, params_vh};
+use crate::text::{kin_params_vh, params_vh, pipe_vh, Pipeline};
 use crate::RtlError;
 use std::ffi::c_void;
 use std::ptr::NonNull;
@@ -30,6 +30,17 @@ pub const BUILT_FOR: (&str, &str) = (
     include_str!(concat!(env!("OUT_DIR"), "/rtl/tfb_params.vh")),
     include_str!(concat!(env!("OUT_DIR"), "/rtl/kin_params.vh")),
 );
+
+/// The pipeline configuration the simulated RTL was built with
+/// (`TACTILE_RTL_PIPELINE`, by default [`Pipeline::Module`]): the clocks each call
+/// takes.
+pub fn built_pipeline() -> Pipeline {
+    let built = include_str!(concat!(env!("OUT_DIR"), "/rtl/pipe.vh"));
+    Pipeline::ALL
+        .into_iter()
+        .find(|p| pipe_vh(*p) == built)
+        .unwrap_or_default()
+}
 
 /// The four modules under simulation: one chip, one sample in flight at a time.
 #[derive(Debug)]

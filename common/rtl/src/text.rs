@@ -64,6 +64,159 @@ pub const MODULES: [&str; 16] = [
     "kin_ik.v",
 ];
 
+/// How deep the modules are pipelined: which of the registers between the stages of
+/// every unit (f32 adder, multiplier, divider, square root; the TFB's functions) are
+/// registers and which are wires. Written into `pipe.vh`; the bits never change, only
+/// the clocks a sample takes and how long a clock must be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Pipeline {
+    /// Every stage a register: one new sample a clock, the shortest clock, the most
+    /// clocks a sample (FK 35, IK 175).
+    #[default]
+    Sample,
+    /// One register a unit, at its output: each f32 operation and each TFB function
+    /// takes one clock (FK 5, IK 14), its whole datapath inside that clock.
+    Unit,
+    /// The paper's architecture: the whole datapath of a module between its input
+    /// and one output register, so a sample takes one clock (as long as the longest
+    /// path through the module): the least latency.
+    Module,
+}
+
+impl Pipeline {
+    /// Every configuration, deepest first.
+    pub const ALL: [Pipeline; 3] = [Pipeline::Sample, Pipeline::Unit, Pipeline::Module];
+
+    /// The name in `pipe.vh`, the CLI and the reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pipeline::Sample => "sample",
+            Pipeline::Unit => "unit",
+            Pipeline::Module => "module",
+        }
+    }
+
+    /// The configuration called `name`, if any.
+    pub fn from_name(name: &str) -> Option<Pipeline> {
+        Pipeline::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// 1 where a unit's inner stages are registers (`PIPE_S`).
+    pub fn stage(self) -> u32 {
+        u32::from(self == Pipeline::Sample)
+    }
+
+    /// 1 where a unit's output is a register (`PIPE_U`).
+    pub fn unit(self) -> u32 {
+        u32::from(self != Pipeline::Module)
+    }
+
+    /// 1 where a module's outputs are registered on their own (`PIPE_M`): when no
+    /// unit holds a register, so a sample still takes one clock.
+    pub fn module(self) -> u32 {
+        u32::from(self == Pipeline::Module)
+    }
+
+    /// Clocks through a unit of `inner` inner stages (f32_lat.vh's formulas).
+    fn through(self, inner: u32) -> u32 {
+        inner * self.stage() + self.unit()
+    }
+
+    /// Clocks from a block's input to its output with a TFB of `iterations`: the
+    /// RTL's LATENCY localparams (f32_lat.vh, kin_*.v), which the co-simulation
+    /// measures and holds to these.
+    pub fn latency(self, block: Block, iterations: u32) -> u32 {
+        let vector = self.through(iterations + 3);
+        let unit = |b| self.latency(b, iterations);
+        match block {
+            Block::Sincos => self.through(iterations + 4),
+            Block::Atan2 => vector,
+            Block::Acos => self.through(32) + vector,
+            Block::Add | Block::Mul => self.through(3),
+            Block::Div | Block::Sqrt => self.through(27),
+            Block::Fk => {
+                unit(Block::Sincos) + 2 * unit(Block::Mul) + 2 * unit(Block::Add) + self.module()
+            }
+            Block::Kff => {
+                unit(Block::Sincos) + 3 * unit(Block::Mul) + 3 * unit(Block::Add) + self.module()
+            }
+            Block::Fbf => unit(Block::Add) + unit(Block::Mul) + self.module(),
+            // The acos's argument, then acos, then the three additions of theta3; 4
+            // stages of comparisons and muxes on the way.
+            Block::Ik => {
+                6 * unit(Block::Add)
+                    + 3 * unit(Block::Mul)
+                    + 2 * unit(Block::Div)
+                    + unit(Block::Sqrt)
+                    + unit(Block::Acos)
+                    + 4 * self.stage()
+                    + self.module()
+            }
+        }
+    }
+}
+
+/// A block whose latency [`Pipeline::latency`] gives: a TFB function, an f32 unit (the
+/// subtractor is the adder), one of the paper's modules.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Block {
+    /// TFB, rotation mode.
+    Sincos,
+    /// TFB, vectoring mode.
+    Atan2,
+    /// TFB: the root, then vectoring.
+    Acos,
+    /// f32 adder (and subtractor).
+    Add,
+    /// f32 multiplier.
+    Mul,
+    /// f32 divider.
+    Div,
+    /// f32 square root.
+    Sqrt,
+    /// FK-HMD / FK-HSD.
+    Fk,
+    /// KFF-HMD.
+    Kff,
+    /// FBF-HSD.
+    Fbf,
+    /// IK-HSD.
+    Ik,
+}
+
+/// The text of `pipe.vh`: the pipeline configuration as the RTL reads it, a macro for
+/// each kind of stage register (`STAGE_REG`, a unit's inner stage; `UNIT_REG`, its
+/// output), clocked or combinational, and the numbers the latencies are computed from.
+pub fn pipe_vh(p: Pipeline) -> String {
+    let block = |on: u32| {
+        if on == 1 {
+            "always @(posedge clk)"
+        } else {
+            "always @*"
+        }
+    };
+    format!(
+        "// pipe.vh: the pipeline configuration \"{name}\". Written by `tactile hdl rtl`\n\
+         // (tactile_rtl::text::Pipeline): regenerate it, do not edit it.\n\
+         // A stage written `STAGE_REG or `UNIT_REG is a register, or (always @*) a wire:\n\
+         // its non-blocking assignments then settle within the clock, in order.\n\
+         `ifndef TACTILE_PIPE_VH\n\
+         `define TACTILE_PIPE_VH\n\
+         `define STAGE_REG {stage_block}\n\
+         `define UNIT_REG {unit_block}\n\
+         `endif\n\
+         localparam integer PIPE_S = {s};  // a unit's inner stages are registers\n\
+         localparam integer PIPE_U = {u};  // a unit's output is a register\n\
+         localparam integer PIPE_M = {m};  // a module's outputs are registered on their own\n",
+        name = p.name(),
+        stage_block = block(p.stage()),
+        unit_block = block(p.unit()),
+        s = p.stage(),
+        u = p.unit(),
+        m = p.module(),
+    )
+}
+
 /// The text of `tfb_params.vh` for one format.
 pub fn params_vh(c: &RtlConstants) -> String {
     let cfg = &c.config;
@@ -150,15 +303,20 @@ pub fn kin_params_vh(geometry: &Geometry) -> String {
     s
 }
 
-/// Every file of the RTL for a format and a geometry: the sources, then
-/// `tfb_params.vh` and `kin_params.vh`.
-pub fn files(c: &RtlConstants, geometry: &Geometry) -> Vec<(&'static str, String)> {
+/// Every file of the RTL for a format, a geometry and a pipeline: the sources, then
+/// `tfb_params.vh`, `kin_params.vh` and `pipe.vh`.
+pub fn files(
+    c: &RtlConstants,
+    geometry: &Geometry,
+    pipeline: Pipeline,
+) -> Vec<(&'static str, String)> {
     SOURCES
         .iter()
         .map(|(n, t)| (*n, (*t).to_string()))
         .chain([
             ("tfb_params.vh", params_vh(c)),
             ("kin_params.vh", kin_params_vh(geometry)),
+            ("pipe.vh", pipe_vh(pipeline)),
         ])
         .collect()
 }

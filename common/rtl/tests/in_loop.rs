@@ -12,6 +12,7 @@ use tactile_math::geometry::Geometry;
 mod simulated {
     use super::*;
     use tactile_math::kernels::IkStatus;
+    use tactile_rtl::text::{Block, Pipeline};
 
     fn engines() -> (Engine, Engine) {
         let c = CordicConfig::S16_13;
@@ -94,11 +95,21 @@ mod simulated {
         rtl.kff([0.1, 0.2, 0.3], [1.0, 0.0, 0.0]);
         rtl.jacobian([0.1, 0.2, 0.3]);
         let c = rtl.hardware_clocks();
-        // FK, KFF, FBF, IK at [s16.13] (14 iterations): docs/09's latencies.
+        // FK, KFF, FBF, IK at [s16.13] (14 iterations), in the pipeline this build
+        // simulates: docs/09's latencies (35, 43, 8, 175 clocks in "sample", 1 each
+        // in "module", the default).
+        let p = tactile_rtl::built_pipeline();
+        let lat = [Block::Fk, Block::Kff, Block::Fbf, Block::Ik].map(|b| p.latency(b, 14));
+        if p == Pipeline::Sample {
+            assert_eq!(lat, [35, 43, 8, 175]);
+        }
         assert_eq!(c.calls, [5, 2, 5, 5]);
-        assert_eq!(c.min, [35, 43, 8, 175]);
+        assert_eq!(c.min, lat);
         assert_eq!(c.max, c.min);
-        assert_eq!(c.total, [175, 86, 40, 875]);
+        assert_eq!(
+            c.total,
+            [0, 1, 2, 3].map(|i| c.calls[i] * u64::from(lat[i]))
+        );
         assert_eq!(c.faults, 0);
         // An angle beyond the TFB's range (3 pi) is flagged, not silently wrong: its
         // sine and cosine are NaN, and so are x and z (y does not use theta1).

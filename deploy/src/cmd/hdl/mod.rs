@@ -19,7 +19,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 pub use params::{latency, model, write_rtl};
-pub use tactile_rtl::text::{params_vh, MODULES};
+pub use tactile_rtl::text::{params_vh, Pipeline, MODULES};
 pub use vectors::vectors;
 
 /// Arguments of `tactile hdl`.
@@ -38,6 +38,9 @@ pub enum HdlCommand {
         /// Folder to write (created if missing).
         #[arg(long)]
         out: PathBuf,
+        /// Which stage registers the modules keep.
+        #[arg(long, value_enum, default_value = "sample")]
+        pipeline: PipelineArg,
         /// Fixed-point format and the arm's geometry (the modules' constants).
         #[command(flatten)]
         datapath: DatapathArgs,
@@ -68,6 +71,29 @@ pub enum HdlCommand {
     /// Place and route each of the paper's modules on an ECP5 (Yosys, nextpnr-ecp5):
     /// its clock rate, its latency in ns, its cells, beside the paper's Virtex-6.
     Timing(timing::TimingArgs),
+}
+
+/// `--pipeline`: which of the stage registers the modules keep
+/// ([`tactile_rtl::text::Pipeline`]). The bits are the same in every configuration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PipelineArg {
+    /// Every stage a register: one sample a clock, the most clocks a sample (FK 35).
+    Sample,
+    /// One register at each unit's output: an f32 operation or a TFB function a clock.
+    Unit,
+    /// The paper's architecture: each module's datapath between its inputs and one
+    /// output register, one clock a sample, the least latency.
+    Module,
+}
+
+impl From<PipelineArg> for Pipeline {
+    fn from(p: PipelineArg) -> Pipeline {
+        match p {
+            PipelineArg::Sample => Pipeline::Sample,
+            PipelineArg::Unit => Pipeline::Unit,
+            PipelineArg::Module => Pipeline::Module,
+        }
+    }
 }
 
 /// A block of the hardware: a TFB function, an f32 unit or one of the paper's modules.
@@ -250,11 +276,18 @@ fn write_vectors(
 /// Runs `tactile hdl`.
 pub fn main(args: &HdlArgs) -> Result<(), Error> {
     match &args.command {
-        HdlCommand::Rtl { out, datapath } => {
+        HdlCommand::Rtl {
+            out,
+            pipeline,
+            datapath,
+        } => {
             let (_, k) = model(datapath.cordic()?)?;
-            write_rtl(out, &k, &datapath.geometry()?)?;
+            let pipeline = Pipeline::from(*pipeline);
+            write_rtl(out, &k, &datapath.geometry()?, pipeline)?;
             crate::outln!(
-                "wrote the RTL (TFB, f32 units, modules) for this format and geometry into {}",
+                "wrote the RTL (TFB, f32 units, modules) for this format and geometry, \
+                 pipeline {}, into {}",
+                pipeline.name(),
                 out.display()
             );
             Ok(())

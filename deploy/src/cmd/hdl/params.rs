@@ -1,55 +1,32 @@
 //! The RTL in a folder: its sources and generated parameters (`tactile_rtl::text`),
-//! each block's latency, and the model a format's RTL is checked against.
+//! each block's latency in each pipeline configuration, and the model a format's RTL
+//! is checked against.
 
 use crate::error::Error;
 use std::path::Path;
 use tactile_math::cordic::hdl::{RtlConstants, REDUCE_GUARD};
 use tactile_math::cordic::{Cordic, CordicConfig};
 use tactile_math::geometry::Geometry;
-use tactile_rtl::text::{files, SOURCES};
+use tactile_rtl::text::{files, Block, Pipeline};
 
-/// Clocks from input to output of each function (the RTL's LATENCY localparams).
-pub fn latency(function: super::Function, cfg: &CordicConfig) -> u32 {
+/// Clocks from input to output of each function in a pipeline configuration
+/// ([`Pipeline::latency`]).
+pub fn latency(function: super::Function, cfg: &CordicConfig, p: Pipeline) -> u32 {
     use super::Function as F;
-    match function {
-        F::Sincos => cfg.iterations + 5,
-        F::Atan2 => cfg.iterations + 4,
-        F::Acos => 33 + cfg.iterations + 4,
-        F::Add | F::Sub => unit_latency("F32_ADD_LAT"),
-        F::Mul => unit_latency("F32_MUL_LAT"),
-        F::Div => unit_latency("F32_DIV_LAT"),
-        F::Sqrt => unit_latency("F32_SQRT_LAT"),
-        F::Fk | F::Kff | F::Fbf | F::Ik => module_latency(function, cfg),
-    }
-}
-
-/// A unit's latency, read from `f32_lat.vh` (the one place it is written).
-fn unit_latency(name: &str) -> u32 {
-    let text = SOURCES
-        .iter()
-        .find(|(n, _)| *n == "f32_lat.vh")
-        .map_or("", |(_, t)| *t);
-    text.lines()
-        .filter_map(|l| l.split_once(name)?.1.trim_start().strip_prefix('='))
-        .find_map(|v| v.trim().trim_end_matches(';').trim().parse().ok())
-        .unwrap_or(0)
-}
-
-/// A module's latency: the formula of its LATENCY localparam (kin_*.v), which the
-/// co-simulation checks against the clocks it measures.
-fn module_latency(function: super::Function, cfg: &CordicConfig) -> u32 {
-    use super::Function as F;
-    let (add, mul) = (unit_latency("F32_ADD_LAT"), unit_latency("F32_MUL_LAT"));
-    let (div, sqrt) = (unit_latency("F32_DIV_LAT"), unit_latency("F32_SQRT_LAT"));
-    let sincos = latency(F::Sincos, cfg);
-    match function {
-        F::Fk => sincos + 2 * mul + 2 * add,
-        F::Kff => sincos + 3 * mul + 3 * add,
-        F::Fbf => add + mul,
-        // The acos's argument, then acos, then the three additions of theta3; 4 clocks
-        // of comparisons and muxes on the way.
-        _ => 6 * add + 3 * mul + 2 * div + sqrt + latency(F::Acos, cfg) + 4,
-    }
+    let block = match function {
+        F::Sincos => Block::Sincos,
+        F::Atan2 => Block::Atan2,
+        F::Acos => Block::Acos,
+        F::Add | F::Sub => Block::Add,
+        F::Mul => Block::Mul,
+        F::Div => Block::Div,
+        F::Sqrt => Block::Sqrt,
+        F::Fk => Block::Fk,
+        F::Kff => Block::Kff,
+        F::Fbf => Block::Fbf,
+        F::Ik => Block::Ik,
+    };
+    p.latency(block, cfg.iterations)
 }
 
 /// The model for `cfg`, refused (with the model's error) where the model refuses it,
@@ -67,11 +44,16 @@ pub fn model(cfg: CordicConfig) -> Result<(Cordic, RtlConstants), Error> {
     Ok((cordic, constants))
 }
 
-/// Writes the sources, `tfb_params.vh` and `kin_params.vh` (the modules' constants
-/// for `geometry`) into `dir` (created if missing).
-pub fn write_rtl(dir: &Path, c: &RtlConstants, geometry: &Geometry) -> Result<(), Error> {
+/// Writes the sources, `tfb_params.vh`, `kin_params.vh` (the modules' constants
+/// for `geometry`) and `pipe.vh` into `dir` (created if missing).
+pub fn write_rtl(
+    dir: &Path,
+    c: &RtlConstants,
+    geometry: &Geometry,
+    pipeline: Pipeline,
+) -> Result<(), Error> {
     std::fs::create_dir_all(dir).map_err(Error::io(format!("creating {}", dir.display())))?;
-    for (name, text) in files(c, geometry) {
+    for (name, text) in files(c, geometry, pipeline) {
         let path = dir.join(name);
         std::fs::write(&path, text).map_err(Error::io(format!("writing {}", path.display())))?;
     }

@@ -2,7 +2,7 @@
 //! testbench over the vectors, Yosys synthesizes each function for Virtex-6 (the
 //! paper's family). Each run works in a fresh folder of its own.
 
-use super::{block_vectors, latency, model, write_rtl, Function, MODULES};
+use super::{block_vectors, latency, model, write_rtl, Function, Pipeline, PipelineArg, MODULES};
 use crate::cmd::datapath::DatapathArgs;
 use crate::error::Error;
 use clap::Args;
@@ -32,6 +32,9 @@ pub struct CosimArgs {
     /// Seed of the random inputs.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Pipeline configurations to run, each over the same vectors (default: all).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub pipeline: Vec<PipelineArg>,
     /// A Verilog macro to define when compiling the RTL (repeatable): the RTL's
     /// deliberately wrong variants are TFB_MUTANT_SHIFT (one iteration shifts one bit
     /// too far), TFB_MUTANT_ROUND (shifts truncate where they must round) and one per
@@ -134,14 +137,23 @@ fn write_hex(
         .map_err(Error::io(format!("writing {}", path.display())))
 }
 
-/// Co-simulation of one function: `(vectors, mismatches)` from the testbench's line.
+/// What a testbench's last line says.
+struct Outcome {
+    vectors: usize,
+    mismatches: usize,
+    /// Clocks from the first input to the first output, as measured (the f32 units'
+    /// testbench reads its outputs at the latency f32_lat.vh gives, and measures none).
+    latency: Option<u32>,
+}
+
+/// Co-simulation of one function, from the testbench's last line.
 fn cosim_one(
     work: &Path,
     function: Function,
     vec_path: &Path,
     n: usize,
     defines: &[String],
-) -> Result<(usize, usize), Error> {
+) -> Result<Outcome, Error> {
     let name = function.name();
     let sim = work.join(format!("{name}.vvp"));
     let (bench, prefix) = function.testbench();
@@ -177,11 +189,16 @@ fn cosim_one(
             .and_then(|v| v.parse().ok())
     };
     match (field("vectors="), field("mismatches=")) {
-        (Some(v), Some(m)) => {
+        (Some(vectors), Some(mismatches)) => {
             for l in out.lines().filter(|l| l.contains("mismatch at")) {
                 crate::noteln!("{l}");
             }
-            Ok((v, m))
+            let latency = field("latency=").and_then(|l| u32::try_from(l).ok());
+            Ok(Outcome {
+                vectors,
+                mismatches,
+                latency,
+            })
         }
         _ => Err(Error::Failed(format!(
             "unreadable testbench result: {last}"
@@ -189,36 +206,59 @@ fn cosim_one(
     }
 }
 
-/// `tactile hdl cosim`.
+/// `tactile hdl cosim`: each block's vectors written once, then run through the RTL
+/// of every pipeline configuration asked for, each in a folder of its own.
 pub fn cosim_main(args: &CosimArgs) -> Result<(), Error> {
     let cfg = args.datapath.cordic()?;
     let geometry = args.datapath.geometry()?;
     let (cordic, k) = model(cfg)?;
     let work = Work::new(args.keep.as_deref())?;
-    write_rtl(&work.dir, &k, &geometry)?;
+    let pipelines: Vec<Pipeline> = if args.pipeline.is_empty() {
+        Pipeline::ALL.to_vec()
+    } else {
+        args.pipeline.iter().map(|p| Pipeline::from(*p)).collect()
+    };
+    for p in &pipelines {
+        write_rtl(&work.dir.join(p.name()), &k, &geometry, *p)?;
+    }
     let mut failed = 0;
     for f in chosen(&args.function, &Function::ALL) {
         let vec_path = work.dir.join(format!("{}.hex", f.name()));
         let n = write_hex(&vec_path, |out| {
             block_vectors(&cordic, &k, &geometry, (f, args.count, args.seed), out)
         })?;
-        let (v, m) = cosim_one(&work.dir, f, &vec_path, n, &args.defines)?;
-        crate::outln!(
-            "{:<7} [s{}.{}] {} iterations {:<8} {v} vectors, {m} mismatches (latency {} clocks)",
-            f.name(),
-            cfg.word,
-            cfg.frac,
-            cfg.iterations,
-            format!("{:?}", cfg.rounding).to_lowercase(),
-            latency(f, &cfg)
-        );
-        if v != n {
-            return Err(Error::Failed(format!(
-                "{}: the testbench compared {v} of {n} vectors",
-                f.name()
-            )));
+        for p in &pipelines {
+            let got = cosim_one(&work.dir.join(p.name()), f, &vec_path, n, &args.defines)?;
+            let (v, m, clocks) = (got.vectors, got.mismatches, latency(f, &cfg, *p));
+            crate::outln!(
+                "{:<7} [s{}.{}] {} iterations {:<8} pipeline {:<6} {v} vectors, {m} mismatches \
+                 (latency {} clocks)",
+                f.name(),
+                cfg.word,
+                cfg.frac,
+                cfg.iterations,
+                format!("{:?}", cfg.rounding).to_lowercase(),
+                p.name(),
+                clocks
+            );
+            let measured = !matches!(f.family(), super::Family::Unit(_));
+            if measured && got.latency != Some(clocks) {
+                return Err(Error::Failed(format!(
+                    "{} (pipeline {}): the RTL took {:?} clocks where its formula says {clocks}",
+                    f.name(),
+                    p.name(),
+                    got.latency
+                )));
+            }
+            if v != n {
+                return Err(Error::Failed(format!(
+                    "{} (pipeline {}): the testbench compared {v} of {n} vectors",
+                    f.name(),
+                    p.name()
+                )));
+            }
+            failed += m;
         }
-        failed += m;
     }
     if failed > 0 {
         return Err(Error::Failed(format!(

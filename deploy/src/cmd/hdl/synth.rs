@@ -6,7 +6,7 @@
 //! path).
 
 use super::sim::{chosen, tool, Work};
-use super::{latency, model, write_rtl, Function, MODULES};
+use super::{latency, model, write_rtl, Function, Pipeline, PipelineArg, MODULES};
 use crate::cmd::datapath::DatapathArgs;
 use crate::error::Error;
 use clap::Args;
@@ -23,6 +23,9 @@ pub struct SynthArgs {
     /// FK-HSD, IK-HSD, FBF-HSD), as its table's total.
     #[arg(long)]
     pub together: bool,
+    /// Which stage registers the modules keep (the bits are the same in each).
+    #[arg(long, value_enum, default_value = "sample")]
+    pub pipeline: PipelineArg,
     /// Keep the work folder (RTL, scripts, Yosys logs) here.
     #[arg(long)]
     pub keep: Option<PathBuf>,
@@ -117,7 +120,8 @@ pub fn synth_main(args: &SynthArgs) -> Result<(), Error> {
     let cfg = args.datapath.cordic()?;
     let (_, k) = model(cfg)?;
     let work = Work::new(args.keep.as_deref())?;
-    write_rtl(&work.dir, &k, &args.datapath.geometry()?)?;
+    let pipeline = Pipeline::from(args.pipeline);
+    write_rtl(&work.dir, &k, &args.datapath.geometry()?, pipeline)?;
     crate::outln!(
         "| block | format | rounding | registers | LUTs | SRLs | DSP48E1 | CARRY4 | latency (clocks) | depth (cells) |"
     );
@@ -142,7 +146,7 @@ pub fn synth_main(args: &SynthArgs) -> Result<(), Error> {
     for f in blocks {
         let (t, chparam) = top(f);
         let (r, depth) = synthesize(&work, f.name(), &t, chparam)?;
-        row(f.name(), r, latency(f, &cfg).to_string(), depth);
+        row(f.name(), r, latency(f, &cfg, pipeline).to_string(), depth);
     }
     if args.together {
         let (r, depth) = synthesize(&work, "all", "top_all", "")?;

@@ -18,7 +18,7 @@
 //! LUT a bit at most) are not.
 
 use super::sim::{chosen, tool, Work};
-use super::{latency, model, write_rtl, Function, MODULES};
+use super::{latency, model, write_rtl, Function, Pipeline, PipelineArg, MODULES};
 use crate::cmd::datapath::DatapathArgs;
 use crate::error::Error;
 use clap::{Args, ValueEnum};
@@ -44,6 +44,9 @@ pub struct TimingArgs {
     /// The placer's and router's seed (results differ a little between seeds).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=i64::from(i32::MAX)))]
     pub seed: u32,
+    /// Which stage registers the modules keep (the bits are the same in each).
+    #[arg(long, value_enum, default_value = "sample")]
+    pub pipeline: PipelineArg,
     /// Keep the work folder (RTL, wrappers, netlists, nextpnr's reports) here.
     #[arg(long)]
     pub keep: Option<PathBuf>,
@@ -325,14 +328,15 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
         .collect::<Result<Vec<_>, _>>()?;
     let nextpnr = Nextpnr::find()?;
     let work = Work::new(args.keep.as_deref())?;
-    write_rtl(&work.dir, &k, &args.datapath.geometry()?)?;
+    let pipeline = Pipeline::from(args.pipeline);
+    write_rtl(&work.dir, &k, &args.datapath.geometry()?, pipeline)?;
     crate::outln!(
         "| module | latency (clocks) | Fmax (MHz) | latency (ns) | throughput (MSps) | logic cells | flip-flops | MULT18 | paper, Virtex-6: registers / LUTs / DSP48 / ns |"
     );
     crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---|");
     for (f, ports) in modules {
         let (p, synthesized, routed) = place(&work, f, &ports, nextpnr, args)?;
-        let clocks = latency(f, &cfg);
+        let clocks = latency(f, &cfg, pipeline);
         let ns = f64::from(clocks) * 1000.0 / p.fmax_mhz;
         let theirs = paper(f).map_or("-".into(), |(r, l, d, t)| format!("{r} / {l} / {d} / {t}"));
         crate::outln!(
