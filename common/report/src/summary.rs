@@ -213,7 +213,8 @@ pub struct Summary {
     pub emulator: Option<EmulatorTotals>,
     /// The slave's counters (summed over its segments).
     pub slave: Option<SlaveTotals>,
-    /// `arithmetic = "rtl"`: the clocks each module took, at a stated clock.
+    /// `arithmetic = "rtl"`: the clocks each module took, and their time where the
+    /// module was placed and routed in the pipeline the nodes simulated.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hardware: Option<crate::hardware::HardwareSummary>,
     /// Each node: where it ran, its memory, how its record ends.

@@ -287,6 +287,7 @@ fn summarise(
     let hardware = crate::hardware::summary(
         &master_totals.counters.rtl,
         &slave.as_ref().map(|s| s.counters.rtl).unwrap_or_default(),
+        scenario.cordic.config().map_or(0, |c| c.iterations),
     );
     let warnings = crate::warnings::warnings(
         a,
