@@ -16,8 +16,10 @@ pub const PART: &str = "Lattice ECP5 LFE5U-85F, speed 6 (Yosys synth_ecp5, nextp
 /// paper's geometry, seed 1: `tactile hdl timing --pipeline P --function M`
 /// (docs/09, "Timing from a real place and route"). A module not listed was not
 /// placed in that pipeline, and its time is not claimed.
-pub const PLACED: [(Pipeline, Block, f64); 4] = [
-    (Pipeline::Module, Block::Fbf, 10.5),
+pub const PLACED: [(Pipeline, Block, f64); 6] = [
+    (Pipeline::Module, Block::Fbf, 10.46),
+    (Pipeline::Module, Block::Fk, 2.89),
+    (Pipeline::Unit, Block::Fbf, 19.33),
     (Pipeline::Sample, Block::Fbf, 37.0),
     (Pipeline::Sample, Block::Fk, 34.9),
     (Pipeline::Sample, Block::Kff, 36.9),
@@ -139,12 +141,12 @@ pub fn lines(h: &HardwareSummary, stages: &BTreeMap<String, Percentiles>) -> Vec
     )];
     for (name, m) in &h.modules {
         let clocks = if m.min == m.max {
-            format!("{} clocks", m.min)
+            format!("{} clock{}", m.min, if m.min == 1 { "" } else { "s" })
         } else {
             format!("{}..{} clocks", m.min, m.max)
         };
         let time = match (m.ns, m.fmax_mhz) {
-            (Some(ns), Some(f)) => format!("{ns:.0} ns at {f:.1} MHz"),
+            (Some(ns), Some(f)) => format!("{ns:.0} ns at {f} MHz"),
             _ => "not placed and routed in this pipeline".to_string(),
         };
         out.push(format!(
