@@ -307,7 +307,7 @@ fn the_rtl_in_the_loop_gives_the_hybrid_models_trace_byte_for_byte() {
     )
     .expect("json");
     let m = &summary["hardware"]["modules"];
-    let p = tactile_rtl::built_pipeline();
+    let p = tactile_rtl::built_pipeline().expect("a build that simulates the RTL");
     let lat = |b| p.latency(b, 14);
     for (name, clocks, calls) in [
         ("FK-HMD", lat(Block::Fk), 1200),

@@ -194,6 +194,10 @@ mod verilate {
                 "-Wno-fatal",
                 "-Wno-lint",
                 "-Wno-style",
+                // The stages pipe.vh makes combinational keep their non-blocking
+                // assignments on purpose (one text for every pipeline): Verilator
+                // makes them blocking, in the order written, which the RTL follows.
+                "-Wno-COMBDLY",
                 "-I.",
             ])
             .args([

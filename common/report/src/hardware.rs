@@ -6,14 +6,20 @@
 use crate::analysis::Percentiles;
 use serde::Serialize;
 use std::collections::BTreeMap;
+use tactile_math::cordic::CordicConfig;
+use tactile_math::geometry::Geometry;
 use tactile_math::hardware::{Clocks, Module};
 use tactile_rtl::text::{Block, Pipeline};
 
 /// The part the clocks below were measured on.
 pub const PART: &str = "Lattice ECP5 LFE5U-85F, speed 6 (Yosys synth_ecp5, nextpnr-ecp5)";
 
-/// Each module's clock, MHz, as placed and routed on [`PART`] at [s16.13] nearest, the
-/// paper's geometry, seed 1: `tactile hdl timing --pipeline P --function M`
+/// The format and geometry [`PLACED`] was measured in: a run in another gets clocks
+/// and no time.
+pub const PLACED_FOR: (CordicConfig, Geometry) = (CordicConfig::S16_13, Geometry::PAPER);
+
+/// Each module's clock, MHz, as placed and routed on [`PART`] in [`PLACED_FOR`] (the
+/// paper's [s16.13] nearest and geometry), seed 1: `tactile hdl timing --pipeline P --function M`
 /// (docs/09, "Timing from a real place and route"). A module not listed was not
 /// placed in that pipeline, and its time is not claimed.
 pub const PLACED: [(Pipeline, Block, f64); 6] = [
@@ -50,6 +56,9 @@ pub struct HardwareSummary {
     pub pipeline: Option<&'static str>,
     /// Where the clock rates come from.
     pub part: &'static str,
+    /// Whether the run's format and geometry are those the modules were placed in
+    /// ([`PLACED_FOR`]); if not, no module has a time.
+    pub placed_for_this_datapath: bool,
     /// Per module, the paper's names (FK-HMD, KFF-HMD: the master's; IK-HSD, FK-HSD,
     /// FBF-HSD: the slave's).
     pub modules: BTreeMap<&'static str, ModuleClocks>,
@@ -78,12 +87,12 @@ fn pipeline_of(clocks: &[&Clocks], iterations: u32) -> Option<Pipeline> {
     })
 }
 
-fn module(c: &Clocks, m: Module, pipeline: Option<Pipeline>) -> Option<ModuleClocks> {
+fn module(c: &Clocks, m: Module, placed: Option<Pipeline>) -> Option<ModuleClocks> {
     let i = Module::ALL.iter().position(|&x| x == m)?;
     let calls = c.calls[i];
     let fmax = PLACED
         .iter()
-        .find(|(p, b, _)| Some(*p) == pipeline && *b == block(m))
+        .find(|(p, b, _)| Some(*p) == placed && *b == block(m))
         .map(|(_, _, mhz)| *mhz);
     (calls > 0).then(|| {
         let mean = c.total[i] as f64 / calls as f64;
@@ -98,13 +107,20 @@ fn module(c: &Clocks, m: Module, pipeline: Option<Pipeline>) -> Option<ModuleClo
     })
 }
 
-/// The summary's hardware part from the master's and the slave's clocks, for a TFB of
-/// `iterations`; `None` when neither ran the RTL.
-pub fn summary(master: &Clocks, slave: &Clocks, iterations: u32) -> Option<HardwareSummary> {
+/// The summary's hardware part from the master's and the slave's clocks, for the run's
+/// format and geometry (`None` if unknown); `None` when neither ran the RTL.
+pub fn summary(
+    master: &Clocks,
+    slave: &Clocks,
+    datapath: Option<(CordicConfig, Geometry)>,
+) -> Option<HardwareSummary> {
     if master.is_empty() && slave.is_empty() {
         return None;
     }
+    let iterations = datapath.map_or(0, |(c, _)| c.iterations);
     let pipeline = pipeline_of(&[master, slave], iterations);
+    let placed_for_this_datapath = datapath == Some(PLACED_FOR);
+    let placed = pipeline.filter(|_| placed_for_this_datapath);
     let names = [
         ("FK-HMD", master, Module::Fk),
         ("KFF-HMD", master, Module::Kff),
@@ -115,9 +131,10 @@ pub fn summary(master: &Clocks, slave: &Clocks, iterations: u32) -> Option<Hardw
     Some(HardwareSummary {
         pipeline: pipeline.map(Pipeline::name),
         part: PART,
+        placed_for_this_datapath,
         modules: names
             .iter()
-            .filter_map(|(name, c, m)| Some((*name, module(c, *m, pipeline)?)))
+            .filter_map(|(name, c, m)| Some((*name, module(c, *m, placed)?)))
             .collect(),
         faults: master.faults + slave.faults,
     })
@@ -147,6 +164,9 @@ pub fn lines(h: &HardwareSummary, stages: &BTreeMap<String, Percentiles>) -> Vec
         };
         let time = match (m.ns, m.fmax_mhz) {
             (Some(ns), Some(f)) => format!("{ns:.0} ns at {f} MHz"),
+            _ if !h.placed_for_this_datapath => {
+                "placed and routed only in the paper's [s16.13] and geometry".to_string()
+            }
             _ => "not placed and routed in this pipeline".to_string(),
         };
         out.push(format!(
@@ -198,7 +218,7 @@ mod tests {
     fn the_pipeline_is_known_by_its_clocks_and_only_placed_modules_get_a_time() {
         let master = clocks([10, 20, 0, 0], [35, 43, 0, 0]);
         let slave = clocks([10, 0, 4, 10], [35, 0, 8, 175]);
-        let h = summary(&master, &slave, 14).expect("hardware ran");
+        let h = summary(&master, &slave, Some(PLACED_FOR)).expect("hardware ran");
         assert_eq!(h.pipeline, Some("sample"));
         let fk = h.modules["FK-HMD"];
         assert_eq!(fk.fmax_mhz, Some(34.9));
@@ -223,13 +243,26 @@ mod tests {
     #[test]
     fn clocks_no_pipeline_gives_are_said_to_be_unknown() {
         let one = clocks([5, 5, 5, 5], [1, 1, 1, 1]);
-        let h = summary(&one, &one, 14).expect("hardware ran");
+        let h = summary(&one, &one, Some(PLACED_FOR)).expect("hardware ran");
         assert_eq!(h.pipeline, Some("module"));
+        assert_eq!(h.modules["FK-HMD"].fmax_mhz, Some(2.89));
+        // Another format: the same clocks, and no time (the modules were placed in
+        // the paper's only).
+        let wide = CordicConfig::new(24, 21, None, tactile_math::cordic::Rounding::Nearest)
+            .expect("a format");
+        let h = summary(&one, &one, Some((wide, Geometry::PAPER))).expect("hardware ran");
+        assert_eq!(
+            (h.pipeline, h.placed_for_this_datapath),
+            (Some("module"), false)
+        );
+        assert!(h.modules.values().all(|m| m.ns.is_none()));
+        let text = lines(&h, &BTreeMap::new()).join("\n");
+        assert!(text.contains("only in the paper's [s16.13]"), "{text}");
         // FK at 35 clocks beside IK at one: no configuration does that.
         let odd = clocks([5, 0, 0, 5], [35, 0, 0, 1]);
-        let h = summary(&odd, &Clocks::default(), 14).expect("hardware ran");
+        let h = summary(&odd, &Clocks::default(), Some(PLACED_FOR)).expect("hardware ran");
         assert_eq!(h.pipeline, None);
         assert!(h.modules.values().all(|m| m.ns.is_none()));
-        assert!(summary(&Clocks::default(), &Clocks::default(), 14).is_none());
+        assert!(summary(&Clocks::default(), &Clocks::default(), Some(PLACED_FOR)).is_none());
     }
 }

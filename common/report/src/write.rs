@@ -287,7 +287,11 @@ fn summarise(
     let hardware = crate::hardware::summary(
         &master_totals.counters.rtl,
         &slave.as_ref().map(|s| s.counters.rtl).unwrap_or_default(),
-        scenario.cordic.config().map_or(0, |c| c.iterations),
+        scenario
+            .cordic
+            .config()
+            .ok()
+            .zip(scenario.device.geometry().ok()),
     );
     let warnings = crate::warnings::warnings(
         a,

@@ -56,7 +56,11 @@ fn modules(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("fbf", name), |b| {
             b.iter(|| {
                 i = (i + 1) & mask;
-                e.fbf(black_box(inp[i].home), black_box(inp[i].position), [12.0; 3])
+                e.fbf(
+                    black_box(inp[i].home),
+                    black_box(inp[i].position),
+                    [12.0; 3],
+                )
             })
         });
     }

@@ -7,8 +7,9 @@
 //   y = (-(L2*c3) + L1*s2) + L3
 //   z = ((L2*c1)*s3 + (L1*c1)*c2) - L4
 //
-// One sample a clock, no back-pressure, no reset on the datapath. Stage map (SC =
-// ITER + 5, the latency of tfb_sincos; MUL, ADD the f32 units' latencies):
+// One sample a clock, no back-pressure, no reset on the datapath. Stage map (SC the
+// latency of tfb_sincos, ITER + 5 in the pipeline "sample"; MUL, ADD the f32 units'
+// latencies):
 //
 //   0 .. SC                 sin, cos of t1, t2, t3   (3 tfb_sincos)
 //   SC .. +MUL              L2*s3, L1*c2, L2*c3, L1*s2, L2*c1, L1*c1      (6 f32_mul)

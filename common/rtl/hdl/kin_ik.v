@@ -18,8 +18,9 @@
 //   status: 0 reachable, 1 clamped, 2 invalid.
 //
 // One sample a clock, no back-pressure, no reset on the datapath. Stage map (ADD, MUL,
-// DIV, SQRT the f32 units' latencies; AT = ITER + 4 of tfb_atan2, AC = ITER + 37 of
-// tfb_acos), times from the input:
+// DIV, SQRT the f32 units' latencies; AT of tfb_atan2, AC of tfb_acos: ITER + 4 and
+// ITER + 37 in the pipeline "sample", f32_lat.vh's formulas in any), times from the
+// input (each "+ 1" below is a stage register, PIPE_S: 0 outside "sample"):
 //
 //   T_A  = ADD            yl = y - L3, zl = z + L4 (2 f32_add); x delayed ADD
 //   T_A+1                 max_of(|x|, |yl|) (comparator, register)
@@ -52,8 +53,9 @@
 // output passes one register more, so that a sample takes one clock, of a period as
 // long as the whole datapath.
 //
-//   LATENCY = 6 ADD + 3 MUL + 2 DIV + SQRT + AC + 4 (+ PIPE_M)
-//           = (ITER + 41) + 6 F32_ADD_LAT + 3 F32_MUL_LAT + 2 F32_DIV_LAT + F32_SQRT_LAT
+//   LATENCY = 6 ADD + 3 MUL + 2 DIV + SQRT + AC + 4 PIPE_S + PIPE_M
+//           (in "sample": (ITER + 41) + 6 F32_ADD_LAT + 3 F32_MUL_LAT + 2 F32_DIV_LAT
+//           + F32_SQRT_LAT)
 //
 // dbg = {xs, ys, zs, atan, rr2, big_r, r2, r, cg, gamma, beta, ca, alpha} (xs in the
 // top 32 bits), each lined up with the outputs: xs, ys, zs after the optional scaling,

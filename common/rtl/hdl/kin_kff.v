@@ -10,8 +10,9 @@
 //   tau_i = (J[0][i]*f1 + J[1][i]*f2) + J[2][i]*f3
 //
 // j22 and j23 are the same f32 products as j11's L1*c2 and L2*s3: computed once.
-// One sample a clock, no back-pressure, no reset on the datapath. Stage map (SC =
-// ITER + 5, the latency of tfb_sincos; MUL, ADD the f32 units' latencies):
+// One sample a clock, no back-pressure, no reset on the datapath. Stage map (SC the
+// latency of tfb_sincos, ITER + 5 in the pipeline "sample"; MUL, ADD the f32 units'
+// latencies):
 //
 //   0 .. SC                 sin, cos of t1, t2, t3                  (3 tfb_sincos)
 //   SC .. +MUL              L2*s3 (j23), L1*c2 (j22), L1*s1, L1*s2, L2*s1, L2*c3 (6 mul)

@@ -1,7 +1,8 @@
 // kin_sincos3: the three sines and cosines FK-HMD, FK-HSD and KFF-HMD start from,
 // three tfb_sincos side by side in the format of tfb_params.vh.
 // One new (t1, t2, t3) a clock; s1 .. c3 and range_err (any of the three angles
-// beyond the TFB's range) appear ITER + 5 clocks later, tfb_sincos's LATENCY.
+// beyond the TFB's range) appear tfb_sincos's LATENCY later (TFB_SINCOS_LAT in
+// f32_lat.vh: ITER + 5 clocks in the pipeline "sample").
 module kin_sincos3 (
     input  wire        clk,
     input  wire        in_valid,

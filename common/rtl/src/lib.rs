@@ -14,7 +14,7 @@ pub mod text;
 mod sim;
 
 #[cfg(tactile_rtl_sim)]
-pub use sim::{built_pipeline, Rtl, BUILT_FOR};
+pub use sim::{Rtl, BUILT_FOR};
 
 use tactile_math::arith::ArithKind;
 use tactile_math::cordic::CordicConfig;
@@ -53,6 +53,20 @@ impl RtlError {
 
 /// True when this build simulates the RTL (`arithmetic = "rtl"` works).
 pub const AVAILABLE: bool = cfg!(tactile_rtl_sim);
+
+/// The pipeline configuration this build simulates (`TACTILE_RTL_PIPELINE` when it
+/// was built, by default [`text::Pipeline::Module`]): the clocks each call takes.
+/// `None` in a build without the simulation.
+pub fn built_pipeline() -> Option<text::Pipeline> {
+    #[cfg(tactile_rtl_sim)]
+    {
+        sim::built_pipeline()
+    }
+    #[cfg(not(tactile_rtl_sim))]
+    {
+        None
+    }
+}
 
 /// Whether this build can run `arithmetic = "rtl"` for `cordic` and `geometry`, without
 /// making the simulator: what a launcher asks before it starts anything.

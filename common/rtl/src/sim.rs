@@ -31,15 +31,12 @@ pub const BUILT_FOR: (&str, &str) = (
     include_str!(concat!(env!("OUT_DIR"), "/rtl/kin_params.vh")),
 );
 
-/// The pipeline configuration the simulated RTL was built with
-/// (`TACTILE_RTL_PIPELINE`, by default [`Pipeline::Module`]): the clocks each call
-/// takes.
-pub fn built_pipeline() -> Pipeline {
+/// The pipeline configuration the simulated RTL was built with: the one whose
+/// `pipe.vh` the build wrote (the build script and this crate generate it from the
+/// same text, so exactly one matches).
+pub(crate) fn built_pipeline() -> Option<Pipeline> {
     let built = include_str!(concat!(env!("OUT_DIR"), "/rtl/pipe.vh"));
-    Pipeline::ALL
-        .into_iter()
-        .find(|p| pipe_vh(*p) == built)
-        .unwrap_or_default()
+    Pipeline::ALL.into_iter().find(|p| pipe_vh(*p) == built)
 }
 
 /// The four modules under simulation: one chip, one sample in flight at a time.

@@ -1,8 +1,9 @@
 //! The RTL's text: the hand-written Verilog (`hdl/`, beside this crate's sources: it
-//! packages with the crate that compiles it) and the two generated
-//! parameter files, `tfb_params.vh` (a format's CORDIC constants) and `kin_params.vh`
+//! packages with the crate that compiles it) and the three generated
+//! parameter files, `tfb_params.vh` (a format's CORDIC constants), `kin_params.vh`
 //! (the modules' constants for a geometry), both computed by the model
-//! (`tactile-math`) so the hardware and the model share every number.
+//! (`tactile-math`) so the hardware and the model share every number, and `pipe.vh`
+//! (which stage registers are registers: [`Pipeline`]).
 //!
 //! Pure: no I/O. `tactile hdl` writes these into a folder; this crate's build script
 //! (feature `verilator`) includes this file to build the RTL it simulates.
@@ -199,7 +200,9 @@ pub fn pipe_vh(p: Pipeline) -> String {
         "// pipe.vh: the pipeline configuration \"{name}\". Written by `tactile hdl rtl`\n\
          // (tactile_rtl::text::Pipeline): regenerate it, do not edit it.\n\
          // A stage written `STAGE_REG or `UNIT_REG is a register, or (always @*) a wire:\n\
-         // its non-blocking assignments then settle within the clock, in order.\n\
+         // its non-blocking assignments then settle within the clock in the order\n\
+         // written (Verilator makes them blocking), so a stage must assign a value\n\
+         // before a later statement of its block reads it.\n\
          `ifndef TACTILE_PIPE_VH\n\
          `define TACTILE_PIPE_VH\n\
          `define STAGE_REG {stage_block}\n\

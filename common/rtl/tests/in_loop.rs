@@ -98,7 +98,7 @@ mod simulated {
         // FK, KFF, FBF, IK at [s16.13] (14 iterations), in the pipeline this build
         // simulates: docs/09's latencies (35, 43, 8, 175 clocks in "sample", 1 each
         // in "module", the default).
-        let p = tactile_rtl::built_pipeline();
+        let p = tactile_rtl::built_pipeline().expect("a simulated pipeline");
         let lat = [Block::Fk, Block::Kff, Block::Fbf, Block::Ik].map(|b| p.latency(b, 14));
         if p == Pipeline::Sample {
             assert_eq!(lat, [35, 43, 8, 175]);

@@ -330,6 +330,12 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
     let work = Work::new(args.keep.as_deref())?;
     let pipeline = Pipeline::from(args.pipeline);
     write_rtl(&work.dir, &k, &args.datapath.geometry()?, pipeline)?;
+    crate::noteln!(
+        "tactile hdl timing: pipeline {} (--pipeline), [s{}.{}]",
+        pipeline.name(),
+        cfg.word,
+        cfg.frac
+    );
     crate::outln!(
         "| module | latency (clocks) | Fmax (MHz) | latency (ns) | throughput (MSps) | logic cells | flip-flops | MULT18 | paper, Virtex-6: registers / LUTs / DSP48 / ns |"
     );
