@@ -323,3 +323,50 @@ pub fn files(
         ])
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The clocks docs/09 gives for each configuration at [s16.13] (14 iterations):
+    /// checked here on any machine, and against the RTL's own clocks by `tactile hdl
+    /// cosim` where Icarus is installed.
+    #[test]
+    fn each_pipeline_has_the_latencies_docs_09_gives() {
+        let modules = [Block::Fk, Block::Kff, Block::Fbf, Block::Ik];
+        let at = |p: Pipeline| modules.map(|b| p.latency(b, 14));
+        assert_eq!(at(Pipeline::Sample), [35, 43, 8, 175]);
+        assert_eq!(at(Pipeline::Unit), [5, 7, 2, 14]);
+        assert_eq!(at(Pipeline::Module), [1, 1, 1, 1]);
+        let units = [
+            Block::Add,
+            Block::Div,
+            Block::Sincos,
+            Block::Atan2,
+            Block::Acos,
+        ];
+        let at = |p: Pipeline| units.map(|b| p.latency(b, 14));
+        assert_eq!(at(Pipeline::Sample), [4, 28, 19, 18, 51]);
+        assert_eq!(at(Pipeline::Unit), [1, 1, 1, 1, 2]);
+        assert_eq!(at(Pipeline::Module), [0, 0, 0, 0, 0]);
+        // A format of more iterations is deeper only where stages are registers.
+        assert_eq!(Pipeline::Sample.latency(Block::Ik, 30), 175 + 16);
+        assert_eq!(Pipeline::Unit.latency(Block::Ik, 30), 14);
+    }
+
+    #[test]
+    fn pipe_vh_says_which_stages_are_registers() {
+        for p in Pipeline::ALL {
+            assert_eq!(Pipeline::from_name(p.name()), Some(p));
+            let text = pipe_vh(p);
+            let clocked = |m: &str| text.contains(&format!("`define {m} always @(posedge clk)"));
+            assert_eq!(
+                (clocked("STAGE_REG"), clocked("UNIT_REG")),
+                (p == Pipeline::Sample, p != Pipeline::Module),
+                "{text}"
+            );
+            assert!(text.contains(&format!("localparam integer PIPE_M = {};", p.module())));
+        }
+        assert_eq!(Pipeline::from_name("fast"), None);
+    }
+}
