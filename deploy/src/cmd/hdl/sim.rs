@@ -146,16 +146,6 @@ struct Outcome {
     latency: Option<u32>,
 }
 
-/// `path` as seen from `dir` when `dir` is inside its folder (the vectors sit beside
-/// the pipelines' folders), else `path` itself.
-fn relative(path: &Path, dir: &Path) -> PathBuf {
-    match (path.parent(), path.file_name()) {
-        (Some(parent), Some(name)) if dir.parent() == Some(parent) => Path::new("..").join(name),
-        (Some(parent), Some(name)) if dir == parent => PathBuf::from(name),
-        _ => path.to_path_buf(),
-    }
-}
-
 /// Co-simulation of one function, from the testbench's last line.
 fn cosim_one(
     work: &Path,
@@ -183,9 +173,15 @@ fn cosim_one(
     run.current_dir(work)
         .args(["-n"])
         .arg(&sim)
-        // Relative to the simulator's folder: the testbench holds the path in a
-        // register of bounded width, and a long absolute one was cut.
-        .arg(format!("+vectors={}", relative(vec_path, work).display()))
+        // The vectors sit beside the pipelines' folders: given from the simulator's,
+        // since the testbench holds the path in a register of bounded width, and a
+        // long absolute one was cut.
+        .arg(format!(
+            "+vectors={}",
+            Path::new("..")
+                .join(vec_path.file_name().unwrap_or_default())
+                .display()
+        ))
         .arg(format!("+count={n}"));
     let out = tool(&mut run, "vvp", "iverilog")?;
     let last = out
