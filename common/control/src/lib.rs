@@ -5,4 +5,5 @@
 //! `tactile-scenario`'s.
 
 pub mod codec;
+pub mod mmt;
 pub mod passivity;
