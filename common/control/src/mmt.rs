@@ -284,5 +284,143 @@ impl PlaneEstimator {
     }
 }
 
+/// The master's rendering of the slave's latest model, against its own handle, every
+/// sample, with no delay in the haptic loop.
+///
+/// A model change must not kick the operator, and the rendered wall must stay passive.
+/// Blending two models in time would do neither by itself: while the handle is inside,
+/// raising the stiffness or moving the surface out adds energy the operator never put
+/// in. So a change is taken only in ways that do not raise the energy the rendered
+/// spring stores at the handle (the energy check; Xu et al. 2016 use the same
+/// criterion for their passive model update):
+///
+/// - The surface is placed so that the force at the handle is what the operator feels
+///   now (force continuity), a `shift` along the normal from the model's surface. The
+///   shift returns to zero only where that does not raise the stored energy: while the
+///   handle is outside, at once but never past the handle; inside, only a surface that
+///   is out of the model's moves, deeper, at `relax` per sample (the force eases off).
+/// - A stiffer model is taken at once (with the force continuous, the stored energy
+///   `F^2 / 2k` falls). A softer one waits until the handle is outside, since at the same
+///   force it would store more.
+///
+/// What the operator feels is the model's stiffness at once, and its surface shifted by
+/// at most the penetration felt when the model arrived, until the handle next leaves
+/// the wall.
+#[derive(Debug, Clone)]
+pub struct ModelRenderer {
+    model: Option<PlaneModel>,
+    /// A softer stiffness waiting for the handle to leave the wall.
+    softer: Option<f64>,
+    /// The rendered surface is at `model.offset - shift`, m.
+    shift: f64,
+    relax: f64,
+    /// Energy model changes added at the handle, J (zero by construction; watched).
+    injected: f64,
+}
+
+impl ModelRenderer {
+    /// `relax`: how fast a surface out of the model's goes deeper while the handle is
+    /// inside, m per sample.
+    pub fn new(relax: f64) -> Self {
+        ModelRenderer {
+            model: None,
+            softer: None,
+            shift: 0.0,
+            relax: relax.abs(),
+            injected: 0.0,
+        }
+    }
+
+    /// The model as rendered now (its surface shifted), if any has arrived.
+    pub fn rendered(&self) -> Option<PlaneModel> {
+        self.model.map(|m| PlaneModel {
+            offset: m.offset - self.shift,
+            ..m
+        })
+    }
+
+    /// The latest model as received (the stiffness it renders once allowed).
+    pub fn model(&self) -> Option<PlaneModel> {
+        self.model.map(|m| PlaneModel {
+            stiffness: self.softer.unwrap_or(m.stiffness),
+            ..m
+        })
+    }
+
+    /// Energy model changes have added at the handle, J.
+    pub fn injected(&self) -> f64 {
+        self.injected
+    }
+
+    /// Takes a model from the slave with the handle at `x` and `felt` the force on the
+    /// handle now (the model's, or before the first model what arrived). An invalid
+    /// model is refused (false) and changes nothing.
+    pub fn receive(&mut self, new: PlaneModel, x: [f64; 3], felt: [f64; 3]) -> bool {
+        if !new.is_valid() || !x.iter().chain(felt.iter()).all(|v| v.is_finite()) {
+            return false;
+        }
+        // The first model takes over the force that arrived over the channel, whose
+        // energy the channel's observers book; from then on changes are this one's.
+        let first = self.model.is_none();
+        let before = self.rendered().map_or(0.0, |m| m.energy(x));
+        let s = dot(new.normal, x);
+        let f = dot(new.normal, felt).max(0.0);
+        let mut k = new.stiffness;
+        self.softer = None;
+        if let Some(old) = self.model {
+            if f > 0.0 && k < old.stiffness {
+                self.softer = Some(k);
+                k = old.stiffness;
+            }
+        }
+        // The rendered surface: where the spring gives the felt force at the handle;
+        // with no force felt, no deeper than the handle.
+        let surface = if f > 0.0 && k > 0.0 {
+            s + f / k
+        } else {
+            new.offset.min(s)
+        };
+        self.model = Some(PlaneModel {
+            stiffness: k,
+            ..new
+        });
+        self.shift = new.offset - surface;
+        if !first {
+            self.book(before, x);
+        }
+        true
+    }
+
+    /// The force on the handle at `x`, N, once a model has arrived; `None` before (the
+    /// node renders what arrives). Moves the surface and the stiffness towards the
+    /// model's where that adds no energy.
+    pub fn force(&mut self, x: [f64; 3]) -> Option<[f64; 3]> {
+        let m = self.model?;
+        let before = self.rendered().map_or(0.0, |r| r.energy(x));
+        let s = dot(m.normal, x);
+        let outside = m.offset - self.shift <= s;
+        if outside {
+            // Nothing stored, nothing felt: the model's surface at once, never past the
+            // handle.
+            self.shift = (m.offset - s).max(0.0);
+        } else if self.shift < 0.0 {
+            // Deeper, a little a sample: the force eases off without a step.
+            self.shift = (self.shift + self.relax).min(0.0);
+        }
+        if outside {
+            if let Some(k) = self.softer.take() {
+                self.model = Some(PlaneModel { stiffness: k, ..m });
+            }
+        }
+        self.book(before, x);
+        self.rendered().map(|r| r.force(x))
+    }
+
+    fn book(&mut self, before: f64, x: [f64; 3]) {
+        let after = self.rendered().map_or(0.0, |m| m.energy(x));
+        self.injected += (after - before).max(0.0);
+    }
+}
+
 #[cfg(test)]
 mod tests;

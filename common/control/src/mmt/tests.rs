@@ -215,3 +215,128 @@ fn the_model_is_a_spring_behind_its_surface() {
     assert!((f[2] - 6.0).abs() < 1e-9 && f[0] == 0.0 && f[1] == 0.0);
     assert!((w.energy([0.0, 0.0, -0.07]) - 0.03).abs() < 1e-12);
 }
+
+/// A renderer that has shown `WALL` to a handle at `x`, from a force `felt`.
+fn shown(x: [f64; 3], felt: [f64; 3]) -> ModelRenderer {
+    let mut r = ModelRenderer::new(1e-5);
+    assert!(r.receive(WALL, x, felt));
+    r
+}
+
+fn z(f: Option<[f64; 3]>) -> f64 {
+    f.expect("a model")[2]
+}
+
+#[test]
+fn nothing_is_rendered_before_a_model_and_invalid_models_are_refused() {
+    let mut r = ModelRenderer::new(1e-5);
+    assert!(r.force([0.0, 0.0, -0.07]).is_none());
+    let bad = PlaneModel {
+        stiffness: f64::NAN,
+        ..WALL
+    };
+    assert!(!r.receive(bad, [0.0; 3], [0.0; 3]));
+    assert!(!r.receive(WALL, [f64::NAN, 0.0, 0.0], [0.0; 3]));
+    assert!(r.force([0.0, 0.0, -0.07]).is_none());
+}
+
+/// The first model, arriving 1 cm deep with 2 N felt: 2 N on, not the model's 6 N; out
+/// of the wall and back in, the model's own surface.
+#[test]
+fn the_first_model_takes_over_the_felt_force_and_the_surface_returns_outside() {
+    let inside = [0.0, 0.0, -0.07];
+    let mut r = shown(inside, [0.0, 0.0, 2.0]);
+    assert!((z(r.force(inside)) - 2.0).abs() < 1e-9);
+    // Held there: the surface stays (moving it out would add energy).
+    for _ in 0..10_000 {
+        r.force(inside);
+    }
+    assert!((z(r.force(inside)) - 2.0).abs() < 1e-9);
+    // Out of the wall, where the model's surface is not past the handle: there at once.
+    assert_eq!(z(r.force([0.0, 0.0, -0.064])), 0.0);
+    assert_eq!(r.rendered().map(|m| m.offset), Some(-0.064));
+    assert_eq!(z(r.force([0.0, 0.0, -0.05])), 0.0);
+    assert_eq!(r.rendered(), Some(WALL));
+    assert!((z(r.force(inside)) - 6.0).abs() < 1e-9);
+}
+
+/// A stiffer model in contact: the force stays, the slope is the new stiffness. A softer
+/// one: kept for when the handle is out.
+#[test]
+fn stiffer_models_are_taken_at_once_and_softer_ones_outside() {
+    let inside = [0.0, 0.0, -0.07];
+    let mut r = shown([0.0, 0.0, -0.05], [0.0; 3]);
+    let f = z(r.force(inside));
+    assert!((f - 6.0).abs() < 1e-9);
+    let stiff = PlaneModel {
+        stiffness: 1200.0,
+        ..WALL
+    };
+    assert!(r.receive(stiff, inside, [0.0, 0.0, f]));
+    assert!((z(r.force(inside)) - 6.0).abs() < 1e-9);
+    assert!((z(r.force([0.0, 0.0, -0.071])) - 6.0 - 1.2).abs() < 1e-6);
+    let soft = PlaneModel {
+        stiffness: 300.0,
+        ..WALL
+    };
+    assert!(r.receive(soft, inside, [0.0, 0.0, f]));
+    assert_eq!(r.rendered().map(|m| m.stiffness), Some(1200.0));
+    assert_eq!(r.model(), Some(soft));
+    for _ in 0..1000 {
+        r.force([0.0, 0.0, -0.04]);
+    }
+    assert_eq!(r.rendered(), Some(soft));
+    assert_eq!(r.injected(), 0.0);
+}
+
+proptest! {
+    /// Whatever models arrive and wherever the handle goes, the changes add no energy
+    /// at the handle, and the force does not step when a model arrives (beyond what the
+    /// spring and one sample's relaxation give).
+    #[test]
+    fn model_changes_add_no_energy_and_no_kick(
+        models in prop::collection::vec(
+            (-0.2f64..0.2, -0.2f64..0.2, -0.08f64..-0.04, 100.0f64..3000.0, 0usize..400),
+            1..12,
+        ),
+        wiggle in prop::collection::vec(-0.03f64..0.03, 50),
+    ) {
+        let mut r = ModelRenderer::new(1e-5);
+        let mut felt = [0.0; 3];
+        let mut t = 0usize;
+        for (nx, ny, offset, k, hold) in models {
+            let m = PlaneModel { normal: unit([nx, ny, 1.0]), offset, stiffness: k };
+            let x = |t: usize| [0.0, 0.0, -0.06 + wiggle[(t / 40) % 50] * ((t % 40) as f64 / 40.0)];
+            prop_assert!(r.receive(m, x(t), felt));
+            // Along the new normal (the force's only direction from now on): what was
+            // felt, less one sample's relaxation at 1e-5 m of at most 3000 N/m.
+            let after = dot(r.force(x(t)).expect("a model"), m.normal);
+            let before = dot(felt, m.normal).max(0.0);
+            prop_assert!((after - before).abs() <= 0.03 + 1e-9, "{before} N to {after} N");
+            for _ in 0..hold {
+                t += 1;
+                felt = r.force(x(t)).expect("a model");
+            }
+        }
+        prop_assert!(r.injected() < 1e-12, "{} J", r.injected());
+    }
+}
+
+/// A model softer than what is felt (8 N where it gives 6 N): the force eases off to the
+/// model's at `relax` a sample, with no step.
+#[test]
+fn a_force_above_the_models_eases_off() {
+    let inside = [0.0, 0.0, -0.07];
+    let mut r = shown(inside, [0.0, 0.0, 8.0]);
+    let mut last = 8.0;
+    for _ in 0..1000 {
+        let f = z(r.force(inside));
+        assert!(
+            f <= last && last - f <= 600.0 * 1e-5 + 1e-12,
+            "{last} N to {f} N"
+        );
+        last = f;
+    }
+    assert!((last - 6.0).abs() < 1e-9);
+    assert_eq!(r.rendered(), Some(WALL));
+}
