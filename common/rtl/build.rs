@@ -11,7 +11,9 @@
 //! `module`, the paper's architecture: a sample takes one clock of each module, so the
 //! simulator evaluates each module's logic once a sample (the deeper pipelines give the
 //! same bits in more clocks, each evaluating the whole module again).
-
+//!
+//! Verilator's options: `TACTILE_RTL_VERILATOR_ARGS`, appended to ours (`-O3`, C++ at
+//! `-O2`), so that each can be measured by the bench (docs/09 gives what each costs).
 //!
 //! Under `cargo clippy`, which links nothing, the models' C++ is not compiled (the
 //! cfg is still set, so the simulation's Rust is linted).
@@ -209,6 +211,9 @@ mod verilate {
             ])
             .arg(&mdir)
             .args(["-CFLAGS", "-fPIC -O2", "-j", "2"])
+            // Options to measure (docs/09, "The hardware in the loop"): after ours, so
+            // a later -O or -CFLAGS -O wins.
+            .args(env("TACTILE_RTL_VERILATOR_ARGS", "").split_whitespace())
             .args(text::MODULES);
         let status = cmd
             .status()
