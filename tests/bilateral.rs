@@ -87,6 +87,44 @@ fn wall_delay_oscillates_without_control_and_settles_with_tdpa_and_wave() {
     }
 }
 
+/// Transparency (summary.json's `transparency`): with no delay the operator feels the
+/// wall in series with the slave's position controller, about 1.6 kN/m at the tool
+/// (1 / (1/600 + 1/1600) = 436 N/m, a ratio of 0.73); 50 ms of round trip makes every
+/// kind feel softer than that, and the environment's own is identified as the 600 N/m
+/// the scenario gives it.
+#[test]
+fn the_felt_stiffness_is_the_series_spring_without_delay_and_softer_with_it() {
+    let sb = Sandbox::new("transparency");
+    let text = wall_delay();
+    let ratio = |s: &serde_json::Value| f(&s["transparency"]["stiffness_ratio"]);
+    let direct = run(
+        &sb,
+        &text,
+        "direct",
+        &[
+            "network.forward.delay=[0,0,0]",
+            "network.backward.delay=[0,0,0]",
+        ],
+    );
+    let env = f(&direct["transparency"]["environment_stiffness_n_per_m"]);
+    assert!((env - 600.0).abs() < 1.0, "environment {env} N/m");
+    let r0 = ratio(&direct);
+    assert!((0.65..0.82).contains(&r0), "no delay: ratio {r0}");
+    for kind in ["none", "tdpa", "wave"] {
+        let s = run(
+            &sb,
+            &text,
+            &format!("t-{kind}"),
+            &[&format!("control.kind={kind}")],
+        );
+        let r = ratio(&s);
+        assert!(
+            r > 0.05 && r < 0.8 * r0,
+            "{kind}: ratio {r} against {r0} without delay"
+        );
+    }
+}
+
 /// The goal the issue sets: TDPA stable at every round trip of the sweep against walls
 /// up to the Omni's nominal 700 N/m (thresholds as in the test above).
 #[test]

@@ -28,6 +28,7 @@ pub mod sweep_plots;
 pub mod task_space;
 pub mod text;
 pub mod trace;
+pub mod transparency;
 pub mod warnings;
 pub mod write;
 

@@ -79,6 +79,8 @@ pub struct Bilateral {
     pub contact: Contact,
     /// Observers and dissipation.
     pub passivity: Passivity,
+    /// The stiffness felt against the environment's.
+    pub felt: crate::transparency::Felt,
     handles: Vec<Option<(u64, [f64; 3])>>,
     forces: Vec<Option<(u64, [f64; 3])>>,
     position_sq: f64,
@@ -97,6 +99,7 @@ impl Default for Bilateral {
             tracking: Tracking::default(),
             contact: Contact::default(),
             passivity: Passivity::default(),
+            felt: crate::transparency::Felt::default(),
             handles: vec![None; LATE_WINDOW as usize],
             forces: vec![None; LATE_WINDOW as usize],
             position_sq: 0.0,
@@ -122,6 +125,7 @@ impl Bilateral {
     /// Adds one row (rows come in sample order).
     pub fn add(&mut self, row: &TraceRow) {
         self.handles[slot(row.n)] = Some((row.n, row.handle));
+        self.felt.add(row);
         self.passivity.dissipated_j += row.dissipated_m + row.dissipated_s;
         self.observe(row.observer_m);
         if row.stepped {

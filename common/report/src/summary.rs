@@ -195,6 +195,8 @@ pub struct Summary {
     pub tracking: Tracking,
     /// How deep the tool went.
     pub contact: Contact,
+    /// The stiffness the operator felt against the environment's.
+    pub transparency: crate::transparency::Transparency,
     /// A URDF arm: the tool against its target after the master's workspace map, in
     /// the arm's base frame, the clutch's releases, the robot's force before
     /// `force_scale`; absent for the paper's arm.

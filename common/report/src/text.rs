@@ -149,6 +149,17 @@ fn motion(t: &mut String, s: &Summary) {
         s.tracking.force_rms_n.map_or("n/a".to_string(), |f| format!("{f:.3} N")),
         s.contact.max_penetration_m * 1e3
     );
+    let tr = &s.transparency;
+    let stiffness = |k: Option<f64>| k.map_or("n/a".to_string(), |k| format!("{k:.0} N/m"));
+    let _ = writeln!(
+        t,
+        "transparency: felt stiffness {} against the environment's {} (ratio {}), from {} master samples behind the surface and {} slave steps in contact",
+        stiffness(tr.felt_stiffness_n_per_m),
+        stiffness(tr.environment_stiffness_n_per_m),
+        tr.stiffness_ratio.map_or("n/a".to_string(), |r| format!("{r:.2}")),
+        tr.felt_samples,
+        tr.environment_samples
+    );
     let _ = writeln!(
         t,
         "passivity: observer min {}, dissipated {:.3} mJ, drift max {}; packets forward {}, backward {}",

@@ -329,6 +329,7 @@ fn summarise(
         control: scenario.control.kind.name(),
         tracking: a.bilateral.tracking,
         contact: a.bilateral.contact,
+        transparency: a.bilateral.felt.finish(),
         task_space: None,
         passivity: a.bilateral.passivity,
         packets: Packets {

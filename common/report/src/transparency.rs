@@ -1,0 +1,217 @@
+//! Transparency as researchers publish it: the stiffness the operator felt against the
+//! environment's, each identified from the run itself (Lawrence, "Stability and
+//! transparency in bilateral teleoperation", IEEE TRA 9(5), 1993: a transparent
+//! teleoperator makes the impedance felt equal the environment's).
+//!
+//! Each is the least-squares spring through the surface (no force there), `k = sum(d f)
+//! / sum(d^2)`, so a steady press identifies it as well as a varying one:
+//!
+//! - The environment's: the contact force's magnitude against the tool's depth behind
+//!   the surface, over the slave's steps in contact.
+//! - The felt: the felt force along the contact's normal against the handle's depth
+//!   behind the same surface, over the master's samples with the handle behind it. A
+//!   delayed force that has not come back yet counts as the zero the operator feels (a
+//!   wall felt late feels soft), and a slave held short of the handle as the farther
+//!   wall it is.
+//!
+//! The surface and its normal are the slave's latest contact (the nearest surface point
+//! and the force's direction): exact for a plane, the tangent plane for a curved
+//! object. Sums only, so memory does not grow with the run.
+
+use crate::trace::TraceRow;
+use serde::Serialize;
+use tactile_math::vec3::{distance, norm};
+use tactile_messages::samples::Flags;
+
+/// `transparency` in summary.json.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Transparency {
+    /// The stiffness the operator felt, N/m; null without enough contact (see
+    /// [`MIN_SAMPLES`] and [`MIN_DEPTH_M`]).
+    pub felt_stiffness_n_per_m: Option<f64>,
+    /// The environment's stiffness at the tool, N/m; null likewise.
+    pub environment_stiffness_n_per_m: Option<f64>,
+    /// Felt over environment: 1 is transparent, below 1 feels softer.
+    pub stiffness_ratio: Option<f64>,
+    /// Master samples with the handle behind the surface.
+    pub felt_samples: u64,
+    /// Slave steps in contact.
+    pub environment_samples: u64,
+}
+
+/// Fewest samples a stiffness is identified from.
+pub const MIN_SAMPLES: u64 = 100;
+/// Least RMS depth a stiffness is identified over, m: a graze is mostly noise.
+pub const MIN_DEPTH_M: f64 = 2.0e-4;
+
+/// Least squares of y = k x (a spring, no force at the surface), as sums.
+#[derive(Debug, Clone, Copy, Default)]
+struct Fit {
+    n: u64,
+    sxx: f64,
+    sxy: f64,
+}
+
+impl Fit {
+    fn add(&mut self, x: f64, y: f64) {
+        if x.is_finite() && y.is_finite() {
+            self.n += 1;
+            self.sxx += x * x;
+            self.sxy += x * y;
+        }
+    }
+
+    fn slope(&self) -> Option<f64> {
+        let deep_enough = self.sxx >= self.n as f64 * MIN_DEPTH_M * MIN_DEPTH_M;
+        (self.n >= MIN_SAMPLES && deep_enough).then(|| self.sxy / self.sxx)
+    }
+}
+
+/// The running sums.
+#[derive(Debug, Clone, Default)]
+pub struct Felt {
+    felt: Fit,
+    environment: Fit,
+    /// The latest contact's surface point and outward normal.
+    surface: Option<([f64; 3], [f64; 3])>,
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl Felt {
+    /// Adds one row (rows come in sample order).
+    pub fn add(&mut self, row: &TraceRow) {
+        let force = norm(row.h);
+        if row.stepped && row.contact_object >= 0 && force > 1e-9 {
+            self.surface = Some((row.surface, row.h.map(|v| v / force)));
+            self.environment.add(distance(row.surface, row.tool), force);
+        }
+        let felt_ok = row.received
+            && !row.flags_m.intersects(Flags::REJECTED)
+            && !row.flags_b.intersects(Flags::CORRUPTED);
+        if let (true, Some((p, n))) = (felt_ok, self.surface) {
+            let depth = dot([0, 1, 2].map(|i| p[i] - row.handle[i]), n);
+            if depth > 0.0 {
+                self.felt.add(depth, dot(row.felt, n));
+            }
+        }
+    }
+
+    /// The figures.
+    pub fn finish(&self) -> Transparency {
+        let felt = self.felt.slope();
+        let environment = self.environment.slope();
+        Transparency {
+            felt_stiffness_n_per_m: felt,
+            environment_stiffness_n_per_m: environment,
+            stiffness_ratio: match (felt, environment) {
+                (Some(f), Some(e)) if e > 0.0 => Some(f / e),
+                _ => None,
+            },
+            felt_samples: self.felt.n,
+            environment_samples: self.environment.n,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wall at z = -0.06 (normal +z) of stiffness `k`; the handle at `handle_z`, the
+    /// tool at `tool_z`, the felt force `felt_z`.
+    fn row(n: u64, tool_z: f64, handle_z: f64, k: f64, felt_z: f64) -> TraceRow {
+        let depth = (-0.06 - tool_z).max(0.0);
+        TraceRow {
+            n,
+            stepped: true,
+            received: true,
+            contact_object: if depth > 0.0 { 0 } else { -1 },
+            tool: [0.0, 0.0, tool_z],
+            surface: [0.0, 0.0, -0.06],
+            h: [0.0, 0.0, k * depth],
+            handle: [0.0, 0.0, handle_z],
+            felt: [0.0, 0.0, felt_z],
+            ..TraceRow::default()
+        }
+    }
+
+    fn press(k: f64, felt: impl Fn(f64) -> f64) -> Transparency {
+        let mut f = Felt::default();
+        for n in 0..2000 {
+            // In and out between 1 and 9 mm deep.
+            let z = -0.065 - 0.004 * (n as f64 * 0.01).sin();
+            f.add(&row(n, z, z, k, felt(-0.06 - z)));
+        }
+        f.finish()
+    }
+
+    #[test]
+    fn a_transparent_loop_feels_the_walls_stiffness() {
+        let t = press(600.0, |d| 600.0 * d);
+        let felt = t.felt_stiffness_n_per_m.expect("felt");
+        let env = t.environment_stiffness_n_per_m.expect("environment");
+        assert!(
+            (felt - 600.0).abs() < 1e-6 && (env - 600.0).abs() < 1e-6,
+            "{t:?}"
+        );
+        assert!((t.stiffness_ratio.expect("ratio") - 1.0).abs() < 1e-9);
+        assert_eq!((t.felt_samples, t.environment_samples), (2000, 2000));
+    }
+
+    #[test]
+    fn a_softer_rendering_is_a_ratio_below_one() {
+        // Felt through a 1.6 kN/m position controller in series with the wall.
+        let series = 1.0 / (1.0 / 600.0 + 1.0 / 1600.0);
+        let t = press(600.0, |d| series * d);
+        assert!(
+            (t.stiffness_ratio.expect("ratio") - series / 600.0).abs() < 1e-9,
+            "{t:?}"
+        );
+    }
+
+    /// The slave held 5 mm short of a handle 10 mm deep: 3 N felt at 10 mm.
+    #[test]
+    fn a_still_hold_short_of_the_handle_feels_softer() {
+        let mut f = Felt::default();
+        for n in 0..5000 {
+            f.add(&row(n, -0.065, -0.07, 600.0, 3.0));
+        }
+        let t = f.finish();
+        assert_eq!((t.felt_samples, t.environment_samples), (5000, 5000));
+        assert!(
+            (t.felt_stiffness_n_per_m.expect("felt") - 300.0).abs() < 1e-6,
+            "{t:?}"
+        );
+        assert!((t.stiffness_ratio.expect("ratio") - 0.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn no_contact_or_a_graze_identifies_nothing() {
+        let mut f = Felt::default();
+        for n in 0..5000 {
+            f.add(&row(n, -0.05, -0.05, 600.0, 0.0));
+        }
+        assert_eq!(f.finish(), Transparency::default());
+        for n in 0..5000 {
+            f.add(&row(n, -0.0601, -0.0601, 600.0, 0.06));
+        }
+        let t = f.finish();
+        assert_eq!(t.felt_samples, 5000);
+        assert_eq!(t.felt_stiffness_n_per_m, None, "0.1 mm deep: {t:?}");
+    }
+
+    #[test]
+    fn rejected_or_corrupted_answers_are_left_out() {
+        let mut f = Felt::default();
+        let mut r = row(0, -0.07, -0.07, 600.0, 1e6);
+        r.flags_m = Flags::REJECTED;
+        f.add(&r);
+        r.flags_m = Flags::NONE;
+        r.flags_b = Flags::CORRUPTED;
+        f.add(&r);
+        assert_eq!(f.finish().felt_samples, 0);
+    }
+}
