@@ -22,9 +22,10 @@ pub const PLACED_FOR: (CordicConfig, Geometry) = (CordicConfig::S16_13, Geometry
 /// paper's [s16.13] nearest and geometry), seed 1: `tactile hdl timing --pipeline P --function M`
 /// (docs/09, "Timing from a real place and route"). A module not listed was not
 /// placed in that pipeline, and its time is not claimed.
-pub const PLACED: [(Pipeline, Block, f64); 6] = [
+pub const PLACED: [(Pipeline, Block, f64); 7] = [
     (Pipeline::Module, Block::Fbf, 10.46),
     (Pipeline::Module, Block::Fk, 2.89),
+    (Pipeline::Module, Block::Kff, 2.21),
     (Pipeline::Unit, Block::Fbf, 19.33),
     (Pipeline::Sample, Block::Fbf, 37.0),
     (Pipeline::Sample, Block::Fk, 34.9),
@@ -246,6 +247,7 @@ mod tests {
         let h = summary(&one, &one, Some(PLACED_FOR)).expect("hardware ran");
         assert_eq!(h.pipeline, Some("module"));
         assert_eq!(h.modules["FK-HMD"].fmax_mhz, Some(2.89));
+        assert_eq!(h.modules["KFF-HMD"].fmax_mhz, Some(2.21));
         // Another format: the same clocks, and no time (the modules were placed in
         // the paper's only).
         let wide = CordicConfig::new(24, 21, None, tactile_math::cordic::Rounding::Nearest)
