@@ -22,11 +22,13 @@ pub const PLACED_FOR: (CordicConfig, Geometry) = (CordicConfig::S16_13, Geometry
 /// paper's [s16.13] nearest and geometry), seed 1: `tactile hdl timing --pipeline P --function M`
 /// (docs/09, "Timing from a real place and route"). A module not listed was not
 /// placed in that pipeline, and its time is not claimed.
-pub const PLACED: [(Pipeline, Block, f64); 7] = [
+pub const PLACED: [(Pipeline, Block, f64); 9] = [
     (Pipeline::Module, Block::Fbf, 10.46),
     (Pipeline::Module, Block::Fk, 2.89),
     (Pipeline::Module, Block::Kff, 2.21),
     (Pipeline::Unit, Block::Fbf, 19.33),
+    (Pipeline::Unit, Block::Fk, 6.45),
+    (Pipeline::Unit, Block::Ik, 5.33),
     (Pipeline::Sample, Block::Fbf, 37.0),
     (Pipeline::Sample, Block::Fk, 34.9),
     (Pipeline::Sample, Block::Kff, 36.9),
