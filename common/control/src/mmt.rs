@@ -352,16 +352,19 @@ impl ModelRenderer {
         self.injected
     }
 
-    /// Takes a model from the slave with the handle at `x` and `felt` the force on the
-    /// handle now (the model's, or before the first model what arrived). An invalid
-    /// model is refused (false) and changes nothing.
-    pub fn receive(&mut self, new: PlaneModel, x: [f64; 3], felt: [f64; 3]) -> bool {
-        if !new.is_valid() || !x.iter().chain(felt.iter()).all(|v| v.is_finite()) {
+    /// Takes a model from the slave with the handle at `x`. The force on the handle now
+    /// is the rendered model's; before the first model it is `arrived`, what came over
+    /// the channel. An invalid model is refused (false) and changes nothing.
+    pub fn receive(&mut self, new: PlaneModel, x: [f64; 3], arrived: [f64; 3]) -> bool {
+        if !new.is_valid() || !x.iter().chain(arrived.iter()).all(|v| v.is_finite()) {
             return false;
         }
         // The first model takes over the force that arrived over the channel, whose
-        // energy the channel's observers book; from then on changes are this one's.
+        // energy the channel's observers book; from then on changes are this one's,
+        // continuous with what it renders (never with a force it is told, which could
+        // be larger and so store more).
         let first = self.model.is_none();
+        let felt = self.rendered().map_or(arrived, |m| m.force(x));
         let before = self.rendered().map_or(0.0, |m| m.energy(x));
         let s = dot(new.normal, x);
         let f = dot(new.normal, felt).max(0.0);

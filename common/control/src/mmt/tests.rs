@@ -307,11 +307,15 @@ proptest! {
         for (nx, ny, offset, k, hold) in models {
             let m = PlaneModel { normal: unit([nx, ny, 1.0]), offset, stiffness: k };
             let x = |t: usize| [0.0, 0.0, -0.06 + wiggle[(t / 40) % 50] * ((t % 40) as f64 / 40.0)];
+            // What the operator feels now: the rendered model's force, or before the
+            // first model what arrived (`felt`, given as such).
+            let now = r.rendered().map_or(felt, |old| old.force(x(t)));
             prop_assert!(r.receive(m, x(t), felt));
             // Along the new normal (the force's only direction from now on): what was
             // felt, less one sample's relaxation at 1e-5 m of at most 3000 N/m.
-            let after = dot(r.force(x(t)).expect("a model"), m.normal);
-            let before = dot(felt, m.normal).max(0.0);
+            felt = r.force(x(t)).expect("a model");
+            let after = dot(felt, m.normal);
+            let before = dot(now, m.normal).max(0.0);
             prop_assert!((after - before).abs() <= 0.03 + 1e-9, "{before} N to {after} N");
             for _ in 0..hold {
                 t += 1;
