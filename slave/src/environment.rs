@@ -5,6 +5,7 @@
 //! the tool penetrates, with that object's stiffness (h_x, h_y, h_z). Pure geometry in
 //! f64: this is the physical world, not the HSD's datapath.
 
+use tactile_math::vec3::dot;
 use tactile_scenario::Object;
 
 /// The tool inside an object.
@@ -22,10 +23,6 @@ pub struct Contact {
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// The scenario's objects as the contact test takes them: a plane's unit normal is

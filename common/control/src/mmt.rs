@@ -20,6 +20,7 @@
 //! evidence too: the surface is at least as deep as the tool, and the estimate moves
 //! there.
 
+use tactile_math::vec3::{dot, norm};
 use tactile_scenario::MAX_STIFFNESS;
 
 /// The estimator's settings.
@@ -77,14 +78,6 @@ impl Default for ChangeThresholds {
             angle: 0.02,
         }
     }
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 impl PlaneModel {

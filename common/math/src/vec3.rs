@@ -1,9 +1,14 @@
-//! Three-vectors as the loop carries them (`[f64; 3]`): the two measures every node
-//! and the report need.
+//! Three-vectors as the loop carries them (`[f64; 3]`): the measures every node and
+//! the report need.
+
+/// Scalar product.
+pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
 
 /// Euclidean length.
 pub fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+    dot(v, v).sqrt()
 }
 
 /// Euclidean distance between two points.

@@ -20,7 +20,7 @@
 
 use crate::trace::TraceRow;
 use serde::Serialize;
-use tactile_math::vec3::{distance, norm};
+use tactile_math::vec3::{distance, dot, norm};
 use tactile_messages::samples::Flags;
 
 /// `transparency` in summary.json.
@@ -74,10 +74,6 @@ pub struct Felt {
     environment: Fit,
     /// The latest contact's surface point and outward normal.
     surface: Option<([f64; 3], [f64; 3])>,
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 impl Felt {
