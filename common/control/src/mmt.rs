@@ -357,8 +357,9 @@ impl ModelRenderer {
         // continuous with what it renders (never with a force it is told, which could
         // be larger and so store more).
         let first = self.model.is_none();
-        let felt = self.rendered().map_or(arrived, |m| m.force(x));
-        let before = self.rendered().map_or(0.0, |m| m.energy(x));
+        let shown = self.rendered();
+        let felt = shown.map_or(arrived, |m| m.force(x));
+        let before = shown.map_or(0.0, |m| m.energy(x));
         let s = dot(new.normal, x);
         let f = dot(new.normal, felt).max(0.0);
         let mut k = new.stiffness;
