@@ -17,12 +17,13 @@
 use crate::operator::{Approach, Operate, OperatorSource, Scripted, Target, IDENTITY};
 use crate::simulated::HeldDevice;
 use tactile_control::codec::{Deadband, Estimate, Guess, Predictor};
+use tactile_control::mmt::{ModelReceiver, Taken};
 use tactile_control::passivity::{MasterForce, MasterSide};
 use tactile_devices::hand::Hand;
 use tactile_math::engine::Engine;
 use tactile_math::kernels::IkStatus;
-use tactile_messages::samples::{stage, Backward, Flags, Forward};
-use tactile_records::master::{Answer, Effect, MasterCounters, Miss, Sent};
+use tactile_messages::samples::{Backward, Flags, Forward};
+use tactile_records::master::{Answer, Effect, MasterCounters, Sent};
 use tactile_scenario::ControlKind;
 use tactile_scenario::{HandInput, HandMode, MasterConfig, Scenario, ScenarioError};
 
@@ -87,6 +88,8 @@ pub struct Master {
     handle: [f64; 3],
     /// The device gives a position, not joints: there are no joint torques to compute.
     pose_input: bool,
+    /// `control.kind = "mmt"`: the slave's latest model, rendered against the handle.
+    mmt: Option<ModelReceiver>,
 }
 
 /// `q` relative to `q0` (both `[x, y, z, w]`): the turn from `q0` to `q`, about the
@@ -164,6 +167,8 @@ impl Master {
             home,
             handle: home,
             pose_input: false,
+            mmt: (scenario.control.kind == ControlKind::Mmt)
+                .then(|| ModelReceiver::new(&scenario.control.mmt, scenario.t_s())),
         })
     }
 
@@ -480,13 +485,27 @@ impl Master {
             self.counters.rejected += 1;
             flags |= Flags::REJECTED;
         }
-        let out = self
-            .control
-            .receive(est.value(), energy, self.limits.force_limit);
+        let value = self.rendered(q, est.value());
+        let out = self.control.receive(value, energy, self.limits.force_limit);
         if self.command(&out) {
             flags |= Flags::CLAMPED;
         }
         self.answer(q, flags, &out)
+    }
+
+    /// MMT: takes the model `q` carries and renders the latest against the handle;
+    /// before the first model, and without MMT, the force that `arrived`. Either way the
+    /// force then passes the control's books and the force limit.
+    fn rendered(&mut self, q: &Backward, arrived: [f64; 3]) -> [f64; 3] {
+        let Some(r) = self.mmt.as_mut() else {
+            return arrived;
+        };
+        match r.take(&q.model, self.handle, arrived) {
+            Taken::New => self.counters.models_received += 1,
+            Taken::Refused => self.counters.models_refused += 1,
+            Taken::Nothing => {}
+        }
+        r.force(self.handle).unwrap_or(arrived)
     }
 
     /// Takes the control's force as the felt force and its KFF-HMD torques, clamped;
@@ -544,52 +563,14 @@ impl Master {
             observer: out.observer,
             port_net_j: self.control.ledger().net(),
             dissipated_j: out.dissipated,
+            model_injected_j: self.mmt.as_ref().map_or(0.0, |r| r.renderer().injected()),
         }
-    }
-
-    /// Sample n got no answer in time. Within the peer timeout the last force is held
-    /// (one lost sample must not jerk the operator's hand; with waves, the last wave
-    /// against the present velocity); past it the loop is broken and the master
-    /// commands zero torque.
-    pub fn missing(&mut self, n: u64) -> Miss {
-        self.silent += 1;
-        let (flags, out) = if self.peer_lost() {
-            if self.silent == self.peer_timeout {
-                self.counters.loop_breaks += 1;
-            }
-            self.counters.peer_lost_samples += 1;
-            let out = self.control.release();
-            self.last_tau = [0.0; 3];
-            self.last_felt = [0.0; 3];
-            (Flags::PEER_LOST, out)
-        } else {
-            self.counters.held_samples += 1;
-            let guess = self.predictor.estimate(n, None).value();
-            let out = self
-                .control
-                .receive(guess, [0.0; 3], self.limits.force_limit);
-            self.command(&out);
-            (Flags::HELD, out)
-        };
-        Miss {
-            n,
-            effect: self.effect(flags, &out),
-        }
-    }
-
-    /// Fills the answer's round trip and overhead from its final stamps: round trip is
-    /// done-time minus the oldest origin among q's values, on the master's clock alone.
-    pub fn account(&self, a: &mut Answer) {
-        let done = a.stamps[stage::MASTER_DONE];
-        let (i, origin) = (0..3)
-            .map(|i| (i, a.q.origin_ns[i]))
-            .min_by_key(|&(_, t)| t)
-            .unwrap_or((0, 0));
-        a.round_trip_ns = done.saturating_sub(origin);
-        let injected = u64::from(a.q.delay_samples[i]) * self.t_s_ns;
-        a.overhead_ns = a.round_trip_ns as i64 - injected as i64;
     }
 }
+
+// What the master does when no answer came, and the round trip of one that did.
+#[path = "hmd_miss.rs"]
+mod miss;
 
 #[cfg(test)]
 #[path = "hmd_tests.rs"]

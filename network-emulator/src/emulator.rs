@@ -11,13 +11,13 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tactile_messages::samples::{Backward, Flags, Forward, Signal};
+use tactile_messages::samples::{Backward, Flags, Forward, Model, Signal};
 
 /// The flags that belong to a sample's packet and arrive with it, not with the sample
 /// that triggers the emulator's output: the clutch (released at the pose it was
 /// released at, however late that pose arrives).
 const CARRIED: Flags = Flags::RELEASED;
-use tactile_netem::channel::{Channel, Value, BACKWARD_STREAM, FORWARD_STREAM};
+use tactile_netem::channel::{Channel, Rest, Value, BACKWARD_STREAM, FORWARD_STREAM};
 use tactile_netem::{Loss, Replay};
 use tactile_records::emulator::{Direction, EmulatorCounters, Fate, Passage};
 use tactile_scenario::{ChannelConfig, Scenario};
@@ -141,13 +141,18 @@ impl Emulator {
     /// each, and returning them copied each on its way out to the follower's reply.
     pub fn forward(&mut self, c: &Forward, v: &mut Option<Forward>, record: &mut Option<Passage>) {
         let out = v.insert(*c);
+        let mut rest = Rest {
+            rotation: c.rotation,
+            ..Rest::default()
+        };
         let (fate, noise, jitter, lost, duplicated) = pass(
             &mut self.forward,
             &mut self.forward_faults,
             c.seq,
             &mut out.signal,
-            &mut out.rotation,
+            &mut rest,
         );
+        out.rotation = rest.rotation;
         let k = &mut self.counters;
         k.forward += 1;
         k.forward_substituted += u64::from(out.signal.flags.intersects(Flags::SUBSTITUTED));
@@ -181,15 +186,28 @@ impl Emulator {
         record: &mut Option<Passage>,
     ) {
         let out = q.insert(*h);
-        let mut torque = [h.torque[0], h.torque[1], h.torque[2], 0.0];
+        let m = &h.model;
+        let mut rest = Rest {
+            rotation: [h.torque[0], h.torque[1], h.torque[2], 0.0],
+            model: [m.normal[0], m.normal[1], m.normal[2], m.offset, m.stiffness],
+            model_seq: m.seq,
+            ..Rest::default()
+        };
         let (fate, noise, jitter, lost, duplicated) = pass(
             &mut self.backward,
             &mut self.backward_faults,
             h.seq,
             &mut out.signal,
-            &mut torque,
+            &mut rest,
         );
-        out.torque = [torque[0], torque[1], torque[2]];
+        let (t, m) = (rest.rotation, rest.model);
+        out.torque = [t[0], t[1], t[2]];
+        out.model = Model {
+            normal: [m[0], m[1], m[2]],
+            offset: m[3],
+            stiffness: m[4],
+            seq: rest.model_seq,
+        };
         let k = &mut self.counters;
         k.backward += 1;
         k.backward_substituted += u64::from(out.signal.flags.intersects(Flags::SUBSTITUTED));
@@ -202,7 +220,7 @@ impl Emulator {
             n: h.seq,
             input: h.signal.value,
             out: out.signal,
-            rotational: (h.signal.flags.intersects(Flags::POSE)).then_some(torque),
+            rotational: (h.signal.flags.intersects(Flags::POSE)).then_some(rest.rotation),
             noise,
             jitter,
             lost,
@@ -215,16 +233,16 @@ impl Emulator {
 }
 
 /// One sample through one channel: delay and noise into `signal`, then the fault
-/// model's decision (a corrupted signal is already NaN when this returns); `extra` is
-/// the sample's rotational half, carried in the same packet. Returns the
-/// decision, the noise added, the jitter drawn, whether a replayed network lost the
-/// packet and whether it was duplicated.
+/// model's decision (a corrupted signal is already NaN when this returns); `rest` is
+/// the sample's rotational half and model, carried in the same packet (its flags are
+/// taken from `signal`'s). Returns the decision, the noise added, the jitter drawn,
+/// whether a replayed network lost the packet and whether it was duplicated.
 fn pass(
     channel: &mut Channel,
     faults: &mut Faults,
     seq: u64,
     signal: &mut Signal,
-    extra: &mut [f64; 4],
+    rest: &mut Rest,
 ) -> (Fate, [f64; 3], f64, bool, bool) {
     // A sample its sender's codec did not send carries no packet, nor one the loss
     // model loses (netem's loss is of packets: the receiver still ticks and fills the
@@ -232,17 +250,21 @@ fn pass(
     // gets nothing). What leaves is what the network delivers at this sample.
     let unsent = signal.flags.intersects(Flags::UNSENT);
     let model_lost = faults.packet_lost() && !unsent;
-    let rest = (*extra, (signal.flags & CARRIED).bits());
-    let e = channel.push_packet(seq, values(signal), rest, !unsent && !model_lost);
+    rest.flags = (signal.flags & CARRIED).bits();
+    let e = channel.push_packet(seq, values(signal), *rest, !unsent && !model_lost);
     signal.flags.remove(Flags::UNSENT);
     apply(signal, &e);
-    *extra = e.extra.0;
-    signal.flags = signal.flags.without(CARRIED) | (Flags::from_bits(e.extra.1) & CARRIED);
+    *rest = e.extra;
+    signal.flags = signal.flags.without(CARRIED) | (Flags::from_bits(rest.flags) & CARRIED);
     let fate = faults.fate();
     if fate == Fate::Corrupt {
         signal.value = [f64::NAN; 3];
         if signal.flags.intersects(Flags::POSE) {
-            *extra = [f64::NAN; 4];
+            rest.rotation = [f64::NAN; 4];
+        }
+        // A model in a corrupted packet is garbage too: the master must refuse it.
+        if rest.model_seq != 0 {
+            rest.model = [f64::NAN; 5];
         }
         signal.flags |= Flags::CORRUPTED;
     }
@@ -301,6 +323,48 @@ mod tests {
         // Both kinds came, and a pass right after a drop.
         let dropped = |f: &Option<Fate>| *f == Some(Fate::Drop);
         assert!(fates.windows(2).any(|w| dropped(&w[0]) && !dropped(&w[1])));
+    }
+
+    /// MMT's model rides in the force's packet: delayed with it, held with it, never
+    /// noised; in a corrupted packet it is garbage (NaN) for the master to refuse.
+    #[test]
+    fn the_model_arrives_with_its_force_and_is_corrupted_with_it() {
+        let mut sc = Scenario::paper();
+        sc.network.backward.delay = [3, 3, 3];
+        sc.network.backward.noise_std = [1e-3; 3];
+        let mut e = Emulator::new(&sc);
+        let model = |n: u64| Model {
+            normal: [0.0, 0.0, 1.0],
+            offset: -0.06 + n as f64 * 1e-4,
+            stiffness: 600.0,
+            seq: n / 2,
+        };
+        let (mut q, mut record) = (None, None);
+        for n in 0..20u64 {
+            let mut h = Backward {
+                seq: n,
+                model: model(n),
+                ..Backward::default()
+            };
+            h.signal.value = [0.0, 0.0, n as f64];
+            h.signal.sent_seq = [n; 3];
+            e.backward(&h, &mut q, &mut record);
+            let q = q.expect("passed");
+            let from = q.signal.sent_seq[0];
+            assert_eq!(q.model, model(from), "sample {n}");
+            assert_eq!(from, n.saturating_sub(3));
+        }
+        sc.network.backward.corrupt = 1.0;
+        let mut e = Emulator::new(&sc);
+        let h = Backward {
+            model: model(4),
+            ..Backward::default()
+        };
+        e.backward(&h, &mut q, &mut record);
+        let q = q.expect("passed");
+        assert!(q.signal.flags.intersects(Flags::CORRUPTED));
+        assert!(q.model.offset.is_nan() && q.model.stiffness.is_nan());
+        assert_eq!(q.model.seq, 2);
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //! f64: this is the physical world, not the HSD's datapath.
 
 use tactile_math::vec3::dot;
-use tactile_scenario::Object;
+use tactile_scenario::{Change, Object};
 
 /// The tool inside an object.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,6 +46,14 @@ impl Scene {
         };
         Scene {
             objects: objects.iter().map(|o| (o.clone(), unit(o))).collect(),
+        }
+    }
+
+    /// Applies a change to its object (a scenario's are checked: an index out of
+    /// range changes nothing).
+    pub fn apply(&mut self, c: &Change) {
+        if let Some((o, _)) = self.objects.get_mut(c.object) {
+            *o = o.changed(c);
         }
     }
 }

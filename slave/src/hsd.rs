@@ -15,6 +15,7 @@
 use crate::environment::{deepest_contact, Scene};
 use crate::slave_arm::SlaveArm;
 use tactile_control::codec::{Deadband, Estimate, Guess, Predictor};
+use tactile_control::mmt::ModelSender;
 use tactile_control::passivity::SlaveSide;
 use tactile_math::arith::StdTrig;
 use tactile_math::joints::Joints;
@@ -22,7 +23,7 @@ use tactile_math::kernels;
 use tactile_math::vec3::distance;
 use tactile_messages::samples::{Backward, Flags, Forward};
 use tactile_records::slave::{HoldStep, SlaveCounters, Step};
-use tactile_scenario::{Scenario, ScenarioError};
+use tactile_scenario::{Change, Scenario, ScenarioError};
 
 /// The slave: its arm (the paper's or a URDF's), its environment and the channel's
 /// control, codec and predictor.
@@ -41,6 +42,11 @@ pub struct Slave {
     measured: Option<Measured>,
     /// A 6-DoF master's last accepted orientation (held while none valid comes).
     rotation: Option<[f64; 4]>,
+    /// `control.kind = "mmt"`: the environment's estimate, and the model last sent.
+    mmt: Option<ModelSender>,
+    /// `[[environment.changes]]` still to come, by the sample they hold from, latest
+    /// first (so the next is popped off the end).
+    changes: Vec<(u64, Change)>,
 }
 
 /// What a real robot measured for one step.
@@ -84,6 +90,9 @@ impl Slave {
             counters: SlaveCounters::default(),
             measured: None,
             rotation: None,
+            mmt: (scenario.control.kind == tactile_scenario::ControlKind::Mmt)
+                .then(|| ModelSender::new(&scenario.control.mmt)),
+            changes: changes(scenario),
         })
     }
 
@@ -123,6 +132,11 @@ impl Slave {
     /// follower's reply): returned, it was copied twice a sample on its way there.
     pub fn step(&mut self, v: &Forward, h: &mut Option<Backward>) -> Step {
         self.counters.steps += 1;
+        while self.changes.last().is_some_and(|(n, _)| *n <= v.seq) {
+            if let Some((_, c)) = self.changes.pop() {
+                self.objects.apply(&c);
+            }
+        }
         self.arm.end_hold();
         let (mut flags, observer, dissipated_j) = self.follow(v);
         let measured = self.measured.take();
@@ -134,6 +148,7 @@ impl Slave {
             self.sense(measured.and_then(|m| m.force), &mut flags);
         let torque = measured.map_or([0.0; 3], |m| m.torque);
         self.reply(v, (force, torque), tool, flags, h);
+        let model = h.as_ref().map_or_else(Default::default, |h| h.model);
         Step {
             n: v.seq,
             received: v.signal,
@@ -150,6 +165,7 @@ impl Slave {
             clamps: moved.clamps,
             contact_object,
             flags,
+            model,
         }
     }
 
@@ -282,7 +298,35 @@ impl Slave {
         // A 6-DoF sample is answered with a wrench.
         out.torque = self.arm.felt(torque);
         out.signal.flags |= v.signal.flags & Flags::POSE;
+        // MMT: the tool and the force as the master sees them (its frame and axes).
+        if let Some(m) = self.mmt.as_mut() {
+            if m.update(tool, force) {
+                self.counters.models_sent += 1;
+                // A new model goes out now, whatever the force's deadband says.
+                if out.signal.flags.intersects(Flags::UNSENT) {
+                    out.signal.flags.remove(Flags::UNSENT);
+                    self.counters.packets_sent += 1;
+                }
+            }
+            out.model = m.sent();
+        }
     }
+}
+
+/// The scenario's environment changes by the first sample each holds from (`n t_s >=
+/// at_s`), latest first; a stable sort, so changes at one sample apply in the file's
+/// order.
+fn changes(scenario: &Scenario) -> Vec<(u64, Change)> {
+    let t_s = scenario.t_s();
+    let mut v: Vec<(u64, Change)> = scenario
+        .environment
+        .changes
+        .iter()
+        .map(|c| ((c.at_s / t_s - 1e-9).ceil().max(0.0) as u64, c.clone()))
+        .collect();
+    v.sort_by_key(|(n, _)| *n);
+    v.reverse();
+    v
 }
 
 /// How far from one a received quaternion's norm may be (the sender normalized it;

@@ -319,6 +319,12 @@ pub fn wall_delay() -> String {
     std::fs::read_to_string(path).expect("deploy/scenarios/wall-delay.toml")
 }
 
+/// `deploy/scenarios/wall-change.toml`: wall-delay at 200 ms in a world that changes.
+pub fn wall_change() -> String {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/wall-change.toml");
+    std::fs::read_to_string(path).expect("deploy/scenarios/wall-change.toml")
+}
+
 /// The paper scenario at 1 kHz in real time, `samples` samples.
 pub fn paper_1khz(samples: u64) -> String {
     tactile::launch::PAPER_SCENARIO

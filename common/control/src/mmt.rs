@@ -59,6 +59,16 @@ pub struct PlaneModel {
     pub stiffness: f64,
 }
 
+/// The softest wall a model may be, N/m: 1 N per metre is no wall a hand can feel.
+pub const MIN_STIFFNESS: f64 = 1.0;
+
+/// A contact force further than this from the model's prediction, N, or than
+/// [`JUMP_FRACTION`] of the force, is not the model's wall: the world changed (a wall
+/// moved, a material hardened) and the fit starts again from here.
+pub const JUMP_FORCE: f64 = 0.5;
+/// See [`JUMP_FORCE`].
+pub const JUMP_FRACTION: f64 = 0.2;
+
 /// How much a model must change before the slave sends it again.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChangeThresholds {
@@ -99,7 +109,8 @@ impl PlaneModel {
     }
 
     /// A model a renderer may use: finite, a unit normal, a stiffness in
-    /// 0..=[`MAX_STIFFNESS`], and an offset within 10 m. Anything a peer sends is
+    /// [`MIN_STIFFNESS`]..=[`MAX_STIFFNESS`] (a spring of nothing could not continue
+    /// the force felt), and an offset within 10 m. Anything a peer sends is
     /// checked with this before it is believed.
     pub fn is_valid(&self) -> bool {
         self.normal.iter().all(|v| v.is_finite())
@@ -107,7 +118,7 @@ impl PlaneModel {
             && self.offset.is_finite()
             && self.offset.abs() <= 10.0
             && self.stiffness.is_finite()
-            && (0.0..=MAX_STIFFNESS).contains(&self.stiffness)
+            && (MIN_STIFFNESS..=MAX_STIFFNESS).contains(&self.stiffness)
     }
 
     /// True when `self` differs from `sent` by more than a threshold in any parameter.
@@ -120,13 +131,16 @@ impl PlaneModel {
     }
 }
 
-/// Recursive least squares on `f = theta0 + theta1 (s - anchor)`, with forgetting and
+/// Recursive least squares on `f = theta0 + theta1 n.(x - anchor)`, with forgetting and
 /// a bounded covariance.
 #[derive(Debug, Clone, Copy)]
 struct Rls {
     theta: [f64; 2],
     p: [[f64; 2]; 2],
-    anchor: f64,
+    /// A point on the first contact: positions are measured from it along the normal,
+    /// so a normal that turns a little does not move them by the tool's distance from
+    /// the origin times the angle.
+    anchor: [f64; 3],
 }
 
 /// The covariance's prior and bound: force (1 N)^2 and stiffness (2000 N/m)^2.
@@ -134,7 +148,7 @@ const P0: [f64; 2] = [1.0, 4.0e6];
 const PRIOR: [[f64; 2]; 2] = [[P0[0], 0.0], [0.0, P0[1]]];
 
 impl Rls {
-    fn new(anchor: f64, f0: f64, k: f64) -> Self {
+    fn new(anchor: [f64; 3], f0: f64, k: f64) -> Self {
         Rls {
             theta: [f0, -k],
             p: PRIOR,
@@ -142,8 +156,9 @@ impl Rls {
         }
     }
 
+    /// A contact sample: `s` the position along the normal from the anchor.
     fn update(&mut self, s: f64, f: f64, lambda: f64) {
-        let phi = [1.0, s - self.anchor];
+        let phi = [1.0, s];
         let p = self.p;
         let pphi = [
             p[0][0] * phi[0] + p[0][1] * phi[1],
@@ -151,7 +166,7 @@ impl Rls {
         ];
         let denom = lambda + phi[0] * pphi[0] + phi[1] * pphi[1];
         let gain = [pphi[0] / denom, pphi[1] / denom];
-        let err = f - (self.theta[0] * phi[0] + self.theta[1] * phi[1]);
+        let err = f - self.predict(phi[1]);
         let next = [self.theta[0] + gain[0] * err, self.theta[1] + gain[1] * err];
         if !next.iter().all(|v| v.is_finite()) {
             return;
@@ -178,14 +193,19 @@ impl Rls {
         }
     }
 
+    /// The force the fit gives at `s`.
+    fn predict(&self, s: f64) -> f64 {
+        self.theta[0] + self.theta[1] * s
+    }
+
     fn stiffness(&self) -> f64 {
         (-self.theta[1]).clamp(0.0, MAX_STIFFNESS)
     }
 
-    /// The surface: where the force along the normal is zero.
-    fn offset(&self) -> f64 {
+    /// The surface along `normal`: where the force is zero.
+    fn offset(&self, normal: [f64; 3]) -> f64 {
         let k = self.stiffness().max(1.0);
-        self.anchor + self.theta[0] / k
+        dot(normal, self.anchor) + self.theta[0] / k
     }
 }
 
@@ -197,6 +217,7 @@ pub struct PlaneEstimator {
     direction: [f64; 3],
     rls: Option<Rls>,
     contacts: u32,
+    jumps: u32,
 }
 
 impl PlaneEstimator {
@@ -207,6 +228,7 @@ impl PlaneEstimator {
             direction: [0.0; 3],
             rls: None,
             contacts: 0,
+            jumps: 0,
         }
     }
 
@@ -224,13 +246,28 @@ impl PlaneEstimator {
         let lambda = self.cfg.forgetting;
         self.direction = std::array::from_fn(|i| lambda * self.direction[i] + h[i] / magnitude);
         let n = self.normal();
-        let s = dot(n, x);
         let f = dot(n, h);
         let rls = self
             .rls
-            .get_or_insert_with(|| Rls::new(s, f, self.cfg.prior_stiffness));
-        rls.update(s, f, lambda);
+            .get_or_insert_with(|| Rls::new(x, f, self.cfg.prior_stiffness));
+        let s = dot(n, [0, 1, 2].map(|i| x[i] - rls.anchor[i]));
+        let jump = (f - rls.predict(s)).abs() > JUMP_FORCE.max(JUMP_FRACTION * f.abs());
+        if jump && self.contacts >= self.cfg.min_contacts {
+            // Another wall from here: its surface where this force says with the
+            // stiffness so far, which the next samples refine.
+            let k = rls.stiffness().max(MIN_STIFFNESS);
+            *rls = Rls::new(x, f, k);
+            self.jumps = self.jumps.saturating_add(1);
+        } else {
+            rls.update(s, f, lambda);
+        }
         self.contacts = self.contacts.saturating_add(1);
+    }
+
+    /// Times the contact force left the model (a changed world) and the fit began
+    /// again.
+    pub fn jumps(&self) -> u32 {
+        self.jumps
     }
 
     /// Free motion: if the model puts the tool inside the wall, the surface is at least
@@ -243,7 +280,7 @@ impl PlaneEstimator {
         if s < model.offset - hidden {
             if let Some(rls) = self.rls.as_mut() {
                 let k = rls.stiffness();
-                *rls = Rls::new(s, 0.0, k);
+                *rls = Rls::new(x, 0.0, k);
             }
         }
     }
@@ -265,7 +302,7 @@ impl PlaneEstimator {
         let rls = self.rls.as_ref()?;
         let m = PlaneModel {
             normal: self.normal(),
-            offset: rls.offset(),
+            offset: rls.offset(self.normal()),
             stiffness: rls.stiffness(),
         };
         m.is_valid().then_some(m)
@@ -280,46 +317,59 @@ impl PlaneEstimator {
 /// The master's rendering of the slave's latest model, against its own handle, every
 /// sample, with no delay in the haptic loop.
 ///
-/// A model change must not kick the operator, and the rendered wall must stay passive.
-/// Blending two models in time would do neither by itself: while the handle is inside,
-/// raising the stiffness or moving the surface out adds energy the operator never put
-/// in. So a change is taken only in ways that do not raise the energy the rendered
-/// spring stores at the handle (the energy check; Xu et al. 2016 use the same
-/// criterion for their passive model update):
+/// A model change must not kick the operator. Whatever the rule, a new model is taken
+/// with the force at the handle continuous: its surface is placed where the new spring
+/// gives the force felt now, a `shift` along the normal from the model's surface. How
+/// the shift then returns to zero is the update rule ([`Update`]):
 ///
-/// - The surface is placed so that the force at the handle is what the operator feels
-///   now (force continuity), a `shift` along the normal from the model's surface. The
-///   shift returns to zero only where that does not raise the stored energy: while the
-///   handle is outside, at once but never past the handle; inside, only a surface that
-///   is out of the model's moves, deeper, at `relax` per sample (the force eases off).
-/// - A stiffer model is taken at once (with the force continuous, the stored energy
-///   `F^2 / 2k` falls). A softer one waits until the handle is outside, since at the same
-///   force it would store more.
-///
-/// What the operator feels is the model's stiffness at once, and its surface shifted by
-/// at most the penetration felt when the model arrived, until the handle next leaves
-/// the wall.
+/// - **`Passive`, the energy check** (Mitra and Niemeyer 2008; Xu et al. 2016): only
+///   changes that do not raise the energy the rendered spring stores at the handle. While
+///   the handle is outside, the model's surface at once but never past the handle;
+///   inside, only a surface that is out of the model's moves, deeper, so that the force
+///   eases off by `step` newtons a sample. A stiffer model is taken at once (at the same force the
+///   stored energy `F^2 / 2k` falls); a softer one waits until the handle is outside.
+///   Nothing is ever added, but a wall first felt late (the handle already deep when the
+///   first model arrives) stays that much farther until the handle next leaves it.
+/// - **`Blend`**: as `Passive`, and inside the wall a surface deeper than the model's
+///   moves out so that the force rises by `step` a sample, and a softer model is taken
+///   at once (its surface then eases deeper). The force changes by at most `step` a
+///   sample, so there is no kick; the energy this adds is at most `k s^2 / 2` for a
+///   shift `s` (what the wall would have stored had it been felt on time) and is booked
+///   in [`ModelRenderer::injected`].
 #[derive(Debug, Clone)]
 pub struct ModelRenderer {
     model: Option<PlaneModel>,
-    /// A softer stiffness waiting for the handle to leave the wall.
+    /// A softer stiffness waiting for the handle to leave the wall (`Passive`).
     softer: Option<f64>,
     /// The rendered surface is at `model.offset - shift`, m.
     shift: f64,
-    relax: f64,
-    /// Energy model changes added at the handle, J (zero by construction; watched).
+    /// N a sample.
+    step: f64,
+    update: Update,
+    /// Energy model changes added at the handle, J (zero with `Passive`).
     injected: f64,
 }
 
+/// How a rendered model's surface returns to the model's after a change (see
+/// [`ModelRenderer`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Update {
+    /// Only changes that add no energy at the handle.
+    Passive,
+    /// Towards the model at a bounded rate either way, the energy added booked.
+    Blend,
+}
+
 impl ModelRenderer {
-    /// `relax`: how fast a surface out of the model's goes deeper while the handle is
-    /// inside, m per sample.
-    pub fn new(relax: f64) -> Self {
+    /// `step`: how fast the felt force follows the rendered surface's return to the
+    /// model's while the handle is inside, N per sample.
+    pub fn new(step: f64, update: Update) -> Self {
         ModelRenderer {
             model: None,
             softer: None,
             shift: 0.0,
-            relax: relax.abs(),
+            step: step.abs(),
+            update,
             injected: 0.0,
         }
     }
@@ -364,7 +414,7 @@ impl ModelRenderer {
         let f = dot(new.normal, felt).max(0.0);
         let mut k = new.stiffness;
         self.softer = None;
-        if let Some(old) = self.model {
+        if let (Some(old), Update::Passive) = (self.model, self.update) {
             if f > 0.0 && k < old.stiffness {
                 self.softer = Some(k);
                 k = old.stiffness;
@@ -390,24 +440,27 @@ impl ModelRenderer {
 
     /// The force on the handle at `x`, N, once a model has arrived; `None` before (the
     /// node renders what arrives). Moves the surface and the stiffness towards the
-    /// model's where that adds no energy.
+    /// model's as the update rule allows.
     pub fn force(&mut self, x: [f64; 3]) -> Option<[f64; 3]> {
         let m = self.model?;
         let before = self.rendered().map_or(0.0, |r| r.energy(x));
         let s = dot(m.normal, x);
         let outside = m.offset - self.shift <= s;
+        // The surface's move that changes the force by `step`.
+        let relax = self.step / m.stiffness.max(1.0);
         if outside {
             // Nothing stored, nothing felt: the model's surface at once, never past the
             // handle.
             self.shift = (m.offset - s).max(0.0);
-        } else if self.shift < 0.0 {
-            // Deeper, a little a sample: the force eases off without a step.
-            self.shift = (self.shift + self.relax).min(0.0);
-        }
-        if outside {
             if let Some(k) = self.softer.take() {
                 self.model = Some(PlaneModel { stiffness: k, ..m });
             }
+        } else if self.shift < 0.0 {
+            // Deeper, a little a sample: the force eases off without a step.
+            self.shift = (self.shift + relax).min(0.0);
+        } else if self.update == Update::Blend {
+            // Out, a little a sample: the force rises without a step.
+            self.shift = (self.shift - relax).max(0.0);
         }
         self.book(before, x);
         self.rendered().map(|r| r.force(x))
@@ -418,6 +471,9 @@ impl ModelRenderer {
         self.injected += (after - before).max(0.0);
     }
 }
+
+mod nodes;
+pub use nodes::{ModelReceiver, ModelSender, Taken};
 
 #[cfg(test)]
 mod tests;

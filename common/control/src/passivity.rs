@@ -152,7 +152,7 @@ impl MasterSide {
     /// What is sent for position `c`: c itself, or the forward wave.
     pub fn transmit(&self, c: [f64; 3]) -> [f64; 3] {
         match self.cfg.kind {
-            ControlKind::None | ControlKind::Tdpa => c,
+            ControlKind::None | ControlKind::Tdpa | ControlKind::Mmt => c,
             ControlKind::Wave => {
                 let s = (2.0 * self.cfg.wave_impedance).sqrt();
                 [0, 1, 2].map(|i| s * self.velocity[i] + self.wave_in[i])
@@ -176,7 +176,7 @@ impl MasterSide {
     pub fn receive(&mut self, value: [f64; 3], energy: [f64; 3], limit: f64) -> MasterForce {
         self.remote.take(energy, self.t_s);
         match self.cfg.kind {
-            ControlKind::None | ControlKind::Tdpa => self.base = value,
+            ControlKind::None | ControlKind::Tdpa | ControlKind::Mmt => self.base = value,
             ControlKind::Wave => {
                 self.wave_in = value;
                 self.base = self.wave_force();
@@ -300,7 +300,8 @@ impl SlaveSide {
         for i in 0..3 {
             let fs = -h[i];
             let (v, extra) = match self.cfg.kind {
-                ControlKind::None => {
+                // MMT's slave follows the master's position as `none`'s does.
+                ControlKind::None | ControlKind::Mmt => {
                     let v = self.velocity_to(i, value[i]);
                     (v, 0.0)
                 }
@@ -318,7 +319,7 @@ impl SlaveSide {
                 }
             };
             match self.cfg.kind {
-                ControlKind::None => self.reference[i] = value[i],
+                ControlKind::None | ControlKind::Mmt => self.reference[i] = value[i],
                 _ => self.reference[i] += v * self.t_s,
             }
             self.ledger.book(i, fs * v * self.t_s + extra);
@@ -333,7 +334,7 @@ impl SlaveSide {
     /// wave of the force the last [`SlaveSide::receive`] resisted with.
     pub fn transmit(&self, h: [f64; 3]) -> [f64; 3] {
         match self.cfg.kind {
-            ControlKind::None | ControlKind::Tdpa => h,
+            ControlKind::None | ControlKind::Tdpa | ControlKind::Mmt => h,
             ControlKind::Wave => self.wave_out,
         }
     }

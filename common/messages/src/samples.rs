@@ -131,7 +131,7 @@ pub struct Forward {
 /// Backward stream: h(n) from the slave, q(n) from the emulator.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
-#[type_name("tactile::Backward/4")]
+#[type_name("tactile::Backward/5")]
 pub struct Backward {
     /// Sample number n on this stream (the forward sample that triggered it).
     pub seq: u64,
@@ -145,8 +145,31 @@ pub struct Backward {
     /// arm's wrench sensor measured, zero for a point contact; flagged [`Flags::POSE`] in
     /// a 6-DoF run. It crosses the network in the force's packet.
     pub torque: [f64; 3],
+    /// With `control.kind = "mmt"`: the last environment model the slave sent. It is
+    /// state, so every sample carries it (a lost packet costs one sample's delay, not
+    /// the model); `seq` says when it is new. It crosses the network in the force's
+    /// packet, never noised.
+    pub model: Model,
     /// Stamps of the triggering forward sample, then the backward stages.
     pub stamps: [u64; stage::COUNT],
+}
+
+/// A plane wall as model-mediated teleoperation sends it: contact where `normal . x <
+/// offset`, force `stiffness (offset - normal . x) normal` there, in the master's frame.
+/// A receiver checks it before believing it (`tactile_control::mmt::PlaneModel::is_valid`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
+#[type_name("tactile::Model/1")]
+pub struct Model {
+    /// Outward unit normal.
+    pub normal: [f64; 3],
+    /// The surface's position along the normal, m.
+    pub offset: f64,
+    /// N/m.
+    pub stiffness: f64,
+    /// The model's number: 0 for none yet, then one more each time the slave sends a
+    /// changed model.
+    pub seq: u64,
 }
 
 /// A sample that belongs to a run.

@@ -68,11 +68,20 @@ struct Slot {
     extra: Rest,
 }
 
-/// A 6-DoF sample's rest beside its three values, carried in the first value's
-/// packet: its rotational half (an orientation forward, a torque backward) and the
-/// flags that belong to the packet (the clutch's), so both arrive with the pose they
-/// came with, however late.
-pub type Rest = ([f64; 4], u32);
+/// A sample's rest beside its three values, carried whole in the first value's packet,
+/// so it arrives with the values it came with, however late; never noised.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Rest {
+    /// A 6-DoF sample's rotational half: an orientation forward, a torque backward.
+    pub rotation: [f64; 4],
+    /// The flags that belong to the packet (the clutch's).
+    pub flags: u32,
+    /// An environment model the packet carries (model-mediated teleoperation's plane:
+    /// normal, offset, stiffness), opaque here.
+    pub model: [f64; 5],
+    /// That model's number (0: none).
+    pub model_seq: u64,
+}
 
 /// One signal's packets in flight: `(arrival sample, newest sequence arriving then)`
 /// by arrival, one entry a sample; and the newest arrived, its value copied on arrival
@@ -260,7 +269,7 @@ impl Channel {
 
     /// Takes input sample `seq` and returns the output for the same sample index.
     pub fn push(&mut self, seq: u64, values: [Value; 3]) -> Emitted {
-        self.push_packet(seq, values, ([0.0; 4], 0), true)
+        self.push_packet(seq, values, Rest::default(), true)
     }
 
     /// As [`Channel::push`]; `sent` false when the sender's codec sent no packet for
@@ -301,7 +310,7 @@ impl Channel {
         };
         let mut out = [Value::default(); 3];
         let mut noise = [0.0; 3];
-        let mut extra = ([0.0; 4], 0);
+        let mut extra = Rest::default();
         let mut substituted = false;
         for i in 0..3 {
             let (v, r, held, x) = self.axis(i, &packet);
@@ -341,7 +350,7 @@ impl Channel {
         let newest = self.newest.unwrap_or(Slot {
             seq,
             values: [Value::default(); 3],
-            extra: ([0.0; 4], 0),
+            extra: Rest::default(),
         });
         let age = u32::try_from(seq.saturating_sub(newest.seq)).unwrap_or(u32::MAX);
         let mut noise = [0.0; 3];
@@ -475,7 +484,7 @@ impl Channel {
                 // Nothing has arrived yet: hold the first value sent.
                 match &self.first {
                     Some(s) => (s.seq, s.values[i], true, s.extra),
-                    None => (p.seq, Value::default(), true, ([0.0; 4], 0)),
+                    None => (p.seq, Value::default(), true, Rest::default()),
                 }
             }
         };

@@ -278,7 +278,12 @@ proptest! {
                 3 => seq + MAX_SEQ_JUMP + 1,
                 _ => seq + 1,
             };
-            let extra = ([seq as f64, 0.5, -0.0, 1.0], seq as u32);
+            let extra = Rest {
+                rotation: [seq as f64, 0.5, -0.0, 1.0],
+                flags: seq as u32,
+                model: [0.25, seq as f64, 0.0, -1.0, 600.0],
+                model_seq: seq / 3,
+            };
             // Values that come with a delay already (from a channel before this one).
             let v = vals(seq).map(|v| Value {
                 delay_samples: (seq % 7) as u32,
@@ -341,15 +346,15 @@ fn samples_not_sent_move_the_numbers_on() {
         };
         let mut ch = Channel::new(&cfg, 1, FORWARD_STREAM);
         assert_eq!(ch.direct, delay == 0);
-        ch.push_packet(0, vals(0), ([0.0; 4], 0), true);
+        ch.push_packet(0, vals(0), Rest::default(), true);
         let quiet = MAX_SEQ_JUMP + 1;
         for seq in 1..=quiet {
-            ch.push_packet(seq, vals(seq), ([0.0; 4], 0), false);
+            ch.push_packet(seq, vals(seq), Rest::default(), false);
         }
         let s = quiet + 1;
-        let mut e = ch.push_packet(s, vals(s), ([0.0; 4], 0), true);
+        let mut e = ch.push_packet(s, vals(s), Rest::default(), true);
         for seq in s + 1..=s + delay as u64 {
-            e = ch.push_packet(seq, vals(seq), ([0.0; 4], 0), false);
+            e = ch.push_packet(seq, vals(seq), Rest::default(), false);
         }
         assert!(
             !e.substituted,
@@ -357,9 +362,9 @@ fn samples_not_sent_move_the_numbers_on() {
         );
         assert_eq!(e.values[0].origin_seq, s);
         let mut ch = Channel::new(&cfg, 1, FORWARD_STREAM);
-        ch.push_packet(5, vals(5), ([0.0; 4], 0), false);
+        ch.push_packet(5, vals(5), Rest::default(), false);
         for seq in 5..=5 + delay as u64 {
-            e = ch.push_packet(seq, vals(seq), ([0.0; 4], 0), seq == 5);
+            e = ch.push_packet(seq, vals(seq), Rest::default(), seq == 5);
         }
         assert!(
             e.substituted,

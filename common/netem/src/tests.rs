@@ -318,11 +318,12 @@ fn phi_is_the_normal_cdf() {
     }
 }
 
-/// A 6-DoF sample's rotational half arrives in its position's packet: delayed and
-/// held exactly as the first value, never noised, and the values unchanged by it.
+/// A sample's rest (a 6-DoF sample's rotational half, an MMT model) arrives in its
+/// position's packet: delayed and held exactly as the first value, never noised, and
+/// the values unchanged by it.
 #[test]
-fn the_rotational_half_rides_the_first_values_packet() {
-    use crate::channel::{Channel, Value, FORWARD_STREAM};
+fn the_rest_rides_the_first_values_packet() {
+    use crate::channel::{Channel, Rest, Value, FORWARD_STREAM};
     use tactile_scenario::{ChannelConfig, JitterConfig};
     let cfg = ChannelConfig {
         delay: [4, 4, 4],
@@ -342,7 +343,12 @@ fn the_rotational_half_rides_the_first_values_packet() {
             ..Default::default()
         })
     };
-    let extra = |n: u64| ([n as f64, -(n as f64), 0.5, 1.0], (n % 3) as u32);
+    let extra = |n: u64| Rest {
+        rotation: [n as f64, -(n as f64), 0.5, 1.0],
+        flags: (n % 3) as u32,
+        model: [0.0, 0.0, 1.0, n as f64 * 1e-3, 600.0],
+        model_seq: n / 4,
+    };
     let (mut with, mut without) = (
         Channel::new(&cfg, 3, FORWARD_STREAM),
         Channel::new(&cfg, 3, FORWARD_STREAM),
@@ -351,7 +357,7 @@ fn the_rotational_half_rides_the_first_values_packet() {
         // Every fifth sample unsent: the receiver holds the last packet, rotation too.
         let sent = n % 5 != 1;
         let e = with.push_packet(n, vals(n), extra(n), sent);
-        let plain = without.push_packet(n, vals(n), ([0.0; 4], 0), sent);
+        let plain = without.push_packet(n, vals(n), Rest::default(), sent);
         assert_eq!(e.values, plain.values, "sample {n}");
         assert_eq!(e.extra, extra(e.values[0].origin_seq), "sample {n}");
     }

@@ -33,6 +33,11 @@ pub struct MasterCounters {
     pub loop_breaks: u64,
     /// Times answers came back after a break.
     pub resumes: u64,
+    /// `control.kind = "mmt"`: new environment models taken and rendered.
+    pub models_received: u64,
+    /// `control.kind = "mmt"`: new models refused (not a valid plane: corrupted, or
+    /// a peer's garbage), each counted once.
+    pub models_refused: u64,
     /// `arithmetic = "rtl"`: the clocks FK-HMD and KFF-HMD spent (zero otherwise).
     pub rtl: Clocks,
 }
@@ -79,6 +84,9 @@ pub struct Effect {
     pub port_net_j: f64,
     /// Energy the control dissipated this sample, J.
     pub dissipated_j: f64,
+    /// `control.kind = "mmt"`: energy the rendered model's changes have added at the
+    /// handle so far, J (zero with `control.mmt.update = "passive"`).
+    pub model_injected_j: f64,
 }
 
 /// q(n) as it came back and the torques it produced.

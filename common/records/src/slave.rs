@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 use tactile_math::hardware::Clocks;
 use tactile_math::joints::Joints;
-use tactile_messages::samples::{Flags, Signal};
+use tactile_messages::samples::{Flags, Model, Signal};
 use tactile_messages::stream::{InboxStats, OutboxStats};
 
 /// What the slave counted over a run.
@@ -30,6 +30,9 @@ pub struct SlaveCounters {
     pub hold_drift_max_m: f64,
     /// Backward samples the codec put on the network (the others went as clock only).
     pub packets_sent: u64,
+    /// `control.kind = "mmt"`: environment models sent (each a changed estimate; every
+    /// sample carries the last one).
+    pub models_sent: u64,
     /// A URDF arm (`[slave.arm]`): IK calls a joint limit clamped.
     pub ik_joint_limited: u64,
     /// A URDF arm: IK calls the joints' velocity limits shortened.
@@ -81,6 +84,8 @@ pub struct Step {
     pub contact_object: u32,
     /// The flags of h(n): the slave's notes on its step, and h(n)'s payload's.
     pub flags: Flags,
+    /// `control.kind = "mmt"`: the model h(n) carried (the last sent; `seq` 0: none).
+    pub model: Model,
 }
 
 /// One step of holding position while the input is silent.

@@ -212,6 +212,7 @@ impl MasterPart {
         if let Some(e) = effect {
             (r.tau, r.felt, r.flags_m, r.observer_m) = (e.tau, e.felt, e.flags, e.observer);
             (r.dissipated_m, r.port_net_m) = (e.dissipated_j, e.port_net_j);
+            r.model_injected_m = e.model_injected_j;
         }
     }
 }
@@ -236,6 +237,9 @@ fn fill_step(r: &mut TraceRow, s: &Step) {
     (r.theta_ref, r.reference) = (s.theta_ref, s.reference);
     (r.observer_s, r.port_net_s, r.dissipated_s) = (s.observer, s.port_net_j, s.dissipated_j);
     (r.theta_sd, r.u, r.tool, r.surface, r.h) = (s.theta, s.torque, s.tool, s.surface, s.force);
+    let m = &s.model;
+    (r.model_seq, r.model_normal, r.model_offset, r.model_k) =
+        (m.seq, m.normal, m.offset, m.stiffness);
     r.contact_object = if s.contact_object == u32::MAX {
         -1
     } else {

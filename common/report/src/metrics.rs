@@ -34,6 +34,10 @@ pub struct Contact {
     /// when it keeps oscillating (the tool bouncing on and off a wall swings between
     /// zero and its peak force).
     pub force_swing_n: f64,
+    /// The largest change of the felt force from one master sample to the next, N: a
+    /// kick the operator's hand takes (a wall that moved, a model changed, a delayed
+    /// force arriving).
+    pub felt_step_max_n: f64,
 }
 
 /// Steps over which [`Contact::force_swing_n`] is taken: one second at 1 kHz.
@@ -81,6 +85,9 @@ pub struct Bilateral {
     pub passivity: Passivity,
     /// The stiffness felt against the environment's.
     pub felt: crate::transparency::Felt,
+    /// MMT: the energy the master's model changes had added by the last row, J.
+    pub model_injected_j: f64,
+    last_felt: [f64; 3],
     handles: Vec<Option<(u64, [f64; 3])>>,
     forces: Vec<Option<(u64, [f64; 3])>>,
     position_sq: f64,
@@ -100,6 +107,8 @@ impl Default for Bilateral {
             contact: Contact::default(),
             passivity: Passivity::default(),
             felt: crate::transparency::Felt::default(),
+            model_injected_j: 0.0,
+            last_felt: [0.0; 3],
             handles: vec![None; LATE_WINDOW as usize],
             forces: vec![None; LATE_WINDOW as usize],
             position_sq: 0.0,
@@ -126,6 +135,10 @@ impl Bilateral {
     pub fn add(&mut self, row: &TraceRow) {
         self.handles[slot(row.n)] = Some((row.n, row.handle));
         self.felt.add(row);
+        self.model_injected_j = self.model_injected_j.max(row.model_injected_m);
+        let step = distance(row.felt, self.last_felt);
+        self.contact.felt_step_max_n = self.contact.felt_step_max_n.max(step);
+        self.last_felt = row.felt;
         self.passivity.dissipated_j += row.dissipated_m + row.dissipated_s;
         self.observe(row.observer_m);
         if row.stepped {

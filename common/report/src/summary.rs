@@ -188,7 +188,7 @@ pub struct Summary {
     pub tracking_rms_m: Option<f64>,
     /// The operator's hand: `position` (ideal) or `impedance`.
     pub hand: tactile_scenario::HandMode,
-    /// The channel's control: `none`, `tdpa` or `wave`.
+    /// The channel's control: `none`, `tdpa`, `wave` or `mmt`.
     pub control: &'static str,
     /// The slave against the master's delay-shifted handle, the felt force against the
     /// environment's.
@@ -207,6 +207,10 @@ pub struct Summary {
     pub passivity: Passivity,
     /// Samples put on the network per direction.
     pub packets: Packets,
+    /// `control.kind = "mmt"`: the models sent and taken, and the energy their changes
+    /// added at the handle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mmt: Option<ModelCounts>,
     /// Everything the master reported.
     pub master: MasterPart,
     /// Per stream: c (master to emulator), v (emulator to slave), h, q.
@@ -265,4 +269,17 @@ pub fn of_these_records(dir: &Path, summary: &serde_json::Value) -> bool {
     };
     let ours = digest(&master);
     !ours.is_empty() && summary["nodes"]["master"]["digest"].as_str() == Some(ours.as_str())
+}
+
+/// `mmt` in summary.json: model-mediated teleoperation's traffic and energy.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct ModelCounts {
+    /// Models the slave sent (each a changed estimate).
+    pub models_sent: u64,
+    /// New models the master took and rendered.
+    pub models_taken: u64,
+    /// New models the master refused (not a valid plane).
+    pub models_refused: u64,
+    /// Energy the rendered model's changes added at the handle, J.
+    pub injected_j: f64,
 }

@@ -11,7 +11,9 @@ use tactile_scenario::overrides::{split_values, Set};
 /// node died or froze, a wait ran out) and 0 otherwise: a failed run's other values
 /// are what it ran before it failed, so a table never passes one off as whole (in
 /// `sweep-summary.csv`, `failed_mean` is the share of the seeds' runs that failed).
-pub const METRICS: [(&str, &str); 23] = [
+/// The transparency metrics and MMT's come after it: they were added later, and
+/// coming last they leave the earlier columns of a table as they were.
+pub const METRICS: [(&str, &str); 31] = [
     ("samples_sent", "/samples_sent"),
     ("samples_lost", "/samples_lost"),
     ("deadline_misses", "/deadline_misses"),
@@ -35,6 +37,23 @@ pub const METRICS: [(&str, &str); 23] = [
     ("packets_forward", "/packets/forward"),
     ("packets_backward", "/packets/backward"),
     ("failed", "/failed"),
+    (
+        "felt_stiffness_n_per_m",
+        "/transparency/felt_stiffness_n_per_m",
+    ),
+    (
+        "environment_stiffness_n_per_m",
+        "/transparency/environment_stiffness_n_per_m",
+    ),
+    ("stiffness_ratio", "/transparency/stiffness_ratio"),
+    (
+        "stiffness_ratio_converged",
+        "/transparency/stiffness_ratio_converged",
+    ),
+    ("model_convergence_ms", "/transparency/model_convergence_ms"),
+    ("models_sent", "/mmt/models_sent"),
+    ("model_injected_j", "/mmt/injected_j"),
+    ("felt_step_max_n", "/contact/felt_step_max_n"),
 ];
 
 /// The metric that says whether a run failed, not how it ran: never plotted.

@@ -160,6 +160,20 @@ fn motion(t: &mut String, s: &Summary) {
         tr.felt_samples,
         tr.environment_samples
     );
+    if let Some(m) = &s.mmt {
+        let _ = writeln!(
+            t,
+            "model (mmt): {} models sent, {} taken, {} refused; converged {} after first contact; felt stiffness since {} (ratio {}) from {} master samples; model changes added {:.3} mJ at the handle",
+            m.models_sent,
+            m.models_taken,
+            m.models_refused,
+            tr.model_convergence_ms.map_or("never".to_string(), |ms| format!("{ms:.0} ms")),
+            stiffness(tr.felt_stiffness_converged_n_per_m),
+            tr.stiffness_ratio_converged.map_or("n/a".to_string(), |r| format!("{r:.2}")),
+            tr.felt_converged_samples,
+            m.injected_j * 1e3,
+        );
+    }
     let _ = writeln!(
         t,
         "passivity: observer min {}, dissipated {:.3} mJ, drift max {}; packets forward {}, backward {}",

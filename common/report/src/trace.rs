@@ -284,6 +284,16 @@ trace_row! {
     port_net_m: f64,
     /// The slave port's net energy into the channel so far, J.
     port_net_s: f64,
+    /// `control.kind = "mmt"`: the number of the model h(n) carried (0: none yet).
+    model_seq: u64,
+    /// That model's outward normal.
+    model_normal: [f64; 3],
+    /// That model's surface along its normal, m.
+    model_offset: f64,
+    /// That model's stiffness, N/m.
+    model_k: f64,
+    /// Energy the master's rendered model changes have added at the handle so far, J.
+    model_injected_m: f64,
     /// Round trip, ns (0 if no answer).
     round_trip_ns: u64,
     /// Round trip minus injected delay, ns.

@@ -17,6 +17,12 @@
 //! The surface and its normal are the slave's latest contact (the nearest surface point
 //! and the force's direction): exact for a plane, the tangent plane for a curved
 //! object. Sums only, so memory does not grow with the run.
+//!
+//! With `control.kind = "mmt"` the model's convergence is measured too: from the
+//! slave's first step in contact to its first step whose model has the stiffness there
+//! within [`CONVERGED_STIFFNESS`] and the surface within [`CONVERGED_SURFACE_M`]. The
+//! felt stiffness is then identified again over the master's samples whose force came
+//! from then on ("once the model converged").
 
 use crate::trace::TraceRow;
 use serde::Serialize;
@@ -37,7 +43,22 @@ pub struct Transparency {
     pub felt_samples: u64,
     /// Slave steps in contact.
     pub environment_samples: u64,
+    /// MMT: from the slave's first contact to its first converged model, ms (null
+    /// without a model, or one that never converged).
+    pub model_convergence_ms: Option<f64>,
+    /// MMT: the felt stiffness over the samples after the model converged, N/m.
+    pub felt_stiffness_converged_n_per_m: Option<f64>,
+    /// MMT: that over the environment's.
+    pub stiffness_ratio_converged: Option<f64>,
+    /// MMT: master samples behind the surface after the model converged.
+    pub felt_converged_samples: u64,
 }
+
+/// A model has converged when its stiffness is within this fraction of the
+/// environment's at the contact ...
+pub const CONVERGED_STIFFNESS: f64 = 0.1;
+/// ... and its surface within this of the contact's surface point, m.
+pub const CONVERGED_SURFACE_M: f64 = 1.0e-3;
 
 /// Fewest samples a stiffness is identified from.
 pub const MIN_SAMPLES: u64 = 100;
@@ -74,6 +95,10 @@ pub struct Felt {
     environment: Fit,
     /// The latest contact's surface point and outward normal.
     surface: Option<([f64; 3], [f64; 3])>,
+    /// The slave's first step in contact, and its first with a converged model.
+    first_contact: Option<u64>,
+    converged: Option<u64>,
+    felt_converged: Fit,
 }
 
 impl Felt {
@@ -82,7 +107,12 @@ impl Felt {
         let force = norm(row.h);
         if row.stepped && row.contact_object >= 0 && force > 1e-9 {
             self.surface = Some((row.surface, row.h.map(|v| v / force)));
-            self.environment.add(distance(row.surface, row.tool), force);
+            let depth = distance(row.surface, row.tool);
+            self.environment.add(depth, force);
+            self.first_contact.get_or_insert(row.n);
+            if self.converged.is_none() && converged(row, depth, force) {
+                self.converged = Some(row.n);
+            }
         }
         let felt_ok = row.received
             && !row.flags_m.intersects(Flags::REJECTED)
@@ -91,25 +121,52 @@ impl Felt {
             let depth = dot([0, 1, 2].map(|i| p[i] - row.handle[i]), n);
             if depth > 0.0 {
                 self.felt.add(depth, dot(row.felt, n));
+                // The force came from a slave step after the model converged.
+                let from = row.q_from.iter().copied().min().unwrap_or(0);
+                if self.converged.is_some_and(|c| from >= c) {
+                    self.felt_converged.add(depth, dot(row.felt, n));
+                }
             }
         }
     }
 
-    /// The figures.
-    pub fn finish(&self) -> Transparency {
+    /// The figures, for a run sampled every `t_s` seconds.
+    pub fn finish(&self, t_s: f64) -> Transparency {
         let felt = self.felt.slope();
         let environment = self.environment.slope();
+        let converged = self.felt_converged.slope();
+        let ratio = |f: Option<f64>| match (f, environment) {
+            (Some(f), Some(e)) if e > 0.0 => Some(f / e),
+            _ => None,
+        };
         Transparency {
             felt_stiffness_n_per_m: felt,
             environment_stiffness_n_per_m: environment,
-            stiffness_ratio: match (felt, environment) {
-                (Some(f), Some(e)) if e > 0.0 => Some(f / e),
-                _ => None,
-            },
+            stiffness_ratio: ratio(felt),
             felt_samples: self.felt.n,
             environment_samples: self.environment.n,
+            model_convergence_ms: self
+                .first_contact
+                .zip(self.converged)
+                .map(|(a, b)| b.saturating_sub(a) as f64 * t_s * 1e3),
+            felt_stiffness_converged_n_per_m: converged,
+            stiffness_ratio_converged: ratio(converged),
+            felt_converged_samples: self.felt_converged.n,
         }
     }
+}
+
+/// Whether the model a contact step carried matches the wall there: its stiffness
+/// against the force over the depth (the wall's spring at this point), its surface
+/// against the surface point, along the model's normal. A graze (depth under
+/// [`MIN_DEPTH_M`]) says nothing.
+fn converged(row: &TraceRow, depth: f64, force: f64) -> bool {
+    if row.model_seq == 0 || depth < MIN_DEPTH_M {
+        return false;
+    }
+    let k = force / depth;
+    (row.model_k - k).abs() <= CONVERGED_STIFFNESS * k
+        && (row.model_offset - dot(row.model_normal, row.surface)).abs() <= CONVERGED_SURFACE_M
 }
 
 #[cfg(test)]
@@ -141,7 +198,55 @@ mod tests {
             let z = -0.065 - 0.004 * (n as f64 * 0.01).sin();
             f.add(&row(n, z, z, k, felt(-0.06 - z)));
         }
-        f.finish()
+        f.finish(1e-3)
+    }
+
+    /// MMT: contact from sample 500, no model for its first 50 steps, then one at 450
+    /// N/m (25 % soft), then the wall's own from step 80 of contact; the force comes
+    /// back 10 samples late, and the master feels 200 N/m until the wall's model is
+    /// back, 600 N/m after.
+    #[test]
+    fn the_model_converges_when_it_matches_the_wall_and_the_felt_is_fitted_after() {
+        let mut f = Felt::default();
+        for n in 0..3000u64 {
+            let z = match n {
+                0..500 => -0.05,
+                _ => -0.065 - 0.003 * (n as f64 * 0.01).sin(),
+            };
+            let mut r = row(n, z, z, 600.0, 0.0);
+            let k = match n {
+                580.. => 600.0,
+                550.. => 450.0,
+                _ => 0.0,
+            };
+            if k > 0.0 {
+                (r.model_seq, r.model_normal, r.model_offset, r.model_k) =
+                    (1, [0.0, 0.0, 1.0], -0.06, k);
+            }
+            r.q_from = [n.saturating_sub(10); 3];
+            let felt_k = if n >= 590 { 600.0 } else { 200.0 };
+            r.felt = [0.0, 0.0, felt_k * (-0.06 - z).max(0.0)];
+            f.add(&r);
+        }
+        let t = f.finish(1e-3);
+        assert!(
+            (t.model_convergence_ms.expect("converged") - 80.0).abs() < 1e-9,
+            "{t:?}"
+        );
+        let k = t.felt_stiffness_converged_n_per_m.expect("felt");
+        assert!((k - 600.0).abs() < 1e-6, "{t:?}");
+        assert!((t.stiffness_ratio_converged.expect("ratio") - 1.0).abs() < 1e-9);
+        assert!(t.felt_stiffness_n_per_m.expect("felt") < 600.0);
+        assert_eq!(t.felt_converged_samples, 3000 - 590);
+    }
+
+    /// No model, or one that never matches: no convergence, no fit after it.
+    #[test]
+    fn without_a_matching_model_nothing_converges() {
+        let t = press(600.0, |d| 600.0 * d);
+        assert_eq!(t.model_convergence_ms, None);
+        assert_eq!(t.felt_stiffness_converged_n_per_m, None);
+        assert_eq!(t.felt_converged_samples, 0);
     }
 
     #[test]
@@ -175,7 +280,7 @@ mod tests {
         for n in 0..5000 {
             f.add(&row(n, -0.065, -0.07, 600.0, 3.0));
         }
-        let t = f.finish();
+        let t = f.finish(1e-3);
         assert_eq!((t.felt_samples, t.environment_samples), (5000, 5000));
         assert!(
             (t.felt_stiffness_n_per_m.expect("felt") - 300.0).abs() < 1e-6,
@@ -190,11 +295,11 @@ mod tests {
         for n in 0..5000 {
             f.add(&row(n, -0.05, -0.05, 600.0, 0.0));
         }
-        assert_eq!(f.finish(), Transparency::default());
+        assert_eq!(f.finish(1e-3), Transparency::default());
         for n in 0..5000 {
             f.add(&row(n, -0.0601, -0.0601, 600.0, 0.06));
         }
-        let t = f.finish();
+        let t = f.finish(1e-3);
         assert_eq!(t.felt_samples, 5000);
         assert_eq!(t.felt_stiffness_n_per_m, None, "0.1 mm deep: {t:?}");
     }
@@ -208,6 +313,6 @@ mod tests {
         r.flags_m = Flags::NONE;
         r.flags_b = Flags::CORRUPTED;
         f.add(&r);
-        assert_eq!(f.finish().felt_samples, 0);
+        assert_eq!(f.finish(1e-3).felt_samples, 0);
     }
 }

@@ -8,7 +8,7 @@ use crate::plots::{self, Series};
 use crate::run_mcap;
 use crate::streams::Streams;
 pub use crate::streams::{Outputs, TraceFormat, PARQUET_FILE};
-use crate::summary::{ChannelCount, Clocks, MasterPart, NodeSummary, Summary};
+use crate::summary::{ChannelCount, Clocks, MasterPart, ModelCounts, NodeSummary, Summary};
 pub use crate::summary::{JOINTS_FILE, REPORT_FILES};
 use crate::Error;
 use serde::de::DeserializeOwned;
@@ -329,9 +329,15 @@ fn summarise(
         control: scenario.control.kind.name(),
         tracking: a.bilateral.tracking,
         contact: a.bilateral.contact,
-        transparency: a.bilateral.felt.finish(),
+        transparency: a.bilateral.felt.finish(scenario.t_s()),
         task_space: None,
         passivity: a.bilateral.passivity,
+        mmt: (scenario.control.kind == tactile_scenario::ControlKind::Mmt).then(|| ModelCounts {
+            models_sent: slave.as_ref().map_or(0, |s| s.counters.models_sent),
+            models_taken: master_totals.counters.models_received,
+            models_refused: master_totals.counters.models_refused,
+            injected_j: a.bilateral.model_injected_j,
+        }),
         packets: Packets {
             forward: master_totals.counters.packets_sent,
             backward: slave.as_ref().map_or(0, |s| s.counters.packets_sent),

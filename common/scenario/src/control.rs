@@ -17,6 +17,9 @@ pub enum ControlKind {
     Tdpa,
     /// Wave variables with an impedance-matched slave.
     Wave,
+    /// Model-mediated teleoperation: the slave estimates the wall it touches and sends
+    /// the model; the master renders it locally.
+    Mmt,
 }
 
 impl ControlKind {
@@ -26,6 +29,7 @@ impl ControlKind {
             ControlKind::None => "none",
             ControlKind::Tdpa => "tdpa",
             ControlKind::Wave => "wave",
+            ControlKind::Mmt => "mmt",
         }
     }
 }
@@ -34,7 +38,7 @@ impl ControlKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ControlConfig {
-    /// `none`, `tdpa` or `wave`.
+    /// `none`, `tdpa`, `wave` or `mmt`.
     pub kind: ControlKind,
     /// Wave impedance b, N s/m: larger feels stiffer contact and more damping in free
     /// motion.
@@ -48,6 +52,97 @@ pub struct ControlConfig {
     /// TDPA: the fastest the slave's reference is pulled back towards the master's
     /// position when energy allows (position drift compensation), m/s; 0 disables it.
     pub drift_rate: f64,
+    /// `[control.mmt]`: the model's estimator and renderer.
+    pub mmt: MmtConfig,
+}
+
+/// `[control.mmt]`: model-mediated teleoperation's settings. The defaults estimate the
+/// shipped walls (300 to 600 N/m) to within 2 % in well under a second of contact.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MmtConfig {
+    /// The estimator's forgetting factor per sample, in (0, 1]: 1 remembers every
+    /// contact sample; 0.995 weighs the last 200 (0.2 s at 1 kHz) [0.995].
+    pub forgetting: f64,
+    /// A contact force above this is contact, below it free motion, N [0.05].
+    pub contact_force: f64,
+    /// The stiffness assumed at first contact, before the data says otherwise, N/m [300].
+    pub prior_stiffness: f64,
+    /// Samples in contact before the first model is sent [20].
+    pub min_contacts: u32,
+    /// A model is sent again when its stiffness changed by more than this fraction
+    /// [0.02] ...
+    pub stiffness_change: f64,
+    /// ... or its surface moved by more than this, m [0.0002] ...
+    pub offset_change: f64,
+    /// ... or its normal turned by more than this, rad [0.02].
+    pub angle_change: f64,
+    /// How fast the felt force may change while the master's rendered surface returns
+    /// to the model's with the handle inside the wall, N/s [50: 50 mN a sample at 1 kHz;
+    /// the Omni's 3.3 N in 66 ms].
+    pub force_rate: f64,
+    /// How a changed model is taken while the handle is inside: `blend` (towards the
+    /// model at `force_rate` either way, the energy added booked) or `passive` (only changes
+    /// that add no energy; the rest wait until the handle leaves the wall) [blend].
+    pub update: MmtUpdate,
+}
+
+/// `control.mmt.update`: how the master takes a changed model while the handle is in
+/// the wall (`tactile_control::mmt::ModelRenderer` says what each does).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum MmtUpdate {
+    /// Blended in at a bounded rate; the energy it adds is booked.
+    #[default]
+    Blend,
+    /// The energy check: nothing that adds energy at the handle.
+    Passive,
+}
+
+impl Default for MmtConfig {
+    fn default() -> Self {
+        MmtConfig {
+            forgetting: 0.995,
+            contact_force: 0.05,
+            prior_stiffness: 300.0,
+            min_contacts: 20,
+            stiffness_change: 0.02,
+            offset_change: 2.0e-4,
+            angle_change: 0.02,
+            force_rate: 50.0,
+            update: MmtUpdate::Blend,
+        }
+    }
+}
+
+impl MmtConfig {
+    /// Checks the ranges; errors name `control.mmt.*`.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        if !(self.forgetting > 0.0 && self.forgetting <= 1.0) {
+            return Err(invalid(
+                "control.mmt.forgetting",
+                format!("{} is outside (0, 1]", Num(self.forgetting)),
+            ));
+        }
+        if !(self.prior_stiffness > 0.0 && self.prior_stiffness <= crate::MAX_STIFFNESS) {
+            return Err(invalid(
+                "control.mmt.prior_stiffness",
+                format!(
+                    "{} N/m is outside (0, {}]",
+                    Num(self.prior_stiffness),
+                    crate::MAX_STIFFNESS
+                ),
+            ));
+        }
+        if self.min_contacts == 0 {
+            return Err(invalid("control.mmt.min_contacts", "must be at least 1"));
+        }
+        positive(self.contact_force, "control.mmt.contact_force", false)?;
+        positive(self.stiffness_change, "control.mmt.stiffness_change", false)?;
+        positive(self.offset_change, "control.mmt.offset_change", false)?;
+        positive(self.angle_change, "control.mmt.angle_change", false)?;
+        positive(self.force_rate, "control.mmt.force_rate", false)
+    }
 }
 
 impl Default for ControlConfig {
@@ -61,6 +156,7 @@ impl Default for ControlConfig {
             velocity_floor: 1.0e-3,
             max_damping: 200.0,
             drift_rate: 0.05,
+            mmt: MmtConfig::default(),
         }
     }
 }
@@ -71,7 +167,8 @@ impl ControlConfig {
         positive(self.wave_impedance, "control.wave_impedance", false)?;
         positive(self.velocity_floor, "control.velocity_floor", false)?;
         positive(self.max_damping, "control.max_damping", false)?;
-        positive(self.drift_rate, "control.drift_rate", true)
+        positive(self.drift_rate, "control.drift_rate", true)?;
+        self.mmt.validate()
     }
 }
 /// `[codec.forward]`, `[codec.backward]`.

@@ -33,7 +33,8 @@ pub mod workspace;
 
 pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
 pub use control::{
-    CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, PredictorConfig, PredictorKind,
+    CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, MmtConfig, MmtUpdate,
+    PredictorConfig, PredictorKind,
 };
 pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
 pub(crate) use error::{finite3, invalid, positive, positive3};
@@ -53,7 +54,7 @@ pub use ros_robot::{RobotCommand, RosRobotConfig, TorqueAbout, PAPER_MAX_VELOCIT
 pub use ros_tls::RosTlsConfig;
 use serde::{Deserialize, Serialize};
 pub use slave::{
-    ControllerConfig, DynamicsConfig, Environment, Object, SlaveConfig, MAX_STIFFNESS,
+    Change, ControllerConfig, DynamicsConfig, Environment, Object, SlaveConfig, MAX_STIFFNESS,
     NOMINAL_MAX_STIFFNESS,
 };
 pub use tactile_math::arith::ArithKind;
@@ -149,6 +150,7 @@ impl Scenario {
                     normal: [0.0, 0.0, 1.0],
                     stiffness: [300.0; 3],
                 }],
+                changes: Vec::new(),
             },
             ..Scenario::default()
         }

@@ -80,6 +80,61 @@ impl Default for DynamicsConfig {
 pub struct Environment {
     /// Objects; the one the tool penetrates most deeply produces the contact force.
     pub objects: Vec<Object>,
+    /// `[[environment.changes]]`: objects that move or change stiffness during the run
+    /// (a wall pushed 1 cm, a material that hardens), in any order.
+    pub changes: Vec<Change>,
+}
+
+/// A change to one object at one moment of the run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Change {
+    /// When, s from the start: the change holds from the first sample n with
+    /// `n t_s >= at_s`.
+    pub at_s: f64,
+    /// Which object (its index in `objects`).
+    pub object: usize,
+    /// Moved by this, m (its point or centre).
+    pub move_by: [f64; 3],
+    /// Its stiffness per axis from then on, N/m (unchanged when left out).
+    pub stiffness: Option<[f64; 3]>,
+}
+
+impl Object {
+    /// The object after `c`: moved, and with the new stiffness if it gives one.
+    pub fn changed(&self, c: &Change) -> Object {
+        let moved = |p: &[f64; 3]| std::array::from_fn(|i| p[i] + c.move_by[i]);
+        let k = |s: &[f64; 3]| c.stiffness.unwrap_or(*s);
+        match self {
+            Object::Plane {
+                point,
+                normal,
+                stiffness,
+            } => Object::Plane {
+                point: moved(point),
+                normal: *normal,
+                stiffness: k(stiffness),
+            },
+            Object::Sphere {
+                center,
+                radius,
+                stiffness,
+            } => Object::Sphere {
+                center: moved(center),
+                radius: *radius,
+                stiffness: k(stiffness),
+            },
+            Object::Box {
+                center,
+                half_extents,
+                stiffness,
+            } => Object::Box {
+                center: moved(center),
+                half_extents: *half_extents,
+                stiffness: k(stiffness),
+            },
+        }
+    }
 }
 
 /// A rigid object with a stiffness per axis (the paper's h_x, h_y, h_z).
@@ -160,8 +215,12 @@ impl SlaveConfig {
 }
 
 impl Environment {
-    /// Checks every object; errors name `environment.objects[k].*`.
+    /// Checks every object and change; errors name `environment.objects[k].*` and
+    /// `environment.changes[k].*`.
     pub fn validate(&self) -> Result<(), ScenarioError> {
+        for (k, c) in self.changes.iter().enumerate() {
+            self.validate_change(k, c)?;
+        }
         for (k, o) in self.objects.iter().enumerate() {
             let f = format!("environment.objects[{k}]");
             positive3(&o.stiffness(), &format!("{f}.stiffness"), true)?;
@@ -204,6 +263,40 @@ impl Environment {
                     finite3(center, &format!("{f}.center"))?;
                     positive3(half_extents, &format!("{f}.half_extents"), false)?;
                 }
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_change(&self, k: usize, c: &Change) -> Result<(), ScenarioError> {
+        let f = format!("environment.changes[{k}]");
+        if !c.at_s.is_finite() || c.at_s < 0.0 {
+            return Err(invalid(
+                format!("{f}.at_s"),
+                format!("{} s must be finite and non-negative", Num(c.at_s)),
+            ));
+        }
+        if c.object >= self.objects.len() {
+            return Err(invalid(
+                format!("{f}.object"),
+                format!(
+                    "{} is not an object: there are {}",
+                    c.object,
+                    self.objects.len()
+                ),
+            ));
+        }
+        finite3(&c.move_by, &format!("{f}.move_by"))?;
+        if c.move_by.iter().any(|v| v.abs() > 1.0) {
+            return Err(invalid(format!("{f}.move_by"), "moves more than 1 m"));
+        }
+        if let Some(s) = &c.stiffness {
+            positive3(s, &format!("{f}.stiffness"), true)?;
+            if let Some(i) = s.iter().position(|h| *h > MAX_STIFFNESS) {
+                return Err(invalid(
+                    format!("{f}.stiffness[{i}]"),
+                    format!("{} N/m is above {MAX_STIFFNESS} N/m", Num(s[i])),
+                ));
             }
         }
         Ok(())

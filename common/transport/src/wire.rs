@@ -17,7 +17,7 @@ use tactile_messages::stream::{InboxStats, OutboxStats};
 /// First bytes of every frame.
 pub const MAGIC: [u8; 4] = *b"TCTL";
 /// The format version; bump it whenever a sample's layout changes.
-pub const VERSION: u16 = 4;
+pub const VERSION: u16 = 5;
 /// Header length, bytes.
 pub const HEADER: usize = 7;
 /// Largest frame a receiver accepts (a sample is about 250 bytes).

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use tactile_report::sweep::{
     combinations, runs_header, runs_row, stats, summary_header, summary_row, Axis,
 };
+use tactile_report::sweep_map::sweep_maps;
 use tactile_report::sweep_plots::{sweep_plots, Point};
 
 /// A run that ended, as the tables take it.
@@ -90,7 +91,11 @@ pub fn write_tables(out: &Path, axes: &[Axis], seeds: usize, results: &[Ran]) ->
     }
     write(&out.join("sweep.csv"), &runs)?;
     write(&out.join("sweep-summary.csv"), &summary)?;
-    sweep_plots(out, axes, &points).map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))
+    sweep_plots(out, axes, &points)
+        .map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))?;
+    sweep_maps(out, axes, &points)
+        .map(|_| ())
+        .map_err(|e| Error::Failed(format!("drawing the sweep's maps: {e}")))
 }
 
 /// The slices' specs, all of one sweep (scenario, `--set`s and seeds).
