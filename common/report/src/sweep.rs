@@ -264,8 +264,9 @@ pub fn mean_ci95(v: &[f64]) -> Option<(f64, Option<f64>)> {
 /// The unit of a swept key, for a plot's labels: `ms` for the milliseconds keys
 /// (`delay_ms`, `schedule_ms[1][0]`, `jitter.jitter_ms`, any `_ms`), `samples` for
 /// their twins that count samples (`delay`, `schedule`, `jitter.jitter`, any
-/// `_samples`); `None` for the rest. A `delay` of 10 and a `delay_ms` of 10 are ten
-/// times apart at 100 Hz, and a plot must say which it shows.
+/// `_samples`); `N/m` for a stiffness (`environment.objects[0].stiffness`), `N s/m`
+/// for a wave impedance or a damping; `None` for the rest. A `delay` of 10 and a
+/// `delay_ms` of 10 are ten times apart at 100 Hz, and a plot must say which it shows.
 pub fn unit(key: &str) -> Option<&'static str> {
     let last = key.rsplit('.').next().unwrap_or(key);
     let name = last.split('[').next().unwrap_or(last);
@@ -276,6 +277,10 @@ pub fn unit(key: &str) -> Option<&'static str> {
         Some("ms")
     } else if samples || name.ends_with("_samples") {
         Some("samples")
+    } else if name.ends_with("stiffness") {
+        Some("N/m")
+    } else if name == "wave_impedance" || name.ends_with("damping") {
+        Some("N s/m")
     } else {
         None
     }
@@ -317,7 +322,7 @@ mod tests {
 
     /// A time key's plot label says its unit; other keys none.
     #[test]
-    fn swept_time_keys_are_labelled_with_their_unit() {
+    fn swept_keys_are_labelled_with_their_unit() {
         for (key, want) in [
             ("network.forward.delay_ms", "network.forward.delay_ms (ms)"),
             ("network.forward.delay", "network.forward.delay (samples)"),
@@ -346,6 +351,11 @@ mod tests {
                 "faults.peer_timeout_samples (samples)",
             ),
             ("network.forward.jitter", "network.forward.jitter"),
+            (
+                "environment.objects[0].stiffness",
+                "environment.objects[0].stiffness (N/m)",
+            ),
+            ("control.wave_impedance", "control.wave_impedance (N s/m)"),
             ("control.kind", "control.kind"),
             ("network.forward.loss", "network.forward.loss"),
         ] {

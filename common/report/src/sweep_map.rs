@@ -1,16 +1,16 @@
 //! `map-VALUE.svg`: the stability and transparency map researchers publish, drawn when
 //! a sweep's first two swept keys are numbers (a wall's stiffness and a delay, say):
 //! one cell per pair, its colour the stiffness the operator felt over the
-//! environment's (`transparency.stiffness_ratio`), a cross on a cell that was not
-//! stable, and one map per value of a third key (`control.kind=none,tdpa,wave,mmt`).
-//!
-//! Stable is decided as docs/05 does, from the run's summary:
-//! - the contact settled: its force swung by less than [`SETTLED_SWING_N`] over the
-//!   last second (a contact that keeps oscillating leaves the wall every cycle and
-//!   swings by its whole force);
-//! - and the channel made no energy to speak of: its passivity observer stayed above
-//!   [`ACTIVE_ENERGY_J`] (fifteen times the 3.3 mJ the wall-delay contact stores at
-//!   rest).
+//! environment's (`transparency.stiffness_ratio`), and one map per value of a third
+//! key (`control.kind=none,tdpa,wave,mmt`). Two marks, decided as docs/05 does from
+//! the run's summary:
+//! - a cross where the contact did not settle (unstable): its force swung by
+//!   [`SETTLED_SWING_N`] or more over the last second (a contact that keeps
+//!   oscillating leaves the wall every cycle and swings by its whole force);
+//! - a bar along the cell's top where the channel made energy: its passivity observer
+//!   fell below [`ACTIVE_ENERGY_J`] (fifteen times the 3.3 mJ the wall-delay contact
+//!   stores at rest). A settled contact can have done so once (MMT's slave presses the
+//!   wall before the master renders it), so it is marked apart from instability.
 
 use crate::plots::tick;
 use crate::sweep::{labelled, numeric, Axis, METRICS};
@@ -20,7 +20,7 @@ use std::path::Path;
 
 /// A settled contact's largest force swing over the last second, N.
 pub const SETTLED_SWING_N: f64 = 0.5;
-/// A channel whose observer fell below this made energy: not stable, J.
+/// A channel whose observer fell below this made energy, J.
 pub const ACTIVE_ENERGY_J: f64 = -0.05;
 
 /// What one cell shows.
@@ -28,8 +28,10 @@ pub const ACTIVE_ENERGY_J: f64 = -0.05;
 pub struct Cell {
     /// Felt over environment's stiffness (None: not identified).
     pub ratio: Option<f64>,
-    /// Stable by the criteria above (None: a figure missing).
-    pub stable: Option<bool>,
+    /// The contact settled (None: the figure missing).
+    pub settled: Option<bool>,
+    /// The channel made no energy to speak of (None: the figure missing).
+    pub passive: Option<bool>,
 }
 
 fn metric(name: &str) -> Option<usize> {
@@ -40,13 +42,10 @@ fn metric(name: &str) -> Option<usize> {
 /// holds them).
 pub fn cell(means: &[(Option<f64>, Option<f64>)]) -> Cell {
     let get = |name| metric(name).and_then(|i| means.get(i)).and_then(|m| m.0);
-    let stable = match (get("force_swing_n"), get("observer_min_j")) {
-        (Some(swing), Some(w)) => Some(swing < SETTLED_SWING_N && w > ACTIVE_ENERGY_J),
-        _ => None,
-    };
     Cell {
         ratio: get("stiffness_ratio"),
-        stable,
+        settled: get("force_swing_n").map(|s| s < SETTLED_SWING_N),
+        passive: get("observer_min_j").map(|w| w > ACTIVE_ENERGY_J),
     }
 }
 
@@ -138,7 +137,8 @@ fn draw(
     let root = SVGBackend::new(path, (crate::plots::WIDTH, 640)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let (nx, ny) = (xv.len() as f64, yv.len() as f64);
-    let caption = format!("felt / environment stiffness, x: not stable {title}");
+    let caption =
+        format!("felt / environment stiffness; x: unsettled, bar: channel made > 50 mJ; {title}");
     let mut chart = ChartBuilder::on(&root)
         .caption(caption, ("sans-serif", 20))
         .margin(10)
@@ -185,13 +185,18 @@ fn draw(
             chart
                 .draw_series([Text::new(text, (x0 + 0.5, y0 + 0.5), style)])
                 .map_err(|e| err(&e))?;
-            if c.is_some_and(|c| c.stable == Some(false)) {
-                let cross = |a: (f64, f64), b: (f64, f64)| {
-                    PathElement::new(vec![a, b], BLACK.stroke_width(2))
-                };
+            let line =
+                |a: (f64, f64), b: (f64, f64)| PathElement::new(vec![a, b], BLACK.stroke_width(2));
+            if c.is_some_and(|c| c.settled == Some(false)) {
                 let (a, b) = ((x0 + 0.1, y0 + 0.1), (x0 + 0.9, y0 + 0.9));
                 chart
-                    .draw_series([cross(a, b), cross((a.0, b.1), (b.0, a.1))])
+                    .draw_series([line(a, b), line((a.0, b.1), (b.0, a.1))])
+                    .map_err(|e| err(&e))?;
+            }
+            if c.is_some_and(|c| c.passive == Some(false)) {
+                let corners = [(x0 + 0.05, y0 + 0.88), (x0 + 0.95, y0 + 0.95)];
+                chart
+                    .draw_series([Rectangle::new(corners, BLACK.filled())])
                     .map_err(|e| err(&e))?;
             }
         }
@@ -214,19 +219,21 @@ mod tests {
     }
 
     #[test]
-    fn stable_is_a_settled_contact_and_a_channel_that_made_no_energy() {
-        assert_eq!(cell(&means(0.1, -0.01, 0.9)).stable, Some(true));
-        assert_eq!(cell(&means(2.0, -0.01, 0.9)).stable, Some(false));
-        assert_eq!(cell(&means(0.1, -0.2, 0.9)).stable, Some(false));
-        assert_eq!(cell(&means(0.1, -0.01, 0.9)).ratio, Some(0.9));
-        let none = vec![(None, None); METRICS.len()];
+    fn a_cell_says_whether_the_contact_settled_and_the_channel_made_energy() {
+        let c = cell(&means(0.1, -0.01, 0.9));
         assert_eq!(
-            cell(&none),
-            Cell {
-                ratio: None,
-                stable: None
-            }
+            (c.settled, c.passive, c.ratio),
+            (Some(true), Some(true), Some(0.9))
         );
+        assert_eq!(cell(&means(2.0, -0.01, 0.9)).settled, Some(false));
+        assert_eq!(cell(&means(0.1, -0.2, 0.9)).passive, Some(false));
+        let none = vec![(None, None); METRICS.len()];
+        let empty = Cell {
+            ratio: None,
+            settled: None,
+            passive: None,
+        };
+        assert_eq!(cell(&none), empty);
     }
 
     #[test]
@@ -256,9 +263,14 @@ mod tests {
         {
             let unstable = k == 0 && j == 1;
             let swing = if unstable { 5.0 } else { 0.0 };
+            let w = if k == 1 && i == 1 && j == 1 {
+                -0.1
+            } else {
+                -0.001
+            };
             points.push((
                 vec![i, j, k],
-                means(swing, -0.001, 0.25 + 0.25 * (i + j + k) as f64),
+                means(swing, w, 0.25 + 0.25 * (i + j + k) as f64),
             ));
         }
         let files = sweep_maps(dir, &axes, &points).expect("maps");
@@ -269,10 +281,13 @@ mod tests {
             assert!(s.contains("network.forward.delay_ms (ms)"), "{s}");
             assert!(s.contains("environment.objects[0].stiffness"));
         }
-        // Two crossed cells (two strokes each) on none's map, none on mmt's.
-        assert_eq!(none.matches("<polyline").count(), 4, "{none}");
-        assert_eq!(mmt.matches("<polyline").count(), 0);
-        assert!(mmt.contains(">1.25<") && none.contains(">0.25<"));
+        // Two crossed cells on none's map (two wide strokes each), none on mmt's; one
+        // bar (a black rectangle) on mmt's, none on none's.
+        let strokes = |s: &str| s.matches(r#"stroke-width="2""#).count();
+        assert_eq!((strokes(&none), strokes(&mmt)), (4, 0), "{none}");
+        let bars = |s: &str| s.matches(r##"fill="#000000" stroke="none"/>"##).count();
+        assert_eq!((bars(&none), bars(&mmt)), (0, 1), "{mmt}");
+        assert!(mmt.contains("\n1.00\n") && none.contains("\n0.25\n"), "{mmt}");
         let words = [
             axis("control.kind=none,mmt").expect("a"),
             axis("seed=1,2").expect("b"),
