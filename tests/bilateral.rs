@@ -174,6 +174,32 @@ fn mmt_feels_the_wall_at_200_ms_where_the_passive_controls_soften_it() {
     }
 }
 
+/// docs/05's wall-delay study, re-run as the docs say: its table is the committed
+/// `deploy/results/wall-delay/sweep.csv` byte for byte (so the rows of the controls
+/// before MMT are unchanged by it, and the docs' figures are the code's).
+#[test]
+fn the_wall_delay_study_gives_the_committed_table() {
+    let sb = Sandbox::new("wallstudy");
+    let s = sb.write("wall.toml", &wall_delay());
+    let o = sb.tactile(&[
+        "sweep",
+        s.to_str().expect("utf-8"),
+        "--set",
+        "network.forward.delay=[0,0,0],[10,10,10],[50,50,50],[100,100,100],[200,200,200]",
+        "--set",
+        "control.kind=none,tdpa,wave,mmt",
+        "--set",
+        "network.backward.delay=[0,0,0]",
+        "--out",
+        "study",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = std::fs::read_to_string(sb.path("study").join("sweep.csv")).expect("sweep.csv");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/results/wall-delay/sweep.csv");
+    let committed = std::fs::read_to_string(path).expect("the committed table");
+    assert_eq!(table, committed);
+}
+
 /// `wall-change.toml`: at 200 ms, the wall jumps 1 cm into the held tool at 4 s and
 /// doubles its stiffness at 6 s. The operator's hand takes the force's largest step
 /// from one sample to the next (`contact.felt_step_max_n`): MMT's slave refits the

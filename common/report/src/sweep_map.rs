@@ -287,7 +287,10 @@ mod tests {
         assert_eq!((strokes(&none), strokes(&mmt)), (4, 0), "{none}");
         let bars = |s: &str| s.matches(r##"fill="#000000" stroke="none"/>"##).count();
         assert_eq!((bars(&none), bars(&mmt)), (0, 1), "{mmt}");
-        assert!(mmt.contains("\n1.00\n") && none.contains("\n0.25\n"), "{mmt}");
+        assert!(
+            mmt.contains("\n1.00\n") && none.contains("\n0.25\n"),
+            "{mmt}"
+        );
         let words = [
             axis("control.kind=none,mmt").expect("a"),
             axis("seed=1,2").expect("b"),

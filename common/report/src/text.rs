@@ -133,7 +133,7 @@ fn motion(t: &mut String, s: &Summary) {
     );
     let _ = writeln!(
         t,
-        "bilateral ({} hand, control {}): position rms {} against the delay-shifted handle{}, force tracking error rms {} (felt against the environment's force it came from), penetration max {:.2} mm",
+        "bilateral ({} hand, control {}): position rms {} against the delay-shifted handle{}, force tracking error rms {} (felt against the environment's force it came from), penetration max {:.2} mm, felt force's largest step {:.3} N",
         match s.hand {
             tactile_scenario::HandMode::Position => "position",
             tactile_scenario::HandMode::Impedance => "impedance",
@@ -147,7 +147,8 @@ fn motion(t: &mut String, s: &Summary) {
             _ => "",
         },
         s.tracking.force_rms_n.map_or("n/a".to_string(), |f| format!("{f:.3} N")),
-        s.contact.max_penetration_m * 1e3
+        s.contact.max_penetration_m * 1e3,
+        s.contact.felt_step_max_n
     );
     let tr = &s.transparency;
     let stiffness = |k: Option<f64>| k.map_or("n/a".to_string(), |k| format!("{k:.0} N/m"));

@@ -15,7 +15,7 @@ ROOT = Path(os.environ["TACTILE_ROOT"])
 WALL = ROOT / "deploy" / "scenarios" / "wall-delay.toml"
 PAPER = ROOT / "deploy" / "scenarios" / "paper.toml"
 DELAYS_MS = [0, 10, 50, 100, 200]
-KINDS = ["none", "tdpa", "wave"]
+KINDS = ["none", "tdpa", "wave", "mmt"]
 
 
 def test_the_wall_delay_sweep_equals_the_commands_table(tmp_path):
@@ -24,7 +24,7 @@ def test_the_wall_delay_sweep_equals_the_commands_table(tmp_path):
                             "network.backward.delay_ms": [0]}, out=tmp_path / "s",
                        progress=False)
     ref = pandas.read_csv(ROOT / "deploy" / "results" / "wall-delay" / "sweep.csv")
-    assert len(df) == len(ref) == 15
+    assert len(df) == len(ref) == 20
     metrics = list(ref.columns[ref.columns.get_loc("seed"):])
     pandas.testing.assert_frame_equal(df[metrics], ref[metrics], check_exact=True)
     assert list(df["network.forward.delay_ms"]) == [d for d in DELAYS_MS for _ in KINDS]
