@@ -174,26 +174,27 @@ fn mmt_feels_the_wall_at_200_ms_where_the_passive_controls_soften_it() {
     }
 }
 
+/// `tactile sweep` over docs/05's round trips (all on the forward channel) and `sets`,
+/// into `out`.
+fn wall_sweep(sb: &Sandbox, out: &str, sets: &[&str]) {
+    let s = sb.write("wall.toml", &wall_delay());
+    let delays = "network.forward.delay=[0,0,0],[10,10,10],[50,50,50],[100,100,100],[200,200,200]";
+    let mut args = vec!["sweep", s.to_str().expect("utf-8"), "--set", delays];
+    for set in sets.iter().chain(&["network.backward.delay=[0,0,0]"]) {
+        args.extend(["--set", set]);
+    }
+    args.extend(["--out", out]);
+    let o = sb.tactile(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 /// docs/05's wall-delay study, re-run as the docs say: its table is the committed
 /// `deploy/results/wall-delay/sweep.csv` byte for byte (so the rows of the controls
 /// before MMT are unchanged by it, and the docs' figures are the code's).
 #[test]
 fn the_wall_delay_study_gives_the_committed_table() {
     let sb = Sandbox::new("wallstudy");
-    let s = sb.write("wall.toml", &wall_delay());
-    let o = sb.tactile(&[
-        "sweep",
-        s.to_str().expect("utf-8"),
-        "--set",
-        "network.forward.delay=[0,0,0],[10,10,10],[50,50,50],[100,100,100],[200,200,200]",
-        "--set",
-        "control.kind=none,tdpa,wave,mmt",
-        "--set",
-        "network.backward.delay=[0,0,0]",
-        "--out",
-        "study",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    wall_sweep(&sb, "study", &["control.kind=none,tdpa,wave,mmt"]);
     let table = std::fs::read_to_string(sb.path("study").join("sweep.csv")).expect("sweep.csv");
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/results/wall-delay/sweep.csv");
     let committed = std::fs::read_to_string(path).expect("the committed table");
@@ -255,22 +256,14 @@ fn a_changing_wall_does_not_kick_the_operator_with_mmt() {
 #[test]
 fn tdpa_is_stable_at_every_delay_against_the_omni_stiffness() {
     let sb = Sandbox::new("tdpasweep");
-    let s = sb.write("wall.toml", &wall_delay());
-    let o = sb.tactile(&[
+    wall_sweep(
+        &sb,
         "sweep",
-        s.to_str().expect("utf-8"),
-        "--set",
-        "network.forward.delay=[0,0,0],[10,10,10],[50,50,50],[100,100,100],[200,200,200]",
-        "--set",
-        "environment.objects[0].stiffness=[600,600,600],[700,700,700]",
-        "--set",
-        "network.backward.delay=[0,0,0]",
-        "--set",
-        "control.kind=tdpa",
-        "--out",
-        "sweep",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        &[
+            "environment.objects[0].stiffness=[600,600,600],[700,700,700]",
+            "control.kind=tdpa",
+        ],
+    );
     // Each run's own summary (sweep.csv quotes the bracketed values).
     for k in 0..10 {
         let s = sb.json(&format!("sweep/run-{k:04}"), "summary.json");
