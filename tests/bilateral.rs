@@ -133,7 +133,8 @@ fn the_felt_stiffness_is_the_series_spring_without_delay_and_softer_with_it() {
 ///   TDPA and waves, which keep the channel passive by softening it, give a quarter of
 ///   that or less.
 /// - The model is sent a few dozen times, not every sample, and every model sent is
-///   taken. Blending the late-felt wall to its place adds energy at the handle, booked,
+///   taken. With `update = "passive"` and `slave = "tdpa"` the channel's energy stays
+///   above -1 mJ, and the wall is felt as TDPA feels it. Blending the late-felt wall to its place adds energy at the handle, booked,
 ///   at most what the wall stores at the hand's 15 mm (67 mJ).
 #[test]
 fn mmt_feels_the_wall_at_200_ms_where_the_passive_controls_soften_it() {
@@ -161,6 +162,18 @@ fn mmt_feels_the_wall_at_200_ms_where_the_passive_controls_soften_it() {
     assert_eq!(counts["models_refused"], 0);
     let injected = f(&counts["injected_j"]);
     assert!(injected > 0.0 && injected < 0.067, "mmt: {injected} J");
+    // The strict settings keep the channel's energy above -1 mJ, at TDPA's price.
+    let strict = [
+        delay[0],
+        delay[1],
+        "control.kind=mmt",
+        "control.mmt.update=passive",
+        "control.mmt.slave=tdpa",
+    ];
+    let s = run(&sb, &text, "strict", &strict);
+    let w = f(&s["passivity"]["observer_min_j"]);
+    assert!(w >= -1e-3, "strict mmt: {w} J");
+    assert!(f(&s["transparency"]["stiffness_ratio"]) < 0.25 * converged);
     for kind in ["tdpa", "wave"] {
         let s = run(
             &sb,
@@ -362,6 +375,7 @@ fn bad_control_settings_name_the_field() {
         ("control.mmt.force_rate=0", "control.mmt.force_rate"),
         ("control.mmt.min_contacts=0", "control.mmt.min_contacts"),
         ("control.mmt.update=maybe", "unknown variant `maybe`"),
+        ("control.mmt.slave=lead", "unknown variant `lead`"),
         ("control.mmt.gain=1", "unknown field `gain`"),
         ("master.hand.mass=-1", "master.hand.mass"),
         ("master.hand.mode=robot", "unknown variant `robot`"),

@@ -31,7 +31,7 @@
 //!   reflected in free motion), integrates the velocity into its position reference and
 //!   returns `w = F_env / sqrt(2b)`; the master feels `-(b v_m + sqrt(2b) w)`.
 
-use tactile_scenario::{ControlConfig, ControlKind};
+use tactile_scenario::{ControlConfig, ControlKind, MmtSlave};
 
 /// Energy that entered and left the channel at one port, per axis, J.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -300,12 +300,13 @@ impl SlaveSide {
         for i in 0..3 {
             let fs = -h[i];
             let (v, extra) = match self.cfg.kind {
-                // MMT's slave follows the master's position as `none`'s does.
-                ControlKind::None | ControlKind::Mmt => {
+                ControlKind::None | ControlKind::Mmt if self.follows() => {
                     let v = self.velocity_to(i, value[i]);
                     (v, 0.0)
                 }
-                ControlKind::Tdpa => self.passive_velocity(i, value[i], fs, &mut out),
+                ControlKind::None | ControlKind::Mmt | ControlKind::Tdpa => {
+                    self.passive_velocity(i, value[i], fs, &mut out)
+                }
                 ControlKind::Wave => {
                     let b = self.cfg.wave_impedance;
                     let v = ((2.0 * b).sqrt() * value[i] - fs) / (2.0 * b);
@@ -319,7 +320,7 @@ impl SlaveSide {
                 }
             };
             match self.cfg.kind {
-                ControlKind::None | ControlKind::Mmt => self.reference[i] = value[i],
+                _ if self.follows() => self.reference[i] = value[i],
                 _ => self.reference[i] += v * self.t_s,
             }
             self.ledger.book(i, fs * v * self.t_s + extra);
@@ -340,6 +341,16 @@ impl SlaveSide {
     }
 
     /// The velocity that takes the reference from the last received position to `x`.
+    /// The slave's reference is the received position itself: `none`, and MMT's
+    /// slave unless `[control.mmt] slave = "tdpa"`.
+    fn follows(&self) -> bool {
+        match self.cfg.kind {
+            ControlKind::None => true,
+            ControlKind::Mmt => self.cfg.mmt.slave == MmtSlave::Follow,
+            ControlKind::Tdpa | ControlKind::Wave => false,
+        }
+    }
+
     fn velocity_to(&self, i: usize, x: f64) -> f64 {
         self.last_received
             .map_or(0.0, |last| (x - last[i]) / self.t_s)
@@ -514,6 +525,34 @@ mod tests {
             let r = run_with(&cfg(ControlKind::Wave), &path, k, d);
             prop_assert!(r.ledger_min >= -1.0, "booked energy {} x the bound", r.ledger_min);
             prop_assert!(r.true_min >= -1.0, "summed energy {} x the bound", r.true_min);
+        }
+    }
+
+    /// MMT's slave follows the received position (`slave = "follow"`), or takes it
+    /// through TDPA's slave side (`"tdpa"`): pressed 2 cm into a 1000 N/m wall by a
+    /// master that put no energy in, it then keeps its own observer at zero and stays
+    /// at the surface.
+    #[test]
+    fn mmts_slave_follows_or_is_tdpas() {
+        for (slave, follows) in [(MmtSlave::Follow, true), (MmtSlave::Tdpa, false)] {
+            let mut c = cfg(ControlKind::Mmt);
+            c.mmt.slave = slave;
+            let mut s = SlaveSide::new(&c, 1e-3, [0.0; 3]);
+            let mut h = [0.0; 3];
+            let mut last = [0.0; 3];
+            for n in 0..200 {
+                let x = -1e-4 * n as f64;
+                let r = s.receive([x; 3], [0.0; 3], h);
+                h = r.position.map(|p| if p < 0.0 { -1000.0 * p } else { 0.0 });
+                last = r.position;
+                if follows {
+                    assert_eq!(r.position, [x; 3], "{n}");
+                } else {
+                    assert!(r.observer[0] >= -1e-12, "{n}: {r:?}");
+                }
+            }
+            let held = last[0] > -2e-4;
+            assert_eq!(held, !follows, "{slave:?}: at {last:?}");
         }
     }
 

@@ -85,6 +85,22 @@ pub struct MmtConfig {
     /// model at `force_rate` either way, the energy added booked) or `passive` (only changes
     /// that add no energy; the rest wait until the handle leaves the wall) [blend].
     pub update: MmtUpdate,
+    /// What the slave does with the master's position: `follow` it (as `none`) or pass
+    /// it through TDPA's slave side, which bounds the energy the slave puts into the
+    /// wall by what the master's port put in, and pulls the drift back with what is
+    /// left (`control.velocity_floor`, `max_damping`, `drift_rate` apply) [follow].
+    pub slave: MmtSlave,
+}
+
+/// `control.mmt.slave`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum MmtSlave {
+    /// The received position is the slave's reference.
+    #[default]
+    Follow,
+    /// TDPA's passive slave reference.
+    Tdpa,
 }
 
 /// `control.mmt.update`: how the master takes a changed model while the handle is in
@@ -111,6 +127,7 @@ impl Default for MmtConfig {
             angle_change: 0.02,
             force_rate: 50.0,
             update: MmtUpdate::Blend,
+            slave: MmtSlave::Follow,
         }
     }
 }

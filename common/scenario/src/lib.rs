@@ -33,7 +33,7 @@ pub mod workspace;
 
 pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
 pub use control::{
-    CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, MmtConfig, MmtUpdate,
+    CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, MmtConfig, MmtSlave, MmtUpdate,
     PredictorConfig, PredictorKind,
 };
 pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
