@@ -214,6 +214,26 @@ fn the_wall_delay_study_gives_the_committed_table() {
     assert_eq!(table, committed);
 }
 
+/// MMT over a backward channel that corrupts 30 % of its packets to NaN: the master
+/// refuses and counts each corrupted new model, takes it from the next whole packet
+/// (every sample carries it), and the run ends with the wall felt.
+#[test]
+fn mmt_refuses_corrupted_models_and_takes_the_next_whole_copy() {
+    let sb = Sandbox::new("mmtcorrupt");
+    let sets = [
+        "control.kind=mmt",
+        "network.backward.corrupt=0.3",
+        "samples=3000",
+    ];
+    let s = run(&sb, &wall_delay(), "corrupt", &sets);
+    let m = &s["mmt"];
+    let (sent, taken) = (m["models_sent"].as_u64(), m["models_taken"].as_u64());
+    assert!(m["models_refused"].as_u64().unwrap_or(0) > 0, "{m}");
+    assert!(sent.is_some() && taken == sent, "{m}");
+    let converged = f(&s["transparency"]["stiffness_ratio_converged"]);
+    assert!(converged > 0.8, "{}", s["transparency"]);
+}
+
 /// `wall-change.toml`: at 200 ms, the wall jumps 1 cm into the held tool at 4 s and
 /// doubles its stiffness at 6 s. The operator's hand takes the force's largest step
 /// from one sample to the next (`contact.felt_step_max_n`): MMT's slave refits the

@@ -129,17 +129,22 @@ impl ModelReceiver {
     /// The model a sample carried, with the handle at `x` and the force that arrived
     /// with it. Numbers only go up: an older model (a reordered packet) is nothing new.
     pub fn take(&mut self, m: &Model, x: [f64; 3], arrived: [f64; 3]) -> Taken {
-        if m.seq <= self.taken || m.seq == self.refused {
+        if m.seq <= self.taken {
             return Taken::Nothing;
         }
         let accepted =
             PlaneModel::of_message(m).is_some_and(|p| self.renderer.receive(p, x, arrived));
-        if accepted {
-            self.taken = m.seq;
-            Taken::New
-        } else {
-            self.refused = m.seq;
-            Taken::Refused
+        match (accepted, m.seq == self.refused) {
+            (true, _) => {
+                self.taken = m.seq;
+                Taken::New
+            }
+            // Refused and counted already: the next sample's copy may still come whole.
+            (false, true) => Taken::Nothing,
+            (false, false) => {
+                self.refused = m.seq;
+                Taken::Refused
+            }
         }
     }
 

@@ -468,7 +468,8 @@ fn the_sender_numbers_models_and_sends_only_changes() {
 }
 
 /// The master takes each new number once, ignores an older or repeated one, refuses
-/// a corrupted model once (counted by the caller) and takes the next good one.
+/// a corrupted model once (counted by the caller), and takes the same number when a
+/// later sample carries it whole (every sample carries the last model sent).
 #[test]
 fn the_receiver_takes_new_models_once_and_refuses_garbage() {
     let mut r = ModelReceiver::new(&MmtConfig::default(), 1e-3);
@@ -484,6 +485,12 @@ fn the_receiver_takes_new_models_once_and_refuses_garbage() {
     assert_eq!(r.take(&bad, x, [0.0; 3]), Taken::Refused);
     assert_eq!(r.take(&bad, x, [0.0; 3]), Taken::Nothing);
     assert_eq!(r.take(&WALL.to_message(1), x, [0.0; 3]), Taken::Nothing);
+    let soft = PlaneModel {
+        stiffness: 450.0,
+        ..WALL
+    };
+    assert_eq!(r.take(&soft.to_message(2), x, [0.0; 3]), Taken::New);
+    assert_eq!(r.renderer().model(), Some(soft));
     let stiff = PlaneModel {
         stiffness: 900.0,
         ..WALL
