@@ -497,15 +497,24 @@ impl Master {
     /// before the first model, and without MMT, the force that `arrived`. Either way the
     /// force then passes the control's books and the force limit.
     fn rendered(&mut self, q: &Backward, arrived: [f64; 3]) -> [f64; 3] {
-        let Some(r) = self.mmt.as_mut() else {
-            return arrived;
-        };
-        match r.take(&q.model, self.handle, arrived) {
-            Taken::New => self.counters.models_received += 1,
-            Taken::Refused => self.counters.models_refused += 1,
-            Taken::Nothing => {}
+        if let Some(r) = self.mmt.as_mut() {
+            match r.take(&q.model, self.handle, arrived) {
+                Taken::New => self.counters.models_received += 1,
+                Taken::Refused => self.counters.models_refused += 1,
+                Taken::Nothing => {}
+            }
         }
-        r.force(self.handle).unwrap_or(arrived)
+        self.model_force(arrived)
+    }
+
+    /// MMT's model rendered against the handle, once one has come; `otherwise` before
+    /// that and without MMT.
+    fn model_force(&mut self, otherwise: [f64; 3]) -> [f64; 3] {
+        let handle = self.handle;
+        self.mmt
+            .as_mut()
+            .and_then(|r| r.force(handle))
+            .unwrap_or(otherwise)
     }
 
     /// Takes the control's force as the felt force and its KFF-HMD torques, clamped;

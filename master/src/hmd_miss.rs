@@ -25,10 +25,7 @@ impl Master {
             self.counters.held_samples += 1;
             let guess = self.predictor.estimate(n, None).value();
             // MMT's model needs no answer: it is rendered against the handle as before.
-            let guess = match self.mmt.as_mut() {
-                Some(r) => r.force(self.handle).unwrap_or(guess),
-                None => guess,
-            };
+            let guess = self.model_force(guess);
             let out = self
                 .control
                 .receive(guess, [0.0; 3], self.limits.force_limit);
