@@ -13,7 +13,7 @@ use tactile_scenario::overrides::{split_values, Set};
 /// `sweep-summary.csv`, `failed_mean` is the share of the seeds' runs that failed).
 /// The transparency metrics and MMT's come after it: they were added later, and
 /// coming last they leave the earlier columns of a table as they were.
-pub const METRICS: [(&str, &str); 31] = [
+pub const METRICS: [(&str, &str); 33] = [
     ("samples_sent", "/samples_sent"),
     ("samples_lost", "/samples_lost"),
     ("deadline_misses", "/deadline_misses"),
@@ -54,6 +54,8 @@ pub const METRICS: [(&str, &str); 31] = [
     ("models_sent", "/mmt/models_sent"),
     ("model_injected_j", "/mmt/injected_j"),
     ("felt_step_max_n", "/contact/felt_step_max_n"),
+    ("unfelt_depth_m", "/transparency/unfelt_depth_m"),
+    ("unfelt_energy_j", "/transparency/unfelt_energy_j"),
 ];
 
 /// The metric that says whether a run failed, not how it ran: never plotted.

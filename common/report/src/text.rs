@@ -161,6 +161,14 @@ fn motion(t: &mut String, s: &Summary) {
         tr.felt_samples,
         tr.environment_samples
     );
+    if let (Some(d), Some(e)) = (tr.unfelt_depth_m, tr.unfelt_energy_j) {
+        let _ = writeln!(
+            t,
+            "first news of the contact: the handle {:.2} mm deep, {:.3} mJ of the wall unfelt (what rendering it where it is leaves the channel short)",
+            d * 1e3,
+            e * 1e3
+        );
+    }
     if let Some(m) = &s.mmt {
         let _ = writeln!(
             t,

@@ -23,6 +23,14 @@
 //! within [`CONVERGED_STIFFNESS`] and the surface within [`CONVERGED_SURFACE_M`]. The
 //! felt stiffness is then identified again over the master's samples whose force came
 //! from then on ("once the model converged").
+//!
+//! How deep the handle was when the first news of the contact reached the master (the
+//! first force from a slave step in contact) is measured for every control: no
+//! control can render a wall before it hears of it, so the wall's energy over that
+//! depth, `k d^2 / 2`, is work the operator never put in. A control that renders the
+//! wall as it is from the news on, with the slave at the handle, leaves the channel
+//! short by exactly that at rest (docs/05 derives it); only one that dissipates it at
+//! the handle, which the operator feels, can make it up.
 
 use crate::trace::TraceRow;
 use serde::Serialize;
@@ -52,6 +60,14 @@ pub struct Transparency {
     pub stiffness_ratio_converged: Option<f64>,
     /// MMT: master samples behind the surface after the model converged.
     pub felt_converged_samples: u64,
+    /// The handle's depth behind the surface at the first master sample whose force
+    /// came from a slave step in contact, m (0 when it was not behind it; null without
+    /// contact, or before the news arrived).
+    pub unfelt_depth_m: Option<f64>,
+    /// The environment's energy over that depth, `k d^2 / 2` with the identified
+    /// stiffness, J: what a control that renders the wall where it is leaves the
+    /// channel short at rest (null without both).
+    pub unfelt_energy_j: Option<f64>,
 }
 
 /// A model has converged when its stiffness is within this fraction of the
@@ -59,6 +75,11 @@ pub struct Transparency {
 pub const CONVERGED_STIFFNESS: f64 = 0.1;
 /// ... and its surface within this of the contact's surface point, m.
 pub const CONVERGED_SURFACE_M: f64 = 1.0e-3;
+
+/// The unfelt depth is measured against the surface of the first slave step pressing
+/// with this much force, N: the first step's force, a hundredth of a newton, points
+/// anywhere, and later contacts (a bouncing tool's) may be elsewhere.
+pub const FIRM_FORCE_N: f64 = 0.1;
 
 /// Fewest samples a stiffness is identified from.
 pub const MIN_SAMPLES: u64 = 100;
@@ -99,6 +120,10 @@ pub struct Felt {
     first_contact: Option<u64>,
     converged: Option<u64>,
     felt_converged: Fit,
+    /// The handle where it was when the first news of the contact arrived.
+    news_handle: Option<[f64; 3]>,
+    /// The first firm contact's surface point and normal (see [`FIRM_FORCE_N`]).
+    first_surface: Option<([f64; 3], [f64; 3])>,
 }
 
 impl Felt {
@@ -107,6 +132,9 @@ impl Felt {
         let force = norm(row.h);
         if row.stepped && row.contact_object >= 0 && force > 1e-9 {
             self.surface = Some((row.surface, row.h.map(|v| v / force)));
+            if force >= FIRM_FORCE_N {
+                self.first_surface = self.first_surface.or(self.surface);
+            }
             let depth = distance(row.surface, row.tool);
             self.environment.add(depth, force);
             self.first_contact.get_or_insert(row.n);
@@ -119,10 +147,13 @@ impl Felt {
             && !row.flags_b.intersects(Flags::CORRUPTED);
         if let (true, Some((p, n))) = (felt_ok, self.surface) {
             let depth = dot([0, 1, 2].map(|i| p[i] - row.handle[i]), n);
+            let from = row.q_from.iter().copied().min().unwrap_or(0);
+            if self.news_handle.is_none() && self.first_contact.is_some_and(|c| from >= c) {
+                self.news_handle = Some(row.handle);
+            }
             if depth > 0.0 {
                 self.felt.add(depth, dot(row.felt, n));
                 // The force came from a slave step after the model converged.
-                let from = row.q_from.iter().copied().min().unwrap_or(0);
                 if self.converged.is_some_and(|c| from >= c) {
                     self.felt_converged.add(depth, dot(row.felt, n));
                 }
@@ -135,6 +166,10 @@ impl Felt {
         let felt = self.felt.slope();
         let environment = self.environment.slope();
         let converged = self.felt_converged.slope();
+        let unfelt = self
+            .news_handle
+            .zip(self.first_surface)
+            .map(|(h, (p, n))| dot([0, 1, 2].map(|i| p[i] - h[i]), n).max(0.0));
         let ratio = |f: Option<f64>| match (f, environment) {
             (Some(f), Some(e)) if e > 0.0 => Some(f / e),
             _ => None,
@@ -152,6 +187,8 @@ impl Felt {
             felt_stiffness_converged_n_per_m: converged,
             stiffness_ratio_converged: ratio(converged),
             felt_converged_samples: self.felt_converged.n,
+            unfelt_depth_m: unfelt,
+            unfelt_energy_j: unfelt.zip(environment).map(|(d, k)| 0.5 * k * d * d),
         }
     }
 }
@@ -238,6 +275,44 @@ mod tests {
         assert!((t.stiffness_ratio_converged.expect("ratio") - 1.0).abs() < 1e-9);
         assert!(t.felt_stiffness_n_per_m.expect("felt") < 600.0);
         assert_eq!(t.felt_converged_samples, 3000 - 590);
+    }
+
+    /// The handle enters a 600 N/m wall at 50 mm/s from sample 500 (the tool with it)
+    /// and the force comes back 200 samples late: the first step in contact is 501 (at
+    /// 500 the tool is on the surface), its news arrives at 701 with the handle 201
+    /// samples, 10.05 mm, deep: 30.3 mJ of wall unfelt.
+    #[test]
+    fn the_depth_entered_before_the_first_news_is_measured() {
+        let mut f = Felt::default();
+        for n in 0..3000u64 {
+            let z = -0.06 - 0.05e-3 * (n as f64 - 500.0).clamp(-100.0, 400.0);
+            let mut r = row(n, z, z, 600.0, 0.0);
+            r.received = n >= 200;
+            r.q_from = [n.saturating_sub(200); 3];
+            if n == 501 {
+                // The first step's force, as on a real run, a hundredth of a newton
+                // pointing into the wall.
+                r.h = [0.0, 0.0, -0.01];
+            }
+            f.add(&r);
+        }
+        // A last contact pushed sideways (6 N at 10 mm, the wall's spring) does not move
+        // the surface the depth was measured on.
+        let mut r = row(3000, -0.07, -0.07, 600.0, 0.0);
+        r.h = [3.6, 0.0, 4.8];
+        f.add(&r);
+        let t = f.finish(1e-3);
+        let d = t.unfelt_depth_m.expect("news arrived");
+        assert!((d - 10.05e-3).abs() < 1e-12, "{t:?}");
+        let e = t.unfelt_energy_j.expect("energy");
+        assert!(
+            (e - 0.5 * 600.0 * 10.05e-3 * 10.05e-3).abs() < 1e-9,
+            "{t:?}"
+        );
+        // Without contact there is no news, and no depth.
+        let mut f = Felt::default();
+        f.add(&row(0, -0.05, -0.07, 600.0, 0.0));
+        assert_eq!(f.finish(1e-3).unfelt_depth_m, None);
     }
 
     /// No model, or one that never matches: no convergence, no fit after it.
