@@ -281,14 +281,7 @@ fn a_late_clutch_arrives_with_its_pose() {
 #[test]
 fn the_reach_scenario_clutches_twice_to_go_three_times_as_far() {
     let sb = Sandbox::new("reach");
-    let scenario = scenarios().join("panda-reach.toml");
-    let out = sb.path("a");
-    let (file, dir) = (
-        scenario.to_str().expect("utf-8"),
-        out.to_str().expect("utf-8"),
-    );
-    let o = sb.tactile(&["run", file, "--in-process", "--out", dir]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = reach(&sb, &[]);
     let trace = sb.trace("a");
     reach_report(
         &String::from_utf8_lossy(&o.stdout),
@@ -342,6 +335,45 @@ fn the_reach_scenario_clutches_twice_to_go_three_times_as_far() {
     );
 }
 
+/// MMT through the reach's two re-clutches: the slave estimates the wall where the
+/// robot's tool meets it and sends it where the master's handle does (less the
+/// clutch's offsets, 12 cm here), so the operator feels it at the end of the third
+/// stroke, at the wall's stiffness, as `none` feels it. Sent as the tool meets it, the
+/// model would stand 12 cm beyond the handle's reach and nothing would be felt.
+#[test]
+fn mmt_renders_the_reach_scenarios_wall_where_the_handle_meets_it() {
+    let sb = Sandbox::new("reachmmt");
+    reach(&sb, &["--set", "control.kind=mmt"]);
+    let s = sb.json("a", "summary.json");
+    let t = &s["transparency"];
+    for key in ["stiffness_ratio", "stiffness_ratio_converged"] {
+        let r = util::num(&t[key]);
+        assert!((0.9..=1.1).contains(&r), "{key}: {t}");
+    }
+    let m = &s["mmt"];
+    assert!(m["models_taken"].as_u64().is_some_and(|n| n >= 1), "{m}");
+    let felt = column(&sb.trace("a"), "felt_3");
+    let end = felt.len() - 1;
+    assert!(felt[end] > 2.0, "the wall at the end: {}", felt[end]);
+}
+
+/// `panda-reach.toml` run in-process into `a` with `extra` arguments; it succeeded.
+fn reach(sb: &Sandbox, extra: &[&str]) -> std::process::Output {
+    let scenario = scenarios().join("panda-reach.toml");
+    let out = sb.path("a");
+    let mut args = vec![
+        "run",
+        scenario.to_str().expect("utf-8"),
+        "--in-process",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ];
+    args.extend(extra);
+    let o = sb.tactile(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
 /// The reach's report in the task space: the robot follows its mapped target within
 /// a millimetre (docs/14: 0.705 mm rms, the wall's 1.4 mm at most; 0.07 mm held while
 /// released), the two releases said, and the robot's force before `force_scale`
@@ -376,6 +408,9 @@ fn reach_report(text: &str, s: &serde_json::Value, trace: &str) {
         text.contains("clutch: released 2400 samples (2.400 s), 2 engages"),
         "{text}"
     );
+    // The wall felt, measured from the handle moved by the clutch's offsets.
+    let ratio = util::num(&s["transparency"]["stiffness_ratio"]);
+    assert!((0.9..1.0).contains(&ratio), "{}", s["transparency"]);
     assert!(
         text.contains("handle (the master's frame, the clutch's offsets and releases included)"),
         "{text}"

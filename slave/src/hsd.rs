@@ -298,9 +298,10 @@ impl Slave {
         // A 6-DoF sample is answered with a wrench.
         out.torque = self.arm.felt(torque);
         out.signal.flags |= v.signal.flags & Flags::POSE;
-        // MMT: the tool and the force as the master sees them (its frame and axes).
+        // MMT: the tool and the force as the master sees them (its frame and axes), the
+        // model as its handle meets it (less the clutch's offset).
         if let Some(m) = self.mmt.as_mut() {
-            if m.update(tool, force) {
+            if m.update(tool, force, self.arm.clutch_shift()) {
                 self.counters.models_sent += 1;
                 // A new model goes out now, whatever the force's deadband says.
                 if out.signal.flags.intersects(Flags::UNSENT) {

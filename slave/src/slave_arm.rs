@@ -70,6 +70,13 @@ pub trait SlaveArm: std::fmt::Debug + Send {
     /// arithmetic) and as it is (f64), which the environment sees.
     fn tool(&self) -> ([f64; 3], [f64; 3]);
 
+    /// Where the operator's clutch puts the tool relative to the master's handle, m in
+    /// the master's frame (zero for an arm without a clutch): MMT's model is rendered
+    /// against the handle, so it is sent shifted back by this.
+    fn clutch_shift(&self) -> [f64; 3] {
+        [0.0; 3]
+    }
+
     /// FBF: the force of a contact at `surface` of `stiffness` (N/m per axis) on the
     /// tool at `tool`,
     /// as the operator is to feel it.

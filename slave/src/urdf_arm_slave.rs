@@ -80,6 +80,10 @@ impl SlaveArm for UrdfArm {
         UrdfArm::end_hold(self);
     }
 
+    fn clutch_shift(&self) -> [f64; 3] {
+        UrdfArm::clutch_shift(self)
+    }
+
     /// A URDF arm's kernels are f64 (tactile-chain): its FK is the truth.
     fn tool(&self) -> ([f64; 3], [f64; 3]) {
         let tool = UrdfArm::tool(self);

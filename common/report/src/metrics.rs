@@ -131,6 +131,11 @@ fn lookup(ring: &[Option<(u64, [f64; 3])>], n: u64) -> Option<[f64; 3]> {
 }
 
 impl Bilateral {
+    /// A URDF arm's clutch as of the next rows (see [`crate::transparency::Felt::clutch`]).
+    pub fn clutch(&mut self, shift: [f64; 3], released: bool) {
+        self.felt.clutch(shift, released);
+    }
+
     /// Adds one row (rows come in sample order).
     pub fn add(&mut self, row: &TraceRow) {
         self.handles[slot(row.n)] = Some((row.n, row.handle));

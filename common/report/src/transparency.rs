@@ -124,9 +124,20 @@ pub struct Felt {
     news_handle: Option<[f64; 3]>,
     /// The first firm contact's surface point and normal (see [`FIRM_FORCE_N`]).
     first_surface: Option<([f64; 3], [f64; 3])>,
+    /// A URDF arm's clutch: where its offset puts the tool relative to the handle (m,
+    /// the master's frame), and whether it is released.
+    clutch: ([f64; 3], bool),
 }
 
 impl Felt {
+    /// The arm's clutch as of the next rows: `shift` is where its offset puts the
+    /// tool relative to the handle, m in the master's frame (the handle at `x` meets
+    /// the surfaces at `x + shift`); while `released` the operator feels the clutch's
+    /// spring, not the wall, and the felt fit leaves the samples out.
+    pub fn clutch(&mut self, shift: [f64; 3], released: bool) {
+        self.clutch = (shift, released);
+    }
+
     /// Adds one row (rows come in sample order).
     pub fn add(&mut self, row: &TraceRow) {
         let force = norm(row.h);
@@ -138,18 +149,21 @@ impl Felt {
             let depth = distance(row.surface, row.tool);
             self.environment.add(depth, force);
             self.first_contact.get_or_insert(row.n);
-            if self.converged.is_none() && converged(row, depth, force) {
+            if self.converged.is_none() && converged(row, depth, force, self.clutch.0) {
                 self.converged = Some(row.n);
             }
         }
+        let (shift, released) = self.clutch;
         let felt_ok = row.received
+            && !released
             && !row.flags_m.intersects(Flags::REJECTED)
             && !row.flags_b.intersects(Flags::CORRUPTED);
         if let (true, Some((p, n))) = (felt_ok, self.surface) {
-            let depth = dot([0, 1, 2].map(|i| p[i] - row.handle[i]), n);
+            let handle = [0, 1, 2].map(|i| row.handle[i] + shift[i]);
+            let depth = dot([0, 1, 2].map(|i| p[i] - handle[i]), n);
             let from = row.q_from.iter().copied().min().unwrap_or(0);
             if self.news_handle.is_none() && self.first_contact.is_some_and(|c| from >= c) {
-                self.news_handle = Some(row.handle);
+                self.news_handle = Some(handle);
             }
             if depth > 0.0 {
                 self.felt.add(depth, dot(row.felt, n));
@@ -195,15 +209,18 @@ impl Felt {
 
 /// Whether the model a contact step carried matches the wall there: its stiffness
 /// against the force over the depth (the wall's spring at this point), its surface
-/// against the surface point, along the model's normal. A graze (depth under
-/// [`MIN_DEPTH_M`]) says nothing.
-fn converged(row: &TraceRow, depth: f64, force: f64) -> bool {
+/// against the surface point, along the model's normal. The model is the handle's
+/// (sent less the clutch's `shift`), the surface point the tool's. A graze (depth
+/// under [`MIN_DEPTH_M`]) says nothing.
+fn converged(row: &TraceRow, depth: f64, force: f64, shift: [f64; 3]) -> bool {
     if row.model_seq == 0 || depth < MIN_DEPTH_M {
         return false;
     }
     let k = force / depth;
     (row.model_k - k).abs() <= CONVERGED_STIFFNESS * k
-        && (row.model_offset - dot(row.model_normal, row.surface)).abs() <= CONVERGED_SURFACE_M
+        && (row.model_offset + dot(row.model_normal, shift) - dot(row.model_normal, row.surface))
+            .abs()
+            <= CONVERGED_SURFACE_M
 }
 
 #[cfg(test)]
@@ -313,6 +330,35 @@ mod tests {
         let mut f = Felt::default();
         f.add(&row(0, -0.05, -0.07, 600.0, 0.0));
         assert_eq!(f.finish(1e-3).unfelt_depth_m, None);
+    }
+
+    /// A URDF arm re-clutched so that the tool is 20 cm below where the handle maps:
+    /// measured from the handle plus that shift, the wall is felt as it is and the
+    /// handle's model matches it; released samples (the clutch's spring felt instead)
+    /// are left out.
+    #[test]
+    fn a_clutchs_offset_is_added_to_the_handle_and_releases_left_out() {
+        let mut f = Felt::default();
+        f.clutch([0.0, 0.0, -0.2], false);
+        for n in 0..2000 {
+            let z = -0.065 - 0.004 * (n as f64 * 0.01).sin();
+            let mut r = row(n, z, z + 0.2, 600.0, 600.0 * (-0.06 - z));
+            if n >= 100 {
+                // The model as the slave sends it: the wall where the handle meets it.
+                (r.model_seq, r.model_normal, r.model_offset, r.model_k) =
+                    (1, [0.0, 0.0, 1.0], -0.06 + 0.2, 600.0);
+            }
+            f.add(&r);
+        }
+        f.clutch([0.0, 0.0, -0.2], true);
+        for n in 2000..3000 {
+            f.add(&row(n, -0.07, 0.1, 600.0, 9.0));
+        }
+        let t = f.finish(1e-3);
+        assert_eq!(t.felt_samples, 2000, "{t:?}");
+        let ratio = t.stiffness_ratio.expect("ratio");
+        assert!((ratio - 1.0).abs() < 1e-9, "{t:?}");
+        assert_eq!(t.model_convergence_ms, Some(100.0), "{t:?}");
     }
 
     /// No model, or one that never matches: no convergence, no fit after it.

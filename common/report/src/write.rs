@@ -479,6 +479,11 @@ fn report_into(
     };
     let mut task = crate::task_space::TaskSpaceSums::of(scenario);
     let logs = join::join_until(dirs, &stopped, |row, joints, rotation| {
+        // The clutch's offset, from the arm's base frame into the master's.
+        if let (Some(arm), Some(j)) = (&scenario.slave.arm, joints) {
+            let shift = arm.to_master([0.0; 3], [0.0; 3], j.offset);
+            analysis.bilateral.clutch(shift, j.released);
+        }
         analysis.add(row);
         if let (Some(t), Some(j)) = (task.as_mut(), joints) {
             t.add(row, j);

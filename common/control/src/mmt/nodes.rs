@@ -3,6 +3,7 @@
 //! model once, refuse garbage, render).
 
 use super::{ChangeThresholds, EstimatorConfig, ModelRenderer, PlaneEstimator, PlaneModel, Update};
+use tactile_math::vec3::dot;
 use tactile_messages::samples::Model;
 use tactile_scenario::{MmtConfig, MmtUpdate};
 
@@ -70,12 +71,17 @@ impl ModelSender {
     }
 
     /// Takes one sample (the tool at `x`, the environment's force `h`); true when the
-    /// estimate changed enough to send a new model.
-    pub fn update(&mut self, x: [f64; 3], h: [f64; 3]) -> bool {
+    /// model changed enough to send it again. `shift` is where the operator's clutch
+    /// puts the tool relative to the master's handle (zero without a clutch): the
+    /// estimate stays in the tool's space, where the wall stands still through a
+    /// re-clutch, and the model is sent in the handle's, which the master renders
+    /// against. A re-clutch moves the model sent, and so sends it.
+    pub fn update(&mut self, x: [f64; 3], h: [f64; 3], shift: [f64; 3]) -> bool {
         self.estimator.update(x, h);
-        let Some(m) = self.estimator.model() else {
+        let Some(mut m) = self.estimator.model() else {
             return false;
         };
+        m.offset -= dot(m.normal, shift);
         let new = PlaneModel::of_message(&self.sent)
             .is_none_or(|sent| m.differs(&sent, &self.thresholds));
         if new {

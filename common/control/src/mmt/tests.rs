@@ -450,7 +450,7 @@ fn the_sender_numbers_models_and_sends_only_changes() {
     assert_eq!(s.sent(), Model::default());
     let mut sent = 0;
     for x in press(&WALL, 0.01, 2000) {
-        if s.update(x, contact(&WALL, x)) {
+        if s.update(x, contact(&WALL, x), [0.0; 3]) {
             sent += 1;
             assert_eq!(s.sent().seq, sent);
         }
@@ -462,9 +462,36 @@ fn the_sender_numbers_models_and_sends_only_changes() {
     // Holding still on the wall changes nothing.
     let hold = [0.0, 0.0, -0.065];
     for _ in 0..1000 {
-        assert!(!s.update(hold, contact(&WALL, hold)));
+        assert!(!s.update(hold, contact(&WALL, hold), [0.0; 3]));
     }
     assert_eq!(s.sent().seq, sent);
+}
+
+/// A re-clutch that puts the tool 2 cm further along the wall's normal than the handle
+/// (the operator brought the handle back while the robot held): the wall, still in the
+/// tool's space, is sent at once 2 cm nearer the handle's side, and holding on changes
+/// nothing more; sideways offsets do not move a plane.
+#[test]
+fn a_reclutch_sends_the_model_where_the_handle_meets_the_wall() {
+    let mut s = ModelSender::new(&MmtConfig::default());
+    for x in press(&WALL, 0.01, 2000) {
+        s.update(x, contact(&WALL, x), [0.0; 3]);
+    }
+    let before = PlaneModel::of_message(&s.sent()).expect("a model");
+    let hold = [0.0, 0.0, -0.065];
+    let shift = [0.05, -0.03, 0.02];
+    assert!(s.update(hold, contact(&WALL, hold), shift));
+    let after = PlaneModel::of_message(&s.sent()).expect("a model");
+    assert!(
+        (after.offset - (before.offset - 0.02 * before.normal[2])).abs() < 1e-3,
+        "{before:?} {after:?}"
+    );
+    assert!((after.stiffness - before.stiffness).abs() < 0.02 * before.stiffness);
+    let seq = s.sent().seq;
+    for _ in 0..1000 {
+        assert!(!s.update(hold, contact(&WALL, hold), shift));
+    }
+    assert_eq!(s.sent().seq, seq);
 }
 
 /// The master takes each new number once, ignores an older or repeated one, refuses
