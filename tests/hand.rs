@@ -34,8 +34,7 @@ fn keyframes(keys: &[(f64, Vec<f64>)], hold: impl Fn(f64) -> f64, end: f64) -> S
         let (t0, a) = &keys[k];
         let v: Vec<f64> = match keys.get(k + 1) {
             Some((t1, b)) => {
-                let s = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-                let s = s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+                let s = util::min_jerk((t - t0) / (t1 - t0));
                 a.iter().zip(b).map(|(x, y)| x + s * (y - x)).collect()
             }
             None => a.clone(),

@@ -416,3 +416,60 @@ fn reach_report(text: &str, s: &serde_json::Value, trace: &str) {
         "{text}"
     );
 }
+
+/// A press, a re-clutch in contact and a hold, at 25 ms rows: 3 cm down from home in
+/// 1 s (2 mm into a wall at z = -0.063 m), held; the clutch released from 1.5 s while
+/// the hand goes 2 cm back up; engaged again at 2.3 s, held there to the end.
+fn press_and_reclutch() -> String {
+    let jerk = util::min_jerk;
+    let mut text = String::from("t,x,y,z,qx,qy,qz,qw,engaged\n");
+    for k in 0..=140 {
+        let t = k as f64 * 0.025;
+        let (z, engaged) = match t {
+            t if t < 1.5 => (-0.035 - 0.03 * jerk(t), 1),
+            t if t < 2.3 => (-0.065 + 0.02 * jerk((t - 1.5) / 0.6), 0),
+            _ => (-0.045, 1),
+        };
+        text += &format!("{t:.3},0,-0.107,{z:.9},0,0,0,1,{engaged}\n");
+    }
+    text
+}
+
+/// MMT through a re-clutch in contact at 200 ms of round trip: the robot holds its
+/// press while the hand goes 2 cm up; at the engage the master moves the wall's model
+/// with the hand at once, so the operator feels the press again where it was, not a
+/// wall 2 cm below for the round trip until the slave's re-clutched model arrives.
+#[test]
+fn mmt_keeps_the_wall_where_a_reclutch_in_contact_left_it() {
+    let sb = Sandbox::new("mmtreclutch");
+    let csv = sb.write("press.csv", &press_and_reclutch());
+    let text = pose_text().replace(
+        &format!("{:?}", scenarios().join("panda-pose.csv")),
+        &format!("{csv:?}"),
+    );
+    let wall = "[[environment.objects]]\nkind = \"plane\"\npoint = [0.0, 0.0, -0.063]\nnormal = [0.0, 0.0, 1.0]\nstiffness = [600.0, 600.0, 600.0]";
+    let s = sb.write("s.toml", &with_table(&text, wall));
+    let sets = [
+        "mode=\"lockstep\"",
+        "samples=3500",
+        "control.kind=mmt",
+        "network.forward.delay_ms=100",
+        "network.backward.delay_ms=100",
+    ];
+    let mut args = vec!["run", s.to_str().expect("utf-8"), "--in-process", "--out"];
+    let out = sb.path("a");
+    args.push(out.to_str().expect("utf-8"));
+    args.extend(sets.iter().flat_map(|x| ["--set", x]));
+    let o = sb.tactile(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let felt = column(&sb.trace("a"), "felt_3");
+    let pressed = felt[1450];
+    assert!(pressed > 0.2, "felt {pressed} N before the release");
+    // From the engage (2.3 s) through the round trip after it and to the end.
+    for (n, f) in felt.iter().enumerate().skip(2301) {
+        assert!(
+            (f - pressed).abs() < 0.5 * pressed,
+            "sample {n}: {f} N against {pressed} N"
+        );
+    }
+}

@@ -22,10 +22,7 @@ const S: [f64; 3] = [1.5, 1.2, 0.8];
 fn trajectory() -> String {
     let home = [0.0, -0.107, -0.035];
     let stroke = [0.02, 0.01, -0.03];
-    let jerk = |s: f64| {
-        let s = s.clamp(0.0, 1.0);
-        s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)
-    };
+    let jerk = util::min_jerk;
     let mut text = String::from("t,x,y,z,qx,qy,qz,qw,engaged\n");
     for k in 0..=120 {
         let t = k as f64 * 0.025;

@@ -252,6 +252,9 @@ impl Master {
         f.signal.flags |= Flags::POSE;
         sent.rotation = Some(r);
         self.released = !engaged;
+        if let Some(m) = self.mmt.as_mut() {
+            m.clutch(self.released, self.handle);
+        }
         if self.released {
             f.signal.flags |= Flags::RELEASED;
             sent.released = true;

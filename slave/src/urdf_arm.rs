@@ -299,13 +299,11 @@ impl UrdfArm {
     }
 
     /// Where the clutch's position offset puts the tool relative to the master's
-    /// handle, m in the master's frame: the tool a handle at `x` sends the arm to is at
-    /// `x` plus this (zero before the first release).
+    /// handle, m in the master's frame: the target a handle at `x` sends the arm to is
+    /// at `x` plus this before the workspace box (zero before the first release).
     pub fn clutch_shift(&self) -> [f64; 3] {
-        let home: Vector3<f64> = self.home_tool.p;
-        let dp = self.indexing.as_ref().map_or(Vector3::zeros(), |ix| ix.dp);
-        let (a, b) = (self.to_master(&(home + dp)), self.to_master(&home));
-        [0, 1, 2].map(|k| a[k] - b[k])
+        let dp = self.indexing.as_ref().map_or([0.0; 3], |ix| ix.dp.into());
+        self.cfg.shift_to_master(dp)
     }
 
     /// True while the operator's clutch is released.

@@ -293,6 +293,13 @@ pub fn free_space_error(trace: &str, from: usize) -> (f64, usize) {
     (free.iter().copied().fold(0.0, f64::max), free.len())
 }
 
+/// The minimum-jerk profile at `s` (0 to 1, clamped): 0 to 1 with no velocity or
+/// acceleration at either end, as the operators' strokes are.
+pub fn min_jerk(s: f64) -> f64 {
+    let s = s.clamp(0.0, 1.0);
+    s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)
+}
+
 /// Column `name` of a CSV text as numbers.
 pub fn column(csv: &str, name: &str) -> Vec<f64> {
     let mut lines = csv.lines();

@@ -438,6 +438,14 @@ impl ModelRenderer {
         true
     }
 
+    /// Moves the model by `d` (a re-clutch carried the handle that far while the robot
+    /// held): the handle then meets it as it did before the clutch was released.
+    pub fn translate(&mut self, d: [f64; 3]) {
+        if let Some(m) = self.model.as_mut() {
+            m.offset += dot(m.normal, d);
+        }
+    }
+
     /// The force on the handle at `x`, N, once a model has arrived; `None` before (the
     /// node renders what arrives). Moves the surface and the stiffness towards the
     /// model's as the update rule allows.

@@ -64,8 +64,8 @@ pub struct Transparency {
     /// came from a slave step in contact, m (0 when it was not behind it; null without
     /// contact, or before the news arrived).
     pub unfelt_depth_m: Option<f64>,
-    /// The environment's energy over that depth, `k d^2 / 2` with the identified
-    /// stiffness, J: what a control that renders the wall where it is leaves the
+    /// The environment's energy over that depth, `k d^2 / 2` with the stiffness
+    /// identified over the run, J: what a control that renders the wall where it is leaves the
     /// channel short at rest (null without both).
     pub unfelt_energy_j: Option<f64>,
 }
@@ -133,7 +133,9 @@ impl Felt {
     /// The arm's clutch as of the next rows: `shift` is where its offset puts the
     /// tool relative to the handle, m in the master's frame (the handle at `x` meets
     /// the surfaces at `x + shift`); while `released` the operator feels the clutch's
-    /// spring, not the wall, and the felt fit leaves the samples out.
+    /// spring, not the wall, and the felt fit leaves the samples out. Both are the
+    /// slave's record's: the master's release reaches it a forward delay later, while
+    /// the handle is leaving the wall.
     pub fn clutch(&mut self, shift: [f64; 3], released: bool) {
         self.clutch = (shift, released);
     }

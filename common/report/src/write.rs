@@ -481,7 +481,7 @@ fn report_into(
     let logs = join::join_until(dirs, &stopped, |row, joints, rotation| {
         // The clutch's offset, from the arm's base frame into the master's.
         if let (Some(arm), Some(j)) = (&scenario.slave.arm, joints) {
-            let shift = arm.to_master([0.0; 3], [0.0; 3], j.offset);
+            let shift = arm.shift_to_master(j.offset);
             analysis.bilateral.clutch(shift, j.released);
         }
         analysis.add(row);

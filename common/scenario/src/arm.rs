@@ -190,6 +190,12 @@ impl ArmConfig {
         [0, 1, 2].map(|k| master_home[k] + d[k])
     }
 
+    /// A displacement `d` in the base frame (a clutch's offset) as one in the
+    /// master's frame: the map's linear part, undone.
+    pub fn shift_to_master(&self, d: [f64; 3]) -> [f64; 3] {
+        self.to_master([0.0; 3], [0.0; 3], d)
+    }
+
     /// A force or torque at the arm's tool, in its base's axes, as the operator is
     /// made to feel it: rotated into the master's axes and scaled by `force_scale`.
     pub fn force_to_master(&self, f: [f64; 3]) -> [f64; 3] {

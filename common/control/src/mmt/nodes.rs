@@ -114,6 +114,8 @@ pub struct ModelReceiver {
     renderer: ModelRenderer,
     taken: u64,
     refused: u64,
+    /// Where the handle was when the operator's clutch was released (`None`: engaged).
+    released_at: Option<[f64; 3]>,
 }
 
 impl ModelReceiver {
@@ -129,6 +131,25 @@ impl ModelReceiver {
             ),
             taken: 0,
             refused: 0,
+            released_at: None,
+        }
+    }
+
+    /// The operator's clutch at this sample, with the handle at `x`. At an engage the
+    /// model moves as far as the handle did while released: the robot held, so that
+    /// is where the slave's re-clutch puts the wall relative to the handle, and the
+    /// master renders it there at once instead of a round trip later, when the slave's
+    /// re-sent model arrives (which then changes nothing). A model the slave sent in
+    /// the round trip before its own re-clutch is in the frame before it: it is taken
+    /// like any change (force-continuous, blended) until that re-sent model comes.
+    pub fn clutch(&mut self, released: bool, x: [f64; 3]) {
+        match (released, self.released_at) {
+            (true, None) => self.released_at = Some(x),
+            (false, Some(at)) => {
+                self.released_at = None;
+                self.renderer.translate([0, 1, 2].map(|i| x[i] - at[i]));
+            }
+            _ => {}
         }
     }
 

@@ -468,7 +468,7 @@ fn the_sender_numbers_models_and_sends_only_changes() {
 }
 
 /// A re-clutch that puts the tool 2 cm further along the wall's normal than the handle
-/// (the operator brought the handle back while the robot held): the wall, still in the
+/// (the operator moved the handle 2 cm towards the wall while the robot held): the wall, still in the
 /// tool's space, is sent at once 2 cm nearer the handle's side, and holding on changes
 /// nothing more; sideways offsets do not move a plane.
 #[test]
@@ -492,6 +492,32 @@ fn a_reclutch_sends_the_model_where_the_handle_meets_the_wall() {
         assert!(!s.update(hold, contact(&WALL, hold), shift));
     }
     assert_eq!(s.sent().seq, seq);
+}
+
+/// A re-clutch that carried the handle 3 cm up (out of the wall, along its normal)
+/// while the robot held: at the engage the model moves with it, so the handle meets it
+/// as before the release; a release and engage in place changes nothing.
+fn apart(a: [f64; 3], b: [f64; 3]) -> f64 {
+    norm([0, 1, 2].map(|i| a[i] - b[i]))
+}
+
+#[test]
+fn a_reclutch_moves_the_rendered_model_with_the_handle() {
+    let mut r = ModelReceiver::new(&MmtConfig::default(), 1e-3);
+    let outside = [0.0, 0.0, -0.05];
+    assert_eq!(r.take(&WALL.to_message(1), outside, [0.0; 3]), Taken::New);
+    let inside = [0.0, 0.0, -0.065];
+    let before = r.force(inside).expect("a model");
+    assert!(before[2] > 1.0, "{before:?}");
+    r.clutch(true, inside);
+    r.clutch(true, [0.01, 0.0, -0.04]);
+    let up = [0.0, 0.0, -0.035];
+    r.clutch(false, up);
+    let after = r.force(up).expect("a model");
+    assert!(apart(after, before) < 1e-9, "{after:?} against {before:?}");
+    r.clutch(true, up);
+    r.clutch(false, up);
+    assert!(apart(r.force(up).expect("a model"), before) < 1e-9);
 }
 
 /// The master takes each new number once, ignores an older or repeated one, refuses
