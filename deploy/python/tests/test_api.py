@@ -148,8 +148,12 @@ def test_the_gil_is_released_while_it_runs():
     assert took > 0.3 and gap < took / 4, (took, gap)
 
 
+# The child installs Python's own SIGINT handler first: an interpreter started with
+# SIGINT ignored (a background job of a non-interactive shell, as CI may start the
+# suite) keeps it ignored, and the run would never hear the Ctrl-C.
 INTERRUPTED = """
 import signal, sys, time, tactile
+signal.signal(signal.SIGINT, signal.default_int_handler)
 sc = tactile.Scenario.paper().with_set({"samples": 100_000_000})
 for k in range(2):
     print("running", k, flush=True)
@@ -173,6 +177,9 @@ def test_ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs(work):
     out = work / "stopped"
     p = subprocess.Popen([sys.executable, "-c", INTERRUPTED, str(out)],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # A run that did not stop would go on for a day, writing gigabytes: ended here.
+    watchdog = threading.Timer(120, p.kill)
+    watchdog.start()
     try:
         for k in range(2):
             assert p.stdout.readline().strip() == f"running {k}"
@@ -191,6 +198,7 @@ def test_ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs(work):
         p.wait(timeout=60)
         assert p.returncode == -signal.SIGTERM, (p.returncode, p.stderr.read())
     finally:
+        watchdog.cancel()
         if p.poll() is None:
             p.kill()
             p.wait()
