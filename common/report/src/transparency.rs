@@ -160,9 +160,10 @@ impl Felt {
             && !released
             && !row.flags_m.intersects(Flags::REJECTED)
             && !row.flags_b.intersects(Flags::CORRUPTED);
-        if let (true, Some((p, n))) = (felt_ok, self.surface) {
+        if let (true, Some(surface)) = (felt_ok, self.surface) {
+            let n = surface.1;
             let handle = [0, 1, 2].map(|i| row.handle[i] + shift[i]);
-            let depth = dot([0, 1, 2].map(|i| p[i] - handle[i]), n);
+            let depth = behind(surface, handle);
             let from = row.q_from.iter().copied().min().unwrap_or(0);
             if self.news_handle.is_none() && self.first_contact.is_some_and(|c| from >= c) {
                 self.news_handle = Some(handle);
@@ -185,7 +186,7 @@ impl Felt {
         let unfelt = self
             .news_handle
             .zip(self.first_surface)
-            .map(|(h, (p, n))| dot([0, 1, 2].map(|i| p[i] - h[i]), n).max(0.0));
+            .map(|(h, surface)| behind(surface, h).max(0.0));
         let ratio = |f: Option<f64>| match (f, environment) {
             (Some(f), Some(e)) if e > 0.0 => Some(f / e),
             _ => None,
@@ -207,6 +208,12 @@ impl Felt {
             unfelt_energy_j: unfelt.zip(environment).map(|(d, k)| 0.5 * k * d * d),
         }
     }
+}
+
+/// How far `x` is behind a surface (its point and outward normal), m: negative in
+/// front of it.
+fn behind((p, n): ([f64; 3], [f64; 3]), x: [f64; 3]) -> f64 {
+    dot([0, 1, 2].map(|i| p[i] - x[i]), n)
 }
 
 /// Whether the model a contact step carried matches the wall there: its stiffness
