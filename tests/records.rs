@@ -234,3 +234,32 @@ fn records_are_checked_by_their_content_and_a_missing_one_is_named() {
         "{events}"
     );
 }
+
+/// In-process runs of different scenarios carry different run tokens, so their
+/// records are not joined into one report: the master's and emulator's of one run
+/// beside the slave's of another (another seed) are refused, naming the runs. Two
+/// runs of one scenario give the same token (their traces stay byte-identical).
+#[test]
+fn records_of_different_in_process_runs_are_not_joined() {
+    let sb = Sandbox::new("mixedruns");
+    let a = sb.write("a.toml", &util::wall_delay());
+    let b = sb.write(
+        "b.toml",
+        &util::wall_delay().replace("seed = 1", "seed = 7"),
+    );
+    sb.simulate(&a, "a");
+    sb.simulate(&a, "a2");
+    sb.simulate(&b, "b");
+    let token = |run: &str| sb.json(run, "summary.json")["run"].clone();
+    assert_eq!(token("a"), token("a2"), "one scenario, one token");
+    assert_ne!(token("a"), token("b"), "another seed, another token");
+    std::fs::create_dir(sb.path("mix")).expect("folder");
+    for (role, from) in [("master", "a"), ("emulator", "a"), ("slave", "b")] {
+        let name = format!("{role}.rec");
+        std::fs::copy(sb.path(from).join(&name), sb.path("mix").join(&name)).expect("copy");
+    }
+    let o = sb.tactile(&["report", "mix"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("not one run"), "{err}");
+}

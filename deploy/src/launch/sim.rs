@@ -91,8 +91,22 @@ impl std::fmt::Debug for Hooks {
     }
 }
 
-/// The run token of a simulation (there is no master process to choose one).
-pub const SIM_RUN: u64 = 1;
+/// The run token of a simulation (there is no master process to choose one): the
+/// FNV-1a hash of the resolved scenario, never zero (zero means "unknown"). Two runs of
+/// one scenario give the same records byte for byte; records of runs of different
+/// scenarios (another seed, another delay) carry different tokens, so the report
+/// refuses to join them as it refuses the node programs' records of different runs.
+pub fn sim_run(resolved_toml: &str) -> u64 {
+    fnv1a64(resolved_toml.as_bytes()).max(1)
+}
+
+/// FNV-1a, 64 bits: a hash that is the same on every build and machine (std's hasher
+/// is seeded per process), for identities written into files.
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
 
 fn start(role: Role, scenario: &Scenario, base_dir: &Path) -> Start {
     Start {
@@ -167,7 +181,7 @@ pub fn simulate(
     let [mp, ep, sp] = tactile_transport::ports::in_memory();
     let link = |p| Link::new(p, std::time::Duration::ZERO);
     let opts = LeadOptions {
-        run: SIM_RUN,
+        run: sim_run(&scenario.resolved(base_dir).to_toml()),
         samples: scenario.samples,
         startup_timeout: std::time::Duration::from_secs(10),
         answer_timeout: std::time::Duration::ZERO,
