@@ -384,3 +384,51 @@ fn every_shipped_scenario_checks() {
     }
     assert!(checked >= 8, "{checked} scenarios");
 }
+
+/// No shipped scenario steps the operator's hand: run in-process, the felt force's
+/// largest step is within what the device's force rate allows in a sample
+/// (`master.ros2.max_force_rate`, 1000 N/s by default: 1 N a sample at 1 kHz). The
+/// scenarios for a real robot need the node programs and the million-sample run is
+/// long: the master's rendering they share is the same code.
+#[test]
+fn no_shipped_scenario_steps_the_operators_hand() {
+    let sb = Sandbox::new("felt-steps");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut ran = 0;
+    for e in std::fs::read_dir(&dir).expect("scenarios") {
+        let p = e.expect("entry").path();
+        let name = p
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or_default()
+            .to_string();
+        if p.extension().is_none_or(|x| x != "toml")
+            || name.contains("ros2")
+            || name.contains("1e6")
+        {
+            continue;
+        }
+        let o = sb.tactile(&[
+            "run",
+            p.to_str().expect("utf-8"),
+            "--in-process",
+            "-q",
+            "--out",
+            &name,
+        ]);
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let s = sb.json(&name, "summary.json");
+        let step = s["contact"]["felt_step_max_n"].as_f64().expect("felt step");
+        let rate_hz = s["rate_hz"].as_f64().expect("rate");
+        assert!(
+            step <= 1000.0 / rate_hz,
+            "{name}: the felt force steps {step} N in a sample"
+        );
+        ran += 1;
+    }
+    assert!(ran >= 7, "{ran} scenarios");
+}

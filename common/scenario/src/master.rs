@@ -1,6 +1,7 @@
 //! `[master]` and `[faults]`: the master device's limits, the operator's hand, the
 //! master device's joints, and how a dead peer is noticed.
 
+use crate::shown::Num;
 use crate::{
     invalid, positive, positive3, Backend, PredictorConfig, RosDeviceConfig, ScenarioError,
 };
@@ -31,6 +32,15 @@ pub struct MasterConfig {
     /// towards the device's home (the middle of its workspace, or where a pose device
     /// started), so the next stroke starts there.
     pub clutch_spring: f64,
+    /// Seconds over which a force the master switches on takes over from the force
+    /// felt before it: the clutch's spring at a release, the robot's force at an
+    /// engage, the loop's force when answers come back after the loop broke. A switch
+    /// at full strength stepped the operator's hand by the whole force (3 N at a
+    /// release of `panda-reach.toml`'s clutch); over 0.1 s the Omni's 3.3 N changes at
+    /// 33 N/s at most, well inside the device's force rate (1000 N/s), yet quicker than
+    /// a hand reacts (about 0.15 s). 0 switches at once. The loop breaking renders zero
+    /// force at once: rendering nothing is the safe state.
+    pub switch_ramp_s: f64,
 }
 
 impl Default for MasterConfig {
@@ -44,6 +54,7 @@ impl Default for MasterConfig {
             backend: Backend::default(),
             ros2: RosDeviceConfig::default(),
             clutch_spring: 0.0,
+            switch_ramp_s: 0.1,
         }
     }
 }
@@ -199,6 +210,12 @@ impl MasterConfig {
                     "{} N/m is stiffer than a desk device renders (1000 N/m)",
                     self.clutch_spring
                 ),
+            ));
+        }
+        if !self.switch_ramp_s.is_finite() || !(0.0..=10.0).contains(&self.switch_ramp_s) {
+            return Err(invalid(
+                "master.switch_ramp_s",
+                format!("{} s is outside 0 to 10 s", Num(self.switch_ramp_s)),
             ));
         }
         self.ros2.validate()

@@ -16,6 +16,7 @@
 
 use crate::operator::{Approach, Operate, OperatorSource, Scripted, Target, IDENTITY};
 use crate::simulated::HeldDevice;
+use switch::{Rendering, Switch};
 use tactile_control::codec::{Deadband, Estimate, Guess, Predictor};
 use tactile_control::mmt::{ModelReceiver, Taken};
 use tactile_control::passivity::{MasterForce, MasterSide};
@@ -90,6 +91,8 @@ pub struct Master {
     pose_input: bool,
     /// `control.kind = "mmt"`: the slave's latest model, rendered against the handle.
     mmt: Option<ModelReceiver>,
+    /// Which force the hand is rendered, and the blend when that changes.
+    switch: Switch,
 }
 
 /// `q` relative to `q0` (both `[x, y, z, w]`): the turn from `q0` to `q`, about the
@@ -169,6 +172,7 @@ impl Master {
             pose_input: false,
             mmt: (scenario.control.kind == ControlKind::Mmt)
                 .then(|| ModelReceiver::new(&scenario.control.mmt, scenario.t_s())),
+            switch: Switch::new(scenario.master.switch_ramp_s, scenario.t_s()),
         })
     }
 
@@ -523,10 +527,11 @@ impl Master {
     /// Takes the control's force as the felt force and its KFF-HMD torques, clamped;
     /// counts the clamps and says whether there were any.
     fn command(&mut self, out: &MasterForce) -> bool {
-        let felt = match self.released {
-            false => out.force,
-            true => self.clutch_spring(),
+        let (mode, to) = match self.released {
+            false => (Rendering::Loop, out.force),
+            true => (Rendering::Clutch, self.clutch_spring()),
         };
+        let felt = self.switch.render(mode, to, self.last_felt);
         // A pose device takes the force itself: no joints, no torques to clamp.
         let raw = match self.pose_input {
             false => self.engine.kff(self.theta_md, felt),
@@ -581,13 +586,11 @@ impl Master {
 }
 
 // What the master does when no answer came, and the round trip of one that did.
-#[path = "hmd_miss.rs"]
 mod miss;
+mod switch;
 
 #[cfg(test)]
-#[path = "hmd_tests.rs"]
 mod tests;
 
 #[cfg(test)]
-#[path = "hmd_device_tests.rs"]
 mod device_tests;

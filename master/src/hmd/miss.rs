@@ -1,6 +1,7 @@
 //! [`Master`]'s answers that did not come (held, or the loop broken) and the round trip
 //! of those that did: the part of the backward path that runs without a q(n).
 
+use super::switch::Rendering;
 use super::Master;
 use tactile_messages::samples::{stage, Flags};
 use tactile_records::master::{Answer, Miss};
@@ -19,7 +20,9 @@ impl Master {
             self.counters.peer_lost_samples += 1;
             let out = self.control.release();
             self.last_tau = [0.0; 3];
-            self.last_felt = [0.0; 3];
+            self.last_felt = self
+                .switch
+                .render(Rendering::Broken, [0.0; 3], self.last_felt);
             (Flags::PEER_LOST, out)
         } else {
             self.counters.held_samples += 1;

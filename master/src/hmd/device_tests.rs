@@ -4,10 +4,17 @@
 use super::*;
 use tactile_messages::samples::Signal;
 
+/// A master at 1 kHz with a clutch `spring`, each switch of force at once (the blend
+/// is tested apart, in `a_switched_force_ramps_and_a_broken_loop_stops_at_once`).
 fn master(spring: f64) -> Master {
+    master_ramped(spring, 0.0)
+}
+
+fn master_ramped(spring: f64, ramp_s: f64) -> Master {
     let mut sc = Scenario::paper();
     sc.rate_hz = 1000.0;
     sc.master.clutch_spring = spring;
+    sc.master.switch_ramp_s = ramp_s;
     let source = OperatorSource::load(&sc.operator, std::path::Path::new(".")).expect("op");
     Master::new(&sc, source).expect("master")
 }
@@ -182,6 +189,65 @@ fn released_the_hand_feels_the_spring_not_the_robot() {
         m.backward(&answer(2, [1.0, 0.5, 0.0]));
         assert_eq!(m.felt(), [1.0, 0.5, 0.0]);
     }
+}
+
+/// A release blends the spring in over `switch_ramp_s` from the robot's force felt
+/// before it, and an engage the robot's force back; the loop breaking renders zero at
+/// once, and its return rises from zero over the same time.
+#[test]
+fn a_switched_force_ramps_and_a_broken_loop_stops_at_once() {
+    let mut m = master_ramped(100.0, 0.01);
+    let at = |x: f64| Hand {
+        point: [x, 0.0, 0.0],
+        rotation: None,
+    };
+    let robot = [1.0, 0.5, 0.0];
+    measured(&mut m, 0, 0, Some(at(0.0)), HandInput::Pose, Some(true));
+    m.backward(&answer(0, robot));
+    assert_eq!(m.felt(), robot);
+    let spring = [-100.0 * 0.02, 0.0, 0.0];
+    // Ten samples from `n` with the clutch `engaged`: the felt force goes from `from`
+    // to `to` in equal steps.
+    let follow = |m: &mut Master, n: &mut u64, engaged: bool, from: [f64; 3], to: [f64; 3]| {
+        for k in 1..=10 {
+            let n_now = *n;
+            measured(
+                m,
+                n_now,
+                n_now,
+                Some(at(0.02)),
+                HandInput::Pose,
+                Some(engaged),
+            );
+            m.backward(&answer(n_now, robot));
+            let a = f64::from(k) / 10.0;
+            let want = [0, 1, 2].map(|i| from[i] + a * (to[i] - from[i]));
+            let felt = m.felt();
+            assert!(
+                (0..3).all(|i| (felt[i] - want[i]).abs() < 1e-12),
+                "sample {n_now}: {felt:?}, not {want:?}"
+            );
+            *n += 1;
+        }
+    };
+    let mut n = 1;
+    follow(&mut m, &mut n, false, robot, spring);
+    follow(&mut m, &mut n, true, spring, robot);
+    let timeout = m.peer_timeout;
+    for k in 0..timeout {
+        measured(
+            &mut m,
+            n + k,
+            n + k,
+            Some(at(0.02)),
+            HandInput::Pose,
+            Some(true),
+        );
+        m.missing(n + k);
+    }
+    assert_eq!(m.felt(), [0.0; 3], "the loop broke: nothing rendered");
+    n += timeout;
+    follow(&mut m, &mut n, true, [0.0; 3], robot);
 }
 
 #[test]
