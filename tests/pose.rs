@@ -412,8 +412,20 @@ fn reach_report(text: &str, s: &serde_json::Value, trace: &str) {
     let ratio = util::num(&s["transparency"]["stiffness_ratio"]);
     assert!((0.9..1.0).contains(&ratio), "{}", s["transparency"]);
     assert!(
-        text.contains("handle (the master's frame, the clutch's offsets and releases included)"),
+        text.contains("handle (the master's frame, the handle moved by the clutch's offsets, released samples left out)"),
         "{text}"
+    );
+    // One meaning for every arm: the headline is the task space's figure, and the
+    // bilateral figures leave the clutch's offsets and releases out (80.5 mm and
+    // 0.81 N with them).
+    assert_eq!(util::num(&s["tracking_rms_m"]), rms);
+    let position = util::num(&s["tracking"]["position_rms_m"]);
+    assert!(position < 1e-3, "{}", s["tracking"]);
+    assert_eq!(s["tracking"]["position_samples"], 6600);
+    assert!(
+        util::num(&s["tracking"]["force_rms_n"]) < 0.1,
+        "{}",
+        s["tracking"]
     );
 }
 
@@ -437,8 +449,9 @@ fn press_and_reclutch() -> String {
 
 /// MMT through a re-clutch in contact at 200 ms of round trip: the robot holds its
 /// press while the hand goes 2 cm up; at the engage the master moves the wall's model
-/// with the hand at once, so the operator feels the press again where it was, not a
-/// wall 2 cm below for the round trip until the slave's re-clutched model arrives.
+/// with the hand at once, so the operator feels the press again where it was (blended
+/// in over the switch's 0.1 s), not a wall 2 cm below for the round trip until the
+/// slave's re-clutched model arrives.
 #[test]
 fn mmt_keeps_the_wall_where_a_reclutch_in_contact_left_it() {
     let sb = Sandbox::new("mmtreclutch");
@@ -465,8 +478,15 @@ fn mmt_keeps_the_wall_where_a_reclutch_in_contact_left_it() {
     let felt = column(&sb.trace("a"), "felt_3");
     let pressed = felt[1450];
     assert!(pressed > 0.2, "felt {pressed} N before the release");
-    // From the engage (2.3 s) through the round trip after it and to the end.
-    for (n, f) in felt.iter().enumerate().skip(2301) {
+    // The engage (2.3 s) blends the press back in over `master.switch_ramp_s` (0.1
+    // s, from the released hand's zero): half of it halfway. From then on, through
+    // the round trip after the engage and to the end, the press as it was.
+    let half = felt[2350];
+    assert!(
+        (half - 0.5 * pressed).abs() < 0.25 * pressed,
+        "{half} N halfway through the blend"
+    );
+    for (n, f) in felt.iter().enumerate().skip(2400) {
         assert!(
             (f - pressed).abs() < 0.5 * pressed,
             "sample {n}: {f} N against {pressed} N"

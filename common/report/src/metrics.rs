@@ -87,6 +87,9 @@ pub struct Bilateral {
     pub felt: crate::transparency::Felt,
     /// MMT: the energy the master's model changes had added by the last row, J.
     pub model_injected_j: f64,
+    /// A URDF arm's clutch as of the next rows: where its offset puts the tool
+    /// relative to the handle (the master's frame), and whether it is released.
+    clutch: ([f64; 3], bool),
     last_felt: [f64; 3],
     handles: Vec<Option<(u64, [f64; 3])>>,
     forces: Vec<Option<(u64, [f64; 3])>>,
@@ -108,6 +111,7 @@ impl Default for Bilateral {
             passivity: Passivity::default(),
             felt: crate::transparency::Felt::default(),
             model_injected_j: 0.0,
+            clutch: ([0.0; 3], false),
             last_felt: [0.0; 3],
             handles: vec![None; LATE_WINDOW as usize],
             forces: vec![None; LATE_WINDOW as usize],
@@ -134,6 +138,7 @@ impl Bilateral {
     /// A URDF arm's clutch as of the next rows (see [`crate::transparency::Felt::clutch`]).
     pub fn clutch(&mut self, shift: [f64; 3], released: bool) {
         self.felt.clutch(shift, released);
+        self.clutch = (shift, released);
     }
 
     /// Adds one row (rows come in sample order).
@@ -158,9 +163,11 @@ impl Bilateral {
         // A force the master rejected was never felt as such; one the channel held (or
         // that was not sent) is compared with the environment where a fresh one would
         // have come from: holding costs what the environment did meanwhile.
+        // Released, the hand feels the clutch's spring, not the robot: not tracking.
         if row.received
             && !row.flags_m.intersects(Flags::REJECTED)
             && !row.flags_b.intersects(Flags::CORRUPTED)
+            && !row.flags_f.intersects(Flags::RELEASED)
         {
             if !row.flags_b.intersects(Flags::SUBSTITUTED) {
                 self.backward_lag = Some([0, 1, 2].map(|i| row.n.saturating_sub(row.q_from[i])));
@@ -218,9 +225,15 @@ impl Bilateral {
         let [Some(x), Some(y), Some(z)] = at else {
             return;
         };
-        let d = distance(row.tool, [x, y, z]);
-        self.position_sq += d * d;
-        self.tracking.position_samples += 1;
+        // The tool follows the handle moved by the clutch's offset, and holds while the
+        // clutch is released: those steps are not tracking (the task space's figure
+        // leaves them out too). The reference is the handle's, before the offset.
+        let (shift, released) = self.clutch;
+        if !released {
+            let d = distance(row.tool, [x + shift[0], y + shift[1], z + shift[2]]);
+            self.position_sq += d * d;
+            self.tracking.position_samples += 1;
+        }
         let drift = distance(row.reference, [x, y, z]);
         self.passivity.drift_max_m = self.passivity.drift_max_m.max(drift);
         self.passivity.drift_final_m = drift;

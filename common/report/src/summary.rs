@@ -184,7 +184,9 @@ pub struct Summary {
     pub samples_lost: u64,
     /// Answers not back by the next tick.
     pub deadline_misses: u64,
-    /// RMS distance of the slave's tool from the position it was asked to reach, m.
+    /// RMS distance of the slave's tool from the position it was asked to reach, m: a
+    /// URDF arm's against its target after the master's map (`task_space`'s
+    /// `position_rms_m`), the paper's arm's against v(n) (`master.motion`'s).
     pub tracking_rms_m: Option<f64>,
     /// The operator's hand: `position` (ideal) or `impedance`.
     pub hand: tactile_scenario::HandMode,

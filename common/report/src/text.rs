@@ -140,10 +140,10 @@ fn motion(t: &mut String, s: &Summary) {
         },
         s.control,
         mm(s.tracking.position_rms_m),
-        // The handle knows no clutch: its distance from the tool grows with each
-        // release, which the task-space line above leaves out.
+        // The handle moved by the clutch's offsets, released samples left out (as the
+        // task-space line above does).
         match &s.task_space {
-            Some(ts) if ts.released_samples > 0 => " (the master's frame, the clutch's offsets and releases included)",
+            Some(ts) if ts.released_samples > 0 => " (the master's frame, the handle moved by the clutch's offsets, released samples left out)",
             _ => "",
         },
         s.tracking.force_rms_n.map_or("n/a".to_string(), |f| format!("{f:.3} N")),
