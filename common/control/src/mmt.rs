@@ -68,6 +68,11 @@ pub const MIN_STIFFNESS: f64 = 1.0;
 pub const JUMP_FORCE: f64 = 0.5;
 /// See [`JUMP_FORCE`].
 pub const JUMP_FRACTION: f64 = 0.2;
+/// A contact force further than this from the model's normal, rad, is another wall
+/// too: the normal and the fit start again from it. A flat wall's force wobbles by a
+/// few hundredths of a radian (the slave's fixed-point tool); 20 degrees is a face
+/// of its own.
+pub const JUMP_ANGLE: f64 = 0.35;
 
 /// How much a model must change before the slave sends it again.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -244,6 +249,15 @@ impl PlaneEstimator {
             return;
         }
         let lambda = self.cfg.forgetting;
+        let turned = self.contacts >= self.cfg.min_contacts
+            && dot(self.normal(), h) < JUMP_ANGLE.cos() * magnitude;
+        if turned {
+            // The force left the plane's normal: another wall (a corner's second
+            // face, a tilted body). Averaged into the old normal it tilted the plane
+            // under a fit that then read a stiffness of a few N/m and a surface metres
+            // away; its own normal from here instead.
+            self.direction = [0.0; 3];
+        }
         self.direction = std::array::from_fn(|i| lambda * self.direction[i] + h[i] / magnitude);
         let n = self.normal();
         let f = dot(n, h);
@@ -251,7 +265,7 @@ impl PlaneEstimator {
             .rls
             .get_or_insert_with(|| Rls::new(x, f, self.cfg.prior_stiffness));
         let s = dot(n, [0, 1, 2].map(|i| x[i] - rls.anchor[i]));
-        let jump = (f - rls.predict(s)).abs() > JUMP_FORCE.max(JUMP_FRACTION * f.abs());
+        let jump = turned || (f - rls.predict(s)).abs() > JUMP_FORCE.max(JUMP_FRACTION * f.abs());
         if jump && self.contacts >= self.cfg.min_contacts {
             // Another wall from here: its surface where this force says with the
             // stiffness so far, which the next samples refine.
@@ -314,174 +328,10 @@ impl PlaneEstimator {
     }
 }
 
-/// The master's rendering of the slave's latest model, against its own handle, every
-/// sample, with no delay in the haptic loop.
-///
-/// A model change must not kick the operator. Whatever the rule, a new model is taken
-/// with the force at the handle continuous: its surface is placed where the new spring
-/// gives the force felt now, a `shift` along the normal from the model's surface. How
-/// the shift then returns to zero is the update rule ([`Update`]):
-///
-/// - **`Passive`, the energy check** (Mitra and Niemeyer 2008; Xu et al. 2016): only
-///   changes that do not raise the energy the rendered spring stores at the handle. While
-///   the handle is outside, the model's surface at once but never past the handle;
-///   inside, only a surface that is out of the model's moves, deeper, so that the force
-///   eases off by `step` newtons a sample. A stiffer model is taken at once (at the same force the
-///   stored energy `F^2 / 2k` falls); a softer one waits until the handle is outside.
-///   Nothing is ever added, but a wall first felt late (the handle already deep when the
-///   first model arrives) stays that much farther until the handle next leaves it.
-/// - **`Blend`**: as `Passive`, and inside the wall a surface deeper than the model's
-///   moves out so that the force rises by `step` a sample, and a softer model is taken
-///   at once (its surface then eases deeper). The force changes by at most `step` a
-///   sample, so there is no kick; the energy this adds is at most `k s^2 / 2` for a
-///   shift `s` (what the wall would have stored had it been felt on time) and is booked
-///   in [`ModelRenderer::injected`].
-#[derive(Debug, Clone)]
-pub struct ModelRenderer {
-    model: Option<PlaneModel>,
-    /// A softer stiffness waiting for the handle to leave the wall (`Passive`).
-    softer: Option<f64>,
-    /// The rendered surface is at `model.offset - shift`, m.
-    shift: f64,
-    /// N a sample.
-    step: f64,
-    update: Update,
-    /// Energy model changes added at the handle, J (zero with `Passive`).
-    injected: f64,
-}
-
-/// How a rendered model's surface returns to the model's after a change (see
-/// [`ModelRenderer`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Update {
-    /// Only changes that add no energy at the handle.
-    Passive,
-    /// Towards the model at a bounded rate either way, the energy added booked.
-    Blend,
-}
-
-impl ModelRenderer {
-    /// `step`: how fast the felt force follows the rendered surface's return to the
-    /// model's while the handle is inside, N per sample.
-    pub fn new(step: f64, update: Update) -> Self {
-        ModelRenderer {
-            model: None,
-            softer: None,
-            shift: 0.0,
-            step: step.abs(),
-            update,
-            injected: 0.0,
-        }
-    }
-
-    /// The model as rendered now (its surface shifted), if any has arrived.
-    pub fn rendered(&self) -> Option<PlaneModel> {
-        self.model.map(|m| PlaneModel {
-            offset: m.offset - self.shift,
-            ..m
-        })
-    }
-
-    /// The latest model as received (the stiffness it renders once allowed).
-    pub fn model(&self) -> Option<PlaneModel> {
-        self.model.map(|m| PlaneModel {
-            stiffness: self.softer.unwrap_or(m.stiffness),
-            ..m
-        })
-    }
-
-    /// Energy model changes have added at the handle, J.
-    pub fn injected(&self) -> f64 {
-        self.injected
-    }
-
-    /// Takes a model from the slave with the handle at `x`. The force on the handle now
-    /// is the rendered model's; before the first model it is `arrived`, what came over
-    /// the channel. An invalid model is refused (false) and changes nothing.
-    pub fn receive(&mut self, new: PlaneModel, x: [f64; 3], arrived: [f64; 3]) -> bool {
-        if !new.is_valid() || !x.iter().chain(arrived.iter()).all(|v| v.is_finite()) {
-            return false;
-        }
-        // The first model takes over the force that arrived over the channel, whose
-        // energy the channel's observers book; from then on changes are this one's,
-        // continuous with what it renders (never with a force it is told, which could
-        // be larger and so store more).
-        let first = self.model.is_none();
-        let shown = self.rendered();
-        let felt = shown.map_or(arrived, |m| m.force(x));
-        let before = shown.map_or(0.0, |m| m.energy(x));
-        let s = dot(new.normal, x);
-        let f = dot(new.normal, felt).max(0.0);
-        let mut k = new.stiffness;
-        self.softer = None;
-        if let (Some(old), Update::Passive) = (self.model, self.update) {
-            if f > 0.0 && k < old.stiffness {
-                self.softer = Some(k);
-                k = old.stiffness;
-            }
-        }
-        // The rendered surface: where the spring gives the felt force at the handle;
-        // with no force felt, no deeper than the handle.
-        let surface = if f > 0.0 && k > 0.0 {
-            s + f / k
-        } else {
-            new.offset.min(s)
-        };
-        self.model = Some(PlaneModel {
-            stiffness: k,
-            ..new
-        });
-        self.shift = new.offset - surface;
-        if !first {
-            self.book(before, x);
-        }
-        true
-    }
-
-    /// Moves the model by `d` (a re-clutch carried the handle that far while the robot
-    /// held): the handle then meets it as it did before the clutch was released.
-    pub fn translate(&mut self, d: [f64; 3]) {
-        if let Some(m) = self.model.as_mut() {
-            m.offset += dot(m.normal, d);
-        }
-    }
-
-    /// The force on the handle at `x`, N, once a model has arrived; `None` before (the
-    /// node renders what arrives). Moves the surface and the stiffness towards the
-    /// model's as the update rule allows.
-    pub fn force(&mut self, x: [f64; 3]) -> Option<[f64; 3]> {
-        let m = self.model?;
-        let before = self.rendered().map_or(0.0, |r| r.energy(x));
-        let s = dot(m.normal, x);
-        let outside = m.offset - self.shift <= s;
-        // The surface's move that changes the force by `step`.
-        let relax = self.step / m.stiffness.max(1.0);
-        if outside {
-            // Nothing stored, nothing felt: the model's surface at once, never past the
-            // handle.
-            self.shift = (m.offset - s).max(0.0);
-            if let Some(k) = self.softer.take() {
-                self.model = Some(PlaneModel { stiffness: k, ..m });
-            }
-        } else if self.shift < 0.0 {
-            // Deeper, a little a sample: the force eases off without a step.
-            self.shift = (self.shift + relax).min(0.0);
-        } else if self.update == Update::Blend {
-            // Out, a little a sample: the force rises without a step.
-            self.shift = (self.shift - relax).max(0.0);
-        }
-        self.book(before, x);
-        self.rendered().map(|r| r.force(x))
-    }
-
-    fn book(&mut self, before: f64, x: [f64; 3]) {
-        let after = self.rendered().map_or(0.0, |m| m.energy(x));
-        self.injected += (after - before).max(0.0);
-    }
-}
-
 mod nodes;
+mod render;
 pub use nodes::{ModelReceiver, ModelSender, Taken};
+pub use render::{ModelRenderer, Update};
 
 #[cfg(test)]
 mod tests;

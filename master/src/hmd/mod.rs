@@ -170,8 +170,13 @@ impl Master {
             home,
             handle: home,
             pose_input: false,
-            mmt: (scenario.control.kind == ControlKind::Mmt)
-                .then(|| ModelReceiver::new(&scenario.control.mmt, scenario.t_s())),
+            mmt: (scenario.control.kind == ControlKind::Mmt).then(|| {
+                ModelReceiver::new(
+                    &scenario.control.mmt,
+                    scenario.t_s(),
+                    scenario.master.force_limit,
+                )
+            }),
             switch: Switch::new(scenario.master.switch_ramp_s, scenario.t_s()),
         })
     }

@@ -119,8 +119,9 @@ pub struct ModelReceiver {
 }
 
 impl ModelReceiver {
-    /// As `[control.mmt]` says, for a master sampled every `t_s` seconds.
-    pub fn new(cfg: &MmtConfig, t_s: f64) -> Self {
+    /// As `[control.mmt]` says, for a master sampled every `t_s` seconds whose force
+    /// is clamped to `force_limit` on each axis (N).
+    pub fn new(cfg: &MmtConfig, t_s: f64, force_limit: f64) -> Self {
         ModelReceiver {
             renderer: ModelRenderer::new(
                 cfg.force_rate * t_s,
@@ -128,7 +129,8 @@ impl ModelReceiver {
                     MmtUpdate::Passive => Update::Passive,
                     MmtUpdate::Blend => Update::Blend,
                 },
-            ),
+            )
+            .with_force_limit(force_limit),
             taken: 0,
             refused: 0,
             released_at: None,
