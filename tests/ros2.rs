@@ -539,6 +539,70 @@ fn a_robot_that_goes_silent_is_held_and_its_sensor_gives_the_force() {
     assert_eq!([h[0][100], h[1][100], h[2][100]], [0.25, -0.5, 1.5]);
 }
 
+/// A robot whose sensor reports 2 kN (past `max_force`, 1000 N by default: no
+/// measurement) has every wrench refused and counted; the loop goes on with no force
+/// (none good ever came) and the summary warns with the count. A wrench of 1e6 N
+/// had gone on to the slave and MMT's estimate unsaid.
+#[test]
+fn a_robot_wrench_past_max_force_is_refused_and_said() {
+    if !python_ready() {
+        return cannot("python3 lacks eclipse-zenoh or rosbags");
+    }
+    let sb = Sandbox::new("ros2-wrench");
+    let ports = [free_port(), free_port()];
+    let robot = standin(
+        &sb,
+        &[
+            "robot",
+            "--domain",
+            "13",
+            "--listen",
+            &format!("tcp/127.0.0.1:{}", ports[1]),
+            "--names",
+            "j1,j2,j3",
+            "--joint-topic",
+            "/arm/joint_states",
+            "--command-topic",
+            "/arm/commands",
+            "--wrench-topic",
+            "/arm/wrench",
+            "--wrench",
+            "0",
+            "0",
+            "2000",
+            "--duration",
+            "60",
+            "--idle-exit",
+            "2",
+            "--report",
+            "robot.json",
+        ],
+    );
+    let tables = ros_tables(13, ports, false, false).replace(
+        "command_topic = \"/arm/commands\"\n",
+        "command_topic = \"/arm/commands\"\nwrench_topic = \"/arm/wrench\"\n",
+    );
+    let scenario = sb.write(
+        "robot.toml",
+        &format!("{}{tables}", looped("realtime", 300)),
+    );
+    listening(ports[1]);
+    sb.run(&scenario, "out");
+    report(&sb, robot, "robot.json");
+    let s = sb.json("out", "summary.json");
+    let sd = &s["slave"]["device"];
+    let refused = num(&sd["rejected"]);
+    assert!(refused > 100.0, "{sd}");
+    let trace = sb.trace("out");
+    let h = util::column(&trace, "h_3");
+    assert!(h.iter().all(|f| *f == 0.0), "a refused force reached h(n)");
+    let warnings = s["warnings"].to_string();
+    assert!(
+        warnings.contains(&format!("slave: {refused} of ")) && warnings.contains("past max_force"),
+        "{warnings}"
+    );
+}
+
 #[test]
 fn ros_settings_are_checked_and_need_the_node_programs() {
     let sb = Sandbox::new("ros2-bad");

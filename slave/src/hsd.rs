@@ -189,9 +189,13 @@ impl Slave {
             Estimate::Fresh(_) => v.signal.energy,
             _ => [0.0; 3],
         };
-        if let Estimate::Rejected(_) = est {
-            flags |= Flags::REJECTED;
-            self.counters.rejected += 1;
+        match est {
+            Estimate::Rejected(_) => {
+                flags |= Flags::REJECTED;
+                self.counters.rejected += 1;
+            }
+            Estimate::Refused(_) => flags |= Flags::GUESS_REFUSED,
+            Estimate::Fresh(_) | Estimate::Predicted(_) => {}
         }
         if !self.predictor.has_value() {
             return (flags, [0.0; 3], 0.0);

@@ -83,13 +83,19 @@ pub enum Estimate {
     Predicted([f64; 3]),
     /// A fresh value that is not physically possible, rejected: the prediction.
     Rejected([f64; 3]),
+    /// No fresh value, and a guess from outside ([`Guess`]) that is not physically
+    /// possible (what a received value would be refused for): the last value held.
+    Refused([f64; 3]),
 }
 
 impl Estimate {
     /// The value to use.
     pub fn value(self) -> [f64; 3] {
         match self {
-            Estimate::Fresh(v) | Estimate::Predicted(v) | Estimate::Rejected(v) => v,
+            Estimate::Fresh(v)
+            | Estimate::Predicted(v)
+            | Estimate::Rejected(v)
+            | Estimate::Refused(v) => v,
         }
     }
 }
@@ -102,8 +108,10 @@ pub const HISTORY: usize = 64;
 /// A guess made outside this crate (a Python function, through the Python API), in
 /// place of the predictor's kind's. The predictor still decides what is accepted
 /// (finite, physically possible), when a guess is needed and how far ahead
-/// (`horizon_s`); a guess that is `None` or not finite holds the last value, as the
-/// kinds' do.
+/// (`horizon_s`); a guess that is `None` holds the last value, as the kinds' do, and
+/// one that a received value would be refused for (not finite, larger than
+/// `max_rate` allows, further from the last value than `max_rate` allows over the
+/// samples guessed ahead) is refused ([`Estimate::Refused`]) and holds it too.
 pub trait Guess: Send {
     /// The value at the sender's sample `to`, for the receiver's sample `n`, from
     /// `history`: the values accepted so far, `(sender's sample, value)`, oldest first,
@@ -264,9 +272,12 @@ impl Predictor {
                 self.arrived_at = n;
                 return Estimate::Fresh(v);
             }
-            return Estimate::Rejected(self.predict(n));
+            return Estimate::Rejected(self.predict(n).0);
         }
-        Estimate::Predicted(self.predict(n))
+        match self.predict(n) {
+            (v, false) => Estimate::Predicted(v),
+            (v, true) => Estimate::Refused(v),
+        }
     }
 
     fn reset(&mut self) {
@@ -334,17 +345,20 @@ impl Predictor {
 
     /// The guess for the receiver's sample `n`: the sender's signal at its sample
     /// number of the last value plus the samples since that value arrived.
-    fn predict(&mut self, n: u64) -> [f64; 3] {
+    /// The value at the receiver's sample `n`, and whether a guess from outside was
+    /// refused for it.
+    fn predict(&mut self, n: u64) -> ([f64; 3], bool) {
         let Some((t1, x1)) = self.last else {
-            return [0.0; 3];
+            return ([0.0; 3], false);
         };
         let horizon = (self.cfg.horizon_s / self.t_s).round() as u64;
         let to = t1 + n.saturating_sub(self.arrived_at).min(horizon);
         if let Some(c) = &mut self.custom {
             let history = c.history.make_contiguous();
             return match c.guess.guess(n, to, history) {
-                Some(g) if g.iter().all(|x| x.is_finite()) => g,
-                _ => x1,
+                Some(g) if self.possible_guess((t1, x1), to, g) => (g, false),
+                Some(_) => (x1, true),
+                None => (x1, false),
             };
         }
         let n = to;
@@ -360,10 +374,22 @@ impl Predictor {
             PredictorKind::Kalman => [0, 1, 2].map(|i| self.kalman[i].peek(n, self.t_s)),
         };
         if guess.iter().all(|x| x.is_finite()) {
-            guess
+            (guess, false)
         } else {
-            x1
+            (x1, false)
         }
+    }
+
+    /// A guess for the sender's sample `to` is held to what a received value is:
+    /// finite, within `max_rate` over a second, and no further from the last accepted
+    /// value `(t1, x1)` than `max_rate` allows over the samples between them (one at
+    /// least). A guess of 1e300 N was rendered at the device's full force where the
+    /// same value received was refused.
+    fn possible_guess(&self, (t1, x1): (u64, [f64; 3]), to: u64, g: [f64; 3]) -> bool {
+        let dt = to.saturating_sub(t1).max(1) as f64 * self.t_s;
+        g.iter().all(|x| x.is_finite())
+            && norm(g) <= self.max_rate
+            && distance(g, x1) <= self.max_rate * dt
     }
 }
 
@@ -509,7 +535,7 @@ mod tests {
 
     #[test]
     fn a_guess_from_outside_sees_a_bounded_history_and_is_checked() {
-        let (mut p, seen) = shown(Some([0.5; 3]));
+        let (mut p, seen) = shown(Some([2.5e-3; 3]));
         // More values than the history holds, each accepted, then a gap.
         for k in 0..100u64 {
             let v = [k as f64 * 1e-5; 3];
@@ -517,18 +543,45 @@ mod tests {
         }
         // The real value of sample 99 replaces the one the channel stood in for.
         p.estimate(100, Some((99, [2e-3; 3])));
-        assert_eq!(p.estimate(101, None), Estimate::Predicted([0.5; 3]));
+        assert_eq!(p.estimate(101, None), Estimate::Predicted([2.5e-3; 3]));
         let seen = seen.lock().expect("not poisoned");
         let (n, to, history) = &seen[0];
         assert_eq!((*n, *to), (101, 100));
         assert_eq!(history.len(), HISTORY);
         assert_eq!(history[0].0, 100 - HISTORY as u64);
         assert_eq!(history[HISTORY - 1], (99, [2e-3; 3]));
-        // Nothing, or a value not finite, holds the last one.
-        for answer in [None, Some([f64::NAN, 0.0, 0.0])] {
-            let (mut p, _) = shown(answer);
+        // Nothing holds the last value.
+        let (mut p, _) = shown(None);
+        p.estimate(0, Some((0, [0.1; 3])));
+        assert_eq!(p.estimate(1, None), Estimate::Predicted([0.1; 3]));
+    }
+
+    /// A guess is held to what a received value is: one that is not finite, larger
+    /// than `max_rate` allows, or further from the last value than `max_rate` allows
+    /// over the samples guessed ahead is refused, the last value held; within them it
+    /// is taken.
+    #[test]
+    fn a_guess_a_received_value_would_be_refused_for_is_refused() {
+        let max_rate = predictor(PredictorKind::Hold).max_rate;
+        let t_s = predictor(PredictorKind::Hold).t_s;
+        for (answer, taken) in [
+            ([f64::NAN, 0.0, 0.0], false),
+            ([1e300, 0.0, 0.0], false),
+            ([0.1 + 1.01 * max_rate * t_s, 0.1, 0.1], false),
+            ([0.1 + 0.99 * max_rate * t_s, 0.1, 0.1], true),
+        ] {
+            let (mut p, _) = shown(Some(answer));
             p.estimate(0, Some((0, [0.1; 3])));
-            assert_eq!(p.estimate(1, None), Estimate::Predicted([0.1; 3]));
+            let want = match taken {
+                true => Estimate::Predicted(answer),
+                false => Estimate::Refused([0.1; 3]),
+            };
+            assert_eq!(p.estimate(1, None), want, "{answer:?}");
         }
+        // Two samples ahead, twice the change.
+        let (mut p, _) = shown(Some([0.1 + 1.9 * max_rate * t_s, 0.1, 0.1]));
+        p.estimate(0, Some((0, [0.1; 3])));
+        p.estimate(1, None);
+        assert!(matches!(p.estimate(2, None), Estimate::Predicted(_)));
     }
 }

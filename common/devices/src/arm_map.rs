@@ -89,11 +89,17 @@ pub type FramedForce = ([f64; 3], [f64; 3], String);
 
 /// The wrench of a CDR `WrenchStamped` and its frame, if `tree` has it (an empty frame
 /// is taken as the base's); not finite, or in a frame the URDF lacks, is rejected.
-pub fn framed_force_cdr(cdr: &[u8], tree: &Tree, base: &str) -> Result<FramedForce, Reject> {
+pub fn framed_force_cdr(
+    cdr: &[u8],
+    tree: &Tree,
+    base: &str,
+    max_force: f64,
+) -> Result<FramedForce, Reject> {
     let w = WrenchStamped::from_cdr(cdr)?;
-    if !w.force.iter().chain(&w.torque).all(|f| f.is_finite()) {
+    if !w.torque.iter().all(|f| f.is_finite()) {
         return Err(Reject::ForceNotFinite);
     }
+    crate::map::plausible(w.force, max_force)?;
     let frame = match w.header.frame_id.as_str() {
         "" => base.to_string(),
         f => f.to_string(),
@@ -210,7 +216,7 @@ mod tests {
             force: [0.0, 0.0, 5.0],
             torque: [0.0; 3],
         };
-        let framed = framed_force_cdr(&w.to_cdr(), &tree, "panda_link0").expect("framed");
+        let framed = framed_force_cdr(&w.to_cdr(), &tree, "panda_link0", 1000.0).expect("framed");
         let (f, t) = in_base(
             &tree,
             ("panda_link0", "panda_hand", TorqueAbout::Frame),
@@ -231,7 +237,8 @@ mod tests {
             force: f,
             torque: p.cross(&fb).into(),
         };
-        let framed = framed_force_cdr(&at_base.to_cdr(), &tree, "panda_link0").expect("framed");
+        let framed =
+            framed_force_cdr(&at_base.to_cdr(), &tree, "panda_link0", 1000.0).expect("framed");
         let (f2, t2) = in_base(
             &tree,
             ("panda_link0", "panda_hand", TorqueAbout::Frame),
@@ -250,7 +257,8 @@ mod tests {
             force: [0.0; 3],
             torque: [0.2, 0.0, 0.0],
         };
-        let framed = framed_force_cdr(&twist.to_cdr(), &tree, "panda_link0").expect("framed");
+        let framed =
+            framed_force_cdr(&twist.to_cdr(), &tree, "panda_link0", 1000.0).expect("framed");
         let (_, t3) = in_base(
             &tree,
             ("panda_link0", "panda_hand", TorqueAbout::Frame),
@@ -270,20 +278,37 @@ mod tests {
             force: f,
             torque: [0.1, 0.0, 0.0],
         };
-        let framed = framed_force_cdr(&franka.to_cdr(), &tree, "panda_link0").expect("framed");
+        let framed =
+            framed_force_cdr(&franka.to_cdr(), &tree, "panda_link0", 1000.0).expect("framed");
         let about = ("panda_link0", "panda_hand", TorqueAbout::Tool);
         let (_, t4) = in_base(&tree, about, &names, &q, &framed);
         assert_eq!(t4, [0.1, 0.0, 0.0]);
         let mut bad = w.clone();
         bad.header.frame_id = "tool0_controller".into();
         assert_eq!(
-            framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0"),
+            framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0", 1000.0),
             Err(Reject::UnknownFrame("tool0_controller".into()))
         );
         bad.header.frame_id = String::new();
         bad.force[0] = f64::INFINITY;
         assert_eq!(
-            framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0"),
+            framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0", 1000.0),
+            Err(Reject::ForceNotFinite)
+        );
+        // A force no sensor measures: refused past max_force, taken at it.
+        bad.force = [0.0, 0.0, 1e6];
+        assert_eq!(
+            framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0", 1000.0),
+            Err(Reject::ForceImplausible {
+                force: 1e6,
+                max: 1000.0
+            })
+        );
+        bad.force = [0.0, 600.0, 800.0];
+        assert!(framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0", 1000.0).is_ok());
+        bad.torque[0] = f64::NAN;
+        assert_eq!(
+            framed_force_cdr(&bad.to_cdr(), &tree, "panda_link0", 1000.0),
             Err(Reject::ForceNotFinite)
         );
     }

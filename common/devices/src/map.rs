@@ -117,14 +117,24 @@ impl JointMap {
     }
 }
 
-/// A force from a CDR `WrenchStamped`, N; not finite is rejected.
-pub fn force_cdr(cdr: &[u8]) -> Result<[f64; 3], Reject> {
+/// A force from a CDR `WrenchStamped`, N; not finite, or longer than `max_force`,
+/// is rejected.
+pub fn force_cdr(cdr: &[u8], max_force: f64) -> Result<[f64; 3], Reject> {
     let w = WrenchStamped::from_cdr(cdr)?;
-    if w.force.iter().all(|f| f.is_finite()) {
-        Ok(w.force)
-    } else {
-        Err(Reject::ForceNotFinite)
+    plausible(w.force, max_force)
+}
+
+/// A force a sensor could have measured: finite and no longer than `max`, N. Past it
+/// a robot's wrench of 1e6 N went on to the slave and MMT's estimate.
+pub fn plausible(force: [f64; 3], max: f64) -> Result<[f64; 3], Reject> {
+    if !force.iter().all(|f| f.is_finite()) {
+        return Err(Reject::ForceNotFinite);
     }
+    let length = tactile_math::vec3::norm(force);
+    if length > max {
+        return Err(Reject::ForceImplausible { force: length, max });
+    }
+    Ok(force)
 }
 
 #[cfg(test)]
@@ -196,7 +206,25 @@ pub(crate) mod tests {
             force: [0.0, f64::INFINITY, 0.0],
             ..WrenchStamped::default()
         };
-        assert_eq!(force_cdr(&w.to_cdr()), Err(Reject::ForceNotFinite));
+        assert_eq!(force_cdr(&w.to_cdr(), 1000.0), Err(Reject::ForceNotFinite));
+        for (force, max) in [([1e300, 0.0, 0.0], 1000.0), ([0.0, 3.0, 4.0], 4.9)] {
+            let w = WrenchStamped {
+                force,
+                ..WrenchStamped::default()
+            };
+            assert!(
+                matches!(
+                    force_cdr(&w.to_cdr(), max),
+                    Err(Reject::ForceImplausible { .. })
+                ),
+                "{force:?}"
+            );
+        }
+        let w = WrenchStamped {
+            force: [0.0, 3.0, 4.0],
+            ..WrenchStamped::default()
+        };
+        assert_eq!(force_cdr(&w.to_cdr(), 5.0), Ok([0.0, 3.0, 4.0]));
     }
 
     /// omni_common's elbow is measured from the shoulder: the paper's theta_3 is their

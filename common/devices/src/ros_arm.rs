@@ -69,8 +69,8 @@ impl RosArm {
             None
         } else {
             let inbox = Inbox::new();
-            let (t, base) = (Arc::clone(&tree), chain.base.clone());
-            let decode = move |cdr: &[u8]| framed_force_cdr(cdr, &t, &base);
+            let (t, base, max) = (Arc::clone(&tree), chain.base.clone(), cfg.max_force);
+            let decode = move |cdr: &[u8]| framed_force_cdr(cdr, &t, &base, max);
             subs.push(node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, &inbox, decode)?);
             Some(inbox)
         };

@@ -57,7 +57,9 @@ impl RosRobot {
             None
         } else {
             let inbox = Inbox::new();
-            subs.push(node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, &inbox, force_cdr)?);
+            let max = cfg.max_force;
+            let decode = move |cdr: &[u8]| force_cdr(cdr, max);
+            subs.push(node.subscribe(&cfg.wrench_topic, WrenchStamped::TYPE, &inbox, decode)?);
             Some(inbox)
         };
         Ok(RosRobot {

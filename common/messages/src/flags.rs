@@ -6,8 +6,8 @@
 //! - the payload's: what a sample carries or how the network treated it
 //!   ([`Flags::PAYLOAD`]: substituted, unsent, corrupted, pose, released);
 //! - notes of what the node that set them did, for the trace ([`Flags::NOTES`]: IK
-//!   clamped, rejected, rotation rejected, contact, held, peer lost, clamped). No
-//!   receiver acts on them.
+//!   clamped, rejected, rotation rejected, contact, held, peer lost, clamped, guess
+//!   refused). No receiver acts on them.
 //!
 //! On the wire and in records a `Flags` is its `u32` (`repr(C)` over one `u32`, serde
 //! transparent), so the layout and the bytes are those of the bare number.
@@ -25,7 +25,7 @@ use std::ops::{BitAnd, BitOr, BitOrAssign};
 pub struct Flags(u32);
 
 /// Each named flag with its bit, in bit order, for [`Flags`]' `Debug`.
-const NAMES: [(&str, Flags); 16] = [
+const NAMES: [(&str, Flags); 17] = [
     ("SUBSTITUTED", Flags::SUBSTITUTED),
     ("IK_CLAMPED", Flags::IK_CLAMPED),
     ("REJECTED", Flags::REJECTED),
@@ -42,6 +42,7 @@ const NAMES: [(&str, Flags); 16] = [
     ("POSE", Flags::POSE),
     ("RELEASED", Flags::RELEASED),
     ("ROTATION_REJECTED", Flags::ROTATION_REJECTED),
+    ("GUESS_REFUSED", Flags::GUESS_REFUSED),
 ];
 
 impl Flags {
@@ -102,6 +103,10 @@ impl Flags {
     /// one) and held the last one it took; the position may still have been followed,
     /// so the position's tracking errors keep the step.
     pub const ROTATION_REJECTED: Flags = Flags(32768);
+    /// Note: the node's predictor refused a guess from outside the scenario (a Python
+    /// function) that a received value would have been refused for (not finite, too
+    /// large, too fast) and held the last value instead.
+    pub const GUESS_REFUSED: Flags = Flags(65536);
 
     /// The flags that make a sample a control message.
     pub(crate) const CONTROL: Flags = Flags(16 | 32 | 2048 | 4096);
@@ -109,7 +114,7 @@ impl Flags {
     /// carries.
     pub const PAYLOAD: Flags = Flags(1 | 256 | 1024 | 8192 | 16384);
     /// Notes of what the node that set them did with the sample, for the trace.
-    pub const NOTES: Flags = Flags(2 | 4 | 8 | 64 | 128 | 512 | 32768);
+    pub const NOTES: Flags = Flags(2 | 4 | 8 | 64 | 128 | 512 | 32768 | 65536);
 
     /// The flags as the number on the wire, in records and in the trace's columns.
     pub const fn bits(self) -> u32 {

@@ -34,6 +34,14 @@ pub enum Reject {
     /// A force that is NaN or infinite.
     #[error("force is not finite")]
     ForceNotFinite,
+    /// A force larger than any measurement could be (`[slave.ros2] max_force`).
+    #[error("force of {force:.3e} N is above max_force ({max} N): no measurement")]
+    ForceImplausible {
+        /// Its length, N.
+        force: f64,
+        /// The bound, N.
+        max: f64,
+    },
     /// A pose that is not one: not finite, or an orientation that is not a rotation.
     #[error("not a pose: {0}")]
     BadPose(String),

@@ -280,6 +280,9 @@ pub struct Analysis {
     pub received: u64,
     /// Rows in all.
     pub rows: u64,
+    /// Samples whose predictor refused a guess from outside the scenario (the Python
+    /// API) as not physically possible: the master's, the slave's.
+    pub guesses_refused: [u64; 2],
     with_stages: bool,
     /// Each node's clock domain (empty: the node left no record).
     domains: [String; 3],
@@ -302,6 +305,7 @@ impl Analysis {
             bilateral: crate::metrics::Bilateral::default(),
             received: 0,
             rows: 0,
+            guesses_refused: [0; 2],
             with_stages,
             domains,
             offsets: Default::default(),
@@ -314,6 +318,9 @@ impl Analysis {
     /// Adds one row.
     pub fn add(&mut self, row: &TraceRow) {
         self.rows += 1;
+        for (k, flags) in [row.flags_m, row.flags_s].into_iter().enumerate() {
+            self.guesses_refused[k] += u64::from(flags.intersects(Flags::GUESS_REFUSED));
+        }
         self.bilateral.add(row);
         let m = &mut self.motion;
         m.force_max_n = m.force_max_n.max(norm(row.h));

@@ -6,6 +6,7 @@
 use crate::analysis::Analysis;
 use crate::join::{Logs, NodeLog};
 use tactile_messages::Role;
+use tactile_records::device::DeviceCounters;
 use tactile_records::slave::SlaveCounters;
 
 /// The warnings of a report from its analysis, the nodes' logs and the slave's summed
@@ -52,6 +53,13 @@ pub fn warnings(
         ));
     }
     out.extend(slave_counters.and_then(dynamics_failed));
+    for (role, refused) in [Role::Master, Role::Slave].iter().zip(a.guesses_refused) {
+        if refused > 0 {
+            out.push(format!(
+                "{role}: {refused} guesses of its predictor from outside the scenario (the Python API) were not physically possible (not finite, too large or too fast for a received value) and were refused: the last value was held instead (GUESS_REFUSED in the trace's flags)"
+            ));
+        }
+    }
     out
 }
 
@@ -65,6 +73,22 @@ pub fn dynamics_failed(c: &SlaveCounters) -> Option<String> {
             c.dynamics_failed
         )
     })
+}
+
+/// A real device or robot whose messages were refused (malformed, not finite, out of
+/// range, a force past `max_force`): the loop went on from its last good value, which
+/// the figures do not say. The first refusal's reason is in that node's log.
+pub fn devices_rejected(master: &DeviceCounters, slave: Option<&DeviceCounters>) -> Vec<String> {
+    [("master", "its device", Some(master)), ("slave", "its robot", slave)]
+        .into_iter()
+        .filter_map(|(role, what, d)| {
+            let d = d.filter(|d| d.rejected > 0)?;
+            Some(format!(
+                "{role}: {} of {} messages from {what} were refused (malformed, not finite, out of range, or a force past max_force: the log names the first) and the loop went on from the last good one",
+                d.rejected, d.messages
+            ))
+        })
+        .collect()
 }
 
 /// A node's sample rows the join left out, if any, and why.
@@ -85,6 +109,25 @@ fn left_out<C: Clone>(role: Role, log: &NodeLog<C>, samples: u64, out: &mut Vec<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 65: a robot's wrench of 1e300 N was refused by nobody, and one refused
+    /// was not said in the summary.
+    #[test]
+    fn refused_device_messages_are_warned_of_with_the_count() {
+        let none = DeviceCounters::default();
+        assert!(devices_rejected(&none, Some(&none)).is_empty());
+        let robot = DeviceCounters {
+            messages: 40,
+            rejected: 3,
+            ..DeviceCounters::default()
+        };
+        let w = devices_rejected(&none, Some(&robot));
+        assert_eq!(w.len(), 1);
+        assert!(
+            w[0].starts_with("slave: 3 of 40 messages from its robot were refused"),
+            "{w:?}"
+        );
+    }
 
     /// Issue 51: an arm whose dynamics failed was counted by the slave, and the report
     /// said nothing of it.

@@ -306,12 +306,16 @@ fn summarise(
             .ok()
             .zip(scenario.device.geometry().ok()),
     );
-    let warnings = crate::warnings::warnings(
+    let mut warnings = crate::warnings::warnings(
         a,
         logs,
         master_totals.counters.sent,
         slave.as_ref().map(|s| &s.counters),
     );
+    warnings.extend(crate::warnings::devices_rejected(
+        &master_totals.device,
+        slave.as_ref().map(|s| &s.device),
+    ));
     Summary {
         scenario: scenario.name.clone(),
         mode: scenario.mode,

@@ -72,6 +72,12 @@ pub struct RosRobotConfig {
     /// frame's axes: Franka's `external_wrench_in_base_frame`, about its stiffness
     /// frame, given in the base).
     pub wrench_torque: TorqueAbout,
+    /// The largest force a wrench message may carry, N (its length, in the sensor's
+    /// frame): past it a message is no measurement (a driver's garbage, a unit
+    /// mix-up, 1e300 N) and is refused and counted as a non-finite one is, the last
+    /// good force kept until it goes stale [1000: past any cobot's sensing range and
+    /// most wrist sensors'].
+    pub max_force: f64,
 }
 
 /// Where a wrench's torque is taken about.
@@ -99,6 +105,7 @@ impl Default for RosRobotConfig {
             command: RobotCommand::Positions,
             trajectory_time_s: None,
             wrench_torque: TorqueAbout::Frame,
+            max_force: 1000.0,
         }
     }
 }
@@ -164,6 +171,7 @@ impl RosRobotConfig {
             topic_name(&self.wrench_topic, "slave.ros2.wrench_topic")?;
         }
         self.paper_wrench_map().validate("slave.ros2.wrench_map")?;
+        positive(self.max_force, "slave.ros2.max_force", false)?;
         for (i, v) in self.paper_max_velocity().iter().enumerate() {
             positive(*v, &format!("slave.ros2.max_velocity[{i}]"), false)?;
         }

@@ -3,6 +3,7 @@
 
 use super::switch::Rendering;
 use super::Master;
+use tactile_control::codec::Estimate;
 use tactile_messages::samples::{stage, Flags};
 use tactile_records::master::{Answer, Miss};
 
@@ -26,14 +27,18 @@ impl Master {
             (Flags::PEER_LOST, out)
         } else {
             self.counters.held_samples += 1;
-            let guess = self.predictor.estimate(n, None).value();
+            let estimate = self.predictor.estimate(n, None);
+            let flags = match estimate {
+                Estimate::Refused(_) => Flags::HELD | Flags::GUESS_REFUSED,
+                _ => Flags::HELD,
+            };
             // MMT's model needs no answer: it is rendered against the handle as before.
-            let guess = self.model_force(guess);
+            let guess = self.model_force(estimate.value());
             let out = self
                 .control
                 .receive(guess, [0.0; 3], self.limits.force_limit);
             self.command(&out);
-            (Flags::HELD, out)
+            (flags, out)
         };
         Miss {
             n,

@@ -493,9 +493,13 @@ impl Master {
             Estimate::Fresh(_) => q.signal.energy,
             _ => [0.0; 3],
         };
-        if let Estimate::Rejected(_) = est {
-            self.counters.rejected += 1;
-            flags |= Flags::REJECTED;
+        match est {
+            Estimate::Rejected(_) => {
+                self.counters.rejected += 1;
+                flags |= Flags::REJECTED;
+            }
+            Estimate::Refused(_) => flags |= Flags::GUESS_REFUSED,
+            Estimate::Fresh(_) | Estimate::Predicted(_) => {}
         }
         let value = self.rendered(q, est.value());
         let out = self.control.receive(value, energy, self.limits.force_limit);
