@@ -185,31 +185,30 @@ pub(crate) fn device_standin_on(sb: &Sandbox, domain: u32, listen: &str, extra: 
 }
 
 /// The stand-in robot on `/arm/...` in ROS domain `domain`, listening on `port`, until
-/// two seconds after the last command.
-fn robot_standin(sb: &Sandbox, domain: u32, port: u16) -> Child {
+/// two seconds after the last command; `extra` after its arguments.
+fn robot_standin(sb: &Sandbox, domain: u32, port: u16, extra: &[&str]) -> Child {
     let (domain, listen) = (domain.to_string(), format!("tcp/127.0.0.1:{port}"));
-    standin(
-        sb,
-        &[
-            "robot",
-            "--domain",
-            &domain,
-            "--listen",
-            &listen,
-            "--names",
-            "j1,j2,j3",
-            "--joint-topic",
-            "/arm/joint_states",
-            "--command-topic",
-            "/arm/commands",
-            "--duration",
-            "60",
-            "--idle-exit",
-            "2",
-            "--report",
-            "robot.json",
-        ],
-    )
+    let mut args = vec![
+        "robot",
+        "--domain",
+        &domain,
+        "--listen",
+        &listen,
+        "--names",
+        "j1,j2,j3",
+        "--joint-topic",
+        "/arm/joint_states",
+        "--command-topic",
+        "/arm/commands",
+        "--duration",
+        "60",
+        "--idle-exit",
+        "2",
+        "--report",
+        "robot.json",
+    ];
+    args.extend_from_slice(extra);
+    standin(sb, &args)
 }
 
 fn mean(v: impl Iterator<Item = f64>) -> f64 {
@@ -246,7 +245,7 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
     // The device plays the same angles in its driver's units, then holds.
     device_csv(&sb, &joints);
     let ports = [free_port(), free_port()];
-    let robot = robot_standin(&sb, 11, ports[1]);
+    let robot = robot_standin(&sb, 11, ports[1], &[]);
     let device = device_standin(
         &sb,
         11,
@@ -464,50 +463,45 @@ fn a_ros2_device_and_robot_close_the_loop_like_the_simulated_ones() {
     assert!(errors.is_empty(), "{errors:?}");
 }
 
+/// The paper arm's stand-in robot with a force sensor reporting `wrench` on
+/// `/arm/wrench`, on `domain`, listening on `ports[1]` (`extra` after its arguments),
+/// and the scenario of `samples` in real time that drives it; the robot's report goes
+/// to `robot.json`.
+fn sensing_robot(
+    sb: &Sandbox,
+    domain: u32,
+    wrench: [&str; 3],
+    extra: &[&str],
+    samples: u64,
+) -> (Child, std::path::PathBuf, [u16; 2]) {
+    let ports = [free_port(), free_port()];
+    let mut args = vec!["--wrench-topic", "/arm/wrench", "--wrench"];
+    args.extend(wrench);
+    args.extend(extra);
+    let robot = robot_standin(sb, domain, ports[1], &args);
+    let tables = ros_tables(domain, ports, false, false).replace(
+        "command_topic = \"/arm/commands\"\n",
+        "command_topic = \"/arm/commands\"\nwrench_topic = \"/arm/wrench\"\n",
+    );
+    let scenario = sb.write(
+        "robot.toml",
+        &format!("{}{tables}", looped("realtime", samples)),
+    );
+    (robot, scenario, ports)
+}
+
 #[test]
 fn a_robot_that_goes_silent_is_held_and_its_sensor_gives_the_force() {
     if !python_ready() {
         return cannot("python3 lacks eclipse-zenoh or rosbags");
     }
     let sb = Sandbox::new("ros2-robot");
-    let ports = [free_port(), free_port()];
-    let robot = standin(
+    let (robot, scenario, ports) = sensing_robot(
         &sb,
-        &[
-            "robot",
-            "--domain",
-            "12",
-            "--listen",
-            &format!("tcp/127.0.0.1:{}", ports[1]),
-            "--names",
-            "j1,j2,j3",
-            "--joint-topic",
-            "/arm/joint_states",
-            "--command-topic",
-            "/arm/commands",
-            "--wrench-topic",
-            "/arm/wrench",
-            "--wrench",
-            "0.25",
-            "-0.5",
-            "1.5",
-            "--silent-at",
-            "2.0",
-            "--duration",
-            "60",
-            "--idle-exit",
-            "2",
-            "--report",
-            "robot.json",
-        ],
-    );
-    let tables = ros_tables(12, ports, false, false).replace(
-        "command_topic = \"/arm/commands\"\n",
-        "command_topic = \"/arm/commands\"\nwrench_topic = \"/arm/wrench\"\n",
-    );
-    let scenario = sb.write(
-        "robot.toml",
-        &format!("{}{tables}", looped("realtime", 400)),
+        12,
+        ["0.25", "-0.5", "1.5"],
+        &["--silent-at", "2.0"],
+        400,
     );
     listening(ports[1]);
     sb.run(&scenario, "out");
@@ -549,43 +543,7 @@ fn a_robot_wrench_past_max_force_is_refused_and_said() {
         return cannot("python3 lacks eclipse-zenoh or rosbags");
     }
     let sb = Sandbox::new("ros2-wrench");
-    let ports = [free_port(), free_port()];
-    let robot = standin(
-        &sb,
-        &[
-            "robot",
-            "--domain",
-            "13",
-            "--listen",
-            &format!("tcp/127.0.0.1:{}", ports[1]),
-            "--names",
-            "j1,j2,j3",
-            "--joint-topic",
-            "/arm/joint_states",
-            "--command-topic",
-            "/arm/commands",
-            "--wrench-topic",
-            "/arm/wrench",
-            "--wrench",
-            "0",
-            "0",
-            "2000",
-            "--duration",
-            "60",
-            "--idle-exit",
-            "2",
-            "--report",
-            "robot.json",
-        ],
-    );
-    let tables = ros_tables(13, ports, false, false).replace(
-        "command_topic = \"/arm/commands\"\n",
-        "command_topic = \"/arm/commands\"\nwrench_topic = \"/arm/wrench\"\n",
-    );
-    let scenario = sb.write(
-        "robot.toml",
-        &format!("{}{tables}", looped("realtime", 300)),
-    );
+    let (robot, scenario, ports) = sensing_robot(&sb, 47, ["0", "0", "2000"], &[], 300);
     listening(ports[1]);
     sb.run(&scenario, "out");
     report(&sb, robot, "robot.json");
@@ -703,7 +661,7 @@ fn a_run_stopped_by_sigint_leaves_no_force_and_the_robot_holding() {
     let (joints, _) = paper_move(&sb);
     device_csv(&sb, &joints);
     let ports = [free_port(), free_port()];
-    let robot = robot_standin(&sb, 13, ports[1]);
+    let robot = robot_standin(&sb, 13, ports[1], &[]);
     let device = device_standin(&sb, 13, ports[0], &["--end-after", "8.0"]);
     let scenario = sb.write(
         "ros.toml",
@@ -789,7 +747,7 @@ fn a_slave_waiting_for_its_robot_is_named_by_the_master() {
     }
     let sb = Sandbox::new("ros2-wait");
     let ports = [free_port(), free_port()];
-    let robot = robot_standin(&sb, 14, ports[1]);
+    let robot = robot_standin(&sb, 14, ports[1], &[]);
     let tables = ros_tables(14, ports, false, false)
         .replace("\"/arm/joint_states\"", "\"/arm/elsewhere\"")
         .replace(&format!("\"tcp/127.0.0.1:{}\", ", ports[0]), "");
@@ -836,7 +794,7 @@ fn a_device_whose_messages_are_all_dropped_says_why() {
     sb.write("device.csv", "t,waist,shoulder,elbow\n0,0,0,0\n1,0,0,0\n");
     let ports = [free_port(), free_port()];
     let device = device_standin(&sb, 15, ports[0], &["--end-after", "0"]);
-    let robot = robot_standin(&sb, 15, ports[1]);
+    let robot = robot_standin(&sb, 15, ports[1], &[]);
     let tables = ros_tables(15, ports, false, true).replace(
         "joints = [\"waist\", \"shoulder\", \"elbow\"]",
         "joints = [\"waist\", \"shoulder\", \"wrist\"]",
