@@ -190,11 +190,15 @@ fn panel(area: &Area, fig: &Figure, p: &Panel, (y0, y1): (f64, f64)) -> Result<(
         if joined {
             draw_line(&mut chart, at.clone(), &look, "")?;
         }
-        let bars = pts.iter().filter(|p| p.2 > 0.0).map(|p| {
-            let style = ShapeStyle::from(look.colour).stroke_width(2);
-            ErrorBar::new_vertical(p.0, p.1 - p.2, p.1, p.1 + p.2, style, 10)
-        });
-        chart.draw_series(bars).map_err(err)?;
+        // The interval as a bar with a cap at each end (plotters' ErrorBar also rings
+        // the mean, which hid the line's own marker).
+        let style = ShapeStyle::from(look.colour).stroke_width(2);
+        for &(x, y, e) in pts.iter().filter(|p| p.2 > 0.0) {
+            let bar = PathElement::new(vec![(x, y - e), (x, y + e)], style);
+            let cap = |y| EmptyElement::at((x, y)) + PathElement::new(vec![(-5, 0), (5, 0)], style);
+            chart.draw_series([bar]).map_err(err)?;
+            chart.draw_series([cap(y - e), cap(y + e)]).map_err(err)?;
+        }
         chart
             .draw_series(at.iter().map(|&a| marker(a, &look)))
             .map_err(err)?;

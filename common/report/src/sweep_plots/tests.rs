@@ -228,3 +228,23 @@ fn a_third_key_is_a_panel_of_its_own() {
         assert!(xs.windows(2).all(|w| w[0] < w[1]), "{xs:?}");
     }
 }
+
+/// With seeds, each mean has its 95 % interval as a bar that leaves the line's own
+/// marker alone (no ring around it), and the title's line says what the bars are.
+#[test]
+fn error_bars_leave_the_markers_as_they_are() {
+    let keys = ["network.forward.delay_ms=0,50", "control.kind=tdpa,wave"];
+    let axes: Vec<Axis> = keys.iter().map(|k| axis(k).expect("axis")).collect();
+    let points: Vec<Point> = combinations(&axes)
+        .into_iter()
+        .map(|c| (c, vec![(Some(1.0), Some(0.25)); METRICS.len()]))
+        .collect();
+    let dir = tempfile::tempdir().expect("tmp");
+    sweep_plots(dir.path(), &axes, &points).expect("plots");
+    let text = read(&dir, "samples_sent");
+    assert_eq!(svg::shapes(&text, &hex(0, 2)), ["circle"]);
+    assert_eq!(svg::shapes(&text, &hex(1, 2)), ["polygon"]);
+    let texts = svg::texts(&text);
+    let note = "error bars: 95 % confidence interval of the mean over the seeds";
+    assert!(texts.iter().any(|t| t == note), "{texts:?}");
+}
