@@ -86,17 +86,18 @@ fn a_sweep_runs_every_combination_and_tabulates_the_summaries() {
         assert_eq!(cell, rms, "row {k}");
         assert!(!sb.path(&format!("sw/run-{k:04}/trace.csv")).exists());
     }
-    // The delay shows in the round trip: 0, 10 and 40 samples forward.
+    // The delay shows in the round trip: 0, 10 and 40 samples forward, to the
+    // nanosecond (in process a round trip is the delay itself; the histogram's bucket
+    // read 10,002,431 ns for 10 ms), and the summary says its percentiles are exact.
     let rt = |k: usize| {
-        sb.json(&format!("sw/run-{k:04}"), "summary.json")["round_trip_ns"]["p50"].as_u64()
+        let p = &sb.json(&format!("sw/run-{k:04}"), "summary.json")["round_trip_ns"];
+        assert_eq!(p["exact"], true, "{p}");
+        p["p50"].as_u64().expect("p50")
     };
-    assert!(
-        rt(0) < rt(2) && rt(2) < rt(4),
-        "{:?} {:?} {:?}",
-        rt(0),
-        rt(2),
-        rt(4)
-    );
+    let (a, b, c) = (rt(0), rt(2), rt(4));
+    assert_eq!((b - a, c - a), (10_000_000, 40_000_000), "{a} {b} {c}");
+    let p50 = &cells(lines[1 + 2])[col("round_trip_p50_ns")];
+    assert_eq!(*p50, b.to_string(), "sweep.csv's cell is the summary's");
     for metric in ["tracking_rms_m", "round_trip_p50_ns"] {
         let svg = sb.path("sw").join(format!("sweep-{metric}.svg"));
         let text = std::fs::read_to_string(&svg).expect("plot");

@@ -10,6 +10,7 @@ pub mod analysis;
 pub mod arm_scene;
 pub mod columns;
 pub mod error;
+pub mod figures;
 pub mod hardware;
 pub mod join;
 pub mod joints;

@@ -119,6 +119,16 @@ where
     }
 }
 
+/// Removes `path` if it is there.
+pub fn remove_if_there(path: &Path) -> Result<(), Error> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(Error::io(format!("removing {}", path.display()))(e))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Writes `text` to `path` whole or not at all.
 pub fn write_file(path: &Path, text: &str) -> Result<(), Error> {
     whole(path, |tmp| std::fs::write(tmp, text))

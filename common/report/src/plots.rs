@@ -16,8 +16,9 @@ use tactile_messages::samples::Flags;
 pub(crate) mod looks;
 mod percentiles;
 mod stretches;
+pub(crate) mod ticked;
 mod timeplot;
-pub(crate) use looks::{draw_legend, draw_line, draw_markers, look};
+pub(crate) use looks::{draw_legend, draw_line, look};
 pub use percentiles::percentile_plot;
 use stretches::Stretches;
 pub(crate) use timeplot::tick;
@@ -253,10 +254,9 @@ pub fn overhead_histogram(lat: &Latency, path: &Path) -> PlotResult {
     let bins = 100usize;
     let width = hi / bins as f64;
     let mut counts = vec![0u64; bins];
-    for v in lat.histogram().iter_recorded() {
-        let us = v.value_iterated_to() as f64 / 1000.0;
-        let k = ((us / width) as usize).min(bins - 1);
-        counts[k] += v.count_at_value();
+    for (v, n) in lat.counts() {
+        let k = ((v as f64 / 1000.0 / width) as usize).min(bins - 1);
+        counts[k] += n;
     }
     let top = counts.iter().copied().max().unwrap_or(1) as f64 * 1.1;
     let mut chart = ChartBuilder::on(&root)

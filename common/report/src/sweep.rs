@@ -266,7 +266,7 @@ pub fn mean_ci95(v: &[f64]) -> Option<(f64, Option<f64>)> {
 /// The unit of a swept key, for a plot's labels: `ms` for the milliseconds keys
 /// (`delay_ms`, `schedule_ms[1][0]`, `jitter.jitter_ms`, any `_ms`), `samples` for
 /// their twins that count samples (`delay`, `schedule`, `jitter.jitter`, any
-/// `_samples`); `N/m` for a stiffness (`environment.objects[0].stiffness`), `N s/m`
+/// `_samples`); `s` for seconds (`operator.move_s`, any `_s`), `Hz` for a rate; `N/m` for a stiffness (`environment.objects[0].stiffness`), `N s/m`
 /// for a wave impedance or a damping; `None` for the rest. A `delay` of 10 and a
 /// `delay_ms` of 10 are ten times apart at 100 Hz, and a plot must say which it shows.
 pub fn unit(key: &str) -> Option<&'static str> {
@@ -277,6 +277,10 @@ pub fn unit(key: &str) -> Option<&'static str> {
         .any(|&(s, _)| s == name && (s != "jitter" || key.ends_with("jitter.jitter")));
     if name.ends_with("_ms") {
         Some("ms")
+    } else if name.ends_with("_s") {
+        Some("s")
+    } else if name.ends_with("_hz") {
+        Some("Hz")
     } else if samples || name.ends_with("_samples") {
         Some("samples")
     } else if name.ends_with("stiffness") {
@@ -293,8 +297,10 @@ pub fn labelled(key: &str) -> String {
     unit(key).map_or_else(|| key.to_string(), |u| format!("{key} ({u})"))
 }
 
-/// A swept value as a number for a plot's axis: the number itself, or a vector's
-/// elements' mean (`[25,25,25]` is 25); `None` for words.
+/// A swept value as a number for a plot's axis: the number itself, or the one number
+/// a vector repeats (`[25,25,25]` is 25); `None` for words and for a vector of
+/// different numbers (`[0,3,6]` is no more 3 than `[3,3,3]`: a plot shows it as a
+/// category, written as it was swept).
 pub fn numeric(value: &str) -> Option<f64> {
     let v = value.trim();
     if let Ok(x) = v.parse::<f64>() {
@@ -306,7 +312,8 @@ pub fn numeric(value: &str) -> Option<f64> {
         .map(|e| e.trim().parse::<f64>())
         .collect::<Result<_, _>>()
         .ok()?;
-    (!xs.is_empty()).then(|| xs.iter().sum::<f64>() / xs.len() as f64)
+    let first = *xs.first()?;
+    xs.iter().all(|x| *x == first).then_some(first)
 }
 
 /// A CSV field, quoted when it holds a comma or a quote.
@@ -358,6 +365,9 @@ mod tests {
                 "environment.objects[0].stiffness (N/m)",
             ),
             ("control.wave_impedance", "control.wave_impedance (N s/m)"),
+            ("operator.move_s", "operator.move_s (s)"),
+            ("rate_hz", "rate_hz (Hz)"),
+            ("samples", "samples"),
             ("control.kind", "control.kind"),
             ("network.forward.loss", "network.forward.loss"),
         ] {
@@ -408,10 +418,11 @@ mod tests {
     }
 
     #[test]
-    fn vector_values_are_numbers_on_an_axis() {
+    fn vectors_of_one_number_are_that_number_on_an_axis() {
         assert_eq!(numeric("25"), Some(25.0));
         assert_eq!(numeric("[25,25,25]"), Some(25.0));
-        assert_eq!(numeric("[0, 3, 6]"), Some(3.0));
+        assert_eq!(numeric("[0, 3, 6]"), None);
+        assert_eq!(numeric("[3, 3, 3.0]"), Some(3.0));
         assert_eq!(numeric("tdpa"), None);
         assert_eq!(numeric("[a,b]"), None);
     }

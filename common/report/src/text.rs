@@ -2,7 +2,7 @@
 //! samples, motion and forces, the counters, devices, nodes, events), each part a
 //! function of its own.
 
-use crate::analysis::{us_header, us_line};
+use crate::analysis::{rounding_note, us_header, us_line};
 use crate::summary::{Summary, REPORT_FILES};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -56,13 +56,21 @@ fn timing(t: &mut String, s: &Summary) {
     if let Some(why) = s.overhead_na {
         let _ = writeln!(t, "system overhead: n/a ({why})");
     }
-    let _ = writeln!(t, "{}", us_header());
+    // The header only over rows (a lockstep run in process has none).
+    if s.overhead_na.is_none() || !s.stages_ns.is_empty() {
+        let _ = writeln!(t, "{}", us_header());
+    }
     if s.overhead_na.is_none() {
         let _ = writeln!(t, "{}", us_line("round trip", s.round_trip_ns.as_ref()));
         let _ = writeln!(t, "{}", us_line("system overhead", s.overhead_ns.as_ref()));
     }
     for (name, p) in &s.stages_ns {
         let _ = writeln!(t, "{}", us_line(&format!("  {name}"), Some(p)));
+    }
+    let rows = [&s.round_trip_ns, &s.overhead_ns].into_iter().flatten();
+    let rows = rows.filter(|_| s.overhead_na.is_none());
+    if let Some(note) = rounding_note(rows.chain(s.stages_ns.values())) {
+        let _ = writeln!(t, "{note}");
     }
     if !s.clocks.shared {
         let _ = writeln!(

@@ -4,7 +4,7 @@
 use crate::analysis::{Analysis, STAGES};
 use crate::join::{self, Logs, NodeLog};
 use crate::metrics::Packets;
-use crate::plots::{self, Series};
+use crate::plots::Series;
 use crate::run_mcap;
 use crate::streams::Streams;
 pub use crate::streams::{Outputs, TraceFormat, PARQUET_FILE};
@@ -64,16 +64,6 @@ impl Launch {
 
 pub fn write_file(path: &Path, text: &str) -> Result<(), Error> {
     crate::out::write_file(path, text)
-}
-
-/// Removes `path` if it is there.
-fn remove_if_there(path: &Path) -> Result<(), Error> {
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(Error::io(format!("removing {}", path.display()))(e))
-        }
-        _ => Ok(()),
-    }
 }
 
 /// Removes what a failed report had started (its temporary files).
@@ -412,37 +402,6 @@ fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
     Ok((starts, scenario))
 }
 
-/// The histograms and the plots of a run.
-fn figures(out: &Path, analysis: &Analysis, series: &Series) -> Result<(), Error> {
-    let round_trip = analysis.round_trip.hgrm();
-    let overhead = analysis.overhead.hgrm();
-    write_file(&out.join("round_trip.hgrm"), &round_trip)?;
-    write_file(&out.join("overhead.hgrm"), &overhead)?;
-    let plot = |name: &str, res: Result<(), String>| {
-        res.map_err(|e| Error::Failed(format!("plotting {name}: {e}")))
-    };
-    plot(
-        "latency",
-        plots::whole_svg(&out.join("latency.svg"), |p| {
-            plots::overhead_histogram(&analysis.overhead, p)
-        }),
-    )?;
-    plot(
-        "percentiles",
-        plots::whole_svg(&out.join("percentiles.svg"), |p| {
-            plots::percentile_plot(
-                p,
-                "Latency by percentile",
-                &[
-                    ("round trip".into(), plots::read_hgrm(&round_trip)),
-                    ("system overhead".into(), plots::read_hgrm(&overhead)),
-                ],
-            )
-        }),
-    )?;
-    plot("positions and forces", series.write(out))
-}
-
 /// The run's runner and the analysis that fits it: the in-process simulation's
 /// stamps are synthetic, so no stage times come from them.
 fn analysis_for(starts: &[Option<Start>; 3]) -> Result<(&'static str, Analysis), Error> {
@@ -471,7 +430,7 @@ pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Sum
     make_out_dir(out)?;
     // Written last: until then the folder holds no summary, so no older one sits beside
     // this report's files if it is cut short.
-    remove_if_there(&out.join("summary.json"))?;
+    crate::out::remove_if_there(&out.join("summary.json"))?;
     report_into(dirs, out, launch, &scenario, (runner, analysis)).inspect_err(|_| discard(out))
 }
 
@@ -511,7 +470,8 @@ fn report_into(
     })?;
     streams.finish(out)?;
     analysis.finish();
-    figures(out, &analysis, &series)?;
+    let lockstep = scenario.mode == tactile_scenario::Mode::Lockstep;
+    crate::figures::write(out, &analysis, &series, lockstep)?;
     // Inputs copied into the folder are referred to relatively, so it reruns anywhere.
     let here = std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
     write_file(

@@ -6,9 +6,9 @@
 
 use super::{err, PlotResult, LOOP_COLOURS};
 use plotters::coord::ranged1d::Ranged;
-use plotters::coord::types::RangedCoordf64;
-use plotters::element::DashedPathElement;
+use plotters::element::{DashedPathElement, Drawable, PointCollection};
 use plotters::prelude::*;
+use plotters_backend::{BackendCoord, DrawingErrorKind};
 
 /// Dash and gap lengths, pixels, per series (solid first): at most a few dozen
 /// points per sweep line, and a percentile line of a few hundred, so the dashes stay
@@ -127,31 +127,61 @@ where
         .map_err(err)
 }
 
-/// Draws a marker in `look` at each of `pts`.
-pub(crate) fn draw_markers<'a, DB>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
-    pts: &[(f64, f64)],
-    look: &Look,
-) -> PlotResult
-where
-    DB: DrawingBackend + 'a,
-{
-    let (s, style) = (look.size, look.style());
-    let at = pts.iter().copied();
-    let half = s as i32 - 1;
-    match look.marker {
-        Marker::Circle => chart.draw_series(at.map(|p| Circle::new(p, s, style.filled()))),
-        Marker::Ring => chart.draw_series(at.map(|p| Circle::new(p, s, style.stroke_width(2)))),
-        Marker::Triangle => {
-            chart.draw_series(at.map(|p| TriangleMarker::new(p, s + 1, style.filled())))
-        }
-        Marker::Cross => chart.draw_series(at.map(|p| Cross::new(p, s, style.stroke_width(2)))),
-        Marker::Square => chart.draw_series(at.map(|p| {
-            EmptyElement::at(p) + Rectangle::new([(-half, -half), (half, half)], style.filled())
-        })),
+/// A text's width in pixels in a sans-serif font of `size` (as plotters takes it: it
+/// writes `size / 1.24` px type), about: an average character is 0.45 of the size,
+/// a little over what the renderers draw. Where a label fits, where a legend's
+/// columns go.
+pub(crate) fn text_w(s: &str, size: u32) -> i32 {
+    (s.chars().count() as f64 * size as f64 * 0.45).ceil() as i32
+}
+
+/// A marker in `look` at a point in any coordinates (a chart's, or a legend's
+/// pixels): the shape is drawn in pixels around where the point lands.
+#[derive(Debug, Clone)]
+pub(crate) struct MarkerAt<C> {
+    at: C,
+    look: Look,
+}
+
+/// The marker of `look` at `at`.
+pub(crate) fn marker<C>(at: C, look: &Look) -> MarkerAt<C> {
+    MarkerAt { at, look: *look }
+}
+
+impl<'a, C> PointCollection<'a, C> for &'a MarkerAt<C> {
+    type Point = &'a C;
+    type IntoIter = std::iter::Once<&'a C>;
+    fn point_iter(self) -> Self::IntoIter {
+        std::iter::once(&self.at)
     }
-    .map_err(err)?;
-    Ok(())
+}
+
+impl<C, DB: DrawingBackend> Drawable<DB> for MarkerAt<C> {
+    fn draw<I: Iterator<Item = BackendCoord>>(
+        &self,
+        mut pos: I,
+        backend: &mut DB,
+        dim: (u32, u32),
+    ) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
+        let Some(p) = pos.next() else {
+            return Ok(());
+        };
+        let (s, style) = (self.look.size, self.look.style());
+        let half = s as i32 - 1;
+        let at = std::iter::once(p);
+        match self.look.marker {
+            Marker::Circle => Circle::new(p, s, style.filled()).draw(at, backend, dim),
+            Marker::Ring => Circle::new(p, s, style.stroke_width(2)).draw(at, backend, dim),
+            Marker::Triangle => {
+                TriangleMarker::new(p, s + 1, style.filled()).draw(at, backend, dim)
+            }
+            Marker::Cross => Cross::new(p, s, style.stroke_width(2)).draw(at, backend, dim),
+            Marker::Square => {
+                let corners = [(p.0 - half, p.1 - half), (p.0 + half, p.1 + half)];
+                Rectangle::new(corners, style.filled()).draw(corners.into_iter(), backend, dim)
+            }
+        }
+    }
 }
 
 /// Reading a plot's SVG back, for tests: its texts and its lines' styles.
@@ -171,6 +201,23 @@ pub(crate) mod svg {
     fn attr<'a>(el: &'a str, name: &str) -> Option<&'a str> {
         let at = el.find(&format!(" {name}=\""))? + name.len() + 3;
         el[at..].split('"').next()
+    }
+
+    /// The integer value of attribute `name` in element text `el`.
+    pub fn int_attr(el: &str, name: &str) -> Option<i32> {
+        attr(el, name)?.parse().ok()
+    }
+
+    /// Every `<text>`'s content, trimmed, with its x and y.
+    pub fn placed(svg: &str) -> Vec<(String, i32, i32)> {
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|el| {
+                let (open, rest) = el.split_once('>')?;
+                let body = rest.split("</text>").next()?.trim();
+                Some((body.to_string(), int_attr(open, "x")?, int_attr(open, "y")?))
+            })
+            .collect()
     }
 
     /// Per stroke colour of the `<polyline>`s drawn in it: how many, and their widths.

@@ -222,7 +222,7 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
         }
     })?;
     crate::outln!(
-        "tactile sweep: {runs} runs{}; sweep.csv and one plot per metric in {}",
+        "tactile sweep: {runs} runs{}; sweep.csv and a plot per metric with values in {}",
         args.shard
             .as_deref()
             .map_or_else(String::new, |s| format!(" (shard {s})")),

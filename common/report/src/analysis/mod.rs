@@ -2,124 +2,21 @@
 //! statistics, gathered row by row from the joined records (so a run of any length is
 //! reported in bounded memory).
 //!
-//! The same code reports a process run and an in-process simulation. Latencies go
-//! into HdrHistograms (1 ns to 60 s, 3 significant digits) and are reported as count,
-//! p50, p90, p99, p99.9 and max; the full distribution is written in HdrHistogram's
-//! percentile-file form (`*.hgrm`, microseconds) so standard tools can plot it.
+//! The same code reports a process run and an in-process simulation. Latencies are
+//! reported as count, p50, p90, p99, p99.9, max and mean, exactly while a distribution
+//! holds few distinct values and from an HdrHistogram past that ([`Latency`]); the full
+//! distribution is written in HdrHistogram's percentile-file form (`*.hgrm`,
+//! microseconds) so standard tools can plot it.
+
+mod latency;
+
+pub use latency::{rounding_note, us_header, us_line, Latency, Percentiles, EXACT_VALUES};
 
 use crate::trace::TraceRow;
-use hdrhistogram::Histogram;
 use serde::Serialize;
-use std::fmt::Write as _;
 use tactile_math::vec3::{distance, norm};
 use tactile_messages::samples::{stage, Flags};
 use tactile_messages::Role;
-
-/// Percentiles of one latency distribution, nanoseconds.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
-pub struct Percentiles {
-    /// Values recorded.
-    pub count: u64,
-    /// Median.
-    pub p50: u64,
-    /// 90th percentile.
-    pub p90: u64,
-    /// 99th percentile.
-    pub p99: u64,
-    /// 99.9th percentile.
-    pub p999: u64,
-    /// Largest value.
-    pub max: u64,
-    /// Mean.
-    pub mean: f64,
-}
-
-/// A latency distribution being collected.
-#[derive(Debug, Clone)]
-pub struct Latency {
-    hist: Histogram<u64>,
-    /// Values below zero clamped to zero (possible for overhead, see docs/06-records-and-reports.md).
-    pub negative: u64,
-}
-
-impl Default for Latency {
-    fn default() -> Self {
-        Latency {
-            // 1 ns .. 60 s at 3 significant digits: bounds are constants, always valid.
-            hist: Histogram::new_with_bounds(1, 60_000_000_000, 3)
-                .expect("constant histogram bounds are valid"),
-            negative: 0,
-        }
-    }
-}
-
-impl Latency {
-    /// Records one value in ns; negatives are clamped to 0 and counted.
-    pub fn record(&mut self, ns: i64) {
-        if ns < 0 {
-            self.negative += 1;
-        }
-        self.hist.saturating_record(ns.max(0) as u64);
-    }
-
-    /// The summary percentiles; `None` when nothing was recorded.
-    pub fn percentiles(&self) -> Option<Percentiles> {
-        let h = &self.hist;
-        if h.is_empty() {
-            return None;
-        }
-        Some(Percentiles {
-            count: h.len(),
-            p50: h.value_at_quantile(0.50),
-            p90: h.value_at_quantile(0.90),
-            p99: h.value_at_quantile(0.99),
-            p999: h.value_at_quantile(0.999),
-            max: h.max(),
-            mean: h.mean(),
-        })
-    }
-
-    /// The histogram itself (for plots).
-    pub fn histogram(&self) -> &Histogram<u64> {
-        &self.hist
-    }
-
-    /// HdrHistogram percentile distribution text, values in microseconds.
-    pub fn hgrm(&self) -> String {
-        let mut s = String::from("       Value     Percentile TotalCount 1/(1-Percentile)\n\n");
-        let h = &self.hist;
-        if h.is_empty() {
-            return s;
-        }
-        let mut total = 0u64;
-        for v in h.iter_quantiles(5) {
-            let q = v.quantile_iterated_to();
-            total += v.count_since_last_iteration();
-            let inv = if q < 1.0 {
-                format!("{:.2}", 1.0 / (1.0 - q))
-            } else {
-                String::from("inf")
-            };
-            let _ = writeln!(
-                s,
-                "{:12.3} {:14.12} {:10} {:>14}",
-                v.value_iterated_to() as f64 / 1000.0,
-                q,
-                total,
-                inv
-            );
-        }
-        let _ = writeln!(
-            s,
-            "#[Mean    = {:12.3}, StdDeviation   = {:12.3}]\n#[Max     = {:12.3}, Total count    = {:12}]",
-            h.mean() / 1000.0,
-            h.stdev() / 1000.0,
-            h.max() as f64 / 1000.0,
-            h.len()
-        );
-        s
-    }
-}
 
 /// Per-stage times of the loop, ns: compute in each process and each transport hop.
 pub const STAGES: [(&str, usize, usize); 9] = [
@@ -421,34 +318,6 @@ impl Analysis {
             self.motion.felt_rms_n = Some((self.felt_sq / self.received as f64).sqrt());
         }
     }
-}
-
-/// Renders percentiles in microseconds for the terminal; "n/a" when none.
-pub fn us_line(name: &str, p: Option<&Percentiles>) -> String {
-    let us = |v: u64| format!("{:.1}", v as f64 / 1000.0);
-    match p {
-        Some(p) => format!(
-            "{name:<24} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10}",
-            p.count,
-            us(p.p50),
-            us(p.p90),
-            us(p.p99),
-            us(p.p999),
-            us(p.max)
-        ),
-        None => format!(
-            "{name:<24} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10}",
-            0, "n/a", "n/a", "n/a", "n/a", "n/a"
-        ),
-    }
-}
-
-/// Header matching [`us_line`].
-pub fn us_header() -> String {
-    format!(
-        "{:<24} {:>8} {:>10} {:>10} {:>10} {:>10} {:>10}",
-        "latency (us)", "count", "p50", "p90", "p99", "p99.9", "max"
-    )
 }
 
 #[cfg(test)]
