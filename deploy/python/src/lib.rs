@@ -10,11 +10,15 @@
 //! `tactile check` and `tactile run --in-process` do.
 //!
 //! Signals stay Python's: the module installs no handler (a SIGTERM still ends the
-//! interpreter, a Ctrl-C raises KeyboardInterrupt wherever Python is). A run computes
-//! on a thread of its own while the caller's thread waits with the GIL released,
-//! looking at Python's signals every [`SIGNAL_POLL`]; a KeyboardInterrupt there asks
-//! the run to stop after the sample in hand, as SIGINT asks the command, and is raised
-//! once the report of what ran is written.
+//! interpreter, a Ctrl-C raises KeyboardInterrupt wherever Python is). A run's loop
+//! computes on the caller's thread with the GIL released, taking it back for its
+//! callables and, every [`SIGNAL_POLL`], to look at Python's signals (Python runs its
+//! handlers on the main thread alone: there a Ctrl-C raises inside a callable that
+//! blocks, and between samples); a KeyboardInterrupt asks the run to stop after the
+//! sample in hand, as SIGINT asks the command, and is raised once the report of what
+//! ran is written. A sweep's runs, and every report, compute on threads of their own
+//! while the caller's thread waits with the GIL released, looking at the signals as
+//! often.
 
 mod hooks;
 
@@ -45,8 +49,8 @@ create_exception!(
     "A run or a report that failed (exit status 1); the message is the command's."
 );
 
-/// How often a waiting call looks at Python's signals: a Ctrl-C is answered within
-/// this (plus the sample in hand).
+/// How often a run's loop, or a waiting call, looks at Python's signals: a Ctrl-C is
+/// answered within this (plus the sample in hand).
 const SIGNAL_POLL: Duration = Duration::from_millis(20);
 
 /// The command's error as the Python exception of its exit status: 2 (bad input)
@@ -176,10 +180,11 @@ fn check(
 
 /// `tactile run --in-process` into `out`, the trace as `trace_format` (csv, parquet,
 /// both; None: `--no-trace`), with the Python callables given in its loop (see [`hooks`]); whether it
-/// completed is its summary's (`failed`). A KeyboardInterrupt while it runs ends it
-/// after the sample in hand and is raised once the report of what ran is written
-/// (marked `interrupted`); so is the first exception a callable raised. The next run
-/// starts afresh.
+/// completed is its summary's (`failed`). A KeyboardInterrupt while it runs (between
+/// samples, or inside a callable, even one blocked in a system call, when called
+/// from the main thread) ends it after the sample in hand and is raised once the
+/// report of what ran is written (marked `interrupted`); so is the first exception a
+/// callable raised. The next run starts afresh.
 #[pyfunction]
 #[pyo3(signature = (text, base_dir, name, path, sets, out, trace_format, operator, backward_predictor, forward_predictor))]
 #[allow(clippy::too_many_arguments)] // the source's four parts, as everywhere here
@@ -201,10 +206,18 @@ fn run(
     let raised = Raised::default();
     let hooks = hooks::hooks([operator, backward_predictor, forward_predictor], &raised);
     signals::clear_stop();
-    let summary = waiting(py, || {
+    // The loop on this thread, the GIL released and taken back for each callable:
+    // Python runs its signal handlers on the main thread alone, so a Ctrl-C reaches a
+    // callable that blocks there (raising KeyboardInterrupt inside it), and the watch
+    // looks at the signals between samples. The report on another thread, while this
+    // one looks at the signals.
+    let simulated = py.detach(|| {
         let loaded = load(&src, &sets)?;
-        tactile::launch::sim::run_in_process(&loaded, &out, &outputs, hooks)
+        tactile::launch::sim::simulate_into(&loaded, &out, hooks)
     });
+    let summary = simulated
+        .map_err(to_py)
+        .and_then(|s| waiting(py, move || s.report(&outputs)));
     if let Some(e) = hooks::take(&raised) {
         return Err(e);
     }

@@ -5,7 +5,6 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
@@ -169,38 +168,26 @@ time.sleep(60)
 """
 
 
-def test_ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs(work):
+def test_ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs(work, child):
     """SIGINT (a terminal's Ctrl-C, a notebook's interrupt) ends a run as it ends the
     command: KeyboardInterrupt, the report of what ran written and marked; again after
     Python's handler is installed anew (as a notebook's kernel does); the next run
     runs whole, and a SIGTERM still ends the interpreter."""
     out = work / "stopped"
-    p = subprocess.Popen([sys.executable, "-c", INTERRUPTED, str(out)],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    # A run that did not stop would go on for a day, writing gigabytes: ended here.
-    watchdog = threading.Timer(120, p.kill)
-    watchdog.start()
-    try:
-        for k in range(2):
-            assert p.stdout.readline().strip() == f"running {k}"
-            rec = Path(f"{out}-{k}") / "master.rec"
-            # The master's record growing is the run going.
-            while not rec.exists() or rec.stat().st_size == 0:
-                assert p.poll() is None, p.stderr.read()
-                time.sleep(0.01)
-            p.send_signal(signal.SIGINT)
-            assert p.stdout.readline().strip() == f"KeyboardInterrupt {k}"
-            s = json.loads((Path(f"{out}-{k}") / "summary.json").read_text())
-            assert s["interrupted"] is True, s
-            assert 0 < s["samples_sent"] < 100_000_000, s["samples_sent"]
-        assert p.stdout.readline().strip() == "then True 50"
-        p.send_signal(signal.SIGTERM)
-        p.wait(timeout=60)
-        assert p.returncode == -signal.SIGTERM, (p.returncode, p.stderr.read())
-    finally:
-        watchdog.cancel()
-        if p.poll() is None:
-            p.kill()
-            p.wait()
-
-
+    p = child(INTERRUPTED, out)
+    for k in range(2):
+        assert p.stdout.readline().strip() == f"running {k}"
+        rec = Path(f"{out}-{k}") / "master.rec"
+        # The master's record growing is the run going.
+        while not rec.exists() or rec.stat().st_size == 0:
+            assert p.poll() is None, p.stderr.read()
+            time.sleep(0.01)
+        p.send_signal(signal.SIGINT)
+        assert p.stdout.readline().strip() == f"KeyboardInterrupt {k}"
+        s = json.loads((Path(f"{out}-{k}") / "summary.json").read_text())
+        assert s["interrupted"] is True, s
+        assert 0 < s["samples_sent"] < 100_000_000, s["samples_sent"]
+    assert p.stdout.readline().strip() == "then True 50"
+    p.send_signal(signal.SIGTERM)
+    p.wait(timeout=60)
+    assert p.returncode == -signal.SIGTERM, (p.returncode, p.stderr.read())

@@ -174,3 +174,33 @@ def test_a_failing_callable_stops_its_own_run_only(tmp_path):
     assert other["run"].completed and other["run"].summary["samples_sent"] == 30_000
     summary = json.loads((tmp_path / "last" / "summary.json").read_text())
     assert summary["interrupted"] is True and summary["samples_sent"] == 400
+
+
+
+@pytest.mark.parametrize("how", ["sleep", "recv", "spin"])
+def test_ctrl_c_reaches_a_callable_that_blocks(tmp_path, child, how):
+    """A Ctrl-C while the operator sleeps, waits on a socket or loops in Python is
+    raised inside it at once (the loop runs on the caller's thread, where Python runs
+    its signal handlers), and the run stops after that sample with its report. The
+    child is the one deploy/python/bench/ctrl_c.py times."""
+    import signal
+    import time
+    out = tmp_path / how
+    # Not heard, the callable would block for a minute: killed sooner, so the test
+    # fails rather than waits.
+    p = child(str(ROOT / "deploy" / "python" / "bench" / "ctrl_c.py"), "child", out, how,
+              seconds=30)
+    assert p.stdout.readline().strip() == "blocking", p.stderr.read()
+    time.sleep(0.2)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    said = p.stdout.readline().strip()
+    took = time.monotonic() - sent
+    assert said == "KeyboardInterrupt in operator", (said, p.stderr.read())
+    # About 50 ms here (the interrupted report is written within 0.7 s); a loaded
+    # machine gets some slack.
+    assert took < 5, took
+    assert p.wait(timeout=30) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["interrupted"] is True and 200 < summary["samples_sent"] <= 203, summary
+    assert not any("hook" in e and "failed" in e for e in summary["events"]), summary["events"]

@@ -4,7 +4,6 @@ Scenario carries, bad input before any run, progress, and a progress callback's
 exception stopping the sweep with the runs that ended kept."""
 import os
 import subprocess
-import threading
 from pathlib import Path
 
 import pandas
@@ -132,28 +131,18 @@ except KeyboardInterrupt:
 """
 
 
-def test_ctrl_c_stops_a_sweep_keeping_the_runs_that_ended(tmp_path):
+def test_ctrl_c_stops_a_sweep_keeping_the_runs_that_ended(tmp_path, child):
     """SIGINT to the interpreter stops a sweep as it stops the command: the run in
     hand ends early, the tables of the runs that ended are written, then
     KeyboardInterrupt; resume=True runs the rest."""
     import signal
-    import sys
     out = tmp_path / "stopped"
-    p = subprocess.Popen([sys.executable, "-c", INTERRUPTED, str(out)],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    # 59 runs that did not stop would take minutes: ended here instead.
-    watchdog = threading.Timer(120, p.kill)
-    watchdog.start()
-    try:
-        assert p.stdout.readline().strip() == "ended run-0000", p.stderr.read()
-        p.send_signal(signal.SIGINT)
-        lines = [line.strip() for line in p.stdout]
-        p.wait(timeout=60)
-    finally:
-        watchdog.cancel()
-        if p.poll() is None:
-            p.kill()
-            p.wait()
+    # 59 runs that did not stop would take minutes: killed sooner.
+    p = child(INTERRUPTED, out)
+    assert p.stdout.readline().strip() == "ended run-0000", p.stderr.read()
+    p.send_signal(signal.SIGINT)
+    lines = [line.strip() for line in p.stdout]
+    p.wait(timeout=60)
     assert lines and lines[-1] == "KeyboardInterrupt", (lines, p.stderr.read())
     rows = list(pandas.read_csv(out / "sweep.csv")["run"])
     ended = ["run-0000"] + [line.split()[1] for line in lines[:-1]]
