@@ -255,10 +255,13 @@ pub fn mean_ci95(v: &[f64]) -> Option<(f64, Option<f64>)> {
     if n == 0 {
         return None;
     }
-    let mean = v.iter().sum::<f64>() / n as f64;
-    if n == 1 {
-        return Some((mean, None));
+    if v.iter().all(|&x| x == v[0]) {
+        // Seeds that changed nothing: the value itself, and an interval of exactly 0
+        // (a mean summed in floating point would differ from the value by a rounding
+        // error, and the interval would be that error posing as variation: 6.8e-16).
+        return Some((v[0], (n > 1).then_some(0.0)));
     }
+    let mean = v.iter().sum::<f64>() / n as f64;
     let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
     Some((mean, Some(t95(n - 1) * (var / n as f64).sqrt())))
 }
@@ -457,6 +460,16 @@ mod tests {
         }
         assert_eq!(mean_ci95(&[3.0]), Some((3.0, None)));
         assert_eq!(mean_ci95(&[]), None);
+    }
+
+    /// Seeds that change nothing give the value and no variation, not a rounding
+    /// error: three 0.1s sum to 0.30000000000000004, whose third is not 0.1.
+    #[test]
+    fn equal_values_have_an_interval_of_zero() {
+        assert_eq!(mean_ci95(&[0.1; 3]), Some((0.1, Some(0.0))));
+        assert_eq!(mean_ci95(&[0.0012345; 20]), Some((0.0012345, Some(0.0))));
+        let (_, ci) = mean_ci95(&[0.1, 0.1, 0.1000001]).expect("values");
+        assert!(ci.expect("three") > 0.0);
     }
 
     #[test]
