@@ -35,6 +35,7 @@ use tactile::launch::{load_source, parse_sets, Loaded, Outputs, Source};
 use tactile_report::write::{write_report, Launch};
 use tactile_runtime::files;
 use tactile_runtime::signals;
+use tactile_scenario::overrides::Set;
 
 create_exception!(
     _native,
@@ -73,8 +74,83 @@ fn source(text: String, base_dir: &str, name: String, path: Option<&str>) -> Sou
     }
 }
 
+/// A scenario and its sets as the command loads them, but a scenario that uses ROS 2
+/// is refused for what it is here: the command's refusal (this build has no ROS 2:
+/// rebuild with zenoh) would send a Python user to a rebuild that could not help,
+/// since a run from Python is in-process and ROS 2 needs the node programs.
 fn load(src: &Source, sets: &[String]) -> Result<Loaded, Error> {
-    load_source(src, &parse_sets(sets)?)
+    let sets = parse_sets(sets)?;
+    if let Some(s) = parsed(src, &sets) {
+        if tactile_runtime::outside::ros_in_run(&s) {
+            return Err(Error::BadInput(format!(
+                "{}: this scenario uses ROS 2 (a ros2 backend or the live view), which needs the node programs: run it with the tactile command built with ROS 2 (`cargo build --release --features zenoh`, then `tactile run {}`); the Python package runs scenarios in-process, where no build reaches ROS 2",
+                src.name, src.name
+            )));
+        }
+    }
+    load_source(src, &sets)
+}
+
+/// The scenario with `sets` applied, parsed and its ranges checked as `load_source`
+/// starts; None where that fails (`load_source` then says why).
+fn parsed(src: &Source, sets: &[Set]) -> Option<tactile_scenario::Scenario> {
+    let text = tactile_scenario::overrides::apply(&src.text, sets).ok()?;
+    tactile_scenario::Scenario::from_toml_str(&text).ok()
+}
+
+/// What `Scenario.with_set` asks at once: the sets' keys are the scenario's and
+/// their values of its types (a misspelt key raises where it was typed, not at the
+/// run). A value out of range, which may hang on other keys still to be set, is left
+/// to `check()` and the run. The error is the command's, as `check()` gives it.
+#[pyfunction]
+#[pyo3(signature = (text, base_dir, name, path, sets))]
+fn check_sets(
+    text: String,
+    base_dir: &str,
+    name: String,
+    path: Option<&str>,
+    sets: Vec<String>,
+) -> PyResult<()> {
+    use tactile_scenario::ScenarioError as Bad;
+    let src = source(text, base_dir, name, path);
+    let parsed = parse_sets(&sets)
+        .and_then(|s| tactile_scenario::overrides::apply(&src.text, &s).map_err(Error::BadInput));
+    let typed = match parsed {
+        Ok(text) => !matches!(
+            tactile_scenario::Scenario::from_toml_str(&text),
+            Err(Bad::Parse(_))
+        ),
+        Err(_) => false,
+    };
+    if typed {
+        return Ok(());
+    }
+    // The command's own message for it: loading fails at the same step.
+    load(&src, &sets).map(drop).map_err(to_py)
+}
+
+/// A sweep's axes and the value of each axis in each combination.
+type Grid = (Vec<(String, bool, Vec<String>)>, Vec<Vec<usize>>);
+
+/// A sweep's `--set`s (its `sweep.json`) as its grid: each key, whether it is paired
+/// with the key before it, and its values as JSON, in order; and every combination
+/// (the index of its value on each axis), in the grid's order.
+#[pyfunction]
+fn sweep_grid(sets: Vec<String>) -> PyResult<Grid> {
+    let axes = tactile::cmd::sweep::parse_axes(&sets).map_err(to_py)?;
+    let combos = tactile_report::sweep::combinations(&axes);
+    let axes = axes
+        .into_iter()
+        .map(|a| {
+            let values = a
+                .sets
+                .iter()
+                .map(|s| serde_json::to_string(&s.value).unwrap_or_else(|_| s.value.to_string()))
+                .collect();
+            (a.key, a.paired, values)
+        })
+        .collect();
+    Ok((axes, combos))
 }
 
 /// What a computing thread tells the waiting one.
@@ -349,11 +425,14 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     signals::handled_by_caller();
     m.add_function(wrap_pyfunction!(read_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(check_sets, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_grid, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
     m.add("RunError", m.py().get_type::<RunError>())?;
     m.add("PAPER_SCENARIO", tactile::launch::PAPER_SCENARIO)?;
+    m.add("MAX_SCENARIO_BYTES", files::MAX_SCENARIO_BYTES)?;
     Ok(())
 }
