@@ -2,13 +2,14 @@
 //! predictors, each called once a sample it is needed at, on the run's thread (the
 //! caller's), with the GIL taken for the call; and the run's watch, which looks at
 //! Python's signals between samples. The package's Python half wraps the user's
-//! function so that what reaches here is already checked (three finite numbers) and
-//! an exception names the sample; an exception, kept in [`Raised`], asks this run
-//! alone to stop after the sample in hand (`Hooks::halt`, not the process's stop
-//! request, which would stop every run of the process) and is raised once the run has
-//! ended; no callable of the run is called after it. A KeyboardInterrupt (a Ctrl-C,
-//! raised by Python's handler inside a callable or at the watch) asks what SIGINT
-//! asks the command: every run of the process stops after the sample in hand.
+//! function so that what reaches here is already checked (three real, finite
+//! numbers) and an exception names the sample; an exception, kept in [`Raised`],
+//! asks this run alone to stop after the sample in hand (`Hooks::halt`, not the
+//! process's stop request, which would stop every run of the process) and is raised
+//! once the run has ended; no callable of the run is called after it. A
+//! KeyboardInterrupt (a Ctrl-C, raised by Python's handler inside a callable or at
+//! the watch) asks what SIGINT asks the command: every run of the process stops
+//! after the sample in hand.
 
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;

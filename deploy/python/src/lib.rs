@@ -74,10 +74,11 @@ fn source(text: String, base_dir: &str, name: String, path: Option<&str>) -> Sou
     }
 }
 
-/// A scenario and its sets as the command loads them, but a scenario that uses ROS 2
-/// is refused for what it is here: the command's refusal (this build has no ROS 2:
-/// rebuild with zenoh) would send a Python user to a rebuild that could not help,
-/// since a run from Python is in-process and ROS 2 needs the node programs.
+/// A scenario and its sets as the command loads them, but what this build cannot
+/// run is said as a Python user can act on it, where the command's refusal names a
+/// `cargo build` flag: a scenario that uses ROS 2 needs the node programs (a run
+/// from Python is in-process, so no rebuild could help), and `arithmetic = "rtl"`
+/// a package built with the RTL (a pip option, not a cargo one).
 fn load(src: &Source, sets: &[String]) -> Result<Loaded, Error> {
     let sets = parse_sets(sets)?;
     if let Some(s) = parsed(src, &sets) {
@@ -85,6 +86,12 @@ fn load(src: &Source, sets: &[String]) -> Result<Loaded, Error> {
             return Err(Error::BadInput(format!(
                 "{}: this scenario uses ROS 2 (a ros2 backend or the live view), which needs the node programs: run it with the tactile command built with ROS 2 (`cargo build --release --features zenoh`, then `tactile run {}`); the Python package runs scenarios in-process, where no build reaches ROS 2",
                 src.name, src.name
+            )));
+        }
+        if s.arithmetic == tactile_math::arith::ArithKind::Rtl && !cfg!(feature = "rtl") {
+            return Err(Error::BadInput(format!(
+                "{}: arithmetic \"rtl\" needs the RTL simulated by Verilator, which this package was built without: install it with the RTL (Verilator, make and g++ present: `python3 -m pip install ./deploy/python --config-settings=build-args=\"--features rtl\"`)",
+                src.name
             )));
         }
     }

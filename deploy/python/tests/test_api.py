@@ -281,3 +281,21 @@ def test_the_shipped_scenarios_are_the_repositorys_and_run_from_anywhere(work, m
     assert r.completed and r.joints.num_rows == 200
     with pytest.raises(tactile.ScenarioError, match="the package ships .*wall-delay"):
         tactile.Scenario.shipped("wall-dealy")
+
+
+def test_what_this_package_cannot_run_says_what_would():
+    """The command's refusals name a cargo flag; from Python they name what helps:
+    the node programs for ROS 2 (no build of the package could), a pip option for
+    the RTL."""
+    ros = tactile.Scenario.shipped("panda-ros2")
+    with pytest.raises(tactile.ScenarioError, match="needs the node programs") as e:
+        tactile.run(ros)
+    assert "in-process" in str(e.value)
+    rtl = tactile.Scenario.paper().with_set({"arithmetic": "rtl"})
+    try:
+        rtl.check()
+    except tactile.ScenarioError as e:
+        # A package built without the RTL (the default; --all-features builds it).
+        said = str(e)
+        assert "this package was built without" in said, said
+        assert "pip install ./deploy/python --config-settings" in said, said
