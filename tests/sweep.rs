@@ -453,3 +453,77 @@ fn jobs_are_capped_and_a_merge_never_writes_into_its_input() {
     );
     assert_eq!(read(&sb, "s1", "sweep.csv"), before, "s1 untouched");
 }
+
+/// A key written `+KEY` moves with the key before it, value for value; a value given
+/// twice (however written), or two that give one scenario, is refused before any
+/// run; a merge says why a run a folder holds is not whole.
+#[test]
+fn paired_keys_repeated_values_and_a_merge_that_says_why() {
+    let sb = Sandbox::new("sweep-pairs");
+    let s = sb.write("s.toml", &scenario(200));
+    let s = s.to_str().expect("utf-8");
+    let paired = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "sweep",
+            s,
+            "-q",
+            "--set",
+            "network.forward.delay=[0,0,0],[2,2,2],[5,5,5]",
+            "--set",
+            "+network.backward.delay=[0,0,0],[2,2,2],[5,5,5]",
+            "--set",
+            "control.kind=none,tdpa",
+            "--out",
+            out,
+        ];
+        args.extend_from_slice(extra);
+        sb.tactile(&args)
+    };
+    let o = paired("p", &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = read(&sb, "p", "sweep.csv");
+    let rows: Vec<Vec<String>> = table.lines().skip(1).map(cells).collect();
+    assert_eq!(rows.len(), 6, "{table}");
+    for (k, r) in rows.iter().enumerate() {
+        let d = ["[0,0,0]", "[2,2,2]", "[5,5,5]"][k / 2];
+        assert_eq!((r[2].as_str(), r[3].as_str()), (d, d), "{table}");
+    }
+    // The plots draw the pair by its first key.
+    assert!(sb.path("p").join("sweep-position_rms_m.svg").exists());
+    for set in [
+        "control.kind=tdpa,tdpa",
+        "control.kind=tdpa,\"tdpa\"",
+        "network.forward.delay_ms=10,10.0",
+        // Both 10 samples at 1 kHz: one scenario.
+        "network.forward.delay_ms=10,10.0000001",
+    ] {
+        let o = sb.tactile(&["sweep", s, "--set", set, "--out", "dup"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
+        assert!(
+            err.contains("are one value") || err.contains("would run the same scenario"),
+            "{set}: {err}"
+        );
+        assert!(!sb.path("dup").join("run-0000").exists(), "{set}");
+    }
+    // Two slices, one with a run whose summary is damaged: merged, that run is named
+    // with why, not called missing.
+    for k in ["1/2", "2/2"] {
+        let o = paired(&format!("shard{}", &k[..1]), &["--shard", k]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    std::fs::write(
+        sb.path("shard2").join("run-0001").join("summary.json"),
+        "{\"samples_",
+    )
+    .expect("damage");
+    let o = sb.tactile(&["sweep", "--merge", "shard1", "shard2", "--out", "m"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("1 runs are whole in none of the folders")
+            && err.contains("run-0001: its summary.json is unreadable (EOF while parsing"),
+        "{err}"
+    );
+    assert_eq!(read(&sb, "m", "sweep.csv").lines().count(), 1 + 5);
+}

@@ -25,6 +25,7 @@ mod source;
 mod streams;
 pub mod summary;
 pub mod sweep;
+pub mod sweep_grid;
 pub mod sweep_map;
 pub mod sweep_plots;
 pub mod task_space;

@@ -64,36 +64,54 @@ pub const FAILED: &str = "failed";
 /// One swept key and its values, each already a `--set`.
 #[derive(Debug, Clone)]
 pub struct Axis {
-    /// The key as written.
+    /// The key as written (without the `+` of a paired key).
     pub key: String,
     /// The values as written, in order.
     pub values: Vec<String>,
     /// `KEY=VALUE` for each value.
     pub sets: Vec<Set>,
+    /// Paired with the axis before it (written `+KEY=V1,V2,...`): its values go with
+    /// that axis's one to one (its first with the first, ...), not in combination.
+    pub paired: bool,
 }
 
-/// Parses `KEY=V1,V2,...` (a value with commas inside brackets or quotes stays one).
+/// Parses `KEY=V1,V2,...` (a value with commas inside brackets or quotes stays one),
+/// or `+KEY=V1,V2,...` for a key paired with the one before it.
 pub fn axis(arg: &str) -> Result<Axis, String> {
     let (key, list) = arg
         .split_once('=')
         .ok_or_else(|| format!("--set {arg:?}: expected KEY=V1,V2,..."))?;
+    let key = key.trim();
+    let (key, paired) = match key.strip_prefix('+') {
+        Some(k) => (k.trim(), true),
+        None => (key, false),
+    };
     let values = split_values(list);
     let sets = values
         .iter()
-        .map(|v| Set::parse(&format!("{}={v}", key.trim())))
+        .map(|v| Set::parse(&format!("{key}={v}")))
         .collect::<Result<Vec<_>, _>>()?;
     Ok(Axis {
-        key: key.trim().to_string(),
+        key: key.to_string(),
         values,
         sets,
+        paired,
     })
 }
 
 /// Every combination of the axes' values, the first axis varying slowest; each
-/// combination is the index of the value on every axis.
+/// combination is the index of the value on every axis. A paired axis takes the
+/// index of the axis before it.
 pub fn combinations(axes: &[Axis]) -> Vec<Vec<usize>> {
     let mut out = vec![Vec::new()];
     for a in axes {
+        if a.paired {
+            for c in &mut out {
+                let i = c.last().copied().unwrap_or(0);
+                c.push(i);
+            }
+            continue;
+        }
         out = out
             .into_iter()
             .flat_map(|c| {
@@ -255,10 +273,13 @@ pub fn mean_ci95(v: &[f64]) -> Option<(f64, Option<f64>)> {
     if n == 0 {
         return None;
     }
-    let mean = v.iter().sum::<f64>() / n as f64;
-    if n == 1 {
-        return Some((mean, None));
+    if v.iter().all(|&x| x == v[0]) {
+        // Seeds that changed nothing: the value itself, and an interval of exactly 0
+        // (a mean summed in floating point would differ from the value by a rounding
+        // error, and the interval would be that error posing as variation: 6.8e-16).
+        return Some((v[0], (n > 1).then_some(0.0)));
     }
+    let mean = v.iter().sum::<f64>() / n as f64;
     let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
     Some((mean, Some(t95(n - 1) * (var / n as f64).sqrt())))
 }
@@ -468,6 +489,36 @@ mod tests {
         }
         assert_eq!(mean_ci95(&[3.0]), Some((3.0, None)));
         assert_eq!(mean_ci95(&[]), None);
+    }
+
+    /// Seeds that change nothing give the value and no variation, not a rounding
+    /// error: three 0.1s sum to 0.30000000000000004, whose third is not 0.1.
+    #[test]
+    fn equal_values_have_an_interval_of_zero() {
+        assert_eq!(mean_ci95(&[0.1; 3]), Some((0.1, Some(0.0))));
+        assert_eq!(mean_ci95(&[0.0012345; 20]), Some((0.0012345, Some(0.0))));
+        let (_, ci) = mean_ci95(&[0.1, 0.1, 0.1000001]).expect("values");
+        assert!(ci.expect("three") > 0.0);
+    }
+
+    #[test]
+    fn a_paired_axis_moves_with_the_one_before() {
+        let axes = [
+            axis("network.forward.delay_ms=0,5,25").expect("a"),
+            axis("+network.backward.delay_ms=0,5,25").expect("b"),
+            axis("control.kind=none,tdpa").expect("c"),
+        ];
+        assert!(!axes[0].paired && axes[1].paired && !axes[2].paired);
+        assert_eq!(axes[1].key, "network.backward.delay_ms");
+        let c = combinations(&axes);
+        assert_eq!(c.len(), 6);
+        assert_eq!(c[0], [0, 0, 0]);
+        assert_eq!(c[1], [0, 0, 1]);
+        assert_eq!(c[5], [2, 2, 1]);
+        assert_eq!(
+            describe(&axes, &c[3]),
+            "network.forward.delay_ms=5 network.backward.delay_ms=5 control.kind=tdpa"
+        );
     }
 
     #[test]

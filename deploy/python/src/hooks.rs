@@ -1,26 +1,72 @@
 //! Python callables in the loop of an in-process run: the operator and the two
-//! predictors, each called once a sample it is needed at, on the run's thread, with
-//! the GIL taken for the call. The package's Python half wraps the user's function so
-//! that what reaches here is already checked (three finite numbers) and an exception
-//! names the sample; an exception, kept in [`Raised`], asks this run alone to stop
-//! after the sample in hand (`Hooks::halt`, not the process's stop request, which
-//! would stop every run of the process) and is raised once the run has ended; no
-//! callable of the run is called after it.
+//! predictors, each called once a sample it is needed at, on the run's thread (the
+//! caller's), with the GIL taken for the call; and the run's watch, which looks at
+//! Python's signals between samples. The package's Python half wraps the user's
+//! function so that what reaches here is already checked (three real, finite
+//! numbers) and an exception names the sample; an exception, kept in [`Raised`],
+//! asks this run alone to stop after the sample in hand (`Hooks::halt`, not the
+//! process's stop request, which would stop every run of the process) and is raised
+//! once the run has ended; no callable of the run is called after it. A
+//! KeyboardInterrupt (a Ctrl-C, raised by Python's handler inside a callable or at
+//! the watch) asks what SIGINT asks the command: every run of the process stops
+//! after the sample in hand.
 
+use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
+use std::time::Instant;
 use tactile::launch::sim::Hooks;
 use tactile_control::codec::{Guess, HISTORY};
 use tactile_master::operator::Operate;
+use tactile_runtime::signals;
 
 /// The first exception a run's callables raised, kept until the run has ended.
 pub type Raised = Arc<Mutex<Option<PyErr>>>;
 
 /// The exception kept, if any.
 pub fn take(raised: &Raised) -> Option<PyErr> {
-    raised.lock().unwrap_or_else(|p| p.into_inner()).take()
+    lock(raised).take()
+}
+
+fn lock(raised: &Raised) -> std::sync::MutexGuard<'_, Option<PyErr>> {
+    raised.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Keeps `e` (unless an exception is kept already); a KeyboardInterrupt asks every
+/// loop of the process to stop, as SIGINT does; anything else this run alone.
+fn keep(py: Python<'_>, raised: &Raised, halt: &AtomicBool, e: PyErr) {
+    if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+        signals::request_stop();
+    } else {
+        halt.store(true, Ordering::SeqCst);
+    }
+    lock(raised).get_or_insert(e);
+}
+
+/// The run's watch (`Hooks::watch`), called between samples on the loop's thread:
+/// every [`SIGNAL_POLL`](super::SIGNAL_POLL) it takes the GIL and runs Python's signal
+/// handlers (Python runs them on the main thread only: from another thread this
+/// finds nothing). What they raise is kept, as a callable's exception is, and stops
+/// the run.
+fn watch(raised: &Raised, halt: &Arc<AtomicBool>) -> Box<dyn FnMut() -> bool + Send> {
+    let (raised, halt) = (Arc::clone(raised), Arc::clone(halt));
+    let mut next = Instant::now() + super::SIGNAL_POLL;
+    Box::new(move || {
+        let now = Instant::now();
+        if now < next {
+            return false;
+        }
+        next = now + super::SIGNAL_POLL;
+        Python::attach(|py| match py.check_signals() {
+            Ok(()) => false,
+            Err(e) => {
+                keep(py, &raised, &halt, e);
+                true
+            }
+        })
+    })
 }
 
 /// One of the run's callables (the Python half's wrapper, which returns three
@@ -39,27 +85,23 @@ impl Callable {
     where
         A: for<'py> pyo3::call::PyCallArgs<'py>,
     {
-        if self.lock().is_some() {
+        if lock(&self.raised).is_some() {
             return None;
         }
         // The lock is not held over the call: the GIL is taken there.
-        let got = Python::attach(|py| {
-            self.f
+        Python::attach(|py| {
+            let got = self
+                .f
                 .call1(py, args(py))
-                .and_then(|r| r.extract::<(f64, f64, f64)>(py))
-        });
-        match got {
-            Ok((x, y, z)) => Some([x, y, z]),
-            Err(e) => {
-                self.lock().get_or_insert(e);
-                self.halt.store(true, Ordering::SeqCst);
-                None
+                .and_then(|r| r.extract::<(f64, f64, f64)>(py));
+            match got {
+                Ok((x, y, z)) => Some([x, y, z]),
+                Err(e) => {
+                    keep(py, &self.raised, &self.halt, e);
+                    None
+                }
             }
-        }
-    }
-
-    fn lock(&self) -> std::sync::MutexGuard<'_, Option<PyErr>> {
-        self.raised.lock().unwrap_or_else(|p| p.into_inner())
+        })
     }
 }
 
@@ -94,7 +136,7 @@ impl Guess for Predictor {
 }
 
 /// The hooks for `[operator, backward predictor, forward predictor]`, each the
-/// Python half's wrapper or None, sharing `raised`.
+/// Python half's wrapper or None, and the watch, sharing `raised`.
 pub fn hooks(f: [Option<Py<PyAny>>; 3], raised: &Raised) -> Hooks {
     let [operator, backward, forward] = f;
     let halt = Arc::new(AtomicBool::new(false));
@@ -113,6 +155,7 @@ pub fn hooks(f: [Option<Py<PyAny>>; 3], raised: &Raised) -> Hooks {
         operator: operator.map(|f| Box::new(Operator(callable(f))) as Box<dyn Operate>),
         backward_predictor: backward.map(predictor),
         forward_predictor: forward.map(predictor),
+        watch: Some(watch(raised, &halt)),
         halt: Arc::clone(&halt),
     }
 }

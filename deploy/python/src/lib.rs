@@ -10,11 +10,15 @@
 //! `tactile check` and `tactile run --in-process` do.
 //!
 //! Signals stay Python's: the module installs no handler (a SIGTERM still ends the
-//! interpreter, a Ctrl-C raises KeyboardInterrupt wherever Python is). A run computes
-//! on a thread of its own while the caller's thread waits with the GIL released,
-//! looking at Python's signals every [`SIGNAL_POLL`]; a KeyboardInterrupt there asks
-//! the run to stop after the sample in hand, as SIGINT asks the command, and is raised
-//! once the report of what ran is written.
+//! interpreter, a Ctrl-C raises KeyboardInterrupt wherever Python is). A run's loop
+//! computes on the caller's thread with the GIL released, taking it back for its
+//! callables and, every [`SIGNAL_POLL`], to look at Python's signals (Python runs its
+//! handlers on the main thread alone: there a Ctrl-C raises inside a callable that
+//! blocks, and between samples); a KeyboardInterrupt asks the run to stop after the
+//! sample in hand, as SIGINT asks the command, and is raised once the report of what
+//! ran is written. A sweep's runs, and every report, compute on threads of their own
+//! while the caller's thread waits with the GIL released, looking at the signals as
+//! often.
 
 mod hooks;
 
@@ -31,6 +35,7 @@ use tactile::launch::{load_source, parse_sets, Loaded, Outputs, Source};
 use tactile_report::write::{write_report, Launch};
 use tactile_runtime::files;
 use tactile_runtime::signals;
+use tactile_scenario::overrides::Set;
 
 create_exception!(
     _native,
@@ -45,8 +50,8 @@ create_exception!(
     "A run or a report that failed (exit status 1); the message is the command's."
 );
 
-/// How often a waiting call looks at Python's signals: a Ctrl-C is answered within
-/// this (plus the sample in hand).
+/// How often a run's loop, or a waiting call, looks at Python's signals: a Ctrl-C is
+/// answered within this (plus the sample in hand).
 const SIGNAL_POLL: Duration = Duration::from_millis(20);
 
 /// The command's error as the Python exception of its exit status: 2 (bad input)
@@ -69,8 +74,90 @@ fn source(text: String, base_dir: &str, name: String, path: Option<&str>) -> Sou
     }
 }
 
+/// A scenario and its sets as the command loads them, but what this build cannot
+/// run is said as a Python user can act on it, where the command's refusal names a
+/// `cargo build` flag: a scenario that uses ROS 2 needs the node programs (a run
+/// from Python is in-process, so no rebuild could help), and `arithmetic = "rtl"`
+/// a package built with the RTL (a pip option, not a cargo one).
 fn load(src: &Source, sets: &[String]) -> Result<Loaded, Error> {
-    load_source(src, &parse_sets(sets)?)
+    let sets = parse_sets(sets)?;
+    if let Some(s) = parsed(src, &sets) {
+        if tactile_runtime::outside::ros_in_run(&s) {
+            return Err(Error::BadInput(format!(
+                "{}: this scenario uses ROS 2 (a ros2 backend or the live view), which needs the node programs: run it with the tactile command built with ROS 2 (`cargo build --release --features zenoh`, then `tactile run {}`); the Python package runs scenarios in-process, where no build reaches ROS 2",
+                src.name, src.name
+            )));
+        }
+        if s.arithmetic == tactile_math::arith::ArithKind::Rtl && !cfg!(feature = "rtl") {
+            return Err(Error::BadInput(format!(
+                "{}: arithmetic \"rtl\" needs the RTL simulated by Verilator, which this package was built without: install it with the RTL (Verilator, make and g++ present: `python3 -m pip install ./deploy/python --config-settings=build-args=\"--features rtl\"`)",
+                src.name
+            )));
+        }
+    }
+    load_source(src, &sets)
+}
+
+/// The scenario with `sets` applied, parsed and its ranges checked as `load_source`
+/// starts; None where that fails (`load_source` then says why).
+fn parsed(src: &Source, sets: &[Set]) -> Option<tactile_scenario::Scenario> {
+    let text = tactile_scenario::overrides::apply(&src.text, sets).ok()?;
+    tactile_scenario::Scenario::from_toml_str(&text).ok()
+}
+
+/// What `Scenario.with_set` asks at once: the sets' keys are the scenario's and
+/// their values of its types (a misspelt key raises where it was typed, not at the
+/// run). A value out of range, which may hang on other keys still to be set, is left
+/// to `check()` and the run. The error is the command's, as `check()` gives it.
+#[pyfunction]
+#[pyo3(signature = (text, base_dir, name, path, sets))]
+fn check_sets(
+    text: String,
+    base_dir: &str,
+    name: String,
+    path: Option<&str>,
+    sets: Vec<String>,
+) -> PyResult<()> {
+    use tactile_scenario::ScenarioError as Bad;
+    let src = source(text, base_dir, name, path);
+    let parsed = parse_sets(&sets)
+        .and_then(|s| tactile_scenario::overrides::apply(&src.text, &s).map_err(Error::BadInput));
+    let typed = match parsed {
+        Ok(text) => !matches!(
+            tactile_scenario::Scenario::from_toml_str(&text),
+            Err(Bad::Parse(_))
+        ),
+        Err(_) => false,
+    };
+    if typed {
+        return Ok(());
+    }
+    // The command's own message for it: loading fails at the same step.
+    load(&src, &sets).map(drop).map_err(to_py)
+}
+
+/// A sweep's axes and the value of each axis in each combination.
+type Grid = (Vec<(String, bool, Vec<String>)>, Vec<Vec<usize>>);
+
+/// A sweep's `--set`s (its `sweep.json`) as its grid: each key, whether it is paired
+/// with the key before it, and its values as JSON, in order; and every combination
+/// (the index of its value on each axis), in the grid's order.
+#[pyfunction]
+fn sweep_grid(sets: Vec<String>) -> PyResult<Grid> {
+    let axes = tactile::cmd::sweep::parse_axes(&sets).map_err(to_py)?;
+    let combos = tactile_report::sweep::combinations(&axes);
+    let axes = axes
+        .into_iter()
+        .map(|a| {
+            let values = a
+                .sets
+                .iter()
+                .map(|s| serde_json::to_string(&s.value).unwrap_or_else(|_| s.value.to_string()))
+                .collect();
+            (a.key, a.paired, values)
+        })
+        .collect();
+    Ok((axes, combos))
 }
 
 /// What a computing thread tells the waiting one.
@@ -176,10 +263,11 @@ fn check(
 
 /// `tactile run --in-process` into `out`, the trace as `trace_format` (csv, parquet,
 /// both; None: `--no-trace`), with the Python callables given in its loop (see [`hooks`]); whether it
-/// completed is its summary's (`failed`). A KeyboardInterrupt while it runs ends it
-/// after the sample in hand and is raised once the report of what ran is written
-/// (marked `interrupted`); so is the first exception a callable raised. The next run
-/// starts afresh.
+/// completed is its summary's (`failed`). A KeyboardInterrupt while it runs (between
+/// samples, or inside a callable, even one blocked in a system call, when called
+/// from the main thread) ends it after the sample in hand and is raised once the
+/// report of what ran is written (marked `interrupted`); so is the first exception a
+/// callable raised. The next run starts afresh.
 #[pyfunction]
 #[pyo3(signature = (text, base_dir, name, path, sets, out, trace_format, operator, backward_predictor, forward_predictor))]
 #[allow(clippy::too_many_arguments)] // the source's four parts, as everywhere here
@@ -201,10 +289,18 @@ fn run(
     let raised = Raised::default();
     let hooks = hooks::hooks([operator, backward_predictor, forward_predictor], &raised);
     signals::clear_stop();
-    let summary = waiting(py, || {
+    // The loop on this thread, the GIL released and taken back for each callable:
+    // Python runs its signal handlers on the main thread alone, so a Ctrl-C reaches a
+    // callable that blocks there (raising KeyboardInterrupt inside it), and the watch
+    // looks at the signals between samples. The report on another thread, while this
+    // one looks at the signals.
+    let simulated = py.detach(|| {
         let loaded = load(&src, &sets)?;
-        tactile::launch::sim::run_in_process(&loaded, &out, &outputs, hooks)
+        tactile::launch::sim::simulate_into(&loaded, &out, hooks)
     });
+    let summary = simulated
+        .map_err(to_py)
+        .and_then(|s| waiting(py, move || s.report(&outputs)));
     if let Some(e) = hooks::take(&raised) {
         return Err(e);
     }
@@ -336,11 +432,14 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     signals::handled_by_caller();
     m.add_function(wrap_pyfunction!(read_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(check_sets, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_grid, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
     m.add("RunError", m.py().get_type::<RunError>())?;
     m.add("PAPER_SCENARIO", tactile::launch::PAPER_SCENARIO)?;
+    m.add("MAX_SCENARIO_BYTES", files::MAX_SCENARIO_BYTES)?;
     Ok(())
 }

@@ -38,15 +38,33 @@ fn folders() -> (PathBuf, PathBuf) {
     (deps, profile)
 }
 
-/// The package as maturin lays it out: the Python half, the module as `_native`.
+/// The package as maturin lays it out: the Python half (its modules, and the shipped
+/// scenarios and robots, which are links into `deploy/`: copied as files, as maturin
+/// puts them in the wheel), the module as `_native`.
 fn package(site: &Path, module: &Path) {
     let pkg = site.join("tactile");
-    std::fs::create_dir_all(&pkg).expect("package folder");
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("python/tactile");
-    for f in ["__init__.py", "_native.pyi", "py.typed"] {
-        std::fs::copy(src.join(f), pkg.join(f)).expect("copy the Python half");
-    }
+    copy_tree(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("python/tactile"),
+        &pkg,
+    );
     std::fs::copy(module, pkg.join("_native.abi3.so")).expect("copy the module");
+}
+
+/// `from` into `to`, links followed; Python's caches left out.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("package folder");
+    for e in std::fs::read_dir(from).expect("the Python half") {
+        let path = e.expect("an entry").path();
+        if path.file_name().is_some_and(|n| n == "__pycache__") {
+            continue;
+        }
+        let target = to.join(path.file_name().expect("a name"));
+        if path.is_dir() {
+            copy_tree(&path, &target);
+        } else {
+            std::fs::copy(&path, &target).expect("copy the Python half");
+        }
+    }
 }
 
 #[test]

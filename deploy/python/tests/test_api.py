@@ -5,7 +5,6 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
@@ -114,7 +113,8 @@ def test_in_memory_and_an_arm():
 def test_no_trace_is_the_commands_no_trace(work):
     sc = tactile.Scenario.paper().with_set({"samples": 200})
     r = tactile.run(sc, out=work / "bare", trace_format=None)
-    assert r.trace is None and r.summary["samples_sent"] == 200
+    with pytest.warns(tactile.NoTraceWarning):
+        assert r.trace is None and r.summary["samples_sent"] == 200
     assert not any((work / "bare" / f).exists() for f in ["trace.parquet", "trace.csv", "run.mcap"])
     with pytest.raises(tactile.ScenarioError, match="trace_format"):
         tactile.run(sc, trace_format="xlsx")
@@ -169,38 +169,133 @@ time.sleep(60)
 """
 
 
-def test_ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs(work):
+def test_ctrl_c_stops_a_run_keeps_its_report_and_the_next_runs(work, child):
     """SIGINT (a terminal's Ctrl-C, a notebook's interrupt) ends a run as it ends the
     command: KeyboardInterrupt, the report of what ran written and marked; again after
     Python's handler is installed anew (as a notebook's kernel does); the next run
     runs whole, and a SIGTERM still ends the interpreter."""
     out = work / "stopped"
-    p = subprocess.Popen([sys.executable, "-c", INTERRUPTED, str(out)],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    # A run that did not stop would go on for a day, writing gigabytes: ended here.
-    watchdog = threading.Timer(120, p.kill)
-    watchdog.start()
+    p = child(INTERRUPTED, out)
+    for k in range(2):
+        assert p.stdout.readline().strip() == f"running {k}"
+        rec = Path(f"{out}-{k}") / "master.rec"
+        # The master's record growing is the run going.
+        while not rec.exists() or rec.stat().st_size == 0:
+            assert p.poll() is None, p.stderr.read()
+            time.sleep(0.01)
+        p.send_signal(signal.SIGINT)
+        assert p.stdout.readline().strip() == f"KeyboardInterrupt {k}"
+        s = json.loads((Path(f"{out}-{k}") / "summary.json").read_text())
+        assert s["interrupted"] is True, s
+        assert 0 < s["samples_sent"] < 100_000_000, s["samples_sent"]
+    assert p.stdout.readline().strip() == "then True 50"
+    p.send_signal(signal.SIGTERM)
+    p.wait(timeout=60)
+    assert p.returncode == -signal.SIGTERM, (p.returncode, p.stderr.read())
+
+
+def test_with_set_says_a_wrong_key_where_it_is_typed(work):
+    sc = tactile.Scenario.load(paper)
+    for key, value, text in [("no.such", 1, "1"), ("control.kidn", "tdpa", '"tdpa"'),
+                             ("samples", "many", '"many"')]:
+        with pytest.raises(tactile.ScenarioError) as e:
+            sc.with_set({key: value})
+        c = cli("check", str(paper), "--set", f"{key}={text}")
+        assert c.returncode == 2 and str(e.value) in c.stderr, (str(e.value), c.stderr)
+    # A value out of range may hang on keys still to come: said by check().
+    later = sc.with_set({"network.forward.delay_ms": [1, 2]})
+    with pytest.raises(tactile.ScenarioError, match="network.forward.delay_ms"):
+        later.check()
+    with pytest.raises(TypeError, match="give a dict"):
+        sc.with_set([("samples", 10)])
+    with pytest.raises(TypeError, match="a key is a scenario key"):
+        sc.with_set({3: 10})
+
+
+def test_wrong_arguments_say_what_to_give(work, monkeypatch):
+    sc = tactile.Scenario.paper().with_set({"samples": 50})
+    with pytest.raises(TypeError, match=r"give a tactile\.Scenario .*Scenario\.load"):
+        tactile.run(str(paper))
+    with pytest.raises(TypeError, match="give a tactile.Scenario"):
+        tactile.sweep(str(paper), {"samples": [10]})
+    with pytest.raises(TypeError, match="give the grid as a dict"):
+        tactile.sweep(sc, [("samples", [10])])
+    with pytest.raises(tactile.ScenarioError, match=r"jobs=18446744073709551616"):
+        tactile.sweep(sc, {"samples": [10]}, jobs=2**64)
+    with pytest.raises(tactile.ScenarioError, match=r"seeds=18446744073709551616: give 1 to 1000"):
+        tactile.sweep(sc, {"samples": [10]}, seeds=2**64)
+    with pytest.raises(TypeError, match=r"jobs=1\.5: give a whole number"):
+        tactile.sweep(sc, {"samples": [10]}, jobs=1.5)
+    with pytest.raises(TypeError, match="progress='yes'"):
+        tactile.sweep(sc, {"samples": [10]}, progress="yes")
+    # An empty output folder is no folder: nothing lands in the working folder.
+    monkeypatch.chdir(work)
+    for call in [lambda: tactile.run(sc, out=""),
+                 lambda: tactile.sweep(sc, {"samples": [10]}, out=""),
+                 lambda: tactile.report(work, out="")]:
+        with pytest.raises(tactile.ScenarioError, match="out='' is no folder"):
+            call()
+    assert list(work.iterdir()) == []
+
+
+def test_scenario_text_has_the_commands_size_limit(work):
+    limit = 1 << 20
+    big = work / "big.toml"
+    big.write_text("#" * (limit + 1))
+    c = cli("check", str(big))
+    said = f"is {limit + 1} bytes, more than the {limit} a scenario may have"
+    assert c.returncode == 2 and said in c.stderr, c.stderr
+    with pytest.raises(tactile.ScenarioError, match=said):
+        tactile.Scenario.from_toml("#" * (limit + 1))
+    # Counted in bytes, as a file's: 2 bytes a character here.
+    with pytest.raises(tactile.ScenarioError, match=f"is {limit + 2} bytes"):
+        tactile.Scenario.from_toml("\u00e9" * (limit // 2 + 1))
+    assert tactile.Scenario.from_toml("#" * limit).sets == ()
+    with pytest.raises(TypeError, match="a scenario's TOML is a str"):
+        tactile.Scenario.from_toml(b"samples = 10")
+    # A value has the same bound (a command line's is the system's argument list).
+    huge = [0.0] * 300_000
+    with pytest.raises(tactile.ScenarioError, match="with_set: the values are .* bytes of TOML"):
+        tactile.Scenario.paper().with_set({"environment.objects": [huge]})
+    with pytest.raises(tactile.ScenarioError, match="sweep: the values are .* bytes of TOML"):
+        tactile.sweep(tactile.Scenario.paper(), {"name": ["x" * limit, "y"]})
+
+
+def test_the_shipped_scenarios_are_the_repositorys_and_run_from_anywhere(work, monkeypatch):
+    names = tactile.Scenario.shipped_names()
+    assert names == sorted(p.stem for p in (ROOT / "deploy" / "scenarios").glob("*.toml"))
+    assert "wall-delay" in names and "panda-reach" in names
+    monkeypatch.chdir(work)
+    for name in names:
+        sc = tactile.Scenario.shipped(name)
+        assert sc._text == (ROOT / "deploy" / "scenarios" / f"{name}.toml").read_text()
+        if "ros2" in name:
+            # ROS 2 needs the node programs: said for what it is, not "rebuild".
+            with pytest.raises(tactile.ScenarioError, match="needs the node programs") as e:
+                sc.check()
+            assert "in-process" in str(e.value)
+        else:
+            sc.check()
+    # Its inputs (a trajectory, an arm's URDF) are shipped beside it.
+    r = tactile.run(tactile.Scenario.shipped("panda-reach").with_set({"samples": 200}))
+    assert r.completed and r.joints.num_rows == 200
+    with pytest.raises(tactile.ScenarioError, match="the package ships .*wall-delay"):
+        tactile.Scenario.shipped("wall-dealy")
+
+
+def test_what_this_package_cannot_run_says_what_would():
+    """The command's refusals name a cargo flag; from Python they name what helps:
+    the node programs for ROS 2 (no build of the package could), a pip option for
+    the RTL."""
+    ros = tactile.Scenario.shipped("panda-ros2")
+    with pytest.raises(tactile.ScenarioError, match="needs the node programs") as e:
+        tactile.run(ros)
+    assert "in-process" in str(e.value)
+    rtl = tactile.Scenario.paper().with_set({"arithmetic": "rtl"})
     try:
-        for k in range(2):
-            assert p.stdout.readline().strip() == f"running {k}"
-            rec = Path(f"{out}-{k}") / "master.rec"
-            # The master's record growing is the run going.
-            while not rec.exists() or rec.stat().st_size == 0:
-                assert p.poll() is None, p.stderr.read()
-                time.sleep(0.01)
-            p.send_signal(signal.SIGINT)
-            assert p.stdout.readline().strip() == f"KeyboardInterrupt {k}"
-            s = json.loads((Path(f"{out}-{k}") / "summary.json").read_text())
-            assert s["interrupted"] is True, s
-            assert 0 < s["samples_sent"] < 100_000_000, s["samples_sent"]
-        assert p.stdout.readline().strip() == "then True 50"
-        p.send_signal(signal.SIGTERM)
-        p.wait(timeout=60)
-        assert p.returncode == -signal.SIGTERM, (p.returncode, p.stderr.read())
-    finally:
-        watchdog.cancel()
-        if p.poll() is None:
-            p.kill()
-            p.wait()
-
-
+        rtl.check()
+    except tactile.ScenarioError as e:
+        # A package built without the RTL (the default; --all-features builds it).
+        said = str(e)
+        assert "this package was built without" in said, said
+        assert "pip install ./deploy/python --config-settings" in said, said

@@ -8,9 +8,10 @@ from pathlib import Path
 
 import tactile
 
-PUBLIC = ["Scenario.load", "Scenario.from_toml", "Scenario.paper", "Scenario.with_set",
-          "Scenario.sets", "Scenario.check", "Scenario.to_toml", "run", "sweep", "report",
-          "Run", "Run.read", "ScenarioError", "RunError", "CallbackError"]
+PUBLIC = ["Scenario.load", "Scenario.from_toml", "Scenario.paper", "Scenario.shipped",
+          "Scenario.shipped_names", "Scenario.with_set", "Scenario.sets", "Scenario.check",
+          "Scenario.to_toml", "run", "sweep", "read_sweep", "report", "Run", "Run.read",
+          "Run.trace", "ScenarioError", "RunError", "CallbackError", "NoTraceWarning"]
 START, END = "<!-- api reference: begin -->", "<!-- api reference: end -->"
 
 
@@ -44,7 +45,8 @@ def reference() -> str:
     for name in PUBLIC:
         obj = tactile
         for part in name.split("."):
-            obj = inspect.getattr_static(obj, part) if part == "sets" else getattr(obj, part)
+            obj = (inspect.getattr_static(obj, part) if part in ("sets", "trace")
+                   else getattr(obj, part))
         if isinstance(obj, property):
             head, doc = f"`tactile.{name}` (property)", obj.__doc__
         elif inspect.isclass(obj):

@@ -123,6 +123,18 @@ def test_a_bad_result_or_an_exception_stops_the_run_naming_the_sample(tmp_path):
         ("shape", lambda n, t, f: (1.0, 2.0) if n == 40 else here,
          r"operator at sample 40: gave an array of shape \(2,\)"),
         ("text", lambda n, t, f: "up" if n == 7 else here, "operator at sample 7: gave 'up'"),
+        # Only real numbers: what float() or NumPy would turn into one is refused.
+        ("texts", lambda n, t, f: ("0", "0.15", "0.05") if n == 9 else here,
+         r"operator at sample 9: gave \('0', '0.15', '0.05'\), not three real numbers \(text\)"),
+        ("complex", lambda n, t, f: np.array(here) + 0j if n == 10 else here,
+         r"operator at sample 10: .*not three real numbers \(complex numbers\)"),
+        ("masked", lambda n, t, f: np.ma.array(here, mask=[0, 1, 0]) if n == 11 else here,
+         r"operator at sample 11: .*a masked array: its mask would be dropped"),
+        ("bools", lambda n, t, f: (True, False, True) if n == 13 else here,
+         r"operator at sample 13: .*\(booleans\)"),
+        ("array of text", lambda n, t, f: np.array(["0", "1", "2"]) if n == 14 else here,
+         r"operator at sample 14: .*\(text\)"),
+        # Last: the cause checked below is its.
         ("raises", lambda n, t, f: 1 / (n - 12) and here,
          "operator at sample 12: ZeroDivisionError"),
     ]
@@ -140,6 +152,18 @@ def test_a_bad_result_or_an_exception_stops_the_run_naming_the_sample(tmp_path):
         tactile.run(lossy, forward_predictor=lambda n, to, h: [math.inf] * 3)
     # The next run runs whole: the stop the callable asked for is not left behind.
     assert tactile.run(sc, operator=lambda n, t, f: here).completed
+
+
+def test_every_kind_of_real_number_is_taken():
+    """The quick path's tuples and float arrays, and what NumPy reads as real
+    numbers (a float32 array, NumPy scalars, fractions), all run."""
+    from fractions import Fraction
+    here = (0.0, 0.15, 0.05)
+    forms = [here, list(here), np.array(here), np.array(here, dtype=np.float32),
+             (np.float64(0.0), np.float32(0.15), 0.05), (0, 0.15, 0.05),
+             (Fraction(0), 0.15, 0.05), np.array([0, 0, 0], dtype=np.int64) + 0.05]
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 80})
+    assert tactile.run(sc, operator=lambda n, t, f: forms[n % len(forms)]).completed
 
 
 def test_what_cannot_take_a_callable_is_refused(tmp_path):
@@ -174,3 +198,33 @@ def test_a_failing_callable_stops_its_own_run_only(tmp_path):
     assert other["run"].completed and other["run"].summary["samples_sent"] == 30_000
     summary = json.loads((tmp_path / "last" / "summary.json").read_text())
     assert summary["interrupted"] is True and summary["samples_sent"] == 400
+
+
+
+@pytest.mark.parametrize("how", ["sleep", "recv", "spin"])
+def test_ctrl_c_reaches_a_callable_that_blocks(tmp_path, child, how):
+    """A Ctrl-C while the operator sleeps, waits on a socket or loops in Python is
+    raised inside it at once (the loop runs on the caller's thread, where Python runs
+    its signal handlers), and the run stops after that sample with its report. The
+    child is the one deploy/python/bench/ctrl_c.py times."""
+    import signal
+    import time
+    out = tmp_path / how
+    # Not heard, the callable would block for a minute: killed sooner, so the test
+    # fails rather than waits.
+    p = child(str(ROOT / "deploy" / "python" / "bench" / "ctrl_c.py"), "child", out, how,
+              seconds=30)
+    assert p.stdout.readline().strip() == "blocking", p.stderr.read()
+    time.sleep(0.2)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    said = p.stdout.readline().strip()
+    took = time.monotonic() - sent
+    assert said == "KeyboardInterrupt in operator", (said, p.stderr.read())
+    # About 50 ms here (the interrupted report is written within 0.7 s); a loaded
+    # machine gets some slack.
+    assert took < 5, took
+    assert p.wait(timeout=30) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["interrupted"] is True and 200 < summary["samples_sent"] <= 203, summary
+    assert not any("hook" in e and "failed" in e for e in summary["events"]), summary["events"]

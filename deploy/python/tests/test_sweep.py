@@ -4,7 +4,6 @@ Scenario carries, bad input before any run, progress, and a progress callback's
 exception stopping the sweep with the runs that ended kept."""
 import os
 import subprocess
-import threading
 from pathlib import Path
 
 import pandas
@@ -109,7 +108,7 @@ def test_progress_is_told_and_an_exception_there_stops_the_sweep(tmp_path, capsy
 
     # The runs after the first are long: the stop reaches the second while it runs.
     with pytest.raises(Enough, match="run-0000"):
-        tactile.sweep(sc, {"samples": [100, 200_000, 200_000]}, jobs=1, out=tmp_path / "b",
+        tactile.sweep(sc, {"samples": [100, 200_000, 200_001]}, jobs=1, out=tmp_path / "b",
                       progress=stop)
     rows = pandas.read_csv(tmp_path / "b" / "sweep.csv")
     assert list(rows["run"]) == ["run-0000"]
@@ -133,28 +132,18 @@ except KeyboardInterrupt:
 """
 
 
-def test_ctrl_c_stops_a_sweep_keeping_the_runs_that_ended(tmp_path):
+def test_ctrl_c_stops_a_sweep_keeping_the_runs_that_ended(tmp_path, child):
     """SIGINT to the interpreter stops a sweep as it stops the command: the run in
     hand ends early, the tables of the runs that ended are written, then
     KeyboardInterrupt; resume=True runs the rest."""
     import signal
-    import sys
     out = tmp_path / "stopped"
-    p = subprocess.Popen([sys.executable, "-c", INTERRUPTED, str(out)],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    # 59 runs that did not stop would take minutes: ended here instead.
-    watchdog = threading.Timer(120, p.kill)
-    watchdog.start()
-    try:
-        assert p.stdout.readline().strip() == "ended run-0000", p.stderr.read()
-        p.send_signal(signal.SIGINT)
-        lines = [line.strip() for line in p.stdout]
-        p.wait(timeout=60)
-    finally:
-        watchdog.cancel()
-        if p.poll() is None:
-            p.kill()
-            p.wait()
+    # 59 runs that did not stop would take minutes: killed sooner.
+    p = child(INTERRUPTED, out)
+    assert p.stdout.readline().strip() == "ended run-0000", p.stderr.read()
+    p.send_signal(signal.SIGINT)
+    lines = [line.strip() for line in p.stdout]
+    p.wait(timeout=60)
     assert lines and lines[-1] == "KeyboardInterrupt", (lines, p.stderr.read())
     rows = list(pandas.read_csv(out / "sweep.csv")["run"])
     ended = ["run-0000"] + [line.split()[1] for line in lines[:-1]]
@@ -168,3 +157,146 @@ def test_ctrl_c_stops_a_sweep_keeping_the_runs_that_ended(tmp_path):
     df = tactile.sweep(sc, {"seed": list(range(1, 60))}, out=out, resume=True, progress=False)
     assert len(df) == 59 and list(df["seed"]) == list(range(1, 60))
     assert (df["samples_sent"] == 5000).all()
+
+
+def cli_sweep(scenario, out, *sets, extra=()):
+    args = [os.environ["TACTILE_BIN"], "sweep", str(scenario), "-q", "--out", str(out)]
+    for s in sets:
+        args += ["--set", s]
+    return subprocess.run(args + list(extra), capture_output=True, text=True)
+
+
+def test_swept_numbers_are_numeric_columns(tmp_path):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 100})
+    df = tactile.sweep(sc, {"network.forward.delay_ms": [0, 10],
+                            "network.forward.loss": [0, 0.5],
+                            "control.kind": ["none"],
+                            "network.backward.delay": [[0, 0, 0]]},
+                       out=tmp_path / "s", progress=False)
+    types = df.dtypes.map(str).to_dict()
+    assert types["network.forward.delay_ms"] == "int64", types
+    # A whole number beside a float is a float, as in any numeric column.
+    assert types["network.forward.loss"] == "float64", types
+    assert types["combination"] == types["seed"] == "int64", types
+    assert types["samples_sent"] == "int64" and types["tracking_rms_m"] == "float64", types
+    assert df["network.forward.loss"].tolist() == [0.0, 0.5, 0.0, 0.5]
+    assert isinstance(df["control.kind"].iloc[0], str)
+    assert df["network.backward.delay"].iloc[0] == [0, 0, 0]
+    # Numbers group and plot as numbers.
+    assert df.groupby("network.forward.delay_ms")["round_trip_p50_ns"].max().index.tolist() == [0, 10]
+
+
+def test_read_sweep_reads_back_either_front_ends_sweep(tmp_path):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 100})
+    grid = {"network.forward.delay_ms": [0, 10], "control.kind": ["none", "tdpa"]}
+    df = tactile.sweep(sc, grid, out=tmp_path / "py", progress=False)
+    pandas.testing.assert_frame_equal(tactile.read_sweep(tmp_path / "py"), df)
+    c = cli_sweep(PAPER, tmp_path / "cli", "network.forward.delay_ms=0,10",
+                  "control.kind=none,tdpa", extra=["--set", "samples=100"])
+    # (The command's grid has samples as a third key: one value.)
+    assert c.returncode == 0, c.stderr
+    theirs = tactile.read_sweep(tmp_path / "cli")
+    assert list(theirs["control.kind"]) == list(df["control.kind"])
+    assert theirs["network.forward.delay_ms"].dtype == "int64"
+    metrics = list(df.columns[df.columns.get_loc("seed"):-1])
+    pandas.testing.assert_frame_equal(theirs[metrics], df[metrics])
+    with pytest.raises(tactile.RunError, match="no sweep to read"):
+        tactile.read_sweep(tmp_path)
+
+
+def test_a_sweep_resumes_across_front_ends(tmp_path):
+    """The command's sweep and the same sweep from Python are one sweep, however each
+    writes its values (tdpa or "tdpa", 1 or 1.0): either resumes the other's."""
+    grid = {"network.forward.delay_ms": [0, 1.0], "control.kind": ["none", "tdpa"]}
+    sets = ["network.forward.delay_ms=0,1", "control.kind=none,tdpa"]
+    small = tmp_path / "small.toml"
+    small.write_text(WALL.read_text().replace("samples = 8000", "samples = 300"))
+    assert "samples = 300" in small.read_text()
+    sc = tactile.Scenario.load(small)
+    # The command runs half the grid; Python runs the rest, keeping that half.
+    c = cli_sweep(small, tmp_path / "a", *sets, extra=["--shard", "1/2"])
+    assert c.returncode == 0, c.stderr
+    seen = []
+    df = tactile.sweep(sc, grid, out=tmp_path / "a", resume=True,
+                       progress=lambda *a: seen.append(a[2]))
+    assert sorted(seen) == ["run-0001", "run-0003"], seen
+    assert len(df) == 4
+    # Python runs the whole grid; the command resumes it, keeping every run.
+    tactile.sweep(sc, grid, out=tmp_path / "b", progress=False)
+    (tmp_path / "b" / "run-0002" / "summary.json").unlink()
+    c = cli_sweep(small, tmp_path / "b", *sets, extra=["--resume"])
+    assert c.returncode == 0 and "3 runs kept from before" in c.stderr, c.stderr
+    # The same rows; the keys' values as the command wrote them last (1, not 1.0).
+    pandas.testing.assert_frame_equal(tactile.read_sweep(tmp_path / "b").drop(columns="folder"),
+                                      df.drop(columns="folder"), check_dtype=False)
+
+
+def test_paired_keys_move_together(tmp_path):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 100})
+    pair = ("network.forward.delay_ms", "network.backward.delay_ms")
+    df = tactile.sweep(sc, {pair: [(0, 0), (10, 10)], "control.kind": ["none", "tdpa"]},
+                       out=tmp_path / "py", progress=False)
+    assert len(df) == 4
+    assert list(df["network.forward.delay_ms"]) == [0, 0, 10, 10]
+    assert list(df["network.backward.delay_ms"]) == [0, 0, 10, 10]
+    assert [round(x / 1e6) for x in df["round_trip_p50_ns"]] == [0, 0, 20, 20]
+    # The command's paired key: the same sweep.
+    c = cli_sweep(PAPER, tmp_path / "cli", "network.forward.delay_ms=0,10",
+                  "+network.backward.delay_ms=0,10", "control.kind=none,tdpa",
+                  extra=["--set", "samples=100"])
+    assert c.returncode == 0, c.stderr
+    cli = tactile.read_sweep(tmp_path / "cli")
+    pandas.testing.assert_frame_equal(cli.drop(columns=["folder", "samples"]),
+                                      df.drop(columns="folder"))
+    for grid, said in [({pair: [(0, 0), 5]}, "each value is a tuple of 2"),
+                       ({("samples",): [(10,)]}, "paired keys are two or more")]:
+        with pytest.raises(tactile.ScenarioError, match=said):
+            tactile.sweep(sc, grid, out=tmp_path / "bad", progress=False)
+    c = cli_sweep(PAPER, tmp_path / "bad", "+network.backward.delay_ms=0,5")
+    assert c.returncode == 2 and "there is none" in c.stderr, c.stderr
+    c = cli_sweep(PAPER, tmp_path / "bad", "network.forward.delay_ms=0,5",
+                  "+network.backward.delay_ms=0")
+    assert c.returncode == 2 and "a paired key takes one value for each" in c.stderr, c.stderr
+
+
+def test_a_value_given_twice_is_refused(tmp_path):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 100})
+    out = tmp_path / "d"
+    for grid, said in [({"control.kind": ["tdpa", "tdpa"]}, "value 1 and value 2 are one value"),
+                       ({"network.forward.delay_ms": [10, 10.0]}, "are one value"),
+                       # Both one sample at the paper's 100 Hz: one scenario.
+                       ({"network.forward.delay_ms": [10, 10.0000001]},
+                        "run-0000 .* and run-0001 .* would run the same scenario")]:
+        with pytest.raises(tactile.ScenarioError, match=said):
+            tactile.sweep(sc, grid, out=out, progress=False)
+        assert not (out / "run-0000").exists()
+    for s in ["control.kind=tdpa,tdpa", "network.forward.delay_ms=10,10.0000001"]:
+        c = cli_sweep(PAPER, out, s)
+        assert c.returncode == 2 and ("one value" in c.stderr or "same scenario" in c.stderr), c.stderr
+
+
+def test_seeds_that_change_nothing_have_no_interval(tmp_path):
+    """The wall scenario has nothing random: every seed gives the same values, whose
+    interval is 0, not a rounding error."""
+    sc = tactile.Scenario.load(WALL).with_set({"samples": 300})
+    tactile.sweep(sc, {"control.kind": ["none", "tdpa"]}, seeds=3, out=tmp_path / "s",
+                  progress=False)
+    summary = pandas.read_csv(tmp_path / "s" / "sweep-summary.csv")
+    ci = summary[[c for c in summary.columns if c.endswith("_ci95")]]
+    assert ((ci == 0) | ci.isna()).all().all(), ci.T[(ci != 0).any()]
+    assert (ci == 0).sum().sum() > 20
+
+
+def test_a_run_without_its_trace_says_how_to_get_it(tmp_path):
+    sc = tactile.Scenario.load(PAPER).with_set({"samples": 100})
+    df = tactile.sweep(sc, {"control.kind": ["none"]}, out=tmp_path / "s", progress=False)
+    r = tactile.Run.read(df["folder"][0])
+    with pytest.warns(tactile.NoTraceWarning, match=r"tactile\.report\(") as said:
+        assert r.trace is None
+    # What it says works.
+    again = tactile.report(df["folder"][0], out=tmp_path / "again")
+    assert again.trace.num_rows == 100
+    assert "trace=True" in str(said[0].message)
+    mem = tactile.run(sc, trace_format=None)
+    with pytest.warns(tactile.NoTraceWarning, match="trace_format='parquet'"):
+        assert mem.trace is None

@@ -44,6 +44,9 @@ pub struct Hooks {
     /// marked interrupted. The run's own, not the process's stop request, so other
     /// runs of the process go on and this run's report is written whole.
     pub halt: Arc<AtomicBool>,
+    /// Asked between samples, on the loop's thread, whether a stop was asked for
+    /// (`Lead::watch_with`): the Python package looks at Python's signals there.
+    pub watch: Option<Box<dyn FnMut() -> bool + Send>>,
 }
 
 impl Hooks {
@@ -87,6 +90,7 @@ impl std::fmt::Debug for Hooks {
             .field("backward_predictor", &self.backward_predictor.is_some())
             .field("forward_predictor", &self.forward_predictor.is_some())
             .field("halt", &self.halt)
+            .field("watch", &self.watch.is_some())
             .finish()
     }
 }
@@ -195,6 +199,10 @@ pub fn simulate(
         None,
     )
     .halt_on(halt);
+    let lead = match hooks.watch {
+        Some(w) => lead.watch_with(w),
+        None => lead,
+    };
     let emu = Follow::new(
         emulator,
         link(ep),
@@ -222,43 +230,79 @@ pub fn run_in_process(
     outputs: &super::Outputs,
     hooks: Hooks,
 ) -> Result<tactile_report::summary::Summary, Error> {
+    simulate_into(loaded, out, hooks)?.report(outputs)
+}
+
+/// An in-process run whose loop has ended, its report not yet written: the two
+/// halves of [`run_in_process`], so a caller may run them on different threads (the
+/// Python package runs the loop on the caller's thread, where its callables can take
+/// a Ctrl-C, and waits for the report on another, looking at the signals meanwhile).
+#[derive(Debug)]
+pub struct Simulated {
+    out: std::path::PathBuf,
+    events: Vec<String>,
+    /// The loop ran to its end.
+    completed: bool,
+    /// A hook asked this run alone to stop.
+    halted: bool,
+    /// The output folder, held until the report is written.
+    _held: tactile_report::out::OutLock,
+}
+
+/// The first half of [`run_in_process`]: the folder made ready and the simulation run.
+pub fn simulate_into(loaded: &super::Loaded, out: &Path, hooks: Hooks) -> Result<Simulated, Error> {
     if tactile_runtime::outside::ros_in_run(&loaded.scenario) {
         return Err(Error::BadInput(
             "an in-process run simulates both devices and has no live view: a ros2 backend or ros.live needs the node programs (tactile run without --in-process)".into(),
         ));
     }
     hooks.check(loaded)?;
-    let (bundled, _held) = super::prepare_out(out, loaded)?;
+    let (bundled, held) = super::prepare_out(out, loaded)?;
     let halt = Arc::clone(&hooks.halt);
     let events = hooks.events();
     // A hook that failed at the last sample stopped nothing, but the master's loop
     // says the run did not complete (`Lead::halt_on`).
     let completed = simulate(&bundled.scenario, &bundled.base_dir, out, hooks)?;
-    let halted = halt.load(Ordering::SeqCst);
-    let launch = tactile_report::write::Launch {
-        stop: tactile_runtime::signals::stop_flag().ok(),
-        outputs: outputs.clone(),
+    Ok(Simulated {
+        out: out.to_path_buf(),
         events,
-        ..Default::default()
-    };
-    let launch = match (completed, halted) {
-        (true, _) => launch,
-        // The run's own stop: no signal hurries the report, which is written whole.
-        (false, true) => {
-            let mut launch = tactile_report::write::Launch {
-                interrupted: true,
-                ..launch
-            };
-            launch
-                .events
-                .push("stopped after the sample in hand: a hook from outside the scenario (the Python API) failed".into());
-            launch
-        }
-        (false, false) => launch.interrupted(),
-    };
-    Ok(tactile_report::write::write_report(
-        std::slice::from_ref(&out.to_path_buf()),
-        out,
-        &launch,
-    )?)
+        completed,
+        halted: halt.load(Ordering::SeqCst),
+        _held: held,
+    })
+}
+
+impl Simulated {
+    /// The second half of [`run_in_process`]: the report, with `outputs`.
+    pub fn report(
+        self,
+        outputs: &super::Outputs,
+    ) -> Result<tactile_report::summary::Summary, Error> {
+        let launch = tactile_report::write::Launch {
+            stop: tactile_runtime::signals::stop_flag().ok(),
+            outputs: outputs.clone(),
+            events: self.events,
+            ..Default::default()
+        };
+        let launch = match (self.completed, self.halted) {
+            (true, _) => launch,
+            // The run's own stop: no signal hurries the report, which is written whole.
+            (false, true) => {
+                let mut launch = tactile_report::write::Launch {
+                    interrupted: true,
+                    ..launch
+                };
+                launch
+                    .events
+                    .push("stopped after the sample in hand: a hook from outside the scenario (the Python API) failed".into());
+                launch
+            }
+            (false, false) => launch.interrupted(),
+        };
+        Ok(tactile_report::write::write_report(
+            std::slice::from_ref(&self.out),
+            &self.out,
+            &launch,
+        )?)
+    }
 }

@@ -96,6 +96,8 @@ pub struct Lead<H: Leader> {
     record: Option<H::Sample>,
     /// This run's own stop request, beside the process's (see [`Lead::halt_on`]).
     halt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Asked between samples whether to stop (see [`Lead::watch_with`]).
+    watch: Option<Box<dyn FnMut() -> bool + Send>>,
 }
 
 impl<H: Leader> std::fmt::Debug for Lead<H> {
@@ -130,6 +132,7 @@ impl<H: Leader> Lead<H> {
             slot: None,
             record: None,
             halt: None,
+            watch: None,
         }
     }
 
@@ -146,6 +149,21 @@ impl<H: Leader> Lead<H> {
     pub fn halt_on(mut self, halt: std::sync::Arc<std::sync::atomic::AtomicBool>) -> Self {
         self.halt = Some(halt);
         self
+    }
+
+    /// Also asks `watch` between samples, and stops after the sample in hand as a stop
+    /// request does when it says true: for a caller that handles the signals itself
+    /// and can look at them only from the loop's own thread (the Python package runs
+    /// a run's loop on the caller's thread, and Python runs its signal handlers on
+    /// the main thread alone).
+    pub fn watch_with(mut self, watch: Box<dyn FnMut() -> bool + Send>) -> Self {
+        self.watch = Some(watch);
+        self
+    }
+
+    /// True if the caller's `watch` asks the run to stop.
+    fn watched(&mut self) -> bool {
+        self.watch.as_mut().is_some_and(|w| w())
     }
 
     /// Runs until every sample was sent (true) or a stop request (false); every way it
@@ -300,7 +318,7 @@ impl<H: Leader> Lead<H> {
     /// Sends sample n and waits for its answer until its deadline; false if a stop
     /// request came.
     fn sample(&mut self, n: u64, t0: u64, block: &mut dyn Block) -> Result<bool, Failure> {
-        if self.halted() || crate::signals::stop_requested() {
+        if self.halted() || self.watched() || crate::signals::stop_requested() {
             return Ok(false);
         }
         let (origin, deadline) = self.instant(n, t0);

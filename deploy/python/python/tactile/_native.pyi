@@ -3,6 +3,7 @@ from pathlib import Path
 from typing import Any, Callable, List, Optional, Tuple
 
 PAPER_SCENARIO: str
+MAX_SCENARIO_BYTES: int
 
 class ScenarioError(ValueError):
     """A scenario, a --set or an input the command would refuse (exit status 2)."""
@@ -13,6 +14,9 @@ class RunError(RuntimeError):
 def read_scenario(path: str) -> Tuple[str, Path, str]: ...
 def check(text: str, base_dir: str, name: str, path: Optional[str],
           sets: List[str]) -> Tuple[str, List[str]]: ...
+def check_sets(text: str, base_dir: str, name: str, path: Optional[str],
+               sets: List[str]) -> None: ...
+def sweep_grid(sets: List[str]) -> Tuple[List[Tuple[str, bool, List[str]]], List[List[int]]]: ...
 def run(text: str, base_dir: str, name: str, path: Optional[str], sets: List[str],
         out: str, trace_format: Optional[str],
         operator: Optional[Callable[[int, float, float, float, float], Tuple[float, float, float]]],

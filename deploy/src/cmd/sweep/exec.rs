@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use tactile_report::summary::of_these_records;
-use tactile_report::sweep::{describe, values, Axis};
+use tactile_report::sweep::{describe, value_cell, values, Axis};
 use tactile_report::write::{TraceFormat, PARQUET_FILE};
 
 /// One run of the sweep.
@@ -25,7 +25,8 @@ pub struct Work {
     /// `KEY=VALUE ...` for the progress line.
     pub what: String,
     /// The combination as `trace.parquet`'s text columns: each key and its value as
-    /// written, the seed with `--seeds`, and the run's name.
+    /// `sweep.csv` writes it (a word as itself, else JSON: the same whichever front
+    /// end wrote the `--set`), the seed with `--seeds`, and the run's name.
     pub columns: Vec<(String, String)>,
     /// Its scenario, checked.
     pub loaded: Loaded,
@@ -61,7 +62,7 @@ pub fn plan(
             let mut columns: Vec<(String, String)> = axes
                 .iter()
                 .zip(&combos[k])
-                .map(|(a, &i)| (a.key.clone(), a.values[i].clone()))
+                .map(|(a, &i)| (a.key.clone(), value_cell(&a.sets[i])))
                 .collect();
             if let Some(x) = seed {
                 what += &format!(" seed={x}");
@@ -79,7 +80,34 @@ pub fn plan(
             });
         }
     }
+    refuse_same_runs(&work)?;
     Ok(work)
+}
+
+/// No two runs of one scenario: values that differ as written but not in the
+/// scenario they give (10 and 10.0000001 ms are both 10 samples at 1 kHz, since a
+/// delay is whole samples) would run the same run twice.
+/// (Scenarios are looked up by a hash of their text, then compared whole: a sweep's
+/// ten thousand texts are not kept.)
+fn refuse_same_runs(work: &[Work]) -> Result<(), Error> {
+    use std::hash::{Hash, Hasher};
+    let mut seen: std::collections::HashMap<u64, Vec<&Work>> = std::collections::HashMap::new();
+    for w in work {
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        w.loaded.scenario.to_toml().hash(&mut h);
+        let like = seen.entry(h.finish()).or_default();
+        if let Some(first) = like.iter().find(|f| f.loaded.scenario == w.loaded.scenario) {
+            return Err(Error::BadInput(format!(
+                "{} ({}) and {} ({}) would run the same scenario: values that differ only beyond what the scenario keeps (a delay is whole samples) are one value; give each once",
+                first.name(),
+                first.what,
+                w.name(),
+                w.what
+            )));
+        }
+        like.push(w);
+    }
+    Ok(())
 }
 
 /// A run's metrics read back from its folder's `summary.json`; `None` unless the
@@ -91,19 +119,24 @@ pub fn finished(dir: &Path) -> Option<Vec<Option<f64>>> {
     whole.then(|| values(&json))
 }
 
-/// The seed the run in `dir` used, from its `scenario.toml`.
-pub fn seed_of(dir: &Path) -> Option<u64> {
-    let text = std::fs::read_to_string(dir.join("scenario.toml")).ok()?;
-    Some(
-        tactile_scenario::Scenario::from_recorded_toml(&text)
-            .ok()?
-            .seed,
-    )
+/// The seed the run in `dir` used, from its `scenario.toml`, or why it cannot be read.
+pub fn seed_of(dir: &Path) -> Result<u64, String> {
+    let text = std::fs::read_to_string(dir.join("scenario.toml"))
+        .map_err(|e| format!("its scenario.toml cannot be read ({e})"))?;
+    tactile_scenario::Scenario::from_recorded_toml(&text)
+        .map(|s| s.seed)
+        .map_err(|e| format!("its scenario.toml is unreadable ({e})"))
+}
+
+/// The run's `summary.json` in `dir`, or why it cannot be read.
+pub fn read_summary(dir: &Path) -> Result<serde_json::Value, String> {
+    let text = std::fs::read_to_string(dir.join("summary.json"))
+        .map_err(|e| format!("its summary.json cannot be read ({e})"))?;
+    serde_json::from_str(&text).map_err(|e| format!("its summary.json is unreadable ({e})"))
 }
 
 fn summary(dir: &Path) -> Option<serde_json::Value> {
-    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
-    serde_json::from_str(&text).ok()
+    read_summary(dir).ok()
 }
 
 /// True if the run in `dir` failed (a node died or a wait ran out).

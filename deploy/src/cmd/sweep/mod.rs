@@ -26,6 +26,7 @@ use clap::Args;
 pub use exec::Progress;
 use std::path::{Path, PathBuf};
 use tactile_report::sweep::{axis, combinations, Axis};
+use tactile_report::sweep_grid::same_value;
 use tactile_scenario::overrides::Set;
 
 /// Most runs one sweep may ask for: beyond this a typo in a list is likelier than a
@@ -40,7 +41,11 @@ pub struct SweepArgs {
     pub scenario: Option<PathBuf>,
     /// A swept key and its values, KEY=V1,V2,... (commas inside brackets or quotes
     /// belong to the value: network.forward.delay=[0,0,0],[5,5,5]). Repeatable: every
-    /// combination runs. The first key is the plots' x axis, the second their lines.
+    /// combination runs. +KEY=V1,V2,... pairs KEY with the key before it, value for
+    /// value, instead of combining them (a round trip split evenly both ways:
+    /// --set network.forward.delay_ms=0,5,25 --set +network.backward.delay_ms=0,5,25).
+    /// The first key is the plots' x axis, the second their lines (a paired key is
+    /// shown by its partner).
     #[arg(long, value_name = "KEY=V1,V2,...", required_unless_present = "merge")]
     pub set: Vec<String>,
     /// Folder for sweep.csv, the plots, and one folder per run (run-0000, ...).
@@ -243,6 +248,7 @@ pub fn sweep(
     progress: &(dyn Fn(&Progress) + Sync),
 ) -> Result<usize, Error> {
     let axes = parse_axes(&args.set)?;
+    refuse_repeats(&axes)?;
     let combos = combinations(&axes);
     check_size(args, &axes, combos.len())?;
     let shard = args.shard.as_deref().map(parse_shard).transpose()?;
@@ -328,18 +334,82 @@ pub fn parse_axes(sets: &[String]) -> Result<Vec<Axis>, Error> {
             &sets[a], &sets[b],
         )));
     }
+    check_pairs(&axes, sets)?;
     let count = axes
         .iter()
+        .filter(|a| !a.paired)
         .try_fold(1usize, |n, a| n.checked_mul(a.values.len()))
         .filter(|&n| n <= MAX_RUNS);
     if count.is_none() {
-        let sizes: Vec<String> = axes.iter().map(|a| a.values.len().to_string()).collect();
+        let sizes: Vec<String> = axes
+            .iter()
+            .filter(|a| !a.paired)
+            .map(|a| a.values.len().to_string())
+            .collect();
         return Err(Error::BadInput(format!(
             "{} combinations: more than the {MAX_RUNS} a sweep may run",
             sizes.join(" x ")
         )));
     }
     Ok(axes)
+}
+
+/// A paired key (`+KEY=...`) has a key before it to pair with, and as many values.
+fn check_pairs(axes: &[Axis], sets: &[String]) -> Result<(), Error> {
+    for (k, a) in axes.iter().enumerate().filter(|(_, a)| a.paired) {
+        let Some(before) = k.checked_sub(1).map(|j| &axes[j]) else {
+            return Err(Error::BadInput(format!(
+                "--set {}: a key written +KEY pairs with the --set before it, and there is none",
+                sets[k]
+            )));
+        };
+        if before.values.len() != a.values.len() {
+            return Err(Error::BadInput(format!(
+                "--set {}: {} values, but {} before it has {}: a paired key takes one value for each of its partner's",
+                sets[k],
+                a.values.len(),
+                before.key,
+                before.values.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// No value of a key given twice (nor a pair of values, for paired keys), however
+/// it is written (`10` and `10.0`, `tdpa` and `"tdpa"`): every combination with it
+/// would run twice.
+fn refuse_repeats(axes: &[Axis]) -> Result<(), Error> {
+    let mut start = 0;
+    while start < axes.len() {
+        let end = (start + 1..axes.len())
+            .find(|&j| !axes[j].paired)
+            .unwrap_or(axes.len());
+        let group = &axes[start..end];
+        let same = |i: usize, j: usize| {
+            group
+                .iter()
+                .all(|a| same_value(&a.sets[i].value, &a.sets[j].value))
+        };
+        let n = group[0].values.len();
+        if let Some((i, j)) = (0..n).find_map(|j| (0..j).find(|&i| same(i, j)).map(|i| (i, j))) {
+            let said = |i: usize| -> String {
+                let v: Vec<&str> = group.iter().map(|a| a.values[i].as_str()).collect();
+                v.join(" and ")
+            };
+            let keys: Vec<&str> = group.iter().map(|a| a.key.as_str()).collect();
+            return Err(Error::BadInput(format!(
+                "--set {}: value {} and value {} are one value ({} and {}): every combination with it would run twice; give each value once",
+                keys.join(" with +"),
+                i + 1,
+                j + 1,
+                said(i),
+                said(j)
+            )));
+        }
+        start = end;
+    }
+    Ok(())
 }
 
 /// `K/N` with `1 <= K <= N`.

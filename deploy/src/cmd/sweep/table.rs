@@ -7,8 +7,9 @@ use crate::error::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use tactile_report::sweep::{
-    combinations, runs_header, runs_row, stats, summary_header, summary_row, Axis,
+    combinations, runs_header, runs_row, stats, summary_header, summary_row, values, Axis,
 };
+use tactile_report::sweep_grid::same_grid;
 use tactile_report::sweep_map::sweep_maps;
 use tactile_report::sweep_plots::{sweep_plots, Point};
 
@@ -43,14 +44,25 @@ fn read_spec(dir: &Path) -> Result<Spec, Error> {
     serde_json::from_str(&text).map_err(|e| Error::BadInput(format!("{}: {e}", path.display())))
 }
 
+/// True if `a` and `b` are one sweep (any slices of it): the same scenario and the
+/// same grid, its values compared as values (`tdpa` or `"tdpa"`, `1` or `1.0`: the
+/// command and the Python package write them differently), so either front end
+/// resumes or merges what the other started.
+fn same_sweep(a: &Spec, b: &Spec) -> bool {
+    let grid = match (parse_axes(&a.sets), parse_axes(&b.sets)) {
+        (Ok(x), Ok(y)) => same_grid(&x, &y),
+        _ => a.sets == b.sets,
+    };
+    a.scenario_hash == b.scenario_hash && grid
+}
+
 /// With `--resume`, the folder must hold this same sweep (any slice of it); without,
 /// a folder of another sweep is left alone rather than mixed into.
 pub fn check_resume(out: &Path, spec: &Spec, resume: bool) -> Result<(), Error> {
     let Ok(old) = read_spec(out) else {
         return Ok(());
     };
-    let same = old.scenario_hash == spec.scenario_hash && old.sets == spec.sets;
-    if !same {
+    if !same_sweep(&old, spec) {
         return Err(Error::BadInput(format!(
             "{}: holds another sweep (its scenario or --set differ); choose another --out",
             out.display()
@@ -91,11 +103,23 @@ pub fn write_tables(out: &Path, axes: &[Axis], seeds: usize, results: &[Ran]) ->
     }
     write(&out.join("sweep.csv"), &runs)?;
     write(&out.join("sweep-summary.csv"), &summary)?;
-    sweep_plots(out, axes, &points)
+    let (axes, points) = unpaired(axes, &points);
+    sweep_plots(out, &axes, &points)
         .map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))?;
-    sweep_maps(out, axes, &points)
+    sweep_maps(out, &axes, &points)
         .map(|_| ())
         .map_err(|e| Error::Failed(format!("drawing the sweep's maps: {e}")))
+}
+
+/// The axes a plot or a map draws, and the points on them: a paired key moves with
+/// its partner, so the partner stands for both.
+fn unpaired(axes: &[Axis], points: &[Point]) -> (Vec<Axis>, Vec<Point>) {
+    let lead: Vec<usize> = (0..axes.len()).filter(|&j| !axes[j].paired).collect();
+    let points = points
+        .iter()
+        .map(|(combo, stats)| (lead.iter().map(|&j| combo[j]).collect(), stats.clone()))
+        .collect();
+    (lead.iter().map(|&j| axes[j].clone()).collect(), points)
 }
 
 /// The slices' specs, all of one sweep (scenario, `--set`s and seeds).
@@ -106,10 +130,7 @@ fn slices_of_one_sweep(dirs: &[PathBuf]) -> Result<Spec, Error> {
         .collect::<Result<Vec<_>, _>>()?;
     let first = &specs[0];
     for (d, s) in dirs.iter().zip(&specs) {
-        let same = s.scenario_hash == first.scenario_hash
-            && s.sets == first.sets
-            && s.seeds == first.seeds;
-        if !same {
+        if !(same_sweep(s, first) && s.seeds == first.seeds) {
             return Err(Error::BadInput(format!(
                 "{}: a slice of another sweep (scenario, --set or --seeds differ from {})",
                 d.display(),
@@ -120,24 +141,35 @@ fn slices_of_one_sweep(dirs: &[PathBuf]) -> Result<Spec, Error> {
     Ok(first.clone())
 }
 
-/// Every run of the grid found, and the runs in none of the folders.
+/// Every run of the grid found, and the runs whole in none of the folders (each with
+/// why, where a folder holds it but not whole).
 type Found = (Vec<Ran>, Vec<String>);
 
-/// Each run of the grid from the one folder that holds it.
+/// Each run of the grid from the one folder that holds it whole.
 fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
     let (mut results, mut missing) = (Vec::new(), Vec::new());
     for k in 0..spec.combinations {
         for s in 0..spec.seeds {
-            let found: Vec<_> = dirs
-                .iter()
-                .filter_map(|d| ran(&run_dir(d, k, s, spec.seeds)))
-                .collect();
+            let mut found = Vec::new();
+            let mut why = Vec::new();
+            for d in dirs {
+                let dir = run_dir(d, k, s, spec.seeds);
+                match ran(&dir) {
+                    Ok(r) => found.push(r),
+                    // A slice holds only its own runs' folders.
+                    Err(_) if !dir.is_dir() => {}
+                    Err(e) => why.push(format!("{}: {e}", dir.display())),
+                }
+            }
             match found.len() {
-                0 => missing.push(
-                    run_dir(Path::new(""), k, s, spec.seeds)
-                        .display()
-                        .to_string(),
-                ),
+                0 => {
+                    let name = run_dir(Path::new(""), k, s, spec.seeds);
+                    missing.push(if why.is_empty() {
+                        format!("{}: in none of the folders", name.display())
+                    } else {
+                        why.join("; ")
+                    });
+                }
                 1 => results.extend(found.into_iter().map(|(seed, values)| Ran {
                     k,
                     s,
@@ -155,9 +187,14 @@ fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
     Ok((results, missing))
 }
 
-/// The seed and metrics of the whole run in `dir`, read back from its folder.
-fn ran(dir: &Path) -> Option<(u64, Vec<Option<f64>>)> {
-    Some((super::exec::seed_of(dir)?, super::exec::finished(dir)?))
+/// The seed and metrics of the whole run in `dir`, read back from its folder, or why
+/// there are none.
+fn ran(dir: &Path) -> Result<(u64, Vec<Option<f64>>), String> {
+    let summary = super::exec::read_summary(dir)?;
+    if summary["interrupted"] != false {
+        return Err("it was stopped before it ended (its summary.json says interrupted)".into());
+    }
+    Ok((super::exec::seed_of(dir)?, values(&summary)))
 }
 
 /// `--out` is none of the folders merged (compared as canonical paths, so `./a` and
@@ -210,10 +247,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(), Error> {
     if !missing.is_empty() {
         let shown: Vec<_> = missing.iter().take(5).cloned().collect();
         return Err(Error::Failed(format!(
-            "{} runs are in none of the folders ({}{}); sweep.csv holds the rest",
+            "{} runs are whole in none of the folders ({}{}); sweep.csv holds the rest",
             missing.len(),
-            shown.join(", "),
-            if missing.len() > 5 { ", ..." } else { "" }
+            shown.join("; "),
+            if missing.len() > 5 { "; ..." } else { "" }
         )));
     }
     crate::outln!(
