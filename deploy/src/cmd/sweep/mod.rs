@@ -201,10 +201,7 @@ impl Base {
             bytes.push(0);
             bytes.extend_from_slice(s.as_bytes());
         }
-        let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-            (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
-        });
-        format!("{h:016x}")
+        format!("{:016x}", crate::launch::sim::fnv1a64(&bytes))
     }
 }
 
