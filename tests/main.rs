@@ -14,6 +14,7 @@ mod chain;
 mod channels;
 mod cli;
 mod crafted;
+mod docs_tables;
 mod faults;
 mod formats;
 mod hand;
