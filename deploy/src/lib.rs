@@ -36,4 +36,12 @@ pub mod guide {
     pub mod recordings {}
     #[doc = include_str!("../../docs/11-real-devices-and-ros2.md")]
     pub mod real_devices_and_ros2 {}
+    #[doc = include_str!("../../docs/12-fuzzing.md")]
+    pub mod fuzzing {}
+    #[doc = include_str!("../../docs/13-any-arm.md")]
+    pub mod any_arm {}
+    #[doc = include_str!("../../docs/14-six-dof-master.md")]
+    pub mod six_dof_master {}
+    #[doc = include_str!("../../docs/15-python.md")]
+    pub mod python {}
 }

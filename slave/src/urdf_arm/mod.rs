@@ -490,12 +490,9 @@ impl UrdfArm {
     }
 }
 
-#[path = "urdf_arm_sim.rs"]
 mod sim;
 
-#[path = "urdf_arm_slave.rs"]
 mod slave;
 
 #[cfg(test)]
-#[path = "urdf_arm_tests.rs"]
 mod tests;

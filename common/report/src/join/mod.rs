@@ -440,5 +440,4 @@ fn check_one_run(logs: &Logs) -> Result<(), Error> {
 }
 
 #[cfg(test)]
-#[path = "join_tests.rs"]
 mod tests;
