@@ -14,6 +14,7 @@ mod chain;
 mod channels;
 mod cli;
 mod crafted;
+mod dependencies;
 mod docs_tables;
 mod faults;
 mod formats;
