@@ -4,6 +4,7 @@ deadband codecs, so the predictors fill thousands of samples); so does an operat
 equal to the built-in circle; the operator is called once a sample in order with the
 force felt at the sample before; a bad result or an exception stops the run and is
 raised naming the callable and the sample, the report kept."""
+import csv
 import filecmp
 import json
 import math
@@ -228,3 +229,24 @@ def test_ctrl_c_reaches_a_callable_that_blocks(tmp_path, child, how):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["interrupted"] is True and 200 < summary["samples_sent"] <= 203, summary
     assert not any("hook" in e and "failed" in e for e in summary["events"]), summary["events"]
+
+
+def test_a_guess_a_received_force_would_be_refused_for_is_refused(tmp_path):
+    """A backward predictor guessing 1e300 N (finite, so the callable's check takes it)
+    had it rendered at the device's full force at every guessed sample, where the same
+    value received was refused: now each such guess is refused and the last value
+    held, so the felt force is the built-in `hold` predictor's to the bit; the sample
+    is flagged GUESS_REFUSED (65536) and the summary warns with the count."""
+    sc = tactile.Scenario.load(PAPER).with_set(
+        {"network.backward.loss": 0.2, "master.predictor.kind": "hold"})
+    held = tactile.run(sc, out=tmp_path / "held", trace_format="csv")
+    run = tactile.run(sc, out=tmp_path / "huge", trace_format="csv",
+                      backward_predictor=lambda n, to, history: (0.0, 0.0, 1e300))
+    rows = {d: list(csv.DictReader(open(tmp_path / d / "trace.csv"))) for d in ["held", "huge"]}
+    refused = sum(1 for r in rows["huge"] if int(r["flags_m"]) & 65536)
+    assert refused > 100, refused
+    for axis in ["felt_1", "felt_2", "felt_3"]:
+        assert [r[axis] for r in rows["huge"]] == [r[axis] for r in rows["held"]], axis
+    warnings = " ".join(run.summary["warnings"])
+    assert f"master: {refused} guesses of its predictor" in warnings, warnings
+    assert not held.summary["warnings"], held.summary["warnings"]
