@@ -19,6 +19,7 @@ mod master;
 mod network;
 mod operator;
 pub mod overrides;
+mod path;
 mod ros;
 mod ros_robot;
 mod ros_tls;
