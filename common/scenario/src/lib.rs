@@ -8,6 +8,7 @@
 
 mod arm;
 mod bounds;
+mod compact;
 mod control;
 pub mod csv;
 mod device;
@@ -243,9 +244,13 @@ impl Scenario {
         s
     }
 
-    /// The scenario as TOML text (what a run's `scenario.toml` holds).
+    /// The scenario as TOML text (what a run's `scenario.toml` holds), an extreme
+    /// number written short ([`compact`]).
     pub fn to_toml(&self) -> String {
-        toml::to_string(self).unwrap_or_else(|e| format!("# cannot encode the scenario: {e}\n"))
+        match toml::to_string(self) {
+            Ok(text) => compact::floats(&text),
+            Err(e) => format!("# cannot encode the scenario: {e}\n"),
+        }
     }
 
     /// Things that load but deserve a word: stiffness above the device's nominal

@@ -1,6 +1,7 @@
 //! `[master]` and `[faults]`: the master device's limits, the operator's hand, the
 //! master device's joints, and how a dead peer is noticed.
 
+use crate::shown::Num;
 use crate::{
     invalid, positive, positive3, Backend, PredictorConfig, RosDeviceConfig, ScenarioError,
 };
@@ -171,7 +172,7 @@ impl MasterDeviceConfig {
         if !self.step_s.is_finite() || self.step_s < 1e-6 || self.step_s > 1e-3 {
             return Err(invalid(
                 "master.device.step_s",
-                format!("{} s is outside 1 us to 1 ms", self.step_s),
+                format!("{} s is outside 1 us to 1 ms", Num(self.step_s)),
             ));
         }
         Ok(())
@@ -184,7 +185,7 @@ impl MasterConfig {
         if !self.force_limit.is_finite() || self.force_limit <= 0.0 {
             return Err(invalid(
                 "master.force_limit",
-                format!("{} N must be positive", self.force_limit),
+                format!("{} N must be positive", Num(self.force_limit)),
             ));
         }
         positive3(&self.torque_limit, "master.torque_limit", false)?;
@@ -197,7 +198,7 @@ impl MasterConfig {
                 "master.clutch_spring",
                 format!(
                     "{} N/m is stiffer than a desk device renders (1000 N/m)",
-                    self.clutch_spring
+                    Num(self.clutch_spring)
                 ),
             ));
         }

@@ -321,13 +321,13 @@ impl LossModel {
                 if p13 + p14 > 1.0 {
                     return Err(invalid(
                         f("p14"),
-                        format!("p13 + p14 = {} exceeds 1", p13 + p14),
+                        format!("p13 + p14 = {} exceeds 1", Num(p13 + p14)),
                     ));
                 }
                 if p31 + p32 > 1.0 {
                     return Err(invalid(
                         f("p32"),
-                        format!("p31 + p32 = {} exceeds 1", p31 + p32),
+                        format!("p31 + p32 = {} exceeds 1", Num(p31 + p32)),
                     ));
                 }
             }

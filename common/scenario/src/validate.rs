@@ -9,7 +9,10 @@ pub(crate) fn check_rate(rate_hz: f64) -> Result<(), ScenarioError> {
     if !rate_hz.is_finite() || !(100.0..=10_000.0).contains(&rate_hz) {
         return Err(invalid(
             "rate_hz",
-            format!("{rate_hz} Hz is outside 100..=10000 Hz"),
+            format!(
+                "{} Hz is outside 100..=10000 Hz",
+                crate::shown::Num(rate_hz)
+            ),
         ));
     }
     Ok(())
@@ -83,5 +86,30 @@ impl Scenario {
             return bad("codec.forward.kind", "the deadband codecs weigh positions only and would leave turns unsent; use \"none\"");
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::overrides::{apply, Set};
+    use crate::Scenario;
+
+    /// `--set rate_hz=1e300` was refused with the rate's 301 digits: every range
+    /// check shows its value short (`crate::shown::Num`).
+    #[test]
+    fn a_huge_value_is_shown_short_by_every_check() {
+        for set in [
+            "rate_hz=1e300",
+            "master.device.step_s=1e300",
+            "master.clutch_spring=1e300",
+            "slave.dynamics.step_s=1e300",
+            "operator={kind=\"circle\",center=[0,0,0],radius=1e300,period_s=1}",
+            "master.ros2.watch.timeout_ms=1e-300",
+        ] {
+            let text = apply("", &[Set::parse(set).expect("set")]).expect("applied");
+            let e = Scenario::from_toml_str(&text).expect_err(set).to_string();
+            assert!(e.len() < 200, "{set}: {e}");
+            assert!(e.contains("e300") || e.contains("e-300"), "{set}: {e}");
+        }
     }
 }

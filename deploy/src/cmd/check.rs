@@ -6,6 +6,7 @@ use crate::error::Error;
 use crate::launch::{load_scenario, parse_sets};
 use clap::Args;
 use std::path::PathBuf;
+use tactile_scenario::shown::Num;
 use tactile_scenario::{Mode, Scenario};
 
 /// Arguments of `tactile check`.
@@ -54,11 +55,11 @@ pub fn report(s: &Scenario) -> Vec<String> {
     let mut v = Vec::new();
     let secs = s.samples as f64 * s.t_s();
     v.push(match s.mode {
-        Mode::Realtime => format!("# runs {} samples at {} Hz: {} of real time", s.samples, s.rate_hz, duration(secs)),
+        Mode::Realtime => format!("# runs {} samples at {} Hz: {} of real time", s.samples, Num(s.rate_hz), duration(secs)),
         Mode::Lockstep => format!(
             "# runs {} samples at {} Hz in lockstep: {} of simulated time, about {} of real time on a 2-core machine",
             s.samples,
-            s.rate_hz,
+            Num(s.rate_hz),
             duration(secs),
             duration(s.samples as f64 / LOCKSTEP_PER_S)
         ),
