@@ -29,6 +29,7 @@ pub use tactile_math::shown;
 mod slave;
 pub mod units;
 mod validate;
+mod warnings;
 mod watch;
 pub use watch::WatchConfig;
 pub mod workspace;
@@ -251,54 +252,6 @@ impl Scenario {
             Ok(text) => compact::floats(&text),
             Err(e) => format!("# cannot encode the scenario: {e}\n"),
         }
-    }
-
-    /// Things that load but deserve a word: stiffness above the device's nominal
-    /// maximum, a delay or a schedule entry beyond the run's length.
-    pub fn warnings(&self) -> Vec<String> {
-        let mut w = Vec::new();
-        let ros_used = self.master.backend == Backend::Ros2
-            || self.slave.backend == Backend::Ros2
-            || self.ros.live.enabled;
-        if ros_used {
-            w.extend(self.ros.in_clear_to_other_hosts().into_iter().map(|e| {
-                format!(
-                    "ros endpoint {e} leaves this host in clear: joint states, forces and robot commands can be read and forged on that network (give [ros.tls] a CA, certificate and key and use tls/ endpoints for mutual TLS, or keep the router on this host, or the network trusted)"
-                )
-            }));
-        }
-        for (k, o) in self.environment.objects.iter().enumerate() {
-            for (i, h) in o.stiffness().iter().enumerate() {
-                if *h > NOMINAL_MAX_STIFFNESS {
-                    w.push(format!(
-                        "environment.objects[{k}].stiffness[{i}] = {h} N/m is above the device's nominal {NOMINAL_MAX_STIFFNESS} N/m: contact may buzz"
-                    ));
-                }
-            }
-        }
-        for (name, c) in [
-            ("forward", &self.network.forward),
-            ("backward", &self.network.backward),
-        ] {
-            for (i, d) in c.delay.iter().enumerate() {
-                if *d > 0 && *d as u64 >= self.samples {
-                    w.push(format!(
-                        "network.{name}.delay[{i}] = {d} samples is not shorter than the run ({} samples): no value of that signal arrives",
-                        self.samples
-                    ));
-                }
-            }
-            for (k, e) in c.schedule.iter().enumerate() {
-                if e[0] as u64 >= self.samples {
-                    w.push(format!(
-                        "network.{name}.schedule[{k}] starts at sample {}, after the run's last ({}): it never takes effect",
-                        e[0],
-                        self.samples - 1
-                    ));
-                }
-            }
-        }
-        w
     }
 
     /// Sampling period t_s in seconds.

@@ -375,6 +375,16 @@ fn default_max_queue() -> u32 {
 }
 
 impl ReplayConfig {
+    /// A Mahimahi replay's settings at their defaults (its path empty).
+    pub fn mahimahi_defaults() -> Self {
+        ReplayConfig {
+            path: String::new(),
+            format: ReplayFormat::Mahimahi,
+            packet_bytes: default_packet_bytes(),
+            max_queue_samples: default_max_queue(),
+        }
+    }
+
     /// Checks the fields; errors name `FIELD.replay.*`.
     pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         if self.path.is_empty() {

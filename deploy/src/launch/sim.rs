@@ -225,6 +225,7 @@ pub fn run_in_process(
         stop: tactile_runtime::signals::stop_flag().ok(),
         outputs: outputs.clone(),
         events,
+        warnings: loaded.warnings.clone(),
         ..Default::default()
     };
     let launch = match (completed, halted) {
