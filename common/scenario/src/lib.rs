@@ -37,7 +37,7 @@ pub mod workspace;
 pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
 pub use control::{
     CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, MmtConfig, MmtSlave, MmtUpdate,
-    PredictorConfig, PredictorKind,
+    PredictorConfig, PredictorKind, MIN_MEMORY_SAMPLES,
 };
 pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
 pub(crate) use error::{finite3, invalid, positive, positive3};
