@@ -700,6 +700,44 @@ fn every_magnitude_has_a_bound_named_in_the_error() {
     );
 }
 
+/// Issue 65, 6: `check` passed what a run could not record (a scenario whose start
+/// entry, the scenario as run, is longer than a record's frame): the run failed at
+/// its first write, leaving an 8-byte master.rec and no summary. Both are refused
+/// before anything starts, naming the field; a name is bounded on its own.
+#[test]
+fn a_scenario_too_large_to_record_is_refused_by_check_and_run() {
+    let sb = Sandbox::new("toolarge");
+    let changes = vec!["{at_s=0.05,object=0,move_by=[0,0,0]}"; 20_000].join(",");
+    let large = format!(
+        "{BASE}[environment]\nobjects = [{{kind = \"plane\", point = [0, 0, -0.16], normal = [0, 0, 1], stiffness = [300, 300, 300]}}]\nchanges = [{changes}]\n"
+    );
+    assert!(
+        large.len() < 1 << 20,
+        "{} bytes: a file check reads",
+        large.len()
+    );
+    let name = format!("name = \"{}\"\nsamples = 10\n", "x".repeat(1_000_000));
+    for (file, toml, field) in [
+        (
+            "changes.toml",
+            large,
+            "field `environment.changes`: the scenario is too large to record",
+        ),
+        (
+            "name.toml",
+            name,
+            "field `name`: is 1000000 characters long",
+        ),
+    ] {
+        let path = sb.write(file, &toml);
+        let o = sb.tactile(&["check", path.to_str().expect("utf-8")]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{file}: {err}");
+        assert!(err.contains(field) && o.stdout.is_empty(), "{file}: {err}");
+        assert_refused(&sb, &path, &[file, field]);
+    }
+}
+
 #[test]
 fn delays_and_schedules_past_the_run_load_with_a_warning() {
     let sb = Sandbox::new("pastrun");

@@ -29,6 +29,7 @@ pub use tactile_math::shown;
 mod slave;
 pub mod units;
 mod validate;
+pub use validate::MAX_NAME_CHARS;
 mod warnings;
 mod watch;
 pub use watch::WatchConfig;

@@ -18,9 +18,23 @@ pub(crate) fn check_rate(rate_hz: f64) -> Result<(), ScenarioError> {
     Ok(())
 }
 
+/// The longest `name`, in characters: a name labels reports, plots and sweep rows,
+/// and goes into every node's record twice (a million characters made the record's
+/// first entry longer than a frame may be).
+pub const MAX_NAME_CHARS: usize = 256;
+
 impl Scenario {
     /// Checks every value is in range; the error names the field.
     pub fn validate(&self) -> Result<(), ScenarioError> {
+        let chars = self.name.chars().count();
+        if chars > MAX_NAME_CHARS {
+            return Err(invalid(
+                "name",
+                format!(
+                    "is {chars} characters long, more than the {MAX_NAME_CHARS} a name may have"
+                ),
+            ));
+        }
         check_rate(self.rate_hz)?;
         if self.samples == 0 || self.samples > 100_000_000 {
             return Err(invalid(
@@ -93,6 +107,17 @@ impl Scenario {
 mod tests {
     use crate::overrides::{apply, Set};
     use crate::Scenario;
+
+    #[test]
+    fn a_name_longer_than_a_label_is_refused() {
+        let name = |n: usize| format!("name = \"{}\"\n", "é".repeat(n));
+        Scenario::from_toml_str(&name(super::MAX_NAME_CHARS)).expect("256 characters");
+        let e = Scenario::from_toml_str(&name(1_000_000)).expect_err("a million");
+        assert_eq!(
+            e.to_string(),
+            "field `name`: is 1000000 characters long, more than the 256 a name may have"
+        );
+    }
 
     /// `--set rate_hz=1e300` was refused with the rate's 301 digits: every range
     /// check shows its value short (`crate::shown::Num`).
