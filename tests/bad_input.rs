@@ -807,6 +807,81 @@ fn an_out_that_is_a_file_a_key_swept_twice_and_options_that_do_nothing_are_refus
     );
 }
 
+/// Issue 65, 9: `tactile run --out /` wrote twelve files into `/`, and a `--no-trace`
+/// run removed a `trace.csv` already in its folder. A folder that holds anything but
+/// an earlier output of ours is refused by every command that writes one (exit 2,
+/// nothing touched); our own earlier run is still overwritten.
+#[test]
+fn an_output_folder_of_other_files_is_refused_and_our_own_is_overwritten() {
+    let sb = Sandbox::new("outguard");
+    let scenario = sb.write("s.toml", BASE);
+    let s = scenario.to_str().expect("utf-8");
+    for d in ["theirs", "sweep/run-0001"] {
+        std::fs::create_dir_all(sb.path(d)).expect("folder");
+    }
+    sb.write("theirs/trace.csv", "their trace");
+    // A sweep's folder of ours, one of its run folders not.
+    sb.write(
+        "sweep/sweep.json",
+        "{\"scenario_hash\": \"0\", \"combinations\": 2}",
+    );
+    sb.write("sweep/run-0001/notes.txt", "their notes");
+    let ran = sb.tactile(&["run", s, "--in-process", "-q", "--out", "ours"]);
+    assert!(ran.status.success(), "{}", text(&ran.stderr));
+    let theirs = sb.path("theirs");
+    let t = theirs.to_str().expect("utf-8");
+    let cases: [&[&str]; 4] = [
+        &["run", s, "--in-process", "--no-trace", "--out", t],
+        &["sweep", s, "--set", "seed=1,2", "--out", t],
+        &["sweep", s, "--set", "seed=1,2", "--out", "sweep"],
+        &["report", "ours", "--out", t],
+    ];
+    for args in cases {
+        let o = sb.tactile(args);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("and no earlier output of tactile's"),
+            "{args:?}: {err}"
+        );
+        assert!(
+            err.contains("theirs") || err.contains("run-0001"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    }
+    let left: Vec<_> = std::fs::read_dir(&theirs)
+        .expect("theirs")
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(left, ["trace.csv"], "nothing written into their folder");
+    assert_eq!(
+        std::fs::read_to_string(theirs.join("trace.csv"))
+            .ok()
+            .as_deref(),
+        Some("their trace")
+    );
+    assert!(
+        !sb.path("sweep/run-0000").exists(),
+        "a refused sweep runs nothing"
+    );
+    let again = sb.tactile(&[
+        "run",
+        s,
+        "--in-process",
+        "-q",
+        "--no-trace",
+        "--out",
+        "ours",
+    ]);
+    assert!(again.status.success(), "{}", text(&again.stderr));
+    assert!(
+        !sb.path("ours/trace.csv").exists(),
+        "our own earlier trace replaced"
+    );
+}
+
 /// The shipped UR5 over ROS 2, its URDF by absolute path, with `extra` put into its
 /// `[slave.ros2]`.
 fn ur5_over_ros2(extra: &str) -> String {

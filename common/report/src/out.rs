@@ -43,8 +43,10 @@ fn still_at(file: &std::fs::File, path: &Path) -> bool {
 }
 
 /// Makes `out` (a folder) and takes it for this process, `holder` saying who holds it;
-/// refused (bad input, exit 2, nothing touched) while another process holds it.
+/// refused (bad input, exit 2, nothing touched) while another process holds it, or
+/// when it holds anything but an earlier output of ours ([`crate::ours`]).
 pub fn take(out: &Path, holder: &str) -> Result<OutLock, Error> {
+    crate::ours::refuse_foreign(out)?;
     make_out_dir(out)?;
     let path = out.join(LOCK_FILE);
     let io = |e| Error::io(format!("locking {}", path.display()))(e);
