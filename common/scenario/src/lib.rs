@@ -8,6 +8,7 @@
 
 mod arm;
 mod bounds;
+pub use bounds::MAX_POSITION_M;
 mod compact;
 mod control;
 pub mod csv;
