@@ -738,6 +738,96 @@ fn a_scenario_too_large_to_record_is_refused_by_check_and_run() {
     }
 }
 
+/// Issue 65, 5 and 12: what `check` passed and should not have, refused by `run` (exit
+/// 2, one line naming the field, nothing written): environment changes that add up past
+/// the bound, MMT forgetting every sample, an integer beyond i64 read as a string, and
+/// type errors that named no field through `--set`.
+#[test]
+fn sums_forgetting_big_integers_and_type_errors_are_refused_naming_the_field() {
+    let sb = Sandbox::new("issue65");
+    let scenario = sb.write(
+        "s.toml",
+        &format!("{BASE}{}", wall("[300.0, 300.0, 300.0]")),
+    );
+    let s = scenario.to_str().expect("utf-8");
+    let climb: Vec<String> = (0..50)
+        .map(|k| {
+            format!(
+                "{{at_s={},object=0,move_by=[0,0,0.9]}}",
+                f64::from(k) * 0.001
+            )
+        })
+        .collect();
+    let climb = format!("environment.changes=[{}]", climb.join(","));
+    for (set, needle) in [
+        (climb.as_str(), "field `environment.changes[11].move_by`: puts environment.objects[0].point at [0, 0, 10.64] m"),
+        ("control.mmt.forgetting=1e-300", "field `control.mmt.forgetting`: 1e-300 is outside [0.95, 1]"),
+        ("samples=99999999999999999999", "samples=99999999999999999999\": 99999999999999999999 is out of range"),
+        ("network.forward.schedule=[[0,5]]", "field `network.forward.schedule[0]`: invalid length 2"),
+        ("network.forward.delay=[1.5,1,1]", "field `network.forward.delay[0]`: invalid type: floating point `1.5`"),
+        ("rate_hz=1e300", "field `rate_hz`: 1e300 Hz is outside"),
+    ] {
+        sb.assert_bad_set(s, set, needle);
+    }
+}
+
+/// Issue 65, 12: settings that do nothing or let nothing through ran without a word.
+/// They are said by `check`, by `run` on stderr, and in the run's `summary.json`.
+#[test]
+fn what_a_run_ignores_or_cannot_pass_is_said_by_check_run_and_the_summary() {
+    let sb = Sandbox::new("warned");
+    let scenario = sb.write(
+        "s.toml",
+        &format!("{BASE}{}", wall("[300.0, 300.0, 300.0]")),
+    );
+    let s = scenario.to_str().expect("utf-8");
+    let sets = [
+        "--set",
+        "network.forward.corrupt=1.0",
+        "--set",
+        "control.kind=tdpa",
+        "--set",
+        "control.mmt.forgetting=0.99",
+        "--set",
+        "environment.changes=[{at_s=5.0,object=0,move_by=[0,0,0.01]}]",
+    ];
+    let expected = [
+        "network.forward.corrupt = 1 makes every sample NaN, which the receiver refuses: no valid position reaches the slave",
+        "control.mmt.forgetting is set, but only control.kind = \"mmt\" uses it, and this run has control.kind = \"tdpa\": it is ignored",
+        "environment.changes[0].at_s = 5 s holds from sample 500, after the run's last (9): it never takes effect",
+    ];
+    let check = sb.tactile(&[&["check", s][..], &sets].concat());
+    let run = sb.tactile(&[&["run", s, "--in-process", "-q", "--out", "w"][..], &sets].concat());
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let summary = sb.json("w", "summary.json");
+    let warnings: Vec<&str> = summary["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .filter_map(|w| w.as_str())
+        .collect();
+    for w in expected {
+        assert!(
+            text(&check.stderr).contains(&format!("warning: {w}")),
+            "check: {}",
+            text(&check.stderr)
+        );
+        assert!(
+            text(&run.stderr).contains(&format!("warning: {w}")),
+            "run: {}",
+            text(&run.stderr)
+        );
+        assert!(warnings.contains(&w), "summary: {warnings:#?}");
+    }
+    // A report made later from the records says the scenario's warnings too.
+    let again = sb.tactile(&["report", "w", "--out", "again", "--no-trace"]);
+    assert!(again.status.success(), "{}", text(&again.stderr));
+    assert_eq!(
+        sb.json("again", "summary.json")["warnings"],
+        summary["warnings"]
+    );
+}
+
 #[test]
 fn delays_and_schedules_past_the_run_load_with_a_warning() {
     let sb = Sandbox::new("pastrun");
