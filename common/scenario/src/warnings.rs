@@ -7,8 +7,9 @@
 
 use crate::shown::Num;
 use crate::{
-    Backend, ChannelConfig, CodecConfig, CodecKind, ControlKind, HandMode, LossModel, MmtSlave,
-    Operator, PredictorConfig, PredictorKind, ReplayFormat, Scenario, NOMINAL_MAX_STIFFNESS,
+    ArmServo, Backend, ChannelConfig, CodecConfig, CodecKind, ControlKind, HandMode, LossModel,
+    MmtSlave, Operator, PredictorConfig, PredictorKind, ReplayFormat, Scenario,
+    NOMINAL_MAX_STIFFNESS,
 };
 use serde::Serialize;
 use tactile_math::arith::ArithKind;
@@ -202,6 +203,17 @@ impl Scenario {
                 "slave.backend = \"ros2\"",
                 "this run's slave is simulated",
             );
+        }
+        if let Some(arm) = self
+            .slave
+            .arm
+            .as_ref()
+            .filter(|a| a.servo != ArmServo::Cartesian)
+        {
+            let d = crate::CartesianConfig::default();
+            let set = changed(&arm.cartesian, &d, "slave.arm.cartesian", &[]);
+            let this = "this run's arm has slave.arm.servo = \"joint\"";
+            say(w, &set, "slave.arm.servo = \"cartesian\"", this);
         }
         if matches!(self.arithmetic, ArithKind::F64 | ArithKind::F32) {
             let set = changed(&self.cordic, &d.cordic, "cordic", &[]);

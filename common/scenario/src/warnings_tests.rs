@@ -149,3 +149,31 @@ fn what_comes_after_the_end_is_said() {
         &["control.mmt.min_contacts = 20", "no model"],
     );
 }
+
+/// The same class in `[slave.arm]`: the Cartesian impedance's settings under the joint
+/// servo.
+#[test]
+fn an_arms_cartesian_settings_under_the_joint_servo_are_said_to_be_ignored() {
+    let arm = "[slave.arm]\nurdf = \"ur5.urdf\"\nbase = \"base_link\"\ntip = \"tool0\"\n\
+               home = [0.0, -1.2, 1.6, -1.97, -1.5708, 0.0]\nkp = [1.0, 1.0, 1.0, 1.0, 1.0, 1.0]\n\
+               kd = [0.1, 0.1, 0.1, 0.1, 0.1, 0.1]\n";
+    let read = |extra: &str| {
+        Scenario::from_toml_str(&format!("{arm}{extra}"))
+            .expect("valid")
+            .warnings()
+    };
+    assert_eq!(read(""), Vec::<String>::new());
+    let cartesian = "[slave.arm.cartesian]\nnullspace_stiffness = 20.0\n";
+    let w = read(cartesian);
+    assert!(
+        w.len() == 1 && w[0].starts_with("slave.arm.cartesian.nullspace_stiffness is set"),
+        "{w:#?}"
+    );
+    assert_eq!(
+        read(&cartesian.replace(
+            "[slave.arm.cartesian]",
+            "servo = \"cartesian\"\n[slave.arm.cartesian]"
+        )),
+        Vec::<String>::new()
+    );
+}
