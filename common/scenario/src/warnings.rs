@@ -186,23 +186,23 @@ impl Scenario {
             let this = "this run's hand has master.hand.mode = \"position\"";
             say(w, &set, "master.hand.mode = \"impedance\"", this);
         }
-        if self.master.backend != Backend::Ros2 {
-            let set = changed(&self.master.ros2, &d.master.ros2, "master.ros2", &[]);
-            say(
-                w,
-                &set,
-                "master.backend = \"ros2\"",
-                "this run's master is simulated",
-            );
-        }
-        if self.slave.backend != Backend::Ros2 {
-            let set = changed(&self.slave.ros2, &d.slave.ros2, "slave.ros2", &[]);
-            say(
-                w,
-                &set,
-                "slave.backend = \"ros2\"",
-                "this run's slave is simulated",
-            );
+        let sides = [
+            (
+                "master",
+                self.master.backend,
+                changed(&self.master.ros2, &d.master.ros2, "master.ros2", &[]),
+            ),
+            (
+                "slave",
+                self.slave.backend,
+                changed(&self.slave.ros2, &d.slave.ros2, "slave.ros2", &[]),
+            ),
+        ];
+        for (side, backend, set) in sides {
+            if backend != Backend::Ros2 {
+                let only = format!("{side}.backend = \"ros2\"");
+                say(w, &set, &only, &format!("this run's {side} is simulated"));
+            }
         }
         if let Some(arm) = self
             .slave
