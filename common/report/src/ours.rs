@@ -2,7 +2,7 @@
 //! one that holds an earlier output of ours. A run removes and writes files by name
 //! in its folder, so `tactile run --out /` wrote twelve files into `/`, and a
 //! `--no-trace` run removed a `trace.csv` that was someone else's. Every command that
-//! writes a folder asks here first ([`crate::out::take`] does, for runs, reports
+//! writes a folder asks here first (`out::take` does, for runs, reports
 //! and sweeps), and refuses a folder that holds anything but ours.
 //!
 //! An earlier output of ours is known by a file only Tactile writes, read far enough
@@ -16,6 +16,9 @@ use crate::Error;
 use std::io::Read;
 use std::path::Path;
 use tactile_messages::Role;
+
+/// The lock file in an output folder (`out::take`).
+pub const LOCK_FILE: &str = ".tactile.lock";
 
 /// The JSON files a command of ours writes, with keys each always holds.
 const JSON_MARKS: [(&str, [&str; 2]); 3] = [
@@ -62,7 +65,7 @@ pub fn refuse_foreign(out: &Path) -> Result<(), Error> {
 
 /// True if `dir` holds a file only an output of ours has.
 pub fn ours(dir: &Path) -> bool {
-    dir.join(crate::out::LOCK_FILE).is_file()
+    dir.join(LOCK_FILE).is_file()
         || Role::ALL
             .iter()
             .any(|r| record(&dir.join(format!("{r}.rec"))))
@@ -141,7 +144,7 @@ mod tests {
                 "bench.json",
                 "{\"rates\": [], \"lockstep_samples_per_s\": 1}",
             ),
-            (crate::out::LOCK_FILE, ""),
+            (LOCK_FILE, ""),
         ] {
             let d = at(&format!("ours-{file}"));
             std::fs::write(d.join("notes.txt"), "x").expect("write");

@@ -15,8 +15,7 @@ use rustix::fs::{flock, FlockOperation};
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
-/// The lock file in an output folder.
-pub const LOCK_FILE: &str = ".tactile.lock";
+pub use crate::ours::LOCK_FILE;
 
 /// An output folder held by this process; released (its lock file removed) on drop.
 #[derive(Debug)]

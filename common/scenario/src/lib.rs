@@ -18,6 +18,8 @@ mod error;
 pub mod hand;
 mod lengths;
 mod master;
+#[cfg(test)]
+mod messages_tests;
 mod network;
 mod operator;
 pub mod overrides;
