@@ -36,6 +36,12 @@ const NAMED: usize = 3;
 /// Refuses (bad input, nothing touched) an existing folder `out` that holds files
 /// or folders and no earlier output of ours.
 pub fn refuse_foreign(out: &Path) -> Result<(), Error> {
+    if out.as_os_str().is_empty() {
+        // It would be the working folder, whatever that holds.
+        return Err(Error::BadInput(
+            "--out \"\": an empty path names no folder; give one".into(),
+        ));
+    }
     let Ok(entries) = std::fs::read_dir(out) else {
         // Missing (made later), or not a folder (refused by whoever makes it).
         return Ok(());
@@ -114,6 +120,7 @@ mod tests {
             d
         };
         refuse_foreign(&dir.path().join("missing")).expect("missing");
+        refuse_foreign(Path::new("")).expect_err("the working folder, unnamed");
         refuse_foreign(&at("empty")).expect("empty");
         let theirs = at("theirs");
         std::fs::write(theirs.join("trace.csv"), "their data").expect("write");
