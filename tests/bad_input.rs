@@ -700,6 +700,134 @@ fn every_magnitude_has_a_bound_named_in_the_error() {
     );
 }
 
+/// Issue 65, 6: `check` passed what a run could not record (a scenario whose start
+/// entry, the scenario as run, is longer than a record's frame): the run failed at
+/// its first write, leaving an 8-byte master.rec and no summary. Both are refused
+/// before anything starts, naming the field; a name is bounded on its own.
+#[test]
+fn a_scenario_too_large_to_record_is_refused_by_check_and_run() {
+    let sb = Sandbox::new("toolarge");
+    let changes = vec!["{at_s=0.05,object=0,move_by=[0,0,0]}"; 20_000].join(",");
+    let large = format!(
+        "{BASE}[environment]\nobjects = [{{kind = \"plane\", point = [0, 0, -0.16], normal = [0, 0, 1], stiffness = [300, 300, 300]}}]\nchanges = [{changes}]\n"
+    );
+    assert!(
+        large.len() < 1 << 20,
+        "{} bytes: a file check reads",
+        large.len()
+    );
+    let name = format!("name = \"{}\"\nsamples = 10\n", "x".repeat(1_000_000));
+    for (file, toml, field) in [
+        (
+            "changes.toml",
+            large,
+            "field `environment.changes`: the scenario is too large to record",
+        ),
+        (
+            "name.toml",
+            name,
+            "field `name`: is 1000000 characters long",
+        ),
+    ] {
+        let path = sb.write(file, &toml);
+        let o = sb.tactile(&["check", path.to_str().expect("utf-8")]);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{file}: {err}");
+        assert!(err.contains(field) && o.stdout.is_empty(), "{file}: {err}");
+        assert_refused(&sb, &path, &[file, field]);
+    }
+}
+
+/// Issue 65, 5 and 12: what `check` passed and should not have, refused by `run` (exit
+/// 2, one line naming the field, nothing written): environment changes that add up past
+/// the bound, MMT forgetting every sample, an integer beyond i64 read as a string, and
+/// type errors that named no field through `--set`.
+#[test]
+fn sums_forgetting_big_integers_and_type_errors_are_refused_naming_the_field() {
+    let sb = Sandbox::new("issue65");
+    let scenario = sb.write(
+        "s.toml",
+        &format!("{BASE}{}", wall("[300.0, 300.0, 300.0]")),
+    );
+    let s = scenario.to_str().expect("utf-8");
+    let climb: Vec<String> = (0..50)
+        .map(|k| {
+            format!(
+                "{{at_s={},object=0,move_by=[0,0,0.9]}}",
+                f64::from(k) * 0.001
+            )
+        })
+        .collect();
+    let climb = format!("environment.changes=[{}]", climb.join(","));
+    for (set, needle) in [
+        (climb.as_str(), "field `environment.changes[11].move_by`: puts environment.objects[0].point at [0, 0, 10.64] m"),
+        ("control.mmt.forgetting=1e-300", "field `control.mmt.forgetting`: 1e-300 is outside [0.95, 1]"),
+        ("samples=99999999999999999999", "samples=99999999999999999999\": 99999999999999999999 is out of range"),
+        ("network.forward.schedule=[[0,5]]", "field `network.forward.schedule[0]`: invalid length 2"),
+        ("network.forward.delay=[1.5,1,1]", "field `network.forward.delay[0]`: invalid type: floating point `1.5`"),
+        ("rate_hz=1e300", "field `rate_hz`: 1e300 Hz is outside"),
+    ] {
+        sb.assert_bad_set(s, set, needle);
+    }
+}
+
+/// Issue 65, 12: settings that do nothing or let nothing through ran without a word.
+/// They are said by `check`, by `run` on stderr, and in the run's `summary.json`.
+#[test]
+fn what_a_run_ignores_or_cannot_pass_is_said_by_check_run_and_the_summary() {
+    let sb = Sandbox::new("warned");
+    let scenario = sb.write(
+        "s.toml",
+        &format!("{BASE}{}", wall("[300.0, 300.0, 300.0]")),
+    );
+    let s = scenario.to_str().expect("utf-8");
+    let sets = [
+        "--set",
+        "network.forward.corrupt=1.0",
+        "--set",
+        "control.kind=tdpa",
+        "--set",
+        "control.mmt.forgetting=0.99",
+        "--set",
+        "environment.changes=[{at_s=5.0,object=0,move_by=[0,0,0.01]}]",
+    ];
+    let expected = [
+        "network.forward.corrupt = 1 makes every sample NaN, which the receiver refuses: no valid position reaches the slave",
+        "control.mmt.forgetting is set, but only control.kind = \"mmt\" uses it, and this run has control.kind = \"tdpa\": it is ignored",
+        "environment.changes[0].at_s = 5 s holds from sample 500, after the run's last (9): it never takes effect",
+    ];
+    let check = sb.tactile(&[&["check", s][..], &sets].concat());
+    let run = sb.tactile(&[&["run", s, "--in-process", "-q", "--out", "w"][..], &sets].concat());
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let summary = sb.json("w", "summary.json");
+    let warnings: Vec<&str> = summary["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .filter_map(|w| w.as_str())
+        .collect();
+    for w in expected {
+        assert!(
+            text(&check.stderr).contains(&format!("warning: {w}")),
+            "check: {}",
+            text(&check.stderr)
+        );
+        assert!(
+            text(&run.stderr).contains(&format!("warning: {w}")),
+            "run: {}",
+            text(&run.stderr)
+        );
+        assert!(warnings.contains(&w), "summary: {warnings:#?}");
+    }
+    // A report made later from the records says the scenario's warnings too.
+    let again = sb.tactile(&["report", "w", "--out", "again", "--no-trace"]);
+    assert!(again.status.success(), "{}", text(&again.stderr));
+    assert_eq!(
+        sb.json("again", "summary.json")["warnings"],
+        summary["warnings"]
+    );
+}
+
 #[test]
 fn delays_and_schedules_past_the_run_load_with_a_warning() {
     let sb = Sandbox::new("pastrun");
@@ -766,6 +894,81 @@ fn an_out_that_is_a_file_a_key_swept_twice_and_options_that_do_nothing_are_refus
     assert_eq!(
         std::fs::read_to_string(sb.path("afile")).ok().as_deref(),
         Some("not a folder")
+    );
+}
+
+/// Issue 65, 9: `tactile run --out /` wrote twelve files into `/`, and a `--no-trace`
+/// run removed a `trace.csv` already in its folder. A folder that holds anything but
+/// an earlier output of ours is refused by every command that writes one (exit 2,
+/// nothing touched); our own earlier run is still overwritten.
+#[test]
+fn an_output_folder_of_other_files_is_refused_and_our_own_is_overwritten() {
+    let sb = Sandbox::new("outguard");
+    let scenario = sb.write("s.toml", BASE);
+    let s = scenario.to_str().expect("utf-8");
+    for d in ["theirs", "sweep/run-0001"] {
+        std::fs::create_dir_all(sb.path(d)).expect("folder");
+    }
+    sb.write("theirs/trace.csv", "their trace");
+    // A sweep's folder of ours, one of its run folders not.
+    sb.write(
+        "sweep/sweep.json",
+        "{\"scenario_hash\": \"0\", \"combinations\": 2}",
+    );
+    sb.write("sweep/run-0001/notes.txt", "their notes");
+    let ran = sb.tactile(&["run", s, "--in-process", "-q", "--out", "ours"]);
+    assert!(ran.status.success(), "{}", text(&ran.stderr));
+    let theirs = sb.path("theirs");
+    let t = theirs.to_str().expect("utf-8");
+    let cases: [&[&str]; 4] = [
+        &["run", s, "--in-process", "--no-trace", "--out", t],
+        &["sweep", s, "--set", "seed=1,2", "--out", t],
+        &["sweep", s, "--set", "seed=1,2", "--out", "sweep"],
+        &["report", "ours", "--out", t],
+    ];
+    for args in cases {
+        let o = sb.tactile(args);
+        let err = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("and no earlier output of tactile's"),
+            "{args:?}: {err}"
+        );
+        assert!(
+            err.contains("theirs") || err.contains("run-0001"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    }
+    let left: Vec<_> = std::fs::read_dir(&theirs)
+        .expect("theirs")
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(left, ["trace.csv"], "nothing written into their folder");
+    assert_eq!(
+        std::fs::read_to_string(theirs.join("trace.csv"))
+            .ok()
+            .as_deref(),
+        Some("their trace")
+    );
+    assert!(
+        !sb.path("sweep/run-0000").exists(),
+        "a refused sweep runs nothing"
+    );
+    let again = sb.tactile(&[
+        "run",
+        s,
+        "--in-process",
+        "-q",
+        "--no-trace",
+        "--out",
+        "ours",
+    ]);
+    assert!(again.status.success(), "{}", text(&again.stderr));
+    assert!(
+        !sb.path("ours/trace.csv").exists(),
+        "our own earlier trace replaced"
     );
 }
 

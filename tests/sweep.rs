@@ -39,7 +39,7 @@ fn set_changes_the_scenario_as_run_and_is_checked_like_the_file() {
         ),
         (
             "rate_hz=fast",
-            "with --set rate_hz=fast: invalid type: string \"fast\", expected f64",
+            "with --set rate_hz=fast: field `rate_hz`: invalid type: string \"fast\", expected f64",
         ),
         ("samples=0", "field `samples`: 0 is outside"),
         ("samples", "expected KEY=VALUE"),

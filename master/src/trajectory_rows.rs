@@ -5,6 +5,8 @@
 //! 1.47 GB that way), and the number of rows is capped.
 
 use nalgebra::{Quaternion, UnitQuaternion};
+use tactile_scenario::shown::Num;
+use tactile_scenario::MAX_POSITION_M;
 
 /// How far a file's quaternion's norm may be from one (rounding in a recorder's
 /// output); it is normalized when read.
@@ -77,6 +79,17 @@ impl Columns {
             )));
         }
         let k = usize::from(self.timed);
+        let point = [r[k], r[k + 1], r[k + 2]];
+        // The bound of every position a scenario gives (an operator's `from`, an
+        // object's `point`): a file's positions were taken at any size. Checked
+        // before any column takes the row in.
+        if let Some(i) = point.iter().position(|x| x.abs() > MAX_POSITION_M) {
+            return Err(bad(format!(
+                "{} = {} m is beyond {MAX_POSITION_M} m, the bound of every position in the arm's space",
+                ["x", "y", "z"][i],
+                Num(point[i])
+            )));
+        }
         if self.timed {
             self.push_time(r[0]).map_err(bad)?;
         }
@@ -87,12 +100,13 @@ impl Columns {
             let v = r[if self.oriented { k + 7 } else { k + 3 }];
             if v != 1.0 && v != 0.0 {
                 return Err(bad(format!(
-                    "engaged = {v}: it is 1 (clutch held) or 0 (released)"
+                    "engaged = {}: it is 1 (clutch held) or 0 (released)",
+                    Num(v)
                 )));
             }
             self.engaged.push(v == 1.0);
         }
-        self.points.push([r[k], r[k + 1], r[k + 2]]);
+        self.points.push(point);
         Ok(())
     }
 
@@ -100,9 +114,14 @@ impl Columns {
     /// the CSV parser refuses anything else).
     fn push_time(&mut self, t: f64) -> Result<(), String> {
         match self.times.last() {
-            None if t < 0.0 => Err(format!("t = {t} s is before 0 (times start at 0 or later)")),
+            None if t < 0.0 => Err(format!(
+                "t = {} s is before 0 (times start at 0 or later)",
+                Num(t)
+            )),
             Some(&prev) if t <= prev => Err(format!(
-                "t = {t} s is not after the previous row's {prev} s (times must increase strictly)"
+                "t = {} s is not after the previous row's {} s (times must increase strictly)",
+                Num(t),
+                Num(prev)
             )),
             _ => {
                 self.times.push(t);
@@ -118,8 +137,8 @@ impl Columns {
         let norm = quat.norm();
         if (norm - 1.0).abs() > UNIT_TOLERANCE {
             return Err(format!(
-                "the quaternion (qx, qy, qz, qw) = ({}, {}, {}, {}) has norm {norm}; an orientation is a unit quaternion (within {UNIT_TOLERANCE})",
-                q[0], q[1], q[2], q[3]
+                "the quaternion (qx, qy, qz, qw) = ({}, {}, {}, {}) has norm {}; an orientation is a unit quaternion (within {UNIT_TOLERANCE})",
+                Num(q[0]), Num(q[1]), Num(q[2]), Num(q[3]), Num(norm)
             ));
         }
         let mut u = UnitQuaternion::new_normalize(quat);
@@ -138,6 +157,29 @@ impl Columns {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A file's positions were taken at any size (the operator's `from` and `to` are
+    /// bounded at 10 m): and a time of 1e300 was shown in 301 digits.
+    #[test]
+    fn positions_beyond_the_bound_are_refused_and_numbers_shown_short() {
+        let mut c = Columns::new(1);
+        c.push(2, &[0.0, 0.0, 0.0, 10.0]).expect("10 m");
+        let e = c.push(3, &[1.0, 0.0, -1e300, 0.0]).expect_err("1e300 m");
+        assert_eq!(e.line, 3);
+        assert!(
+            e.problem.starts_with("y = -1e300 m is beyond 10 m"),
+            "{}",
+            e.problem
+        );
+        let e = c
+            .push(3, &[-1e300, 0.0, 0.0, 0.0])
+            .expect_err("before the last");
+        assert!(
+            e.problem.starts_with("t = -1e300 s is not after"),
+            "{}",
+            e.problem
+        );
+    }
 
     #[test]
     fn rows_past_the_cap_are_refused_naming_the_line() {

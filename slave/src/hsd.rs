@@ -318,18 +318,15 @@ impl Slave {
     }
 }
 
-/// The scenario's environment changes by the first sample each holds from (`n t_s >=
-/// at_s`), latest first; a stable sort, so changes at one sample apply in the file's
-/// order.
+/// The scenario's environment changes by the first sample each holds from, latest
+/// first (popped from the end: in the order `Environment::changes_in_order` gives).
 fn changes(scenario: &Scenario) -> Vec<(u64, Change)> {
-    let t_s = scenario.t_s();
     let mut v: Vec<(u64, Change)> = scenario
         .environment
-        .changes
-        .iter()
-        .map(|c| ((c.at_s / t_s - 1e-9).ceil().max(0.0) as u64, c.clone()))
+        .changes_in_order(scenario.t_s())
+        .into_iter()
+        .map(|(_, n, c)| (n, c.clone()))
         .collect();
-    v.sort_by_key(|(n, _)| *n);
     v.reverse();
     v
 }

@@ -86,6 +86,31 @@ fn row_config() -> impl bincode::config::Config {
         .with_limit::<{ MAX_FRAME as usize }>()
 }
 
+/// The length of `entry`'s frame body as a [`RecordWriter`] encodes it, counted
+/// without writing it: what a scenario's check measures a run's start entry with, so
+/// it refuses what a node could not record.
+pub fn body_len<E: Serialize>(entry: &E) -> Result<usize, bincode::error::EncodeError> {
+    let mut size = bincode::enc::write::SizeWriter::default();
+    bincode::serde::encode_into_writer(entry, &mut size, config())?;
+    Ok(size.bytes_written)
+}
+
+/// An entry longer than a frame may be: a reader would take it for damage.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+#[error("a record of {len} bytes is longer than a frame may be ({MAX_FRAME} bytes)")]
+pub struct TooLong {
+    /// The entry's body, bytes.
+    pub len: usize,
+}
+
+/// A frame body of `len` bytes, or [`TooLong`] past [`MAX_FRAME`].
+pub fn fits(len: usize) -> Result<(), TooLong> {
+    if len > MAX_FRAME as usize {
+        return Err(TooLong { len });
+    }
+    Ok(())
+}
+
 /// Appends records to a node's file: entries one `write` each, samples a block at a
 /// time.
 pub struct RecordWriter<T> {
@@ -153,14 +178,9 @@ impl<T> RecordWriter<T> {
         self.buf.resize(HEADER, 0);
         bincode::serde::encode_into_std_write(entry, &mut self.buf, config())
             .map_err(std::io::Error::other)?;
-        let body = self.buf.len() - HEADER;
-        if body > MAX_FRAME as usize {
-            // A reader would take it for damage: refuse it here instead.
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                format!("a record of {body} bytes is longer than a frame may be"),
-            ));
-        }
+        // A reader would take a longer one for damage: refused here instead.
+        fits(self.buf.len() - HEADER)
+            .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e))?;
         seal(&mut self.buf);
         self.file.write_all(&self.buf)
     }

@@ -356,3 +356,34 @@ fn a_row_that_fails_to_encode_leaves_the_rows_as_they_were() {
     assert_eq!(rows.append(&(8u64, 1u32)).expect("a row"), 12);
     assert_eq!(rows.as_slice().len(), 24);
 }
+
+/// `body_len` is the length the writer writes (what a scenario's check measures a
+/// run's start entry with), and an entry past a frame is refused, the file as it was.
+#[test]
+fn an_entrys_length_is_counted_as_written_and_a_frame_too_long_is_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("r.rec");
+    let mut w = RecordWriter::<R>::create(&path, false).expect("create");
+    let len = |p: &Path| std::fs::metadata(p).expect("meta").len() as usize;
+    for what in [String::new(), "x".repeat(1000)] {
+        let e: R = Record::Event(Event {
+            sample: 7,
+            mono_ns: u64::MAX,
+            what,
+        });
+        let before = len(&path);
+        w.write(&e).expect("write");
+        assert_eq!(len(&path) - before, HEADER + body_len(&e).expect("len"));
+    }
+    let long: R = Record::Event(Event {
+        sample: 0,
+        mono_ns: 0,
+        what: "x".repeat(MAX_FRAME as usize),
+    });
+    let n = body_len(&long).expect("len");
+    assert_eq!(fits(n), Err(TooLong { len: n }));
+    let before = len(&path);
+    let e = w.write(&long).expect_err("longer than a frame");
+    assert!(e.to_string().contains("longer than a frame may be"), "{e}");
+    assert_eq!(len(&path), before);
+}

@@ -17,6 +17,6 @@ pub mod recorder;
 pub mod slave;
 
 pub use entry::{AnyRecord, Event, Record, SampleBlock, Sched, Start, Stop, Totals};
-pub use file::{rows_in, RecordReader, RecordWriter};
-pub use frames::{Damage, RecordError, MAGIC};
+pub use file::{body_len, fits, rows_in, RecordReader, RecordWriter, TooLong};
+pub use frames::{Damage, RecordError, MAGIC, MAX_FRAME};
 pub use recorder::{record_path, Events, Recorder, WriteError};

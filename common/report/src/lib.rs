@@ -17,6 +17,7 @@ pub mod joints;
 pub mod mcap;
 pub mod metrics;
 mod node_log;
+pub mod ours;
 pub mod out;
 pub mod parquet_trace;
 pub mod plots;

@@ -15,8 +15,7 @@ use rustix::fs::{flock, FlockOperation};
 use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
-/// The lock file in an output folder.
-pub const LOCK_FILE: &str = ".tactile.lock";
+pub use crate::ours::LOCK_FILE;
 
 /// An output folder held by this process; released (its lock file removed) on drop.
 #[derive(Debug)]
@@ -43,8 +42,10 @@ fn still_at(file: &std::fs::File, path: &Path) -> bool {
 }
 
 /// Makes `out` (a folder) and takes it for this process, `holder` saying who holds it;
-/// refused (bad input, exit 2, nothing touched) while another process holds it.
+/// refused (bad input, exit 2, nothing touched) while another process holds it, or
+/// when it holds anything but an earlier output of ours ([`crate::ours`]).
 pub fn take(out: &Path, holder: &str) -> Result<OutLock, Error> {
+    crate::ours::refuse_foreign(out)?;
     make_out_dir(out)?;
     let path = out.join(LOCK_FILE);
     let io = |e| Error::io(format!("locking {}", path.display()))(e);

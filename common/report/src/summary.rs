@@ -227,9 +227,12 @@ pub struct Summary {
     pub hardware: Option<crate::hardware::HardwareSummary>,
     /// Each node: where it ran, its memory, how its record ends.
     pub nodes: BTreeMap<&'static str, NodeSummary>,
-    /// What the figures leave out: a part of the run they are not computed from
-    /// (rows left out of the join, damaged), or counts of the trace and a node's own
-    /// that disagree. Empty when the figures cover the whole run.
+    /// What the scenario's check said before the run (a setting that does nothing,
+    /// a change after the end, a channel that lets nothing through, a trajectory
+    /// shorter than the run: `tactile check` says the same), then what the figures
+    /// leave out: a part of the run they are not computed from (rows left out of the
+    /// join, damaged), or counts of the trace and a node's own that disagree. Empty
+    /// when the scenario deserves no word and the figures cover the whole run.
     pub warnings: Vec<String>,
     /// What happened: processes that died and were restarted, loop breaks, resumes.
     pub events: Vec<String>,

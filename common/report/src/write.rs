@@ -34,6 +34,10 @@ pub const IN_PROCESS: &str = "in-process";
 pub struct Launch {
     /// The launcher's own events (deaths, restarts, stop requests), first in the list.
     pub events: Vec<String>,
+    /// What the launcher said of the run before it started (the scenario's warnings
+    /// and its inputs', a trajectory shorter than the run): first in the summary's
+    /// warnings. The scenario's own are added however the report is made.
+    pub warnings: Vec<String>,
     /// A node died during the run.
     pub failed: bool,
     /// A stop request cut the run short.
@@ -296,12 +300,18 @@ fn summarise(
             .ok()
             .zip(scenario.device.geometry().ok()),
     );
-    let mut warnings = crate::warnings::warnings(
+    let mut warnings = launch.warnings.clone();
+    for w in scenario.warnings() {
+        if !warnings.contains(&w) {
+            warnings.push(w);
+        }
+    }
+    warnings.extend(crate::warnings::warnings(
         a,
         logs,
         master_totals.counters.sent,
         slave.as_ref().map(|s| &s.counters),
-    );
+    ));
     warnings.extend(crate::warnings::devices_rejected(
         &master_totals.device,
         slave.as_ref().map(|s| &s.device),

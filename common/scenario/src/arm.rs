@@ -279,14 +279,14 @@ impl ArmConfig {
         if !self.step_s.is_finite() || self.step_s < 1e-6 || self.step_s > 0.01 {
             return Err(invalid(
                 "slave.arm.step_s",
-                format!("{} s is outside 1 us to 10 ms", self.step_s),
+                format!("{} s is outside 1 us to 10 ms", Num(self.step_s)),
             ));
         }
         for (i, g) in self.gravity.iter().enumerate() {
             if !g.is_finite() || g.abs() > 100.0 {
                 return Err(invalid(
                     format!("slave.arm.gravity[{i}]"),
-                    format!("{g} m/s^2 is not a finite number within 100"),
+                    format!("{} m/s^2 is not a finite number within 100", Num(*g)),
                 ));
             }
         }

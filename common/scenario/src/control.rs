@@ -61,8 +61,14 @@ pub struct ControlConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct MmtConfig {
-    /// The estimator's forgetting factor per sample, in (0, 1]: 1 remembers every
-    /// contact sample; 0.995 weighs the last 200 (0.2 s at 1 kHz) [0.995].
+    /// The estimator's forgetting factor per sample, at most 1: 1 remembers every
+    /// contact sample; 0.995 weighs the last 200 (0.2 s at 1 kHz) [0.995]. Its memory,
+    /// 1/(1 - forgetting) samples, must be at least [`MIN_MEMORY_SAMPLES`] and at
+    /// least `min_contacts` (a model waits for that many samples; one from a shorter
+    /// memory rests on fewer): 0.95 at the defaults. Below that the model follows
+    /// each sample's force, and every change is sent and felt: on `wall-change.toml`
+    /// the largest felt step is 0.09 N from 0.95 to 0.995, 0.14 N at 0.9, 0.31 N at
+    /// 0.8, 0.56 N at 0.5 and 1.24 N at 1e-300 (docs/05).
     pub forgetting: f64,
     /// A contact force above this is contact, below it free motion, N [0.05].
     pub contact_force: f64,
@@ -132,27 +138,44 @@ impl Default for MmtConfig {
     }
 }
 
+/// The fewest samples the MMT estimator may remember (1/(1 - forgetting)): the
+/// default `min_contacts`, where the largest felt step of `wall-change.toml` reaches
+/// its floor (0.09 N; `control.mmt.forgetting`'s documentation has the figures).
+pub const MIN_MEMORY_SAMPLES: u32 = 20;
+
 impl MmtConfig {
+    /// The smallest `forgetting` allowed: a memory of [`MIN_MEMORY_SAMPLES`] and of
+    /// `min_contacts` samples.
+    pub fn min_forgetting(&self) -> f64 {
+        1.0 - 1.0 / f64::from(self.min_contacts.max(MIN_MEMORY_SAMPLES))
+    }
+
     /// Checks the ranges; errors name `control.mmt.*`.
     pub fn validate(&self) -> Result<(), ScenarioError> {
-        if !(self.forgetting > 0.0 && self.forgetting <= 1.0) {
-            return Err(invalid(
-                "control.mmt.forgetting",
-                format!("{} is outside (0, 1]", Num(self.forgetting)),
-            ));
-        }
-        if !(self.prior_stiffness > 0.0 && self.prior_stiffness <= crate::MAX_STIFFNESS) {
-            return Err(invalid(
-                "control.mmt.prior_stiffness",
-                format!(
-                    "{} N/m is outside (0, {}]",
-                    Num(self.prior_stiffness),
-                    crate::MAX_STIFFNESS
-                ),
-            ));
-        }
         if self.min_contacts == 0 {
             return Err(invalid("control.mmt.min_contacts", "must be at least 1"));
+        }
+        let floor = self.min_forgetting();
+        if !(self.forgetting >= floor && self.forgetting <= 1.0) {
+            let memory = if self.forgetting < 1.0 {
+                let m = 1.0 / (1.0 - self.forgetting);
+                format!(
+                    "it remembers about {} samples (1/(1 - forgetting)), and ",
+                    Num((m * 10.0).round() / 10.0)
+                )
+            } else {
+                String::new()
+            };
+            return Err(invalid(
+                "control.mmt.forgetting",
+                format!(
+                    "{} is outside [{}, 1]: {memory}the estimator must remember at least {} samples ({MIN_MEMORY_SAMPLES}, and control.mmt.min_contacts = {}), or its model follows each sample's force",
+                    Num(self.forgetting),
+                    Num(floor),
+                    self.min_contacts.max(MIN_MEMORY_SAMPLES),
+                    self.min_contacts
+                ),
+            ));
         }
         positive(self.contact_force, "control.mmt.contact_force", false)?;
         positive(self.stiffness_change, "control.mmt.stiffness_change", false)?;
@@ -331,5 +354,49 @@ impl PredictorConfig {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::overrides::{apply, Set};
+    use crate::Scenario;
+
+    fn read(sets: &[&str]) -> Result<Scenario, String> {
+        let sets: Vec<Set> = sets.iter().map(|s| Set::parse(s).expect("set")).collect();
+        Scenario::from_toml_str(&apply("", &sets).expect("applied")).map_err(|e| e.to_string())
+    }
+
+    /// `forgetting = 1e-300` was accepted: the estimator forgot everything every
+    /// sample, and the felt force stepped 1.24 N on wall-change.toml.
+    #[test]
+    fn forgetting_keeps_a_memory_of_the_samples_a_model_waits_for() {
+        let e = read(&["control.mmt.forgetting=1e-300"]).expect_err("no memory");
+        assert!(
+            e.contains("field `control.mmt.forgetting`: 1e-300 is outside [0.95, 1]")
+                && e.contains("about 1 samples"),
+            "{e}"
+        );
+        read(&["control.mmt.forgetting=0.95"]).expect("20 samples");
+        read(&["control.mmt.forgetting=1.0"]).expect("remembers all");
+        read(&["control.mmt.forgetting=0.949"]).expect_err("under 20 samples");
+        // A model that waits for 100 samples needs a memory of 100.
+        let e = read(&[
+            "control.mmt.min_contacts=100",
+            "control.mmt.forgetting=0.98",
+        ])
+        .expect_err("50 samples");
+        assert!(
+            e.contains("[0.99, 1]") && e.contains("min_contacts = 100"),
+            "{e}"
+        );
+        read(&[
+            "control.mmt.min_contacts=100",
+            "control.mmt.forgetting=0.99",
+        ])
+        .expect("100");
+        // Fewer contacts than the floor do not lower it.
+        read(&["control.mmt.min_contacts=2", "control.mmt.forgetting=0.9"])
+            .expect_err("10 samples");
     }
 }

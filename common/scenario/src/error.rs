@@ -68,7 +68,9 @@ pub(crate) fn positive3(v: &[f64; 3], field: &str, allow_zero: bool) -> Result<(
     Ok(())
 }
 
-/// A TOML error as one line: `line L, column C: message`.
+/// A TOML error as one line: `line L, column C: field `PATH`: message`, the field's
+/// dotted path where the error's place is in one (serde's own messages, such as
+/// `invalid length 2, expected an array of length 4`, do not say which field).
 pub fn one_line(text: &str, e: &toml::de::Error) -> String {
     let msg = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
     match e.span() {
@@ -76,7 +78,10 @@ pub fn one_line(text: &str, e: &toml::de::Error) -> String {
             let before = &text[..span.start.min(text.len())];
             let line = before.matches('\n').count() + 1;
             let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-            format!("line {line}, column {column}: {msg}")
+            match crate::path::field_at(text, span.start) {
+                Some(f) => format!("line {line}, column {column}: field `{f}`: {msg}"),
+                None => format!("line {line}, column {column}: {msg}"),
+            }
         }
         None => msg,
     }

@@ -8,6 +8,8 @@
 
 mod arm;
 mod bounds;
+pub use bounds::MAX_POSITION_M;
+mod compact;
 mod control;
 pub mod csv;
 mod device;
@@ -16,9 +18,12 @@ mod error;
 pub mod hand;
 mod lengths;
 mod master;
+#[cfg(test)]
+mod messages_tests;
 mod network;
 mod operator;
 pub mod overrides;
+mod path;
 mod ros;
 mod ros_robot;
 mod ros_tls;
@@ -27,6 +32,8 @@ pub use tactile_math::shown;
 mod slave;
 pub mod units;
 mod validate;
+pub use validate::MAX_NAME_CHARS;
+mod warnings;
 mod watch;
 pub use watch::WatchConfig;
 pub mod workspace;
@@ -34,7 +41,7 @@ pub mod workspace;
 pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
 pub use control::{
     CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, MmtConfig, MmtSlave, MmtUpdate,
-    PredictorConfig, PredictorKind,
+    PredictorConfig, PredictorKind, MIN_MEMORY_SAMPLES,
 };
 pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
 pub(crate) use error::{finite3, invalid, positive, positive3};
@@ -242,57 +249,13 @@ impl Scenario {
         s
     }
 
-    /// The scenario as TOML text (what a run's `scenario.toml` holds).
+    /// The scenario as TOML text (what a run's `scenario.toml` holds), an extreme
+    /// number written short ([`compact`]).
     pub fn to_toml(&self) -> String {
-        toml::to_string(self).unwrap_or_else(|e| format!("# cannot encode the scenario: {e}\n"))
-    }
-
-    /// Things that load but deserve a word: stiffness above the device's nominal
-    /// maximum, a delay or a schedule entry beyond the run's length.
-    pub fn warnings(&self) -> Vec<String> {
-        let mut w = Vec::new();
-        let ros_used = self.master.backend == Backend::Ros2
-            || self.slave.backend == Backend::Ros2
-            || self.ros.live.enabled;
-        if ros_used {
-            w.extend(self.ros.in_clear_to_other_hosts().into_iter().map(|e| {
-                format!(
-                    "ros endpoint {e} leaves this host in clear: joint states, forces and robot commands can be read and forged on that network (give [ros.tls] a CA, certificate and key and use tls/ endpoints for mutual TLS, or keep the router on this host, or the network trusted)"
-                )
-            }));
+        match toml::to_string(self) {
+            Ok(text) => compact::floats(&text),
+            Err(e) => format!("# cannot encode the scenario: {e}\n"),
         }
-        for (k, o) in self.environment.objects.iter().enumerate() {
-            for (i, h) in o.stiffness().iter().enumerate() {
-                if *h > NOMINAL_MAX_STIFFNESS {
-                    w.push(format!(
-                        "environment.objects[{k}].stiffness[{i}] = {h} N/m is above the device's nominal {NOMINAL_MAX_STIFFNESS} N/m: contact may buzz"
-                    ));
-                }
-            }
-        }
-        for (name, c) in [
-            ("forward", &self.network.forward),
-            ("backward", &self.network.backward),
-        ] {
-            for (i, d) in c.delay.iter().enumerate() {
-                if *d > 0 && *d as u64 >= self.samples {
-                    w.push(format!(
-                        "network.{name}.delay[{i}] = {d} samples is not shorter than the run ({} samples): no value of that signal arrives",
-                        self.samples
-                    ));
-                }
-            }
-            for (k, e) in c.schedule.iter().enumerate() {
-                if e[0] as u64 >= self.samples {
-                    w.push(format!(
-                        "network.{name}.schedule[{k}] starts at sample {}, after the run's last ({}): it never takes effect",
-                        e[0],
-                        self.samples - 1
-                    ));
-                }
-            }
-        }
-        w
     }
 
     /// Sampling period t_s in seconds.

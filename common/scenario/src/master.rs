@@ -182,7 +182,7 @@ impl MasterDeviceConfig {
         if !self.step_s.is_finite() || self.step_s < 1e-6 || self.step_s > 1e-3 {
             return Err(invalid(
                 "master.device.step_s",
-                format!("{} s is outside 1 us to 1 ms", self.step_s),
+                format!("{} s is outside 1 us to 1 ms", Num(self.step_s)),
             ));
         }
         Ok(())
@@ -195,7 +195,7 @@ impl MasterConfig {
         if !self.force_limit.is_finite() || self.force_limit <= 0.0 {
             return Err(invalid(
                 "master.force_limit",
-                format!("{} N must be positive", self.force_limit),
+                format!("{} N must be positive", Num(self.force_limit)),
             ));
         }
         positive3(&self.torque_limit, "master.torque_limit", false)?;
@@ -208,7 +208,7 @@ impl MasterConfig {
                 "master.clutch_spring",
                 format!(
                     "{} N/m is stiffer than a desk device renders (1000 N/m)",
-                    self.clutch_spring
+                    Num(self.clutch_spring)
                 ),
             ));
         }

@@ -321,13 +321,13 @@ impl LossModel {
                 if p13 + p14 > 1.0 {
                     return Err(invalid(
                         f("p14"),
-                        format!("p13 + p14 = {} exceeds 1", p13 + p14),
+                        format!("p13 + p14 = {} exceeds 1", Num(p13 + p14)),
                     ));
                 }
                 if p31 + p32 > 1.0 {
                     return Err(invalid(
                         f("p32"),
-                        format!("p31 + p32 = {} exceeds 1", p31 + p32),
+                        format!("p31 + p32 = {} exceeds 1", Num(p31 + p32)),
                     ));
                 }
             }
@@ -375,6 +375,16 @@ fn default_max_queue() -> u32 {
 }
 
 impl ReplayConfig {
+    /// A Mahimahi replay's settings at their defaults (its path empty).
+    pub fn mahimahi_defaults() -> Self {
+        ReplayConfig {
+            path: String::new(),
+            format: ReplayFormat::Mahimahi,
+            packet_bytes: default_packet_bytes(),
+            max_queue_samples: default_max_queue(),
+        }
+    }
+
     /// Checks the fields; errors name `FIELD.replay.*`.
     pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         if self.path.is_empty() {

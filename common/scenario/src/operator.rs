@@ -113,7 +113,7 @@ impl Operator {
                 if !radius.is_finite() || *radius <= 0.0 || *radius > 1.0 {
                     return Err(invalid(
                         "operator.radius",
-                        format!("{radius} m is outside (0, 1] m"),
+                        format!("{} m is outside (0, 1] m", Num(*radius)),
                     ));
                 }
                 if !period_s.is_finite() || *period_s <= 0.0 {

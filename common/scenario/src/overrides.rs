@@ -87,17 +87,40 @@ fn parse_value(text: &str) -> Result<Value, String> {
     match format!("v = {text}").parse::<Table>() {
         Ok(mut t) => t.remove("v").ok_or_else(|| "no value".to_string()),
         Err(e) => {
+            let first = e.message().lines().next().unwrap_or("").to_string();
             let word = text
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || "-_./".contains(c));
-            if word {
+            if numeric(text) {
+                // A number TOML cannot hold is no string: `samples=99999999999999999999`
+                // read as one was refused as "expected u64", naming no range.
+                let digits = text.trim_start_matches(['+', '-']);
+                if digits.chars().all(|c| c.is_ascii_digit() || c == '_') {
+                    Err(format!(
+                        "{text} is out of range: a scenario's integers are {} to {}",
+                        i64::MIN,
+                        i64::MAX
+                    ))
+                } else {
+                    Err(format!("{text:?} is not a number ({first})"))
+                }
+            } else if word {
                 Ok(Value::String(text.to_string()))
             } else {
-                let first = e.message().lines().next().unwrap_or("").to_string();
                 Err(format!("{text:?} is not a TOML value ({first})"))
             }
         }
     }
+}
+
+/// True if `text` is written as a number is (a sign, a digit first, then only what a
+/// number holds): TOML refusing it means the number is wrong, not that it is a word.
+fn numeric(text: &str) -> bool {
+    let body = text.strip_prefix(['+', '-']).unwrap_or(text);
+    body.starts_with(|c: char| c.is_ascii_digit())
+        && body
+            .chars()
+            .all(|c| c.is_ascii_digit() || "_.eE+-".contains(c))
 }
 
 /// The scenario text `text` with every set applied in order; the result still has to
@@ -258,6 +281,9 @@ mod tests {
             ("a..b=1", "dotted path"),
             ("rate_hz=[1,", "not a TOML value"),
             ("objects[x]=1", "not an index"),
+            ("samples=99999999999999999999", "out of range"),
+            ("seed=-99999999999999999999", "out of range"),
+            ("rate_hz=1.5.3", "is not a number"),
         ] {
             let e = Set::parse(s).expect_err(s);
             assert!(e.contains(needle), "{s}: {e}");
@@ -270,6 +296,22 @@ mod tests {
             let e = apply(BASE, &[set(s)]).expect_err(s);
             assert!(e.contains(needle) && e.contains(s), "{s}: {e}");
         }
+    }
+
+    /// A number beyond i64 was read as a string, so the scenario said "expected u64"
+    /// and no range; a word that merely starts with a digit stays a string.
+    #[test]
+    fn numbers_toml_cannot_hold_are_refused_and_words_stay_strings() {
+        let e = Set::parse("samples=99999999999999999999").expect_err("beyond i64");
+        assert!(
+            e.contains("samples=99999999999999999999") && e.contains("9223372036854775807"),
+            "{e}"
+        );
+        assert_eq!(set("name=2024run").value, Value::String("2024run".into()));
+        assert_eq!(
+            set("seed=9223372036854775807").value,
+            Value::Integer(i64::MAX)
+        );
     }
 
     #[test]

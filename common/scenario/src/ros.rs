@@ -318,10 +318,23 @@ impl Default for RosDeviceConfig {
     }
 }
 
+/// The longest ROS 2 topic name, characters: rmw's `RMW_TOPIC_MAX_NAME_LENGTH`
+/// (255, less 8 for the middleware's prefix); a longer one is refused by every node
+/// that would subscribe or publish it.
+pub const MAX_TOPIC_CHARS: usize = 255 - 8;
+
 /// A ROS 2 topic name: starts with `/`, then `/`-separated tokens of letters, digits
-/// and underscores, each not starting with a digit (ROS 2's topic rules, absolute).
+/// and underscores, each not starting with a digit (ROS 2's topic rules, absolute),
+/// at most [`MAX_TOPIC_CHARS`] long.
 pub fn topic_name(name: &str, field: &str) -> Result<(), ScenarioError> {
-    let bad = |why: &str| Err(invalid(field, format!("{name:?}: {why}")));
+    let shown = crate::csv::shortened(name);
+    let bad = |why: &str| Err(invalid(field, format!("{shown:?}: {why}")));
+    if name.len() > MAX_TOPIC_CHARS {
+        return bad(&format!(
+            "{} characters, more than the {MAX_TOPIC_CHARS} a ROS 2 topic name may have (rmw's RMW_TOPIC_MAX_NAME_LENGTH)",
+            name.len()
+        ));
+    }
     let Some(rest) = name.strip_prefix('/') else {
         return bad("a topic name starts with /");
     };

@@ -29,6 +29,17 @@ fn topic_names_follow_ros_rules() {
     for bad in ["joint_states", "/", "/a//b", "/1abc", "/a-b", "/a/"] {
         assert!(topic_name(bad, "f").is_err(), "{bad}");
     }
+    // rmw's limit, and a long name is quoted short (a megabyte of name was quoted
+    // whole).
+    let at = |n: usize| format!("/{}", "a".repeat(n - 1));
+    assert!(topic_name(&at(super::MAX_TOPIC_CHARS), "f").is_ok());
+    let e = topic_name(&at(1_000_000), "f")
+        .expect_err("too long")
+        .to_string();
+    assert!(
+        e.contains("1000000 characters, more than the 247") && e.len() < 300,
+        "{e}"
+    );
 }
 
 #[test]

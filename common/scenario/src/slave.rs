@@ -100,7 +100,40 @@ pub struct Change {
     pub stiffness: Option<[f64; 3]>,
 }
 
+impl Change {
+    /// The first sample n the change holds from: `n t_s >= at_s` (a nanosecond's
+    /// slack, so `at_s = 0.3` at 100 Hz is sample 30, not 31).
+    pub fn first_sample(&self, t_s: f64) -> u64 {
+        (self.at_s / t_s - 1e-9).ceil().max(0.0) as u64
+    }
+}
+
+impl Environment {
+    /// The changes as the slave applies them, each with its index in `changes` and
+    /// the first sample it holds from: by that sample, changes at one sample in the
+    /// file's order (a stable sort).
+    pub fn changes_in_order(&self, t_s: f64) -> Vec<(usize, u64, &Change)> {
+        let mut v: Vec<(usize, u64, &Change)> = self
+            .changes
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (k, c.first_sample(t_s), c))
+            .collect();
+        v.sort_by_key(|(_, n, _)| *n);
+        v
+    }
+}
+
 impl Object {
+    /// What places the object, by the name its field has (`point` of a plane,
+    /// `center` of a sphere or a box), and its value.
+    pub fn position(&self) -> (&'static str, [f64; 3]) {
+        match self {
+            Object::Plane { point, .. } => ("point", *point),
+            Object::Sphere { center, .. } | Object::Box { center, .. } => ("center", *center),
+        }
+    }
+
     /// The object after `c`: moved, and with the new stiffness if it gives one.
     pub fn changed(&self, c: &Change) -> Object {
         let moved = |p: &[f64; 3]| std::array::from_fn(|i| p[i] + c.move_by[i]);

@@ -277,29 +277,13 @@ pub(crate) fn parse_converted(text: &str, converted: &Value) -> Result<Scenario,
     })
 }
 
-/// `e`'s message with the dotted path of the key its span is on in `text` (a text
-/// `toml::to_string` wrote: a `[table]` header, then one `key = value` a line).
+/// `e`'s message with the dotted path of the field its span is on in `text` (the
+/// converted text: its lines and columns are not the user's).
 fn field_of(text: &str, e: &toml::de::Error) -> String {
     let msg = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
-    let Some(span) = e.span() else {
-        return msg;
-    };
-    let before = &text[..span.start.min(text.len())];
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    let line = text[line_start..].lines().next().unwrap_or_default();
-    let header = |l: &str| {
-        let l = l.trim();
-        l.starts_with('[')
-            .then(|| l.trim_matches(|c| c == '[' || c == ']').to_string())
-    };
-    if let Some(h) = header(line) {
-        return format!("table `{h}`: {msg}");
-    }
-    let key = line.split_once('=').map_or("", |(k, _)| k).trim();
-    let table = before[..line_start].lines().rev().find_map(header);
-    match table {
-        Some(t) => format!("field `{t}.{key}`: {msg}"),
-        None => format!("field `{key}`: {msg}"),
+    match e.span().and_then(|s| crate::path::field_at(text, s.start)) {
+        Some(f) => format!("field `{f}`: {msg}"),
+        None => msg,
     }
 }
 

@@ -149,7 +149,7 @@ fn bad_times_in_ms_are_refused_naming_the_field() {
         // A mistake the text as written makes too keeps its line and column.
         (
             "[network.forward]\ndelya = 1\ndelay_ms = 10\n",
-            &["line 2, column 1: unknown field `delya`"],
+            &["line 2, column 1: field `network.forward.delya`: unknown field `delya`"],
         ),
     ] {
         refused(text, needles);

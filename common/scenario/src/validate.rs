@@ -9,15 +9,32 @@ pub(crate) fn check_rate(rate_hz: f64) -> Result<(), ScenarioError> {
     if !rate_hz.is_finite() || !(100.0..=10_000.0).contains(&rate_hz) {
         return Err(invalid(
             "rate_hz",
-            format!("{rate_hz} Hz is outside 100..=10000 Hz"),
+            format!(
+                "{} Hz is outside 100..=10000 Hz",
+                crate::shown::Num(rate_hz)
+            ),
         ));
     }
     Ok(())
 }
 
+/// The longest `name`, in characters: a name labels reports, plots and sweep rows,
+/// and goes into every node's record twice (a million characters made the record's
+/// first entry longer than a frame may be).
+pub const MAX_NAME_CHARS: usize = 256;
+
 impl Scenario {
     /// Checks every value is in range; the error names the field.
     pub fn validate(&self) -> Result<(), ScenarioError> {
+        let chars = self.name.chars().count();
+        if chars > MAX_NAME_CHARS {
+            return Err(invalid(
+                "name",
+                format!(
+                    "is {chars} characters long, more than the {MAX_NAME_CHARS} a name may have"
+                ),
+            ));
+        }
         check_rate(self.rate_hz)?;
         if self.samples == 0 || self.samples > 100_000_000 {
             return Err(invalid(

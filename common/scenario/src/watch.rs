@@ -1,6 +1,7 @@
 //! `[master.ros2.watch]` and `[slave.ros2.watch]`: when a device's or robot's samples
 //! stop being trusted (stale, then lost).
 
+use crate::shown::Num;
 use crate::{invalid, positive, ScenarioError};
 use serde::{Deserialize, Serialize};
 
@@ -42,8 +43,10 @@ impl WatchConfig {
             return Err(invalid(
                 format!("{field}.timeout_ms"),
                 format!(
-                    "{} ms is not longer than the stale window ({} periods, {stale_ms} ms)",
-                    self.timeout_ms, self.stale_periods
+                    "{} ms is not longer than the stale window ({} periods, {} ms)",
+                    Num(self.timeout_ms),
+                    self.stale_periods,
+                    Num(stale_ms)
                 ),
             ));
         }

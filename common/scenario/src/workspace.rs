@@ -153,7 +153,7 @@ impl FrameRotation {
                 if !(n.is_finite() && (n - 1.0).abs() <= UNIT_TOLERANCE) {
                     return Err(invalid(
                         format!("{field}.quaternion"),
-                        format!("{q:?} has norm {n}, not 1"),
+                        format!("{q:?} has norm {}, not 1", Num(n)),
                     ));
                 }
             }

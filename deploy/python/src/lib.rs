@@ -255,10 +255,8 @@ fn check(
     sets: Vec<String>,
 ) -> PyResult<(String, Vec<String>)> {
     let loaded = load(&source(text, base_dir, name, path), &sets).map_err(to_py)?;
-    let s = &loaded.scenario;
-    let mut notes = tactile::cmd::check::report(s);
-    notes.extend(loaded.warnings.iter().map(|w| format!("warning: {w}")));
-    Ok((s.resolved(&loaded.base_dir).to_toml(), notes))
+    let notes = tactile::cmd::check::report(&loaded);
+    Ok((loaded.scenario.resolved(&loaded.base_dir).to_toml(), notes))
 }
 
 /// `tactile run --in-process` into `out`, the trace as `trace_format` (csv, parquet,

@@ -3,10 +3,11 @@
 //! much it writes, before anything starts.
 
 use crate::error::Error;
-use crate::launch::{load_scenario, parse_sets};
+use crate::launch::{load_scenario, parse_sets, Loaded};
 use clap::Args;
 use std::path::PathBuf;
-use tactile_scenario::{Mode, Scenario};
+use tactile_scenario::shown::Num;
+use tactile_scenario::Mode;
 
 /// Arguments of `tactile check`.
 #[derive(Debug, Args)]
@@ -43,22 +44,25 @@ pub fn main(args: &CheckArgs) -> Result<(), Error> {
     let loaded = load_scenario(args.scenario.as_deref(), &sets)?;
     let s = &loaded.scenario;
     crate::out!("{}", s.resolved(&loaded.base_dir).to_toml());
-    for line in report(s) {
+    for line in report(&loaded) {
         crate::noteln!("{line}");
     }
     Ok(())
 }
 
-/// What `check` says about a valid scenario: its length, its files, its warnings.
-pub fn report(s: &Scenario) -> Vec<String> {
+/// What `check` says about a valid scenario: its length, its files, its warnings
+/// (the scenario's and its inputs', as `tactile run` says them and its summary
+/// holds them).
+pub fn report(loaded: &Loaded) -> Vec<String> {
+    let s = &loaded.scenario;
     let mut v = Vec::new();
     let secs = s.samples as f64 * s.t_s();
     v.push(match s.mode {
-        Mode::Realtime => format!("# runs {} samples at {} Hz: {} of real time", s.samples, s.rate_hz, duration(secs)),
+        Mode::Realtime => format!("# runs {} samples at {} Hz: {} of real time", s.samples, Num(s.rate_hz), duration(secs)),
         Mode::Lockstep => format!(
             "# runs {} samples at {} Hz in lockstep: {} of simulated time, about {} of real time on a 2-core machine",
             s.samples,
-            s.rate_hz,
+            Num(s.rate_hz),
             duration(secs),
             duration(s.samples as f64 / LOCKSTEP_PER_S)
         ),
@@ -90,7 +94,7 @@ pub fn report(s: &Scenario) -> Vec<String> {
             bytes((PER_SAMPLE[3].1 + PER_SAMPLE[4].1) * s.samples as f64)
         ));
     }
-    v.extend(s.warnings().into_iter().map(|w| format!("warning: {w}")));
+    v.extend(loaded.warnings.iter().map(|w| format!("warning: {w}")));
     v
 }
 

@@ -6,6 +6,7 @@ pub mod links;
 pub mod netns;
 pub mod nodes;
 pub mod pki;
+pub mod recordable;
 pub mod scenario;
 pub mod sim;
 pub mod stall;

@@ -100,6 +100,10 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
         };
         Error::BadInput(format!("{name}{with}: {}", msg.trim_end()))
     })?;
+    super::recordable::check(&scenario, &base_dir).map_err(|e| match e {
+        Error::BadInput(m) => Error::BadInput(format!("{name}{with}: {m}")),
+        other => other,
+    })?;
     if scenario.arithmetic == tactile_math::arith::ArithKind::Rtl {
         // A build without the RTL, or with the RTL of another format or geometry, is
         // refused before anything starts.

@@ -241,6 +241,8 @@ pub fn run_in_process(
 pub struct Simulated {
     out: std::path::PathBuf,
     events: Vec<String>,
+    /// What the launcher found to warn of (the scenario's inputs), for the summary.
+    warnings: Vec<String>,
     /// The loop ran to its end.
     completed: bool,
     /// A hook asked this run alone to stop.
@@ -266,6 +268,7 @@ pub fn simulate_into(loaded: &super::Loaded, out: &Path, hooks: Hooks) -> Result
     Ok(Simulated {
         out: out.to_path_buf(),
         events,
+        warnings: loaded.warnings.clone(),
         completed,
         halted: halt.load(Ordering::SeqCst),
         _held: held,
@@ -282,6 +285,7 @@ impl Simulated {
             stop: tactile_runtime::signals::stop_flag().ok(),
             outputs: outputs.clone(),
             events: self.events,
+            warnings: self.warnings,
             ..Default::default()
         };
         let launch = match (self.completed, self.halted) {

@@ -550,11 +550,17 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     run.watch(&loaded.scenario, &stop)?;
     let w = run.finish();
     tactile_transport::ipc::remove_run_files(&sup.prefix);
-    report(out, w, &sup.outputs)
+    report(out, w, &sup.outputs, &loaded.warnings)
 }
 
-/// The report of a supervised run, or the error that ended it.
-fn report(out: &Path, w: Watch, outputs: &super::Outputs) -> Result<Summary, Error> {
+/// The report of a supervised run (with `warnings`, what its scenario and inputs
+/// said before it), or the error that ended it.
+fn report(
+    out: &Path,
+    w: Watch,
+    outputs: &super::Outputs,
+    warnings: &[String],
+) -> Result<Summary, Error> {
     if let Some(msg) = w.config_error {
         return Err(Error::BadInput(msg));
     }
@@ -569,6 +575,7 @@ fn report(out: &Path, w: Watch, outputs: &super::Outputs) -> Result<Summary, Err
         failed: w.failed,
         stop: tactile_runtime::signals::stop_flag().ok(),
         outputs: outputs.clone(),
+        warnings: warnings.to_vec(),
         ..Launch::default()
     };
     let launch = if w.interrupted {

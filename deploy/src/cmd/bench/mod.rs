@@ -232,6 +232,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
             args.probe_s
         )));
     }
+    tactile_report::ours::refuse_foreign(&args.out)?;
     tactile_report::write::make_out_dir(&args.out)?;
     crate::launch::clean_stale_runs();
     // From here a stop request is a flag the runs look at, not the end of this

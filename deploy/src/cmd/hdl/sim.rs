@@ -49,6 +49,20 @@ pub struct CosimArgs {
     pub datapath: DatapathArgs,
 }
 
+/// `dir` if `--keep` may write into it: missing, empty, or an earlier work folder of
+/// ours (its `pipe.vh`, which every one holds); the tools write their files there by
+/// name, so a folder of other files (`--keep /`) is refused, nothing touched.
+fn kept_folder(dir: &Path) -> Result<PathBuf, Error> {
+    let holds_others = std::fs::read_dir(dir).is_ok_and(|mut e| e.next().is_some());
+    if holds_others && !dir.join("pipe.vh").is_file() {
+        return Err(Error::BadInput(format!(
+            "--keep {}: holds files and is no earlier work folder of tactile hdl's (no pipe.vh): the tools write theirs there by name; give an empty or new folder",
+            dir.display()
+        )));
+    }
+    Ok(dir.to_path_buf())
+}
+
 /// A work folder, removed on drop unless the user asked to keep it.
 pub(super) struct Work {
     pub(super) dir: PathBuf,
@@ -61,8 +75,10 @@ impl Work {
     pub(super) fn new(keep: Option<&Path>) -> Result<Work, Error> {
         let (dir, kept) = match keep {
             Some(d) => (
-                std::path::absolute(d)
-                    .map_err(Error::io(format!("resolving --keep {}", d.display())))?,
+                kept_folder(
+                    &std::path::absolute(d)
+                        .map_err(Error::io(format!("resolving --keep {}", d.display())))?,
+                )?,
                 true,
             ),
             None => {
@@ -274,4 +290,22 @@ pub fn cosim_main(args: &CosimArgs) -> Result<(), Error> {
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// `--keep` wrote the tools' files into any folder: one of other files is
+    /// refused, an empty, a new or an earlier work folder of ours is taken.
+    #[test]
+    fn a_kept_folder_must_be_empty_new_or_ours() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let d = dir.path();
+        super::kept_folder(&d.join("new")).expect("new");
+        super::kept_folder(d).expect("empty");
+        std::fs::write(d.join("notes.txt"), "x").expect("write");
+        let e = super::kept_folder(d).expect_err("their files");
+        assert!(e.to_string().contains("no earlier work folder"), "{e}");
+        std::fs::write(d.join("pipe.vh"), "").expect("write");
+        super::kept_folder(d).expect("ours");
+    }
 }

@@ -262,6 +262,12 @@ pub fn sweep(
         .filter(|k| shard.is_none_or(|(s, n)| k % n == s - 1))
         .collect();
     let work = exec::plan(base, &axes, &combos, &mine, args)?;
+    // Every folder the sweep writes, before any is touched: a run's refused half-way
+    // would leave the sweep cut short.
+    tactile_report::ours::refuse_foreign(&args.out)?;
+    for w in &work {
+        tactile_report::ours::refuse_foreign(&w.dir)?;
+    }
     warn_once(&work);
     let holder = format!("tactile sweep (pid {})", std::process::id());
     let _held = tactile_report::out::take(&args.out, &holder)?;
