@@ -18,7 +18,7 @@ use crate::operator::{Approach, Operate, OperatorSource, Scripted, Target, IDENT
 use crate::simulated::HeldDevice;
 use switch::{Rendering, Switch};
 use tactile_control::codec::{Deadband, Estimate, Guess, Predictor};
-use tactile_control::mmt::{ModelReceiver, Taken};
+use tactile_control::mmt::ModelReceiver;
 use tactile_control::passivity::{MasterForce, MasterSide};
 use tactile_devices::hand::Hand;
 use tactile_math::engine::Engine;
@@ -509,30 +509,6 @@ impl Master {
         self.answer(q, flags, &out)
     }
 
-    /// MMT: takes the model `q` carries and renders the latest against the handle;
-    /// before the first model, and without MMT, the force that `arrived`. Either way the
-    /// force then passes the control's books and the force limit.
-    fn rendered(&mut self, q: &Backward, arrived: [f64; 3]) -> [f64; 3] {
-        if let Some(r) = self.mmt.as_mut() {
-            match r.take(&q.model, self.handle, arrived) {
-                Taken::New => self.counters.models_received += 1,
-                Taken::Refused => self.counters.models_refused += 1,
-                Taken::Nothing => {}
-            }
-        }
-        self.model_force(arrived)
-    }
-
-    /// MMT's model rendered against the handle, once one has come; `otherwise` before
-    /// that and without MMT.
-    fn model_force(&mut self, otherwise: [f64; 3]) -> [f64; 3] {
-        let handle = self.handle;
-        self.mmt
-            .as_mut()
-            .and_then(|r| r.force(handle))
-            .unwrap_or(otherwise)
-    }
-
     /// Takes the control's force as the felt force and its KFF-HMD torques, clamped;
     /// counts the clamps and says whether there were any.
     fn command(&mut self, out: &MasterForce) -> bool {
@@ -596,6 +572,8 @@ impl Master {
 
 // What the master does when no answer came, and the round trip of one that did.
 mod miss;
+// MMT's models taken and rendered against the handle.
+mod model;
 mod switch;
 
 #[cfg(test)]

@@ -274,3 +274,6 @@ fn turn(a: [f64; 3], b: [f64; 3], most: f64) -> [f64; 3] {
     let (s, c) = most.sin_cos();
     [0, 1, 2].map(|i| a[i] * c + perp[i] * s)
 }
+
+#[cfg(test)]
+mod tests;
