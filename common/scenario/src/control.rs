@@ -66,9 +66,10 @@ pub struct MmtConfig {
     /// 1/(1 - forgetting) samples, must be at least [`MIN_MEMORY_SAMPLES`] and at
     /// least `min_contacts` (a model waits for that many samples; one from a shorter
     /// memory rests on fewer): 0.95 at the defaults. Below that the model follows
-    /// each sample's force, and every change is sent and felt: on `wall-change.toml`
-    /// the largest felt step is 0.09 N from 0.95 to 0.995, 0.14 N at 0.9, 0.31 N at
-    /// 0.8, 0.56 N at 0.5 and 1.24 N at 1e-300 (docs/05).
+    /// each sample's force, not a wall: on `wall-change.toml` 245 models are sent at
+    /// 0.95, 513 at 0.9 and 2,170 at 1e-300 (32 at 0.995); the renderer keeps them
+    /// from kicking the hand (largest felt step 0.063 N down to 0.8, 0.09 N at
+    /// 1e-300; docs/05).
     pub forgetting: f64,
     /// A contact force above this is contact, below it free motion, N [0.05].
     pub contact_force: f64,
@@ -139,8 +140,7 @@ impl Default for MmtConfig {
 }
 
 /// The fewest samples the MMT estimator may remember (1/(1 - forgetting)): the
-/// default `min_contacts`, where the largest felt step of `wall-change.toml` reaches
-/// its floor (0.09 N; `control.mmt.forgetting`'s documentation has the figures).
+/// default `min_contacts` (`control.mmt.forgetting`'s documentation has the figures).
 pub const MIN_MEMORY_SAMPLES: u32 = 20;
 
 impl MmtConfig {
