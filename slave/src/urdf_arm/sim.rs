@@ -1,10 +1,10 @@
 //! The simulated arm's integration (see [`super`]): at every integration step its
 //! servo's efforts, the contact's, and the articulated-body algorithm, all into
-//! buffers made with the arm (issue 52: a sample allocates nothing, as a real-time
-//! loop must not; the Cartesian servo's three products of a 7-column Jacobian excepted,
-//! whose packing buffers nalgebra's `matrixmultiply` allocates, see docs/13). The
-//! arithmetic is the allocating version's, operation for operation, so every figure
-//! is the same bit for bit.
+//! buffers made with the arm, the sample's IK call's workspace among them (issues 52
+//! and 66: they allocate nothing, as a real-time loop must not; the Cartesian servo's
+//! three products of a 7-column Jacobian excepted, whose packing buffers nalgebra's
+//! `matrixmultiply` allocates, see docs/13). The arithmetic is the allocating
+//! version's, operation for operation, so every figure is the same bit for bit.
 
 use super::UrdfArm;
 use crate::environment::{deepest_contact, Scene};
@@ -12,13 +12,15 @@ use nalgebra::{
     DMatrix, DVector, DVectorView, Dyn, Matrix6, Matrix6xX, OMatrix, Vector3, Vector6, U6,
 };
 use tactile_chain::dynamics::Workspace;
-use tactile_chain::{Chain, Frame};
+use tactile_chain::{ik, Chain, Frame, Ik};
 use tactile_math::kernels;
 use tactile_scenario::ArmServo;
 
 /// The buffers of the integration, sized for the chain when the arm is made.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Scratch {
+    /// The IK's own (the sample's IK call, [`UrdfArm::follow`]).
+    pub(super) ik: ik::Workspace,
     /// The dynamics' own.
     ws: Workspace,
     /// The joints' frames in the base (the Jacobian's).
@@ -55,8 +57,8 @@ struct Impedance {
 }
 
 impl Scratch {
-    /// Buffers for `chain`.
-    pub(super) fn new(chain: &Chain) -> Scratch {
+    /// Buffers for `chain` and its `ik`.
+    pub(super) fn new(chain: &Chain, ik: &Ik) -> Scratch {
         let n = chain.dof();
         let imp = Impedance {
             jt: OMatrix::<f64, Dyn, U6>::zeros(n),
@@ -69,6 +71,7 @@ impl Scratch {
             pulled: DVector::zeros(n),
         };
         Scratch {
+            ik: ik::Workspace::new(ik),
             ws: Workspace::new(chain),
             frames: Vec::with_capacity(chain.joints.len()),
             jac: Matrix6xX::zeros(n),
@@ -170,7 +173,7 @@ impl UrdfArm {
     /// The servo's efforts at the state now, as the next integration step applies them.
     #[cfg(test)]
     pub(super) fn servo_now(&self) -> Vec<f64> {
-        let mut s = Scratch::new(&self.chain);
+        let mut s = Scratch::new(&self.chain, &self.ik);
         self.servo(&mut s);
         s.tau
     }
