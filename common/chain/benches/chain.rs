@@ -7,30 +7,16 @@
 //!
 //! Run with `cargo bench -p tactile-chain --bench chain`.
 
+mod arms;
 #[path = "../tests/ik_reference/mod.rs"]
 mod ik_reference;
 
+use arms::{arms, circle};
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
-use nalgebra::{Matrix6xX, Vector3};
+use nalgebra::Matrix6xX;
 use tactile_chain::dynamics::{Workspace, EARTH};
 use tactile_chain::ik::Workspace as IkWorkspace;
-use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig};
-
-const PANDA: &str = include_str!("../../../deploy/robots/panda.urdf");
-const UR5: &str = include_str!("../../../deploy/robots/ur5_robot.urdf");
-
-fn arms() -> Vec<(&'static str, Chain, Vec<f64>)> {
-    let panda = Chain::from_urdf(PANDA, "panda_link0", "panda_hand").expect("panda");
-    let ur5 = Chain::from_urdf(UR5, "base_link", "tool0").expect("ur5");
-    vec![
-        (
-            "panda",
-            panda,
-            vec![0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785],
-        ),
-        ("ur5", ur5, vec![0.0, -1.2, 1.4, -1.8, -1.2, 0.0]),
-    ]
-}
+use tactile_chain::{Dynamics, Ik, IkConfig};
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("chain");
@@ -63,19 +49,13 @@ fn bench(c: &mut Criterion) {
         // The target circles 5 cm around the start at 1 Hz, sampled at 1 kHz: each
         // call starts from the last one's answer, as the slave's does.
         let home = arm.fk(&q);
-        let circle = |k: u64| {
-            let t = (k % 1000) as f64 * 1e-3 * std::f64::consts::TAU;
-            let mut target: Frame = home;
-            target.p += Vector3::new(0.05 * t.cos() - 0.05, 0.05 * t.sin(), 0.0);
-            target
-        };
         let mut ik = Ik::new(&arm, IkConfig::default()).expect("ik");
         let mut ws = IkWorkspace::new(&ik);
         let (mut now, mut next, mut k) = (q.clone(), q.clone(), 0u64);
         g.bench_function(BenchmarkId::new("ik_step", name), |b| {
             b.iter(|| {
                 k += 1;
-                ik.step_into(&mut ws, &now, black_box(&circle(k)), 1e-3, &mut next)
+                ik.step_into(&mut ws, &now, black_box(&circle(&home, k)), 1e-3, &mut next)
                     .expect("step");
                 std::mem::swap(&mut now, &mut next);
             })
@@ -87,7 +67,7 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 k += 1;
                 now = reference
-                    .step(&now, black_box(&circle(k)), 1e-3)
+                    .step(&now, black_box(&circle(&home, k)), 1e-3)
                     .expect("step")
                     .q;
             })

@@ -8,17 +8,16 @@
 //!
 //! Run with `cargo bench -p tactile-chain --bench ik_ratio`.
 
+mod arms;
 #[path = "../tests/ik_reference/mod.rs"]
 mod ik_reference;
 
-use nalgebra::Vector3;
+use arms::{arms, circle};
 use std::hint::black_box;
 use std::time::Instant;
 use tactile_chain::ik::Workspace;
-use tactile_chain::{Chain, Frame, Ik, IkConfig};
+use tactile_chain::{Ik, IkConfig};
 
-const PANDA: &str = include_str!("../../../deploy/robots/panda.urdf");
-const UR5: &str = include_str!("../../../deploy/robots/ur5_robot.urdf");
 const ROUNDS: usize = 300;
 const CALLS: u64 = 1000;
 
@@ -28,26 +27,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    let arms = [
-        (
-            "panda",
-            Chain::from_urdf(PANDA, "panda_link0", "panda_hand").expect("panda"),
-            vec![0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785],
-        ),
-        (
-            "ur5",
-            Chain::from_urdf(UR5, "base_link", "tool0").expect("ur5"),
-            vec![0.0, -1.2, 1.4, -1.8, -1.2, 0.0],
-        ),
-    ];
-    for (name, arm, q) in arms {
+    for (name, arm, q) in arms() {
         let home = arm.fk(&q);
-        let circle = |k: u64| {
-            let t = (k % 1000) as f64 * 1e-3 * std::f64::consts::TAU;
-            let mut target: Frame = home;
-            target.p += Vector3::new(0.05 * t.cos() - 0.05, 0.05 * t.sin(), 0.0);
-            target
-        };
         let mut ik = Ik::new(&arm, IkConfig::default()).expect("ik");
         let mut ws = Workspace::new(&ik);
         let mut reference = ik_reference::Reference::new(&arm, IkConfig::default()).expect("ik");
@@ -56,7 +37,7 @@ fn main() {
         for round in 0..ROUNDS as u64 {
             let t = Instant::now();
             for k in round * CALLS..(round + 1) * CALLS {
-                ik.step_into(&mut ws, &now, black_box(&circle(k)), 1e-3, &mut next)
+                ik.step_into(&mut ws, &now, black_box(&circle(&home, k)), 1e-3, &mut next)
                     .expect("step");
                 std::mem::swap(&mut now, &mut next);
             }
@@ -64,7 +45,7 @@ fn main() {
             let t = Instant::now();
             for k in round * CALLS..(round + 1) * CALLS {
                 was = reference
-                    .step(&was, black_box(&circle(k)), 1e-3)
+                    .step(&was, black_box(&circle(&home, k)), 1e-3)
                     .expect("step")
                     .q;
             }
