@@ -208,7 +208,7 @@ impl SlaveArm for PaperArm {
         }
     }
 
-    fn joints(&self, _: [f64; 3], _: Option<[f64; 4]>) -> Option<Box<ArmJoints>> {
+    fn joints(&self, _: [f64; 3], _: Option<[f64; 4]>) -> Option<ArmJoints> {
         None
     }
 

@@ -94,7 +94,8 @@ pub trait SlaveArm: std::fmt::Debug + Send {
 
     /// The record's entry of an arm with joints of its own (`None`: the paper's, whose
     /// angles are the step's): `torque` is h(n)'s, `master` the orientation followed.
-    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> Option<Box<ArmJoints>>;
+    /// Inline, as every sample makes one.
+    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> Option<ArmJoints>;
 
     /// The live view's sample of the step `view`.
     fn live(&self, view: SlaveView) -> SampleView;

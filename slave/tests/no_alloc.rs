@@ -1,18 +1,25 @@
-//! The simulated arm's integration allocates nothing once warm (issue 52): a counting
-//! global allocator, counting only on the thread that steps the arm, so the test
-//! harness's own threads do not disturb the count. One test in this binary, so no
-//! other test shares the allocator.
+//! A URDF arm's whole slave step allocates nothing once warm (issues 52 and 66): the
+//! slave's step on v(n) (the predictor, the control, the IK, the servo and the
+//! dynamics over the period, the tool, the contact, h(n)), the record's sample with the
+//! arm's joints, the live view's sample, and the steps holding while input is silent.
+//! A counting global allocator counts only on the thread that steps the slave, so the
+//! test harness's own threads do not disturb the count. One test in this binary, so
+//! no other test shares the allocator.
 
 // A global allocator is unsafe by its trait: it only forwards to the system's.
 #![allow(unsafe_code)]
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
+use std::hint::black_box;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
-use tactile_scenario::{ArmServo, Object, Scenario};
-use tactile_slave::environment::Scene;
-use tactile_slave::urdf_arm::UrdfArm;
+use tactile_messages::samples::{Flags, Forward, Signal};
+use tactile_records::slave::SlaveSample;
+use tactile_ros::view::SlaveView;
+use tactile_scenario::{ArmServo, Scenario};
+use tactile_slave::hsd::Slave;
+use tactile_slave::peripherals::read_arm;
 
 /// The system's allocator, counting the allocations of a thread that asked for it.
 struct Counting;
@@ -63,56 +70,111 @@ fn allocations(f: impl FnOnce()) -> u64 {
 /// The paper master's home, where the operator of `panda.toml` starts.
 const HOME: [f64; 3] = [0.0, -0.107, -0.035];
 
-/// The shipped Panda scenario's arm (4 integration steps a sample) under `servo`, in
-/// a wall above its home: the contact's efforts are computed at every step.
-fn panda(servo: ArmServo) -> (UrdfArm, Scene) {
+/// The shipped Panda scenario (4 integration steps a sample, a wall 4.5 cm below the
+/// home) with its arm under `servo`, as the slave node makes it.
+fn panda(servo: ArmServo) -> Slave {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../deploy/scenarios");
     let text = std::fs::read_to_string(dir.join("panda.toml")).expect("panda.toml");
-    let scenario = Scenario::from_toml_str(&text).expect("the panda scenario");
-    let mut cfg = scenario.slave.arm.expect("a [slave.arm]");
-    cfg.servo = servo;
-    let xml = std::fs::read_to_string(dir.join(&cfg.urdf)).expect("panda.urdf");
-    let arm = UrdfArm::new(&cfg, &xml, HOME).expect("the panda");
-    let wall = Object::Plane {
-        point: [0.0, 0.0, 0.0],
-        normal: [0.0, 0.0, 1.0],
-        stiffness: [600.0; 3],
-    };
-    (arm, Scene::new(&[wall]))
+    let mut scenario = Scenario::from_toml_str(&text).expect("the panda scenario");
+    if let Some(arm) = scenario.slave.arm.as_mut() {
+        arm.servo = servo;
+    }
+    let arm = read_arm(&scenario, &dir).expect("the panda");
+    Slave::new(&scenario, arm).expect("the slave")
 }
 
-/// Allocations in 200 samples of integration, 200 more of holding, and the tool read
-/// after each as the slave's handler reads it, after a warm-up of 10 samples.
-fn allocations_in_400_samples(servo: ArmServo) -> u64 {
-    let (mut arm, scene) = panda(servo);
-    for _ in 0..10 {
-        arm.follow([HOME[0], HOME[1], HOME[2] - 0.06], None, 1e-3);
-        arm.advance(1e-3, &scene);
+/// v(n) of a 6-DoF master pressing down at 0.15 m/s into the wall and turning about
+/// the vertical, its clutch released for samples 200 to 219 (the references hold, and
+/// the engage after captures the offsets).
+fn forward(n: u64) -> Forward {
+    let t = n as f64 * 1e-3;
+    let turn = 0.2 * t;
+    let mut flags = Flags::POSE;
+    if (200..220).contains(&n) {
+        flags |= Flags::RELEASED;
     }
-    arm.hold(1e-3, &scene);
+    Forward {
+        seq: n,
+        signal: Signal {
+            value: [HOME[0], HOME[1], HOME[2] - 0.15 * t.min(0.4)],
+            sent_seq: [n; 3],
+            origin_seq: [n; 3],
+            flags,
+            ..Signal::default()
+        },
+        rotation: [0.0, 0.0, (turn / 2.0).sin(), (turn / 2.0).cos()],
+        ..Forward::default()
+    }
+}
+
+/// One sample as the slave's handler takes it: the step on v(n) and its record with
+/// the arm's joints, and the live view's sample.
+fn step(slave: &mut Slave, n: u64) -> f64 {
+    let mut h = None;
+    let step = slave.step(&forward(n), &mut h);
+    let torque = h.as_ref().map_or([0.0; 3], |h| h.torque);
+    let joints = slave.arm().joints(torque, slave.rotation());
+    let view = slave.arm().live(SlaveView {
+        theta: step.theta,
+        velocity: None,
+        torque: step.torque,
+        tool: step.tool,
+        force: step.force,
+    });
+    let tool = step.tool[2];
+    let record = match joints {
+        Some(j) => SlaveSample::ArmStep(step, j),
+        None => SlaveSample::Step(step),
+    };
+    black_box((&record, &view));
+    tool + view.arm.map_or(f64::NAN, |a| a.q[0])
+}
+
+/// One sample of holding while input is silent, and its record.
+fn hold(slave: &mut Slave) -> f64 {
+    let held = slave.hold(None);
+    let joints = slave.arm().joints([0.0; 3], slave.rotation());
+    let record = match joints {
+        Some(j) => SlaveSample::ArmHold(held, j),
+        None => SlaveSample::Hold(held),
+    };
+    black_box(&record);
+    held.tool[2]
+}
+
+/// Allocations in 400 samples of the whole step (IK included: the target moves and
+/// turns every sample, the clutch is released and engaged again) and 100 of holding,
+/// after a warm-up of 10 samples.
+fn allocations_in_500_samples(servo: ArmServo) -> u64 {
+    let mut slave = panda(servo);
+    for n in 0..10 {
+        step(&mut slave, n);
+    }
     let mut seen = 0.0;
-    let n = allocations(|| {
-        for _ in 0..200 {
-            arm.advance(1e-3, &scene);
-            arm.hold(1e-3, &scene);
-            seen += arm.tool()[2] + arm.tool_rotation()[3];
+    let count = allocations(|| {
+        for n in 10..410 {
+            seen += step(&mut slave, n);
+        }
+        for _ in 0..100 {
+            seen += hold(&mut slave);
         }
     });
-    assert!(seen.is_finite() && arm.dynamics_failures() == 0);
-    n
+    let c = slave.counters();
+    assert!(seen.is_finite(), "{seen}");
+    assert_eq!(c.dynamics_failed, 0);
+    assert!(c.contact_steps > 0, "the tool met the wall: {c:?}");
+    assert!(c.held_steps == 100 && c.steps == 410, "{c:?}");
+    count
 }
 
-/// Issue 52: the joint servo's integration allocates nothing once warm; the
-/// Cartesian servo only the packing buffers of its three 7-column matrix products
-/// (nalgebra hands them to `matrixmultiply`, which allocates them per call), 3 an
-/// integration step, 4 steps a sample.
+/// Issues 52 and 66: a URDF arm's whole slave step allocates nothing once warm,
+/// under either servo (the Cartesian servo's products, nalgebra's through
+/// `matrixmultiply`, which allocated 3 times an integration step, now go through
+/// `tactile_chain::matmul::mul_to`).
 #[test]
-fn the_arms_integration_allocates_nothing_once_warm() {
-    let joint = allocations_in_400_samples(ArmServo::Joint);
-    assert_eq!(joint, 0, "joint servo: {joint} allocations in 400 samples");
-    let cartesian = allocations_in_400_samples(ArmServo::Cartesian);
-    assert!(
-        cartesian <= 3 * 4 * 400,
-        "Cartesian servo: {cartesian} allocations in 400 samples"
-    );
+fn the_arms_whole_step_allocates_nothing_once_warm() {
+    for servo in [ArmServo::Joint, ArmServo::Cartesian] {
+        let n = allocations_in_500_samples(servo);
+        assert_eq!(n, 0, "{servo:?} servo: {n} allocations in 500 samples");
+    }
 }

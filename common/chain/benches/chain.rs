@@ -1,30 +1,22 @@
 //! Time per call of the chain's kernels on a 7-joint arm (the Panda) and a 6-joint
 //! one (the UR5): FK, the Jacobian, RNEA, ABA (allocating, and into a workspace made
 //! once), and the IK following a moving target as a slave does every period (the
-//! paper gives each side 37.5 us).
+//! paper gives each side 37.5 us): into a workspace made once (`ik_step`), and as it
+//! was before its workspace (`ik_step_reference`, the test's reference, issue 66), in
+//! the same run.
 //!
 //! Run with `cargo bench -p tactile-chain --bench chain`.
 
+mod arms;
+#[path = "../tests/ik_reference/mod.rs"]
+mod ik_reference;
+
+use arms::{arms, circle};
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
-use nalgebra::{Matrix6xX, Vector3};
+use nalgebra::Matrix6xX;
 use tactile_chain::dynamics::{Workspace, EARTH};
-use tactile_chain::{Chain, Dynamics, Ik, IkConfig};
-
-const PANDA: &str = include_str!("../../../deploy/robots/panda.urdf");
-const UR5: &str = include_str!("../../../deploy/robots/ur5_robot.urdf");
-
-fn arms() -> Vec<(&'static str, Chain, Vec<f64>)> {
-    let panda = Chain::from_urdf(PANDA, "panda_link0", "panda_hand").expect("panda");
-    let ur5 = Chain::from_urdf(UR5, "base_link", "tool0").expect("ur5");
-    vec![
-        (
-            "panda",
-            panda,
-            vec![0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785],
-        ),
-        ("ur5", ur5, vec![0.0, -1.2, 1.4, -1.8, -1.2, 0.0]),
-    ]
-}
+use tactile_chain::ik::Workspace as IkWorkspace;
+use tactile_chain::{Dynamics, Ik, IkConfig};
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("chain");
@@ -58,17 +50,28 @@ fn bench(c: &mut Criterion) {
         // call starts from the last one's answer, as the slave's does.
         let home = arm.fk(&q);
         let mut ik = Ik::new(&arm, IkConfig::default()).expect("ik");
-        let (mut now, mut k) = (q.clone(), 0u64);
+        let mut ws = IkWorkspace::new(&ik);
+        let (mut now, mut next, mut k) = (q.clone(), q.clone(), 0u64);
         g.bench_function(BenchmarkId::new("ik_step", name), |b| {
             b.iter(|| {
                 k += 1;
-                let t = (k % 1000) as f64 * 1e-3 * std::f64::consts::TAU;
-                let mut target = home;
-                target.p += Vector3::new(0.05 * t.cos() - 0.05, 0.05 * t.sin(), 0.0);
-                now = ik.step(&now, black_box(&target), 1e-3).expect("step").q;
+                ik.step_into(&mut ws, &now, black_box(&circle(&home, k)), 1e-3, &mut next)
+                    .expect("step");
+                std::mem::swap(&mut now, &mut next);
             })
         });
         eprintln!("{name}: {:?}", ik.stats);
+        let mut reference = ik_reference::Reference::new(&arm, IkConfig::default()).expect("ik");
+        let (mut now, mut k) = (q.clone(), 0u64);
+        g.bench_function(BenchmarkId::new("ik_step_reference", name), |b| {
+            b.iter(|| {
+                k += 1;
+                now = reference
+                    .step(&now, black_box(&circle(&home, k)), 1e-3)
+                    .expect("step")
+                    .q;
+            })
+        });
     }
     g.finish();
 }

@@ -20,6 +20,7 @@ mod error;
 pub mod file;
 pub mod ik;
 pub mod kinematics;
+pub mod matmul;
 pub mod spatial;
 pub mod topology;
 pub mod tree;

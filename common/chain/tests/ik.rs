@@ -24,8 +24,8 @@ const READY: [f64; 7] = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
 /// Steps `calls` times toward `target`, checking every command against the limits.
 fn follow(ik: &mut Ik, mut q: Vec<f64>, target: &Frame, calls: usize) -> Vec<f64> {
     for _ in 0..calls {
-        let s = ik.step(&q, target, DT).expect("a step");
-        for ((a, b), d) in q.iter().zip(&s.q).zip(&ik.chain().dofs) {
+        let (next, _) = ik.step(&q, target, DT).expect("a step");
+        for ((a, b), d) in q.iter().zip(&next).zip(&ik.chain().dofs) {
             assert!(
                 (b - a).abs() <= d.velocity * DT * (1.0 + 1e-9),
                 "{}: {a} -> {b}",
@@ -37,7 +37,7 @@ fn follow(ik: &mut Ik, mut q: Vec<f64>, target: &Frame, calls: usize) -> Vec<f64
                 d.name
             );
         }
-        q = s.q;
+        q = next;
     }
     q
 }

@@ -104,8 +104,10 @@ pub struct HoldStep {
 }
 
 /// A URDF arm's joints after a step (`[slave.arm]`), in the chain's order; the
-/// step's three-angle fields are the paper arm's and stay zero.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+/// step's three-angle fields are the paper arm's and stay zero. Inline (its joints are
+/// [`Joints`], at most [`tactile_math::joints::MAX_JOINTS`], which the arm's loader
+/// refuses beyond): making one allocates nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct ArmJoints {
     /// The IK's joint references, rad or m.
     pub q_ref: Joints,
@@ -146,10 +148,11 @@ pub struct ArmJoints {
 }
 
 /// One entry per step the slave took. A sample lives for one write or one read, and
-/// steps outnumber holds: boxing the step would allocate on every sample for nothing.
-/// A URDF arm's joints are boxed (their vectors allocate anyway), so the paper arm's
-/// samples are 384 bytes, not 624, wherever they are moved (the encoding is the same:
-/// a box encodes as what it holds).
+/// is made on every step: nothing in it is boxed, so making one allocates nothing
+/// (issue 66: a URDF arm's joints were boxed, an allocation a sample). A sample is
+/// then 1,056 bytes wherever it is moved, the paper arm's too (424 with the box), a
+/// copy well under a microsecond; its encoding is the same (a box encodes as what it
+/// holds), so records are byte for byte what they were.
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum SlaveSample {
@@ -158,9 +161,9 @@ pub enum SlaveSample {
     /// A step holding position.
     Hold(HoldStep),
     /// A step on v(n) of a URDF arm, with its joints.
-    ArmStep(Step, Box<ArmJoints>),
+    ArmStep(Step, ArmJoints),
     /// A step holding position of a URDF arm, with its joints.
-    ArmHold(HoldStep, Box<ArmJoints>),
+    ArmHold(HoldStep, ArmJoints),
 }
 
 impl SlaveSample {
@@ -189,3 +192,66 @@ pub struct SlaveTotals {
 
 /// The slave's record type.
 pub type SlaveRecord = crate::Record<SlaveSample, SlaveTotals>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tactile_math::joints::Joints;
+
+    /// The sample as it was before issue 66, its joints boxed.
+    #[allow(clippy::large_enum_variant)]
+    #[derive(Serialize)]
+    enum Boxed {
+        #[allow(dead_code)]
+        Step(Step),
+        #[allow(dead_code)]
+        Hold(HoldStep),
+        ArmStep(Step, Box<ArmJoints>),
+        ArmHold(HoldStep, Box<ArmJoints>),
+    }
+
+    /// Issue 66: a URDF arm's joints inline encode as the boxed ones did, in both of
+    /// the records' integer encodings: the records' bytes are unchanged.
+    #[test]
+    fn inline_joints_encode_as_the_boxed_ones_did() {
+        let q = Joints::from_slice(&[0.5, -1.25, 2.0, 0.0, -0.0, 1e-300, 3.5]).expect("7");
+        let j = ArmJoints {
+            q_ref: q,
+            q,
+            tau: Joints::from_slice(&[9.0; 16]).expect("16"),
+            torque: [1.0, 2.0, 3.0],
+            target_rotation: [0.0, 0.0, 0.6, 0.8],
+            released: true,
+            ..ArmJoints::default()
+        };
+        let step = Step {
+            n: 123_456,
+            clamps: 3,
+            ..Step::default()
+        };
+        let hold = HoldStep {
+            step: 7,
+            ..HoldStep::default()
+        };
+        let fixed = bincode::config::standard().with_fixed_int_encoding();
+        let varint = bincode::config::standard();
+        let pairs = [
+            (
+                SlaveSample::ArmStep(step, j),
+                Boxed::ArmStep(step, Box::new(j)),
+            ),
+            (
+                SlaveSample::ArmHold(hold, j),
+                Boxed::ArmHold(hold, Box::new(j)),
+            ),
+        ];
+        for (inline, boxed) in &pairs {
+            let a = bincode::serde::encode_to_vec(inline, fixed).expect("encode");
+            let b = bincode::serde::encode_to_vec(boxed, fixed).expect("encode");
+            assert_eq!(a, b);
+            let a = bincode::serde::encode_to_vec(inline, varint).expect("encode");
+            let b = bincode::serde::encode_to_vec(boxed, varint).expect("encode");
+            assert_eq!(a, b);
+        }
+    }
+}

@@ -9,6 +9,7 @@ use crate::msg::{
 };
 use crate::topics::{Topic, TOPICS};
 use std::marker::PhantomData;
+use tactile_math::joints::Joints;
 
 /// A topic of [`TOPICS`] whose messages are `M`s.
 #[derive(Debug)]
@@ -214,10 +215,10 @@ pub struct ArmSample {
     pub base: std::sync::Arc<str>,
     /// The joints' names.
     pub names: std::sync::Arc<[String]>,
-    /// Joint values, rad or m.
-    pub q: Vec<f64>,
+    /// Joint values, rad or m (inline: a sample for the view allocates nothing).
+    pub q: Joints,
     /// Efforts, N m or N.
-    pub effort: Vec<f64>,
+    pub effort: Joints,
     /// The tool in the base frame, m.
     pub tool: [f64; 3],
     /// The contact force, N, in the base's axes.
@@ -370,8 +371,8 @@ mod tests {
             arm: Some(ArmSample {
                 base: "panda_link0".into(),
                 names: vec!["a".to_string()].into(),
-                q: vec![0.5],
-                effort: vec![1.0],
+                q: Joints::from_slice(&[0.5]).expect("one joint"),
+                effort: Joints::from_slice(&[1.0]).expect("one joint"),
                 tool: [0.0; 3],
                 force: [0.0; 3],
             }),

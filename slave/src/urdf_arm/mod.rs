@@ -203,7 +203,7 @@ impl UrdfArm {
             tau: zeros,
         };
         Ok(UrdfArm {
-            scratch: sim::Scratch::new(&chain),
+            scratch: sim::Scratch::new(&chain, &ik),
             ik,
             dynamics,
             cfg: cfg.clone(),
@@ -389,18 +389,24 @@ impl UrdfArm {
             false => Vector3::zeros(),
         };
         self.reference = (target, Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z));
-        match self.ik.step(&self.state.q_ref, &target, dt) {
+        // Into the arm's IK workspace and an inline buffer: a call allocates nothing.
+        let mut q = self.state.q_ref;
+        let ws = &mut self.scratch.ik;
+        match self
+            .ik
+            .step_into(ws, &self.state.q_ref, &target, dt, &mut q)
+        {
             Ok(s) => {
                 for ((v, new), old) in self
                     .state
                     .qd_ref
                     .iter_mut()
-                    .zip(&s.q)
+                    .zip(&q)
                     .zip(self.state.q_ref.iter())
                 {
                     *v = (new - old) / dt;
                 }
-                self.state.q_ref.copy_from_slice(&s.q);
+                self.state.q_ref = q;
                 Followed {
                     unreachable: s.unreachable,
                     joint_limited: s.clamped,

@@ -1,10 +1,11 @@
 //! The simulated arm's integration (see [`super`]): at every integration step its
 //! servo's efforts, the contact's, and the articulated-body algorithm, all into
-//! buffers made with the arm (issue 52: a sample allocates nothing, as a real-time
-//! loop must not; the Cartesian servo's three products of a 7-column Jacobian excepted,
-//! whose packing buffers nalgebra's `matrixmultiply` allocates, see docs/13). The
-//! arithmetic is the allocating version's, operation for operation, so every figure
-//! is the same bit for bit.
+//! buffers made with the arm (issues 52 and 66: a sample allocates nothing, as a
+//! real-time loop must not, the IK's workspace among them). The arithmetic is the
+//! allocating version's, operation for operation, so every figure is the same bit for
+//! bit: the Cartesian servo's products of a Jacobian of 6 columns or more, which
+//! nalgebra hands to `matrixmultiply` (whose packing buffers it allocates on every
+//! call), go through `tactile_chain::matmul::mul_to`, the same sums without them.
 
 use super::UrdfArm;
 use crate::environment::{deepest_contact, Scene};
@@ -12,13 +13,16 @@ use nalgebra::{
     DMatrix, DVector, DVectorView, Dyn, Matrix6, Matrix6xX, OMatrix, Vector3, Vector6, U6,
 };
 use tactile_chain::dynamics::Workspace;
-use tactile_chain::{Chain, Frame};
+use tactile_chain::matmul::mul_to;
+use tactile_chain::{ik, Chain, Frame, Ik};
 use tactile_math::kernels;
 use tactile_scenario::ArmServo;
 
 /// The buffers of the integration, sized for the chain when the arm is made.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Scratch {
+    /// The IK's own (the sample's IK call, [`UrdfArm::follow`]).
+    pub(super) ik: ik::Workspace,
     /// The dynamics' own.
     ws: Workspace,
     /// The joints' frames in the base (the Jacobian's).
@@ -55,8 +59,8 @@ struct Impedance {
 }
 
 impl Scratch {
-    /// Buffers for `chain`.
-    pub(super) fn new(chain: &Chain) -> Scratch {
+    /// Buffers for `chain` and its `ik`.
+    pub(super) fn new(chain: &Chain, ik: &Ik) -> Scratch {
         let n = chain.dof();
         let imp = Impedance {
             jt: OMatrix::<f64, Dyn, U6>::zeros(n),
@@ -69,6 +73,7 @@ impl Scratch {
             pulled: DVector::zeros(n),
         };
         Scratch {
+            ik: ik::Workspace::new(ik),
             ws: Workspace::new(chain),
             frames: Vec::with_capacity(chain.joints.len()),
             jac: Matrix6xX::zeros(n),
@@ -170,7 +175,7 @@ impl UrdfArm {
     /// The servo's efforts at the state now, as the next integration step applies them.
     #[cfg(test)]
     pub(super) fn servo_now(&self) -> Vec<f64> {
-        let mut s = Scratch::new(&self.chain);
+        let mut s = Scratch::new(&self.chain, &self.ik);
         self.servo(&mut s);
         s.tau
     }
@@ -178,7 +183,7 @@ impl UrdfArm {
     /// The Cartesian impedance without gravity into `s.tau`: `J^T (K e - D (v -
     /// v_ref))` toward the pose reference, and in the null space of the task (`I - J^T
     /// J^+T`, `J^+` damped) a PD toward the IK's references, so a redundant arm keeps
-    /// its posture. (`mul_to` is `*` into a buffer: the same kernels, the same bits.)
+    /// its posture. (`mul_to` is `*` into a buffer: the same bits, no allocation.)
     fn impedance(&self, s: &mut Scratch) {
         let n = self.chain.dof();
         let tip = self
@@ -194,15 +199,15 @@ impl UrdfArm {
         let w = Vector6::from_fn(|i, _| k[i] * e[i] - d[i] * (v[i] - v_ref[i]));
         let m = &mut s.imp;
         s.jac.transpose_to(&mut m.jt);
-        m.jt.mul_to(&w, &mut m.task);
+        mul_to(&m.jt, &w, &mut m.task);
         // J^+ = J^T (J J^T + lambda^2 I)^-1: damped, so a singular pose stays finite.
         let mut jjt = Matrix6::zeros();
-        s.jac.mul_to(&m.jt, &mut jjt);
+        mul_to(&s.jac, &m.jt, &mut jjt);
         let jjt = jjt + Matrix6::identity() * 1e-6;
         let inv = jjt.try_inverse().unwrap_or_else(Matrix6::zeros);
-        m.jt.mul_to(&inv, &mut m.pinv);
+        mul_to(&m.jt, &inv, &mut m.pinv);
         m.pinv.transpose_to(&mut m.pinv_t);
-        m.jt.mul_to(&m.pinv_t, &mut m.jp);
+        mul_to(&m.jt, &m.pinv_t, &mut m.jp);
         m.null.fill_with_identity();
         m.null -= &m.jp;
         let kn = c.nullspace_stiffness;
@@ -211,7 +216,7 @@ impl UrdfArm {
         for i in 0..n {
             m.posture[i] = kn * (st.q_ref[i] - st.q[i]) - dn * st.qd[i];
         }
-        m.null.mul_to(&m.posture, &mut m.pulled);
+        mul_to(&m.null, &m.posture, &mut m.pulled);
         for i in 0..n {
             s.tau[i] = m.task[i] + m.pulled[i];
         }

@@ -109,10 +109,10 @@ impl SlaveArm for UrdfArm {
         }
     }
 
-    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> Option<Box<ArmJoints>> {
+    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> Option<ArmJoints> {
         let a = self.state();
         let (offset, offset_rotation) = self.offsets();
-        Some(Box::new(ArmJoints {
+        Some(ArmJoints {
             q_ref: a.q_ref,
             q: a.q,
             tau: a.tau,
@@ -125,7 +125,7 @@ impl SlaveArm for UrdfArm {
             master_rotation: master.unwrap_or([0.0, 0.0, 0.0, 1.0]),
             offset,
             offset_rotation,
-        }))
+        })
     }
 
     fn live(&self, view: SlaveView) -> SampleView {
@@ -135,8 +135,8 @@ impl SlaveArm for UrdfArm {
             arm: Some(ArmSample {
                 base: Arc::clone(base),
                 names: Arc::clone(names),
-                q: a.q.to_vec(),
-                effort: a.tau.to_vec(),
+                q: a.q,
+                effort: a.tau,
                 tool: self.tool_in_base(),
                 force: view.force,
             }),

@@ -347,7 +347,7 @@ fn step_of<'a>(
 ) -> (Option<Step>, Option<&'a ArmJoints>) {
     let mut all = steps.iter().filter_map(|x| match x {
         SlaveSample::Step(s) => Some((Some(*s), None)),
-        SlaveSample::ArmStep(s, j) => Some((Some(*s), Some(&**j))),
+        SlaveSample::ArmStep(s, j) => Some((Some(*s), Some(j))),
         SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
     });
     let first = all.next().unwrap_or((None, None));

@@ -5,11 +5,19 @@
 //! the step scaled down so that no joint moves faster than its velocity limit, and a
 //! posture term in the task's null space for redundant arms. A call never jumps: its
 //! result is at most one period's travel from where the arm is.
+//!
+//! [`Ik`] is the model (the chain, the configuration, the counters), [`Workspace`] the
+//! data a call works in (Pinocchio's `Model` and `Data`, as [`crate::Dynamics`] and its
+//! workspace): [`Ik::step_into`] with a workspace made once allocates nothing, so a
+//! slave calls it every sample; [`Ik::step`] makes both for one call.
 
 use crate::chain::Chain;
 use crate::error::Error;
 use crate::spatial::{log_rotation, Frame};
-use nalgebra::{DMatrix, DVector, Matrix6xX, SymmetricEigen};
+
+mod solve;
+
+pub use solve::Workspace;
 
 /// The middle of a joint's limits, the default posture (0 where a limit is
 /// infinite). Halved before the sum: `(lower + upper) / 2` overflows to infinity for
@@ -75,14 +83,14 @@ impl Default for IkConfig {
     }
 }
 
-/// What one call did.
-#[derive(Debug, Clone, PartialEq)]
+/// What one call did (the joint values to command are the caller's: see
+/// [`Ik::step_into`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct IkStep {
-    /// The joint values to command.
-    pub q: Vec<f64>,
-    /// Position error left at `q`, m.
+    /// Position error left at the command, m.
     pub position_error: f64,
-    /// Orientation error left at `q`, rad (0 when only the position is followed).
+    /// Orientation error left at the command, rad (0 when only the position is
+    /// followed).
     pub orientation_error: f64,
     /// Newton steps taken.
     pub iterations: usize,
@@ -121,7 +129,6 @@ pub struct Ik {
     posture: Vec<f64>,
     /// Counters over every call.
     pub stats: IkStats,
-    jac: Matrix6xX<f64>,
 }
 
 fn bad(field: &str, problem: String) -> Error {
@@ -175,7 +182,6 @@ impl Ik {
                 .collect(),
         };
         Ok(Ik {
-            jac: Matrix6xX::zeros(chain.dof()),
             chain: chain.clone(),
             config,
             posture,
@@ -197,17 +203,13 @@ impl Ik {
         }
     }
 
-    /// The errors left at `q`: position (m), orientation (rad), and the weighted
-    /// error vector.
-    fn error(&self, tip: &Frame, target: &Pose) -> (f64, f64, DVector<f64>) {
+    /// The errors left at `tip`: position (m), orientation (rad), and the weighted
+    /// error vector (its first [`Ik::rows`] entries are the task's).
+    fn error(&self, tip: &Frame, target: &Pose) -> (f64, f64, [f64; 6]) {
         let ep = target.p - tip.p;
         let er = log_rotation(&(target.r * tip.r.transpose()));
         let w = self.config.orientation_weight;
-        let e = if self.config.position_only {
-            DVector::from_column_slice(ep.as_slice())
-        } else {
-            DVector::from_column_slice(&[ep.x, ep.y, ep.z, w * er.x, w * er.y, w * er.z])
-        };
+        let e = [ep.x, ep.y, ep.z, w * er.x, w * er.y, w * er.z];
         let rot = if self.config.position_only {
             0.0
         } else {
@@ -216,105 +218,32 @@ impl Ik {
         (ep.norm(), rot, e)
     }
 
-    /// One Newton step from `q` toward `target` with the `locked` joints held: the
-    /// damped step, plus the posture term when `posture` (once a call). Returns the
-    /// step, the damping used, and whether `q` already meets the target.
-    fn newton(
-        &mut self,
-        q: &[f64],
-        target: &Pose,
-        posture: bool,
-        locked: &[bool],
-    ) -> (DVector<f64>, f64, bool) {
-        let tip = self.chain.jacobian(q, &mut self.jac);
-        let (ep, er, e) = self.error(&tip, target);
-        if ep < self.config.tolerance_m && er < self.config.tolerance_rad && !posture {
-            return (DVector::zeros(q.len()), 0.0, true);
-        }
-        let (m, n, w) = (self.rows(), q.len(), self.config.orientation_weight);
-        let jw = DMatrix::from_fn(m, n, |i, k| {
-            let weight = if i >= 3 { w } else { 1.0 };
-            if locked[k] {
-                0.0
-            } else {
-                self.jac[(i, k)] * weight
-            }
-        });
-        let a = &jw * jw.transpose();
-        let smallest = SymmetricEigen::new(a.clone())
-            .eigenvalues
-            .min()
-            .max(0.0)
-            .sqrt();
-        let eps = self.config.singular_threshold;
-        let lambda2 = if smallest < eps {
-            (1.0 - (smallest / eps).powi(2)) * self.config.damping_max.powi(2)
-        } else {
-            0.0
-        };
-        let damped = a + DMatrix::identity(m, m) * lambda2.max(1e-12);
-        let Some(chol) = damped.cholesky() else {
-            return (DVector::zeros(n), self.config.damping_max, false);
-        };
-        let mut dq = jw.transpose() * chol.solve(&e);
-        if posture && n > m && self.config.posture_gain > 0.0 {
-            // N = I - J# J, J# = J^T (J J^T + l^2 I)^-1.
-            let pinv = jw.transpose() * chol.solve(&DMatrix::identity(m, m));
-            let null = DMatrix::identity(n, n) - pinv * &jw;
-            let pull = DVector::from_fn(n, |k, _| {
-                if locked[k] {
-                    0.0
-                } else {
-                    self.config.posture_gain * (self.posture[k] - q[k])
-                }
-            });
-            dq += null * pull;
-        }
-        (dq, lambda2.sqrt(), false)
-    }
-
-    /// One Newton iteration from `q` that respects the joint limits: a joint the step
-    /// would carry past a limit is put at the limit and held, and the step is solved
-    /// again for the others (the clamping loop of Baerlocher and Boulic 2004), so the
-    /// solution slides along the limits instead of fighting them. Returns the damping
-    /// used, whether a limit was met, whether `q` already met the target, or `None`
-    /// when the step was not finite.
-    fn iterate(
-        &mut self,
-        q: &mut [f64],
-        target: &Pose,
-        posture: bool,
-    ) -> Option<(f64, bool, bool)> {
-        let mut locked = vec![false; q.len()];
-        let mut clamped = false;
-        for _ in 0..=q.len() {
-            let (dq, lambda, converged) = self.newton(q, target, posture, &locked);
-            if converged || dq.iter().any(|d| !d.is_finite()) {
-                return converged.then_some((0.0, clamped, true));
-            }
-            let mut met = false;
-            for (k, d) in self.chain.dofs.iter().enumerate() {
-                let x = q[k] + dq[k];
-                if !locked[k] && (x < d.lower || x > d.upper) {
-                    q[k] = x.clamp(d.lower, d.upper);
-                    locked[k] = true;
-                    met = true;
-                }
-            }
-            clamped |= met;
-            if !met {
-                for (x, d) in q.iter_mut().zip(dq.iter()) {
-                    *x += d;
-                }
-                return Some((lambda, clamped, false));
-            }
-        }
-        Some((self.config.damping_max, clamped, false))
-    }
-
     /// One period's command toward `target` from the arm at `q_now`, for a period of
-    /// `dt` seconds.
-    pub fn step(&mut self, q_now: &[f64], target: &Pose, dt: f64) -> Result<IkStep, Error> {
+    /// `dt` seconds: the joint values to command, and what the call did. Makes a
+    /// workspace and the result for the one call; a loop calls [`Ik::step_into`].
+    pub fn step(
+        &mut self,
+        q_now: &[f64],
+        target: &Pose,
+        dt: f64,
+    ) -> Result<(Vec<f64>, IkStep), Error> {
+        let mut q = vec![0.0; q_now.len()];
+        let step = self.step_into(&mut Workspace::new(self), q_now, target, dt, &mut q)?;
+        Ok((q, step))
+    }
+
+    /// [`Ik::step`] with the command written into `q` (one value per degree of
+    /// freedom, untouched on an error) and its scratch in `ws`: no allocation once `ws`
+    /// fits this IK (as [`Workspace::new`] makes it; one that served another grows on
+    /// its first call here).
+    pub fn step_into(
+        &mut self,
+        ws: &mut Workspace,
+        q_now: &[f64],
+        target: &Pose,
+        dt: f64,
+        q: &mut [f64],
+    ) -> Result<IkStep, Error> {
         self.chain.check_len("ik q", q_now)?;
         if !(dt.is_finite() && dt > 0.0) || q_now.iter().any(|x| !x.is_finite()) {
             return Err(bad(
@@ -322,13 +251,15 @@ impl Ik {
                 "the joint values and the period must be finite".into(),
             ));
         }
-        let mut start = q_now.to_vec();
-        let mut clamped = self.chain.clamp(&mut start) > 0;
-        let mut q = start.clone();
+        self.chain.check_len("ik command", q)?;
+        ws.fit(self);
+        ws.start.copy_from_slice(q_now);
+        let mut clamped = self.chain.clamp(&mut ws.start) > 0;
+        q.copy_from_slice(&ws.start);
         let (mut iterations, mut damping) = (0, 0.0f64);
         for it in 0..self.config.max_iterations {
-            let before = q.clone();
-            match self.iterate(&mut q, target, it == 0) {
+            ws.before.copy_from_slice(q);
+            match self.iterate(ws, q, target, it == 0) {
                 Some((_, c, true)) => {
                     clamped |= c;
                     break;
@@ -340,19 +271,19 @@ impl Ik {
                 }
                 // Nothing non-finite leaves: the arm holds where the last step left it.
                 None => {
-                    q = before;
+                    q.copy_from_slice(&ws.before);
                     break;
                 }
             }
         }
         // Out of reach: even unhurried, the solution leaves an error and gains little
         // on where the arm stands.
-        let (ep0, er0, _) = self.error(&self.chain.fk(&start), target);
-        let (ep1, er1, _) = self.error(&self.chain.fk(&q), target);
+        let (ep0, er0, _) = self.error(&self.chain.fk(&ws.start), target);
+        let (ep1, er1, _) = self.error(&self.chain.fk(q), target);
         let (cm, cr) = (self.config.unreachable_m, self.config.unreachable_rad);
         let unreachable = (ep1 > cm && ep1 > 0.9 * ep0) || (er1 > cr && er1 > 0.9 * er0);
-        let velocity_limited = self.limit_speed(&start, &mut q, dt);
-        let (position_error, orientation_error, _) = self.error(&self.chain.fk(&q), target);
+        let velocity_limited = self.limit_speed(&ws.start, q, dt);
+        let (position_error, orientation_error, _) = self.error(&self.chain.fk(q), target);
         let s = &mut self.stats;
         s.calls += 1;
         s.iterations += iterations as u64;
@@ -361,7 +292,6 @@ impl Ik {
         s.unreachable += u64::from(unreachable);
         s.damped += u64::from(damping > 0.0);
         Ok(IkStep {
-            q,
             position_error,
             orientation_error,
             iterations,
