@@ -1,6 +1,8 @@
 //! The system calls that neither std nor rustix offer, each in a function of its own:
-//! the only unsafe code of the workspace, calls with plain values whose results are
-//! checked.
+//! calls with plain values whose results are checked. The workspace's other unsafe
+//! code: the Verilated modules' FFI (`tactile-rtl`'s `sim.rs`) and the fused
+//! multiply-add kernel called after the CPU is checked for it (`tactile-chain`'s
+//! `matmul.rs`).
 #![allow(unsafe_code)]
 
 use std::io::{Error, Result};
