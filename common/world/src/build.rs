@@ -2,6 +2,9 @@
 //! the tool and the links, checked (the overlap at the start computed with parry), and
 //! every buffer a step needs sized once.
 
+use crate::contacts::Owner;
+use crate::error::invalid;
+use crate::error::WorldError;
 use crate::joints::JointInfo;
 use crate::shapes::{shared, LinkShape, Use};
 use crate::watch::Watch;
@@ -11,57 +14,6 @@ use rapier3d_f64::prelude::*;
 use std::path::Path;
 use tactile_scenario::world::{BodyConfig, BodyKind, Engine};
 use tactile_scenario::Environment;
-
-/// A world that cannot be built: the field and the problem, worded as the scenario's
-/// own errors are (`tactile check` shows it the same way).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum WorldError {
-    /// A value (or a file it names) the world cannot take.
-    #[error("field `{field}`: {problem}")]
-    Invalid {
-        /// Dotted path of the field, e.g. `environment.bodies[2].shape.file`.
-        field: String,
-        /// What is wrong.
-        problem: String,
-    },
-}
-
-pub(crate) fn invalid(field: impl Into<String>, problem: impl Into<String>) -> WorldError {
-    WorldError::Invalid {
-        field: field.into(),
-        problem: problem.into(),
-    }
-}
-
-/// What a collider belongs to, kept in its `user_data`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Owner {
-    /// A body of the scene (its index).
-    Body(usize),
-    /// The tool.
-    Tool,
-    /// A link of the arm (its index).
-    Link(usize),
-}
-
-impl Owner {
-    pub(crate) fn encode(self) -> u128 {
-        match self {
-            Owner::Body(i) => i as u128,
-            Owner::Tool => 1 << 64,
-            Owner::Link(i) => (2 << 64) | i as u128,
-        }
-    }
-
-    pub(crate) fn decode(v: u128) -> Owner {
-        let i = (v & u128::from(u64::MAX)) as usize;
-        match v >> 64 {
-            0 => Owner::Body(i),
-            1 => Owner::Tool,
-            _ => Owner::Link(i),
-        }
-    }
-}
 
 /// The physics world: rapier's sets and pipeline, the scene's names, the tool and its
 /// coupling's gains, the links, and the buffers of [`Sensed`].
@@ -210,8 +162,9 @@ impl PhysicsWorld {
             ColliderBuilder::new(tool_shape)
                 .mass(t.mass)
                 .friction(t.friction)
+                .friction_combine_rule(CoefficientCombineRule::Min)
                 .restitution(t.restitution)
-                .user_data(crate::build::Owner::Tool.encode())
+                .user_data(Owner::Tool.encode())
                 .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS)
                 .build(),
             tool,

@@ -7,7 +7,35 @@
 //! not keep: the wrenches here carry the normal part, and the friction's work is
 //! bounded by `sqrt(1 + mu^2)` times the normal's.
 
-use crate::build::Owner;
+/// What a collider belongs to, kept in its `user_data`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Owner {
+    /// A body of the scene (its index).
+    Body(usize),
+    /// The tool.
+    Tool,
+    /// A link of the arm (its index).
+    Link(usize),
+}
+
+impl Owner {
+    pub(crate) fn encode(self) -> u128 {
+        match self {
+            Owner::Body(i) => i as u128,
+            Owner::Tool => 1 << 64,
+            Owner::Link(i) => (2 << 64) | i as u128,
+        }
+    }
+
+    pub(crate) fn decode(v: u128) -> Owner {
+        let i = (v & u128::from(u64::MAX)) as usize;
+        match v >> 64 {
+            0 => Owner::Body(i),
+            1 => Owner::Tool,
+            _ => Owner::Link(i),
+        }
+    }
+}
 
 /// Starts every contact's solve from zero impulse. rapier 0.27 reports a contact's
 /// impulse as the sum over its internal substeps plus the warm-start impulse it began

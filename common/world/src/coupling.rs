@@ -19,7 +19,7 @@
 //! passive ([`arm_damping_needed`]). With the defaults (K = 1000 N/m, B = 10 N s/m,
 //! T = 1 ms) that is 10.5 N s/m; at 100 Hz, 15 N s/m.
 
-use crate::build::WorldError;
+use crate::error::WorldError;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use tactile_scenario::world::ToolConfig;
 

@@ -6,7 +6,7 @@
 //! axis; damping applied explicitly is exact at steady speed, F/b, and stable while
 //! `b h / m < 1`, which is checked).
 
-use crate::build::{invalid, WorldError};
+use crate::error::{invalid, WorldError};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
 use tactile_scenario::world::JointKind;

@@ -14,6 +14,7 @@
 mod build;
 mod contacts;
 pub mod coupling;
+mod error;
 pub mod fuzz;
 mod joints;
 pub mod mesh;
@@ -24,7 +25,8 @@ pub mod task;
 mod tests;
 mod watch;
 
-pub use build::{PhysicsWorld, WorldError};
+pub use build::PhysicsWorld;
+pub use error::WorldError;
 pub use shapes::LinkShape;
 pub use task::{TaskMonitor, TaskProgress};
 pub use watch::ENERGY_TOLERANCE_J;

@@ -4,7 +4,7 @@
 //! bounded, and the engine's own constructors (which may panic on degenerate input in
 //! some versions) run inside a guard, so a bad file is an error naming the field.
 
-use crate::build::{invalid, WorldError};
+use crate::error::{invalid, WorldError};
 use crate::mesh::{self, Mesh};
 use crate::Pose;
 use nalgebra::{Point3, Vector3};

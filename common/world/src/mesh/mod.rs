@@ -244,6 +244,34 @@ impl Mesh {
         self.vertices.iter().map(|v| v.map(|x| x * scale)).collect()
     }
 
+    /// A prism of `sides` faces around z (a polygon of circumradius `radius`), centred
+    /// on the origin, `2 half_height` long: a peg; closed and outward.
+    pub fn prism(sides: u32, radius: f64, half_height: f64) -> Mesh {
+        let n = sides.max(3);
+        let mut vertices = Vec::with_capacity(2 * n as usize + 2);
+        for z in [-half_height, half_height] {
+            for k in 0..n {
+                let a = std::f64::consts::TAU * f64::from(k) / f64::from(n);
+                vertices.push([radius * a.cos(), radius * a.sin(), z]);
+            }
+        }
+        vertices.push([0.0, 0.0, -half_height]);
+        vertices.push([0.0, 0.0, half_height]);
+        let (bottom, top) = (2 * n, 2 * n + 1);
+        let mut triangles = Vec::with_capacity(4 * n as usize);
+        for k in 0..n {
+            let j = (k + 1) % n;
+            triangles.push([k, j, n + j]);
+            triangles.push([k, n + j, n + k]);
+            triangles.push([bottom, j, k]);
+            triangles.push([top, n + k, n + j]);
+        }
+        Mesh {
+            vertices,
+            triangles,
+        }
+    }
+
     /// A box centred on the origin, 12 triangles, closed and outward (the tests' and
     /// the fuzz seeds' mesh).
     pub fn cuboid(h: [f64; 3]) -> Mesh {

@@ -153,3 +153,37 @@ fn files_are_read_by_extension_with_a_size_cap() {
         Err(MeshError::Io { .. })
     ));
 }
+
+#[test]
+fn a_prism_is_closed() {
+    let m = Mesh::prism(8, 0.005, 0.02);
+    assert_eq!(m.triangles.len(), 32);
+    m.check_closed().expect("closed");
+}
+
+/// deploy/scenarios/meshes/ holds what the writers make (`TACTILE_WRITE_MESHES=1`
+/// writes them anew).
+#[test]
+fn the_shipped_meshes_are_the_writers_and_closed() {
+    let dir =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../deploy/scenarios/meshes");
+    let files: [(&str, Vec<u8>); 2] = [
+        (
+            "block.stl",
+            to_stl_binary(&Mesh::cuboid([0.02, 0.02, 0.02])),
+        ),
+        (
+            "peg.obj",
+            to_obj(&Mesh::prism(16, 0.005, 0.03)).into_bytes(),
+        ),
+    ];
+    for (name, bytes) in &files {
+        let p = dir.join(name);
+        if std::env::var("TACTILE_WRITE_MESHES").is_ok_and(|v| v == "1") {
+            std::fs::create_dir_all(&dir).expect("folder");
+            std::fs::write(&p, bytes).expect("write");
+        }
+        assert_eq!(&std::fs::read(&p).expect("a shipped mesh"), bytes, "{name}");
+        read(&p).expect("reads").check_closed().expect("closed");
+    }
+}

@@ -7,7 +7,7 @@ const G: f64 = 9.81;
 
 /// A table (static box, top at z = 0) and a box of `m` kg, half side 2 cm, resting on
 /// it at `x`, both of friction `mu`.
-fn table_and_box(m: f64, mu: f64, extra: &str) -> String {
+pub(crate) fn table_and_box(m: f64, mu: f64, extra: &str) -> String {
     format!(
         r#"
 [environment]
@@ -102,24 +102,44 @@ fn a_box_on_an_incline_stays_exactly_while_tan_angle_is_below_mu() {
     assert!(above > 0.03, "{above} m slid at {:.2} degrees", onset + 1.0);
 }
 
-/// Pushes the box along x with the tool (a 1 cm ball at the box's centre height)
-/// whose arm moves at `v` m/s; the mean push force over the last `window` samples
-/// of `n`, and the box's travel.
+/// The tool's height when it pushes the box: below the box's centre (2 cm), so the
+/// box slides flat instead of rocking on its front edge.
+pub(crate) const PUSH_HEIGHT: f64 = 0.012;
+/// Where the tool's centre starts, m: 2 mm clear of the box's face.
+pub(crate) const PUSH_START: f64 = -0.032;
+
+/// Pushes the box along x with the tool (a 1 cm ball at [`PUSH_HEIGHT`]) whose arm
+/// moves at `v` m/s; the mean push force over the last `window` samples of `n`, and
+/// the box's travel.
 pub(crate) fn push(m: f64, mu: f64, v: f64, n: usize, window: usize) -> (f64, f64) {
-    let extra = "tool = { shape = { type = \"sphere\", radius = 0.01 }, mass = 0.1, friction = 0.01, stiffness = 1000.0, damping = 10.0 }";
-    let mut w = world(&table_and_box(m, mu, extra));
-    let x0 = -0.02 - 0.01 - 0.002;
     let mut force = 0.0;
-    for k in 0..n {
-        let mut t = at([x0 + v * k as f64 * DT, 0.0, 0.02]);
-        t.velocity = [v, 0.0, 0.0];
-        let s = w.step(&t, &[], DT);
+    let travel = pushed(m, mu, v, n, |k, s| {
         if k >= n - window {
             // The arm feels -F; the push on the box is +x.
             force -= s.wrench[0] / window as f64;
         }
+    });
+    (force, travel)
+}
+
+/// [`push`]'s run, each sample's sensing (and its index) handed to `each`; the box's
+/// travel.
+pub(crate) fn pushed(
+    m: f64,
+    mu: f64,
+    v: f64,
+    n: usize,
+    mut each: impl FnMut(usize, &Sensed),
+) -> f64 {
+    let extra = "tool = { shape = { type = \"sphere\", radius = 0.01 }, mass = 0.1, friction = 0.01, stiffness = 1000.0, damping = 10.0 }";
+    let mut w = world(&table_and_box(m, mu, extra));
+    let x0 = w.sensed().poses[1].position[0];
+    for k in 0..n {
+        let mut t = at([PUSH_START + v * k as f64 * DT, 0.0, PUSH_HEIGHT]);
+        t.velocity = [v, 0.0, 0.0];
+        each(k, w.step(&t, &[], DT));
     }
-    (force, w.sensed().poses[1].position[0])
+    w.sensed().poses[1].position[0] - x0
 }
 
 #[test]

@@ -2,7 +2,10 @@
 //! catches going wrong.
 
 mod closed_forms;
+mod mujoco;
+mod random;
 mod refused;
+mod tasks;
 mod wrong;
 
 use crate::{LinkState, PhysicsWorld, Pose, Sensed, ToolState, World};
