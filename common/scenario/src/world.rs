@@ -51,7 +51,8 @@ impl Default for WorldBounds {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverConfig {
-    /// Velocity iterations per substep (rapier's `num_solver_iterations`).
+    /// The solver's substeps per physics step (rapier's `num_solver_iterations`: its
+    /// TGS solver integrates each step in this many substeps, each one iteration).
     pub iterations: u32,
     /// Natural frequency of the contacts' stabilising spring, Hz (rapier's
     /// `contact_natural_frequency`): how fast a penetration is pushed out.
@@ -255,7 +256,8 @@ pub struct ToolConfig {
     pub shape: Shape,
     /// Its mass, kg (weightless: the arm carries it).
     pub mass: f64,
-    /// Its friction coefficient.
+    /// Its friction coefficient, and the arm's links' (a contact of the arm takes the
+    /// smaller of this and the body's).
     pub friction: f64,
     /// Its restitution.
     pub restitution: f64,

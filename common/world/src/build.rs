@@ -186,7 +186,8 @@ impl PhysicsWorld {
                     colliders.insert_with_parent(
                         ColliderBuilder::new(s)
                             .position(isometry(pose))
-                            .friction(0.5)
+                            .friction(t.friction)
+                        .friction_combine_rule(CoefficientCombineRule::Min)
                             .user_data(Owner::Link(i).encode())
                             .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS)
                             .build(),

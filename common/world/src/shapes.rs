@@ -139,3 +139,59 @@ pub(crate) fn shared(
         }
     })
 }
+
+/// The collision shapes of the arm's `links` (by name, in that order) from its URDF:
+/// boxes, cylinders and spheres as they are, meshes by the file `resolve` finds for
+/// their `filename` (a `package://` path, a path relative to the URDF). A link
+/// without a `<collision>` has no shape (it touches nothing); a link the robot does not
+/// have, a mesh `resolve` cannot find or one scaled unevenly is an error naming it.
+pub fn link_shapes(
+    robot: &tactile_chain::Robot,
+    links: &[&str],
+    resolve: impl Fn(&str) -> Option<std::path::PathBuf>,
+) -> Result<Vec<LinkShape>, WorldError> {
+    use tactile_chain::urdf::Geometry;
+    links
+        .iter()
+        .map(|name| {
+            let link = robot
+                .link(name)
+                .ok_or_else(|| invalid(format!("link `{name}`"), "is not a link of the URDF"))?;
+            let mut shapes = Vec::with_capacity(link.collisions.len());
+            for (k, c) in link.collisions.iter().enumerate() {
+                let at = format!("link `{name}` collision[{k}]");
+                let shape = match &c.geometry {
+                    Geometry::Box { size } => Shape::Box {
+                        half_extents: size.map(|s| s / 2.0),
+                    },
+                    Geometry::Cylinder { radius, length } => Shape::Cylinder {
+                        half_height: length / 2.0,
+                        radius: *radius,
+                    },
+                    Geometry::Sphere { radius } => Shape::Sphere { radius: *radius },
+                    Geometry::Mesh { filename, scale } => {
+                        if scale.iter().any(|s| *s != scale[0]) {
+                            return Err(invalid(at, format!("mesh {filename} is scaled unevenly ({scale:?}): a world takes one scale")));
+                        }
+                        let file = resolve(filename)
+                            .ok_or_else(|| invalid(&at, format!("mesh {filename} is not found")))?;
+                        Shape::Mesh {
+                            file: file.display().to_string(),
+                            scale: scale[0],
+                        }
+                    }
+                };
+                let q = nalgebra::UnitQuaternion::from_matrix(&c.origin.r);
+                let pose = Pose {
+                    position: c.origin.p.into(),
+                    rotation: [q.i, q.j, q.k, q.w],
+                };
+                shapes.push((pose, shape));
+            }
+            Ok(LinkShape {
+                name: (*name).to_string(),
+                shapes,
+            })
+        })
+        .collect()
+}

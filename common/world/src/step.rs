@@ -49,11 +49,18 @@ impl PhysicsWorld {
         })
     }
 
+    /// Puts the tool and the links where the arm is at the first sample (from where
+    /// the world was built, they would sweep through whatever lies between).
     fn place_tool(&mut self, t: &ToolState) {
         if let Some(r) = self.bodies.get_mut(self.tool) {
             r.set_position(isometry(&t.pose), true);
             r.set_linvel(Vector3::from(t.velocity), true);
             r.set_angvel(Vector3::from(t.angular_velocity), true);
+        }
+        for ((body, _), l) in self.links.iter().zip(&self.last_links) {
+            if let Some(r) = self.bodies.get_mut(*body) {
+                r.set_position(isometry(&l.pose), true);
+            }
         }
         self.tool_placed = true;
     }

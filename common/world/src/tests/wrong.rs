@@ -74,3 +74,45 @@ fn non_finite_inputs_are_held_counted_and_never_panic() {
     assert!(s.fault && s.wrench == [0.0; 6]);
     assert_eq!(w.counters().bad_inputs, 1);
 }
+
+/// An arm's link from a URDF's `<collision>`, moved into a box resting on a table:
+/// the link's contact wrench pushes it back, and the box is pushed.
+#[test]
+fn a_link_from_its_urdf_pushes_a_box_and_feels_it() {
+    let urdf = r#"<robot name="r"><link name="paddle">
+        <collision><origin xyz="0 0 0.01" rpy="0 0 0"/><geometry><box size="0.01 0.1 0.016"/></geometry></collision>
+        </link></robot>"#;
+    let robot = tactile_chain::Robot::parse(urdf).expect("urdf");
+    let links = crate::link_shapes(&robot, &["paddle"], |_| None).expect("shapes");
+    assert!(crate::link_shapes(&robot, &["arm"], |_| None).is_err());
+    // The arm's friction is the tool's: a slippery paddle, so that it does not hold
+    // the box up by its face (with 0.3 it carries 0.4 N of the box's weight).
+    let text = super::closed_forms::table_and_box(0.4, 0.3, "tool = { friction = 0.01 }");
+    let s = Scenario::from_toml_str(&text).expect("scene");
+    let mut w = PhysicsWorld::new(&s.environment, Path::new("."), &links, DT).expect("world");
+    let v = 0.05;
+    let mut push = 0.0;
+    for k in 0..2000 {
+        let link = LinkState {
+            pose: Pose {
+                position: [-0.027 + v * k as f64 * DT, 0.0, 0.0],
+                ..Pose::default()
+            },
+            velocity: [v, 0.0, 0.0],
+            ..LinkState::default()
+        };
+        let s = w.step(&at([0.5, 0.5, 0.5]), &[link], DT);
+        if k >= 1000 {
+            push -= s.link_wrenches[0][0] / 1000.0;
+        }
+
+
+    }
+    let want = 0.3 * 0.4 * 9.81;
+    assert!(
+        (push - want).abs() < 0.03 * want,
+        "the link feels {push} N back, mu m g {want} N"
+    );
+    assert!(w.sensed().poses[1].position[0] > 0.04);
+    assert_eq!(w.counters().energy_gains, 0);
+}
