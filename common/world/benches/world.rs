@@ -38,13 +38,19 @@ fn floor() -> Mesh {
     }
 }
 
-fn scene(bodies: usize, dir: &std::path::Path) -> PhysicsWorld {
+/// The world: `bodies` boxes and balls resting on the mesh (`on_mesh`), or on a box
+/// table with the mesh beside them as a fixture (under the table, touching nothing).
+fn scene(bodies: usize, dir: &std::path::Path, on_mesh: bool) -> PhysicsWorld {
     let path = dir.join("floor.obj");
     std::fs::write(&path, to_obj(&floor())).expect("floor written");
     let mut text = format!(
-        "[environment]\nengine = \"physics\"\n[[environment.bodies]]\nname = \"floor\"\nshape = {{ type = \"mesh\", file = \"{}\" }}\n",
-        path.display()
+        "[environment]\nengine = \"physics\"\n[[environment.bodies]]\nname = \"floor\"\nshape = {{ type = \"mesh\", file = \"{}\" }}\nposition = [0.0, 0.0, {}]\n",
+        path.display(),
+        if on_mesh { 0.0 } else { -0.1 }
     );
+    if !on_mesh {
+        text.push_str("[[environment.bodies]]\nname = \"table\"\nshape = { type = \"box\", half_extents = [0.5, 0.25, 0.01] }\nposition = [0.0, 0.0, -0.01]\n");
+    }
     for k in 0..bodies {
         let (i, j) = (k % 10, k / 10);
         let shape = if k % 2 == 0 {
@@ -54,7 +60,7 @@ fn scene(bodies: usize, dir: &std::path::Path) -> PhysicsWorld {
         };
         let _ = write!(
             text,
-            "[[environment.bodies]]\nname = \"b{k}\"\nkind = \"dynamic\"\nshape = {shape}\nposition = [{}, {}, 0.03]\nmass = 0.1\n",
+            "[[environment.bodies]]\nname = \"b{k}\"\nkind = \"dynamic\"\nshape = {shape}\nposition = [{}, {}, 0.016]\nmass = 0.1\n",
             -0.3 + 0.05 * i as f64,
             -0.1 + 0.05 * j as f64
         );
@@ -76,8 +82,8 @@ fn tool(k: usize) -> ToolState {
     }
 }
 
-fn percentiles(bodies: usize, dir: &std::path::Path) {
-    let mut w = scene(bodies, dir);
+fn percentiles(bodies: usize, dir: &std::path::Path, on_mesh: bool) {
+    let mut w = scene(bodies, dir, on_mesh);
     for k in 0..1000 {
         w.step(&tool(k), &[], DT);
     }
@@ -91,7 +97,8 @@ fn percentiles(bodies: usize, dir: &std::path::Path) {
     ns.sort_unstable();
     let p = |q: f64| ns[((ns.len() - 1) as f64 * q) as usize] as f64 / 1e3;
     eprintln!(
-        "world step, {bodies} dynamic bodies + 10,000-triangle mesh: p50 {:.1} us, p99 {:.1} us, max {:.1} us (5,000 steps, events {:?})",
+        "world step, {bodies} dynamic bodies {} the 10,000-triangle mesh: p50 {:.1} us, p99 {:.1} us, max {:.1} us (5,000 steps, events {:?})",
+        if on_mesh { "on" } else { "on a table beside" },
         p(0.5),
         p(0.99),
         p(1.0),
@@ -101,12 +108,14 @@ fn percentiles(bodies: usize, dir: &std::path::Path) {
 
 fn bench(c: &mut Criterion) {
     let dir = tempfile::tempdir().expect("temp dir");
-    for n in [5, 10, 20, 40] {
-        percentiles(n, dir.path());
+    for on_mesh in [true, false] {
+        for n in [5, 10, 20, 40] {
+            percentiles(n, dir.path(), on_mesh);
+        }
     }
     let mut g = c.benchmark_group("world_step");
     for n in [5, 10, 20, 40] {
-        let mut w = scene(n, dir.path());
+        let mut w = scene(n, dir.path(), true);
         let mut k = 0usize;
         g.bench_function(BenchmarkId::new("bodies", n), |b| {
             b.iter(|| {

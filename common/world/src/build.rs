@@ -187,7 +187,7 @@ impl PhysicsWorld {
                         ColliderBuilder::new(s)
                             .position(isometry(pose))
                             .friction(t.friction)
-                        .friction_combine_rule(CoefficientCombineRule::Min)
+                            .friction_combine_rule(CoefficientCombineRule::Min)
                             .user_data(Owner::Link(i).encode())
                             .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS)
                             .build(),

@@ -105,8 +105,6 @@ fn a_link_from_its_urdf_pushes_a_box_and_feels_it() {
         if k >= 1000 {
             push -= s.link_wrenches[0][0] / 1000.0;
         }
-
-
     }
     let want = 0.3 * 0.4 * 9.81;
     assert!(
