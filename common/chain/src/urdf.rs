@@ -1,12 +1,17 @@
 //! URDF, read: the links' inertias and the joints (type, origin, axis, limits,
 //! dynamics, mimic), checked as they are read so that a fault names its element.
-//! Only what a serial chain needs; visuals and collisions are the viewers' business.
+//! Only what a serial chain and a physics world need: visuals are the viewers'
+//! business, collisions are read ([`collision`]).
 
 use crate::error::Error;
 use crate::spatial::Frame;
 use nalgebra::{Matrix3, Vector3};
 use roxmltree::{Document, Node};
 use tactile_math::shown::Num;
+
+#[path = "urdf_collision.rs"]
+mod collision;
+pub use collision::{Collision, Geometry};
 
 /// xacro's XML namespace.
 const XACRO: &str = "http://www.ros.org/wiki/xacro";
@@ -53,6 +58,8 @@ pub struct Link {
     pub name: String,
     /// Its mass properties, if given.
     pub inertial: Option<Inertial>,
+    /// Its `<collision>` shapes, in file order.
+    pub collisions: Vec<Collision>,
 }
 
 /// A joint's type.
@@ -273,10 +280,12 @@ fn origin(owner: &Node, holder: Node) -> Result<Frame, Error> {
 
 fn link(n: Node) -> Result<Link, Error> {
     let name = named(n)?;
+    let collisions = collision::collisions(n)?;
     let Some(i) = child(n, "inertial") else {
         return Ok(Link {
             name,
             inertial: None,
+            collisions,
         });
     };
     let mass = child(i, "mass").ok_or_else(|| bad(&n, "inertial mass", "missing"))?;
@@ -307,6 +316,7 @@ fn link(n: Node) -> Result<Link, Error> {
             mass,
             inertia,
         }),
+        collisions,
     })
 }
 

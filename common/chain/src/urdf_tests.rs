@@ -107,3 +107,47 @@ fn a_rounded_flat_bodys_inertia_is_taken() {
     let e = physical(&diag(-1e-3, 1.0, 1.0)).err().unwrap_or_default();
     assert!(e.contains("negative"), "{e}");
 }
+
+#[test]
+fn collisions_are_read_with_their_origins_and_bad_sizes_refused() {
+    let xml = r#"<robot name="r"><link name="a">
+        <collision><origin xyz="0 0 0.1" rpy="0 0 0"/><geometry><box size="0.1 0.2 0.3"/></geometry></collision>
+        <collision><geometry><cylinder radius="0.05" length="0.4"/></geometry></collision>
+        <collision><geometry><sphere radius="0.02"/></geometry></collision>
+        <collision><geometry><mesh filename="package://p/m.stl" scale="0.001 0.001 0.001"/></geometry></collision>
+        <collision><geometry><capsule radius="1" length="2"/></geometry></collision>
+        </link></robot>"#;
+    let r = Robot::parse(xml).expect("collisions");
+    let c = &r.links[0].collisions;
+    assert_eq!(c.len(), 4, "the capsule (not URDF's) is left out");
+    assert_eq!(
+        c[0].geometry,
+        Geometry::Box {
+            size: [0.1, 0.2, 0.3]
+        }
+    );
+    assert_eq!(c[0].origin.p.z, 0.1);
+    assert_eq!(
+        c[1].geometry,
+        Geometry::Cylinder {
+            radius: 0.05,
+            length: 0.4
+        }
+    );
+    assert_eq!(c[2].geometry, Geometry::Sphere { radius: 0.02 });
+    assert_eq!(
+        c[3].geometry,
+        Geometry::Mesh {
+            filename: "package://p/m.stl".into(),
+            scale: [0.001; 3]
+        }
+    );
+    let bad = xml.replace("radius=\"0.02\"", "radius=\"-1\"");
+    let e = Robot::parse(&bad)
+        .expect_err("a negative radius")
+        .to_string();
+    assert!(
+        e.contains("link `a`") && e.contains("collision sphere radius"),
+        "{e}"
+    );
+}

@@ -30,12 +30,17 @@ mod ros_tls;
 /// Numbers and name lists as error messages show them (defined in `tactile-math`, shared with the URDF chain).
 pub use tactile_math::shown;
 mod slave;
+mod task;
 pub mod units;
 mod validate;
 pub use validate::MAX_NAME_CHARS;
 mod warnings;
 mod watch;
 pub use watch::WatchConfig;
+pub mod world;
+mod world_check;
+pub use task::{TaskConfig, TOOL_BODY};
+pub use world_check::{MAX_BODIES, MAX_HULL_POINTS, MAX_SIZE_M};
 pub mod workspace;
 
 pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
@@ -61,8 +66,8 @@ pub use ros_robot::{RobotCommand, RosRobotConfig, TorqueAbout, PAPER_MAX_VELOCIT
 pub use ros_tls::RosTlsConfig;
 use serde::{Deserialize, Serialize};
 pub use slave::{
-    Change, ControllerConfig, DynamicsConfig, Environment, Object, SlaveConfig, MAX_STIFFNESS,
-    NOMINAL_MAX_STIFFNESS,
+    Change, ControllerConfig, DynamicsConfig, Environment, Object, SlaveConfig, GRAVITY,
+    MAX_STIFFNESS, NOMINAL_MAX_STIFFNESS, SUBSTEPS,
 };
 pub use tactile_math::arith::ArithKind;
 pub use workspace::{FrameRotation, Scale, Workspace};
@@ -116,6 +121,9 @@ pub struct Scenario {
     pub codec: Codecs,
     /// How the nodes reach ROS 2 (devices, robots, the live view).
     pub ros: RosConfig,
+    /// What success is, in a physics world (docs/16); none by default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub task: Option<TaskConfig>,
 }
 
 impl Default for Scenario {
@@ -140,6 +148,7 @@ impl Default for Scenario {
             control: ControlConfig::default(),
             codec: Codecs::default(),
             ros: RosConfig::default(),
+            task: None,
         }
     }
 }
@@ -157,7 +166,7 @@ impl Scenario {
                     normal: [0.0, 0.0, 1.0],
                     stiffness: [300.0; 3],
                 }],
-                changes: Vec::new(),
+                ..Environment::default()
             },
             ..Scenario::default()
         }
@@ -222,6 +231,16 @@ impl Scenario {
         }
         if let Some(g) = &mut self.master.ros2.gimbal {
             v.push(&mut g.urdf);
+        }
+        let shapes = self.environment.bodies.iter_mut().map(|b| &mut b.shape);
+        for shape in shapes.chain([&mut self.environment.tool.shape]) {
+            match shape {
+                world::Shape::Mesh { file, .. }
+                | world::Shape::ConvexHull {
+                    file: Some(file), ..
+                } => v.push(file),
+                _ => {}
+            }
         }
         for c in [&mut self.network.forward, &mut self.network.backward] {
             if let Some(r) = &mut c.replay {

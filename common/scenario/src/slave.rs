@@ -2,6 +2,9 @@
 //! objects the tool can touch.
 
 use crate::shown::Num;
+use crate::world::{
+    is_default, BodyConfig, Engine, JointConfig, SolverConfig, ToolConfig, WorldBounds,
+};
 use crate::{finite3, invalid, positive3, ScenarioError};
 use crate::{ArmConfig, Backend, PredictorConfig, RosRobotConfig};
 use serde::{Deserialize, Serialize};
@@ -75,7 +78,7 @@ impl Default for DynamicsConfig {
 }
 
 /// The slave's environment.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Environment {
     /// Objects; the one the tool penetrates most deeply produces the contact force.
@@ -83,6 +86,65 @@ pub struct Environment {
     /// `[[environment.changes]]`: objects that move or change stiffness during the run
     /// (a wall pushed 1 cm, a material that hardens), in any order.
     pub changes: Vec<Change>,
+    /// `analytic` (the springs of `objects`, the default) or `physics` (the rigid
+    /// bodies below, docs/16). The keys below belong to `physics`; each is written
+    /// back only when it is not its default, so an analytic scenario reads and writes
+    /// as it always did.
+    #[serde(skip_serializing_if = "is_default")]
+    pub engine: Engine,
+    /// Gravity, m/s^2 (physics only; default `[0, 0, -9.81]`).
+    #[serde(skip_serializing_if = "is_default_gravity")]
+    pub gravity: [f64; 3],
+    /// Whole physics steps (collision detection, the coupling, the solver) per sample
+    /// of the loop, 1 to 64 (default 1: the solver already takes
+    /// `solver.iterations` substeps of its own inside each step).
+    #[serde(skip_serializing_if = "is_default_substeps")]
+    pub substeps: u32,
+    /// The world's box: a dynamic body leaving it is an event.
+    #[serde(skip_serializing_if = "is_default")]
+    pub bounds: WorldBounds,
+    /// The contact solver's settings.
+    #[serde(skip_serializing_if = "is_default")]
+    pub solver: SolverConfig,
+    /// `[[environment.bodies]]`: the world's bodies.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodyConfig>,
+    /// `[[environment.joints]]`: revolute and prismatic joints between bodies.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub joints: Vec<JointConfig>,
+    /// `[environment.tool]`: the tool body and its coupling to the arm.
+    #[serde(skip_serializing_if = "is_default")]
+    pub tool: ToolConfig,
+}
+
+/// Gravity of a physics world unless told: the Earth's, along -z.
+pub const GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+/// Substeps per sample unless told.
+pub const SUBSTEPS: u32 = 1;
+
+fn is_default_gravity(g: &[f64; 3]) -> bool {
+    *g == GRAVITY
+}
+
+fn is_default_substeps(n: &u32) -> bool {
+    *n == SUBSTEPS
+}
+
+impl Default for Environment {
+    fn default() -> Self {
+        Environment {
+            objects: Vec::new(),
+            changes: Vec::new(),
+            engine: Engine::default(),
+            gravity: GRAVITY,
+            substeps: SUBSTEPS,
+            bounds: WorldBounds::default(),
+            solver: SolverConfig::default(),
+            bodies: Vec::new(),
+            joints: Vec::new(),
+            tool: ToolConfig::default(),
+        }
+    }
 }
 
 /// A change to one object at one moment of the run.
@@ -248,6 +310,14 @@ impl SlaveConfig {
 }
 
 impl Environment {
+    /// Checks every object and change, and the physics world's keys with the task
+    /// that names its bodies; errors name `environment.objects[k].*`,
+    /// `environment.changes[k].*`, `environment.bodies[k].*` and `task.*`.
+    pub fn validate_with(&self, task: Option<&crate::TaskConfig>) -> Result<(), ScenarioError> {
+        self.validate()?;
+        self.validate_physics(task)
+    }
+
     /// Checks every object and change; errors name `environment.objects[k].*` and
     /// `environment.changes[k].*`.
     pub fn validate(&self) -> Result<(), ScenarioError> {

@@ -55,7 +55,7 @@ impl Scenario {
         if self.faults.peer_timeout_samples == 0 {
             return Err(invalid("faults.peer_timeout_samples", "must be at least 1"));
         }
-        self.environment.validate()?;
+        self.environment.validate_with(self.task.as_ref())?;
         self.ros.validate(self.rate_hz)?;
         self.master
             .ros2
