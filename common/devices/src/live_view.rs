@@ -110,7 +110,7 @@ impl LiveView {
 
 impl LiveSink<SampleView> for LiveView {
     fn due(&self, n: u64) -> bool {
-        n % self.every == 0
+        n.is_multiple_of(self.every)
     }
 
     fn offer(&mut self, state: SampleView) {

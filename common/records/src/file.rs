@@ -254,7 +254,7 @@ impl<S: Serialize, C: Serialize> RecordWriter<Record<S, C>> {
         // The clock is read every eighth sample: a block is late by a few samples at
         // most, for an eighth of the cost.
         if n >= self.block_rows
-            || (n % 8 == 0 && now_ns().saturating_sub(self.started_ns) >= BLOCK_NS)
+            || (n.is_multiple_of(8) && now_ns().saturating_sub(self.started_ns) >= BLOCK_NS)
         {
             self.flush()?;
         }

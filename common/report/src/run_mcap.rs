@@ -127,7 +127,7 @@ impl<W: Write> Recording<W> {
         if self.prev.is_none() {
             self.first(log)?;
         }
-        if row.n % self.rate_hz == 0 || self.prev.is_none() {
+        if row.n.is_multiple_of(self.rate_hz) || self.prev.is_none() {
             self.environment(log)?;
         }
         let (vm, vs) = self.velocities(row);

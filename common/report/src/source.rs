@@ -128,7 +128,7 @@ where
                 return Ok(());
             };
             self.read += 1;
-            if self.read % STOP_EVERY == 0 && stop() {
+            if self.read.is_multiple_of(STOP_EVERY) && stop() {
                 self.stopped = true;
             }
             if let Some(s) = self.log.take(rec) {
