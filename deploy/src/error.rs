@@ -38,7 +38,9 @@ impl Error {
             Error::BadInput(_) | Error::Report(tactile_report::Error::BadInput(_)) => {
                 EXIT_BAD_INPUT
             }
-            Error::Interrupted | Error::Stopped(_) => EXIT_INTERRUPTED,
+            Error::Interrupted
+            | Error::Stopped(_)
+            | Error::Report(tactile_report::Error::Stopped(_)) => EXIT_INTERRUPTED,
             Error::Report(_) => EXIT_FAILURE,
             Error::Io { .. } | Error::Failed(_) => EXIT_FAILURE,
         }

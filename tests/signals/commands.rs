@@ -1,6 +1,6 @@
 //! The commands that are not a run stop on SIGINT and SIGTERM within a second, with
 //! exit 130, leaving no process and no temporary file (issue 65): `fuzz`, `kernels`
-//! (input that never comes, or never ends), `bench`,
+//! (input that never comes, or never ends), `report` over a damaged record, `bench`,
 //! and the node programs' build a `run` starts on a fresh clone.
 
 use crate::util::procs;
@@ -54,6 +54,44 @@ fn kernels_stops_on_either_signal_however_its_input_comes() {
             writer.join().expect("writer");
         }
     }
+}
+
+/// Issue 65's record: the slave's record holds 16 MB of sync words each claiming a
+/// megabyte, then a hole of 64 GiB (a sparse file: no disk used), more than any
+/// machine reads in a second. `report` stops on SIGINT within a second, with no
+/// report (it was reading the records' starts), where it was 80 s past the signal.
+#[test]
+fn report_stops_on_sigint_inside_a_damaged_record() {
+    let sb = Sandbox::new("sigreport");
+    sb.write(
+        "s.toml",
+        &util::wall_delay().replace("samples = 8000", "samples = 500"),
+    );
+    let o = sb.tactile(&["run", "s.toml", "--in-process", "-q", "--out", "run"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut bytes = tactile_records::MAGIC.to_vec();
+    let mut header = tactile_records::frames::SYNC.to_vec();
+    header.extend_from_slice(&(1u32 << 20).to_le_bytes());
+    header.extend_from_slice(&0u32.to_le_bytes());
+    while bytes.len() < 16 << 20 {
+        bytes.extend_from_slice(&header);
+    }
+    let slave = sb.path("run").join("slave.rec");
+    std::fs::write(&slave, &bytes).expect("write");
+    let f = std::fs::OpenOptions::new()
+        .write(true)
+        .open(&slave)
+        .expect("open");
+    f.set_len(bytes.len() as u64 + (64 << 30))
+        .expect("a sparse hole");
+    drop(f);
+    let child = procs::spawn(&mut sb.command(&["report", "run", "--out", "rep"]));
+    procs::wait_until_it_catches(child.id());
+    // Into the damage: reading its starts.
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let err = procs::stopped(child, Signal::INT);
+    assert!(err.contains("stop request"), "{err}");
+    assert!(!sb.path("rep").join("summary.json").exists());
 }
 
 /// `bench` stopped by SIGINT while its first loop runs: exit 130 within a second, no
