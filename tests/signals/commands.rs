@@ -94,18 +94,19 @@ fn report_stops_on_sigint_inside_a_damaged_record() {
     assert!(!sb.path("rep").join("summary.json").exists());
 }
 
-/// `bench` stopped by SIGINT while its first loop runs: exit 130 within a second, no
-/// node left running.
+/// `bench` stopped by SIGINT in its bare iceoryx2 hop (6 s of pings, after two loops
+/// of 6 s), which took no notice of a stop: exit 130 within a second, the echo process
+/// ended too, no node left running.
 #[test]
-fn bench_stops_on_sigint_with_no_process_left() {
+fn bench_stops_on_sigint_inside_its_bare_hop() {
     let sb = Sandbox::new("sigbench");
     let out = sb.path("bench");
     let child = procs::spawn(&mut sb.command(&[
         "bench",
         "--samples",
-        "200000",
+        "24000",
         "--rates",
-        "1000",
+        "4000",
         "--probe-s",
         "0",
         "--out",
@@ -113,12 +114,16 @@ fn bench_stops_on_sigint_with_no_process_left() {
         "--prefix",
         &sb.prefix,
     ]));
-    util::wait_for_rows(
-        &out.join("iceoryx2-1000").join("slave.rec"),
-        500,
-        util::LIMIT,
+    let mut echo = Vec::new();
+    util::wait_for("the bare hop's echo runs", util::LIMIT, || {
+        echo = procs::children_running(child.id() as i32, "bench-echo");
+        !echo.is_empty()
+    });
+    let err = procs::stopped(child, Signal::INT);
+    assert!(
+        echo.iter().all(|&p| !procs::alive(p)),
+        "the echo runs on: {err}"
     );
-    procs::stopped(child, Signal::INT);
     sb.assert_no_leftover_processes();
 }
 
@@ -148,4 +153,30 @@ fn run_stops_the_node_programs_build_on_sigterm() {
         "the build runs on"
     );
     assert!(!sb.path("run").exists(), "nothing written");
+}
+
+/// A run stopped before its master began its record (a Ctrl-C at once: here node
+/// programs that never start recording) is a stop, exit 130, not "the run failed, no
+/// record from the master", exit 1; no node is left running.
+#[test]
+fn a_run_stopped_before_the_master_records_is_a_stop() {
+    let sb = Sandbox::new("sigearly");
+    let (nodes, log) = (sb.path("nodes"), sb.path("log"));
+    std::fs::create_dir_all(&log).expect("log");
+    for role in ["master", "emulator", "slave"] {
+        procs::script(&nodes, &format!("tactile-{role}"), &procs::busy(&log, role));
+    }
+    sb.write("s.toml", &util::wall_delay());
+    let child = procs::spawn(
+        sb.command(&["run", "s.toml", "--out", "run", "--prefix", &sb.prefix])
+            .env("TACTILE_NODE_DIR", &nodes),
+    );
+    // The master runs.
+    procs::pid_in(&log.join("master.pid"));
+    let err = procs::stopped(child, Signal::INT);
+    assert!(err.contains("before the master began its record"), "{err}");
+    for role in ["master", "emulator", "slave"] {
+        let pid = procs::pid_in(&log.join(format!("{role}.pid")));
+        assert!(!procs::alive(pid), "{role} runs on: {err}");
+    }
 }

@@ -41,17 +41,29 @@ fn all() -> Vec<(i32, i32, i32)> {
         .collect()
 }
 
-/// The running children of `pid` named `name` (their `comm`).
-pub fn children_named(pid: i32, name: &str) -> Vec<i32> {
+/// The running children of `pid` that `keep` keeps.
+fn children(pid: i32, keep: impl Fn(i32) -> bool) -> Vec<i32> {
     all()
         .into_iter()
-        .filter(|&(child, parent, _)| {
-            parent == pid
-                && std::fs::read_to_string(format!("/proc/{child}/comm"))
-                    .is_ok_and(|c| c.trim() == name)
-        })
+        .filter(|&(child, parent, _)| parent == pid && keep(child))
         .map(|(child, _, _)| child)
         .collect()
+}
+
+/// The running children of `pid` named `name` (their `comm`).
+pub fn children_named(pid: i32, name: &str) -> Vec<i32> {
+    children(pid, |child| {
+        std::fs::read_to_string(format!("/proc/{child}/comm")).is_ok_and(|c| c.trim() == name)
+    })
+}
+
+/// The running children of `pid` whose command line holds the argument `arg` (a
+/// child between its fork and its exec has its parent's command line, and name).
+pub fn children_running(pid: i32, arg: &str) -> Vec<i32> {
+    children(pid, |child| {
+        std::fs::read(format!("/proc/{child}/cmdline"))
+            .is_ok_and(|c| c.split(|b| *b == 0).any(|a| a == arg.as_bytes()))
+    })
 }
 
 /// The running processes of process group `group`.
