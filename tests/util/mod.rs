@@ -5,6 +5,7 @@
 #![allow(dead_code)]
 
 pub mod ports;
+pub mod procs;
 
 #[cfg(feature = "zenoh")]
 pub use ports::free_port;

@@ -10,7 +10,7 @@
 use crate::block;
 use crate::entry::{Record, SampleBlock};
 use crate::frames::MAX_FRAME;
-use crate::frames::{config, open_for_writing, seal, Damage, Frames, RecordError, HEADER};
+use crate::frames::{config, open_for_writing, seal, Damage, Frames, Next, RecordError, HEADER};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -291,7 +291,7 @@ pub fn rows_in(path: &Path) -> u64 {
         return 0;
     };
     let mut n = 0;
-    while let Ok(true) = frames.next_frame() {
+    while let Ok(Next::Frame) = frames.next_frame(&|| false) {
         let decoded =
             bincode::serde::decode_from_slice::<Record<(), ()>, _>(&frames.body, config());
         if let Ok((Record::Samples(b), _)) = decoded {
@@ -336,16 +336,35 @@ impl<S: DeserializeOwned, C: DeserializeOwned> RecordReader<Record<S, C>> {
     /// but whose body does not decode (another build's types) counts as damage too,
     /// and a block that does not unpack as a whole.
     pub fn next_record(&mut self) -> Result<Option<Record<S, C>>, RecordError> {
+        self.next_record_until(&|| false)
+    }
+
+    /// [`RecordReader::next_record`], looking at `stop` (a stop request) while it
+    /// reads through damage, which may be the whole file: once `stop` says so, the
+    /// answer is [`RecordError::Stopped`].
+    pub fn next_record_until(
+        &mut self,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Option<Record<S, C>>, RecordError> {
         loop {
             if let Some(r) = self.pending.pop_front() {
                 return Ok(Some(r));
             }
-            let more = self.frames.next_frame().map_err(|source| RecordError::Io {
-                path: self.path.clone(),
-                source,
-            })?;
-            if !more {
-                return Ok(None);
+            let next = self
+                .frames
+                .next_frame(stop)
+                .map_err(|source| RecordError::Io {
+                    path: self.path.clone(),
+                    source,
+                })?;
+            match next {
+                Next::Frame => {}
+                Next::End => return Ok(None),
+                Next::Stopped => {
+                    return Err(RecordError::Stopped {
+                        path: self.path.clone(),
+                    })
+                }
             }
             let body = &self.frames.body;
             let decoded = bincode::serde::decode_from_slice::<Record<S, C>, _>(body, config());
@@ -393,6 +412,12 @@ impl<S: DeserializeOwned, C: DeserializeOwned> RecordReader<Record<S, C>> {
     /// Bytes and stretches skipped so far, all of them.
     pub fn damaged(&self) -> (u64, u64) {
         (self.frames.damaged_bytes, self.frames.damaged_stretches)
+    }
+
+    /// Bytes read from the file so far: the reader's work, which stays within twice
+    /// the file's size whatever damage it reads through.
+    pub fn bytes_read(&self) -> u64 {
+        self.frames.bytes_read
     }
 }
 

@@ -8,6 +8,7 @@
 //! sync word that starts a frame whose checksum and body are whole. Appending (a
 //! restarted node) first trims a torn tail, so the new segment starts on a frame.
 
+use crate::ahead::Ahead;
 use std::io::{BufReader, Read, Seek, Write};
 use std::path::Path;
 use thiserror::Error;
@@ -20,6 +21,8 @@ pub const SYNC: [u8; 4] = [0xA5, b'T', b'F', 0x5A];
 pub const HEADER: usize = 12;
 /// Largest frame body a reader accepts; a longer length is damage.
 pub const MAX_FRAME: u32 = 1 << 20;
+/// Bytes a reader reads at a time while it resynchronises.
+const CHUNK: usize = 1 << 16;
 /// Damaged stretches a reader keeps the place of (the rest are counted).
 pub const MAX_KEPT_DAMAGE: usize = 32;
 
@@ -58,6 +61,13 @@ pub enum RecordError {
         found: u8,
         /// The version this build reads.
         reads: u8,
+    },
+    /// A stop request came while the reader read through damage; asked again, it goes
+    /// on from where it was.
+    #[error("{path}: reading stopped by a stop request")]
+    Stopped {
+        /// The file.
+        path: String,
     },
 }
 
@@ -137,13 +147,32 @@ pub(crate) fn whole_end(path: &Path) -> std::io::Result<u64> {
         other => std::io::Error::new(std::io::ErrorKind::InvalidData, other.to_string()),
     })?;
     let mut end = r.offset;
-    while r.next_frame()? {
+    while r.next_frame(&|| false)? == Next::Frame {
         end = r.offset;
     }
     Ok(end)
 }
 
-/// The frames of a record file, checked and resynchronised, in bounded memory.
+/// What [`Frames::next_frame`] came to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Next {
+    /// A whole frame: its body is in [`Frames::body`].
+    Frame,
+    /// The end of the file.
+    End,
+    /// A stop request came while damage was being read through; asked again, the
+    /// reader goes on from where it was.
+    Stopped,
+}
+
+/// The frames of a record file, checked and resynchronised, in bounded memory and in
+/// time linear in the file's size.
+///
+/// Frames are read in order, one header and one body at a time. Where no whole frame
+/// starts, the reader looks for the next sync word that starts one, reading ahead
+/// ([`Ahead`]); the bytes it read ahead are where it looks for frames until it is
+/// past all it has read, so no byte is read more than twice (once by a frame that
+/// proved damaged, once ahead) whatever the damage.
 #[derive(Debug)]
 pub(crate) struct Frames {
     input: BufReader<std::fs::File>,
@@ -157,6 +186,15 @@ pub(crate) struct Frames {
     pub(crate) damage: Vec<Damage>,
     pub(crate) damaged_bytes: u64,
     pub(crate) damaged_stretches: u64,
+    /// The bytes read ahead while resynchronising, while `offset` is before
+    /// `read_to`.
+    ahead: Option<Ahead>,
+    /// The furthest offset read so far.
+    read_to: u64,
+    /// A piece of the file read ahead.
+    chunk: Vec<u8>,
+    /// Bytes read from the file in all: the work done, which a test bounds.
+    pub(crate) bytes_read: u64,
 }
 
 impl Frames {
@@ -191,6 +229,10 @@ impl Frames {
             damage: Vec::new(),
             damaged_bytes: 0,
             damaged_stretches: 0,
+            ahead: None,
+            read_to: MAGIC.len() as u64,
+            chunk: Vec::new(),
+            bytes_read: 0,
         })
     }
 
@@ -206,6 +248,8 @@ impl Frames {
             }
         }
         self.pos += got as u64;
+        self.read_to = self.read_to.max(self.pos);
+        self.bytes_read += got as u64;
         Ok(got)
     }
 
@@ -243,25 +287,96 @@ impl Frames {
         Ok(whole)
     }
 
-    /// The first offset after `from` where a whole frame starts, or the file's end.
-    fn resync(&mut self, from: u64) -> std::io::Result<u64> {
-        let mut at = from;
-        let mut chunk = vec![0u8; 1 << 16];
-        while at + HEADER as u64 <= self.len {
-            self.move_to(at)?;
-            let n = self.read_full(&mut chunk)?;
-            let Some(k) = chunk[..n].windows(SYNC.len()).position(|w| w == SYNC) else {
-                // Keep the last bytes: a sync word may straddle the chunks.
-                at += n.saturating_sub(SYNC.len() - 1).max(1) as u64;
+    /// The first offset from `from` on where a whole frame starts (its body then in
+    /// `self.body`), or the file's end; None if `stop` said so first. The bytes are
+    /// read ahead into [`Ahead`], kept for the next frames.
+    fn resync(&mut self, from: u64, stop: &dyn Fn() -> bool) -> std::io::Result<Option<u64>> {
+        let mut ahead = self.ahead.take().unwrap_or_else(|| Ahead::new(from));
+        let found = self.look(&mut ahead, from, stop);
+        self.ahead = Some(ahead);
+        found
+    }
+
+    /// [`Frames::resync`] through `ahead`.
+    fn look(
+        &mut self,
+        ahead: &mut Ahead,
+        from: u64,
+        stop: &dyn Fn() -> bool,
+    ) -> std::io::Result<Option<u64>> {
+        let mut at = from.max(ahead.search);
+        loop {
+            ahead.search = at;
+            if at + HEADER as u64 > self.len {
+                return Ok(Some(self.len));
+            }
+            if ahead.end() < at + HEADER as u64 {
+                ahead.forget_before(at);
+                if !self.read_ahead(ahead, at + HEADER as u64, stop)? {
+                    return Ok(None);
+                }
+                continue;
+            }
+            let Some(k) = ahead
+                .bytes(at, ahead.end())
+                .windows(SYNC.len())
+                .position(|w| w == SYNC)
+            else {
+                // Keep the last bytes: a sync word may straddle what is read next.
+                at = ahead.end() - (SYNC.len() - 1) as u64;
                 continue;
             };
-            let candidate = at + k as u64;
-            if self.frame_at(candidate)? {
-                return Ok(candidate);
+            at += k as u64;
+            if at + HEADER as u64 > ahead.end() {
+                continue;
             }
-            at = candidate + 1;
+            let h = ahead.bytes(at, at + HEADER as u64);
+            let len = u32::from_le_bytes([h[4], h[5], h[6], h[7]]);
+            let crc = u32::from_le_bytes([h[8], h[9], h[10], h[11]]);
+            let (body, end) = (at + HEADER as u64, at + HEADER as u64 + u64::from(len));
+            if len <= MAX_FRAME && end <= self.len {
+                ahead.forget_before(at);
+                if !self.read_ahead(ahead, end, stop)? {
+                    ahead.search = at;
+                    return Ok(None);
+                }
+                if end <= ahead.end() && ahead.crc(body, end) == crc {
+                    ahead.search = at;
+                    self.body.clear();
+                    self.body.extend_from_slice(ahead.bytes(body, end));
+                    return Ok(Some(at));
+                }
+            }
+            at += 1;
         }
-        Ok(self.len)
+    }
+
+    /// Reads on into `ahead` until it holds the bytes up to `to` (or the file's end,
+    /// which is moved up if the file proves shorter); false if `stop` said so first.
+    fn read_ahead(
+        &mut self,
+        ahead: &mut Ahead,
+        to: u64,
+        stop: &dyn Fn() -> bool,
+    ) -> std::io::Result<bool> {
+        while ahead.end() < to.min(self.len) {
+            if stop() {
+                return Ok(false);
+            }
+            let n = CHUNK.min((self.len - ahead.end()) as usize);
+            self.chunk.resize(n, 0);
+            self.move_to(ahead.end())?;
+            let mut chunk = std::mem::take(&mut self.chunk);
+            let got = self.read_full(&mut chunk);
+            self.chunk = chunk;
+            let got = got?;
+            if got == 0 {
+                self.len = ahead.end();
+                break;
+            }
+            ahead.push(&self.chunk[..got]);
+        }
+        Ok(true)
     }
 
     pub(crate) fn note_damage(&mut self, offset: u64, bytes: u64) {
@@ -272,25 +387,40 @@ impl Frames {
         }
     }
 
-    /// Advances to the next whole frame (its body in `self.body`); false at the end.
-    /// Damage on the way is noted and skipped.
-    pub(crate) fn next_frame(&mut self) -> std::io::Result<bool> {
+    /// Advances to the next whole frame (its body in `self.body`). Damage on the way
+    /// is noted and skipped; `stop` is looked at while damage is read through.
+    pub(crate) fn next_frame(&mut self, stop: &dyn Fn() -> bool) -> std::io::Result<Next> {
         if self.offset >= self.len {
-            return Ok(false);
+            return Ok(Next::End);
         }
         let at = self.offset;
-        let start = if self.frame_at(at)? {
-            at
+        let found = if self.ahead.is_some() {
+            self.resync(at, stop)?
+        } else if self.frame_at(at)? {
+            Some(at)
         } else {
-            let next = self.resync(at + 1)?;
-            self.note_damage(at, next - at);
-            next
+            self.resync(at + 1, stop)?
         };
+        let Some(start) = found else {
+            return Ok(Next::Stopped);
+        };
+        if start > at {
+            self.note_damage(at, start - at);
+        }
         if start >= self.len {
             self.offset = self.len;
-            return Ok(false);
+            self.ahead = None;
+            return Ok(Next::End);
         }
         self.offset = start + (HEADER + self.body.len()) as u64;
-        Ok(true)
+        if self.offset >= self.read_to {
+            // Past everything read: frames are read in order again.
+            self.ahead = None;
+        }
+        Ok(Next::Frame)
     }
 }
+
+#[cfg(test)]
+#[path = "resync_tests.rs"]
+mod resync_tests;

@@ -6,6 +6,7 @@
 //! through ([`recorder`]). The report reads records with these types alone, so it
 //! needs none of the node crates; a node writes with the same ones.
 
+mod ahead;
 pub mod block;
 pub mod device;
 pub mod emulator;

@@ -19,6 +19,10 @@ pub enum Error {
     /// Something else went wrong while writing (a plot, an encoding).
     #[error("{0}")]
     Failed(String),
+    /// A stop request (SIGINT, SIGTERM) came before a sample was joined: no report was
+    /// written.
+    #[error("{0}")]
+    Stopped(String),
 }
 
 impl Error {

@@ -18,7 +18,7 @@ use crate::Error;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use tactile_messages::samples::LATE_WINDOW;
-use tactile_records::{Record, RecordReader};
+use tactile_records::{Record, RecordError, RecordReader};
 
 /// Rows of one sample number a source holds: more than any node writes for one
 /// sample in a segment (the master: a `Sent`, an answer or a miss; the emulator: a
@@ -120,9 +120,14 @@ where
             let Some(reader) = self.reader.as_mut() else {
                 return Ok(());
             };
-            let next = reader
-                .next_record()
-                .map_err(|e| Error::Failed(e.to_string()))?;
+            let next = match reader.next_record_until(stop) {
+                Ok(next) => next,
+                Err(RecordError::Stopped { .. }) => {
+                    self.stopped = true;
+                    return Ok(());
+                }
+                Err(e) => return Err(Error::Failed(e.to_string())),
+            };
             let Some(rec) = next else {
                 self.close();
                 return Ok(());

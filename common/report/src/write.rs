@@ -54,6 +54,13 @@ pub struct Launch {
 }
 
 impl Launch {
+    /// Whether the report is to stop joining: a stop request came, or its deadline
+    /// passed.
+    fn stopped(&self) -> bool {
+        self.stop.as_ref().is_some_and(|f| f.load(Ordering::SeqCst))
+            || self.until.is_some_and(|u| Instant::now() >= u)
+    }
+
     /// The report of a run a stop request cut short: interrupted, and written within
     /// a moment from what can be joined by then.
     pub fn interrupted(mut self) -> Launch {
@@ -384,9 +391,12 @@ fn summarise(
 /// The nodes' start records and the scenario the master recorded (or, where the
 /// master's start frame was damaged, the one another node recorded: every node records
 /// the scenario it runs).
-fn recorded(dirs: &[PathBuf]) -> Result<([Option<Start>; 3], Scenario), Error> {
+fn recorded(
+    dirs: &[PathBuf],
+    stop: &dyn Fn() -> bool,
+) -> Result<([Option<Start>; 3], Scenario), Error> {
     let found = join::locate(dirs)?;
-    let starts = join::starts(&found)?;
+    let starts = join::starts(&found, stop)?;
     let Some((k, start)) = starts
         .iter()
         .enumerate()
@@ -435,7 +445,7 @@ fn analysis_for(starts: &[Option<Start>; 3]) -> Result<(&'static str, Analysis),
 /// histograms, plots and the scenario as run. Returns the summary. On any error the
 /// files begun (their partial names) are removed: a folder holds whole files only.
 pub fn write_report(dirs: &[PathBuf], out: &Path, launch: &Launch) -> Result<Summary, Error> {
-    let (starts, scenario) = recorded(dirs)?;
+    let (starts, scenario) = recorded(dirs, &|| launch.stopped())?;
     let (runner, analysis) = analysis_for(&starts)?;
     make_out_dir(out)?;
     // Written last: until then the folder holds no summary, so no older one sits beside
@@ -456,13 +466,7 @@ fn report_into(
     let mut series = Series::default();
     let mut streams = Streams::create(out, scenario, &launch.outputs)?;
     let warning = streams.warning.clone();
-    let stopped = || {
-        launch
-            .stop
-            .as_ref()
-            .is_some_and(|f| f.load(Ordering::SeqCst))
-            || launch.until.is_some_and(|u| Instant::now() >= u)
-    };
+    let stopped = || launch.stopped();
     let mut task = crate::task_space::TaskSpaceSums::of(scenario);
     let logs = join::join_until(dirs, &stopped, |row, joints, rotation| {
         // The clutch's offset, from the arm's base frame into the master's.
@@ -526,7 +530,7 @@ pub fn write_mcap(
     compression: crate::mcap::Compression,
     stop: &dyn Fn() -> bool,
 ) -> Result<McapWritten, Error> {
-    let (_, scenario) = recorded(dirs)?;
+    let (_, scenario) = recorded(dirs, stop)?;
     make_out_dir(out)?;
     let (mut rec, warning) =
         run_mcap::create(out, &scenario, compression).map_err(Error::io("writing run.mcap"))?;

@@ -84,7 +84,10 @@ impl<R: BufRead> Lines<R> {
         let got = (&mut self.input)
             .take(limit)
             .read_until(b'\n', &mut self.buf)
-            .map_err(Error::io(format!("reading line {n} of stdin")))?;
+            .map_err(crate::stop::or_io(
+                format!("reading line {n} of stdin"),
+                "nothing written to stdout",
+            ))?;
         if got == 0 {
             return Ok(None);
         }
@@ -134,7 +137,10 @@ fn evaluate(engine: &Engine, module: Module, v: &[f64]) -> ([f64; 3], Option<boo
     }
 }
 
-/// Evaluates `args.module` over the CSV on `input`, writing CSV to `output`.
+/// Evaluates `args.module` over the CSV on `input`, writing CSV to `output`. The
+/// command reads and writes through [`crate::stop::Input`] and
+/// [`crate::stop::Output`], so a stop request (SIGINT, SIGTERM) ends it within a
+/// second however its input comes (a FIFO that gives nothing, an endless stream).
 pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> Result<(), Error> {
     let kind = ArithKind::from(args.arith);
     let engine = Engine::new(kind, args.datapath.geometry()?, args.datapath.cordic()?)
@@ -179,5 +185,8 @@ pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> 
     output
         .write_all(out.as_bytes())
         .and_then(|()| output.flush())
-        .map_err(Error::io("writing stdout"))
+        .map_err(crate::stop::or_io(
+            "writing stdout",
+            "stdout holds part of the output",
+        ))
 }

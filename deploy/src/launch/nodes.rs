@@ -8,6 +8,7 @@
 //! `TACTILE_NODE_DIR` names their folder outright (the tests use it).
 
 use crate::error::Error;
+use crate::stop::ToolError;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use tactile_messages::Role;
@@ -41,8 +42,8 @@ fn cargo_build(dir: &Path) -> Result<(), String> {
     let target = dir.parent().ok_or("no target folder")?;
     let profile = profile_args(dir).ok_or("no profile folder")?;
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let out = Command::new(cargo)
-        .arg("build")
+    let mut cmd = Command::new(cargo);
+    cmd.arg("build")
         .arg("--quiet")
         .arg("--manifest-path")
         .arg(&manifest)
@@ -74,9 +75,14 @@ fn cargo_build(dir: &Path) -> Result<(), String> {
                 .then_some(["--features", "tactile/rtl"])
                 .into_iter()
                 .flatten(),
-        )
-        .output()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
+        );
+    // Its own process group, killed on a stop request: a launcher stopped while it
+    // builds leaves no build running.
+    let out = crate::stop::run_tool(&mut cmd).map_err(|e| match e {
+        ToolError::Start(e) => format!("cannot run cargo: {e}"),
+        ToolError::Stopped => "stopped by a signal".into(),
+        ToolError::Wait(e) => format!("running cargo: {e}"),
+    })?;
     if out.status.success() {
         Ok(())
     } else {
@@ -109,7 +115,10 @@ pub fn node_dir() -> Result<PathBuf, Error> {
         if !all_in(&dir) {
             crate::noteln!("tactile: building the node programs (once)...");
         }
+        // A build takes minutes on a fresh clone: SIGINT and SIGTERM stop it.
+        crate::stop::watch()?;
         why = cargo_build(&dir).err();
+        crate::stop::check("the node programs' build stopped; nothing was run")?;
     }
     if all_in(&dir) {
         if let Some(w) = &why {

@@ -565,6 +565,13 @@ fn report(
         return Err(Error::BadInput(msg));
     }
     if !out.join("master.rec").exists() {
+        // Stopped before the master began its record (a Ctrl-C at once): a stop, not
+        // a failure, with nothing to report.
+        if w.interrupted {
+            return Err(Error::Stopped(
+                "before the master began its record: no report written".into(),
+            ));
+        }
         return Err(Error::Failed(format!(
             "the run failed, no record from the master:\n{}",
             w.events.join("\n")

@@ -19,7 +19,7 @@ use tactile_messages::Role;
 use tactile_records::emulator::{Direction, EmulatorTotals, Passage};
 use tactile_records::master::{Answer, MasterSample, MasterTotals, Miss, Sent};
 use tactile_records::slave::{ArmJoints, SlaveSample, SlaveTotals, Step};
-use tactile_records::{record_path, Record, RecordReader, Start};
+use tactile_records::{record_path, Record, RecordError, RecordReader, Start};
 
 /// The three nodes' logs after a join.
 #[derive(Debug, Clone)]
@@ -77,14 +77,18 @@ pub fn locate(dirs: &[PathBuf]) -> Result<[Option<PathBuf>; 3], Error> {
 /// The `Start` a record opens with, read without joining (a frame of any role's
 /// record decodes as a `Start` alike: the variant does not depend on the samples'
 /// type). Only the first whole frame is looked at: nothing precedes a start, and
-/// reading on for a later segment's would read a whole crafted file with no stop
-/// request looked at. A damaged start frame leaves the node's start unknown.
-fn first_start(path: &Path) -> Result<Option<Start>, Error> {
+/// reading on for a later segment's would read a whole crafted file. A damaged start
+/// frame leaves the node's start unknown. Damage before the first whole frame is read
+/// through looking at `stop`, a stop request.
+fn first_start(path: &Path, stop: &dyn Fn() -> bool) -> Result<Option<Start>, Error> {
     let mut r = RecordReader::<tactile_records::AnyRecord>::open(path)
         .map_err(|e| Error::BadInput(e.to_string()))?;
-    match r.next_record() {
+    match r.next_record_until(stop) {
         Ok(Some(Record::Start(s))) => Ok(Some(s)),
         Ok(_) => Ok(None),
+        Err(e @ RecordError::Stopped { .. }) => Err(Error::Stopped(format!(
+            "{e} before its start was read: no report written"
+        ))),
         Err(e) => Err(Error::BadInput(e.to_string())),
     }
 }
@@ -93,11 +97,14 @@ fn first_start(path: &Path) -> Result<Option<Start>, Error> {
 /// starts were all lost), read without joining: the master's holds the scenario, each
 /// one its clock domain. A record whose start names another role than its file is
 /// refused: renamed or copied files would otherwise join as nothing.
-pub fn starts(found: &[Option<PathBuf>; 3]) -> Result<[Option<Start>; 3], Error> {
+pub fn starts(
+    found: &[Option<PathBuf>; 3],
+    stop: &dyn Fn() -> bool,
+) -> Result<[Option<Start>; 3], Error> {
     let mut out: [Option<Start>; 3] = [None, None, None];
     for ((slot, path), role) in out.iter_mut().zip(found).zip(Role::ALL) {
         let Some(path) = path else { continue };
-        let Some(start) = first_start(path)? else {
+        let Some(start) = first_start(path, stop)? else {
             continue;
         };
         if start.role != role.name() {
@@ -324,8 +331,11 @@ impl Sources {
 /// the run has; no node's start may lift it for the others), or where the master's
 /// start was lost the smallest another node claims; without a start none is known and
 /// no number is refused. With it, the nodes whose start claims another count.
-fn sample_count(found: &[Option<PathBuf>; 3]) -> Result<(u64, Vec<(Role, u64)>), Error> {
-    let starts = starts(found)?;
+fn sample_count(
+    found: &[Option<PathBuf>; 3],
+    stop: &dyn Fn() -> bool,
+) -> Result<(u64, Vec<(Role, u64)>), Error> {
+    let starts = starts(found, stop)?;
     let claims: Vec<(Role, u64)> = Role::ALL
         .into_iter()
         .zip(&starts)
@@ -381,7 +391,7 @@ pub fn join_until(
     ) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
     let found = locate(dirs)?;
-    let limit = sample_count(&found)?;
+    let limit = sample_count(&found, stop)?;
     let mut src = Sources::open(found, limit)?;
     let (mut n, mut turn) = (0u64, 0u64);
     loop {

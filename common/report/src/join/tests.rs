@@ -134,7 +134,7 @@ fn write_run(root: &Path, slave_run: u64) -> [PathBuf; 3] {
 fn records_of_two_clock_domains_join_sample_by_sample_within_the_window() {
     let dir = tempfile::tempdir().expect("tempdir");
     let dirs = write_run(dir.path(), RUN);
-    let starts = starts(&locate(&dirs).expect("located")).expect("starts");
+    let starts = starts(&locate(&dirs).expect("located"), &|| false).expect("starts");
     let clocks: Vec<String> = starts.iter().flatten().map(|s| s.clock.clone()).collect();
     assert_eq!(clocks, ["host-a", "host-b", "host-b"]);
     let mut rows = Vec::new();

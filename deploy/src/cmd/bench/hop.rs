@@ -106,13 +106,19 @@ fn find_echo(link: &mut Link) -> Result<(), Error> {
 }
 
 /// `n` pings at `rate`, each at its tick; the round trips and the misses (no pong
-/// within a period).
+/// within a period). A stop request (SIGINT, SIGTERM) ends them at the next tick (a
+/// wait it cut short is no miss), the echo told to end all the same.
 fn ping(link: &mut Link, rate: f64, n: u64) -> Result<(Latency, u64), Error> {
     let t_s = (1e9 / rate) as u64;
     let t0 = now_ns() + 2_000_000;
     let mut lat = Latency::default();
     let mut misses = 0;
+    let mut stopped = false;
     for i in 0..n {
+        if tactile_runtime::signals::stop_requested() {
+            stopped = true;
+            break;
+        }
         let tick = t0 + i * t_s;
         sleep_until_ns(tick.saturating_sub(tactile_runtime::pace::default_wake_early_ns(t_s)));
         while now_ns() < tick {
@@ -141,6 +147,9 @@ fn ping(link: &mut Link, rate: f64, n: u64) -> Result<(Latency, u64), Error> {
     }
     let end = Forward::control(Control::End, 0, 0);
     link.send_forward(&end, true).map_err(fail)?;
+    if stopped {
+        return Err(Error::Interrupted);
+    }
     Ok((lat, misses))
 }
 

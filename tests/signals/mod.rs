@@ -2,6 +2,9 @@
 //! process group of a launcher (the terminal's Ctrl-C) ends each with exit 130 and the
 //! report of what ran; a closed stdout ends a command quietly.
 
+mod commands;
+mod hdl;
+
 use crate::util;
 
 use std::os::unix::process::CommandExt;
