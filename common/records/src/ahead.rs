@@ -105,7 +105,7 @@ impl Ahead {
         let mut pos = self.buf.len();
         self.buf.extend_from_slice(bytes);
         while pos < self.buf.len() {
-            if pos % MARK == 0 {
+            if pos.is_multiple_of(MARK) {
                 self.marks.push(self.run);
             }
             let next = ((pos / MARK + 1) * MARK).min(self.buf.len());
