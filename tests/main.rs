@@ -27,6 +27,7 @@ mod lifecycle;
 mod logs;
 mod loop_processes;
 mod nodes;
+mod physics;
 mod pose;
 mod recordings;
 mod records;

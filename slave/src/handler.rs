@@ -144,6 +144,7 @@ impl Handler for SlaveHandler {
             v_in: c.ports.forward_in,
             h_out: c.ports.backward_out,
             device: self.peripheral().map(|r| r.counters()).unwrap_or_default(),
+            world: self.slave.world_counters(),
         }
     }
 
@@ -195,6 +196,9 @@ impl Follower for SlaveHandler {
             self.slave.measure(measured);
         }
         let step = self.slave.step(v, &mut out.backward);
+        for e in self.slave.take_events() {
+            io.event(v.seq, &e)?;
+        }
         if let Some(hw) = &mut self.robot {
             hw.due = Some(self.slave.arm().reference());
         }
@@ -253,6 +257,9 @@ impl Follower for SlaveHandler {
                 held
             }
         };
+        for e in self.slave.take_events() {
+            io.event(last, &e)?;
+        }
         Ok(Some(
             match self.slave.arm().joints([0.0; 3], self.slave.rotation()) {
                 Some(joints) => SlaveSample::ArmHold(held, joints),

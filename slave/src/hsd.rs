@@ -12,8 +12,9 @@
 //! one trait ([`crate::slave_arm::SlaveArm`]); the paper's runs its kernels in the
 //! scenario's arithmetic, the physical world (the true tool, the contact) in f64.
 
-use crate::environment::{deepest_contact, Scene};
+use crate::environment::deepest_contact;
 use crate::slave_arm::SlaveArm;
+use crate::world::{Felt, SlaveWorld};
 use tactile_control::codec::{Deadband, Estimate, Guess, Predictor};
 use tactile_control::mmt::ModelSender;
 use tactile_control::passivity::SlaveSide;
@@ -22,15 +23,18 @@ use tactile_math::joints::Joints;
 use tactile_math::kernels;
 use tactile_math::vec3::distance;
 use tactile_messages::samples::{Backward, Flags, Forward};
-use tactile_records::slave::{HoldStep, SlaveCounters, Step};
+use tactile_records::slave::{HoldStep, SlaveCounters, Step, WorldCounters};
 use tactile_scenario::{Change, Scenario, ScenarioError};
 
-/// The slave: its arm (the paper's or a URDF's), its environment and the channel's
-/// control, codec and predictor.
+/// The slave: its arm (the paper's or a URDF's), its world (the analytic scene or a
+/// physics world) and the channel's control, codec and predictor.
 #[derive(Debug)]
 pub struct Slave {
     arm: Box<dyn SlaveArm>,
-    objects: Scene,
+    world: SlaveWorld,
+    /// What the physics world said went wrong, for the run's record (the handler
+    /// takes them).
+    events: Vec<String>,
     t_s: f64,
     counters: SlaveCounters,
     control: SlaveSide,
@@ -63,8 +67,13 @@ pub struct Measured {
 }
 
 impl Slave {
-    /// A slave at rest with `arm` (the scenario's, [`crate::peripherals::of_scenario`]).
-    pub fn new(scenario: &Scenario, arm: Box<dyn SlaveArm>) -> Result<Slave, ScenarioError> {
+    /// A slave at rest with `arm` (the scenario's, [`crate::peripherals::of_scenario`])
+    /// in `world` (the scenario's, [`SlaveWorld::of_scenario`]).
+    pub fn new(
+        scenario: &Scenario,
+        arm: Box<dyn SlaveArm>,
+        world: SlaveWorld,
+    ) -> Result<Slave, ScenarioError> {
         // Where the paper's arm's tool is at zero angles: where the master starts.
         let start = kernels::fk(&scenario.device.geometry()?.lengths(), &StdTrig, [0.0; 3]);
         // Wave variables are neither positions nor forces: the codec measures them from
@@ -85,7 +94,8 @@ impl Slave {
                 scenario.t_s(),
                 if wave { 1e6 } else { 100.0 },
             ),
-            objects: Scene::new(&scenario.environment.objects),
+            world,
+            events: Vec::new(),
             t_s: scenario.t_s(),
             counters: SlaveCounters::default(),
             measured: None,
@@ -112,12 +122,41 @@ impl Slave {
         self.arm.as_ref()
     }
 
+    /// The world the arm touches.
+    pub fn world(&self) -> &SlaveWorld {
+        &self.world
+    }
+
+    /// What the world counted so far.
+    pub fn world_counters(&self) -> WorldCounters {
+        self.world.counters()
+    }
+
+    /// What the physics world said went wrong since the last call, as text.
+    pub fn take_events(&mut self) -> std::vec::Drain<'_, String> {
+        self.events.drain(..)
+    }
+
     /// One sample of t_s with no input: hold the arm where it was when the input went
     /// silent (the master or the network is gone; the arm must not wander); a real
     /// robot's `measured` joints say where it is.
     pub fn hold(&mut self, measured: Option<&Joints>) -> HoldStep {
-        self.arm
-            .hold(measured, &self.objects, self.t_s, &mut self.counters)
+        let held = self
+            .arm
+            .hold(measured, self.world.touch(), self.t_s, &mut self.counters);
+        // The world goes on while the input is silent (a box keeps sliding); nothing
+        // is sent back.
+        self.step_world();
+        held
+    }
+
+    /// Steps a physics world one sample with the arm's tool frame (nothing for the
+    /// analytic scene, which is a function of the tool's position).
+    fn step_world(&mut self) -> Option<Felt> {
+        let SlaveWorld::Physics(p) = &mut self.world else {
+            return None;
+        };
+        Some(p.step(self.arm.tool_frame(), self.t_s, &mut self.events))
     }
 
     /// A real robot's reading for the next step: its joints (SD is the robot, FCS its
@@ -134,7 +173,7 @@ impl Slave {
         self.counters.steps += 1;
         while self.changes.last().is_some_and(|(n, _)| *n <= v.seq) {
             if let Some((_, c)) = self.changes.pop() {
-                self.objects.apply(&c);
+                self.world.apply(&c);
             }
         }
         self.arm.end_hold();
@@ -143,10 +182,19 @@ impl Slave {
         let joints = measured.as_ref().map(|m| &m.joints);
         let moved = self
             .arm
-            .advance(joints, &self.objects, self.t_s, &mut self.counters);
-        let (tool, force, surface, contact_object) =
-            self.sense(measured.and_then(|m| m.force), &mut flags);
-        let torque = measured.map_or([0.0; 3], |m| m.torque);
+            .advance(joints, self.world.touch(), self.t_s, &mut self.counters);
+        let felt = self.step_world();
+        let sensor = match (measured.as_ref(), &felt) {
+            (Some(m), _) => m.force.map(|f| (f, None)),
+            (None, Some(f)) => Some((f.force, Some(f.contact))),
+            (None, None) => None,
+        };
+        let (tool, force, surface, contact_object) = self.sense(sensor, &mut flags);
+        let torque = match (measured, felt) {
+            (Some(m), _) => m.torque,
+            (None, Some(f)) => f.torque,
+            (None, None) => [0.0; 3],
+        };
         self.reply(v, (force, torque), tool, flags, h);
         let model = h.as_ref().map_or_else(Default::default, |h| h.model);
         Step {
@@ -239,25 +287,40 @@ impl Slave {
     }
 
     /// FK-HSD in the HSD's arithmetic, then ENV and FBF-HSD: the tool, the contact
-    /// force (a force-torque sensor's if there is one), the surface point and the
-    /// object touched (u32::MAX for none).
+    /// force, the surface point and the object touched (u32::MAX for none). A
+    /// force-torque sensor's force, or a physics world's coupling force (with its
+    /// contact, if the tool touches a body), is h(n) in place of FBF's.
     fn sense(
         &mut self,
-        sensor: Option<[f64; 3]>,
+        sensor: Option<Sensor>,
         flags: &mut Flags,
     ) -> ([f64; 3], [f64; 3], [f64; 3], u32) {
         let (tool, truth) = self.arm.tool();
-        let contact = deepest_contact(&self.objects, truth);
+        let contact = match &self.world {
+            SlaveWorld::Analytic(scene) if sensor.is_none() => deepest_contact(scene, truth),
+            _ => None,
+        };
         let (force, surface, object) = match (sensor, contact) {
-            (Some(f), _) => {
-                // A force-torque sensor: its force is h(n); no surface is known. An
-                // arm's is in its base's axes: turned into the master's and scaled.
+            (Some((f, touched)), _) => {
+                // A sensor's force (a real arm's, or the physics world's coupling) is
+                // h(n). An arm's is in its base's axes: turned into the master's and
+                // scaled. A real sensor knows no surface; the world does.
                 let f = self.arm.felt(f);
-                if f.iter().any(|x| *x != 0.0) {
+                let (surface, object) = match touched.flatten() {
+                    Some((p, body)) => (self.arm.point_to_master(p), body),
+                    None => ([0.0; 3], u32::MAX),
+                };
+                // A sensor's force is contact; the world's coupling also carries the
+                // tool's own inertia and damping, so there contact is a touch.
+                let touching = match touched {
+                    Some(_) => object != u32::MAX,
+                    None => f.iter().any(|x| *x != 0.0),
+                };
+                if touching {
                     *flags |= Flags::CONTACT;
                     self.counters.contact_steps += 1;
                 }
-                (f, [0.0; 3], u32::MAX)
+                (f, surface, object)
             }
             (None, Some(c)) => {
                 *flags |= Flags::CONTACT;
@@ -330,6 +393,11 @@ fn changes(scenario: &Scenario) -> Vec<(u64, Change)> {
     v.reverse();
     v
 }
+
+/// A force sensed at the tool, N in the arm's frame, and, from a physics world, its
+/// contact point (arm's frame) and body, if it touches one (`None`: a real sensor,
+/// which knows no surface).
+type Sensor = ([f64; 3], Option<Option<([f64; 3], u32)>>);
 
 /// How far from one a received quaternion's norm may be (the sender normalized it;
 /// a wire carries it exactly): anything further is not a rotation and is rejected.

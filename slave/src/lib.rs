@@ -1,7 +1,8 @@
 //! The slave side of the loop (the paper's HSD, SD and ENV): the slave's arm as one
 //! trait ([`slave_arm`]) that the paper's arm ([`paper_arm`]: its controller and joint
 //! dynamics in [`arm`]) and any arm from its URDF ([`urdf_arm`]) implement, its
-//! environment ([`environment`]), the step as a pure state machine ([`hsd`]), what the slave does with each sample the
+//! environment: the analytic scene ([`environment`]) or a physics world, as the arm
+//! touches either ([`world`]), the step as a pure state machine ([`hsd`]), what the slave does with each sample the
 //! loop's driver hands it ([`handler`]), the arm's URDF read once and the real robot
 //! and live view it opens for its driver ([`peripherals`]), and its program
 //! ([`node`]). The same handler
@@ -16,3 +17,4 @@ pub mod paper_arm;
 pub mod peripherals;
 pub mod slave_arm;
 pub mod urdf_arm;
+pub mod world;

@@ -4,6 +4,7 @@ use crate::handler::SlaveHandler;
 use crate::hsd::Slave;
 use crate::peripherals;
 use crate::urdf_arm::UrdfArm;
+use crate::world::SlaveWorld;
 use clap::Parser;
 use std::process::ExitCode;
 use tactile_messages::Role;
@@ -49,9 +50,13 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let (sc, base_dir) = (program.scenario(), &program.prepared().base_dir);
     let urdf = UrdfArm::read_urdf(sc, base_dir).map_err(NodeError::BadInput)?;
     let arm = peripherals::of_scenario(sc, urdf.as_ref()).map_err(NodeError::BadInput)?;
+    // A physics world's meshes and start are checked here too: bad input, exit 2.
+    let world =
+        SlaveWorld::of_scenario(sc, base_dir).map_err(|e| NodeError::BadInput(e.to_string()))?;
     program.follow(Box::new(move |p| {
         let opened = peripherals::open(&p.scenario, &p.base_dir, urdf.as_ref())?;
-        let slave = Slave::new(&p.scenario, arm).map_err(|e| NodeError::Failed(e.to_string()))?;
+        let slave =
+            Slave::new(&p.scenario, arm, world).map_err(|e| NodeError::Failed(e.to_string()))?;
         Ok(Opened {
             handler: SlaveHandler::new(slave, &p.scenario, opened.robot),
             live: opened.live,

@@ -3,8 +3,9 @@
 //! force acting on the joints; the physical world (the true tool, the contact) in f64.
 
 use crate::arm::{Controller, Dynamics};
-use crate::environment::{deepest_contact, Scene};
+use crate::environment::deepest_contact;
 use crate::slave_arm::{Moved, SlaveArm};
+use crate::world::Touch;
 use tactile_math::arith::StdTrig;
 use tactile_math::engine::Engine;
 use tactile_math::geometry::Lengths;
@@ -52,30 +53,34 @@ impl PaperArm {
     }
 
     /// Integrates the joints over one sample under `torque`, pushed back by whatever
-    /// the tool touches (true tool position, f64).
-    fn integrate(&mut self, torque: [f64; 3], objects: &Scene, dt: f64) {
+    /// the tool touches (true tool position, f64): the scene's springs at each
+    /// integration step, or a physics world's force held over the sample.
+    fn integrate(&mut self, torque: [f64; 3], touch: Touch<'_>, dt: f64) {
         let truth = self.truth;
         self.dynamics.advance(torque, dt, |s| {
-            let tool = kernels::fk(&truth, &StdTrig, s.theta);
-            match deepest_contact(objects, tool) {
-                Some(c) => {
-                    let f = kernels::fbf(c.surface, tool, c.stiffness);
-                    let j = kernels::jacobian(&truth, &StdTrig, s.theta);
-                    [0, 1, 2].map(|k| j[0][k] * f[0] + j[1][k] * f[1] + j[2][k] * f[2])
+            let f = match touch {
+                Touch::Scene(objects) => {
+                    let tool = kernels::fk(&truth, &StdTrig, s.theta);
+                    match deepest_contact(objects, tool) {
+                        Some(c) => kernels::fbf(c.surface, tool, c.stiffness),
+                        None => return [0.0; 3],
+                    }
                 }
-                None => [0.0; 3],
-            }
+                Touch::Held(f) => f,
+            };
+            let j = kernels::jacobian(&truth, &StdTrig, s.theta);
+            [0, 1, 2].map(|k| j[0][k] * f[0] + j[1][k] * f[1] + j[2][k] * f[2])
         });
         self.theta = self.dynamics.state.theta;
     }
 
     /// FCS then SD toward `reference`: the torques and how many were clamped.
-    fn servo(&mut self, reference: [f64; 3], objects: &Scene, dt: f64) -> ([f64; 3], u32) {
+    fn servo(&mut self, reference: [f64; 3], touch: Touch<'_>, dt: f64) -> ([f64; 3], u32) {
         let state = self.dynamics.state;
         let cmd = self
             .controller
             .update(reference, state.theta, state.velocity, dt);
-        self.integrate(cmd.torque, objects, dt);
+        self.integrate(cmd.torque, touch, dt);
         (cmd.torque, cmd.clamped)
     }
 }
@@ -112,7 +117,7 @@ impl SlaveArm for PaperArm {
     fn advance(
         &mut self,
         measured: Option<&Joints>,
-        objects: &Scene,
+        touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
     ) -> Moved {
@@ -124,7 +129,7 @@ impl SlaveArm for PaperArm {
                 ..Moved::default()
             };
         }
-        let (torque, clamps) = self.servo(self.reference, objects, dt);
+        let (torque, clamps) = self.servo(self.reference, touch, dt);
         c.torque_clamps += u64::from(clamps);
         Moved {
             theta_ref: self.reference,
@@ -139,7 +144,7 @@ impl SlaveArm for PaperArm {
     fn hold(
         &mut self,
         measured: Option<&Joints>,
-        objects: &Scene,
+        touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
     ) -> HoldStep {
@@ -159,7 +164,7 @@ impl SlaveArm for PaperArm {
             }
             None => {
                 self.reference = from;
-                let (torque, clamps) = self.servo(from, objects, dt);
+                let (torque, clamps) = self.servo(from, touch, dt);
                 c.torque_clamps += u64::from(clamps);
                 torque
             }

@@ -5,7 +5,7 @@
 //! channel's target, moves (or is measured), holds while the input is silent, and
 //! says where its tool is and what force the operator is to feel.
 
-use crate::environment::Scene;
+use crate::world::Touch;
 use tactile_math::joints::Joints;
 use tactile_messages::samples::Flags;
 use tactile_records::slave::{ArmJoints, HoldStep, SlaveCounters};
@@ -43,11 +43,11 @@ pub trait SlaveArm: std::fmt::Debug + Send {
 
     /// One period of `dt` s: a real robot's `measured` joints are the arm's (its own controller
     /// follows the reference); without, the simulated joints move under the servo,
-    /// pushed back by what the tool touches in `objects`.
+    /// pushed back by what the tool `touch`es.
     fn advance(
         &mut self,
         measured: Option<&Joints>,
-        objects: &Scene,
+        touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
     ) -> Moved;
@@ -58,7 +58,7 @@ pub trait SlaveArm: std::fmt::Debug + Send {
     fn hold(
         &mut self,
         measured: Option<&Joints>,
-        objects: &Scene,
+        touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
     ) -> HoldStep;
@@ -69,6 +69,21 @@ pub trait SlaveArm: std::fmt::Debug + Send {
     /// The tool, m in the master's frame: as the HSD's FK computes it (the paper's
     /// arithmetic) and as it is (f64), which the environment sees.
     fn tool(&self) -> ([f64; 3], [f64; 3]);
+
+    /// The tool frame in the arm's own frame (the paper's arm: the paper's frame, the
+    /// true tool, no orientation; a URDF arm: its base frame), which is a physics
+    /// world's frame: the world is built around the arm.
+    fn tool_frame(&self) -> tactile_world::Pose {
+        tactile_world::Pose {
+            position: self.tool().1,
+            ..tactile_world::Pose::default()
+        }
+    }
+
+    /// A point of the arm's frame in the master's, m (the paper's arm: the same).
+    fn point_to_master(&self, p: [f64; 3]) -> [f64; 3] {
+        p
+    }
 
     /// Where the operator's clutch puts the tool relative to the master's handle, m in
     /// the master's frame (zero for an arm without a clutch): MMT's model is rendered

@@ -80,7 +80,8 @@ fn panda(servo: ArmServo) -> Slave {
         arm.servo = servo;
     }
     let arm = read_arm(&scenario, &dir).expect("the panda");
-    Slave::new(&scenario, arm).expect("the slave")
+    let world = tactile_slave::world::SlaveWorld::of_scenario(&scenario, &dir).expect("the wall");
+    Slave::new(&scenario, arm, world).expect("the slave")
 }
 
 /// v(n) of a 6-DoF master pressing down at 0.15 m/s into the wall and turning about

@@ -188,6 +188,46 @@ pub struct SlaveTotals {
     /// A real robot (`slave.backend = "ros2"`): what it delivered and how the loop
     /// judged it; all zero with the simulated arm.
     pub device: crate::device::DeviceCounters,
+    /// A physics world (`[environment] engine = "physics"`): what went wrong in it and
+    /// the task's outcome; all zero (and `physics` false) with the analytic scene.
+    pub world: WorldCounters,
+}
+
+/// What a physics world counted over a run (docs/16): its faults, each also named in
+/// the record's events, and the task's outcome.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct WorldCounters {
+    /// Whether the slave stepped a physics world at all.
+    pub physics: bool,
+    /// Dynamic bodies that left the world's bounds (taken out).
+    pub left_bounds: u64,
+    /// Episodes of energy rising without a source (explosions).
+    pub energy_gains: u64,
+    /// Bodies whose state became non-finite (taken out).
+    pub non_finite: u64,
+    /// Samples whose tool frame came in non-finite (the last good one held).
+    pub bad_inputs: u64,
+    /// Engine failures (at most one: the world froze).
+    pub engine_failures: u64,
+    /// Samples whose force to the operator was ramped down after a fault.
+    pub ramped_steps: u64,
+    /// The `[task]`'s outcome, if the scenario has one.
+    pub task: Option<TaskResult>,
+}
+
+/// A `[task]`'s outcome over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct TaskResult {
+    /// Whether the goal was met and held for the task's `hold_s`.
+    pub success: bool,
+    /// Seconds from the start to the end of the first such hold.
+    pub completion_s: Option<f64>,
+    /// The distance to the goal at the last sample (m, or rad for a hinge).
+    pub distance: f64,
+    /// The closest the run came to the goal.
+    pub closest: f64,
+    /// Samples the task was evaluated on.
+    pub steps: u64,
 }
 
 /// The slave's record type.

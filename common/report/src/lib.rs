@@ -29,6 +29,7 @@ pub mod sweep;
 pub mod sweep_grid;
 pub mod sweep_map;
 pub mod sweep_plots;
+pub mod task;
 pub mod task_space;
 pub mod text;
 pub mod trace;

@@ -204,6 +204,10 @@ pub struct Summary {
     /// `force_scale`; absent for the paper's arm.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub task_space: Option<crate::task_space::TaskSpace>,
+    /// A physics scene's `[task]` (docs/16): whether and when it succeeded, the
+    /// contact force, the tool's path and the operator's work; absent without a task.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub task: Option<crate::task::TaskSummary>,
     /// The channel's passivity observers, the energy the control dissipated, and the
     /// drift of the slave's reference.
     pub passivity: Passivity,

@@ -75,6 +75,29 @@ pub fn dynamics_failed(c: &SlaveCounters) -> Option<String> {
     })
 }
 
+/// A physics world that went wrong (docs/16): what it counted, said once; the
+/// record's events name each body and sample.
+pub fn world_faults(w: &tactile_records::slave::WorldCounters) -> Option<String> {
+    let parts: Vec<String> = [
+        (w.left_bounds, "bodies left its bounds"),
+        (w.energy_gains, "episodes of energy without a source"),
+        (w.non_finite, "bodies became non-finite"),
+        (w.bad_inputs, "samples of a non-finite tool frame"),
+        (w.engine_failures, "engine failures (the world froze)"),
+    ]
+    .into_iter()
+    .filter(|(n, _)| *n > 0)
+    .map(|(n, what)| format!("{n} {what}"))
+    .collect();
+    (!parts.is_empty()).then(|| {
+        format!(
+            "the physics world went wrong: {}; the force to the operator was ramped down over {} samples (the events say where)",
+            parts.join(", "),
+            w.ramped_steps
+        )
+    })
+}
+
 /// A real device or robot whose messages were refused (malformed, not finite, out of
 /// range, a force past `max_force`): the loop went on from its last good value, which
 /// the figures do not say. The first refusal's reason is in that node's log.
@@ -140,5 +163,22 @@ mod tests {
         };
         let w = dynamics_failed(&c).expect("a warning");
         assert!(w.contains("failed in 7 periods"), "{w}");
+    }
+
+    #[test]
+    fn a_world_that_went_wrong_is_warned_of_with_its_counts() {
+        use tactile_records::slave::WorldCounters;
+        assert_eq!(world_faults(&WorldCounters::default()), None);
+        let w = WorldCounters {
+            physics: true,
+            left_bounds: 2,
+            energy_gains: 1,
+            ramped_steps: 150,
+            ..WorldCounters::default()
+        };
+        assert_eq!(
+            world_faults(&w).as_deref(),
+            Some("the physics world went wrong: 2 bodies left its bounds, 1 episodes of energy without a source; the force to the operator was ramped down over 150 samples (the events say where)")
+        );
     }
 }

@@ -323,6 +323,11 @@ fn summarise(
         &master_totals.device,
         slave.as_ref().map(|s| &s.device),
     ));
+    warnings.extend(
+        slave
+            .as_ref()
+            .and_then(|s| crate::warnings::world_faults(&s.world)),
+    );
     Summary {
         scenario: scenario.name.clone(),
         mode: scenario.mode,
@@ -355,6 +360,10 @@ fn summarise(
         contact: a.bilateral.contact,
         transparency: a.bilateral.felt.finish(scenario.t_s()),
         task_space: None,
+        task: slave
+            .as_ref()
+            .and_then(|s| s.world.task)
+            .map(|t| crate::task::TaskSummary::new(&t, &a.task)),
         passivity: a.bilateral.passivity,
         mmt: (scenario.control.kind == tactile_scenario::ControlKind::Mmt).then(|| ModelCounts {
             models_sent: slave.as_ref().map_or(0, |s| s.counters.models_sent),

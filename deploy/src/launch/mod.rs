@@ -3,6 +3,7 @@
 //! `tactile run`, `sweep` and `bench` all start runs through here.
 
 pub mod links;
+mod logs;
 pub mod netns;
 pub mod nodes;
 pub mod pki;

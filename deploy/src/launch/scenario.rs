@@ -137,6 +137,10 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     tactile_slave::urdf_arm::UrdfArm::of_scenario(&scenario, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    // A physics world is built once here: its meshes read and checked, its bodies'
+    // overlap at the start, its coupling and joints' stability at the substep.
+    tactile_slave::world::SlaveWorld::of_scenario(&scenario, &base_dir)
+        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     if scenario.master.backend == tactile_scenario::Backend::Ros2 {
         tactile_master::peripherals::gimbal(&scenario, &base_dir)
             .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;

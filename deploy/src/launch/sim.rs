@@ -174,7 +174,9 @@ pub fn simulate(
         tactile_network_emulator::replay::load(scenario, base_dir).map_err(Error::BadInput)?;
     let emulator = EmulatorHandler::new(Emulator::with_replays(scenario, replays));
     let arm = tactile_slave::peripherals::read_arm(scenario, base_dir).map_err(Error::BadInput)?;
-    let mut slave = Slave::new(scenario, arm).map_err(bad)?;
+    let world = tactile_slave::world::SlaveWorld::of_scenario(scenario, base_dir)
+        .map_err(|e| Error::BadInput(e.to_string()))?;
+    let mut slave = Slave::new(scenario, arm, world).map_err(bad)?;
     if let Some(g) = hooks.forward_predictor {
         slave.set_predictor(g);
     }

@@ -3,6 +3,7 @@
 //! writes the report from their records.
 
 use super::links::node_command;
+use super::logs::log_tail;
 use super::stall::{self, Progress};
 use super::{nodes, prepare_out, survivor_grace, two_cpus, Loaded, Supervision};
 use crate::error::Error;
@@ -101,30 +102,6 @@ impl Proc {
         }
         self.child.try_wait().ok().flatten()
     }
-}
-
-/// The last lines of a node's log, bounded: the log of a long run can be large.
-fn log_tail(out: &Path, role: Role) -> String {
-    let tail = log_lines(out, role);
-    if tail.trim().is_empty() {
-        // A full disk leaves the log unwritten too: say so rather than nothing.
-        return format!("(its log, {role}.log, says nothing: it could not be written, or the node wrote nothing before it ended)");
-    }
-    tail
-}
-
-/// The last five lines of a node's log, from its last 4 kB.
-fn log_lines(out: &Path, role: Role) -> String {
-    use std::io::{Read, Seek, SeekFrom};
-    let Ok(mut f) = std::fs::File::open(out.join(format!("{role}.log"))) else {
-        return String::new();
-    };
-    let len = f.metadata().map_or(0, |m| m.len());
-    let _ = f.seek(SeekFrom::Start(len.saturating_sub(4096)));
-    let mut text = String::new();
-    let _ = f.take(4096).read_to_string(&mut text);
-    let lines: Vec<&str> = text.lines().collect();
-    lines[lines.len().saturating_sub(5)..].join("\n")
 }
 
 /// What the supervision saw.

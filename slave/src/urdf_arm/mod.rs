@@ -27,7 +27,7 @@ use tactile_chain::{Chain, Dynamics, Frame, Ik, IkConfig, Robot};
 use tactile_scenario::shown::{listed, Num};
 use tactile_scenario::ArmConfig;
 
-use crate::environment::Scene;
+use crate::world::Touch;
 use std::sync::Arc;
 use tactile_math::joints::{Joints, MAX_JOINTS};
 
@@ -349,6 +349,18 @@ impl UrdfArm {
         self.chain.fk(&self.state.q).p.into()
     }
 
+    /// The tool frame in the base frame: FK's position and orientation `[x, y, z, w]`
+    /// (not relative to home: a physics world built around the arm takes it as is).
+    pub fn tool_frame_in_base(&self) -> ([f64; 3], [f64; 4]) {
+        let f = self.chain.fk(&self.state.q);
+        (f.p.into(), quaternion(&f.r))
+    }
+
+    /// A point of the base frame in the master's, m.
+    pub fn point_to_master(&self, p: [f64; 3]) -> [f64; 3] {
+        self.to_master(&Vector3::from(p))
+    }
+
     /// A displacement's length in the master's workspace, m.
     fn master_distance(&self, d: Vector3<f64>) -> f64 {
         match self.cfg.scale {
@@ -426,7 +438,7 @@ impl UrdfArm {
 
     /// One period of `dt` with no input: the servo holds the joints where they were
     /// when the input went silent, the arm integrated as in [`UrdfArm::advance`].
-    pub fn hold(&mut self, dt: f64, objects: &Scene) -> Holding {
+    pub fn hold(&mut self, dt: f64, touch: Touch<'_>) -> Holding {
         let started = self.held.is_none();
         let q = self.state.q;
         let from = self.held.get_or_insert(q);
@@ -435,7 +447,7 @@ impl UrdfArm {
         let held = self.chain.fk(&self.state.q_ref);
         self.reference = (held, Vector6::zeros());
         let p0 = held.p;
-        let clamps = self.advance(dt, objects);
+        let clamps = self.advance(dt, touch);
         let p = self.chain.fk(&self.state.q).p;
         Holding {
             started,

@@ -8,7 +8,8 @@
 //! call), go through `tactile_chain::matmul::mul_to`, the same sums without them.
 
 use super::UrdfArm;
-use crate::environment::{deepest_contact, Scene};
+use crate::environment::deepest_contact;
+use crate::world::Touch;
 use nalgebra::{
     DMatrix, DVector, DVectorView, Dyn, Matrix6, Matrix6xX, OMatrix, Vector3, Vector6, U6,
 };
@@ -90,8 +91,8 @@ impl Scratch {
 
 impl UrdfArm {
     /// Integrates the arm over `dt` under its servo, pushed by whatever the tool
-    /// touches among `objects`. Returns how many joints hit their effort limit.
-    pub fn advance(&mut self, dt: f64, objects: &Scene) -> u32 {
+    /// `touch`es. Returns how many joints hit their effort limit.
+    pub fn advance(&mut self, dt: f64, touch: Touch<'_>) -> u32 {
         let steps = (dt / self.cfg.step_s).ceil().max(1.0) as u32;
         let h = dt / f64::from(steps);
         // Out of the arm for the period, so that the steps borrow both apart (the
@@ -99,7 +100,7 @@ impl UrdfArm {
         let mut s = std::mem::take(&mut self.scratch);
         s.clamped.iter_mut().for_each(|c| *c = false);
         for _ in 0..steps {
-            if !self.step(&mut s, objects, h) {
+            if !self.step(&mut s, touch, h) {
                 break;
             }
         }
@@ -109,9 +110,9 @@ impl UrdfArm {
     }
 
     /// One integration step of `h`; false if the dynamics failed.
-    fn step(&mut self, s: &mut Scratch, objects: &Scene, h: f64) -> bool {
+    fn step(&mut self, s: &mut Scratch, touch: Touch<'_>, h: f64) -> bool {
         self.servo(s);
-        self.contact_torques(s, objects);
+        self.contact_torques(s, touch);
         for i in 0..s.drive.len() {
             s.drive[i] = s.tau[i] + s.ext[i] - self.chain.dofs[i].damping * self.state.qd[i];
         }
@@ -222,21 +223,26 @@ impl UrdfArm {
         }
     }
 
-    /// The contact force at the tool (the environment's, evaluated in the master's
-    /// frame) as joint efforts into `s.ext`: J_v^T f.
-    fn contact_torques(&self, s: &mut Scratch, objects: &Scene) {
+    /// The contact force at the tool as joint efforts into `s.ext`: J_v^T f. The
+    /// analytic scene's is evaluated in the master's frame and turned into the base's;
+    /// a physics world's comes in the base's.
+    fn contact_torques(&self, s: &mut Scratch, touch: Touch<'_>) {
         let tip = self
             .chain
             .jacobian_with(&self.state.q, &mut s.jac, &mut s.frames);
-        let tool = self.to_master(&tip.p);
-        let Some(c) = deepest_contact(objects, tool) else {
-            s.ext.iter_mut().for_each(|e| *e = 0.0);
-            return;
+        let f = match touch {
+            Touch::Scene(objects) => {
+                let tool = self.to_master(&tip.p);
+                let Some(c) = deepest_contact(objects, tool) else {
+                    s.ext.iter_mut().for_each(|e| *e = 0.0);
+                    return;
+                };
+                self.cfg
+                    .force_to_robot(kernels::fbf(c.surface, tool, c.stiffness))
+            }
+            Touch::Held(f) => f,
         };
-        let f = Vector3::from(
-            self.cfg
-                .force_to_robot(kernels::fbf(c.surface, tool, c.stiffness)),
-        );
+        let f = Vector3::from(f);
         for (i, e) in s.ext.iter_mut().enumerate() {
             *e = s.jac.fixed_view::<3, 1>(0, i).dot(&f);
         }

@@ -3,8 +3,8 @@
 //! periods are counted and said once.
 
 use super::UrdfArm;
-use crate::environment::Scene;
 use crate::slave_arm::{Moved, SlaveArm};
+use crate::world::Touch;
 use std::sync::Arc;
 use tactile_math::joints::Joints;
 use tactile_math::kernels;
@@ -31,7 +31,7 @@ impl SlaveArm for UrdfArm {
     fn advance(
         &mut self,
         measured: Option<&Joints>,
-        objects: &Scene,
+        touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
     ) -> Moved {
@@ -40,7 +40,7 @@ impl SlaveArm for UrdfArm {
             self.set_measured(q, dt);
             return Moved::default();
         }
-        let clamps = UrdfArm::advance(self, dt, objects);
+        let clamps = UrdfArm::advance(self, dt, touch);
         c.torque_clamps += u64::from(clamps);
         log_first_failure(self);
         Moved {
@@ -52,14 +52,14 @@ impl SlaveArm for UrdfArm {
     fn hold(
         &mut self,
         measured: Option<&Joints>,
-        objects: &Scene,
+        touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
     ) -> HoldStep {
         let h = match measured {
             Some(q) => self.hold_measured(q, dt),
             None => {
-                let h = UrdfArm::hold(self, dt, objects);
+                let h = UrdfArm::hold(self, dt, touch);
                 log_first_failure(self);
                 h
             }
@@ -88,6 +88,15 @@ impl SlaveArm for UrdfArm {
     fn tool(&self) -> ([f64; 3], [f64; 3]) {
         let tool = UrdfArm::tool(self);
         (tool, tool)
+    }
+
+    fn tool_frame(&self) -> tactile_world::Pose {
+        let (position, rotation) = self.tool_frame_in_base();
+        tactile_world::Pose { position, rotation }
+    }
+
+    fn point_to_master(&self, p: [f64; 3]) -> [f64; 3] {
+        UrdfArm::point_to_master(self, p)
     }
 
     fn contact_force(&self, surface: [f64; 3], tool: [f64; 3], stiffness: [f64; 3]) -> [f64; 3] {

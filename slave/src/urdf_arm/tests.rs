@@ -1,5 +1,6 @@
 //! The URDF arm's unit tests (beside the module, which they would double).
 use super::*;
+use crate::environment::Scene;
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 use tactile_scenario::{
@@ -46,7 +47,7 @@ fn gravity_compensation_holds_the_arm_at_home() {
     let mut arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
     for _ in 0..1000 {
         arm.follow(HOME, None, 1e-3);
-        assert_eq!(arm.advance(1e-3, &Scene::new(&[])), 0);
+        assert_eq!(arm.advance(1e-3, Touch::Scene(&Scene::new(&[]))), 0);
     }
     let s = arm.state();
     for (q, h) in s.q.iter().zip(&panda_cfg().home) {
@@ -80,7 +81,7 @@ fn the_tool_follows_a_scaled_displacement_and_maps_back() {
     let goal = [HOME[0] + 0.01, HOME[1] - 0.02, HOME[2] + 0.015];
     for _ in 0..2000 {
         arm.follow(goal, None, 1e-3);
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     // In the robot's frame the tool moved twice the master's displacement...
     let p = arm.chain().fk(&arm.state().q).p - home_tool.p;
@@ -167,7 +168,7 @@ fn a_target_outside_the_workspace_is_clamped_and_counted() {
     let mut clamped = 0;
     for _ in 0..3000 {
         clamped += u32::from(arm.follow(down, None, 1e-3).workspace_clamped);
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     assert!(clamped > 2000, "{clamped}");
     let z = arm.chain().fk(&arm.state().q).p.z;
@@ -194,7 +195,7 @@ fn a_cartesian_impedance_yields_as_its_stiffness_says() {
         let mut arm = UrdfArm::new(cfg, &panda_xml(), HOME).expect("arm");
         for _ in 0..4000 {
             arm.follow(goal, None, 1e-3);
-            arm.advance(1e-3, &Scene::new(std::slice::from_ref(&wall)));
+            arm.advance(1e-3, Touch::Scene(&Scene::new(std::slice::from_ref(&wall))));
         }
         wall_z - arm.tool()[2]
     };
@@ -226,7 +227,7 @@ fn a_wall_pushes_the_tool_back_and_efforts_stay_in_limits() {
     let goal = [HOME[0], HOME[1], HOME[2] - 0.03];
     for _ in 0..3000 {
         arm.follow(goal, None, 1e-3);
-        arm.advance(1e-3, &Scene::new(std::slice::from_ref(&wall)));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(std::slice::from_ref(&wall))));
     }
     let t = arm.tool();
     // Held between the wall and the target: inside the wall, short of the target.
@@ -242,15 +243,15 @@ fn a_hold_keeps_the_joints_where_the_input_went_silent() {
     let goal = [HOME[0] + 0.02, HOME[1], HOME[2]];
     for _ in 0..100 {
         arm.follow(goal, None, 1e-3);
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     // Still moving when the input stops: the servo brings it back to where it was.
     let at_silence = arm.state().q;
-    let first = arm.hold(1e-3, &Scene::new(&[]));
+    let first = arm.hold(1e-3, Touch::Scene(&Scene::new(&[])));
     assert!(first.started);
     let mut last = first;
     for _ in 0..1000 {
-        last = arm.hold(1e-3, &Scene::new(&[]));
+        last = arm.hold(1e-3, Touch::Scene(&Scene::new(&[])));
         assert!(!last.started);
         // Braking from the velocity limit overshoots by about 2 mm, no more.
         assert!(last.drift_m < 5e-3, "{last:?}");
@@ -260,7 +261,7 @@ fn a_hold_keeps_the_joints_where_the_input_went_silent() {
         assert!((q - h).abs() < 1e-5);
     }
     arm.end_hold();
-    assert!(arm.hold(1e-3, &Scene::new(&[])).started);
+    assert!(arm.hold(1e-3, Touch::Scene(&Scene::new(&[]))).started);
 }
 
 #[test]
@@ -311,7 +312,7 @@ fn both_servos_turn_the_hand_to_the_masters_rotation() {
                 s,
             );
             arm.follow(HOME, Some([r.i, r.j, r.k, r.w]), 1e-3);
-            arm.advance(1e-3, &Scene::new(&[]));
+            arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
         }
         let got = arm.tool_rotation();
         let err = (0..4).map(|k| (got[k] - turn[k]).abs()).fold(0.0, f64::max);
@@ -333,12 +334,12 @@ fn the_clutch_holds_the_references_and_reengages_without_a_step() {
     let away = [HOME[0] + 0.02, HOME[1], HOME[2]];
     for _ in 0..500 {
         arm.follow(away, None, 1e-3);
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     let held = arm.state().q_ref;
     for _ in 0..200 {
         arm.release();
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     assert_eq!(arm.state().q_ref, held);
     assert!(arm.released());
@@ -355,7 +356,7 @@ fn the_clutch_holds_the_references_and_reengages_without_a_step() {
     let at_engage = arm.tool();
     for _ in 0..1000 {
         arm.follow([HOME[0], HOME[1] + 0.01, HOME[2]], None, 1e-3);
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     let p = arm.tool();
     assert!(
@@ -378,12 +379,12 @@ fn a_turned_reengage_continues_from_the_held_orientation() {
     };
     for _ in 0..1000 {
         arm.follow(HOME, Some(about(2, 20.0)), 1e-3);
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     let held = arm.target_rotation();
     for _ in 0..100 {
         arm.release();
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     // Engaged with the hand turned elsewhere (30 degrees about x): no step.
     let before = arm.state().q_ref;
@@ -399,7 +400,7 @@ fn a_turned_reengage_continues_from_the_held_orientation() {
     let turned = quaternion(&(rotation_matrix(about(2, 10.0)) * rotation_matrix(about(0, 30.0))));
     for _ in 0..1500 {
         arm.follow(HOME, Some(turned), 1e-3);
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     let want = quaternion(&(rotation_matrix(about(2, 10.0)) * rotation_matrix(held)));
     let got = arm.target_rotation();
@@ -492,7 +493,7 @@ fn a_failed_dynamics_step_is_counted_and_its_cause_kept() {
     let mut arm = UrdfArm::new(&cfg, &xml, HOME).expect("arm");
     arm.state.qd[0] = 1.0;
     for _ in 0..100 {
-        arm.advance(1e-3, &Scene::new(&[]));
+        arm.advance(1e-3, Touch::Scene(&Scene::new(&[])));
     }
     assert!(arm.dynamics_failures() > 0, "no failure counted");
     let e = arm.take_failure().expect("a cause");
@@ -510,7 +511,8 @@ fn failed_dynamics_steps_reach_the_slaves_counters() {
     arm.state.qd[0] = 1.0;
     let mut scenario = tactile_scenario::Scenario::default();
     scenario.slave.arm = Some(cfg);
-    let mut slave = crate::hsd::Slave::new(&scenario, Box::new(arm)).expect("slave");
+    let mut slave =
+        crate::hsd::Slave::new(&scenario, Box::new(arm), analytic(&scenario)).expect("slave");
     assert_eq!(slave.counters().dynamics_failed, 0);
     for _ in 0..100 {
         slave.hold(None);
@@ -542,7 +544,8 @@ fn a_rejected_orientation_is_told_apart_from_a_rejected_position() {
     let arm = UrdfArm::new(&panda_cfg(), &panda_xml(), HOME).expect("arm");
     let mut scenario = tactile_scenario::Scenario::default();
     scenario.slave.arm = Some(panda_cfg());
-    let mut slave = crate::hsd::Slave::new(&scenario, Box::new(arm)).expect("slave");
+    let mut slave =
+        crate::hsd::Slave::new(&scenario, Box::new(arm), analytic(&scenario)).expect("slave");
     let pose = |seq: u64, value: [f64; 3], rotation: [f64; 4]| Forward {
         seq,
         signal: Signal {
@@ -571,4 +574,9 @@ fn a_rejected_orientation_is_told_apart_from_a_rejected_position() {
         "{both:?}"
     );
     assert_eq!(slave.counters().rejected, 2, "one sample, counted once");
+}
+
+/// The scenario's analytic scene as the slave's world.
+fn analytic(scenario: &tactile_scenario::Scenario) -> crate::world::SlaveWorld {
+    crate::world::SlaveWorld::Analytic(Scene::new(&scenario.environment.objects))
 }

@@ -173,6 +173,8 @@ pub struct Analysis {
     pub motion: Motion,
     /// The bilateral loop's metrics.
     pub bilateral: crate::metrics::Bilateral,
+    /// A physics scene's task: the effort it took.
+    pub task: crate::task::TaskFigures,
     /// Rows with an answer.
     pub received: u64,
     /// Rows in all.
@@ -200,6 +202,7 @@ impl Analysis {
             stages: vec![Latency::default(); STAGES.len()],
             motion: Motion::default(),
             bilateral: crate::metrics::Bilateral::default(),
+            task: crate::task::TaskFigures::default(),
             received: 0,
             rows: 0,
             guesses_refused: [0; 2],
@@ -219,6 +222,7 @@ impl Analysis {
             self.guesses_refused[k] += u64::from(flags.intersects(Flags::GUESS_REFUSED));
         }
         self.bilateral.add(row);
+        self.task.add(row);
         let m = &mut self.motion;
         m.force_max_n = m.force_max_n.max(norm(row.h));
         if row.contact_object >= 0 {

@@ -180,7 +180,7 @@ fn arm(xml: &str, chain: &Chain) -> String {
     for k in 0..3 {
         let p = [0, 1, 2].map(|i| MASTER_HOME[i] + 0.002 * f64::from(k + i as i32));
         let f = a.follow(p, Some(turn), 1e-3);
-        a.advance(1e-3, &scene);
+        a.advance(1e-3, tactile_slave::world::Touch::Scene(&scene));
         let s = a.state();
         finite(
             "the arm's state",

@@ -1,0 +1,221 @@
+//! What the slave's arm touches: the paper's analytic springs or a physics world
+//! (`tactile-world`), one sample at a time.
+//!
+//! The two differ in where contact is worked out. The analytic scene is a function of
+//! the tool's position, so the arm's integrator evaluates it at each of its own
+//! integration steps ([`Touch::Scene`]), as the paper's SD does. A physics world is a
+//! state of its own that steps once a sample with the arm's tool frame and answers
+//! with its coupling's wrench; the arm's dynamics take that wrench held over the next
+//! sample ([`Touch::Held`]), as a real arm takes what its force-torque sensor read,
+//! and the slave sends it back as h(n). Either way the contact the slave records and
+//! sends is computed once a sample, in [`crate::hsd::Slave`].
+
+use crate::environment::Scene;
+use std::path::Path;
+use tactile_records::slave::{TaskResult, WorldCounters};
+use tactile_scenario::world::Engine;
+use tactile_scenario::{Change, Scenario};
+use tactile_world::{PhysicsWorld, Pose, Sensed, TaskMonitor, ToolState, World, WorldError};
+
+/// What pushes on the arm's tool while its dynamics integrate one sample.
+#[derive(Debug, Clone, Copy)]
+pub enum Touch<'a> {
+    /// The analytic scene's springs, evaluated at every integration step.
+    Scene(&'a Scene),
+    /// A force on the tool held over the sample, N in the arm's frame: a physics
+    /// world's coupling force of the sample before.
+    Held([f64; 3]),
+}
+
+/// The world of a scenario's `[environment]`.
+#[derive(Debug)]
+pub enum SlaveWorld {
+    /// `engine = "analytic"`: the springs of `[[environment.objects]]`.
+    Analytic(Scene),
+    /// `engine = "physics"`: rigid bodies stepped by rapier.
+    Physics(Box<Physics>),
+}
+
+impl SlaveWorld {
+    /// The scenario's world, its mesh files read against `base_dir`. A physics world
+    /// that cannot be built (a mesh that is no mesh, bodies overlapping at the start)
+    /// is refused naming the field.
+    pub fn of_scenario(scenario: &Scenario, base_dir: &Path) -> Result<SlaveWorld, WorldError> {
+        let env = &scenario.environment;
+        Ok(match env.engine {
+            Engine::Analytic => SlaveWorld::Analytic(Scene::new(&env.objects)),
+            Engine::Physics => {
+                let world = PhysicsWorld::new(env, base_dir, &[], scenario.t_s())?;
+                let task = scenario
+                    .task
+                    .as_ref()
+                    .and_then(|t| TaskMonitor::new(t, &world));
+                SlaveWorld::Physics(Box::new(Physics::new(world, task)))
+            }
+        })
+    }
+
+    /// What the arm's dynamics take this sample.
+    pub fn touch(&self) -> Touch<'_> {
+        match self {
+            SlaveWorld::Analytic(scene) => Touch::Scene(scene),
+            SlaveWorld::Physics(p) => Touch::Held(p.held_force()),
+        }
+    }
+
+    /// An `[[environment.changes]]` entry (the analytic scene's only: a physics
+    /// scenario has none).
+    pub fn apply(&mut self, c: &Change) {
+        if let SlaveWorld::Analytic(scene) = self {
+            scene.apply(c);
+        }
+    }
+
+    /// What the world counted so far (all zero for the analytic scene).
+    pub fn counters(&self) -> WorldCounters {
+        match self {
+            SlaveWorld::Analytic(_) => WorldCounters::default(),
+            SlaveWorld::Physics(p) => p.counters(),
+        }
+    }
+}
+
+/// How long the force to the operator takes to ramp to zero when the world faults,
+/// and back once it has been quiet for [`QUIET_S`], s: the device's force must never
+/// step (chapter 5's mode switches ramp over the same 0.1 s).
+pub const RAMP_S: f64 = 0.1;
+
+/// How long a world must go without a fault before the force ramps back, s.
+pub const QUIET_S: f64 = 0.5;
+
+/// What the physics world answered for one sample, in the arm's frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Felt {
+    /// The coupling's force on the arm's tool, N, scaled by the fault ramp.
+    pub force: [f64; 3],
+    /// Its torque about the tool frame, N m, scaled alike.
+    pub torque: [f64; 3],
+    /// The tool's deepest contact: its point on the body's surface (m) and the body.
+    pub contact: Option<([f64; 3], u32)>,
+}
+
+/// A physics world as the slave steps it: the world, the task's monitor, the wrench
+/// held for the arm's next sample and the fault ramp.
+#[derive(Debug)]
+pub struct Physics {
+    world: PhysicsWorld,
+    task: Option<TaskMonitor>,
+    /// The coupling's wrench of the last sample, unramped: what the arm feels.
+    held: [f64; 6],
+    /// The tool frame's position at the last sample (its velocity is the difference).
+    last: Option<[f64; 3]>,
+    /// The fault ramp's gain on the force sent back, 0 to 1.
+    gain: f64,
+    /// Seconds since the last fault (infinite: none yet).
+    quiet_s: f64,
+    counters: WorldCounters,
+}
+
+impl Physics {
+    fn new(world: PhysicsWorld, task: Option<TaskMonitor>) -> Physics {
+        Physics {
+            world,
+            counters: WorldCounters {
+                physics: true,
+                task: task.as_ref().map(|_| TaskResult::default()),
+                ..WorldCounters::default()
+            },
+            task,
+            held: [0.0; 6],
+            last: None,
+            gain: 1.0,
+            quiet_s: f64::INFINITY,
+        }
+    }
+
+    /// The force the arm's dynamics take over the next sample, N in the arm's frame.
+    pub fn held_force(&self) -> [f64; 3] {
+        [self.held[0], self.held[1], self.held[2]]
+    }
+
+    /// Steps the world one sample of `dt` s with the arm's tool frame at `tool` (in
+    /// the arm's frame, which is the world's). Events are appended to `events` as
+    /// text for the run's record.
+    pub fn step(&mut self, tool: Pose, dt: f64, events: &mut Vec<String>) -> Felt {
+        let velocity = match self.last {
+            Some(p) => [0, 1, 2].map(|k| (tool.position[k] - p[k]) / dt),
+            None => [0.0; 3],
+        };
+        self.last = Some(tool.position);
+        let state = ToolState {
+            pose: tool,
+            velocity,
+            angular_velocity: [0.0; 3],
+        };
+        let time_s = self.world.time_s() + dt;
+        let sensed = self.world.step(&state, &[], dt);
+        events.extend(sensed.events.iter().map(|e| e.to_string()));
+        let fault = sensed.fault;
+        self.held = sensed.wrench;
+        let contact = sensed.contact.map(|c| (c.point, c.body as u32));
+        let progress = self.task.as_mut().map(|t| t.update(sensed, time_s));
+        self.ramp(fault, dt);
+        self.count(progress);
+        let g = self.gain;
+        Felt {
+            force: [0, 1, 2].map(|k| g * self.held[k]),
+            torque: [3, 4, 5].map(|k| g * self.held[k]),
+            contact,
+        }
+    }
+
+    /// The world's state after the last sample.
+    pub fn sensed(&self) -> &Sensed {
+        self.world.sensed()
+    }
+
+    /// The bodies' names, in the order of [`Sensed::poses`].
+    pub fn body_names(&self) -> &[String] {
+        self.world.body_names()
+    }
+
+    /// Down toward zero while the world has faulted within [`QUIET_S`], back up
+    /// after, at 1 / [`RAMP_S`] a second either way.
+    fn ramp(&mut self, fault: bool, dt: f64) {
+        self.quiet_s = if fault { 0.0 } else { self.quiet_s + dt };
+        let rate = dt / RAMP_S;
+        self.gain = if self.quiet_s < QUIET_S {
+            (self.gain - rate).max(0.0)
+        } else {
+            (self.gain + rate).min(1.0)
+        };
+        if self.gain < 1.0 {
+            self.counters.ramped_steps += 1;
+        }
+    }
+
+    fn count(&mut self, progress: Option<tactile_world::TaskProgress>) {
+        let c = self.world.counters();
+        let w = &mut self.counters;
+        w.left_bounds = c.left_bounds;
+        w.energy_gains = c.energy_gains;
+        w.non_finite = c.non_finite;
+        w.bad_inputs = c.bad_inputs;
+        w.engine_failures = c.engine_failures;
+        if let (Some(p), Some(t)) = (progress, w.task.as_mut()) {
+            t.success = p.success;
+            t.completion_s = p.completion_s;
+            t.distance = p.distance;
+            t.closest = if t.steps == 0 {
+                p.distance
+            } else {
+                t.closest.min(p.distance)
+            };
+            t.steps += 1;
+        }
+    }
+
+    fn counters(&self) -> WorldCounters {
+        self.counters
+    }
+}
