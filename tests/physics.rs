@@ -149,3 +149,46 @@ fn a_world_that_cannot_be_built_is_refused_before_anything_starts() {
         sb.assert_refused(10 + k, text, want);
     }
 }
+
+#[test]
+fn every_shipped_task_succeeds_at_zero_delay_and_a_misaligned_peg_does_not() {
+    let sb = Sandbox::new("tasks");
+    for name in ["drawer.toml", "peg-in-hole.toml"] {
+        let out = name.trim_end_matches(".toml");
+        sb.simulate(&shipped(name), out);
+        let task = &sb.json(out, "summary.json")["task"];
+        assert_eq!(task["success"], true, "{name}: {task}");
+    }
+    // The hole 3 mm off the peg's path: the peg lands on the block's top and the
+    // operator's press is held there (the mesh is solid, not a picture).
+    let o = sb.tactile(&[
+        "run",
+        shipped("peg-in-hole.toml").to_str().expect("utf-8"),
+        "--in-process",
+        "-q",
+        "--out",
+        sb.path("off").to_str().expect("utf-8"),
+        "--set",
+        "environment.bodies[0].position=[0.003,-0.11,-0.09]",
+        "--set",
+        "task.mouth=[0.003,-0.11,-0.07]",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let task = &sb.json("off", "summary.json")["task"];
+    assert_eq!(task["success"], false, "{task}");
+    // Its centre 1.5 cm over the mouth: 2.5 cm from going 1 cm in.
+    let d = util::num(&task["closest_distance"]);
+    assert!((d - 0.025).abs() < 5e-4, "closest {d} m");
+    assert!(util::num(&task["peak_force_n"]) > 2.0, "{task}");
+}
+
+#[test]
+fn the_physics_wall_is_felt_as_stiff_as_its_coupling() {
+    let sb = Sandbox::new("pwall");
+    sb.simulate(&shipped("physics-wall.toml"), "run");
+    let s = sb.json("run", "summary.json");
+    assert!(s.get("task").is_none(), "no task, no task figures");
+    let k = util::num(&s["transparency"]["environment_stiffness_n_per_m"]);
+    // The contact is rigid: the 600 N/m coupling is the wall's stiffness.
+    assert!((k - 600.0).abs() < 0.25 * 600.0, "{k} N/m");
+}

@@ -22,6 +22,9 @@ pub fn render(s: &Summary, out: &Path) -> String {
     timing(&mut t, s);
     samples(&mut t, s);
     motion(&mut t, s);
+    if let Some(task) = &s.task {
+        task_line(&mut t, task);
+    }
     counters(&mut t, s);
     if let Some(h) = &s.hardware {
         for line in crate::hardware::lines(h, &s.stages_ns) {
@@ -169,7 +172,9 @@ fn motion(t: &mut String, s: &Summary) {
         tr.felt_samples,
         tr.environment_samples
     );
-    if let (Some(d), Some(e)) = (tr.unfelt_depth_m, tr.unfelt_energy_j) {
+    // A wall's figure: a physics world's surface is wherever the tool met a body.
+    let physics = s.slave.as_ref().is_some_and(|sl| sl.world.physics);
+    if let (Some(d), Some(e), false) = (tr.unfelt_depth_m, tr.unfelt_energy_j, physics) {
         let _ = writeln!(
             t,
             "first news of the contact: the handle {:.2} mm deep, {:.3} mJ of the wall unfelt (what rendering it where it is leaves the channel short)",
@@ -199,6 +204,24 @@ fn motion(t: &mut String, s: &Summary) {
         mm(Some(s.passivity.drift_max_m)),
         s.packets.forward,
         s.packets.backward
+    );
+}
+
+/// A physics scene's task: how it ended and what it took.
+fn task_line(t: &mut String, task: &crate::task::TaskSummary) {
+    let outcome = match (task.success, task.completion_s) {
+        (true, Some(c)) => format!("succeeded at {c:.2} s"),
+        _ => "did not succeed".to_string(),
+    };
+    let _ = writeln!(
+        t,
+        "task: {outcome} (distance to the goal at the end {:.2} mm, closest {:.2} mm); contact force peak {:.3} N, rms {:.3} N; tool path {:.1} mm; the operator's work {:.3} mJ",
+        task.final_distance * 1e3,
+        task.closest_distance * 1e3,
+        task.peak_force_n,
+        task.rms_force_n,
+        task.path_length_m * 1e3,
+        task.operator_energy_j * 1e3
     );
 }
 

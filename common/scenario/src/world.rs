@@ -212,6 +212,9 @@ pub enum JointKind {
     Revolute,
     /// Slides along `axis` (a drawer).
     Prismatic,
+    /// Holds `body2` to `body1` as they are at the start: one rigid body of two
+    /// shapes (a handle on a drawer). No limits, damping or friction.
+    Fixed,
 }
 
 /// One `[[environment.joints]]`: two bodies (or a body and the world) held together

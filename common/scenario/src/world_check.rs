@@ -3,7 +3,7 @@
 //! (`environment.bodies[2].mass`) and says what is wrong with the value.
 
 use crate::shown::Num;
-use crate::world::{BodyConfig, BodyKind, Engine, JointConfig, Shape, ToolConfig};
+use crate::world::{BodyConfig, BodyKind, Engine, JointConfig, JointKind, Shape, ToolConfig};
 use crate::{finite3, invalid, Environment, ScenarioError, TaskConfig, TOOL_BODY};
 
 /// Most bodies and most joints a world holds: a bound on what a scenario can make the
@@ -236,6 +236,19 @@ fn joint(
     }
     position(&j.anchor, &format!("{f}.anchor"))?;
     direction(&j.axis, &format!("{f}.axis"))?;
+    if j.kind == JointKind::Fixed {
+        let moves = [
+            ("limits", j.limits.is_some()),
+            ("damping", j.damping != 0.0),
+            ("friction", j.friction != 0.0),
+        ];
+        if let Some((key, _)) = moves.iter().find(|(_, set)| *set) {
+            return Err(invalid(
+                format!("{f}.{key}"),
+                "a fixed joint does not move: its limits, damping and friction would do nothing",
+            ));
+        }
+    }
     if let Some([lo, hi]) = j.limits {
         for (i, v) in [lo, hi].iter().enumerate() {
             within(*v, &format!("{f}.limits[{i}]"), -1e3, 1e3, true)?;

@@ -260,6 +260,18 @@ fn bad_joints_and_tasks_are_refused_naming_the_field() {
             "damping = -2.0",
             "environment.joints[0].damping",
         ),
+        // A fixed joint moves nothing: its limits (first), damping and friction are
+        // refused.
+        (
+            "kind = \"prismatic\"",
+            "kind = \"fixed\"",
+            "environment.joints[0].limits",
+        ),
+        (
+            "kind = \"prismatic\"\nbody2 = \"drawer\"\nanchor = [-0.2, 0.0, 0.03]\naxis = [1.0, 0.0, 0.0]\nlimits = [0.0, 0.3]",
+            "kind = \"fixed\"\nbody2 = \"drawer\"\nanchor = [-0.2, 0.0, 0.03]\naxis = [1.0, 0.0, 0.0]",
+            "environment.joints[0].damping",
+        ),
         ("body = \"box\"", "body = \"crate\"", "task.body"),
         ("tolerance = 0.01", "tolerance = 0.0", "task.tolerance"),
     ];

@@ -82,6 +82,9 @@ pub(crate) fn build(
         let (locked, free) = match j.kind {
             JointKind::Revolute => (JointAxesMask::LOCKED_REVOLUTE_AXES, JointAxis::AngX),
             JointKind::Prismatic => (JointAxesMask::LOCKED_PRISMATIC_AXES, JointAxis::LinX),
+            // Nothing is free: the scenario's check refuses limits, damping and
+            // friction on it, so no motor or limit is set on this axis.
+            JointKind::Fixed => (JointAxesMask::LOCKED_FIXED_AXES, JointAxis::LinX),
         };
         let mut g = GenericJointBuilder::new(locked)
             .local_frame1(frame1)
@@ -177,6 +180,7 @@ impl JointInfo {
     pub(crate) fn position(&self, bodies: &RigidBodySet) -> f64 {
         let (f1, f2) = self.frames(bodies);
         match self.kind {
+            JointKind::Fixed => 0.0,
             JointKind::Prismatic => {
                 (f2.translation.vector - f1.translation.vector).dot(&(f1.rotation * Vector3::x()))
             }

@@ -4,6 +4,7 @@
 //! world. The readers are pure functions of the bytes ([`parse`]); [`read`] is the one
 //! place that touches the file system.
 
+mod hole;
 mod obj;
 mod stl;
 mod write;

@@ -167,7 +167,7 @@ fn a_prism_is_closed() {
 fn the_shipped_meshes_are_the_writers_and_closed() {
     let dir =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../deploy/scenarios/meshes");
-    let files: [(&str, Vec<u8>); 2] = [
+    let files: [(&str, Vec<u8>); 3] = [
         (
             "block.stl",
             to_stl_binary(&Mesh::cuboid([0.02, 0.02, 0.02])),
@@ -175,6 +175,10 @@ fn the_shipped_meshes_are_the_writers_and_closed() {
         (
             "peg.obj",
             to_obj(&Mesh::prism(16, 0.005, 0.03)).into_bytes(),
+        ),
+        (
+            "hole-block.stl",
+            to_stl_binary(&Mesh::block_with_hole(0.03, 0.02, 32, 0.0055, 0.03)),
         ),
     ];
     for (name, bytes) in &files {
@@ -186,4 +190,39 @@ fn the_shipped_meshes_are_the_writers_and_closed() {
         assert_eq!(&std::fs::read(&p).expect("a shipped mesh"), bytes, "{name}");
         read(&p).expect("reads").check_closed().expect("closed");
     }
+}
+
+/// The block with a hole is closed, faces outward (its signed volume is the box's
+/// less the hole's, which only an outward surface gives), and its hole's walls are
+/// at the inscribed radius asked for.
+#[test]
+fn a_block_with_a_hole_is_closed_and_holds_the_volume_it_should() {
+    let (h, n, r, d) = ([0.03, 0.03, 0.015], 32u32, 0.0055, 0.02);
+    let m = Mesh::block_with_hole(h[0], h[2], n, r, d);
+    m.check_closed().expect("closed");
+    let v = &m.vertices;
+    let volume: f64 = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| v[i as usize]);
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum();
+    let angle = std::f64::consts::PI / f64::from(n);
+    // A regular n-gon of inscribed radius r has area n r^2 tan(pi / n).
+    let hole = f64::from(n) * r * r * angle.tan() * d;
+    let want = 8.0 * h[0] * h[1] * h[2] - hole;
+    assert!((volume - want).abs() < 1e-12, "{volume} m^3, want {want}");
+    // Every wall's midpoint at the top is r from the axis.
+    let top: Vec<&[f64; 3]> = v
+        .iter()
+        .filter(|p| p[2] == h[2] && (p[0].hypot(p[1]) - r / angle.cos()).abs() < 1e-12)
+        .collect();
+    assert_eq!(top.len(), n as usize);
+    let (a, b) = (top[0], top[1]);
+    let mid = ((a[0] + b[0]) / 2.0).hypot((a[1] + b[1]) / 2.0);
+    assert!((mid - r).abs() < 1e-12, "{mid}");
 }

@@ -212,3 +212,60 @@ fn the_same_scene_stepped_twice_is_bit_identical() {
     assert!(a.iter().any(|b| *b != 0));
     assert_eq!(a, run());
 }
+
+/// A fixed joint makes two bodies one: a second mass held to the damped slider
+/// above falls with it at (m1 + m2) g / b.
+#[test]
+fn a_fixed_joint_carries_its_body_with_the_other() {
+    let (m1, m2, b) = (1.0, 0.5, 20.0);
+    let text = format!(
+        r#"
+[environment]
+engine = "physics"
+
+[[environment.bodies]]
+name = "slider"
+kind = "dynamic"
+shape = {{ type = "box", half_extents = [0.02, 0.02, 0.02] }}
+mass = {m1}
+
+[[environment.bodies]]
+name = "weight"
+kind = "dynamic"
+shape = {{ type = "sphere", radius = 0.02 }}
+position = [0.05, 0.0, 0.0]
+mass = {m2}
+
+[[environment.joints]]
+name = "rail"
+kind = "prismatic"
+body2 = "slider"
+axis = [0.0, 0.0, -1.0]
+damping = {b}
+
+[[environment.joints]]
+name = "glue"
+kind = "fixed"
+body1 = "slider"
+body2 = "weight"
+anchor = [0.05, 0.0, 0.0]
+axis = [1.0, 0.0, 0.0]
+"#
+    );
+    let mut w = world(&text);
+    let s1 = hold(&mut w, AWAY, 500);
+    let s2 = hold(&mut w, AWAY, 100);
+    let v = (s2.joint_positions[0] - s1.joint_positions[0]) / (100.0 * DT);
+    let want = (m1 + m2) * G / b;
+    assert!(
+        (v - want).abs() < 0.01 * want,
+        "{v} m/s, (m1 + m2) g / b {want} m/s"
+    );
+    // The weight kept its place beside the slider.
+    let gap = [0, 1, 2].map(|k| s2.poses[1].position[k] - s2.poses[0].position[k]);
+    assert!(
+        (gap[0] - 0.05).abs() < 1e-4 && gap[2].abs() < 1e-4,
+        "{gap:?}"
+    );
+    assert_eq!(s2.joint_positions[1], 0.0);
+}
