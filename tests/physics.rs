@@ -90,8 +90,8 @@ fn a_body_that_leaves_the_world_is_named_and_the_force_ramps_down() {
             "engine = \"physics\"\nbounds = { min = [-1.0, -1.0, -0.5], max = [1.0, 1.0, 1.0] }",
         )
         .replace(
-            "position = [0.0, -0.11, -0.06]",
-            "position = [0.5, -0.11, -0.06]",
+            "position = [0.0, -0.11, -0.07]",
+            "position = [0.5, -0.11, -0.07]",
         );
     let scenario = sb.write("leaves.toml", &text);
     sb.simulate(&scenario, "run");
@@ -134,8 +134,8 @@ fn a_world_that_cannot_be_built_is_refused_before_anything_starts() {
         ),
         (
             base.replace(
-                "position = [0.0, -0.11, -0.06]",
-                "position = [0.0, -0.11, -0.085]",
+                "position = [0.0, -0.11, -0.07]",
+                "position = [0.0, -0.11, -0.095]",
             ),
             "overlap",
         ),
@@ -153,7 +153,7 @@ fn a_world_that_cannot_be_built_is_refused_before_anything_starts() {
 #[test]
 fn every_shipped_task_succeeds_at_zero_delay_and_a_misaligned_peg_does_not() {
     let sb = Sandbox::new("tasks");
-    for name in ["drawer.toml", "peg-in-hole.toml"] {
+    for name in ["drawer.toml", "peg-in-hole.toml", "panda-push-box.toml"] {
         let out = name.trim_end_matches(".toml");
         sb.simulate(&shipped(name), out);
         let task = &sb.json(out, "summary.json")["task"];

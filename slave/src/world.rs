@@ -157,6 +157,8 @@ impl Physics {
         events.extend(sensed.events.iter().map(|e| e.to_string()));
         let fault = sensed.fault;
         self.held = sensed.wrench;
+        // A contact the solver sees: touching, or within its prediction distance
+        // (a resting contact may sit a hair apart under soft contacts).
         let contact = sensed.contact.map(|c| (c.point, c.body as u32));
         let progress = self.task.as_mut().map(|t| t.update(sensed, time_s));
         self.ramp(fault, dt);
