@@ -13,7 +13,7 @@ use tactile_scenario::overrides::{split_values, Set};
 /// `sweep-summary.csv`, `failed_mean` is the share of the seeds' runs that failed).
 /// The transparency metrics and MMT's come after it: they were added later, and
 /// coming last they leave the earlier columns of a table as they were.
-pub const METRICS: [(&str, &str); 33] = [
+pub const METRICS: [(&str, &str); 39] = [
     ("samples_sent", "/samples_sent"),
     ("samples_lost", "/samples_lost"),
     ("deadline_misses", "/deadline_misses"),
@@ -56,7 +56,31 @@ pub const METRICS: [(&str, &str); 33] = [
     ("felt_step_max_n", "/contact/felt_step_max_n"),
     ("unfelt_depth_m", "/transparency/unfelt_depth_m"),
     ("unfelt_energy_j", "/transparency/unfelt_energy_j"),
+    // A physics scene's task (docs/16): columns of their own only in a sweep with a
+    // task ([`columns`]), so every other table is as it was.
+    ("task_success", "/task/success"),
+    ("task_completion_s", "/task/completion_s"),
+    ("task_peak_force_n", "/task/peak_force_n"),
+    ("task_rms_force_n", "/task/rms_force_n"),
+    ("task_path_length_m", "/task/path_length_m"),
+    ("task_operator_energy_j", "/task/operator_energy_j"),
 ];
+
+/// Where the task's metrics start in [`METRICS`].
+pub const TASK_METRICS: usize = 33;
+
+/// How many of [`METRICS`] the tables write: the task's only where some run of the
+/// sweep had one (its `values` hold them).
+pub fn columns<'a>(runs: impl IntoIterator<Item = &'a [Option<f64>]>) -> usize {
+    let task = runs
+        .into_iter()
+        .any(|v| v.iter().skip(TASK_METRICS).any(Option::is_some));
+    if task {
+        METRICS.len()
+    } else {
+        TASK_METRICS
+    }
+}
 
 /// The metric that says whether a run failed, not how it ran: never plotted.
 pub const FAILED: &str = "failed";
@@ -167,17 +191,17 @@ fn keyed(axes: &[Axis]) -> impl Iterator<Item = (usize, &Axis)> {
 
 /// The header of `sweep.csv`, one row per run with the same columns whatever
 /// `--seeds`: the run's folder, its combination's index, each swept key, the seed the
-/// run used, every metric.
-pub fn runs_header(axes: &[Axis]) -> String {
+/// run used, the first `n` metrics ([`columns`]).
+pub fn runs_header(axes: &[Axis], n: usize) -> String {
     let mut cols: Vec<String> = vec!["run".into(), "combination".into()];
     cols.extend(keyed(axes).map(|(_, a)| csv_field(&a.key)));
     cols.push("seed".into());
-    cols.extend(METRICS.iter().map(|(n, _)| n.to_string()));
+    cols.extend(METRICS.iter().take(n).map(|(n, _)| n.to_string()));
     cols.join(",") + "\n"
 }
 
 /// One run's line of `sweep.csv`: its folder's name, combination `k`, the seed it ran
-/// with and its metrics.
+/// with and its metrics (as many as `values` holds: cut to the header's).
 pub fn runs_row(
     run: &str,
     k: usize,
@@ -194,15 +218,15 @@ pub fn runs_row(
 }
 
 /// The header of `sweep-summary.csv`, one row per combination with the same columns
-/// whatever `--seeds`: per metric its mean and the half width of its 95 % confidence
-/// interval, and how many runs were averaged.
-pub fn summary_header(axes: &[Axis]) -> String {
+/// whatever `--seeds`: per metric (the first `n`, [`columns`]) its mean and the half
+/// width of its 95 % confidence interval, and how many runs were averaged.
+pub fn summary_header(axes: &[Axis], n: usize) -> String {
     let mut cols: Vec<String> = vec!["combination".into()];
     cols.extend(axes.iter().map(|a| csv_field(&a.key)));
     cols.push("seeds".into());
-    for (n, _) in METRICS {
-        cols.push(format!("{n}_mean"));
-        cols.push(format!("{n}_ci95"));
+    for (name, _) in METRICS.iter().take(n) {
+        cols.push(format!("{name}_mean"));
+        cols.push(format!("{name}_ci95"));
     }
     cols.join(",") + "\n"
 }
@@ -394,6 +418,22 @@ mod tests {
         ] {
             assert_eq!(labelled(key), want);
         }
+    }
+
+    /// The task's columns are written only for a sweep where a run had a task: every
+    /// other sweep's tables keep their columns.
+    #[test]
+    fn the_tasks_columns_come_with_a_task_only() {
+        let wall = values(&serde_json::json!({"samples_sent": 5}));
+        let task = values(&serde_json::json!({"task": {"success": true, "completion_s": 4.5}}));
+        assert_eq!(wall.len(), METRICS.len());
+        assert_eq!(columns([wall.as_slice()]), TASK_METRICS);
+        assert_eq!(columns([wall.as_slice(), task.as_slice()]), METRICS.len());
+        assert_eq!(METRICS[TASK_METRICS].0, "task_success");
+        assert_eq!(task[TASK_METRICS], Some(1.0));
+        assert_eq!(task[TASK_METRICS + 1], Some(4.5));
+        let header = runs_header(&[], TASK_METRICS);
+        assert!(header.trim_end().ends_with("unfelt_energy_j"), "{header}");
     }
 
     #[test]

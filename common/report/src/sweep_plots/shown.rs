@@ -68,6 +68,12 @@ pub fn shown(name: &str) -> Option<Shown> {
         "felt_step_max_n" => ("largest felt force step", N),
         "unfelt_depth_m" => ("depth unfelt at the first news of contact", MM),
         "unfelt_energy_j" => ("wall energy unfelt at the first news of contact", MJ),
+        "task_success" => ("share of runs whose task succeeded", ONE),
+        "task_completion_s" => ("task completion time", ("s", 1.0)),
+        "task_peak_force_n" => ("peak contact force in the task", N),
+        "task_rms_force_n" => ("RMS contact force in the task", N),
+        "task_path_length_m" => ("tool path length", MM),
+        "task_operator_energy_j" => ("operator's work", MJ),
         _ => return None,
     };
     Some(Shown { label, unit, scale })
@@ -103,6 +109,7 @@ mod tests {
                 ("round_trip_p50_ns", "ms"),
                 ("round_trip_p99_ns", "ms"),
                 ("_ns", "us"),
+                ("_s", "s"),
             ]
             .iter()
             .find(|(suffix, _)| name.ends_with(suffix))

@@ -7,7 +7,7 @@ use crate::error::Error;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use tactile_report::sweep::{
-    combinations, runs_header, runs_row, stats, summary_header, summary_row, values, Axis,
+    columns, combinations, runs_header, runs_row, stats, summary_header, summary_row, values, Axis,
 };
 use tactile_report::sweep_grid::same_grid;
 use tactile_report::sweep_map::sweep_maps;
@@ -84,21 +84,23 @@ pub fn write_tables(out: &Path, axes: &[Axis], seeds: usize, results: &[Ran]) ->
         by.entry(r.k).or_default().insert(r.s, r);
     }
     let mut points: Vec<Point> = Vec::new();
-    let mut runs = runs_header(axes);
-    let mut summary = summary_header(axes);
+    let n = columns(results.iter().map(|r| r.values.as_slice()));
+    let mut runs = runs_header(axes, n);
+    let mut summary = summary_header(axes, n);
     for (&k, per_seed) in &by {
         let combo = &combos[k];
         for r in per_seed.values() {
             let dir = run_dir(Path::new(""), k, r.s, seeds);
             let name = dir.display().to_string();
-            runs += &runs_row(&name, k, axes, combo, r.seed, &r.values);
+            let cut = n.min(r.values.len());
+            runs += &runs_row(&name, k, axes, combo, r.seed, &r.values[..cut]);
         }
         if per_seed.len() < seeds {
             continue;
         }
         let values: Vec<Vec<Option<f64>>> = per_seed.values().map(|r| r.values.clone()).collect();
         let stats = stats(&values);
-        summary += &summary_row(k, axes, combo, values.len(), &stats);
+        summary += &summary_row(k, axes, combo, values.len(), &stats[..n.min(stats.len())]);
         points.push((combo.clone(), stats));
     }
     write(&out.join("sweep.csv"), &runs)?;
