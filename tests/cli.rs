@@ -310,6 +310,7 @@ fn a_short_fuzz_campaign_finds_no_panic() {
         "urdf",
         "map",
         "trajectory6",
+        "meshes",
     ] {
         let line = text
             .lines()

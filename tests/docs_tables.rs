@@ -161,3 +161,60 @@ fn the_guides_tables_are_the_committed_studies() {
     ];
     assert!(compared.iter().all(|n| *n >= 12), "{compared:?}");
 }
+
+/// docs/16's cell for one round trip and control: the runs that succeeded of the
+/// seeds', the mean completion time of those, the mean peak contact force.
+fn task_cell(runs: &[&BTreeMap<String, String>]) -> String {
+    let num = |r: &BTreeMap<String, String>, c: &str| r[c].parse::<f64>().ok();
+    let done: Vec<f64> = runs
+        .iter()
+        .filter(|r| num(r, "task_success") == Some(1.0))
+        .filter_map(|r| num(r, "task_completion_s"))
+        .collect();
+    let peak: f64 = runs
+        .iter()
+        .filter_map(|r| num(r, "task_peak_force_n"))
+        .sum::<f64>()
+        / runs.len() as f64;
+    let mut cell = format!("{}/{}", done.len(), runs.len());
+    if !done.is_empty() {
+        cell += &format!(", {:.2} s", done.iter().sum::<f64>() / done.len() as f64);
+    }
+    cell + &format!(", {peak:.2} N")
+}
+
+/// docs/16's task tables (one per scene, after `NAME:`) against its committed study.
+fn check_task(doc: &str, scene: &str) -> usize {
+    let rows = sweep(&format!("{scene}-study"));
+    let from = doc
+        .find(&format!("\n{scene}:\n"))
+        .unwrap_or_else(|| panic!("no {scene} table"));
+    let (header, docs_rows) = table(&doc[from..], "| round trip | none |");
+    let mut compared = 0;
+    for cells in &docs_rows {
+        let ms: u64 = cells[0].trim_end_matches(" ms").parse().expect("ms");
+        let delay = format!("[{0},{0},{0}]", ms / 2);
+        for (kind, cell) in header.iter().zip(cells).skip(1) {
+            let runs: Vec<&BTreeMap<String, String>> = rows
+                .iter()
+                .filter(|r| r["network.forward.delay"] == delay && r["control.kind"] == *kind)
+                .collect();
+            assert_eq!(runs.len(), 3, "{scene} {ms} ms {kind}");
+            assert_eq!(task_cell(&runs), *cell, "{scene} {ms} ms {kind}");
+            compared += 1;
+        }
+    }
+    compared
+}
+
+#[test]
+fn the_task_studys_tables_are_the_committed_studies() {
+    let doc = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../docs/16-physics-world.md"
+    ))
+    .expect("docs/16");
+    for scene in ["push-box", "peg-in-hole"] {
+        assert_eq!(check_task(&doc, scene), 20, "{scene}");
+    }
+}

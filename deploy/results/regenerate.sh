@@ -53,3 +53,12 @@ study mmt-map "$wall" \
   --set network.forward.delay_ms=0,10,50,100,200 --set control.kind=none,tdpa,wave,mmt \
   --set 'network.backward.delay=[0,0,0]'
 study wall-change deploy/scenarios/wall-change.toml --set control.kind=none,tdpa,wave,mmt
+# The task scenes (docs/16): round trips of 0 to 200 ms split evenly both ways, 2 ms
+# of jitter each way, three seeds.
+trips='[0,0,0],[25,25,25],[50,50,50],[75,75,75],[100,100,100]'
+for scene in push-box peg-in-hole; do
+  study "$scene-study" deploy/scenarios/$scene.toml \
+    --set "network.forward.delay=$trips" --set "+network.backward.delay=$trips" \
+    --set control.kind=none,tdpa,wave,mmt --set 'network.forward.jitter={jitter_ms=2.0}' \
+    --set 'network.backward.jitter={jitter_ms=2.0}' --seeds 3
+done

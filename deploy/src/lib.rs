@@ -45,4 +45,6 @@ pub mod guide {
     pub mod six_dof_master {}
     #[doc = include_str!("../../docs/15-python.md")]
     pub mod python {}
+    #[doc = include_str!("../../docs/16-physics-world.md")]
+    pub mod physics_world {}
 }

@@ -129,6 +129,12 @@ fn all_targets(scratch: &Path) -> Result<Vec<targets::Target>, String> {
         arm::urdf(),
         arm::map()?,
         trajectory6::trajectory6(),
+        targets::Target {
+            name: tactile_world::fuzz::NAME,
+            seeds: tactile_world::fuzz::seeds(),
+            dict: tactile_world::fuzz::DICT,
+            run: Box::new(tactile_world::fuzz::run),
+        },
     ])
 }
 
