@@ -202,20 +202,17 @@ impl Follower for SlaveHandler {
         if let Some(hw) = &mut self.robot {
             hw.due = Some(self.slave.arm().reference());
         }
+        let torque = out.backward.as_ref().map_or([0.0; 3], |h| h.torque);
+        let joints = self.slave.arm().joints(torque, self.slave.rotation());
+        // The live view's three angles are the paper arm's (a URDF arm shows its own).
         self.last_view = Some(SlaveView {
-            theta: step.theta,
+            theta: joints.q.to_array3(),
             velocity: None,
-            torque: step.torque,
+            torque: joints.tau.to_array3(),
             tool: step.tool,
             force: step.force,
         });
-        let torque = out.backward.as_ref().map_or([0.0; 3], |h| h.torque);
-        out.record = Some(
-            match self.slave.arm().joints(torque, self.slave.rotation()) {
-                Some(joints) => SlaveSample::ArmStep(step, joints),
-                None => SlaveSample::Step(step),
-            },
-        );
+        out.record = Some(SlaveSample::Step(step, joints));
         Ok(())
     }
 
@@ -260,11 +257,7 @@ impl Follower for SlaveHandler {
         for e in self.slave.take_events() {
             io.event(last, &e)?;
         }
-        Ok(Some(
-            match self.slave.arm().joints([0.0; 3], self.slave.rotation()) {
-                Some(joints) => SlaveSample::ArmHold(held, joints),
-                None => SlaveSample::Hold(held),
-            },
-        ))
+        let joints = self.slave.arm().joints([0.0; 3], self.slave.rotation());
+        Ok(Some(SlaveSample::Hold(held, joints)))
     }
 }

@@ -180,7 +180,7 @@ impl Slave {
         let (mut flags, observer, dissipated_j) = self.follow(v);
         let measured = self.measured.take();
         let joints = measured.as_ref().map(|m| &m.joints);
-        let moved = self
+        let clamps = self
             .arm
             .advance(joints, self.world.touch(), self.t_s, &mut self.counters);
         let felt = self.step_world();
@@ -201,16 +201,13 @@ impl Slave {
             n: v.seq,
             received: v.signal,
             reference: self.control.position(),
-            theta_ref: moved.theta_ref,
-            theta: moved.theta,
-            torque: moved.torque,
             tool,
             surface,
             force,
             observer,
             port_net_j: self.control.ledger().net(),
             dissipated_j,
-            clamps: moved.clamps,
+            clamps,
             contact_object,
             flags,
             model,

@@ -4,7 +4,7 @@
 
 use crate::arm::{Controller, Dynamics};
 use crate::environment::deepest_contact;
-use crate::slave_arm::{Moved, SlaveArm};
+use crate::slave_arm::SlaveArm;
 use crate::world::Touch;
 use tactile_math::arith::StdTrig;
 use tactile_math::engine::Engine;
@@ -28,6 +28,9 @@ pub struct PaperArm {
     reference: [f64; 3],
     /// Where the arm is: the simulated joints, or the robot's as last measured.
     theta: [f64; 3],
+    /// FCS's torques of the last period (zero for a real robot's, whose own
+    /// controller applies them).
+    torque: [f64; 3],
     /// The reference held since the input went silent, if it is.
     hold_from: Option<[f64; 3]>,
 }
@@ -48,6 +51,7 @@ impl PaperArm {
             dynamics: Dynamics::new(scenario.slave.dynamics.clone(), [0.0; 3]),
             reference: [0.0; 3],
             theta: [0.0; 3],
+            torque: [0.0; 3],
             hold_from: None,
         })
     }
@@ -120,23 +124,16 @@ impl SlaveArm for PaperArm {
         touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
-    ) -> Moved {
+    ) -> u32 {
         if let Some(q) = measured {
             self.theta = q.to_array3();
-            return Moved {
-                theta_ref: self.reference,
-                theta: self.theta,
-                ..Moved::default()
-            };
+            self.torque = [0.0; 3];
+            return 0;
         }
         let (torque, clamps) = self.servo(self.reference, touch, dt);
+        self.torque = torque;
         c.torque_clamps += u64::from(clamps);
-        Moved {
-            theta_ref: self.reference,
-            theta: self.theta,
-            torque,
-            clamps,
-        }
+        clamps
     }
 
     /// Simulated, the joints are held where they were; a real robot is commanded the
@@ -157,7 +154,7 @@ impl SlaveArm for PaperArm {
             now
         });
         c.held_steps += 1;
-        let torque = match measured {
+        self.torque = match measured {
             Some(q) => {
                 self.theta = q.to_array3();
                 [0.0; 3]
@@ -174,9 +171,6 @@ impl SlaveArm for PaperArm {
         c.hold_drift_max_m = c.hold_drift_max_m.max(distance(p, p0));
         HoldStep {
             step: c.held_steps,
-            theta_ref: from,
-            theta: self.theta,
-            torque,
             tool: p,
         }
     }
@@ -213,8 +207,16 @@ impl SlaveArm for PaperArm {
         }
     }
 
-    fn joints(&self, _: [f64; 3], _: Option<[f64; 4]>) -> Option<ArmJoints> {
-        None
+    /// The three angles, their reference (IK-HSD's, or the one held) and FCS's
+    /// torques; the paper's arm has no orientation, clutch or sensor torque.
+    fn joints(&self, torque: [f64; 3], _: Option<[f64; 4]>) -> ArmJoints {
+        ArmJoints {
+            q_ref: Joints::from(self.reference),
+            q: Joints::from(self.theta),
+            tau: Joints::from(self.torque),
+            torque,
+            ..ArmJoints::default()
+        }
     }
 
     fn live(&self, view: SlaveView) -> SampleView {

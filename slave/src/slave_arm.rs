@@ -11,21 +11,6 @@ use tactile_messages::samples::Flags;
 use tactile_records::slave::{ArmJoints, HoldStep, SlaveCounters};
 use tactile_ros::view::{SampleView, SlaveView};
 
-/// What one period's motion gave the step's record: the paper's three angles, their
-/// reference, their torques (zero for an arm whose joints are in their own record entry) and the
-/// torque clamps.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Moved {
-    /// The joints' reference theta_ref, rad (the paper's arm's).
-    pub theta_ref: [f64; 3],
-    /// Joint angles theta^SD, rad (the paper's arm's).
-    pub theta: [f64; 3],
-    /// The joint controller's torques, N m (the paper's arm's).
-    pub torque: [f64; 3],
-    /// Joint efforts clamped to their limits this period.
-    pub clamps: u32,
-}
-
 /// The slave's arm. Positions and forces are in the master's frame, as the loop
 /// carries them; each arm maps them into its own.
 pub trait SlaveArm: std::fmt::Debug + Send {
@@ -43,14 +28,15 @@ pub trait SlaveArm: std::fmt::Debug + Send {
 
     /// One period of `dt` s: a real robot's `measured` joints are the arm's (its own controller
     /// follows the reference); without, the simulated joints move under the servo,
-    /// pushed back by what the tool `touch`es.
+    /// pushed back by what the tool `touch`es. Returns the joint efforts clamped to
+    /// their limits this period.
     fn advance(
         &mut self,
         measured: Option<&Joints>,
         touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
-    ) -> Moved;
+    ) -> u32;
 
     /// One period with no input: simulated, the arm holds where it was when the input
     /// went silent; a real robot (`measured`) is commanded the reference it had then.
@@ -107,10 +93,10 @@ pub trait SlaveArm: std::fmt::Debug + Send {
     /// `c` with what the arm counts itself (the hardware's clocks, failed dynamics).
     fn counters(&self, c: SlaveCounters) -> SlaveCounters;
 
-    /// The record's entry of an arm with joints of its own (`None`: the paper's, whose
-    /// angles are the step's): `torque` is h(n)'s, `master` the orientation followed.
-    /// Inline, as every sample makes one.
-    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> Option<ArmJoints>;
+    /// The arm's state for the record after a step, whichever arm (the paper's: its
+    /// three angles, their reference and FCS's torques): `torque` is h(n)'s, `master`
+    /// the orientation followed. Inline, as every sample makes one.
+    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> ArmJoints;
 
     /// The live view's sample of the step `view`.
     fn live(&self, view: SlaveView) -> SampleView;

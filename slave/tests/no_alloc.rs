@@ -116,17 +116,14 @@ fn step(slave: &mut Slave, n: u64) -> f64 {
     let torque = h.as_ref().map_or([0.0; 3], |h| h.torque);
     let joints = slave.arm().joints(torque, slave.rotation());
     let view = slave.arm().live(SlaveView {
-        theta: step.theta,
+        theta: joints.q.to_array3(),
         velocity: None,
-        torque: step.torque,
+        torque: joints.tau.to_array3(),
         tool: step.tool,
         force: step.force,
     });
     let tool = step.tool[2];
-    let record = match joints {
-        Some(j) => SlaveSample::ArmStep(step, j),
-        None => SlaveSample::Step(step),
-    };
+    let record = SlaveSample::Step(step, joints);
     black_box((&record, &view));
     tool + view.arm.map_or(f64::NAN, |a| a.q[0])
 }
@@ -135,10 +132,7 @@ fn step(slave: &mut Slave, n: u64) -> f64 {
 fn hold(slave: &mut Slave) -> f64 {
     let held = slave.hold(None);
     let joints = slave.arm().joints([0.0; 3], slave.rotation());
-    let record = match joints {
-        Some(j) => SlaveSample::ArmHold(held, j),
-        None => SlaveSample::Hold(held),
-    };
+    let record = SlaveSample::Hold(held, joints);
     black_box(&record);
     held.tool[2]
 }

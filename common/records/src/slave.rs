@@ -59,12 +59,6 @@ pub struct Step {
     /// The control's Cartesian reference (the received position itself without
     /// control), m.
     pub reference: [f64; 3],
-    /// IK-HSD reference angles, rad.
-    pub theta_ref: [f64; 3],
-    /// Joint angles after the step, rad.
-    pub theta: [f64; 3],
-    /// Controller torques after clamping, N m.
-    pub torque: [f64; 3],
     /// FK-HSD tool position l(n), m.
     pub tool: [f64; 3],
     /// Nearest surface point s^OBJ(n), m (zero without contact).
@@ -93,27 +87,23 @@ pub struct Step {
 pub struct HoldStep {
     /// Held steps so far in the run.
     pub step: u64,
-    /// Angles held, rad.
-    pub theta_ref: [f64; 3],
-    /// Joint angles after the step, rad.
-    pub theta: [f64; 3],
-    /// Controller torques, N m.
-    pub torque: [f64; 3],
     /// Tool position (true device), m.
     pub tool: [f64; 3],
 }
 
-/// A URDF arm's joints after a step (`[slave.arm]`), in the chain's order; the
-/// step's three-angle fields are the paper arm's and stay zero. Inline (its joints are
-/// [`Joints`], at most [`tactile_math::joints::MAX_JOINTS`], which the arm's loader
-/// refuses beyond): making one allocates nothing.
+/// The arm after a step, whichever arm it is: its joints in their order (the paper's
+/// arm's three angles theta, their reference theta_ref from IK-HSD and FCS's torques
+/// u; a URDF arm's chain), and for a URDF arm its tool's targets and clutch. One arm
+/// state for every arm: the step's record has no paper-only fields. Inline (its joints
+/// are [`Joints`], at most [`tactile_math::joints::MAX_JOINTS`], which the arm's
+/// loader refuses beyond): making one allocates nothing.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct ArmJoints {
-    /// The IK's joint references, rad or m.
+    /// The IK's joint references, rad or m (the paper's arm: theta_ref).
     pub q_ref: Joints,
-    /// Joint values, rad or m.
+    /// Joint values, rad or m (the paper's arm: theta^SD).
     pub q: Joints,
-    /// Efforts the servo applied, N m or N.
+    /// Efforts the servo applied, N m or N (the paper's arm: FCS's torques u).
     pub tau: Joints,
     /// h(n)'s torque about the tool in the base's axes (a real arm's sensor's; zero
     /// for the simulated point contact), N m.
@@ -147,31 +137,32 @@ pub struct ArmJoints {
     pub released: bool,
 }
 
-/// One entry per step the slave took. A sample lives for one write or one read, and
-/// is made on every step: nothing in it is boxed, so making one allocates nothing
-/// (issue 66: a URDF arm's joints were boxed, an allocation a sample). A sample is
-/// then 1,056 bytes wherever it is moved, the paper arm's too (424 with the box), a
-/// copy well under a microsecond; its encoding is the same (a box encodes as what it
-/// holds), so records are byte for byte what they were.
+/// One entry per step the slave took, with the arm's state after it. A sample lives
+/// for one write or one read, and is made on every step: nothing in it is boxed, so
+/// making one allocates nothing (a hold is as large as a step: the arm's state is
+/// most of either, and a copy of a kilobyte is well under a microsecond).
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum SlaveSample {
     /// A step on v(n).
-    Step(Step),
+    Step(Step, ArmJoints),
     /// A step holding position.
-    Hold(HoldStep),
-    /// A step on v(n) of a URDF arm, with its joints.
-    ArmStep(Step, ArmJoints),
-    /// A step holding position of a URDF arm, with its joints.
-    ArmHold(HoldStep, ArmJoints),
+    Hold(HoldStep, ArmJoints),
 }
 
 impl SlaveSample {
-    /// The step on v(n), if this is one (of any arm).
+    /// The step on v(n), if this is one.
     pub fn step(&self) -> Option<&Step> {
         match self {
-            SlaveSample::Step(s) | SlaveSample::ArmStep(s, _) => Some(s),
-            SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
+            SlaveSample::Step(s, _) => Some(s),
+            SlaveSample::Hold(..) => None,
+        }
+    }
+
+    /// The arm after the step, whichever it was.
+    pub fn joints(&self) -> &ArmJoints {
+        match self {
+            SlaveSample::Step(_, j) | SlaveSample::Hold(_, j) => j,
         }
     }
 }
@@ -238,30 +229,14 @@ mod tests {
     use super::*;
     use tactile_math::joints::Joints;
 
-    /// The sample as it was before issue 66, its joints boxed.
-    #[allow(clippy::large_enum_variant)]
-    #[derive(Serialize)]
-    enum Boxed {
-        #[allow(dead_code)]
-        Step(Step),
-        #[allow(dead_code)]
-        Hold(HoldStep),
-        ArmStep(Step, Box<ArmJoints>),
-        ArmHold(HoldStep, Box<ArmJoints>),
-    }
-
-    /// Issue 66: a URDF arm's joints inline encode as the boxed ones did, in both of
-    /// the records' integer encodings: the records' bytes are unchanged.
+    /// The paper's arm's three angles are an arm state like any other: its joints of
+    /// length 3 round-trip through the record's encodings.
     #[test]
-    fn inline_joints_encode_as_the_boxed_ones_did() {
-        let q = Joints::from_slice(&[0.5, -1.25, 2.0, 0.0, -0.0, 1e-300, 3.5]).expect("7");
+    fn a_paper_arms_joints_round_trip_as_any_arms() {
         let j = ArmJoints {
-            q_ref: q,
-            q,
-            tau: Joints::from_slice(&[9.0; 16]).expect("16"),
-            torque: [1.0, 2.0, 3.0],
-            target_rotation: [0.0, 0.0, 0.6, 0.8],
-            released: true,
+            q_ref: Joints::from([0.1, -0.2, 0.3]),
+            q: Joints::from([0.5, -1.25, 2.0]),
+            tau: Joints::from([1e-300, -0.0, 0.45]),
             ..ArmJoints::default()
         };
         let step = Step {
@@ -269,29 +244,22 @@ mod tests {
             clamps: 3,
             ..Step::default()
         };
-        let hold = HoldStep {
-            step: 7,
-            ..HoldStep::default()
-        };
-        let fixed = bincode::config::standard().with_fixed_int_encoding();
-        let varint = bincode::config::standard();
-        let pairs = [
-            (
-                SlaveSample::ArmStep(step, j),
-                Boxed::ArmStep(step, Box::new(j)),
+        for sample in [
+            SlaveSample::Step(step, j),
+            SlaveSample::Hold(
+                HoldStep {
+                    step: 7,
+                    tool: [0.1; 3],
+                },
+                j,
             ),
-            (
-                SlaveSample::ArmHold(hold, j),
-                Boxed::ArmHold(hold, Box::new(j)),
-            ),
-        ];
-        for (inline, boxed) in &pairs {
-            let a = bincode::serde::encode_to_vec(inline, fixed).expect("encode");
-            let b = bincode::serde::encode_to_vec(boxed, fixed).expect("encode");
-            assert_eq!(a, b);
-            let a = bincode::serde::encode_to_vec(inline, varint).expect("encode");
-            let b = bincode::serde::encode_to_vec(boxed, varint).expect("encode");
-            assert_eq!(a, b);
+        ] {
+            let config = bincode::config::standard();
+            let bytes = bincode::serde::encode_to_vec(&sample, config).expect("encode");
+            let (back, _): (SlaveSample, usize) =
+                bincode::serde::decode_from_slice(&bytes, config).expect("decode");
+            assert_eq!(back, sample);
+            assert_eq!(back.joints().q.len(), 3);
         }
     }
 }

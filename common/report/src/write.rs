@@ -477,7 +477,8 @@ fn report_into(
     let warning = streams.warning.clone();
     let stopped = || launch.stopped();
     let mut task = crate::task_space::TaskSpaceSums::of(scenario);
-    let logs = join::join_until(dirs, &stopped, |row, joints, rotation| {
+    let arm = join::Arm::of(scenario);
+    let logs = join::join_until(dirs, &stopped, arm, |row, joints, rotation| {
         // The clutch's offset, from the arm's base frame into the master's.
         if let (Some(arm), Some(j)) = (&scenario.slave.arm, joints) {
             let shift = arm.shift_to_master(j.offset);
@@ -545,7 +546,8 @@ pub fn write_mcap(
         run_mcap::create(out, &scenario, compression).map_err(Error::io("writing run.mcap"))?;
 
     let mut samples = 0;
-    let logs = join::join_until(dirs, stop, |row, joints, rotation| {
+    let arm = join::Arm::of(&scenario);
+    let logs = join::join_until(dirs, stop, arm, |row, joints, rotation| {
         samples += 1;
         rec.add(row, joints, rotation)
             .map_err(Error::io("writing run.mcap"))?;

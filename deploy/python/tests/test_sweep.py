@@ -300,3 +300,21 @@ def test_a_run_without_its_trace_says_how_to_get_it(tmp_path):
     mem = tactile.run(sc, trace_format=None)
     with pytest.warns(tactile.NoTraceWarning, match="trace_format='parquet'"):
         assert mem.trace is None
+
+
+def test_a_task_scene_runs_and_sweeps_with_its_task(tmp_path):
+    """A physics scene's task (docs/16) from Python: the run's summary says it
+    succeeded and when; a sweep's table has the task's columns, the command's."""
+    sc = tactile.Scenario.shipped("push-box")
+    r = tactile.run(sc, trace_format=None)
+    assert r.summary["task"]["success"] is True
+    assert 4.0 < r.summary["task"]["completion_s"] < 6.0
+    df = tactile.sweep(sc, {"control.kind": ["none", "wave"]}, out=tmp_path / "s",
+                       progress=False)
+    assert list(df["task_success"]) == [1, 1]
+    assert (df["task_completion_s"] > 4.0).all()
+    assert (df["task_peak_force_n"] > 0.5).all()
+    # A sweep without a task has no task columns, as the command's.
+    wall = tactile.sweep(tactile.Scenario.load(WALL), {"control.kind": ["none"]},
+                         out=tmp_path / "w", progress=False)
+    assert not [c for c in wall.columns if c.startswith("task_")]

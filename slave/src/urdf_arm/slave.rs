@@ -3,7 +3,7 @@
 //! periods are counted and said once.
 
 use super::UrdfArm;
-use crate::slave_arm::{Moved, SlaveArm};
+use crate::slave_arm::SlaveArm;
 use crate::world::Touch;
 use std::sync::Arc;
 use tactile_math::joints::Joints;
@@ -34,19 +34,15 @@ impl SlaveArm for UrdfArm {
         touch: Touch<'_>,
         dt: f64,
         c: &mut SlaveCounters,
-    ) -> Moved {
-        // The arm's joints are in its own record entry: not three angles.
+    ) -> u32 {
         if let Some(q) = measured {
             self.set_measured(q, dt);
-            return Moved::default();
+            return 0;
         }
         let clamps = UrdfArm::advance(self, dt, touch);
         c.torque_clamps += u64::from(clamps);
         log_first_failure(self);
-        Moved {
-            clamps,
-            ..Moved::default()
-        }
+        clamps
     }
 
     fn hold(
@@ -68,11 +64,9 @@ impl SlaveArm for UrdfArm {
         c.held_steps += 1;
         c.torque_clamps += u64::from(h.clamps);
         c.hold_drift_max_m = c.hold_drift_max_m.max(h.drift_m);
-        // The arm's joints are in its own record entry: not three angles.
         HoldStep {
             step: c.held_steps,
             tool: h.tool,
-            ..HoldStep::default()
         }
     }
 
@@ -118,10 +112,10 @@ impl SlaveArm for UrdfArm {
         }
     }
 
-    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> Option<ArmJoints> {
+    fn joints(&self, torque: [f64; 3], master: Option<[f64; 4]>) -> ArmJoints {
         let a = self.state();
         let (offset, offset_rotation) = self.offsets();
-        Some(ArmJoints {
+        ArmJoints {
             q_ref: a.q_ref,
             q: a.q,
             tau: a.tau,
@@ -134,7 +128,7 @@ impl SlaveArm for UrdfArm {
             master_rotation: master.unwrap_or([0.0, 0.0, 0.0, 1.0]),
             offset,
             offset_rotation,
-        })
+        }
     }
 
     fn live(&self, view: SlaveView) -> SampleView {

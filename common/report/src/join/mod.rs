@@ -241,9 +241,9 @@ fn fill_passages(r: &mut TraceRow, passages: &[Passage]) {
 fn fill_step(r: &mut TraceRow, s: &Step) {
     (r.stepped, r.flags_s) = (true, s.flags);
     (r.v, r.delay_f, r.flags_f) = (s.received.value, s.received.delay_samples, s.received.flags);
-    (r.theta_ref, r.reference) = (s.theta_ref, s.reference);
+    r.reference = s.reference;
     (r.observer_s, r.port_net_s, r.dissipated_s) = (s.observer, s.port_net_j, s.dissipated_j);
-    (r.theta_sd, r.u, r.tool, r.surface, r.h) = (s.theta, s.torque, s.tool, s.surface, s.force);
+    (r.tool, r.surface, r.h) = (s.tool, s.surface, s.force);
     let m = &s.model;
     (r.model_seq, r.model_normal, r.model_offset, r.model_k) =
         (m.seq, m.normal, m.offset, m.stiffness);
@@ -252,6 +252,12 @@ fn fill_step(r: &mut TraceRow, s: &Step) {
     } else {
         i64::from(s.contact_object)
     };
+}
+
+/// The paper arm's columns of a sample: its three angles, their reference and FCS's
+/// torques (a URDF arm's joints go to joints.csv, and these stay zero).
+fn fill_paper_arm(r: &mut TraceRow, j: &ArmJoints) {
+    (r.theta_ref, r.theta_sd, r.u) = (j.q_ref.to_array3(), j.q.to_array3(), j.tau.to_array3());
 }
 
 /// Builds sample n's row from what each node recorded for it.
@@ -349,16 +355,15 @@ fn sample_count(
     Ok((limit, disagree))
 }
 
-/// The slave's step of a sample, with a URDF arm's joints; further steps of the same
+/// The slave's step of a sample, with the arm's joints; further steps of the same
 /// sample are counted in `duplicates`.
 fn step_of<'a>(
     steps: &'a [SlaveSample],
     duplicates: &mut u64,
 ) -> (Option<Step>, Option<&'a ArmJoints>) {
     let mut all = steps.iter().filter_map(|x| match x {
-        SlaveSample::Step(s) => Some((Some(*s), None)),
-        SlaveSample::ArmStep(s, j) => Some((Some(*s), Some(j))),
-        SlaveSample::Hold(_) | SlaveSample::ArmHold(..) => None,
+        SlaveSample::Step(s, j) => Some((Some(*s), Some(j))),
+        SlaveSample::Hold(..) => None,
     });
     let first = all.next().unwrap_or((None, None));
     *duplicates += all.count() as u64;
@@ -368,14 +373,36 @@ fn step_of<'a>(
 /// Samples joined between two looks at the stop request.
 const STOP_EVERY: u64 = 1024;
 
+/// Which arm the slave's joints are: the paper's (in the trace's three-angle columns)
+/// or a URDF arm's (handed over for joints.csv and the task space).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Arm {
+    /// No `[slave.arm]`: the paper's three joints.
+    Paper,
+    /// `[slave.arm]`: a chain from its URDF.
+    Urdf,
+}
+
+impl Arm {
+    /// The scenario's arm.
+    pub fn of(scenario: &tactile_scenario::Scenario) -> Arm {
+        match scenario.slave.arm {
+            Some(_) => Arm::Urdf,
+            None => Arm::Paper,
+        }
+    }
+}
+
 /// Joins the records found in `dirs`, handing each sample's row to `each` in order,
-/// with a URDF arm's joints where the slave is one and a 6-DoF master's orientation.
-/// `each` may stop the join early: the logs then hold what was read so far.
+/// with a URDF arm's joints where the slave is one (`arm`) and a 6-DoF master's
+/// orientation. `each` may stop the join early: the logs then hold what was read so
+/// far.
 pub fn join(
     dirs: &[PathBuf],
+    arm: Arm,
     each: impl FnMut(&TraceRow, Option<&ArmJoints>, Option<[f64; 4]>) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
-    join_until(dirs, &|| false, each)
+    join_until(dirs, &|| false, arm, each)
 }
 
 /// [`join`], looking at `stop` (a stop request) as it reads, however long a record
@@ -384,6 +411,7 @@ pub fn join(
 pub fn join_until(
     dirs: &[PathBuf],
     stop: &dyn Fn() -> bool,
+    arm: Arm,
     mut each: impl FnMut(
         &TraceRow,
         Option<&ArmJoints>,
@@ -416,7 +444,15 @@ pub fn join_until(
         }
         let (step, joints) = step_of(&steps, &mut src.slave.log.duplicates);
         let rotation = part.sent.rotation;
-        if each(&row(&part, &passages, step.as_ref()), joints, rotation)?.is_break() {
+        let mut r = row(&part, &passages, step.as_ref());
+        let joints = match (arm, joints) {
+            (Arm::Paper, Some(j)) => {
+                fill_paper_arm(&mut r, j);
+                None
+            }
+            (_, j) => j,
+        };
+        if each(&r, joints, rotation)?.is_break() {
             return src.logs(n, false, stop);
         }
         n += 1;
