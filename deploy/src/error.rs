@@ -3,6 +3,14 @@
 use tactile_runtime::exit::{EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED};
 use thiserror::Error;
 
+/// What makes a scenario one that cannot run, each fault kept whole.
+#[derive(Debug, Error)]
+pub enum InputError {
+    /// The `--set`s cannot be applied to its text.
+    #[error(transparent)]
+    Set(#[from] tactile_scenario::overrides::SetError),
+}
+
 /// Everything the launcher can fail with.
 #[derive(Debug, Error)]
 pub enum Error {
@@ -16,6 +24,20 @@ pub enum Error {
         context: String,
         /// The operating system's reason.
         source: std::io::Error,
+    },
+    /// A malformed `--set KEY=VALUE`, or sets that cannot be applied.
+    #[error(transparent)]
+    Set(#[from] tactile_scenario::overrides::SetError),
+    /// A malformed sweep axis `--set KEY=V1,V2,...`.
+    #[error(transparent)]
+    Axis(#[from] tactile_report::sweep::AxisError),
+    /// The scenario named cannot run: its sets, its values, or a file it names.
+    #[error("{name}: {source}")]
+    Input {
+        /// The scenario's name (its file, or the caller's name for its text).
+        name: String,
+        /// Why not.
+        source: InputError,
     },
     /// A failure while running.
     #[error("{0}")]
@@ -35,9 +57,11 @@ impl Error {
     /// The process exit status for this error.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::BadInput(_) | Error::Report(tactile_report::Error::BadInput(_)) => {
-                EXIT_BAD_INPUT
-            }
+            Error::BadInput(_)
+            | Error::Set(_)
+            | Error::Axis(_)
+            | Error::Input { .. }
+            | Error::Report(tactile_report::Error::BadInput(_)) => EXIT_BAD_INPUT,
             Error::Interrupted
             | Error::Stopped(_)
             | Error::Report(tactile_report::Error::Stopped(_)) => EXIT_INTERRUPTED,

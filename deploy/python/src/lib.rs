@@ -121,7 +121,7 @@ fn check_sets(
     use tactile_scenario::ScenarioError as Bad;
     let src = source(text, base_dir, name, path);
     let parsed = parse_sets(&sets)
-        .and_then(|s| tactile_scenario::overrides::apply(&src.text, &s).map_err(Error::BadInput));
+        .and_then(|s| tactile_scenario::overrides::apply(&src.text, &s).map_err(Error::from));
     let typed = match parsed {
         Ok(text) => !matches!(
             tactile_scenario::Scenario::from_toml_str(&text),

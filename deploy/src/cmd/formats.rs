@@ -1,6 +1,7 @@
 //! The output format options `tactile run`, `report` and `sweep` share.
 
 use clap::Args;
+use tactile_report::error::UnknownChoice;
 use tactile_report::mcap::Compression;
 use tactile_report::write::TraceFormat;
 
@@ -18,11 +19,11 @@ pub struct FormatArgs {
     pub mcap_compression: Compression,
 }
 
-fn parse_trace(s: &str) -> Result<TraceFormat, String> {
+fn parse_trace(s: &str) -> Result<TraceFormat, UnknownChoice> {
     s.parse()
 }
 
-fn parse_mcap(s: &str) -> Result<Compression, String> {
+fn parse_mcap(s: &str) -> Result<Compression, UnknownChoice> {
     s.parse()
 }
 

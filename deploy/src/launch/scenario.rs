@@ -2,7 +2,7 @@
 //! inputs (trajectory, recorded networks), and the output folder made ready for it.
 //! Everything here can refuse a run, so it all happens before any process starts.
 
-use crate::error::Error;
+use crate::error::{Error, InputError};
 use std::path::{Path, PathBuf};
 use tactile_master::operator::OperatorSource;
 use tactile_messages::Role;
@@ -83,8 +83,12 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
         &source.name,
         source.path.as_deref(),
     );
-    let text = tactile_scenario::overrides::apply(&source.text, sets)
-        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    let input = |source: InputError| Error::Input {
+        name: name.clone(),
+        source,
+    };
+    let text =
+        tactile_scenario::overrides::apply(&source.text, sets).map_err(|e| input(e.into()))?;
     let with = if sets.is_empty() {
         String::new()
     } else {
@@ -158,7 +162,7 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
 /// The `--set KEY=VALUE` arguments, parsed (bad input when one is malformed).
 pub fn parse_sets(args: &[String]) -> Result<Vec<Set>, Error> {
     args.iter()
-        .map(|a| Set::parse(a).map_err(Error::BadInput))
+        .map(|a| Set::parse(a).map_err(Error::from))
         .collect()
 }
 

@@ -321,7 +321,7 @@ pub fn sweep(
 pub fn parse_axes(sets: &[String]) -> Result<Vec<Axis>, Error> {
     let axes = sets
         .iter()
-        .map(|a| axis(a).map_err(Error::BadInput))
+        .map(|a| axis(a).map_err(Error::from))
         .collect::<Result<Vec<_>, _>>()?;
     for (k, a) in axes.iter().enumerate() {
         if axes[..k].iter().any(|b| b.key == a.key) {
@@ -447,7 +447,7 @@ fn sets_of(
     let mut sets: Vec<Set> = base.iter().filter(|b| !swept(b)).cloned().collect();
     sets.extend(axes.iter().zip(combo).map(|(a, &i)| a.sets[i].clone()));
     if let Some(s) = seed {
-        sets.push(Set::parse(&format!("seed={s}")).map_err(Error::BadInput)?);
+        sets.push(Set::parse(&format!("seed={s}"))?);
     }
     Ok(sets)
 }

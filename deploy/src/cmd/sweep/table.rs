@@ -104,11 +104,14 @@ pub fn write_tables(out: &Path, axes: &[Axis], seeds: usize, results: &[Ran]) ->
     write(&out.join("sweep.csv"), &runs)?;
     write(&out.join("sweep-summary.csv"), &summary)?;
     let (axes, points) = unpaired(axes, &points);
-    sweep_plots(out, &axes, &points)
-        .map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))?;
+    let plot = |what: &str| {
+        let what = what.to_string();
+        move |source| Error::Report(tactile_report::Error::Plot { what, source })
+    };
+    sweep_plots(out, &axes, &points).map_err(plot("plotting the sweep"))?;
     sweep_maps(out, &axes, &points)
         .map(|_| ())
-        .map_err(|e| Error::Failed(format!("drawing the sweep's maps: {e}")))
+        .map_err(plot("drawing the sweep's maps"))
 }
 
 /// The axes a plot or a map draws, and the points on them: a paired key moves with
