@@ -9,6 +9,15 @@ pub enum InputError {
     /// The `--set`s cannot be applied to its text.
     #[error(transparent)]
     Set(#[from] tactile_scenario::overrides::SetError),
+    /// A file it names cannot be read, or is not there.
+    #[error(transparent)]
+    File(#[from] tactile_runtime::files::FileError),
+    /// A recorded network it replays cannot be used.
+    #[error(transparent)]
+    Replay(#[from] tactile_network_emulator::replay::LoadError),
+    /// The device's gimbal cannot be used.
+    #[error(transparent)]
+    Gimbal(#[from] tactile_master::peripherals::GimbalError),
 }
 
 /// Everything the launcher can fail with.
@@ -28,6 +37,15 @@ pub enum Error {
     /// A malformed `--set KEY=VALUE`, or sets that cannot be applied.
     #[error(transparent)]
     Set(#[from] tactile_scenario::overrides::SetError),
+    /// A file named cannot be read (a scenario, a device file).
+    #[error(transparent)]
+    File(#[from] tactile_runtime::files::FileError),
+    /// The run's prefix is malformed or held by another process.
+    #[error(transparent)]
+    Lock(#[from] tactile_runtime::lock::LockError),
+    /// A recorded network the scenario replays cannot be used.
+    #[error(transparent)]
+    Replay(#[from] tactile_network_emulator::replay::LoadError),
     /// A malformed sweep axis `--set KEY=V1,V2,...`.
     #[error(transparent)]
     Axis(#[from] tactile_report::sweep::AxisError),
@@ -36,8 +54,8 @@ pub enum Error {
     Input {
         /// The scenario's name (its file, or the caller's name for its text).
         name: String,
-        /// Why not.
-        source: InputError,
+        /// Why not (boxed: the launcher's error stays small).
+        source: Box<InputError>,
     },
     /// A failure while running.
     #[error("{0}")]
@@ -59,6 +77,9 @@ impl Error {
         match self {
             Error::BadInput(_)
             | Error::Set(_)
+            | Error::File(_)
+            | Error::Lock(_)
+            | Error::Replay(_)
             | Error::Axis(_)
             | Error::Input { .. }
             | Error::Report(tactile_report::Error::BadInput(_)) => EXIT_BAD_INPUT,

@@ -238,7 +238,7 @@ fn waiting<T: Send>(py: Python<'_>, work: impl FnOnce() -> Result<T, Error> + Se
 #[pyfunction]
 fn read_scenario(path: PathBuf) -> PyResult<(String, PathBuf, String)> {
     let text = files::read_text(&path, "scenario", files::MAX_SCENARIO_BYTES)
-        .map_err(|e| to_py(Error::BadInput(e)))?;
+        .map_err(|e| to_py(e.into()))?;
     Ok((text, files::base_dir(&path), path.display().to_string()))
 }
 
@@ -416,7 +416,9 @@ fn outputs(trace_format: Option<&str>) -> PyResult<Outputs> {
     };
     let trace_format = format
         .parse()
-        .map_err(|e: String| ScenarioError::new_err(format!("trace_format: {e}")))?;
+        .map_err(|e: tactile_report::error::UnknownChoice| {
+            ScenarioError::new_err(format!("trace_format: {e}"))
+        })?;
     Ok(Outputs {
         trace_format,
         ..Outputs::default()

@@ -508,14 +508,13 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     // Every check that can refuse the run comes before anything starts or is written:
     // a prefix held by any process (a launcher, a node started by hand), the output
     // folder, the node programs.
-    tactile_runtime::lock::in_use(&sup.prefix).map_err(Error::BadInput)?;
+    tactile_runtime::lock::in_use(&sup.prefix)?;
     let holder = format!(
         "tactile run (pid {}, writing to {})",
         std::process::id(),
         out.display()
     );
-    let _lock =
-        tactile_runtime::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
+    let _lock = tactile_runtime::lock::take(&sup.prefix, "run", &holder)?;
     let dir = nodes::node_dir()?;
     let (bundled, _held) = prepare_out(out, loaded)?;
     // The nodes run the scenario as written here, reading the copies of its inputs

@@ -157,8 +157,7 @@ fn ping(link: &mut Link, rate: f64, n: u64) -> Result<(Latency, u64), Error> {
 pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
     let prefix = format!("{}h", sup.prefix);
     // Held while the hop runs, so no cleaner takes its shared memory for a dead run's.
-    let _lock = tactile_runtime::lock::take(&prefix, "run", "tactile bench's bare hop")
-        .map_err(Error::BadInput)?;
+    let _lock = tactile_runtime::lock::take(&prefix, "run", "tactile bench's bare hop")?;
     let mut child = spawn_echo(&prefix, rate, sup)?;
     let saved_affinity = rustix::thread::sched_getaffinity(None).ok();
     let result = (|| -> Result<(Latency, u64), Error> {
