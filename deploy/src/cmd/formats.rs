@@ -42,9 +42,13 @@ impl FormatArgs {
     /// Refuses a format option that would change nothing (`writes`: the command writes
     /// the trace and the recording), so a study does not find out at its end that its
     /// Parquet traces were never written.
-    pub fn refuse_unless(&self, writes: bool, why: &str) -> Result<(), crate::error::Error> {
+    pub fn refuse_unless(
+        &self,
+        writes: bool,
+        why: &str,
+    ) -> Result<(), tactile_launch::error::Error> {
         match self.given() {
-            Some(flag) if !writes => Err(crate::error::Error::BadInput(format!(
+            Some(flag) if !writes => Err(tactile_launch::error::Error::BadInput(format!(
                 "{flag} {why}: no trace and no recording are written"
             ))),
             _ => Ok(()),
@@ -52,8 +56,8 @@ impl FormatArgs {
     }
 
     /// The launcher's outputs for these options.
-    pub fn outputs(&self, no_trace: bool) -> crate::launch::Outputs {
-        crate::launch::Outputs {
+    pub fn outputs(&self, no_trace: bool) -> tactile_launch::Outputs {
+        tactile_launch::Outputs {
             no_trace,
             trace_format: self.trace_format,
             mcap_compression: self.mcap_compression,

@@ -1,10 +1,10 @@
 //! The bare iceoryx2 hop: a ping-pong between the bench and an echo process (two
 //! hops, no computing), the floor any loop over iceoryx2 stands on.
 
-use crate::error::Error;
-use crate::launch::Supervision;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+use tactile_launch::error::Error;
+use tactile_launch::Supervision;
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{Control, Forward};
 use tactile_report::analysis::Latency;

@@ -2,9 +2,9 @@
 //! folder, progress with an estimate of the time left, and `--resume` keeping the
 //! runs that already ended.
 
-use super::{run_dir, sets_of, Base, SweepArgs};
+use super::{run_dir, sets_of, Base, SweepOptions};
 use crate::error::Error;
-use crate::launch::{self, load_source, parse_sets, Loaded};
+use crate::{load_source, parse_sets, Loaded};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -47,7 +47,7 @@ pub fn plan(
     axes: &[Axis],
     combos: &[Vec<usize>],
     mine: &[usize],
-    args: &SweepArgs,
+    args: &SweepOptions,
 ) -> Result<Vec<Work>, Error> {
     let base_sets = parse_sets(&base.sets)?;
     let first = load_source(&base.source, &base_sets)?.scenario.seed;
@@ -149,10 +149,10 @@ pub fn failed(dir: &Path) -> bool {
 /// summary the report of the folder's own record, never another scenario's or
 /// another run's summary left in the folder; with `--trace`, one that wrote the
 /// trace files asked for.
-fn kept(w: &Work, args: &SweepArgs) -> Option<Vec<Option<f64>>> {
+fn kept(w: &Work, args: &SweepOptions) -> Option<Vec<Option<f64>>> {
     // With --trace, a run kept has the trace files asked for (else it runs again).
     if args.trace {
-        let f = args.formats.trace_format;
+        let f = args.trace_format;
         let csv = f != TraceFormat::Parquet;
         let parquet = f != TraceFormat::Csv;
         let has = |name: &str| w.dir.join(name).is_file();
@@ -180,7 +180,7 @@ fn kept(w: &Work, args: &SweepArgs) -> Option<Vec<Option<f64>>> {
 pub fn run_all(
     work: &[Work],
     jobs: usize,
-    args: &SweepArgs,
+    args: &SweepOptions,
     progress: &(dyn Fn(&Progress) + Sync),
 ) -> Result<Vec<Option<Vec<Option<f64>>>>, Error> {
     let stop =
@@ -292,18 +292,18 @@ fn stopped(w: &Work) {
 
 /// One run and its report; its metrics as its `summary.json` holds them, or `None` if
 /// a stop request cut it short.
-fn run_one(w: &Work, args: &SweepArgs) -> Result<Option<Vec<Option<f64>>>, Error> {
+fn run_one(w: &Work, args: &SweepOptions) -> Result<Option<Vec<Option<f64>>>, Error> {
     let l = &w.loaded;
-    let outputs = launch::Outputs {
+    let outputs = crate::Outputs {
         trace_columns: w.columns.clone(),
-        ..args.formats.outputs(!args.trace)
+        ..args.outputs()
     };
     let summary = if args.processes {
-        launch::clean_stale_runs();
-        let sup = launch::sweep_supervision(outputs);
-        launch::run_processes(l, &w.dir, &sup)?
+        crate::clean_stale_runs();
+        let sup = crate::sweep_supervision(outputs);
+        crate::run_processes(l, &w.dir, &sup)?
     } else {
-        launch::sim::run_in_process(l, &w.dir, &outputs, Default::default())?
+        crate::sim::run_in_process(l, &w.dir, &outputs, Default::default())?
     };
     if summary.interrupted {
         return Ok(None);

@@ -97,3 +97,37 @@ impl Error {
         move |source| Error::Io { context, source }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// A scenario's bad input keeps its cause under the scenario's name, and is exit 2.
+    #[test]
+    fn an_input_error_keeps_its_cause() {
+        let set = tactile_scenario::overrides::Set::parse("rate_hz.x=1").expect("a set");
+        let cause = tactile_scenario::overrides::apply("rate_hz = 1.0\n", &[set])
+            .expect_err("rate_hz is no table");
+        let e = Error::Input {
+            name: "s.toml".into(),
+            source: Box::new(cause.into()),
+        };
+        assert_eq!(e.exit_code(), EXIT_BAD_INPUT);
+        assert!(
+            e.to_string().starts_with("s.toml: --set rate_hz.x=1: "),
+            "{e}"
+        );
+        let input = e.source().expect("the input's error");
+        assert!(
+            input.to_string().starts_with("--set rate_hz.x=1: "),
+            "{input}"
+        );
+        // InputError::Set is transparent: the set's own cause is next.
+        let problem = input.source().expect("the set's problem");
+        assert!(
+            problem.is::<tactile_scenario::overrides::Problem>(),
+            "{problem:?}"
+        );
+    }
+}
