@@ -245,10 +245,19 @@ impl Block {
     }
 }
 
-/// A name that is no block's.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{0:?} is not a block (sincos, atan2, acos, add, sub, mul, div, sqrt, fk, kff, fbf, ik)")]
+/// A name that is no block's. (Display and Error by hand: the build script compiles
+/// this file too, without the crate's dependencies.)
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct UnknownBlock(pub String);
+
+impl std::fmt::Display for UnknownBlock {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let names: Vec<&str> = Block::ALL.iter().map(|b| b.name()).collect();
+        write!(f, "{:?} is not a block ({})", self.0, names.join(", "))
+    }
+}
+
+impl std::error::Error for UnknownBlock {}
 
 impl std::str::FromStr for Block {
     type Err = UnknownBlock;

@@ -10,6 +10,7 @@ pub mod links;
 pub mod netns;
 pub mod nodes;
 pub mod pki;
+mod proc;
 pub mod recordable;
 pub mod say;
 pub mod scenario;

@@ -119,20 +119,40 @@ pub fn finished(dir: &Path) -> Option<Vec<Option<f64>>> {
     whole.then(|| values(&json))
 }
 
+/// Why a run's folder holds no whole run (`--merge` names the folder before it).
+#[derive(Debug, thiserror::Error)]
+pub enum RunFolderError {
+    /// Its `scenario.toml` cannot be read.
+    #[error("its scenario.toml cannot be read ({0})")]
+    ScenarioUnread(#[source] std::io::Error),
+    /// Its `scenario.toml` is not a scenario.
+    #[error("its scenario.toml is unreadable ({0})")]
+    ScenarioBad(#[source] tactile_scenario::ScenarioError),
+    /// Its `summary.json` cannot be read.
+    #[error("its summary.json cannot be read ({0})")]
+    SummaryUnread(#[source] std::io::Error),
+    /// Its `summary.json` is not JSON.
+    #[error("its summary.json is unreadable ({0})")]
+    SummaryBad(#[source] serde_json::Error),
+    /// The run was cut short.
+    #[error("it was stopped before it ended (its summary.json says interrupted)")]
+    Interrupted,
+}
+
 /// The seed the run in `dir` used, from its `scenario.toml`, or why it cannot be read.
-pub fn seed_of(dir: &Path) -> Result<u64, String> {
+pub fn seed_of(dir: &Path) -> Result<u64, RunFolderError> {
     let text = std::fs::read_to_string(dir.join("scenario.toml"))
-        .map_err(|e| format!("its scenario.toml cannot be read ({e})"))?;
+        .map_err(RunFolderError::ScenarioUnread)?;
     tactile_scenario::Scenario::from_recorded_toml(&text)
         .map(|s| s.seed)
-        .map_err(|e| format!("its scenario.toml is unreadable ({e})"))
+        .map_err(RunFolderError::ScenarioBad)
 }
 
 /// The run's `summary.json` in `dir`, or why it cannot be read.
-pub fn read_summary(dir: &Path) -> Result<serde_json::Value, String> {
-    let text = std::fs::read_to_string(dir.join("summary.json"))
-        .map_err(|e| format!("its summary.json cannot be read ({e})"))?;
-    serde_json::from_str(&text).map_err(|e| format!("its summary.json is unreadable ({e})"))
+pub fn read_summary(dir: &Path) -> Result<serde_json::Value, RunFolderError> {
+    let text =
+        std::fs::read_to_string(dir.join("summary.json")).map_err(RunFolderError::SummaryUnread)?;
+    serde_json::from_str(&text).map_err(RunFolderError::SummaryBad)
 }
 
 fn summary(dir: &Path) -> Option<serde_json::Value> {
@@ -314,4 +334,27 @@ fn run_one(w: &Work, args: &SweepOptions) -> Result<Option<Vec<Option<f64>>>, Er
             w.dir.display()
         ))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// A run folder with a garbled summary says which file and keeps the parser's
+    /// reason; one with no scenario keeps the system's.
+    #[test]
+    fn a_run_folders_error_keeps_its_cause() {
+        let dir = tempfile::tempdir().expect("tmp");
+        std::fs::write(dir.path().join("summary.json"), "{ nope").expect("write");
+        let e = read_summary(dir.path()).expect_err("not JSON");
+        assert!(
+            e.to_string()
+                .starts_with("its summary.json is unreadable ("),
+            "{e}"
+        );
+        assert!(e.source().is_some_and(|c| c.is::<serde_json::Error>()));
+        let e = seed_of(dir.path()).expect_err("no scenario.toml");
+        assert!(e.source().is_some_and(|c| c.is::<std::io::Error>()));
+    }
 }

@@ -2,6 +2,7 @@
 //! same from the folders of a sharded sweep. `sweep.json` records what the sweep is,
 //! so slices of different sweeps are never joined.
 
+use super::exec::RunFolderError;
 use super::{parse_axes, run_dir, Spec};
 use crate::error::Error;
 use std::collections::BTreeMap;
@@ -192,10 +193,10 @@ fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
 
 /// The seed and metrics of the whole run in `dir`, read back from its folder, or why
 /// there are none.
-fn ran(dir: &Path) -> Result<(u64, Vec<Option<f64>>), String> {
+fn ran(dir: &Path) -> Result<(u64, Vec<Option<f64>>), RunFolderError> {
     let summary = super::exec::read_summary(dir)?;
     if summary["interrupted"] != false {
-        return Err("it was stopped before it ended (its summary.json says interrupted)".into());
+        return Err(RunFolderError::Interrupted);
     }
     Ok((super::exec::seed_of(dir)?, values(&summary)))
 }
