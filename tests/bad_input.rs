@@ -7,7 +7,7 @@ use crate::util;
 
 use std::path::Path;
 use std::process::Output;
-use tactile::launch::PAPER_SCENARIO;
+use tactile_launch::PAPER_SCENARIO;
 use util::Sandbox;
 
 /// A minimal valid scenario: top-level keys only, so more keys or tables can follow.

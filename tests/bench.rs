@@ -107,7 +107,7 @@ fn bench_reports_both_transports_the_floor_and_the_throughput() {
 #[test]
 fn lockstep_over_udp_equals_the_in_process_simulation() {
     let sb = Sandbox::new("udplock");
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace(
             "noise_std = [0.0, 0.0, 0.0]\n\n[network.backward]",

@@ -416,7 +416,7 @@ fn tdpa_is_stable_at_every_delay_against_the_omni_stiffness() {
 #[test]
 fn the_impedance_hand_tracks_like_the_ideal_hand() {
     let sb = Sandbox::new("hand");
-    let text = tactile::launch::PAPER_SCENARIO;
+    let text = tactile_launch::PAPER_SCENARIO;
     let ideal = run(&sb, text, "ideal", &[]);
     let hand = run(&sb, text, "hand", &["master.hand.mode=impedance"]);
     assert_eq!(ideal["hand"], "position");

@@ -164,7 +164,7 @@ fn deadband_with_tdpa_sends_far_fewer_packets_and_stays_passive() {
 #[test]
 fn predictors_fill_the_gaps_better_than_holding_on_a_moving_target() {
     let sb = Sandbox::new("predictors");
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("rate_hz = 100.0", "rate_hz = 1000.0")
         .replace("samples = 1200", "samples = 6000")
         .replace("mode = \"realtime\"", "mode = \"lockstep\"");
@@ -269,7 +269,7 @@ fn a_replayed_trace_reproduces_its_delays_and_losses() {
 /// The paper at 100 Hz (lockstep) with a network given in samples, and the same given
 /// in milliseconds (`delay_ms`, `schedule_ms`, `jitter_ms`).
 fn paper_network(forward: &str, jitter: &str, backward: &str) -> String {
-    tactile::launch::PAPER_SCENARIO
+    tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replacen("delay = [0, 0, 0]", forward, 1)
         .replacen("delay = [0, 0, 0]", backward, 1)

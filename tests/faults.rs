@@ -268,7 +268,7 @@ fn a_full_subscriber_buffer_loses_exactly_the_overwritten_samples() {
 #[test]
 fn corrupted_samples_never_reach_a_torque() {
     let sb = Sandbox::new("corrupt");
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace("[network.forward]\n", "[network.forward]\ncorrupt = 0.05\n")
         .replace(
@@ -340,7 +340,7 @@ fn forces_and_torques_are_clamped_to_the_device_limits() {
     let sb = Sandbox::new("clamp");
     // A stiff wall (above the Omni's nominal 700 N/m: loads with a warning) that the
     // tool is driven deep into.
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace(
             "stiffness = [300.0, 300.0, 300.0]",

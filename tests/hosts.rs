@@ -17,14 +17,14 @@ use util::{column, finish_ok, free_port, node_dir, Sandbox};
 
 /// Two hosts: network namespaces made for the test, removed on drop.
 struct Hosts {
-    pair: tactile::launch::netns::Pair,
+    pair: tactile_launch::netns::Pair,
     addrs: [String; 2],
 }
 
 impl Hosts {
     /// Creates the pair, or says why it cannot and returns None (the test skips).
     fn new(tag: &str) -> Option<Hosts> {
-        match tactile::launch::netns::Pair::new(&format!("{}{tag}", std::process::id() % 100_000)) {
+        match tactile_launch::netns::Pair::new(&format!("{}{tag}", std::process::id() % 100_000)) {
             Ok(pair) => Some(Hosts {
                 addrs: pair.addrs.clone(),
                 pair,
@@ -249,7 +249,7 @@ fn the_slave_host_node_killed_breaks_the_loop_and_it_resumes_after_restart() {
 #[test]
 fn lockstep_over_zenoh_equals_the_in_process_simulation() {
     let sb = Sandbox::new("zlock");
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace(
             "[network.forward]\ndelay = [0, 0, 0]\nnoise_std = [0.0, 0.0, 0.0]",
@@ -448,9 +448,9 @@ fn garbage_datagrams_at_a_udp_node_are_counted_and_dropped() {
 
 /// A PKI for the hosts' addresses, or None (after saying why) without openssl.
 fn pki(dir: &std::path::Path, name: &str, ips: &[String]) -> Option<[std::path::PathBuf; 3]> {
-    match tactile::launch::pki::make(dir, name, ips) {
+    match tactile_launch::pki::make(dir, name, ips) {
         Ok(files) => Some(files),
-        Err(e) if e.starts_with("running openssl") => {
+        Err(e @ tactile_launch::pki::PkiError::Start(_)) => {
             util::cannot(&format!(
                 "openssl is needed to make the test certificates ({e})"
             ));
@@ -483,7 +483,7 @@ fn mutual_tls_admits_the_run_and_refuses_strangers() {
     let s = scenario.to_str().expect("utf-8");
     let a = format!("tls/{}:7447", hosts.addrs[0]);
     let p = sb.prefix.clone();
-    let tls = tactile::launch::pki::args(&run_pki);
+    let tls = tactile_launch::pki::args(&run_pki);
     let tls: Vec<&str> = tls.iter().map(String::as_str).collect();
     let common = |dir: &'static str| vec!["--scenario", s, "--out", dir, "--prefix", &p];
     let mut m = common("a-master");
@@ -506,7 +506,7 @@ fn mutual_tls_admits_the_run_and_refuses_strangers() {
     util::wait_for_rows(&rec, util::MASTER_ROWS * 3_000, Duration::from_secs(30));
     // Strangers on host B, under other prefixes (the run's are locked): one with a
     // certificate of another CA, one in clear.
-    let rogue = tactile::launch::pki::args(&rogue_pki);
+    let rogue = tactile_launch::pki::args(&rogue_pki);
     let (p1, p2) = (format!("{p}r"), format!("{p}s"));
     let mut r1 = vec!["--scenario", s, "--out", "rogue1", "--prefix", &p1];
     r1.extend(["--link", "zenoh", "--connect", &a]);

@@ -285,6 +285,20 @@ fn the_crates_depend_as_the_architecture_says() {
         let t = tree(low);
         assert!(!has(&t, "tactile-runtime"), "{low} depends on the runtime");
     }
+    // Launching and sweeping are a library the command and the Python package both
+    // call: neither it nor the Python package builds the command's crate (its clap
+    // arguments, its developer tooling).
+    for lib in ["tactile-launch", "tactile-py"] {
+        let t = tree(lib);
+        assert!(
+            has(&t, "tactile-launch"),
+            "{lib} does not have tactile-launch"
+        );
+        assert!(
+            !has(&t, "tactile"),
+            "{lib} depends on the command's crate:\n{t}"
+        );
+    }
     // The nodes own their peripherals: the runtime drives them through
     // tactile-peripheral's traits and knows no device, arm or gimbal.
     let runtime = tree("tactile-runtime");

@@ -7,7 +7,7 @@ use util::{column, std_dev, Sandbox};
 
 /// The paper scenario with a delayed, noisy network, in the given mode.
 fn paper_with_network(mode: &str, rate: f64, samples: u64) -> String {
-    let base = tactile::launch::PAPER_SCENARIO
+    let base = tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", &format!("mode = \"{mode}\""))
         .replace("rate_hz = 100.0", &format!("rate_hz = {rate:?}"))
         .replace("samples = 1200", &format!("samples = {samples}"));
@@ -92,7 +92,7 @@ fn injected_noise_has_the_configured_spread() {
 fn injected_delay_shows_in_the_round_trip() {
     let sb = Sandbox::new("delay");
     // 1 kHz, forward delay 3 samples, backward 2: 5 ms on top of the overhead.
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("rate_hz = 100.0", "rate_hz = 1000.0")
         .replace("samples = 1200", "samples = 1500")
         .replace(
@@ -138,7 +138,7 @@ fn injected_delay_shows_in_the_round_trip() {
 #[test]
 fn realtime_1khz_loses_nothing_and_reports_everything() {
     let sb = Sandbox::new("realtime");
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("rate_hz = 100.0", "rate_hz = 1000.0")
         .replace("samples = 1200", "samples = 3000");
     let scenario = sb.write("s.toml", &text);

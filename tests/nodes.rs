@@ -12,7 +12,7 @@ use util::{column, finish, kill_once_recorded, pid_of, start_node, Sandbox};
 
 /// The paper scenario in lockstep with a noisy, delayed network.
 fn lockstep(samples: u64) -> String {
-    tactile::launch::PAPER_SCENARIO
+    tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace("samples = 1200", &format!("samples = {samples}"))
         .replace(
@@ -647,11 +647,11 @@ fn a_nodes_own_bad_tls_files_are_named_and_refused() {
     let sb = Sandbox::new("tlsown");
     let ips = vec!["127.0.0.1".to_string()];
     let (run, other) = match (
-        tactile::launch::pki::make(&sb.path("run"), "run", &ips),
-        tactile::launch::pki::make(&sb.path("other"), "other", &ips),
+        tactile_launch::pki::make(&sb.path("run"), "run", &ips),
+        tactile_launch::pki::make(&sb.path("other"), "other", &ips),
     ) {
         (Ok(a), Ok(b)) => (a, b),
-        (Err(e), _) | (_, Err(e)) => return util::cannot(&e),
+        (Err(e), _) | (_, Err(e)) => return util::cannot(&e.to_string()),
     };
     let garbled = sb.write(
         "garbled.pem",

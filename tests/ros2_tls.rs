@@ -1,7 +1,7 @@
 //! The ROS 2 session over mutual TLS (`[ros.tls]`), against an independent Zenoh peer:
 //! the stand-in device of tests/ros2_standin.py (eclipse-zenoh's own TLS settings)
 //! listening on a `tls/` endpoint, with certificates made by openssl as the loop's
-//! tests make them (`tactile::launch::pki`); and the files refused, named, when bad.
+//! tests make them (`tactile_launch::pki`); and the files refused, named, when bad.
 #![cfg(feature = "zenoh")]
 
 use crate::ros2::{device_standin_on, listening, python_ready, report};
@@ -11,9 +11,9 @@ use std::path::PathBuf;
 /// A CA and a node certificate for 127.0.0.1 in `sb/dir`, or None without openssl.
 fn pki(sb: &Sandbox, dir: &str) -> Option<[PathBuf; 3]> {
     let ips = ["127.0.0.1".to_string()];
-    match tactile::launch::pki::make(&sb.path(dir), dir, &ips) {
+    match tactile_launch::pki::make(&sb.path(dir), dir, &ips) {
         Ok(f) => Some(f),
-        Err(e) if e.starts_with("running openssl") => {
+        Err(e @ tactile_launch::pki::PkiError::Start(_)) => {
             cannot(&format!("openssl makes the test certificates ({e})"));
             None
         }

@@ -47,7 +47,7 @@ fn realtime_nodes_run_sched_fifo_and_the_summary_says_how() {
         assert_eq!(s["memory_locked"], true, "{role}: {s}");
         assert_eq!(s["idle_poll"], false, "{role}: {s}");
         assert!(s["note"].is_null(), "{role}: {s}");
-        if tactile::launch::two_cpus() {
+        if tactile_launch::two_cpus() {
             assert_eq!(s["cpu"], cpu, "{role}: {s}");
         }
     }
@@ -109,7 +109,7 @@ fn where_sched_fifo_is_refused_the_nodes_run_sched_other_and_say_so() {
 #[test]
 fn lockstep_runs_sched_other_whatever_is_asked() {
     let sb = Sandbox::new("lockrt");
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace("samples = 1200", "samples = 300");
     let (_, sum) = run(&sb, &text, &["--sched", "fifo", "--idle", "poll"]);

@@ -127,7 +127,7 @@ fn a_timed_file_plays_at_its_own_speed() {
 #[test]
 fn a_circle_away_from_home_is_reached_smoothly() {
     let sb = Sandbox::new("trajcircle");
-    let text = tactile::launch::PAPER_SCENARIO
+    let text = tactile_launch::PAPER_SCENARIO
         .replace("mode = \"realtime\"", "mode = \"lockstep\"")
         .replace("rate_hz = 100.0", "rate_hz = 1000.0")
         .replace("samples = 1200", "samples = 2000")

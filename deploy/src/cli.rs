@@ -8,10 +8,10 @@ use crate::cmd::paper::PaperArgs;
 use crate::cmd::report::ReportArgs;
 use crate::cmd::run::RunArgs;
 use crate::cmd::sweep::SweepArgs;
-use crate::error::Error;
 use clap::{Parser, Subcommand};
 use std::io::Write;
 use std::process::ExitCode;
+use tactile_launch::error::Error;
 use tactile_runtime::exit::EXIT_BAD_INPUT;
 
 /// Tactile: runtime and testbed for bilateral tactile-internet teleoperation.
@@ -69,7 +69,9 @@ pub fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         // The reader of stdout has gone (`| head`): it has all it wanted.
-        Err(Error::Io { source, .. }) if crate::say::closed_pipe(&source) => ExitCode::SUCCESS,
+        Err(Error::Io { source, .. }) if tactile_launch::say::closed_pipe(&source) => {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             let _ = writeln!(std::io::stderr(), "tactile: {e}");
             ExitCode::from(e.exit_code())
@@ -81,9 +83,10 @@ pub fn main() -> ExitCode {
 pub fn run(cli: Cli) -> Result<(), Error> {
     match cli.command {
         Command::Kernels(args) => {
-            crate::stop::watch()?;
-            let stdin = std::io::BufReader::with_capacity(1 << 16, crate::stop::Input::stdin());
-            crate::cmd::kernels::run(&args, stdin, &mut crate::stop::Output::stdout())
+            tactile_launch::stop::watch()?;
+            let stdin =
+                std::io::BufReader::with_capacity(1 << 16, tactile_launch::stop::Input::stdin());
+            crate::cmd::kernels::run(&args, stdin, &mut tactile_launch::stop::Output::stdout())
         }
         Command::Paper(args) => {
             let mut stdout = std::io::stdout().lock();

@@ -1,16 +1,12 @@
 //! The `tactile` command as a library: the binary is a thin wrapper around
 //! [`cli::main`], so every subcommand can also be driven in-process. [`cmd`] holds one
-//! module per subcommand, each owning its arguments; [`launch`] starts and supervises
-//! runs (the node programs, or the loop in this process); the report itself is the
-//! `tactile-report` crate.
+//! module per subcommand, each owning its arguments, its printing and its exit status;
+//! launching and sweeping runs is the `tactile-launch` crate (which the Python package
+//! calls too), the report the `tactile-report` crate.
 #![doc = include_str!("../../README.md")]
 
 pub mod cli;
 pub mod cmd;
-pub mod error;
-pub mod launch;
-pub mod say;
-pub mod stop;
 
 /// The user guide (`docs/`), one module per chapter, so its Rust examples run as
 /// doctests and the guide reads in rustdoc beside the code.

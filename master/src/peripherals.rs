@@ -28,19 +28,36 @@ impl std::fmt::Debug for Peripherals {
     }
 }
 
+/// Why the device's gimbal cannot be used; each message names the field and the file.
+#[derive(Debug, thiserror::Error)]
+pub enum GimbalError {
+    /// Its URDF cannot be read or parsed.
+    #[error("master.ros2.gimbal: {0}")]
+    Read(#[from] tactile_chain::file::ReadError),
+    /// Its URDF has no such chain.
+    #[error("master.ros2.gimbal: {}: {source}", path.display())]
+    Chain {
+        /// The URDF.
+        path: std::path::PathBuf,
+        /// Why.
+        source: tactile_chain::Error,
+    },
+}
+
 /// The device's gimbal (`[master.ros2.gimbal]`, its URDF relative to `base_dir`), its
 /// URDF read and parsed once and its chain checked; None without one. The message
 /// names the field and the file.
-pub fn gimbal(sc: &Scenario, base_dir: &Path) -> Result<Option<Gimbal>, String> {
+pub fn gimbal(sc: &Scenario, base_dir: &Path) -> Result<Option<Gimbal>, GimbalError> {
     let Some(g) = &sc.master.ros2.gimbal else {
         return Ok(None);
     };
-    let field = "master.ros2.gimbal";
-    let urdf =
-        tactile_chain::file::read(&base_dir.join(&g.urdf)).map_err(|e| format!("{field}: {e}"))?;
+    let urdf = tactile_chain::file::read(&base_dir.join(&g.urdf))?;
     Gimbal::of_robot(&urdf.robot, &g.base, &g.tip, &g.frame)
         .map(Some)
-        .map_err(|e| format!("{field}: {}: {e}", urdf.path.display()))
+        .map_err(|source| GimbalError::Chain {
+            path: urdf.path,
+            source,
+        })
 }
 
 /// Opens what the scenario asks of the master (nothing for a simulated device without
@@ -82,4 +99,33 @@ pub fn open(
 pub fn open(sc: &Scenario, _: &Path, _: Option<Gimbal>) -> Result<Peripherals, NodeError> {
     tactile_runtime::outside::check(sc, tactile_messages::Role::Master)?;
     Ok(Peripherals::default())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// The gimbal's error keeps the chain's fault, with the field and the file above it.
+    #[test]
+    fn a_gimbal_error_keeps_the_chains_fault() {
+        let robot = tactile_chain::Robot::parse("<robot name=\"r\"><link name=\"a\"/></robot>")
+            .expect("a robot of one link");
+        let source =
+            Gimbal::of_robot(&robot, "a", "tip", &Default::default()).expect_err("no link tip");
+        let e = GimbalError::Chain {
+            path: "hand.urdf".into(),
+            source,
+        };
+        assert!(
+            e.to_string()
+                .starts_with("master.ros2.gimbal: hand.urdf: chain from `a` to `tip`"),
+            "{e}"
+        );
+        assert!(matches!(
+            e.source()
+                .and_then(|c| c.downcast_ref::<tactile_chain::Error>()),
+            Some(tactile_chain::Error::Chain { .. })
+        ));
+    }
 }

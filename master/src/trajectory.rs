@@ -36,8 +36,8 @@ const HEADERS: [&[&str]; 8] = [
 #[derive(Debug, Error)]
 pub enum OperatorError {
     /// The file could not be read (missing, not a regular file, too large).
-    #[error("{0}")]
-    Read(String),
+    #[error(transparent)]
+    Read(#[from] tactile_runtime::files::FileError),
     /// The file's content is malformed.
     #[error("{path}: {source}")]
     Csv {

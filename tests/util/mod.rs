@@ -335,7 +335,7 @@ pub fn wall_change() -> String {
 
 /// The paper scenario at 1 kHz in real time, `samples` samples.
 pub fn paper_1khz(samples: u64) -> String {
-    tactile::launch::PAPER_SCENARIO
+    tactile_launch::PAPER_SCENARIO
         .replace("rate_hz = 100.0", "rate_hz = 1000.0")
         .replace("samples = 1200", &format!("samples = {samples}"))
 }

@@ -47,8 +47,13 @@ pub struct Gimbal {
 impl Gimbal {
     /// The gimbal of the URDF text `xml` from `base` to `tip`, its base turned by
     /// `frame` into the master's.
-    pub fn new(xml: &str, base: &str, tip: &str, frame: &FrameRotation) -> Result<Gimbal, String> {
-        let robot = tactile_chain::Robot::parse(xml).map_err(|e| e.to_string())?;
+    pub fn new(
+        xml: &str,
+        base: &str,
+        tip: &str,
+        frame: &FrameRotation,
+    ) -> Result<Gimbal, tactile_chain::Error> {
+        let robot = tactile_chain::Robot::parse(xml)?;
         Gimbal::of_robot(&robot, base, tip, frame)
     }
 
@@ -59,8 +64,8 @@ impl Gimbal {
         base: &str,
         tip: &str,
         frame: &FrameRotation,
-    ) -> Result<Gimbal, String> {
-        let chain = Chain::new(robot, base, tip).map_err(|e| e.to_string())?;
+    ) -> Result<Gimbal, tactile_chain::Error> {
+        let chain = Chain::new(robot, base, tip)?;
         let names = chain.dofs.iter().map(|d| d.name.clone()).collect();
         let m = frame.matrix();
         Ok(Gimbal {

@@ -17,4 +17,4 @@ mod tests;
 
 pub use jitter::Jitter;
 pub use loss::{loss_rate, Loss};
-pub use replay::{Mahimahi, Replay};
+pub use replay::{Mahimahi, Replay, ReplayError};

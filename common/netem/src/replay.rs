@@ -3,6 +3,63 @@
 
 use tactile_scenario::ReplayConfig;
 
+/// What is wrong in a replay file; each message names the line.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ReplayError {
+    /// A CSV whose first line is not `delay,lost`.
+    #[error("line 1: header is {0:?}, expected delay,lost")]
+    Header(String),
+    /// An empty CSV.
+    #[error("empty: expected the header delay,lost")]
+    Empty,
+    /// A row of another number of columns.
+    #[error("line {0}: expected 2 columns (delay,lost)")]
+    Columns(usize),
+    /// A delay that is no whole number of samples in range.
+    #[error("line {line}: delay {delay} is not a whole number of samples in 0..=100000")]
+    Delay {
+        /// The line.
+        line: usize,
+        /// The delay as written.
+        delay: String,
+    },
+    /// A loss that is neither 0 nor 1.
+    #[error("line {line}: lost {lost} is not 0 or 1")]
+    Lost {
+        /// The line.
+        line: usize,
+        /// The loss as written.
+        lost: String,
+    },
+    /// A header and nothing else.
+    #[error("no packets after the header")]
+    NoPackets,
+    /// A Mahimahi line that is no whole number of milliseconds.
+    #[error("line {line}: {text:?} is not a whole number of milliseconds")]
+    NotMs {
+        /// The line.
+        line: usize,
+        /// What it holds.
+        text: String,
+        /// Why it is no number.
+        source: std::num::ParseIntError,
+    },
+    /// A Mahimahi time before the one above it.
+    #[error("line {line}: {ms} ms goes back in time")]
+    Backwards {
+        /// The line.
+        line: usize,
+        /// The time.
+        ms: u64,
+    },
+    /// A Mahimahi trace with no line.
+    #[error("no delivery opportunities")]
+    NoOpportunities,
+    /// A Mahimahi trace of only time 0.
+    #[error("the trace lasts 0 ms")]
+    Instant,
+}
+
 /// A loaded replay: each packet's delay (samples) and whether it is lost.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Replay {
@@ -26,12 +83,12 @@ pub struct Mahimahi {
 impl Replay {
     /// Parses a CSV replay: header `delay,lost`; the error names the line. Rows are
     /// read straight into 5 bytes each (a replay file may hold hours of packets).
-    pub fn parse_csv(text: &str) -> Result<Replay, String> {
+    pub fn parse_csv(text: &str) -> Result<Replay, ReplayError> {
         let mut lines = text.lines().enumerate();
         match lines.next() {
             Some((_, h)) if h.trim().replace(' ', "") == "delay,lost" => {}
-            Some((_, h)) => return Err(format!("line 1: header is {h:?}, expected delay,lost")),
-            None => return Err("empty: expected the header delay,lost".into()),
+            Some((_, h)) => return Err(ReplayError::Header(h.to_string())),
+            None => return Err(ReplayError::Empty),
         }
         let mut out = Vec::new();
         for (k, raw) in lines {
@@ -42,52 +99,57 @@ impl Replay {
             }
             let mut cells = row.split(',').map(str::trim);
             let (Some(d), Some(l), None) = (cells.next(), cells.next(), cells.next()) else {
-                return Err(format!("line {line}: expected 2 columns (delay,lost)"));
+                return Err(ReplayError::Columns(line));
             };
             let d: u32 = d
                 .parse()
                 .ok()
                 .filter(|d| i64::from(*d) <= tactile_scenario::MAX_DELAY_SAMPLES)
-                .ok_or_else(|| {
-                    format!("line {line}: delay {d} is not a whole number of samples in 0..=100000")
+                .ok_or_else(|| ReplayError::Delay {
+                    line,
+                    delay: d.to_string(),
                 })?;
             let l = match l {
                 "0" => false,
                 "1" => true,
-                other => return Err(format!("line {line}: lost {other} is not 0 or 1")),
+                other => {
+                    return Err(ReplayError::Lost {
+                        line,
+                        lost: other.to_string(),
+                    })
+                }
             };
             out.push((d, l));
         }
         if out.is_empty() {
-            return Err("no packets after the header".into());
+            return Err(ReplayError::NoPackets);
         }
         Ok(Replay::Packets(out, 0))
     }
 
     /// Parses a Mahimahi trace (one non-decreasing millisecond timestamp per line).
-    pub fn parse_mahimahi(text: &str, cfg: &ReplayConfig) -> Result<Replay, String> {
+    pub fn parse_mahimahi(text: &str, cfg: &ReplayConfig) -> Result<Replay, ReplayError> {
         let mut times = Vec::new();
         for (k, line) in text.lines().enumerate() {
             let t = line.trim();
             if t.is_empty() {
                 continue;
             }
-            let v: u64 = t.parse().map_err(|_| {
-                format!(
-                    "line {}: {t:?} is not a whole number of milliseconds",
-                    k + 1
-                )
+            let v: u64 = t.parse().map_err(|source| ReplayError::NotMs {
+                line: k + 1,
+                text: t.to_string(),
+                source,
             })?;
             if times.last().is_some_and(|&last| v < last) {
-                return Err(format!("line {}: {v} ms goes back in time", k + 1));
+                return Err(ReplayError::Backwards { line: k + 1, ms: v });
             }
             times.push(v);
         }
         let Some(&last) = times.last() else {
-            return Err("no delivery opportunities".into());
+            return Err(ReplayError::NoOpportunities);
         };
         if last == 0 {
-            return Err("the trace lasts 0 ms".into());
+            return Err(ReplayError::Instant);
         }
         Ok(Replay::Mahimahi(Mahimahi {
             times_ms: times,

@@ -251,7 +251,7 @@ fn a_csv_replay_reads_back_row_by_row_and_loops() {
         ("delay,lost\n", "no packets"),
         ("d,l\n1,0\n", "header"),
     ] {
-        let e = Replay::parse_csv(text).expect_err(text);
+        let e = Replay::parse_csv(text).expect_err(text).to_string();
         assert!(e.contains(needle), "{text}: {e}");
     }
 }
@@ -292,7 +292,13 @@ fn a_mahimahi_link_queues_and_drops_what_it_cannot_carry() {
     let mut quiet = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
     assert!((0..10_000).all(|n| !quiet.packet(n, 1e-4, n % 10 == 0).1));
     assert!(Replay::parse_mahimahi("3\n2\n", &cfg).is_err());
-    assert!(Replay::parse_mahimahi("x\n", &cfg).is_err());
+    let e = Replay::parse_mahimahi("x\n", &cfg).expect_err("no number");
+    let cause = std::error::Error::source(&e).expect("the integer's reason");
+    assert!(cause.is::<std::num::ParseIntError>(), "{cause:?}");
+    assert_eq!(
+        e.to_string(),
+        "line 1: \"x\" is not a whole number of milliseconds"
+    );
 }
 
 #[test]

@@ -17,6 +17,36 @@ use tactile_scenario::{ArmConfig, Object, Scenario};
 /// The joint that stands the robot in the world.
 pub const MOUNT: &str = "slave_mount";
 
+/// Why the scenario's arm cannot be drawn: its file, its geometry, or the robot in it.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The URDF file could not be read or parsed.
+    #[error("slave.arm: {0}")]
+    Read(#[from] tactile_chain::file::ReadError),
+    /// The master's geometry (the device) is not one the scenario can have.
+    #[error(transparent)]
+    Geometry(#[from] tactile_scenario::ScenarioError),
+    /// The file was read, but its robot cannot be drawn.
+    #[error("slave.arm: {}: {source}", path.display())]
+    Robot {
+        /// The URDF file.
+        path: std::path::PathBuf,
+        /// Why its robot cannot be drawn.
+        source: RobotError,
+    },
+}
+
+/// Why a robot (a URDF's text and model) cannot be drawn beside the master.
+#[derive(Debug, thiserror::Error)]
+pub enum RobotError {
+    /// The URDF, the chain asked for or its tree is wrong.
+    #[error(transparent)]
+    Urdf(#[from] tactile_chain::Error),
+    /// The robot names a link or joint the master's drawing names too.
+    #[error("the URDF names `{0}`, as the master's drawing does: rename it")]
+    Clash(String),
+}
+
 /// A URDF arm, for drawing.
 #[derive(Debug, Clone)]
 pub struct ArmScene {
@@ -35,22 +65,24 @@ pub struct ArmScene {
 
 impl ArmScene {
     /// The scenario's arm, its URDF read; None for the paper's arm.
-    pub fn of_scenario(scenario: &Scenario) -> Result<Option<ArmScene>, String> {
+    pub fn of_scenario(scenario: &Scenario) -> Result<Option<ArmScene>, SceneError> {
         let Some(cfg) = &scenario.slave.arm else {
             return Ok(None);
         };
         // The nodes' one reader of a URDF: the same cap and messages.
-        let urdf = tactile_chain::file::read(std::path::Path::new(&cfg.urdf))
-            .map_err(|e| format!("slave.arm: {e}"))?;
-        let g = scenario.device.geometry().map_err(|e| e.to_string())?;
+        let urdf = tactile_chain::file::read(std::path::Path::new(&cfg.urdf))?;
+        let g = scenario.device.geometry()?;
         ArmScene::of_robot(cfg, &urdf.text, &urdf.robot, &g)
             .map(Some)
-            .map_err(|e| format!("slave.arm: {}: {e}", urdf.path.display()))
+            .map_err(|source| SceneError::Robot {
+                path: urdf.path,
+                source,
+            })
     }
 
     /// The arm of `cfg` from its URDF text `xml`, beside the master of geometry `g`.
-    pub fn new(cfg: &ArmConfig, xml: &str, g: &Geometry) -> Result<ArmScene, String> {
-        let robot = Robot::parse(xml).map_err(|e| e.to_string())?;
+    pub fn new(cfg: &ArmConfig, xml: &str, g: &Geometry) -> Result<ArmScene, RobotError> {
+        let robot = Robot::parse(xml)?;
         ArmScene::of_robot(cfg, xml, &robot, g)
     }
 
@@ -61,9 +93,9 @@ impl ArmScene {
         xml: &str,
         robot: &Robot,
         g: &Geometry,
-    ) -> Result<ArmScene, String> {
-        let chain = Chain::new(robot, &cfg.base, &cfg.tip).map_err(|e| e.to_string())?;
-        let tree = Tree::new(robot).map_err(|e| e.to_string())?;
+    ) -> Result<ArmScene, RobotError> {
+        let chain = Chain::new(robot, &cfg.base, &cfg.tip)?;
+        let tree = Tree::new(robot)?;
         let names: Vec<String> = chain.dofs.iter().map(|d| d.name.clone()).collect();
         let home_tool = chain.fk(&cfg.home).p.into();
         let master_home = kernels::fk(&g.lengths(), &StdTrig, [0.0; 3]);
@@ -71,11 +103,9 @@ impl ArmScene {
         let ours = names_in(&robot_of(&description)?);
         let theirs = names_in(robot);
         if let Some(clash) = theirs.iter().find(|n| *n != WORLD && ours.contains(n)) {
-            return Err(format!(
-                "the URDF names `{clash}`, as the master's drawing does: rename it"
-            ));
+            return Err(RobotError::Clash(clash.clone()));
         }
-        for e in urdf::elements(xml, &["material", "link", "joint"]).map_err(|e| e.to_string())? {
+        for e in urdf::elements(xml, &["material", "link", "joint"])? {
             if tree.root == WORLD && e.starts_with("<link") && names_in_element(e) == WORLD {
                 continue; // the robot's world is the drawing's
             }
@@ -195,8 +225,8 @@ impl ArmScene {
     }
 }
 
-fn robot_of(open: &str) -> Result<Robot, String> {
-    Robot::parse(&format!("{open}</robot>")).map_err(|e| e.to_string())
+fn robot_of(open: &str) -> Result<Robot, tactile_chain::Error> {
+    Robot::parse(&format!("{open}</robot>"))
 }
 
 /// Every link and joint name of `robot`.
@@ -306,7 +336,45 @@ mod tests {
     fn a_urdf_naming_a_master_link_is_refused() {
         let clash = PANDA.replace("panda_link3", "master_base");
         let e = ArmScene::new(&cfg(1.0), &clash, &Geometry::PAPER).expect_err("clash");
-        assert!(e.contains("`master_base`"), "{e}");
+        assert!(e.to_string().contains("`master_base`"), "{e}");
+    }
+
+    #[test]
+    fn a_scene_error_keeps_the_urdf_fault_as_its_source() {
+        use std::error::Error as _;
+        let broken = &PANDA[..PANDA.len() / 2];
+        let e = ArmScene::new(&cfg(1.0), broken, &Geometry::PAPER).expect_err("bad XML");
+        assert!(
+            matches!(e, RobotError::Urdf(tactile_chain::Error::Xml(_))),
+            "{e:?}"
+        );
+        let e = SceneError::Robot {
+            path: "panda.urdf".into(),
+            source: e,
+        };
+        let cause = e.source().expect("the robot's fault");
+        assert!(cause.downcast_ref::<RobotError>().is_some(), "{cause:?}");
+        assert_eq!(e.to_string(), format!("slave.arm: panda.urdf: {cause}"));
+    }
+
+    #[test]
+    fn a_missing_urdf_is_named_with_its_read_error_as_source() {
+        use std::error::Error as _;
+        let text = include_str!("../../../deploy/scenarios/panda.toml");
+        let mut s = Scenario::from_toml_str(text).expect("the shipped scenario");
+        if let Some(arm) = s.slave.arm.as_mut() {
+            arm.urdf = "/nonexistent/robot.urdf".into();
+        }
+        let e = ArmScene::of_scenario(&s).expect_err("no file");
+        assert!(
+            e.to_string().starts_with("slave.arm: cannot read URDF"),
+            "{e}"
+        );
+        let cause = e.source().expect("the read error");
+        assert!(cause
+            .downcast_ref::<tactile_chain::file::ReadError>()
+            .is_some());
+        assert!(cause.source().is_some(), "the I/O error under it");
     }
 
     #[test]

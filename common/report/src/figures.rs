@@ -23,8 +23,11 @@ pub fn write(
 ) -> Result<(), Error> {
     let round_trip = analysis.round_trip.hgrm();
     write_file(&out.join("round_trip.hgrm"), &round_trip)?;
-    let plot = |name: &str, res: Result<(), String>| {
-        res.map_err(|e| Error::Failed(format!("plotting {name}: {e}")))
+    let plot = |name: &str, res: plots::PlotResult| {
+        res.map_err(|source| Error::Plot {
+            what: format!("plotting {name}"),
+            source,
+        })
     };
     let mut lines = vec![("round trip".to_string(), plots::read_hgrm(&round_trip))];
     if lockstep {

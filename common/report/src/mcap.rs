@@ -60,12 +60,15 @@ impl Compression {
 }
 
 impl std::str::FromStr for Compression {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = crate::error::UnknownChoice;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s {
             "lz4" => Ok(Compression::Lz4),
             "zstd" => Ok(Compression::Zstd),
-            _ => Err(format!("{s:?}: give lz4 or zstd")),
+            _ => Err(crate::error::UnknownChoice {
+                given: s.to_string(),
+                choices: "lz4 or zstd",
+            }),
         }
     }
 }

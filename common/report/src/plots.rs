@@ -23,10 +23,23 @@ pub use percentiles::percentile_plot;
 use stretches::Stretches;
 pub(crate) use timeplot::tick;
 
-type PlotResult = Result<(), String>;
+/// Why a plot could not be drawn: plotters' fault (its SVG backend's, or an element's),
+/// or the file's.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// plotters could not draw (the fault as plotters gives it, kept as the source).
+    #[error("{0}")]
+    Draw(#[source] Box<dyn std::error::Error + Send + Sync>),
+    /// The plot's file could not be written, renamed or removed.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+}
 
-fn err(e: impl std::fmt::Display) -> String {
-    e.to_string()
+pub type PlotResult<T = ()> = Result<T, PlotError>;
+
+/// plotters' error, kept whole.
+pub(crate) fn err(e: impl std::error::Error + Send + Sync + 'static) -> PlotError {
+    PlotError::Draw(Box::new(e))
 }
 
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -237,8 +250,7 @@ fn pairs(a: &[Thinned; 3], b: &[Thinned; 3], la: &str, lb: &str, pre: &str) -> V
 /// Draws `path` by `draw` under its temporary name, renamed when whole (a report cut
 /// short leaves the old plot or none, never half of one).
 pub fn whole_svg(path: &Path, draw: impl FnOnce(&Path) -> PlotResult) -> PlotResult {
-    crate::out::whole(path, |tmp| draw(tmp).map_err(std::io::Error::other))
-        .map_err(|e| e.to_string())
+    crate::out::whole(path, draw)
 }
 
 /// Histogram of the system overhead per round trip, in microseconds.

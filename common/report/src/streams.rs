@@ -26,13 +26,16 @@ pub enum TraceFormat {
 }
 
 impl std::str::FromStr for TraceFormat {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = crate::error::UnknownChoice;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s {
             "csv" => Ok(TraceFormat::Csv),
             "parquet" => Ok(TraceFormat::Parquet),
             "both" => Ok(TraceFormat::Both),
-            _ => Err(format!("{s:?}: give csv, parquet or both")),
+            _ => Err(crate::error::UnknownChoice {
+                given: s.to_string(),
+                choices: "csv, parquet or both",
+            }),
         }
     }
 }

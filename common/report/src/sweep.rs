@@ -99,12 +99,26 @@ pub struct Axis {
     pub paired: bool,
 }
 
+/// What is wrong with a sweep's `--set KEY=V1,V2,...`.
+#[derive(Debug, thiserror::Error)]
+pub enum AxisError {
+    /// No `=` in it.
+    #[error("--set {arg:?}: expected KEY=V1,V2,...")]
+    NoValues {
+        /// The argument as written.
+        arg: String,
+    },
+    /// One of its values, as a `--set KEY=V`, is wrong.
+    #[error(transparent)]
+    Set(#[from] tactile_scenario::overrides::SetError),
+}
+
 /// Parses `KEY=V1,V2,...` (a value with commas inside brackets or quotes stays one),
 /// or `+KEY=V1,V2,...` for a key paired with the one before it.
-pub fn axis(arg: &str) -> Result<Axis, String> {
-    let (key, list) = arg
-        .split_once('=')
-        .ok_or_else(|| format!("--set {arg:?}: expected KEY=V1,V2,..."))?;
+pub fn axis(arg: &str) -> Result<Axis, AxisError> {
+    let (key, list) = arg.split_once('=').ok_or_else(|| AxisError::NoValues {
+        arg: arg.to_string(),
+    })?;
     let key = key.trim();
     let (key, paired) = match key.strip_prefix('+') {
         Some(k) => (k.trim(), true),

@@ -133,7 +133,7 @@ impl Pipeline {
             Block::Sincos => self.through(iterations + 4),
             Block::Atan2 => vector,
             Block::Acos => self.through(32) + vector,
-            Block::Add | Block::Mul => self.through(3),
+            Block::Add | Block::Sub | Block::Mul => self.through(3),
             Block::Div | Block::Sqrt => self.through(27),
             Block::Fk => {
                 unit(Block::Sincos) + 2 * unit(Block::Mul) + 2 * unit(Block::Add) + self.module()
@@ -157,8 +157,9 @@ impl Pipeline {
     }
 }
 
-/// A block whose latency [`Pipeline::latency`] gives: a TFB function, an f32 unit (the
-/// subtractor is the adder), one of the paper's modules.
+/// A block of the hardware: a TFB function, an f32 unit, one of the paper's modules.
+/// The one list of them: their latencies ([`Pipeline::latency`]), their names on the
+/// command line and in the reports (`tactile hdl --function`), the placed figures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Block {
     /// TFB, rotation mode.
@@ -167,8 +168,10 @@ pub enum Block {
     Atan2,
     /// TFB: the root, then vectoring.
     Acos,
-    /// f32 adder (and subtractor).
+    /// f32 adder.
     Add,
+    /// f32 subtractor (the adder with b negated).
+    Sub,
     /// f32 multiplier.
     Mul,
     /// f32 divider.
@@ -183,6 +186,87 @@ pub enum Block {
     Fbf,
     /// IK-HSD.
     Ik,
+}
+
+impl Block {
+    /// Every block, in the order the reports list them.
+    pub const ALL: [Block; 12] = [
+        Block::Sincos,
+        Block::Atan2,
+        Block::Acos,
+        Block::Add,
+        Block::Sub,
+        Block::Mul,
+        Block::Div,
+        Block::Sqrt,
+        Block::Fk,
+        Block::Kff,
+        Block::Fbf,
+        Block::Ik,
+    ];
+
+    /// The TFB's three functions.
+    pub const TFB: [Block; 3] = [Block::Sincos, Block::Atan2, Block::Acos];
+
+    /// The name on the command line and in the reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Block::Sincos => "sincos",
+            Block::Atan2 => "atan2",
+            Block::Acos => "acos",
+            Block::Add => "add",
+            Block::Sub => "sub",
+            Block::Mul => "mul",
+            Block::Div => "div",
+            Block::Sqrt => "sqrt",
+            Block::Fk => "fk",
+            Block::Kff => "kff",
+            Block::Fbf => "fbf",
+            Block::Ik => "ik",
+        }
+    }
+
+    /// What it computes, in a line (the command line's help).
+    pub fn what(self) -> &'static str {
+        match self {
+            Block::Sincos => "TFB, rotation mode: sin and cos of an angle",
+            Block::Atan2 => "TFB, vectoring mode: the angle of (x, y)",
+            Block::Acos => "TFB: acos(a) = atan2(sqrt((1 - a)(1 + a)), a), the root in f32",
+            Block::Add => "f32 unit: a + b",
+            Block::Sub => "f32 unit: a - b (the adder with b negated)",
+            Block::Mul => "f32 unit: a * b",
+            Block::Div => "f32 unit: a / b",
+            Block::Sqrt => "f32 unit: sqrt(a)",
+            Block::Fk => "Module FK-HMD / FK-HSD: forward kinematics",
+            Block::Kff => "Module KFF-HMD: joint torques J^T F",
+            Block::Fbf => "Module FBF-HSD: the feedback force h (obj - env)",
+            Block::Ik => "Module IK-HSD: inverse kinematics",
+        }
+    }
+}
+
+/// A name that is no block's. (Display and Error by hand: the build script compiles
+/// this file too, without the crate's dependencies.)
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownBlock(pub String);
+
+impl std::fmt::Display for UnknownBlock {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let names: Vec<&str> = Block::ALL.iter().map(|b| b.name()).collect();
+        write!(f, "{:?} is not a block ({})", self.0, names.join(", "))
+    }
+}
+
+impl std::error::Error for UnknownBlock {}
+
+impl std::str::FromStr for Block {
+    type Err = UnknownBlock;
+    fn from_str(s: &str) -> Result<Block, UnknownBlock> {
+        Block::ALL
+            .into_iter()
+            .find(|b| b.name() == s)
+            .ok_or_else(|| UnknownBlock(s.to_string()))
+    }
 }
 
 /// The text of `pipe.vh`: the pipeline configuration as the RTL reads it, a macro for
@@ -331,6 +415,14 @@ mod tests {
     /// The clocks docs/09 gives for each configuration at [s16.13] (14 iterations):
     /// checked here on any machine, and against the RTL's own clocks by `tactile hdl
     /// cosim` where Icarus is installed.
+    #[test]
+    fn every_block_is_found_by_its_name() {
+        for b in Block::ALL {
+            assert_eq!(b.name().parse::<Block>(), Ok(b));
+        }
+        assert!("tan".parse::<Block>().is_err());
+    }
+
     #[test]
     fn each_pipeline_has_the_latencies_docs_09_gives() {
         let modules = [Block::Fk, Block::Kff, Block::Fbf, Block::Ik];

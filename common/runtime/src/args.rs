@@ -99,11 +99,25 @@ impl NodeArgs {
 }
 
 /// Why a node stopped without completing.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum NodeError {
     /// Bad input; nothing was started (exit 2).
+    #[error("{0}")]
     BadInput(String),
+    /// The scenario or a file it names cannot be read (exit 2).
+    #[error(transparent)]
+    File(#[from] crate::files::FileError),
+    /// The prefix is malformed or held (exit 2).
+    #[error(transparent)]
+    Lock(#[from] crate::lock::LockError),
+    /// `--cpu` cannot be honoured (exit 2).
+    #[error(transparent)]
+    Sched(#[from] crate::sched::SchedError),
+    /// The log file cannot be opened (exit 2).
+    #[error(transparent)]
+    Log(#[from] crate::logging::LogError),
     /// A failure while running (exit 1).
+    #[error("{0}")]
     Failed(String),
 }
 
@@ -111,16 +125,8 @@ impl NodeError {
     /// The exit status.
     pub fn code(&self) -> u8 {
         match self {
-            NodeError::BadInput(_) => EXIT_BAD_INPUT,
             NodeError::Failed(_) => EXIT_FAILURE,
-        }
-    }
-}
-
-impl std::fmt::Display for NodeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            NodeError::BadInput(m) | NodeError::Failed(m) => f.write_str(m),
+            _ => EXIT_BAD_INPUT,
         }
     }
 }

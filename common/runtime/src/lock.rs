@@ -23,26 +23,53 @@ use std::path::PathBuf;
 /// to two characters to a user's prefix for its runs, so users get 24.
 pub const MAX_PREFIX_LEN: usize = 24;
 
+/// Why a run's prefix cannot be taken: the prefix itself, the lock's file, or another
+/// process holding it.
+#[derive(Debug, thiserror::Error)]
+pub enum LockError {
+    /// Empty or longer than [`MAX_PREFIX_LEN`].
+    #[error("--prefix {0:?}: must be 1 to {MAX_PREFIX_LEN} characters long")]
+    Length(String),
+    /// Starts with another character than a letter or a digit.
+    #[error("--prefix {0:?}: must start with a letter or a digit")]
+    Start(String),
+    /// Holds a character outside `A-Z a-z 0-9 _ -`.
+    #[error("--prefix {0:?}: character {1:?} not allowed (use A-Z a-z 0-9 _ -)")]
+    Character(String, char),
+    /// The lock's folder or file could not be made or opened.
+    #[error("{doing} {}: {source}", path.display())]
+    Io {
+        /// `creating`, `opening`.
+        doing: &'static str,
+        /// The folder or file.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+    /// Another process holds it.
+    #[error("prefix {prefix:?} is in use: {who} holds it; wait for that run to end or choose another --prefix")]
+    InUse {
+        /// The prefix.
+        prefix: String,
+        /// The holder, as it described itself.
+        who: String,
+    },
+}
+
 /// Checks a prefix: 1 to 24 characters from `A-Z a-z 0-9 _ -`, starting with a letter
 /// or digit.
-pub fn check_prefix(prefix: &str) -> Result<(), String> {
+pub fn check_prefix(prefix: &str) -> Result<(), LockError> {
     if prefix.is_empty() || prefix.len() > MAX_PREFIX_LEN {
-        return Err(format!(
-            "--prefix {prefix:?}: must be 1 to {MAX_PREFIX_LEN} characters long"
-        ));
+        return Err(LockError::Length(prefix.to_string()));
     }
     if !prefix.starts_with(|c: char| c.is_ascii_alphanumeric()) {
-        return Err(format!(
-            "--prefix {prefix:?}: must start with a letter or a digit"
-        ));
+        return Err(LockError::Start(prefix.to_string()));
     }
     if let Some(c) = prefix
         .chars()
         .find(|c| !(c.is_ascii_alphanumeric() || *c == '_' || *c == '-'))
     {
-        return Err(format!(
-            "--prefix {prefix:?}: character {c:?} not allowed (use A-Z a-z 0-9 _ -)"
-        ));
+        return Err(LockError::Character(prefix.to_string(), c));
     }
     Ok(())
 }
@@ -130,7 +157,7 @@ fn holder(path: &std::path::Path) -> Option<String> {
 /// Refuses a prefix that any process of a run holds (a launcher or any node started
 /// by hand), naming the holder; creates nothing. Checked before a launcher starts
 /// anything, so a refused run never touches the live one.
-pub fn in_use(prefix: &str) -> Result<(), String> {
+pub fn in_use(prefix: &str) -> Result<(), LockError> {
     check_prefix(prefix)?;
     for what in RUN_LOCKS {
         if let Some(who) = holder(&lock_path(prefix, what)) {
@@ -140,8 +167,11 @@ pub fn in_use(prefix: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn in_use_message(prefix: &str, who: &str) -> String {
-    format!("prefix {prefix:?} is in use: {who} holds it; wait for that run to end or choose another --prefix")
+fn in_use_message(prefix: &str, who: &str) -> LockError {
+    LockError::InUse {
+        prefix: prefix.to_string(),
+        who: who.to_string(),
+    }
 }
 
 /// Every lock of run `prefix`, if no other process holds any (held while the caller
@@ -189,24 +219,31 @@ fn lock_path(prefix: &str, what: &str) -> PathBuf {
 
 /// Takes `<prefix>.<what>.lock`, writing `holder` (a description of this process) into
 /// it; if another process holds it, the error says who.
-pub fn take(prefix: &str, what: &str, holder_text: &str) -> Result<Lock, String> {
+pub fn take(prefix: &str, what: &str, holder_text: &str) -> Result<Lock, LockError> {
     // A free lock may be held for a moment by another process's probe (`holder`,
     // `take_all`): 40 tries over 200 ms before it counts as in use.
     take_with(prefix, what, holder_text, 40)
 }
 
-fn take_with(prefix: &str, what: &str, holder_text: &str, tries: u32) -> Result<Lock, String> {
+fn take_with(prefix: &str, what: &str, holder_text: &str, tries: u32) -> Result<Lock, LockError> {
     check_prefix(prefix)?;
     let dir = lock_dir();
-    std::fs::create_dir_all(&dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(|source| LockError::Io {
+        doing: "creating",
+        path: dir.clone(),
+        source,
+    })?;
     let path = lock_path(prefix, what);
     let mut opened = None;
     for k in 0..tries {
         if k > 0 {
             std::thread::sleep(std::time::Duration::from_millis(5));
         }
-        opened =
-            locked_file(&path, true).map_err(|e| format!("opening {}: {e}", path.display()))?;
+        opened = locked_file(&path, true).map_err(|source| LockError::Io {
+            doing: "opening",
+            path: path.clone(),
+            source,
+        })?;
         if opened.is_some() {
             break;
         }
@@ -226,6 +263,22 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_lock_that_cannot_be_opened_keeps_the_systems_reason() {
+        use std::error::Error as _;
+        let e = LockError::Io {
+            doing: "opening",
+            path: PathBuf::from("/x.lock"),
+            source: std::io::Error::from(std::io::ErrorKind::PermissionDenied),
+        };
+        assert!(e.to_string().starts_with("opening /x.lock: "), "{e}");
+        let io = e.source().and_then(|c| c.downcast_ref::<std::io::Error>());
+        assert_eq!(
+            io.map(std::io::Error::kind),
+            Some(std::io::ErrorKind::PermissionDenied)
+        );
+    }
+
+    #[test]
     fn prefixes_are_checked() {
         assert!(check_prefix("run-1_a").is_ok());
         for bad in ["", "-x", "a/b", "a b", "ä", &"x".repeat(25)] {
@@ -238,7 +291,7 @@ mod tests {
         let p = format!("locktest{}", std::process::id());
         let held = take(&p, "master", "the master of run A (pid 1)").expect("first");
         // flock locks belong to the open file: a second open in this process conflicts.
-        let e = take(&p, "master", "B").expect_err("second");
+        let e = take(&p, "master", "B").expect_err("second").to_string();
         assert!(e.contains("the master of run A (pid 1)"), "{e}");
         drop(held);
         let again = take(&p, "master", "B").expect("free again");
@@ -251,12 +304,12 @@ mod tests {
     #[test]
     fn in_use_sees_every_lock_of_a_run_and_creates_nothing() {
         let p = format!("inuse{}", std::process::id());
-        assert_eq!(in_use(&p), Ok(()));
+        assert!(in_use(&p).is_ok());
         for what in RUN_LOCKS {
             assert!(!lock_dir().join(format!("{p}.{what}.lock")).exists());
         }
         let slave = take(&p, "slave", "a slave by hand (pid 7)").expect("take");
-        let e = in_use(&p).expect_err("held");
+        let e = in_use(&p).expect_err("held").to_string();
         assert!(e.contains("a slave by hand (pid 7)"), "{e}");
         assert!(!idle(&p));
         drop(slave);

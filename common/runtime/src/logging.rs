@@ -15,15 +15,25 @@ use tracing_subscriber::{fmt, EnvFilter, Layer};
 /// its router says why on its own side too.
 pub const DEFAULT_FILTER: &str = "info,zenoh::net::runtime::orchestrator=debug";
 
+/// The node's log file could not be opened.
+#[derive(Debug, thiserror::Error)]
+#[error("opening {}: {source}", path.display())]
+pub struct LogError {
+    /// The log file.
+    pub path: std::path::PathBuf,
+    /// The operating system's reason.
+    pub source: std::io::Error,
+}
+
 /// Installs the node's logger; `to_stderr` adds a copy on stderr. Returns an error line
 /// if the log file cannot be opened.
-pub fn init(dir: &Path, role: tactile_messages::Role, to_stderr: bool) -> Result<(), String> {
+pub fn init(dir: &Path, role: tactile_messages::Role, to_stderr: bool) -> Result<(), LogError> {
     let path = dir.join(format!("{role}.log"));
     let file = std::fs::OpenOptions::new()
         .create(true)
         .append(true)
         .open(&path)
-        .map_err(|e| format!("opening {}: {e}", path.display()))?;
+        .map_err(|source| LogError { path, source })?;
     let filter =
         || EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new(DEFAULT_FILTER));
     let file_layer = fmt::layer()

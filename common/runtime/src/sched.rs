@@ -159,10 +159,40 @@ pub struct KeepAwake {
     threads: Vec<std::thread::JoinHandle<()>>,
 }
 
+/// Why a CPU could not be asked about, pinned or kept awake.
+#[derive(Debug, thiserror::Error)]
+pub enum SchedError {
+    /// The CPUs this thread may use could not be read.
+    #[error("reading CPU affinity: {0}")]
+    Affinity(#[source] rustix::io::Errno),
+    /// `--cpu` names a CPU this process may not use.
+    #[error("--cpu {0}: not a CPU this process may use")]
+    NotAllowed(usize),
+    /// Pinning to the CPU failed.
+    #[error("pinning {who}to CPU {cpu}: {source}")]
+    Pin {
+        /// Whose pinning (`the idle-poll thread `, or empty for the node).
+        who: &'static str,
+        /// The CPU.
+        cpu: usize,
+        /// The kernel's reason.
+        source: rustix::io::Errno,
+    },
+    /// The spinning thread could not lower itself to SCHED_IDLE.
+    #[error("SCHED_IDLE for the idle-poll thread: {0}")]
+    Idle(#[source] std::io::Error),
+    /// The spinning thread could not be started.
+    #[error("starting the idle-poll thread: {0}")]
+    Spawn(#[source] std::io::Error),
+    /// The spinning thread ended before it said whether it could lower itself.
+    #[error("the idle-poll thread ended at start")]
+    Ended(#[source] std::sync::mpsc::RecvError),
+}
+
 impl KeepAwake {
     /// Starts one spinning thread on each CPU the calling thread may run on; each
     /// lowers itself to SCHED_IDLE before it spins.
-    pub fn start() -> Result<KeepAwake, String> {
+    pub fn start() -> Result<KeepAwake, SchedError> {
         let cpus = allowed_cpus()?;
         let stop = Arc::new(AtomicBool::new(false));
         let mut awake = KeepAwake {
@@ -182,21 +212,20 @@ impl KeepAwake {
                     let _ = tx.send(ready);
                     while ok && !stop.load(Ordering::Relaxed) {}
                 })
-                .map_err(|e| format!("starting the idle-poll thread: {e}"))?;
+                .map_err(SchedError::Spawn)?;
             awake.threads.push(t);
             // Each thread says whether it could lower itself before it spins: a thread
             // left at the node's SCHED_FIFO must never spin.
-            rx.recv()
-                .map_err(|_| "the idle-poll thread ended at start".to_string())??;
+            rx.recv().map_err(SchedError::Ended)??;
         }
         Ok(awake)
     }
 }
 
 /// The CPUs the calling thread may run on.
-pub fn allowed_cpus() -> Result<Vec<usize>, String> {
+pub fn allowed_cpus() -> Result<Vec<usize>, SchedError> {
     use rustix::thread::{sched_getaffinity, CpuSet};
-    let set = sched_getaffinity(None).map_err(|e| format!("reading CPU affinity: {e}"))?;
+    let set = sched_getaffinity(None).map_err(SchedError::Affinity)?;
     Ok((0..CpuSet::MAX_CPU).filter(|&c| set.is_set(c)).collect())
 }
 
@@ -208,9 +237,13 @@ pub fn pin_thread(cpu: usize) -> rustix::io::Result<()> {
 }
 
 /// Pins the calling thread to `cpu` and lowers it to SCHED_IDLE.
-fn spinner_setup(cpu: usize) -> Result<(), String> {
-    pin_thread(cpu).map_err(|e| format!("pinning the idle-poll thread to CPU {cpu}: {e}"))?;
-    crate::sys::set_idle().map_err(|e| format!("SCHED_IDLE for the idle-poll thread: {e}"))
+fn spinner_setup(cpu: usize) -> Result<(), SchedError> {
+    pin_thread(cpu).map_err(|source| SchedError::Pin {
+        who: "the idle-poll thread ",
+        cpu,
+        source,
+    })?;
+    crate::sys::set_idle().map_err(SchedError::Idle)
 }
 
 impl Drop for KeepAwake {

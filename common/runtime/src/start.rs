@@ -37,8 +37,8 @@ pub fn prepare(role: Role, args: &NodeArgs, links: &Links) -> Result<Prepared, N
     // From here on a stop request is never fatal: it is noticed by the loop's driver
     // and the record is closed.
     crate::signals::stop_flag().map_err(|e| bad(format!("installing signal handlers: {e}")))?;
-    lock::check_prefix(&args.link.prefix).map_err(bad)?;
-    let (scenario, base_dir) = crate::files::load_scenario(&args.scenario).map_err(bad)?;
+    lock::check_prefix(&args.link.prefix)?;
+    let (scenario, base_dir) = crate::files::load_scenario(&args.scenario)?;
     args.link
         .check(&links.kinds())
         .map_err(|e| bad(e.to_string()))?;
@@ -62,13 +62,13 @@ pub fn prepare(role: Role, args: &NodeArgs, links: &Links) -> Result<Prepared, N
         std::process::id(),
         args.out.display()
     );
-    let lock = lock::take(&args.link.prefix, role.name(), &holder).map_err(bad)?;
-    crate::logging::init(&args.out, role, args.supervised.is_none()).map_err(bad)?;
+    let lock = lock::take(&args.link.prefix, role.name(), &holder)?;
+    crate::logging::init(&args.out, role, args.supervised.is_none())?;
     if let Some(parent) = args.supervised {
         supervise(parent)?;
     }
     if let Some(cpu) = args.cpu {
-        pin(cpu).map_err(bad)?;
+        pin(cpu)?;
     }
     let (wake_early, spin) = waiting(&scenario, args.wake_early_us, args.spin_us);
     check_waiting(args, &scenario, wake_early, spin)?;
@@ -191,11 +191,16 @@ fn supervise(parent: u32) -> Result<(), NodeError> {
 }
 
 /// Pins the calling thread (the node's only thread) to `cpu`.
-pub fn pin(cpu: usize) -> Result<(), String> {
+pub fn pin(cpu: usize) -> Result<(), crate::sched::SchedError> {
+    use crate::sched::SchedError;
     if !crate::sched::allowed_cpus()?.contains(&cpu) {
-        return Err(format!("--cpu {cpu}: not a CPU this process may use"));
+        return Err(SchedError::NotAllowed(cpu));
     }
-    crate::sched::pin_thread(cpu).map_err(|e| format!("pinning to CPU {cpu}: {e}"))
+    crate::sched::pin_thread(cpu).map_err(|source| SchedError::Pin {
+        who: "",
+        cpu,
+        source,
+    })
 }
 
 /// This node's clock domain: `TACTILE_CLOCK_DOMAIN` if set, else the kernel's boot id

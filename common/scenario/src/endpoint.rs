@@ -1,40 +1,79 @@
 //! Zenoh endpoints as a scenario names them (`[ros]` `connect`, `listen`): checked
 //! before anything connects, and told apart by whether they leave this host in clear.
 
+/// What is wrong with a Zenoh endpoint.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum EndpointError {
+    /// No `PROTOCOL/`.
+    #[error("no protocol (tcp/, udp/, tls/, quic/)")]
+    NoProtocol,
+    /// A protocol Zenoh does not have.
+    #[error("protocol {0:?} is not tcp, udp, tls or quic")]
+    Protocol(String),
+    /// Port 0 to connect to.
+    #[error("port 0 is outside 1..=65535 (it connects nowhere)")]
+    ConnectToZero,
+    /// No `:PORT`.
+    #[error("no :PORT")]
+    NoPort,
+    /// The port is not a number.
+    #[error("port {port:?} is not a number")]
+    PortNotNumber {
+        /// The port as written.
+        port: String,
+        /// Why it is no number.
+        source: std::num::ParseIntError,
+    },
+    /// The port is out of range.
+    #[error("port {0} is outside 1..=65535")]
+    PortRange(u32),
+    /// An IP address (IPv6 in brackets, or one that parsed without its port) that
+    /// did not parse with its port.
+    #[error("{0} is not an IP address with a port")]
+    IpWithPort(String),
+    /// Digits and dots that are no IPv4 address.
+    #[error("{0} is not an IP address")]
+    NotIp(String),
+    /// Not a host name either.
+    #[error("{0:?} is neither an IP address nor a host name")]
+    NotHost(String),
+}
+
 /// Checks a Zenoh endpoint `PROTOCOL/HOST:PORT` as far as it can be without the
 /// network: a known protocol, a port in 1..=65535, an IP address that parses (a dotted
 /// quad like 999.1.1.1 does not) or a host name of letters, digits, `-` and `.`.
 /// Anything after `#` (Zenoh's endpoint options) is left to Zenoh. Port 0 listens on
 /// any free port, and connects nowhere.
-pub fn check(e: &str, connect: bool) -> Result<(), String> {
+pub fn check(e: &str, connect: bool) -> Result<(), EndpointError> {
     let locator = e.split('#').next().unwrap_or(e);
-    let (proto, addr) = locator
-        .split_once('/')
-        .ok_or("no protocol (tcp/, udp/, tls/, quic/)")?;
+    let (proto, addr) = locator.split_once('/').ok_or(EndpointError::NoProtocol)?;
     if !matches!(proto, "tcp" | "udp" | "tls" | "quic") {
-        return Err(format!("protocol {proto:?} is not tcp, udp, tls or quic"));
+        return Err(EndpointError::Protocol(proto.to_string()));
     }
     if let Ok(a) = addr.parse::<std::net::SocketAddr>() {
         if connect && a.port() == 0 {
-            return Err("port 0 is outside 1..=65535 (it connects nowhere)".into());
+            return Err(EndpointError::ConnectToZero);
         }
         return Ok(());
     }
-    let (host, port) = addr.rsplit_once(':').ok_or("no :PORT")?;
+    let (host, port) = addr.rsplit_once(':').ok_or(EndpointError::NoPort)?;
     let port: u32 = port
         .parse()
-        .map_err(|_| format!("port {port:?} is not a number"))?;
+        .map_err(|source| EndpointError::PortNotNumber {
+            port: port.to_string(),
+            source,
+        })?;
     if !(1..=65535).contains(&port) {
-        return Err(format!("port {port} is outside 1..=65535"));
+        return Err(EndpointError::PortRange(port));
     }
     if host.starts_with('[') || host.parse::<std::net::IpAddr>().is_ok() {
-        return Err(format!("{host} is not an IP address with a port"));
+        return Err(EndpointError::IpWithPort(host.to_string()));
     }
     if host
         .split('.')
         .all(|p| p.chars().all(|c| c.is_ascii_digit()))
     {
-        return Err(format!("{host} is not an IP address"));
+        return Err(EndpointError::NotIp(host.to_string()));
     }
     let name_ok = !host.is_empty()
         && host.len() <= 253
@@ -45,7 +84,7 @@ pub fn check(e: &str, connect: bool) -> Result<(), String> {
                 && !l.starts_with('-')
         });
     if !name_ok {
-        return Err(format!("{host:?} is neither an IP address nor a host name"));
+        return Err(EndpointError::NotHost(host.to_string()));
     }
     Ok(())
 }
@@ -89,7 +128,7 @@ mod tests {
             ("tcp/a b:7447", "neither an IP address nor a host name"),
             ("tcp/host:port", "port \"port\" is not a number"),
         ] {
-            let e = check(bad, true).expect_err(bad);
+            let e = check(bad, true).expect_err(bad).to_string();
             assert!(e.contains(why), "{bad}: {e}");
         }
         assert_eq!(check("tcp/0.0.0.0:0", false), Ok(()), "listen on any port");
@@ -99,5 +138,13 @@ mod tests {
         };
         let e = cfg.validate(1000.0).expect_err("bad port").to_string();
         assert!(e.contains("ros.connect[0]") && e.contains("99999"), "{e}");
+    }
+
+    #[test]
+    fn a_port_that_is_no_number_keeps_the_parsers_reason() {
+        use std::error::Error as _;
+        let e = check("tcp/host:port", true).expect_err("no number");
+        let cause = e.source().expect("the integer's reason");
+        assert!(cause.is::<std::num::ParseIntError>(), "{cause:?}");
     }
 }

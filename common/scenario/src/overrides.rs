@@ -8,6 +8,144 @@
 
 use toml::{Table, Value};
 
+/// What is wrong with a `--set`, or with applying the sets to a scenario's text.
+#[derive(Debug, thiserror::Error)]
+pub enum SetError {
+    /// No `=` in it.
+    #[error("--set {text:?}: expected KEY=VALUE")]
+    NoValue {
+        /// The set as written.
+        text: String,
+    },
+    /// Its key or its value is wrong.
+    #[error("--set {text:?}: {source}")]
+    Parse {
+        /// The set as written.
+        text: String,
+        /// What is wrong.
+        source: Problem,
+    },
+    /// Two sets of one time in two units.
+    #[error("{}", twice(.0, .1))]
+    Twice(String, String),
+    /// The scenario's text is not TOML.
+    #[error("the scenario is not TOML: {}", .0.message().trim_end())]
+    NotToml(#[source] Box<toml::de::Error>),
+    /// The set's path does not fit the scenario's tables.
+    #[error("--set {text}: {source}")]
+    Put {
+        /// The set as written.
+        text: String,
+        /// Where it does not fit.
+        source: Problem,
+    },
+    /// The changed table could not be written back as TOML.
+    #[error("encoding the scenario: {0}")]
+    Encode(#[from] toml::ser::Error),
+}
+
+/// What is wrong in one part of a `--set`: its key, its value, or the place it names.
+#[derive(Debug, thiserror::Error)]
+pub enum Problem {
+    /// A segment of the key is not a name.
+    #[error("{key:?} is not a dotted path of names (segment {seg:?})")]
+    NotNames {
+        /// The key.
+        key: String,
+        /// The segment.
+        seg: String,
+    },
+    /// A `[` without its `]`.
+    #[error("{key:?}: unclosed [ in {seg:?}")]
+    Unclosed {
+        /// The key.
+        key: String,
+        /// The segment.
+        seg: String,
+    },
+    /// Not a number in `[...]`.
+    #[error("{key:?}: [{idx}] is not an index")]
+    NotIndex {
+        /// The key.
+        key: String,
+        /// What is in the brackets.
+        idx: String,
+        /// Why it is no index.
+        source: std::num::ParseIntError,
+    },
+    /// Something after a `]` that is not another `[`.
+    #[error("{key:?}: unexpected {after:?} after ]")]
+    After {
+        /// The key.
+        key: String,
+        /// What follows.
+        after: String,
+    },
+    /// Nothing after `=`.
+    #[error("no value after =")]
+    Empty,
+    /// An integer TOML cannot hold.
+    #[error(
+        "{text} is out of range: a scenario's integers are {} to {}",
+        i64::MIN,
+        i64::MAX
+    )]
+    OutOfRange {
+        /// The value.
+        text: String,
+    },
+    /// Written as a number, but not one.
+    #[error("{text:?} is not a number ({})", first_line(source))]
+    NotNumber {
+        /// The value.
+        text: String,
+        /// TOML's reason.
+        source: Box<toml::de::Error>,
+    },
+    /// Neither a TOML value nor a bare word.
+    #[error("{text:?} is not a TOML value ({})", first_line(source))]
+    NotToml {
+        /// The value.
+        text: String,
+        /// TOML's reason.
+        source: Box<toml::de::Error>,
+    },
+    /// A path that starts with an index.
+    #[error("the path must start with a key")]
+    NoKey,
+    /// An index past an array's end.
+    #[error("{name}[{i}]: {name} has {len} entries")]
+    NoEntry {
+        /// The array.
+        name: String,
+        /// The index.
+        i: usize,
+        /// Its entries.
+        len: usize,
+    },
+    /// A key under something that is no table.
+    #[error("{name} is not a table, so it has no {key}")]
+    NotTable {
+        /// What is there.
+        name: String,
+        /// The key under it.
+        key: String,
+    },
+    /// An index into something that is no array.
+    #[error("{name} is not an array, so it has no [{i}]")]
+    NotArray {
+        /// What is there.
+        name: String,
+        /// The index.
+        i: usize,
+    },
+}
+
+/// The first line of TOML's message (the rest draws the text under it).
+fn first_line(e: &toml::de::Error) -> &str {
+    e.message().lines().next().unwrap_or("")
+}
+
 /// One `KEY=VALUE`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Set {
@@ -30,13 +168,17 @@ pub enum Step {
 
 impl Set {
     /// Parses `KEY=VALUE`; the error says what is wrong with it.
-    pub fn parse(text: &str) -> Result<Set, String> {
-        let (key, value) = text
-            .split_once('=')
-            .ok_or_else(|| format!("--set {text:?}: expected KEY=VALUE"))?;
+    pub fn parse(text: &str) -> Result<Set, SetError> {
+        let (key, value) = text.split_once('=').ok_or_else(|| SetError::NoValue {
+            text: text.to_string(),
+        })?;
+        let parse = |source| SetError::Parse {
+            text: text.to_string(),
+            source,
+        };
         Ok(Set {
-            path: parse_path(key.trim()).map_err(|e| format!("--set {text:?}: {e}"))?,
-            value: parse_value(value.trim()).map_err(|e| format!("--set {text:?}: {e}"))?,
+            path: parse_path(key.trim()).map_err(parse)?,
+            value: parse_value(value.trim()).map_err(parse)?,
             text: text.to_string(),
         })
     }
@@ -49,7 +191,7 @@ impl Set {
     }
 }
 
-fn parse_path(key: &str) -> Result<Vec<Step>, String> {
+fn parse_path(key: &str) -> Result<Vec<Step>, Problem> {
     let mut path = Vec::new();
     for seg in key.split('.') {
         let (name, mut rest) = seg.split_once('[').map_or((seg, ""), |(n, r)| (n, r));
@@ -58,56 +200,60 @@ fn parse_path(key: &str) -> Result<Vec<Step>, String> {
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
         if !ok {
-            return Err(format!(
-                "{key:?} is not a dotted path of names (segment {seg:?})"
-            ));
+            return Err(Problem::NotNames {
+                key: key.to_string(),
+                seg: seg.to_string(),
+            });
         }
         path.push(Step::Key(name.to_string()));
         while !rest.is_empty() {
-            let (idx, after) = rest
-                .split_once(']')
-                .ok_or_else(|| format!("{key:?}: unclosed [ in {seg:?}"))?;
-            let i = idx
-                .parse::<usize>()
-                .map_err(|_| format!("{key:?}: [{idx}] is not an index"))?;
+            let (idx, after) = rest.split_once(']').ok_or_else(|| Problem::Unclosed {
+                key: key.to_string(),
+                seg: seg.to_string(),
+            })?;
+            let i = idx.parse::<usize>().map_err(|source| Problem::NotIndex {
+                key: key.to_string(),
+                idx: idx.to_string(),
+                source,
+            })?;
             path.push(Step::Index(i));
             rest = after.strip_prefix('[').unwrap_or(after);
             if !after.is_empty() && !after.starts_with('[') {
-                return Err(format!("{key:?}: unexpected {after:?} after ]"));
+                return Err(Problem::After {
+                    key: key.to_string(),
+                    after: after.to_string(),
+                });
             }
         }
     }
     Ok(path)
 }
 
-fn parse_value(text: &str) -> Result<Value, String> {
+fn parse_value(text: &str) -> Result<Value, Problem> {
     if text.is_empty() {
-        return Err("no value after =".into());
+        return Err(Problem::Empty);
     }
     match format!("v = {text}").parse::<Table>() {
-        Ok(mut t) => t.remove("v").ok_or_else(|| "no value".to_string()),
-        Err(e) => {
-            let first = e.message().lines().next().unwrap_or("").to_string();
+        // `v = X` parsed is a table of one key, `v`.
+        Ok(mut t) => t.remove("v").ok_or(Problem::Empty),
+        Err(source) => {
+            let (text, source) = (text.to_string(), Box::new(source));
             let word = text
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || "-_./".contains(c));
-            if numeric(text) {
+            if numeric(&text) {
                 // A number TOML cannot hold is no string: `samples=99999999999999999999`
                 // read as one was refused as "expected u64", naming no range.
                 let digits = text.trim_start_matches(['+', '-']);
                 if digits.chars().all(|c| c.is_ascii_digit() || c == '_') {
-                    Err(format!(
-                        "{text} is out of range: a scenario's integers are {} to {}",
-                        i64::MIN,
-                        i64::MAX
-                    ))
+                    Err(Problem::OutOfRange { text })
                 } else {
-                    Err(format!("{text:?} is not a number ({first})"))
+                    Err(Problem::NotNumber { text, source })
                 }
             } else if word {
-                Ok(Value::String(text.to_string()))
+                Ok(Value::String(text))
             } else {
-                Err(format!("{text:?} is not a TOML value ({first})"))
+                Err(Problem::NotToml { text, source })
             }
         }
     }
@@ -125,21 +271,22 @@ fn numeric(text: &str) -> bool {
 
 /// The scenario text `text` with every set applied in order; the result still has to
 /// be read as a scenario (which checks keys and values).
-pub fn apply(text: &str, sets: &[Set]) -> Result<String, String> {
+pub fn apply(text: &str, sets: &[Set]) -> Result<String, SetError> {
     if sets.is_empty() {
         return Ok(text.to_string());
     }
     let keys: Vec<String> = sets.iter().map(Set::key).collect();
     if let Some((a, b)) = twins(&keys) {
-        return Err(twice(&sets[a].text, &sets[b].text));
+        return Err(SetError::Twice(sets[a].text.clone(), sets[b].text.clone()));
     }
-    let mut table: Table = text.parse().map_err(|e: toml::de::Error| {
-        format!("the scenario is not TOML: {}", e.message().trim_end())
-    })?;
+    let mut table: Table = text.parse().map_err(|e| SetError::NotToml(Box::new(e)))?;
     for s in sets {
-        put(&mut table, &s.path, s.value.clone()).map_err(|e| format!("--set {}: {e}", s.text))?;
+        put(&mut table, &s.path, s.value.clone()).map_err(|source| SetError::Put {
+            text: s.text.clone(),
+            source,
+        })?;
     }
-    toml::to_string(&table).map_err(|e| format!("encoding the scenario: {e}"))
+    Ok(toml::to_string(&table)?)
 }
 
 /// The first two of `keys` that say one time in two units at one place
@@ -169,9 +316,9 @@ pub fn twice(a: &str, b: &str) -> String {
 }
 
 /// Puts `value` at `path` in `table`, making the tables on the way that do not exist.
-fn put(table: &mut Table, path: &[Step], value: Value) -> Result<(), String> {
+fn put(table: &mut Table, path: &[Step], value: Value) -> Result<(), Problem> {
     let Some((Step::Key(first), rest)) = path.split_first() else {
-        return Err("the path must start with a key".into());
+        return Err(Problem::NoKey);
     };
     if rest.is_empty() {
         // A time given in one unit replaces the file's in the other (`delay_ms` the
@@ -191,14 +338,16 @@ fn put(table: &mut Table, path: &[Step], value: Value) -> Result<(), String> {
     put_in(slot, first, rest, value)
 }
 
-fn put_in(slot: &mut Value, name: &str, rest: &[Step], value: Value) -> Result<(), String> {
+fn put_in(slot: &mut Value, name: &str, rest: &[Step], value: Value) -> Result<(), Problem> {
     match (&rest[0], slot) {
         (Step::Key(_), Value::Table(t)) => put(t, rest, value),
         (Step::Index(i), Value::Array(a)) => {
             let len = a.len();
-            let item = a
-                .get_mut(*i)
-                .ok_or_else(|| format!("{name}[{i}]: {name} has {len} entries"))?;
+            let item = a.get_mut(*i).ok_or_else(|| Problem::NoEntry {
+                name: name.to_string(),
+                i: *i,
+                len,
+            })?;
             if rest.len() == 1 {
                 *item = value;
                 Ok(())
@@ -206,8 +355,14 @@ fn put_in(slot: &mut Value, name: &str, rest: &[Step], value: Value) -> Result<(
                 put_in(item, &format!("{name}[{i}]"), &rest[1..], value)
             }
         }
-        (Step::Key(k), _) => Err(format!("{name} is not a table, so it has no {k}")),
-        (Step::Index(i), _) => Err(format!("{name} is not an array, so it has no [{i}]")),
+        (Step::Key(k), _) => Err(Problem::NotTable {
+            name: name.to_string(),
+            key: k.clone(),
+        }),
+        (Step::Index(i), _) => Err(Problem::NotArray {
+            name: name.to_string(),
+            i: *i,
+        }),
     }
 }
 
@@ -239,6 +394,26 @@ mod tests {
     use super::*;
 
     const BASE: &str = "name = \"t\"\nrate_hz = 100.0\n\n[network.forward]\ndelay = [0, 0, 0]\n\n[[objects]]\nstiffness = [1.0, 2.0]\n";
+
+    /// The cause stays under the set's error: the set's text above, TOML's or the
+    /// integer parser's reason below, each reached through `source()`.
+    #[test]
+    fn a_bad_set_keeps_its_cause() {
+        use std::error::Error as _;
+        let e = Set::parse("objects[x]=1").expect_err("no index");
+        let problem = e.source().expect("the problem");
+        assert!(matches!(
+            problem.downcast_ref::<Problem>(),
+            Some(Problem::NotIndex { .. })
+        ));
+        let int = problem.source().expect("the integer's reason");
+        assert!(int.downcast_ref::<std::num::ParseIntError>().is_some());
+        let e = Set::parse("rate_hz=[1,").expect_err("not TOML");
+        let toml = e.source().and_then(|p| p.source()).expect("TOML's reason");
+        assert!(toml.is::<Box<toml::de::Error>>(), "{toml:?}");
+        let e = apply("= nope", &[set("rate_hz=1")]).expect_err("not TOML");
+        assert!(e.source().is_some_and(|c| c.is::<Box<toml::de::Error>>()));
+    }
 
     fn set(s: &str) -> Set {
         Set::parse(s).expect("parse")
@@ -285,7 +460,7 @@ mod tests {
             ("seed=-99999999999999999999", "out of range"),
             ("rate_hz=1.5.3", "is not a number"),
         ] {
-            let e = Set::parse(s).expect_err(s);
+            let e = Set::parse(s).expect_err(s).to_string();
             assert!(e.contains(needle), "{s}: {e}");
         }
         for (s, needle) in [
@@ -293,7 +468,7 @@ mod tests {
             ("objects[3].stiffness=1", "objects has 1 entries"),
             ("name[0]=1", "name is not an array"),
         ] {
-            let e = apply(BASE, &[set(s)]).expect_err(s);
+            let e = apply(BASE, &[set(s)]).expect_err(s).to_string();
             assert!(e.contains(needle) && e.contains(s), "{s}: {e}");
         }
     }
@@ -302,7 +477,9 @@ mod tests {
     /// and no range; a word that merely starts with a digit stays a string.
     #[test]
     fn numbers_toml_cannot_hold_are_refused_and_words_stay_strings() {
-        let e = Set::parse("samples=99999999999999999999").expect_err("beyond i64");
+        let e = Set::parse("samples=99999999999999999999")
+            .expect_err("beyond i64")
+            .to_string();
         assert!(
             e.contains("samples=99999999999999999999") && e.contains("9223372036854775807"),
             "{e}"

@@ -263,7 +263,7 @@ fn two_sets_of_one_time_in_two_units_are_refused() {
         Set::parse("network.forward.delay=[5,5,5]").expect("set"),
         Set::parse("network.forward.delay_ms=10").expect("set"),
     ];
-    let e = apply(file, &sets).expect_err("twins");
+    let e = apply(file, &sets).expect_err("twins").to_string();
     assert!(
         e.contains("network.forward.delay=[5,5,5]") && e.contains("network.forward.delay_ms=10"),
         "{e}"

@@ -48,14 +48,16 @@ fn config() -> impl bincode::config::Config {
         .with_limit::<MAX_FRAME>()
 }
 
-fn encode_into<T: Serialize>(kind: Kind, value: &T, buf: &mut Vec<u8>) -> Result<(), String> {
+fn encode_into<T: Serialize>(
+    kind: Kind,
+    value: &T,
+    buf: &mut Vec<u8>,
+) -> Result<(), bincode::error::EncodeError> {
     buf.clear();
     buf.extend_from_slice(&MAGIC);
     buf.extend_from_slice(&VERSION.to_le_bytes());
     buf.push(kind as u8);
-    bincode::serde::encode_into_std_write(value, buf, config())
-        .map(|_| ())
-        .map_err(|e| e.to_string())
+    bincode::serde::encode_into_std_write(value, buf, config()).map(|_| ())
 }
 
 fn body<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, Reject> {
@@ -111,7 +113,7 @@ impl OnWire for Backward {
 }
 
 /// Encodes `value` as one frame into `buf` (cleared first).
-pub fn encode<T: OnWire>(value: &T, buf: &mut Vec<u8>) -> Result<(), String> {
+pub fn encode<T: OnWire>(value: &T, buf: &mut Vec<u8>) -> Result<(), bincode::error::EncodeError> {
     encode_into(T::KIND, value, buf)
 }
 

@@ -17,8 +17,8 @@ use pyo3::types::PyBytes;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
-use tactile::launch::sim::Hooks;
 use tactile_control::codec::{Guess, HISTORY};
+use tactile_launch::sim::Hooks;
 use tactile_master::operator::Operate;
 use tactile_runtime::signals;
 

@@ -28,10 +28,9 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
-use tactile::cmd::formats::FormatArgs;
-use tactile::cmd::sweep::{Base, Progress, SweepArgs};
-use tactile::error::Error;
-use tactile::launch::{load_source, parse_sets, Loaded, Outputs, Source};
+use tactile_launch::error::Error;
+use tactile_launch::sweep::{Base, Progress, SweepOptions};
+use tactile_launch::{load_source, parse_sets, Loaded, Outputs, Source};
 use tactile_report::write::{write_report, Launch};
 use tactile_runtime::files;
 use tactile_runtime::signals;
@@ -121,7 +120,7 @@ fn check_sets(
     use tactile_scenario::ScenarioError as Bad;
     let src = source(text, base_dir, name, path);
     let parsed = parse_sets(&sets)
-        .and_then(|s| tactile_scenario::overrides::apply(&src.text, &s).map_err(Error::BadInput));
+        .and_then(|s| tactile_scenario::overrides::apply(&src.text, &s).map_err(Error::from));
     let typed = match parsed {
         Ok(text) => !matches!(
             tactile_scenario::Scenario::from_toml_str(&text),
@@ -144,7 +143,7 @@ type Grid = (Vec<(String, bool, Vec<String>)>, Vec<Vec<usize>>);
 /// (the index of its value on each axis), in the grid's order.
 #[pyfunction]
 fn sweep_grid(sets: Vec<String>) -> PyResult<Grid> {
-    let axes = tactile::cmd::sweep::parse_axes(&sets).map_err(to_py)?;
+    let axes = tactile_launch::sweep::parse_axes(&sets).map_err(to_py)?;
     let combos = tactile_report::sweep::combinations(&axes);
     let axes = axes
         .into_iter()
@@ -238,7 +237,7 @@ fn waiting<T: Send>(py: Python<'_>, work: impl FnOnce() -> Result<T, Error> + Se
 #[pyfunction]
 fn read_scenario(path: PathBuf) -> PyResult<(String, PathBuf, String)> {
     let text = files::read_text(&path, "scenario", files::MAX_SCENARIO_BYTES)
-        .map_err(|e| to_py(Error::BadInput(e)))?;
+        .map_err(|e| to_py(e.into()))?;
     Ok((text, files::base_dir(&path), path.display().to_string()))
 }
 
@@ -255,7 +254,7 @@ fn check(
     sets: Vec<String>,
 ) -> PyResult<(String, Vec<String>)> {
     let loaded = load(&source(text, base_dir, name, path), &sets).map_err(to_py)?;
-    let notes = tactile::cmd::check::report(&loaded);
+    let notes = tactile_launch::estimate::report(&loaded);
     Ok((loaded.scenario.resolved(&loaded.base_dir).to_toml(), notes))
 }
 
@@ -294,7 +293,7 @@ fn run(
     // one looks at the signals.
     let simulated = py.detach(|| {
         let loaded = load(&src, &sets)?;
-        tactile::launch::sim::simulate_into(&loaded, &out, hooks)
+        tactile_launch::sim::simulate_into(&loaded, &out, hooks)
     });
     let summary = simulated
         .map_err(to_py)
@@ -333,22 +332,17 @@ fn sweep(
     resume: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<usize> {
-    let args = SweepArgs {
-        scenario: None,
+    let args = SweepOptions {
         set: swept,
         out,
         processes: false,
         trace,
-        formats: FormatArgs {
-            trace_format: outputs(Some(trace_format))?.trace_format,
-            mcap_compression: Default::default(),
-        },
+        trace_format: outputs(Some(trace_format))?.trace_format,
+        mcap_compression: Default::default(),
         jobs,
         seeds,
         resume,
         shard: None,
-        quiet: true,
-        merge: Vec::new(),
     };
     let base = Base {
         source: source(text, base_dir, name, path),
@@ -358,7 +352,7 @@ fn sweep(
     interruptible(
         py,
         |tell: &(dyn Fn(Progress) + Sync)| {
-            tactile::cmd::sweep::sweep(&base, &args, &|p: &Progress| tell(p.clone()))
+            tactile_launch::sweep::sweep(&base, &args, &|p: &Progress| tell(p.clone()))
         },
         |py, p: Progress| match &progress {
             Some(f) => f.call1(py, (p.ended, p.total, p.run, p.what)).map(drop),
@@ -383,7 +377,7 @@ fn report(
     waiting(py, || {
         let out = match out {
             Some(o) => o,
-            None => tactile::cmd::report::default_out(&dirs)?,
+            None => tactile_launch::report_out(&dirs)?,
         };
         write_into(&dirs, &out, outputs)?;
         Ok(out)
@@ -416,7 +410,9 @@ fn outputs(trace_format: Option<&str>) -> PyResult<Outputs> {
     };
     let trace_format = format
         .parse()
-        .map_err(|e: String| ScenarioError::new_err(format!("trace_format: {e}")))?;
+        .map_err(|e: tactile_report::error::UnknownChoice| {
+            ScenarioError::new_err(format!("trace_format: {e}"))
+        })?;
     Ok(Outputs {
         trace_format,
         ..Outputs::default()
@@ -437,7 +433,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
     m.add("RunError", m.py().get_type::<RunError>())?;
-    m.add("PAPER_SCENARIO", tactile::launch::PAPER_SCENARIO)?;
+    m.add("PAPER_SCENARIO", tactile_launch::PAPER_SCENARIO)?;
     m.add("MAX_SCENARIO_BYTES", files::MAX_SCENARIO_BYTES)?;
     Ok(())
 }

@@ -1,9 +1,9 @@
 //! The datapath options `tactile kernels` and `tactile paper` share: arithmetic,
 //! fixed-point format of the hybrid CORDIC block, and the device geometry.
 
-use crate::error::Error;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
+use tactile_launch::error::Error;
 use tactile_math::arith::ArithKind;
 use tactile_math::cordic::{CordicConfig, Rounding};
 use tactile_math::geometry::Geometry;

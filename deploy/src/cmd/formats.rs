@@ -1,6 +1,7 @@
 //! The output format options `tactile run`, `report` and `sweep` share.
 
 use clap::Args;
+use tactile_report::error::UnknownChoice;
 use tactile_report::mcap::Compression;
 use tactile_report::write::TraceFormat;
 
@@ -18,11 +19,11 @@ pub struct FormatArgs {
     pub mcap_compression: Compression,
 }
 
-fn parse_trace(s: &str) -> Result<TraceFormat, String> {
+fn parse_trace(s: &str) -> Result<TraceFormat, UnknownChoice> {
     s.parse()
 }
 
-fn parse_mcap(s: &str) -> Result<Compression, String> {
+fn parse_mcap(s: &str) -> Result<Compression, UnknownChoice> {
     s.parse()
 }
 
@@ -41,9 +42,13 @@ impl FormatArgs {
     /// Refuses a format option that would change nothing (`writes`: the command writes
     /// the trace and the recording), so a study does not find out at its end that its
     /// Parquet traces were never written.
-    pub fn refuse_unless(&self, writes: bool, why: &str) -> Result<(), crate::error::Error> {
+    pub fn refuse_unless(
+        &self,
+        writes: bool,
+        why: &str,
+    ) -> Result<(), tactile_launch::error::Error> {
         match self.given() {
-            Some(flag) if !writes => Err(crate::error::Error::BadInput(format!(
+            Some(flag) if !writes => Err(tactile_launch::error::Error::BadInput(format!(
                 "{flag} {why}: no trace and no recording are written"
             ))),
             _ => Ok(()),
@@ -51,8 +56,8 @@ impl FormatArgs {
     }
 
     /// The launcher's outputs for these options.
-    pub fn outputs(&self, no_trace: bool) -> crate::launch::Outputs {
-        crate::launch::Outputs {
+    pub fn outputs(&self, no_trace: bool) -> tactile_launch::Outputs {
+        tactile_launch::Outputs {
             no_trace,
             trace_format: self.trace_format,
             mcap_compression: self.mcap_compression,

@@ -6,9 +6,9 @@
 //! parsed, so a bad row leaves stdout empty rather than half written.
 
 use super::datapath::{ArithArg, DatapathArgs, Module};
-use crate::error::Error;
 use clap::Args;
 use std::io::{BufRead, Read, Write};
+use tactile_launch::error::Error;
 use tactile_math::arith::ArithKind;
 use tactile_math::engine::Engine;
 use tactile_math::kernels::IkStatus;
@@ -84,7 +84,7 @@ impl<R: BufRead> Lines<R> {
         let got = (&mut self.input)
             .take(limit)
             .read_until(b'\n', &mut self.buf)
-            .map_err(crate::stop::or_io(
+            .map_err(tactile_launch::stop::or_io(
                 format!("reading line {n} of stdin"),
                 "nothing written to stdout",
             ))?;
@@ -138,8 +138,8 @@ fn evaluate(engine: &Engine, module: Module, v: &[f64]) -> ([f64; 3], Option<boo
 }
 
 /// Evaluates `args.module` over the CSV on `input`, writing CSV to `output`. The
-/// command reads and writes through [`crate::stop::Input`] and
-/// [`crate::stop::Output`], so a stop request (SIGINT, SIGTERM) ends it within a
+/// command reads and writes through [`tactile_launch::stop::Input`] and
+/// [`tactile_launch::stop::Output`], so a stop request (SIGINT, SIGTERM) ends it within a
 /// second however its input comes (a FIFO that gives nothing, an endless stream).
 pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> Result<(), Error> {
     let kind = ArithKind::from(args.arith);
@@ -185,7 +185,7 @@ pub fn run(args: &KernelsArgs, input: impl BufRead, output: &mut impl Write) -> 
     output
         .write_all(out.as_bytes())
         .and_then(|()| output.flush())
-        .map_err(crate::stop::or_io(
+        .map_err(tactile_launch::stop::or_io(
             "writing stdout",
             "stdout holds part of the output",
         ))

@@ -7,6 +7,7 @@ pub mod formats;
 pub mod fuzz;
 pub mod hdl;
 pub mod kernels;
+pub mod node_options;
 pub mod paper;
 pub mod report;
 pub mod run;

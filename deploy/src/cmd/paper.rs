@@ -1,10 +1,10 @@
 //! `tactile paper`: the paper's MSE table from our own kernels.
 
 use super::datapath::DatapathArgs;
-use crate::error::Error;
 use clap::Args;
 use serde::Serialize;
 use std::io::Write;
+use tactile_launch::error::Error;
 use tactile_math::cordic::{CordicConfig, Rounding};
 use tactile_math::validation::{self, MseRow};
 

@@ -1,11 +1,10 @@
 //! `tactile report DIR...`: the run's report from the nodes' records (one folder, or
 //! one folder per node from several hosts).
 
-use crate::error::Error;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use tactile_report::join;
+use tactile_launch::error::Error;
 use tactile_report::text::render;
 use tactile_report::write::{write_mcap, write_report, Launch};
 
@@ -31,16 +30,6 @@ pub struct ReportArgs {
     pub formats: super::formats::FormatArgs,
 }
 
-/// Where a report of the records in `dirs` goes without `--out`: beside the master's
-/// record (the run's folder; with one folder per node, the master's).
-pub fn default_out(dirs: &[PathBuf]) -> Result<PathBuf, Error> {
-    let [master, _, _] = join::locate(dirs)?;
-    Ok(master
-        .as_deref()
-        .and_then(Path::parent)
-        .map_or_else(|| PathBuf::from("."), Path::to_path_buf))
-}
-
 /// `tactile report DIR... [--out OUT]`.
 pub fn main(args: &ReportArgs) -> Result<(), Error> {
     args.formats
@@ -52,7 +41,7 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
     }
     let out = match &args.out {
         Some(o) => o.clone(),
-        None => default_out(&args.dirs)?,
+        None => tactile_launch::report_out(&args.dirs)?,
     };
     let holder = format!("tactile report (pid {})", std::process::id());
     let _held = tactile_report::out::take(&out, &holder)?;
@@ -67,7 +56,7 @@ pub fn main(args: &ReportArgs) -> Result<(), Error> {
         ..Launch::default()
     };
     let summary = write_report(&args.dirs, &out, &launch)?;
-    crate::out!("{}", render(&summary, &out));
+    tactile_launch::out!("{}", render(&summary, &out));
     if summary.interrupted {
         return Err(Error::Interrupted);
     }
@@ -81,15 +70,15 @@ fn mcap_only(args: &ReportArgs, out: &Path, stop: &AtomicBool) -> Result<(), Err
     let w = write_mcap(&args.dirs, out, args.formats.mcap_compression, &stopped)?;
     let file = out.join(tactile_report::run_mcap::FILE);
     if let Some(n) = w.stopped_at {
-        crate::noteln!(
+        tactile_launch::noteln!(
             "stopped at sample {n} by a stop request: {} not written",
             file.display()
         );
         return Err(Error::Interrupted);
     }
     if let Some(w) = w.warning {
-        crate::noteln!("warning: {w}");
+        tactile_launch::noteln!("warning: {w}");
     }
-    crate::outln!("wrote {}: {} samples", file.display(), w.samples);
+    tactile_launch::outln!("wrote {}: {} samples", file.display(), w.samples);
     Ok(())
 }

@@ -1,10 +1,11 @@
 //! `tactile run`: a scenario's loop as three node programs (or in this process), and
 //! its report.
 
-use crate::error::Error;
-use crate::launch::{self, load_scenario, parse_sets, Links, NodeOptions, Supervision};
+use crate::cmd::node_options::NodeOptions;
 use clap::Args;
 use std::path::PathBuf;
+use tactile_launch::error::Error;
+use tactile_launch::{self as launch, load_scenario, parse_sets, Links, Supervision};
 use tactile_report::text::render;
 use tactile_runtime::args::LinkKind;
 
@@ -80,7 +81,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
     let sets = parse_sets(&args.set)?;
     let loaded = load_scenario(args.scenario.as_deref(), &sets)?;
     for w in &loaded.warnings {
-        crate::noteln!("tactile: warning: {w}");
+        tactile_launch::noteln!("tactile: warning: {w}");
     }
     let summary = if args.in_process {
         launch::sim::run_in_process(
@@ -101,7 +102,7 @@ pub fn main(args: &RunArgs) -> Result<(), Error> {
         };
         launch::run_processes(&loaded, &args.out, &sup)?
     };
-    crate::out!("{}", render(&summary, &args.out));
+    tactile_launch::out!("{}", render(&summary, &args.out));
     if summary.interrupted {
         return Err(Error::Interrupted);
     }

@@ -92,6 +92,7 @@ pub(crate) fn draw_line<'a, DB, X>(
 ) -> PlotResult
 where
     DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
     X: Ranged<ValueType = f64>,
 {
     let style = look.style();
@@ -115,6 +116,7 @@ pub(crate) fn draw_legend<'a, DB, X, Y>(
 ) -> PlotResult
 where
     DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
     X: Ranged,
     Y: Ranged,
 {

@@ -14,9 +14,7 @@ use std::path::Path;
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
-fn err(e: impl std::fmt::Display) -> String {
-    e.to_string()
-}
+use crate::plots::{err, PlotResult};
 
 /// Everything one map shows.
 #[derive(Debug, Clone)]
@@ -55,7 +53,7 @@ fn centred() -> Pos {
 }
 
 /// Draws `map` into `path`.
-pub(super) fn draw(path: &Path, map: &Map) -> Result<(), String> {
+pub(super) fn draw(path: &Path, map: &Map) -> PlotResult {
     let header = if map.subtitle.is_empty() { 40 } else { 64 };
     let root = SVGBackend::new(path, (WIDTH, header + MAP_H + legend_h())).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
@@ -81,7 +79,7 @@ pub(super) fn draw(path: &Path, map: &Map) -> Result<(), String> {
 
 /// The cells, their axes, numbers and marks; returns the plotting area's top and
 /// bottom, px, in `area`, for the colour bar to match.
-fn grid(area: &Area, map: &Map) -> Result<(i32, i32), String> {
+fn grid(area: &Area, map: &Map) -> PlotResult<(i32, i32)> {
     let (nx, ny) = (map.x.len(), map.y.len());
     let labels = |v: &[f64]| v.iter().map(|x| number(*x)).collect::<Vec<_>>();
     let (xl, yl) = (labels(&map.x), labels(&map.y));
@@ -129,7 +127,7 @@ fn one_cell(
     (x0, y0): (f64, f64),
     c: Option<Cell>,
     px: (f64, f64),
-) -> Result<(), String> {
+) -> PlotResult {
     let fill = colour(c.and_then(|c| c.ratio));
     let ink = ink(fill);
     let rect = Rectangle::new([(x0, y0), (x0 + 1.0, y0 + 1.0)], fill.filled());
@@ -168,7 +166,7 @@ fn one_cell(
 
 /// The colour bar, from 0 at `bottom` to [`RATIO_TOP`] and above at `top` (px in
 /// `area`), its ticks every 0.25, and its title along it.
-fn colour_bar(area: &Area, (top, bottom): (i32, i32)) -> Result<(), String> {
+fn colour_bar(area: &Area, (top, bottom): (i32, i32)) -> PlotResult {
     let (x0, x1) = (14, 38);
     let at = |r: f64| bottom - ((r / RATIO_TOP) * (bottom - top) as f64).round() as i32;
     for k in 0..STEPS {
@@ -244,7 +242,7 @@ fn legend_h() -> u32 {
 }
 
 /// The marks' legend.
-fn legend(area: &Area) -> Result<(), String> {
+fn legend(area: &Area) -> PlotResult {
     let left = Pos::new(HPos::Left, VPos::Center);
     let entries = entries();
     let s = SQUARE;

@@ -65,7 +65,7 @@ pub fn sweep_maps(
     out: &Path,
     axes: &[Axis],
     points: &[crate::sweep_plots::Point],
-) -> Result<Vec<String>, String> {
+) -> crate::plots::PlotResult<Vec<String>> {
     let roles = Roles::of(axes);
     let (Some(&x), Some(&y)) = (roles.varying.first(), roles.varying.get(1)) else {
         return Ok(Vec::new());

@@ -18,9 +18,7 @@ use std::path::Path;
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
-fn err(e: impl std::fmt::Display) -> String {
-    e.to_string()
-}
+use crate::plots::{err, PlotResult};
 
 /// Tick labels, axis titles, panel titles, the figure's title, px.
 const TICK: u32 = 15;
@@ -45,7 +43,7 @@ fn per_row(labels: &[String]) -> usize {
 }
 
 /// Draws `fig` into `path`.
-pub(super) fn draw(path: &Path, fig: &Figure) -> Result<(), String> {
+pub(super) fn draw(path: &Path, fig: &Figure) -> PlotResult {
     let (cols, panel_h) = grid(fig.panels.len());
     let rows = fig.panels.len().div_ceil(cols);
     let header = if fig.subtitle.is_empty() { 40 } else { 64 };
@@ -144,7 +142,7 @@ fn nice(range: (f64, f64)) -> Vec<(f64, String)> {
 
 /// Draws one panel: its title, axes, and every line's markers (and, on a numeric
 /// axis, the line through them) with their error bars.
-fn panel(area: &Area, fig: &Figure, p: &Panel, (y0, y1): (f64, f64)) -> Result<(), String> {
+fn panel(area: &Area, fig: &Figure, p: &Panel, (y0, y1): (f64, f64)) -> PlotResult {
     let yt = nice((y0, y1));
     let y_area = yt.iter().map(|t| text_w(&t.1, TICK)).max().unwrap_or(0) + 46;
     let (w, _) = area.dim_in_pixel();
@@ -218,7 +216,7 @@ fn panel(area: &Area, fig: &Figure, p: &Panel, (y0, y1): (f64, f64)) -> Result<(
 
 /// The legend under the panels: per line its marker (on a numeric axis, on a stretch
 /// of its line) and its words, row by row.
-fn legend(area: &Area, fig: &Figure) -> Result<(), String> {
+fn legend(area: &Area, fig: &Figure) -> PlotResult {
     if fig.legend.is_empty() {
         return Ok(());
     }

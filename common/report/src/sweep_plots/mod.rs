@@ -60,7 +60,11 @@ struct Figure {
 
 /// Writes `sweep-METRIC.svg` into `out` for every metric some run has a value of,
 /// removing an older one of a metric with none; returns the files written.
-pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<Vec<String>, String> {
+pub fn sweep_plots(
+    out: &Path,
+    axes: &[Axis],
+    points: &[Point],
+) -> crate::plots::PlotResult<Vec<String>> {
     let roles = Roles::of(axes);
     let Some(x) = roles.x() else {
         return Ok(Vec::new());
@@ -74,7 +78,7 @@ pub fn sweep_plots(out: &Path, axes: &[Axis], points: &[Point]) -> Result<Vec<St
         let path = out.join(&file);
         let Some(fig) = figure(axes, &roles, x, points, m) else {
             match std::fs::remove_file(&path) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e.to_string()),
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e.into()),
                 _ => continue,
             }
         };

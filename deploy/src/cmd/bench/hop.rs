@@ -1,10 +1,10 @@
 //! The bare iceoryx2 hop: a ping-pong between the bench and an echo process (two
 //! hops, no computing), the floor any loop over iceoryx2 stands on.
 
-use crate::error::Error;
-use crate::launch::Supervision;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+use tactile_launch::error::Error;
+use tactile_launch::Supervision;
 use tactile_messages::clock::{now_ns, sleep_until_ns};
 use tactile_messages::samples::{Control, Forward};
 use tactile_report::analysis::Latency;
@@ -157,8 +157,7 @@ fn ping(link: &mut Link, rate: f64, n: u64) -> Result<(Latency, u64), Error> {
 pub fn bare_hop(rate: f64, n: u64, sup: &Supervision) -> Result<(Latency, u64), Error> {
     let prefix = format!("{}h", sup.prefix);
     // Held while the hop runs, so no cleaner takes its shared memory for a dead run's.
-    let _lock = tactile_runtime::lock::take(&prefix, "run", "tactile bench's bare hop")
-        .map_err(Error::BadInput)?;
+    let _lock = tactile_runtime::lock::take(&prefix, "run", "tactile bench's bare hop")?;
     let mut child = spawn_echo(&prefix, rate, sup)?;
     let saved_affinity = rustix::thread::sched_getaffinity(None).ok();
     let result = (|| -> Result<(Latency, u64), Error> {

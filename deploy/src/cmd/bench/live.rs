@@ -2,9 +2,9 @@
 //! publishing its state to a viewer, a Zenoh session in this process that takes every
 //! message on the domain (as Foxglove's bridge or `ros2 topic echo` would).
 
-use crate::error::Error;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
+use tactile_launch::error::Error;
 use tactile_scenario::{RosConfig, Scenario};
 use tactile_transport::zenoh_link::zenoh;
 use zenoh::Wait as _;

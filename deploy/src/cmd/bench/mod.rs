@@ -14,15 +14,15 @@ mod stalls;
 
 pub use hop::echo;
 
-use crate::error::Error;
-use crate::launch::netns::Pair;
-use crate::launch::{run_processes, Loaded, Supervision, PAPER_SCENARIO};
 use clap::Args;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use tactile_launch::error::Error;
+use tactile_launch::netns::Pair;
+use tactile_launch::{run_processes, Loaded, Supervision, PAPER_SCENARIO};
 use tactile_report::analysis::{us_header, us_line, Percentiles};
 use tactile_report::summary::Summary;
 use tactile_report::write::write_json;
@@ -128,7 +128,7 @@ pub struct BenchArgs {
     pub out: PathBuf,
     /// How the node programs wait and are scheduled (the same for every transport).
     #[command(flatten)]
-    pub nodes: crate::launch::NodeOptions,
+    pub nodes: crate::cmd::node_options::NodeOptions,
     /// Also run the loops across two hosts: Zenoh in clear, Zenoh over mutual TLS
     /// (certificates made with `openssl` for the run) and UDP, in two network
     /// namespaces joined by a veth pair (made and removed by the bench; needs root).
@@ -184,7 +184,7 @@ fn trio(sc: &Scenario, out: &Path, sup: &Supervision, link: LinkKind) -> Result<
         sc,
         out,
         sup,
-        crate::launch::Links::on_this_host(link)?,
+        tactile_launch::Links::on_this_host(link)?,
         Default::default(),
     )
 }
@@ -194,7 +194,7 @@ fn trio_with(
     sc: &Scenario,
     out: &Path,
     sup: &Supervision,
-    links: crate::launch::Links,
+    links: tactile_launch::Links,
     wrap: [Vec<String>; 3],
 ) -> Result<Summary, Error> {
     let sup = Supervision {
@@ -234,19 +234,19 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     }
     tactile_report::ours::refuse_foreign(&args.out)?;
     tactile_report::write::make_out_dir(&args.out)?;
-    crate::launch::clean_stale_runs();
+    tactile_launch::clean_stale_runs();
     // From here a stop request is a flag the runs look at, not the end of this
     // process: the bench stops between runs and removes what it made.
     let stop =
         tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
     if !cfg!(feature = "zenoh") {
-        crate::noteln!(
+        tactile_launch::noteln!(
             "tactile bench: no Zenoh loop: this build has no Zenoh link (build with --features zenoh)"
         );
     }
     let hosts = if args.hosts {
         let tag = format!("b{}", std::process::id() % 100_000);
-        Some(crate::launch::netns::Pair::new(&tag).map_err(|e| {
+        Some(tactile_launch::netns::Pair::new(&tag).map_err(|e| {
             Error::Failed(format!("--hosts: cannot make two network namespaces: {e}"))
         })?)
     } else {
@@ -257,7 +257,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
         // No restarts (a death fails the bench), no progress line.
         sup: args
             .nodes
-            .supervision(crate::launch::Links::plain(LinkKind::Iceoryx2), "b"),
+            .supervision(tactile_launch::Links::plain(LinkKind::Iceoryx2), "b"),
         stop: &stop,
     };
     let mut rates = Vec::new();
@@ -266,7 +266,7 @@ pub fn main(args: &BenchArgs) -> Result<(), Error> {
     }
     let report = bench.finish(rates)?;
     write_json(&args.out.join("bench.json"), &report)?;
-    crate::out!("{}", render(&report));
+    tactile_launch::out!("{}", render(&report));
     Ok(())
 }
 
@@ -295,7 +295,7 @@ impl Bench<'_> {
             loops.extend(self.across_hosts(&sc, pair)?);
         }
         percentile_plot(&self.args.out, rate, &loops)?;
-        crate::noteln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
+        tactile_launch::noteln!("tactile bench: {rate} Hz: bare iceoryx2 hop");
         let (hop, hop_misses) = hop::bare_hop(rate, self.args.samples, &self.sup)?;
         let mut r = RateResult {
             rate_hz: rate,
@@ -327,7 +327,7 @@ impl Bench<'_> {
         .filter(|&(_, l)| zenoh_built(l))
         {
             let (rate, n) = (sc.rate_hz, sc.samples);
-            crate::noteln!("tactile bench: {rate} Hz, {n} samples: {name} loop");
+            tactile_launch::noteln!("tactile bench: {rate} Hz, {n} samples: {name} loop");
             let out = self.args.out.join(format!("{name}-{rate}"));
             let s = trio(sc, &out, &self.sup, link)?;
             loops.push(loop_result(name, s)?);
@@ -347,7 +347,7 @@ impl Bench<'_> {
             // Off, then on, back to back: the machine's noise drifts over minutes, so
             // the pair compared is the pair run together.
             for (name, sc) in [("live-off", sc.clone()), ("live-on", viewer.scenario(sc))] {
-                crate::noteln!(
+                tactile_launch::noteln!(
                     "tactile bench: {rate} Hz, {n} samples: iceoryx2 loop, {name} (live view at {} Hz)",
                     live::LIVE_HZ.min(rate)
                 );
@@ -373,10 +373,10 @@ impl Bench<'_> {
     fn across_hosts(&self, sc: &Scenario, pair: &Pair) -> Result<Vec<LoopResult>, Error> {
         let mut loops = Vec::new();
         let tls = if zenoh_built(LinkKind::Zenoh) {
-            match crate::launch::pki::make(&self.args.out.join("pki"), "bench", &pair.addrs) {
+            match tactile_launch::pki::make(&self.args.out.join("pki"), "bench", &pair.addrs) {
                 Ok(files) => Some(files),
                 Err(e) => {
-                    crate::noteln!("tactile bench: no TLS loop: {e}");
+                    tactile_launch::noteln!("tactile bench: no TLS loop: {e}");
                     None
                 }
             }
@@ -384,10 +384,10 @@ impl Bench<'_> {
             None
         };
         let links = |name: &str| match (name, &tls) {
-            ("zenoh-tls-hosts", Some(t)) => Some(crate::launch::Links::across_tls(pair, t)),
+            ("zenoh-tls-hosts", Some(t)) => Some(tactile_launch::Links::across_tls(pair, t)),
             ("zenoh-tls-hosts", None) => None,
-            ("zenoh-hosts", _) => Some(crate::launch::Links::across(LinkKind::Zenoh, pair)),
-            _ => Some(crate::launch::Links::across(LinkKind::Udp, pair)),
+            ("zenoh-hosts", _) => Some(tactile_launch::Links::across(LinkKind::Zenoh, pair)),
+            _ => Some(tactile_launch::Links::across(LinkKind::Udp, pair)),
         };
         for (name, link) in [
             ("zenoh-hosts", LinkKind::Zenoh),
@@ -399,7 +399,7 @@ impl Bench<'_> {
         {
             let Some(links) = links(name) else { continue };
             let rate = sc.rate_hz;
-            crate::noteln!(
+            tactile_launch::noteln!(
                 "tactile bench: {rate} Hz: {name} loop, master in {}, emulator and slave in {}",
                 pair.names[0],
                 pair.names[1]
@@ -420,7 +420,7 @@ impl Bench<'_> {
 
     /// The lockstep throughput and the machine's own stalls, with the rates' results.
     fn finish(&self, rates: Vec<RateResult>) -> Result<BenchReport, Error> {
-        crate::noteln!("tactile bench: lockstep throughput");
+        tactile_launch::noteln!("tactile bench: lockstep throughput");
         let n = self.args.lockstep_samples;
         let sc = scenario(1000.0, n, Mode::Lockstep)?;
         let lock = trio(
@@ -431,7 +431,7 @@ impl Bench<'_> {
         )?;
         let machine = if self.args.probe_s > 0.0 {
             let s = self.args.probe_s;
-            crate::noteln!("tactile bench: the machine's own stalls, {s} s per CPU");
+            tactile_launch::noteln!("tactile bench: the machine's own stalls, {s} s per CPU");
             stalls::probe(s, true, self.stop)
         } else {
             stalls::StallReport {

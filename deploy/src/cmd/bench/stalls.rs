@@ -81,7 +81,7 @@ pub fn probe(seconds: f64, fifo: bool, stop: &Arc<AtomicBool>) -> StallReport {
         Ok(c) => c,
         Err(e) => {
             return StallReport {
-                note: Some(e),
+                note: Some(e.to_string()),
                 ..Default::default()
             }
         }

@@ -17,11 +17,11 @@ mod mutate;
 mod targets;
 mod trajectory6;
 
-use crate::error::Error;
 use clap::Args;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+use tactile_launch::error::Error;
 
 /// Arguments of `tactile fuzz`.
 #[derive(Debug, Args)]
@@ -155,7 +155,7 @@ fn campaign(t: &targets::Target, args: &FuzzArgs, k: u64) -> Result<Campaign, Er
     let mut queue: Vec<Vec<u8>> = t.seeds.clone();
     while Instant::now() < until
         && args.runs.is_none_or(|n| c.inputs < n)
-        && !crate::stop::requested()
+        && !tactile_launch::stop::requested()
     {
         let input = queue
             .pop()
@@ -198,7 +198,7 @@ fn campaign(t: &targets::Target, args: &FuzzArgs, k: u64) -> Result<Campaign, Er
 /// `tactile fuzz`. A stop request (SIGINT, SIGTERM) ends the target in hand after the
 /// input in hand: its row says what it did, and the command exits 130.
 pub fn main(args: &FuzzArgs) -> Result<(), Error> {
-    crate::stop::watch()?;
+    tactile_launch::stop::watch()?;
     let scratch = tempfile::tempdir().map_err(Error::io("making a scratch folder"))?;
     let all = all_targets(scratch.path()).map_err(Error::Failed)?;
     for name in &args.targets {
@@ -218,7 +218,7 @@ pub fn main(args: &FuzzArgs) -> Result<(), Error> {
             *m = info.to_string();
         }
     }));
-    crate::outln!("target        inputs    inputs/s  paths  corpus  max_ms  panics");
+    tactile_launch::outln!("target        inputs    inputs/s  paths  corpus  max_ms  panics");
     let mut panics = 0;
     let mut result = Ok(());
     for (k, t) in all.iter().enumerate() {
@@ -233,7 +233,7 @@ pub fn main(args: &FuzzArgs) -> Result<(), Error> {
                 } else {
                     c.paths.to_string()
                 };
-                crate::outln!(
+                tactile_launch::outln!(
                     "{:<11} {:>8} {:>11.0} {:>6} {:>7} {:>7.1} {:>7}",
                     t.name,
                     c.inputs,
@@ -249,7 +249,7 @@ pub fn main(args: &FuzzArgs) -> Result<(), Error> {
                 break;
             }
         }
-        if crate::stop::requested() {
+        if tactile_launch::stop::requested() {
             result = Err(Error::Stopped(format!(
                 "{} stopped before its time, the targets after it not fuzzed",
                 t.name

@@ -58,10 +58,10 @@ pub(super) fn blocks() -> Target {
 /// The three nodes' record files: the reader of each role over the same bytes.
 pub(super) fn records(scratch: &Path) -> Result<Target, String> {
     let out = scratch.join("seed-run");
-    let text = crate::launch::PAPER_SCENARIO.replace("samples = 1200", "samples = 30");
+    let text = tactile_launch::PAPER_SCENARIO.replace("samples = 1200", "samples = 30");
     let scenario = tactile_scenario::Scenario::from_toml_str(&text).map_err(|e| e.to_string())?;
     std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
-    crate::launch::sim::simulate(&scenario, scratch, &out, Default::default())
+    tactile_launch::sim::simulate(&scenario, scratch, &out, Default::default())
         .map_err(|e| e.to_string())?;
     let seeds = ["master", "emulator", "slave"]
         .iter()
@@ -173,7 +173,7 @@ pub(super) fn attachment() -> Target {
 /// Scenario files.
 pub(super) fn scenario() -> Target {
     let seeds = [
-        crate::launch::PAPER_SCENARIO,
+        tactile_launch::PAPER_SCENARIO,
         include_str!("../../../scenarios/wall-delay.toml"),
     ];
     Target {

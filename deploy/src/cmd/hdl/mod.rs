@@ -13,13 +13,14 @@ mod units;
 mod vectors;
 
 use super::datapath::DatapathArgs;
-use crate::error::Error;
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
+use tactile_launch::error::Error;
 
 pub use params::{latency, model, write_rtl};
-pub use tactile_rtl::text::{params_vh, Pipeline, MODULES};
+pub use tactile_rtl::text::{params_vh, Block, Pipeline, MODULES};
 pub use vectors::vectors;
 
 /// Arguments of `tactile hdl`.
@@ -48,8 +49,8 @@ pub enum HdlCommand {
     /// Write test vectors from the hybrid model (stdout, or --out).
     Vectors {
         /// Which block: a TFB function, an f32 unit or a module.
-        #[arg(long, value_enum)]
-        function: Function,
+        #[arg(long, value_parser = block_parser())]
+        function: Block,
         /// Samples beyond the edge cases: half an even sweep of the input range, half
         /// random from the seed (1 to 10^7).
         #[arg(long, default_value_t = 20_000, value_parser = sim::count_parser())]
@@ -96,36 +97,13 @@ impl From<PipelineArg> for Pipeline {
     }
 }
 
-/// A block of the hardware: a TFB function, an f32 unit or one of the paper's modules.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Function {
-    /// TFB, rotation mode: sin and cos of an angle.
-    Sincos,
-    /// TFB, vectoring mode: the angle of (x, y).
-    Atan2,
-    /// TFB: acos(a) = atan2(sqrt((1 - a)(1 + a)), a), the root in f32.
-    Acos,
-    /// f32 unit: a + b.
-    Add,
-    /// f32 unit: a - b (the adder with b negated).
-    Sub,
-    /// f32 unit: a * b.
-    Mul,
-    /// f32 unit: a / b.
-    Div,
-    /// f32 unit: sqrt(a).
-    Sqrt,
-    /// Module FK-HMD / FK-HSD: forward kinematics.
-    Fk,
-    /// Module KFF-HMD: joint torques J^T F.
-    Kff,
-    /// Module FBF-HSD: the feedback force h (obj - env).
-    Fbf,
-    /// Module IK-HSD: inverse kinematics.
-    Ik,
+/// `--function`: a block by its name ([`Block::name`]), its help [`Block::what`].
+pub fn block_parser() -> impl TypedValueParser<Value = Block> {
+    PossibleValuesParser::new(Block::ALL.map(|b| PossibleValue::new(b.name()).help(b.what())))
+        .try_map(|s| s.parse::<Block>())
 }
 
-/// What kind of block a [`Function`] is: each kind has its own testbench.
+/// What kind of block a [`Block`] is: each kind has its own testbench.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Family {
     /// A TFB function (`tb_tfb.v`).
@@ -136,83 +114,56 @@ pub enum Family {
     Module(kin::Module),
 }
 
-impl Function {
-    /// Every block, in the order the reports list them.
-    pub const ALL: [Function; 12] = [
-        Function::Sincos,
-        Function::Atan2,
-        Function::Acos,
-        Function::Add,
-        Function::Sub,
-        Function::Mul,
-        Function::Div,
-        Function::Sqrt,
-        Function::Fk,
-        Function::Kff,
-        Function::Fbf,
-        Function::Ik,
-    ];
-
-    /// The TFB's three functions.
-    pub const TFB: [Function; 3] = [Function::Sincos, Function::Atan2, Function::Acos];
-
-    /// The CLI and report name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Function::Sincos => "sincos",
-            Function::Atan2 => "atan2",
-            Function::Acos => "acos",
-            Function::Add => "add",
-            Function::Sub => "sub",
-            Function::Mul => "mul",
-            Function::Div => "div",
-            Function::Sqrt => "sqrt",
-            Function::Fk => "fk",
-            Function::Kff => "kff",
-            Function::Fbf => "fbf",
-            Function::Ik => "ik",
-        }
-    }
-
+/// What `tactile hdl` knows of a block beyond the RTL's list ([`Block`]): its
+/// family, its testbench and its vectors' fields.
+pub trait Bench {
     /// Which kind of block it is.
-    pub fn family(self) -> Family {
+    fn family(self) -> Family;
+    /// The vector file's fields, in order.
+    fn fields(self) -> &'static str;
+    /// The testbench's define (the synthesis top is `top_<name>`).
+    fn define(self) -> String;
+    /// The testbench and the prefix of its result line.
+    fn testbench(self) -> (&'static str, &'static str);
+}
+
+impl Bench for Block {
+    fn family(self) -> Family {
         use kin::Module;
         use units::Unit;
         match self {
-            Function::Sincos | Function::Atan2 | Function::Acos => Family::Tfb,
-            Function::Add => Family::Unit(Unit::Add),
-            Function::Sub => Family::Unit(Unit::Sub),
-            Function::Mul => Family::Unit(Unit::Mul),
-            Function::Div => Family::Unit(Unit::Div),
-            Function::Sqrt => Family::Unit(Unit::Sqrt),
-            Function::Fk => Family::Module(Module::Fk),
-            Function::Kff => Family::Module(Module::Kff),
-            Function::Fbf => Family::Module(Module::Fbf),
-            Function::Ik => Family::Module(Module::Ik),
+            Block::Sincos | Block::Atan2 | Block::Acos => Family::Tfb,
+            Block::Add => Family::Unit(Unit::Add),
+            Block::Sub => Family::Unit(Unit::Sub),
+            Block::Mul => Family::Unit(Unit::Mul),
+            Block::Div => Family::Unit(Unit::Div),
+            Block::Sqrt => Family::Unit(Unit::Sqrt),
+            Block::Fk => Family::Module(Module::Fk),
+            Block::Kff => Family::Module(Module::Kff),
+            Block::Fbf => Family::Module(Module::Fbf),
+            Block::Ik => Family::Module(Module::Ik),
         }
     }
 
-    /// The vector file's fields, in order.
-    pub fn fields(self) -> &'static str {
+    fn fields(self) -> &'static str {
         match self {
-            Function::Sincos => "angle range_err code folded flip sin_code cos_code sin cos",
-            Function::Atan2 => "y x stages x_code y_code z_code angle",
-            Function::Acos => "a stages root x_code y_code z_code angle",
-            Function::Add | Function::Sub | Function::Mul | Function::Div => "a b r",
-            Function::Sqrt => "a r",
-            Function::Fk => "t1 t2 t3 err s1 c1 s2 c2 s3 c3 x y z",
-            Function::Kff => {
+            Block::Sincos => "angle range_err code folded flip sin_code cos_code sin cos",
+            Block::Atan2 => "y x stages x_code y_code z_code angle",
+            Block::Acos => "a stages root x_code y_code z_code angle",
+            Block::Add | Block::Sub | Block::Mul | Block::Div => "a b r",
+            Block::Sqrt => "a r",
+            Block::Fk => "t1 t2 t3 err s1 c1 s2 c2 s3 c3 x y z",
+            Block::Kff => {
                 "t1 t2 t3 f1 f2 f3 err s1 c1 s2 c2 s3 c3 j11 j12 j13 j21 j22 j23 j31 j32 j33 \
                  tau1 tau2 tau3"
             }
-            Function::Fbf => "o1 o2 o3 e1 e2 e3 h1 h2 h3 d1 d2 d3 f1 f2 f3",
-            Function::Ik => {
+            Block::Fbf => "o1 o2 o3 e1 e2 e3 h1 h2 h3 d1 d2 d3 f1 f2 f3",
+            Block::Ik => {
                 "x y z status xs ys zs atan rr2 big_r r2 r cg gamma beta ca alpha t1 t2 t3"
             }
         }
     }
 
-    /// The testbench's define (the synthesis top is `top_<name>`).
     fn define(self) -> String {
         let prefix = match self.family() {
             Family::Tfb => "FUNC",
@@ -222,7 +173,6 @@ impl Function {
         format!("{prefix}_{}", self.name().to_uppercase())
     }
 
-    /// The testbench and the prefix of its result line.
     fn testbench(self) -> (&'static str, &'static str) {
         match self.family() {
             Family::Tfb => ("tb_tfb.v", "tfb-cosim"),
@@ -237,7 +187,7 @@ pub fn block_vectors(
     cordic: &tactile_math::cordic::Cordic,
     k: &tactile_math::cordic::hdl::RtlConstants,
     geometry: &tactile_math::geometry::Geometry,
-    (f, count, seed): (Function, usize, u64),
+    (f, count, seed): (Block, usize, u64),
     out: &mut dyn Write,
 ) -> std::io::Result<usize> {
     match f.family() {
@@ -254,7 +204,7 @@ pub fn block_vectors(
 /// `tactile hdl vectors`: to a file or stdout, through a buffer, never held whole;
 /// a stop request (SIGINT, SIGTERM) ends it at the next write.
 fn write_vectors(
-    (function, count, seed): (Function, usize, u64),
+    (function, count, seed): (Block, usize, u64),
     out: Option<&std::path::Path>,
     datapath: &DatapathArgs,
 ) -> Result<(), Error> {
@@ -265,19 +215,19 @@ fn write_vectors(
             let file = std::fs::File::create(path)
                 .map_err(Error::io(format!("writing {}", path.display())))?;
             (
-                Box::new(crate::stop::Checked(file)),
+                Box::new(tactile_launch::stop::Checked(file)),
                 path.display().to_string(),
             )
         }
         None => (
-            Box::new(crate::stop::Output::stdout()),
+            Box::new(tactile_launch::stop::Output::stdout()),
             "stdout".to_string(),
         ),
     };
     let mut buf = std::io::BufWriter::with_capacity(1 << 16, &mut sink);
     block_vectors(&cordic, &k, &geometry, (function, count, seed), &mut buf)
         .and_then(|_| buf.flush())
-        .map_err(crate::stop::or_io(
+        .map_err(tactile_launch::stop::or_io(
             format!("writing {shown}"),
             "the vectors written so far are incomplete",
         ))
@@ -287,7 +237,7 @@ fn write_vectors(
 /// SIGTERM) ends it within a second, its tools killed and its work folder removed.
 pub fn main(args: &HdlArgs) -> Result<(), Error> {
     if !matches!(args.command, HdlCommand::Rtl { .. }) {
-        crate::stop::watch()?;
+        tactile_launch::stop::watch()?;
     }
     match &args.command {
         HdlCommand::Rtl {
@@ -298,7 +248,7 @@ pub fn main(args: &HdlArgs) -> Result<(), Error> {
             let (_, k) = model(datapath.cordic()?)?;
             let pipeline = Pipeline::from(*pipeline);
             write_rtl(out, &k, &datapath.geometry()?, pipeline)?;
-            crate::outln!(
+            tactile_launch::outln!(
                 "wrote the RTL (TFB, f32 units, modules) for this format and geometry, \
                  pipeline {}, into {}",
                 pipeline.name(),

@@ -2,30 +2,16 @@
 //! each block's latency in each pipeline configuration, and the model a format's RTL
 //! is checked against.
 
-use crate::error::Error;
 use std::path::Path;
+use tactile_launch::error::Error;
 use tactile_math::cordic::hdl::{RtlConstants, REDUCE_GUARD};
 use tactile_math::cordic::{Cordic, CordicConfig};
 use tactile_math::geometry::Geometry;
 use tactile_rtl::text::{files, Block, Pipeline};
 
-/// Clocks from input to output of each function in a pipeline configuration
+/// Clocks from input to output of each block in a pipeline configuration
 /// ([`Pipeline::latency`]).
-pub fn latency(function: super::Function, cfg: &CordicConfig, p: Pipeline) -> u32 {
-    use super::Function as F;
-    let block = match function {
-        F::Sincos => Block::Sincos,
-        F::Atan2 => Block::Atan2,
-        F::Acos => Block::Acos,
-        F::Add | F::Sub => Block::Add,
-        F::Mul => Block::Mul,
-        F::Div => Block::Div,
-        F::Sqrt => Block::Sqrt,
-        F::Fk => Block::Fk,
-        F::Kff => Block::Kff,
-        F::Fbf => Block::Fbf,
-        F::Ik => Block::Ik,
-    };
+pub fn latency(block: Block, cfg: &CordicConfig, p: Pipeline) -> u32 {
     p.latency(block, cfg.iterations)
 }
 

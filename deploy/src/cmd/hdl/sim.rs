@@ -2,13 +2,14 @@
 //! testbench over the vectors, Yosys synthesizes each function for Virtex-6 (the
 //! paper's family). Each run works in a fresh folder of its own.
 
-use super::{block_vectors, latency, model, write_rtl, Function, Pipeline, PipelineArg, MODULES};
+use super::Bench as _;
+use super::{block_vectors, latency, model, write_rtl, Block, Pipeline, PipelineArg, MODULES};
 use crate::cmd::datapath::DatapathArgs;
-use crate::error::Error;
-use crate::stop::ToolError;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use tactile_launch::error::Error;
+use tactile_launch::stop::ToolError;
 
 /// The most vectors a function may be asked for: every input class is covered far
 /// below it, and the vectors, held in memory before they are written, stay in tens of
@@ -25,8 +26,8 @@ pub fn count_parser() -> clap::builder::RangedU64ValueParser<usize> {
 pub struct CosimArgs {
     /// Blocks to run (default: all: the TFB's three functions, the f32 units, the
     /// paper's modules).
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub function: Vec<Function>,
+    #[arg(long, value_parser = super::block_parser(), value_delimiter = ',')]
+    pub function: Vec<Block>,
     /// Samples beyond the edge cases, per block (1 to 10^7).
     #[arg(long, default_value_t = 20_000, value_parser = count_parser())]
     pub count: usize,
@@ -112,7 +113,7 @@ pub(super) fn tool(cmd: &mut Command, name: &str, package: &str) -> Result<Strin
     if let Some(dir) = cmd.get_current_dir().map(Path::to_path_buf) {
         cmd.env("TMPDIR", dir);
     }
-    let out = crate::stop::run_tool(cmd).map_err(|e| match e {
+    let out = tactile_launch::stop::run_tool(cmd).map_err(|e| match e {
         ToolError::Start(e) => Error::Failed(format!(
             "cannot run {name} ({e}): install it (Debian: apt-get install {package})"
         )),
@@ -143,7 +144,7 @@ fn tail(text: &str, lines: usize) -> String {
     s
 }
 
-pub(super) fn chosen(functions: &[Function], default: &[Function]) -> Vec<Function> {
+pub(super) fn chosen(functions: &[Block], default: &[Block]) -> Vec<Block> {
     if functions.is_empty() {
         default.to_vec()
     } else {
@@ -159,10 +160,10 @@ fn write_hex(
     use std::io::Write as _;
     let file =
         std::fs::File::create(path).map_err(Error::io(format!("writing {}", path.display())))?;
-    let mut buf = std::io::BufWriter::with_capacity(1 << 16, crate::stop::Checked(file));
+    let mut buf = std::io::BufWriter::with_capacity(1 << 16, tactile_launch::stop::Checked(file));
     make(&mut buf)
         .and_then(|n| buf.flush().map(|()| n))
-        .map_err(crate::stop::or_io(
+        .map_err(tactile_launch::stop::or_io(
             format!("writing {}", path.display()),
             "the work folder removed (unless kept with --keep)",
         ))
@@ -180,7 +181,7 @@ struct Outcome {
 /// Co-simulation of one function, from the testbench's last line.
 fn cosim_one(
     work: &Path,
-    function: Function,
+    function: Block,
     vec_path: &Path,
     n: usize,
     defines: &[String],
@@ -230,7 +231,7 @@ fn cosim_one(
     match (field("vectors="), field("mismatches=")) {
         (Some(vectors), Some(mismatches)) => {
             for l in out.lines().filter(|l| l.contains("mismatch at")) {
-                crate::noteln!("{l}");
+                tactile_launch::noteln!("{l}");
             }
             let latency = field("latency=").and_then(|l| u32::try_from(l).ok());
             Ok(Outcome {
@@ -261,7 +262,7 @@ pub fn cosim_main(args: &CosimArgs) -> Result<(), Error> {
         write_rtl(&work.dir.join(p.name()), &k, &geometry, *p)?;
     }
     let mut failed = 0;
-    for f in chosen(&args.function, &Function::ALL) {
+    for f in chosen(&args.function, &Block::ALL) {
         let vec_path = work.dir.join(format!("{}.hex", f.name()));
         let n = write_hex(&vec_path, |out| {
             block_vectors(&cordic, &k, &geometry, (f, args.count, args.seed), out)
@@ -269,7 +270,7 @@ pub fn cosim_main(args: &CosimArgs) -> Result<(), Error> {
         for p in &pipelines {
             let got = cosim_one(&work.dir.join(p.name()), f, &vec_path, n, &args.defines)?;
             let (v, m, clocks) = (got.vectors, got.mismatches, latency(f, &cfg, *p));
-            crate::outln!(
+            tactile_launch::outln!(
                 "{:<7} [s{}.{}] {} iterations {:<8} pipeline {:<6} {v} vectors, {m} mismatches \
                  (latency {} clocks)",
                 f.name(),

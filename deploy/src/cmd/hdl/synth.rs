@@ -6,19 +6,20 @@
 //! path).
 
 use super::sim::{chosen, tool, Work};
-use super::{latency, model, write_rtl, Function, Pipeline, PipelineArg, MODULES};
+use super::Bench as _;
+use super::{latency, model, write_rtl, Block, Pipeline, PipelineArg, MODULES};
 use crate::cmd::datapath::DatapathArgs;
-use crate::error::Error;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::Command;
+use tactile_launch::error::Error;
 
 /// Arguments of `tactile hdl synth`.
 #[derive(Debug, Args)]
 pub struct SynthArgs {
     /// Blocks to synthesize (default: the TFB's three functions).
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub function: Vec<Function>,
+    #[arg(long, value_parser = super::block_parser(), value_delimiter = ',')]
+    pub function: Vec<Block>,
     /// Also synthesize the paper's five modules as one design (FK-HMD, KFF-HMD,
     /// FK-HSD, IK-HSD, FBF-HSD), as its table's total.
     #[arg(long)]
@@ -79,9 +80,9 @@ pub fn parse_ltp(text: &str) -> Option<u64> {
 
 /// The synthesis top of a block and the `chparam` it needs (the subtractor is the
 /// adder with SUB = 1).
-fn top(f: Function) -> (String, &'static str) {
+fn top(f: Block) -> (String, &'static str) {
     match f.family() {
-        super::Family::Unit(_) if f == Function::Sub => {
+        super::Family::Unit(_) if f == Block::Sub => {
             ("f32_add".into(), "chparam -set SUB 1 f32_add; ")
         }
         super::Family::Unit(_) => (format!("f32_{}", f.name()), ""),
@@ -122,15 +123,15 @@ pub fn synth_main(args: &SynthArgs) -> Result<(), Error> {
     let work = Work::new(args.keep.as_deref())?;
     let pipeline = Pipeline::from(args.pipeline);
     write_rtl(&work.dir, &k, &args.datapath.geometry()?, pipeline)?;
-    crate::outln!(
+    tactile_launch::outln!(
         "| block | format | rounding | registers | LUTs | SRLs | DSP48E1 | CARRY4 | latency (clocks) | depth (cells) |"
     );
-    crate::outln!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    tactile_launch::outln!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|");
     let format = format!("[s{}.{}] {} it.", cfg.word, cfg.frac, cfg.iterations);
     let rounding = format!("{:?}", cfg.rounding).to_lowercase();
     let row = |name: &str, r: Resources, lat: String, depth: Option<u64>| {
         let depth = depth.map_or("?".into(), |d| d.to_string());
-        crate::outln!(
+        tactile_launch::outln!(
             "| {name} | {format} | {rounding} | {} | {} | {} | {} | {} | {lat} | {depth} |",
             r.registers,
             r.luts,
@@ -141,7 +142,7 @@ pub fn synth_main(args: &SynthArgs) -> Result<(), Error> {
     };
     let blocks = chosen(
         &args.function,
-        if args.together { &[] } else { &Function::TFB },
+        if args.together { &[] } else { &Block::TFB },
     );
     for f in blocks {
         let (t, chparam) = top(f);

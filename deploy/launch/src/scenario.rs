@@ -2,7 +2,7 @@
 //! inputs (trajectory, recorded networks), and the output folder made ready for it.
 //! Everything here can refuse a run, so it all happens before any process starts.
 
-use crate::error::Error;
+use crate::error::{Error, InputError};
 use std::path::{Path, PathBuf};
 use tactile_master::operator::OperatorSource;
 use tactile_messages::Role;
@@ -67,8 +67,7 @@ impl Source {
     /// [`files::MAX_SCENARIO_BYTES`]); its relative paths are read beside it.
     pub fn file(path: &Path) -> Result<Self, Error> {
         Ok(Source {
-            text: files::read_text(path, "scenario", files::MAX_SCENARIO_BYTES)
-                .map_err(Error::BadInput)?,
+            text: files::read_text(path, "scenario", files::MAX_SCENARIO_BYTES)?,
             base_dir: files::base_dir(path),
             name: path.display().to_string(),
             path: Some(path.to_path_buf()),
@@ -83,8 +82,12 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
         &source.name,
         source.path.as_deref(),
     );
-    let text = tactile_scenario::overrides::apply(&source.text, sets)
-        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    let input = |source: InputError| Error::Input {
+        name: name.clone(),
+        source: Box::new(source),
+    };
+    let text =
+        tactile_scenario::overrides::apply(&source.text, sets).map_err(|e| input(e.into()))?;
     let with = if sets.is_empty() {
         String::new()
     } else {
@@ -124,8 +127,7 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
             tactile_runtime::outside::NO_ROS
         )));
     }
-    files::inputs_present(&scenario, &base_dir)
-        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    files::inputs_present(&scenario, &base_dir).map_err(|e| input(e.into()))?;
     let source = OperatorSource::load(&scenario.operator, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: operator: {e}")))?;
     source
@@ -133,8 +135,7 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
         .map_err(|e| Error::BadInput(format!("{name}{with}: {e}")))?;
     let mut warnings = scenario.warnings();
     warnings.extend(source.warnings(scenario.samples, scenario.t_s()));
-    tactile_network_emulator::replay::load(&scenario, &base_dir)
-        .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+    tactile_network_emulator::replay::load(&scenario, &base_dir).map_err(|e| input(e.into()))?;
     tactile_slave::urdf_arm::UrdfArm::of_scenario(&scenario, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     // A physics world is built once here: its meshes read and checked, its bodies'
@@ -142,8 +143,7 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
     tactile_slave::world::SlaveWorld::of_scenario(&scenario, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     if scenario.master.backend == tactile_scenario::Backend::Ros2 {
-        tactile_master::peripherals::gimbal(&scenario, &base_dir)
-            .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
+        tactile_master::peripherals::gimbal(&scenario, &base_dir).map_err(|e| input(e.into()))?;
     }
     if tactile_runtime::outside::ros_in_run(&scenario) {
         tactile_devices::ros_side::check_tls(&scenario.ros, &base_dir)
@@ -162,7 +162,7 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
 /// The `--set KEY=VALUE` arguments, parsed (bad input when one is malformed).
 pub fn parse_sets(args: &[String]) -> Result<Vec<Set>, Error> {
     args.iter()
-        .map(|a| Set::parse(a).map_err(Error::BadInput))
+        .map(|a| Set::parse(a).map_err(Error::from))
         .collect()
 }
 

@@ -170,8 +170,7 @@ pub fn simulate(
         master.set_predictor(g);
     }
     let master = MasterHandler::new(master, None, scenario.faults.peer_timeout_samples);
-    let replays =
-        tactile_network_emulator::replay::load(scenario, base_dir).map_err(Error::BadInput)?;
+    let replays = tactile_network_emulator::replay::load(scenario, base_dir)?;
     let emulator = EmulatorHandler::new(Emulator::with_replays(scenario, replays));
     let arm = tactile_slave::peripherals::read_arm(scenario, base_dir).map_err(Error::BadInput)?;
     let world = tactile_slave::world::SlaveWorld::of_scenario(scenario, base_dir)

@@ -7,21 +7,46 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// Why the certificates could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum PkiError {
+    /// `openssl` could not be run (not installed).
+    #[error("running openssl: {0}")]
+    Start(#[source] std::io::Error),
+    /// `openssl` ran and refused; its stderr says why.
+    #[error("openssl {command}: {stderr}")]
+    Openssl {
+        /// Its subcommand (`req`, `x509`).
+        command: String,
+        /// What it said.
+        stderr: String,
+    },
+    /// The folder or a file in it could not be written.
+    #[error("{doing} {}: {source}", path.display())]
+    Io {
+        /// `creating`, `writing`.
+        doing: &'static str,
+        /// The folder or file.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
+}
+
 /// Runs `openssl ARGS` in `dir`; its stderr is the error.
-fn openssl(dir: &Path, args: &[&str]) -> Result<(), String> {
+fn openssl(dir: &Path, args: &[&str]) -> Result<(), PkiError> {
     let o = Command::new("openssl")
         .args(args)
         .current_dir(dir)
         .output()
-        .map_err(|e| format!("running openssl: {e}"))?;
+        .map_err(PkiError::Start)?;
     if o.status.success() {
         Ok(())
     } else {
-        Err(format!(
-            "openssl {}: {}",
-            args.first().unwrap_or(&""),
-            String::from_utf8_lossy(&o.stderr).trim()
-        ))
+        Err(PkiError::Openssl {
+            command: args.first().unwrap_or(&"").to_string(),
+            stderr: String::from_utf8_lossy(&o.stderr).trim().to_string(),
+        })
     }
 }
 
@@ -35,7 +60,7 @@ const EC_KEY: [&str; 5] = [
 ];
 
 /// `ca.pem` and `ca.key`: a CA that signs certificates and nothing else.
-fn make_ca(dir: &Path, name: &str) -> Result<(), String> {
+fn make_ca(dir: &Path, name: &str) -> Result<(), PkiError> {
     let cn = format!("/CN={name}-ca");
     let mut ca = vec!["req", "-x509"];
     ca.extend(EC_KEY);
@@ -49,14 +74,18 @@ fn make_ca(dir: &Path, name: &str) -> Result<(), String> {
 
 /// `node.pem` and `node.key`: one certificate for server and client use, signed by
 /// the CA, its SubjectAltName holding every address in `ips`.
-fn make_node(dir: &Path, ips: &[String]) -> Result<(), String> {
+fn make_node(dir: &Path, ips: &[String]) -> Result<(), PkiError> {
     let sans: Vec<String> = ips.iter().map(|ip| format!("IP:{ip}")).collect();
     let ext = format!(
         "basicConstraints=critical,CA:FALSE\nkeyUsage=critical,digitalSignature\n\
          extendedKeyUsage=serverAuth,clientAuth\nsubjectAltName={}\n",
         sans.join(",")
     );
-    std::fs::write(dir.join("node.ext"), ext).map_err(|e| format!("writing node.ext: {e}"))?;
+    std::fs::write(dir.join("node.ext"), ext).map_err(|source| PkiError::Io {
+        doing: "writing",
+        path: "node.ext".into(),
+        source,
+    })?;
     let mut req = vec!["req", "-new"];
     req.extend(EC_KEY);
     req.extend([
@@ -71,8 +100,12 @@ fn make_node(dir: &Path, ips: &[String]) -> Result<(), String> {
 /// Makes `ca.pem`, `node.pem` and `node.key` in `dir` (certificates valid two days,
 /// the node's SubjectAltName holding every address in `ips`); returns their paths in
 /// that order.
-pub fn make(dir: &Path, name: &str, ips: &[String]) -> Result<[PathBuf; 3], String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+pub fn make(dir: &Path, name: &str, ips: &[String]) -> Result<[PathBuf; 3], PkiError> {
+    std::fs::create_dir_all(dir).map_err(|source| PkiError::Io {
+        doing: "creating",
+        path: dir.to_path_buf(),
+        source,
+    })?;
     make_ca(dir, name)?;
     make_node(dir, ips)?;
     Ok(["ca.pem", "node.pem", "node.key"].map(|f| dir.join(f)))
@@ -86,4 +119,21 @@ pub fn args(files: &[PathBuf; 3]) -> Vec<String> {
         v.push(f.display().to_string());
     }
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// A folder that cannot be made names it and keeps the system's reason.
+    #[test]
+    fn a_folder_that_cannot_be_made_keeps_its_cause() {
+        let dir = tempfile::tempdir().expect("tmp");
+        let file = dir.path().join("a-file");
+        std::fs::write(&file, "").expect("write");
+        let e = make(&file.join("pki"), "t", &[]).expect_err("under a file");
+        assert!(e.to_string().starts_with("creating "), "{e}");
+        assert!(e.source().is_some_and(|c| c.is::<std::io::Error>()));
+    }
 }

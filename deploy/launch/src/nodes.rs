@@ -32,15 +32,47 @@ fn profile_args(dir: &Path) -> Option<Vec<String>> {
     })
 }
 
+/// Why the node programs could not be built (the launcher then looks for built ones).
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    /// The source tree the launcher was built from is not there any more.
+    #[error("the source tree {} is gone", .0.display())]
+    TreeGone(PathBuf),
+    /// The launcher is not in a Cargo target folder's profile folder.
+    #[error("no target folder")]
+    NoTarget,
+    /// The same, its profile folder unnamed.
+    #[error("no profile folder")]
+    NoProfile,
+    /// Cargo could not be started.
+    #[error("cannot run cargo: {0}")]
+    Start(#[source] std::io::Error),
+    /// A stop request ended the build.
+    #[error("stopped by a signal")]
+    Stopped,
+    /// Waiting for Cargo failed.
+    #[error("running cargo: {0}")]
+    Wait(#[source] std::io::Error),
+    /// Cargo failed; the last lines it said.
+    #[error("{0}")]
+    Failed(String),
+}
+
+/// The manifest of the workspace this launcher was built from (this crate is
+/// deploy/launch: two folders up), whose node programs it builds.
+fn workspace_manifest() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../Cargo.toml")
+}
+
 /// Builds the node programs into `dir` (a Cargo target profile folder) from the
 /// source tree this launcher was built from.
-fn cargo_build(dir: &Path) -> Result<(), String> {
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("../Cargo.toml");
+fn cargo_build(dir: &Path) -> Result<(), BuildError> {
+    let manifest = workspace_manifest();
     if !manifest.is_file() {
-        return Err(format!("the source tree {} is gone", manifest.display()));
+        return Err(BuildError::TreeGone(manifest));
     }
-    let target = dir.parent().ok_or("no target folder")?;
-    let profile = profile_args(dir).ok_or("no profile folder")?;
+    let target = dir.parent().ok_or(BuildError::NoTarget)?;
+    let profile = profile_args(dir).ok_or(BuildError::NoProfile)?;
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let mut cmd = Command::new(cargo);
     cmd.arg("build")
@@ -79,16 +111,18 @@ fn cargo_build(dir: &Path) -> Result<(), String> {
     // Its own process group, killed on a stop request: a launcher stopped while it
     // builds leaves no build running.
     let out = crate::stop::run_tool(&mut cmd).map_err(|e| match e {
-        ToolError::Start(e) => format!("cannot run cargo: {e}"),
-        ToolError::Stopped => "stopped by a signal".into(),
-        ToolError::Wait(e) => format!("running cargo: {e}"),
+        ToolError::Start(e) => BuildError::Start(e),
+        ToolError::Stopped => BuildError::Stopped,
+        ToolError::Wait(e) => BuildError::Wait(e),
     })?;
     if out.status.success() {
         Ok(())
     } else {
         let err = String::from_utf8_lossy(&out.stderr);
         let tail: Vec<&str> = err.lines().rev().take(8).collect();
-        Err(tail.into_iter().rev().collect::<Vec<_>>().join("\n"))
+        Err(BuildError::Failed(
+            tail.into_iter().rev().collect::<Vec<_>>().join("\n"),
+        ))
     }
 }
 
@@ -139,4 +173,33 @@ pub fn node_dir() -> Result<PathBuf, Error> {
         me.display(),
         why.map_or(String::new(), |w| format!(" (building them failed: {w})"))
     )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// The build asks the workspace for the node programs, not a package's manifest
+    /// (which would not know them).
+    #[test]
+    fn the_build_names_the_workspaces_manifest() {
+        let text = std::fs::read_to_string(workspace_manifest()).expect("the manifest");
+        assert!(
+            text.contains("[workspace]"),
+            "{}",
+            workspace_manifest().display()
+        );
+        assert!(
+            text.contains("\"slave\""),
+            "the workspace holds the node programs"
+        );
+    }
+
+    #[test]
+    fn a_build_that_cannot_start_keeps_the_systems_reason() {
+        let e = BuildError::Start(std::io::Error::from(std::io::ErrorKind::NotFound));
+        assert!(e.to_string().starts_with("cannot run cargo: "), "{e}");
+        assert!(e.source().is_some_and(|c| c.is::<std::io::Error>()));
+    }
 }

@@ -2,6 +2,7 @@
 //! same from the folders of a sharded sweep. `sweep.json` records what the sweep is,
 //! so slices of different sweeps are never joined.
 
+use super::exec::RunFolderError;
 use super::{parse_axes, run_dir, Spec};
 use crate::error::Error;
 use std::collections::BTreeMap;
@@ -106,11 +107,14 @@ pub fn write_tables(out: &Path, axes: &[Axis], seeds: usize, results: &[Ran]) ->
     write(&out.join("sweep.csv"), &runs)?;
     write(&out.join("sweep-summary.csv"), &summary)?;
     let (axes, points) = unpaired(axes, &points);
-    sweep_plots(out, &axes, &points)
-        .map_err(|e| Error::Failed(format!("plotting the sweep: {e}")))?;
+    let plot = |what: &str| {
+        let what = what.to_string();
+        move |source| Error::Report(tactile_report::Error::Plot { what, source })
+    };
+    sweep_plots(out, &axes, &points).map_err(plot("plotting the sweep"))?;
     sweep_maps(out, &axes, &points)
         .map(|_| ())
-        .map_err(|e| Error::Failed(format!("drawing the sweep's maps: {e}")))
+        .map_err(plot("drawing the sweep's maps"))
 }
 
 /// The axes a plot or a map draws, and the points on them: a paired key moves with
@@ -191,10 +195,10 @@ fn gather(dirs: &[PathBuf], spec: &Spec) -> Result<Found, Error> {
 
 /// The seed and metrics of the whole run in `dir`, read back from its folder, or why
 /// there are none.
-fn ran(dir: &Path) -> Result<(u64, Vec<Option<f64>>), String> {
+fn ran(dir: &Path) -> Result<(u64, Vec<Option<f64>>), RunFolderError> {
     let summary = super::exec::read_summary(dir)?;
     if summary["interrupted"] != false {
-        return Err("it was stopped before it ended (its summary.json says interrupted)".into());
+        return Err(RunFolderError::Interrupted);
     }
     Ok((super::exec::seed_of(dir)?, values(&summary)))
 }

@@ -2,9 +2,9 @@
 //! folder, progress with an estimate of the time left, and `--resume` keeping the
 //! runs that already ended.
 
-use super::{run_dir, sets_of, Base, SweepArgs};
+use super::{run_dir, sets_of, Base, SweepOptions};
 use crate::error::Error;
-use crate::launch::{self, load_source, parse_sets, Loaded};
+use crate::{load_source, parse_sets, Loaded};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -47,7 +47,7 @@ pub fn plan(
     axes: &[Axis],
     combos: &[Vec<usize>],
     mine: &[usize],
-    args: &SweepArgs,
+    args: &SweepOptions,
 ) -> Result<Vec<Work>, Error> {
     let base_sets = parse_sets(&base.sets)?;
     let first = load_source(&base.source, &base_sets)?.scenario.seed;
@@ -119,20 +119,40 @@ pub fn finished(dir: &Path) -> Option<Vec<Option<f64>>> {
     whole.then(|| values(&json))
 }
 
+/// Why a run's folder holds no whole run (`--merge` names the folder before it).
+#[derive(Debug, thiserror::Error)]
+pub enum RunFolderError {
+    /// Its `scenario.toml` cannot be read.
+    #[error("its scenario.toml cannot be read ({0})")]
+    ScenarioUnread(#[source] std::io::Error),
+    /// Its `scenario.toml` is not a scenario.
+    #[error("its scenario.toml is unreadable ({0})")]
+    ScenarioBad(#[source] tactile_scenario::ScenarioError),
+    /// Its `summary.json` cannot be read.
+    #[error("its summary.json cannot be read ({0})")]
+    SummaryUnread(#[source] std::io::Error),
+    /// Its `summary.json` is not JSON.
+    #[error("its summary.json is unreadable ({0})")]
+    SummaryBad(#[source] serde_json::Error),
+    /// The run was cut short.
+    #[error("it was stopped before it ended (its summary.json says interrupted)")]
+    Interrupted,
+}
+
 /// The seed the run in `dir` used, from its `scenario.toml`, or why it cannot be read.
-pub fn seed_of(dir: &Path) -> Result<u64, String> {
+pub fn seed_of(dir: &Path) -> Result<u64, RunFolderError> {
     let text = std::fs::read_to_string(dir.join("scenario.toml"))
-        .map_err(|e| format!("its scenario.toml cannot be read ({e})"))?;
+        .map_err(RunFolderError::ScenarioUnread)?;
     tactile_scenario::Scenario::from_recorded_toml(&text)
         .map(|s| s.seed)
-        .map_err(|e| format!("its scenario.toml is unreadable ({e})"))
+        .map_err(RunFolderError::ScenarioBad)
 }
 
 /// The run's `summary.json` in `dir`, or why it cannot be read.
-pub fn read_summary(dir: &Path) -> Result<serde_json::Value, String> {
-    let text = std::fs::read_to_string(dir.join("summary.json"))
-        .map_err(|e| format!("its summary.json cannot be read ({e})"))?;
-    serde_json::from_str(&text).map_err(|e| format!("its summary.json is unreadable ({e})"))
+pub fn read_summary(dir: &Path) -> Result<serde_json::Value, RunFolderError> {
+    let text =
+        std::fs::read_to_string(dir.join("summary.json")).map_err(RunFolderError::SummaryUnread)?;
+    serde_json::from_str(&text).map_err(RunFolderError::SummaryBad)
 }
 
 fn summary(dir: &Path) -> Option<serde_json::Value> {
@@ -149,10 +169,10 @@ pub fn failed(dir: &Path) -> bool {
 /// summary the report of the folder's own record, never another scenario's or
 /// another run's summary left in the folder; with `--trace`, one that wrote the
 /// trace files asked for.
-fn kept(w: &Work, args: &SweepArgs) -> Option<Vec<Option<f64>>> {
+fn kept(w: &Work, args: &SweepOptions) -> Option<Vec<Option<f64>>> {
     // With --trace, a run kept has the trace files asked for (else it runs again).
     if args.trace {
-        let f = args.formats.trace_format;
+        let f = args.trace_format;
         let csv = f != TraceFormat::Parquet;
         let parquet = f != TraceFormat::Csv;
         let has = |name: &str| w.dir.join(name).is_file();
@@ -180,7 +200,7 @@ fn kept(w: &Work, args: &SweepArgs) -> Option<Vec<Option<f64>>> {
 pub fn run_all(
     work: &[Work],
     jobs: usize,
-    args: &SweepArgs,
+    args: &SweepOptions,
     progress: &(dyn Fn(&Progress) + Sync),
 ) -> Result<Vec<Option<Vec<Option<f64>>>>, Error> {
     let stop =
@@ -292,18 +312,18 @@ fn stopped(w: &Work) {
 
 /// One run and its report; its metrics as its `summary.json` holds them, or `None` if
 /// a stop request cut it short.
-fn run_one(w: &Work, args: &SweepArgs) -> Result<Option<Vec<Option<f64>>>, Error> {
+fn run_one(w: &Work, args: &SweepOptions) -> Result<Option<Vec<Option<f64>>>, Error> {
     let l = &w.loaded;
-    let outputs = launch::Outputs {
+    let outputs = crate::Outputs {
         trace_columns: w.columns.clone(),
-        ..args.formats.outputs(!args.trace)
+        ..args.outputs()
     };
     let summary = if args.processes {
-        launch::clean_stale_runs();
-        let sup = launch::sweep_supervision(outputs);
-        launch::run_processes(l, &w.dir, &sup)?
+        crate::clean_stale_runs();
+        let sup = crate::sweep_supervision(outputs);
+        crate::run_processes(l, &w.dir, &sup)?
     } else {
-        launch::sim::run_in_process(l, &w.dir, &outputs, Default::default())?
+        crate::sim::run_in_process(l, &w.dir, &outputs, Default::default())?
     };
     if summary.interrupted {
         return Ok(None);
@@ -314,4 +334,27 @@ fn run_one(w: &Work, args: &SweepArgs) -> Result<Option<Vec<Option<f64>>>, Error
             w.dir.display()
         ))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// A run folder with a garbled summary says which file and keeps the parser's
+    /// reason; one with no scenario keeps the system's.
+    #[test]
+    fn a_run_folders_error_keeps_its_cause() {
+        let dir = tempfile::tempdir().expect("tmp");
+        std::fs::write(dir.path().join("summary.json"), "{ nope").expect("write");
+        let e = read_summary(dir.path()).expect_err("not JSON");
+        assert!(
+            e.to_string()
+                .starts_with("its summary.json is unreadable ("),
+            "{e}"
+        );
+        assert!(e.source().is_some_and(|c| c.is::<serde_json::Error>()));
+        let e = seed_of(dir.path()).expect_err("no scenario.toml");
+        assert!(e.source().is_some_and(|c| c.is::<std::io::Error>()));
+    }
 }

@@ -1,4 +1,4 @@
-//! `tactile sweep`: one scenario run for every combination of the values given to
+//! A sweep (`tactile sweep`): one scenario run for every combination of the values given to
 //! `--set KEY=V1,V2,...` (each repeated over `--seeds` seeds), a table of their metrics
 //! (`sweep.csv`, one row per run), their mean and interval per combination
 //! (`sweep-summary.csv`) and a plot per metric against the first swept key, one line
@@ -20,76 +20,59 @@ mod exec;
 mod table;
 mod traces;
 
+pub use table::merge;
+
 use crate::error::Error;
-use crate::launch::Source;
-use clap::Args;
+use crate::Source;
 pub use exec::Progress;
 use std::path::{Path, PathBuf};
+use tactile_report::mcap::Compression;
 use tactile_report::sweep::{axis, combinations, Axis};
 use tactile_report::sweep_grid::same_value;
+use tactile_report::write::TraceFormat;
 use tactile_scenario::overrides::Set;
 
 /// Most runs one sweep may ask for: beyond this a typo in a list is likelier than a
 /// plan, and the folder would hold more reports than anyone reads.
 pub const MAX_RUNS: usize = 10_000;
 
-/// Arguments of `tactile sweep`.
-#[derive(Debug, Args)]
-pub struct SweepArgs {
-    /// Scenario file (TOML) every run starts from.
-    #[arg(required_unless_present = "merge")]
-    pub scenario: Option<PathBuf>,
-    /// A swept key and its values, KEY=V1,V2,... (commas inside brackets or quotes
-    /// belong to the value: network.forward.delay=[0,0,0],[5,5,5]). Repeatable: every
-    /// combination runs. +KEY=V1,V2,... pairs KEY with the key before it, value for
-    /// value, instead of combining them (a round trip split evenly both ways:
-    /// --set network.forward.delay_ms=0,5,25 --set +network.backward.delay_ms=0,5,25).
-    /// The first key is the plots' x axis, the second their lines (a paired key is
-    /// shown by its partner).
-    #[arg(long, value_name = "KEY=V1,V2,...", required_unless_present = "merge")]
+/// What a sweep runs, as plain values (the command's `tactile sweep` arguments, a
+/// Python `Scenario.sweep`'s): the swept keys and their values, the folder, how the
+/// runs go and what each writes.
+#[derive(Debug, Clone)]
+pub struct SweepOptions {
+    /// The swept keys, `KEY=V1,V2,...` or `+KEY=V1,V2,...` (paired with the one before).
     pub set: Vec<String>,
-    /// Folder for sweep.csv, the plots, and one folder per run (run-0000, ...).
-    #[arg(long, default_value = "sweep-out")]
+    /// Folder for sweep.csv, the plots, and one folder per run.
     pub out: PathBuf,
-    /// Start the three node programs for every run (in realtime, each run then takes
-    /// its real time), one run at a time, instead of running them in-process.
-    #[arg(long)]
+    /// The three node programs for every run, one run at a time (else in-process).
     pub processes: bool,
-    /// Write each run's trace.csv and run.mcap too (about 1 kB and 0.75 kB per
-    /// sample).
-    #[arg(long)]
+    /// Each run's trace and recording too.
     pub trace: bool,
-    /// With --trace: the trace's and the recording's formats. With
-    /// --trace-format parquet (or both), every run's trace.parquet carries its
-    /// combination as text columns and is linked into traces/, one table for pandas
-    /// (`pandas.read_parquet("OUT/traces")`).
-    #[command(flatten)]
-    pub formats: crate::cmd::formats::FormatArgs,
-    /// Runs at once [default: the CPUs this process may use; 1 with --processes].
-    /// The results equal --jobs 1's: every run has its own scenario and seed.
-    #[arg(long, value_name = "N")]
+    /// With `trace`: the trace's format.
+    pub trace_format: TraceFormat,
+    /// With `trace`: run.mcap's compression.
+    pub mcap_compression: Compression,
+    /// Runs at once (None: the CPUs this process may use; 1 with `processes`).
     pub jobs: Option<usize>,
-    /// Repeat every combination over N seeds (the scenario's seed, then +1, +2, ...):
-    /// sweep.csv has every run with the seed it used, sweep-summary.csv each metric's
-    /// mean and 95 % confidence half width over them, the plots error bars.
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    /// Seeds per combination.
     pub seeds: usize,
-    /// Keep the runs whose folders already hold a whole report (a sweep cut short, or
-    /// run again with more seeds) and run only the others.
-    #[arg(long)]
+    /// Keep the runs whose folders already hold a whole report.
     pub resume: bool,
-    /// Run one slice of the grid, K of N (1 <= K <= N): combinations K-1, K-1+N,
-    /// K-1+2N, ... with all their seeds. `--merge` joins the slices' folders.
-    #[arg(long, value_name = "K/N")]
+    /// One slice of the grid, `K/N`.
     pub shard: Option<String>,
-    /// No progress line per run (as `tactile run -q`); warnings, errors and the
-    /// closing line still print.
-    #[arg(long, short)]
-    pub quiet: bool,
-    /// Join the folders of a sharded sweep into --out: the same sweep.csv and plots as
-    /// the sweep run whole.
-    #[arg(long, value_name = "DIR", num_args = 1.., conflicts_with_all = ["scenario", "set", "shard", "resume", "processes", "trace", "jobs"])]
-    pub merge: Vec<PathBuf>,
+}
+
+impl SweepOptions {
+    /// The launcher's outputs for each run.
+    fn outputs(&self) -> crate::Outputs {
+        crate::Outputs {
+            no_trace: !self.trace,
+            trace_format: self.trace_format,
+            mcap_compression: self.mcap_compression,
+            trace_columns: Vec::new(),
+        }
+    }
 }
 
 /// What a sweep is, as its folder records it (`sweep.json`), so `--merge` and
@@ -113,7 +96,7 @@ pub struct Spec {
 
 /// `--seeds` within its range and not beside a seed axis; the grid within
 /// [`MAX_RUNS`].
-fn check_size(args: &SweepArgs, axes: &[Axis], combinations: usize) -> Result<(), Error> {
+fn check_size(args: &SweepOptions, axes: &[Axis], combinations: usize) -> Result<(), Error> {
     if args.seeds == 0 || args.seeds > 1000 {
         return Err(Error::BadInput(format!(
             "--seeds {}: give 1 to 1000",
@@ -141,7 +124,7 @@ pub const JOBS_PER_CPU: usize = 4;
 /// Runs at a time: as given, up to [`JOBS_PER_CPU`] x the CPUs this process may use
 /// (and never more than the runs to do, see `exec::run_all`); one with `--processes`
 /// (they take the machine's CPUs), else the CPUs.
-fn jobs(args: &SweepArgs) -> Result<usize, Error> {
+fn jobs(args: &SweepOptions) -> Result<usize, Error> {
     let cpus = tactile_runtime::sched::allowed_cpus().map_or(1, |c| c.len().max(1));
     let cap = cpus.saturating_mul(JOBS_PER_CPU);
     match (args.jobs, args.processes) {
@@ -201,36 +184,8 @@ impl Base {
             bytes.push(0);
             bytes.extend_from_slice(s.as_bytes());
         }
-        format!("{:016x}", crate::launch::sim::fnv1a64(&bytes))
+        format!("{:016x}", crate::sim::fnv1a64(&bytes))
     }
-}
-
-/// `tactile sweep`.
-pub fn main(args: &SweepArgs) -> Result<(), Error> {
-    args.formats.refuse_unless(
-        args.trace && args.merge.is_empty(),
-        "without --trace (or with --merge)",
-    )?;
-    if !args.merge.is_empty() {
-        return table::merge(&args.merge, &args.out);
-    }
-    let scenario = args
-        .scenario
-        .as_deref()
-        .ok_or_else(|| Error::BadInput("a scenario file is needed".into()))?;
-    let runs = sweep(&Base::file(scenario)?, args, &|p: &Progress| {
-        if !args.quiet {
-            p.say();
-        }
-    })?;
-    crate::outln!(
-        "tactile sweep: {runs} runs{}; sweep.csv and a plot per metric with values in {}",
-        args.shard
-            .as_deref()
-            .map_or_else(String::new, |s| format!(" (shard {s})")),
-        args.out.display()
-    );
-    Ok(())
 }
 
 /// Runs the sweep `args` asks for (its scenario file aside: `base` is what every
@@ -241,7 +196,7 @@ pub fn main(args: &SweepArgs) -> Result<(), Error> {
 /// run that could not be run at all ends the sweep with its error.
 pub fn sweep(
     base: &Base,
-    args: &SweepArgs,
+    args: &SweepOptions,
     progress: &(dyn Fn(&Progress) + Sync),
 ) -> Result<usize, Error> {
     let axes = parse_axes(&args.set)?;
@@ -321,7 +276,7 @@ pub fn sweep(
 pub fn parse_axes(sets: &[String]) -> Result<Vec<Axis>, Error> {
     let axes = sets
         .iter()
-        .map(|a| axis(a).map_err(Error::BadInput))
+        .map(|a| axis(a).map_err(Error::from))
         .collect::<Result<Vec<_>, _>>()?;
     for (k, a) in axes.iter().enumerate() {
         if axes[..k].iter().any(|b| b.key == a.key) {
@@ -447,7 +402,7 @@ fn sets_of(
     let mut sets: Vec<Set> = base.iter().filter(|b| !swept(b)).cloned().collect();
     sets.extend(axes.iter().zip(combo).map(|(a, &i)| a.sets[i].clone()));
     if let Some(s) = seed {
-        sets.push(Set::parse(&format!("seed={s}")).map_err(Error::BadInput)?);
+        sets.push(Set::parse(&format!("seed={s}"))?);
     }
     Ok(sets)
 }

@@ -14,19 +14,34 @@ pub struct Pair {
     pub addrs: [String; 2],
 }
 
-fn ip(args: &[&str]) -> Result<(), String> {
+/// Why the namespaces could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum NetnsError {
+    /// No `ip` program.
+    #[error("no `ip` command ({0}): install iproute2")]
+    NoIp(#[source] std::io::Error),
+    /// `ip` ran and refused (without root, for one); its stderr says why.
+    #[error("ip {args}: {stderr}")]
+    Ip {
+        /// Its arguments.
+        args: String,
+        /// What it said.
+        stderr: String,
+    },
+}
+
+fn ip(args: &[&str]) -> Result<(), NetnsError> {
     let out = Command::new("ip")
         .args(args)
         .output()
-        .map_err(|e| format!("no `ip` command ({e}): install iproute2"))?;
+        .map_err(NetnsError::NoIp)?;
     if out.status.success() {
         Ok(())
     } else {
-        Err(format!(
-            "ip {}: {}",
-            args.join(" "),
-            String::from_utf8_lossy(&out.stderr).trim()
-        ))
+        Err(NetnsError::Ip {
+            args: args.join(" "),
+            stderr: String::from_utf8_lossy(&out.stderr).trim().to_string(),
+        })
     }
 }
 
@@ -34,7 +49,7 @@ impl Pair {
     /// Creates the namespaces `tta<tag>` and `ttb<tag>` (tag: a few letters or digits,
     /// unique among the pairs alive at once), joined by a veth pair with addresses
     /// 198.18.7.1 and 198.18.7.2.
-    pub fn new(tag: &str) -> Result<Pair, String> {
+    pub fn new(tag: &str) -> Result<Pair, NetnsError> {
         let pair = Pair {
             names: [format!("tta{tag}"), format!("ttb{tag}")],
             addrs: ["198.18.7.1".to_string(), "198.18.7.2".to_string()],
@@ -73,5 +88,18 @@ impl Drop for Pair {
         for n in &self.names {
             let _ = ip(&["netns", "del", n]);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    #[test]
+    fn no_ip_command_keeps_the_systems_reason() {
+        let e = NetnsError::NoIp(std::io::Error::from(std::io::ErrorKind::NotFound));
+        assert!(e.to_string().ends_with(": install iproute2"), "{e}");
+        assert!(e.source().is_some_and(|c| c.is::<std::io::Error>()));
     }
 }

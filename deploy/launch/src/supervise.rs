@@ -3,11 +3,10 @@
 //! writes the report from their records.
 
 use super::links::node_command;
-use super::logs::log_tail;
+use super::proc::{describe, log_tail, stopped_by_signal, Proc};
 use super::stall::{self, Progress};
 use super::{nodes, prepare_out, survivor_grace, two_cpus, Loaded, Supervision};
 use crate::error::Error;
-use signal_hook::consts::{SIGINT, SIGTERM};
 use std::io::Write as _;
 use std::path::Path;
 use std::process::{Child, ExitStatus, Stdio};
@@ -34,75 +33,6 @@ const POLL: Duration = Duration::from_millis(20);
 
 /// Starts the node of a role (`true`: appending to its record after a restart).
 type Spawn<'a> = dyn Fn(Role, bool) -> Result<Child, Error> + 'a;
-
-/// How a child process ended, in words.
-pub fn describe(status: ExitStatus) -> String {
-    use std::os::unix::process::ExitStatusExt;
-    match (status.code(), status.signal()) {
-        (Some(c), _) => format!("exited with status {c}"),
-        (None, Some(s)) => format!("was killed by signal {s}"),
-        _ => "ended".to_string(),
-    }
-}
-
-/// True if a node ended because of a stop request: its own exit status for one
-/// (130), or killed by SIGINT or SIGTERM.
-fn stopped_by_signal(status: ExitStatus) -> bool {
-    use std::os::unix::process::ExitStatusExt;
-    status.code() == Some(i32::from(EXIT_INTERRUPTED))
-        || matches!(status.signal(), Some(s) if s == SIGINT || s == SIGTERM)
-}
-
-/// One node program under supervision.
-struct Proc {
-    role: Role,
-    child: Child,
-    status: Option<ExitStatus>,
-    restarts: u32,
-    /// Set while a dead process waits out the restart backoff.
-    restart_at: Option<Instant>,
-    /// Since when its process is stopped: a node stopped too long is frozen.
-    progress: Progress,
-}
-
-impl Proc {
-    fn signal(&self, sig: rustix::process::Signal) {
-        if let Some(pid) = rustix::process::Pid::from_raw(self.child.id() as i32) {
-            let _ = rustix::process::kill_process(pid, sig);
-        }
-    }
-
-    /// SIGTERM, then SIGKILL after `grace`; records how it ended.
-    fn stop(&mut self, grace: Duration) {
-        if self.status.is_some() {
-            return;
-        }
-        self.signal(rustix::process::Signal::TERM);
-        let until = Instant::now() + grace;
-        while Instant::now() < until {
-            if let Ok(Some(s)) = self.child.try_wait() {
-                self.status = Some(s);
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        let _ = self.child.kill();
-        self.status = self.child.wait().ok();
-    }
-
-    /// True while the program runs.
-    fn running(&mut self) -> bool {
-        self.status.is_none() && !matches!(self.child.try_wait(), Ok(Some(_)))
-    }
-
-    /// The exit status if it has ended since the last look.
-    fn ended(&mut self) -> Option<ExitStatus> {
-        if self.status.is_some() || self.restart_at.is_some() {
-            return None;
-        }
-        self.child.try_wait().ok().flatten()
-    }
-}
 
 /// What the supervision saw.
 struct Watch {
@@ -485,14 +415,13 @@ pub fn run_processes(loaded: &Loaded, out: &Path, sup: &Supervision) -> Result<S
     // Every check that can refuse the run comes before anything starts or is written:
     // a prefix held by any process (a launcher, a node started by hand), the output
     // folder, the node programs.
-    tactile_runtime::lock::in_use(&sup.prefix).map_err(Error::BadInput)?;
+    tactile_runtime::lock::in_use(&sup.prefix)?;
     let holder = format!(
         "tactile run (pid {}, writing to {})",
         std::process::id(),
         out.display()
     );
-    let _lock =
-        tactile_runtime::lock::take(&sup.prefix, "run", &holder).map_err(Error::BadInput)?;
+    let _lock = tactile_runtime::lock::take(&sup.prefix, "run", &holder)?;
     let dir = nodes::node_dir()?;
     let (bundled, _held) = prepare_out(out, loaded)?;
     // The nodes run the scenario as written here, reading the copies of its inputs
