@@ -192,3 +192,33 @@ fn the_physics_wall_is_felt_as_stiff_as_its_coupling() {
     // The contact is rigid: the 600 N/m coupling is the wall's stiffness.
     assert!((k - 600.0).abs() < 0.25 * 600.0, "{k} N/m");
 }
+
+#[test]
+fn a_physics_sweep_on_two_jobs_equals_one_job() {
+    let sb = Sandbox::new("pjobs");
+    let scenario = shipped("push-box.toml");
+    let sweep = |jobs: &str, out: &str| {
+        let o = sb.tactile(&[
+            "sweep",
+            scenario.to_str().expect("utf-8"),
+            "--set",
+            "control.kind=none,wave",
+            "--set",
+            "network.forward.delay=[0,0,0],[25,25,25]",
+            "--jobs",
+            jobs,
+            "-q",
+            "--out",
+            sb.path(out).to_str().expect("utf-8"),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read_to_string(sb.path(out).join("sweep.csv")).expect("sweep.csv")
+    };
+    let one = sweep("1", "one");
+    assert_eq!(one, sweep("2", "two"));
+    assert!(one
+        .lines()
+        .next()
+        .is_some_and(|h| h.contains("task_success")));
+    assert_eq!(one.lines().count(), 5);
+}
