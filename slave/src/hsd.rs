@@ -184,17 +184,14 @@ impl Slave {
             .arm
             .advance(joints, self.world.touch(), self.t_s, &mut self.counters);
         let felt = self.step_world();
-        let sensor = match (measured.as_ref(), &felt) {
-            (Some(m), _) => m.force.map(|f| (f, None)),
-            (None, Some(f)) => Some((f.force, Some(f.contact))),
-            (None, None) => None,
+        // A real force-torque sensor's reading wins; then a physics world's coupling;
+        // then (in `sense`) the analytic scene.
+        let (sensor, torque) = match (measured.and_then(|m| m.force.map(|f| (f, m.torque))), felt) {
+            (Some((f, t)), _) => (Some((f, None)), t),
+            (None, Some(w)) => (Some((w.force, Some(w.contact))), w.torque),
+            (None, None) => (None, measured.map_or([0.0; 3], |m| m.torque)),
         };
         let (tool, force, surface, contact_object) = self.sense(sensor, &mut flags);
-        let torque = match (measured, felt) {
-            (Some(m), _) => m.torque,
-            (None, Some(f)) => f.torque,
-            (None, None) => [0.0; 3],
-        };
         self.reply(v, (force, torque), tool, flags, h);
         let model = h.as_ref().map_or_else(Default::default, |h| h.model);
         Step {
