@@ -122,11 +122,6 @@ impl Slave {
         self.arm.as_ref()
     }
 
-    /// The world the arm touches.
-    pub fn world(&self) -> &SlaveWorld {
-        &self.world
-    }
-
     /// What the world counted so far.
     pub fn world_counters(&self) -> WorldCounters {
         self.world.counters()

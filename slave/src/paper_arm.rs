@@ -78,14 +78,23 @@ impl PaperArm {
         self.theta = self.dynamics.state.theta;
     }
 
-    /// FCS then SD toward `reference`: the torques and how many were clamped.
-    fn servo(&mut self, reference: [f64; 3], touch: Touch<'_>, dt: f64) -> ([f64; 3], u32) {
+    /// FCS then SD toward `reference`: the torques kept for the record, the clamps
+    /// counted into `c` and returned.
+    fn servo(
+        &mut self,
+        reference: [f64; 3],
+        touch: Touch<'_>,
+        dt: f64,
+        c: &mut SlaveCounters,
+    ) -> u32 {
         let state = self.dynamics.state;
         let cmd = self
             .controller
             .update(reference, state.theta, state.velocity, dt);
         self.integrate(cmd.torque, touch, dt);
-        (cmd.torque, cmd.clamped)
+        self.torque = cmd.torque;
+        c.torque_clamps += u64::from(cmd.clamped);
+        cmd.clamped
     }
 }
 
@@ -130,10 +139,7 @@ impl SlaveArm for PaperArm {
             self.torque = [0.0; 3];
             return 0;
         }
-        let (torque, clamps) = self.servo(self.reference, touch, dt);
-        self.torque = torque;
-        c.torque_clamps += u64::from(clamps);
-        clamps
+        self.servo(self.reference, touch, dt, c)
     }
 
     /// Simulated, the joints are held where they were; a real robot is commanded the
@@ -154,18 +160,16 @@ impl SlaveArm for PaperArm {
             now
         });
         c.held_steps += 1;
-        self.torque = match measured {
+        match measured {
             Some(q) => {
                 self.theta = q.to_array3();
-                [0.0; 3]
+                self.torque = [0.0; 3];
             }
             None => {
                 self.reference = from;
-                let (torque, clamps) = self.servo(from, touch, dt);
-                c.torque_clamps += u64::from(clamps);
-                torque
+                self.servo(from, touch, dt, c);
             }
-        };
+        }
         let p0 = kernels::fk(&self.truth, &StdTrig, from);
         let p = kernels::fk(&self.truth, &StdTrig, self.theta);
         c.hold_drift_max_m = c.hold_drift_max_m.max(distance(p, p0));

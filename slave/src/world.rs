@@ -15,7 +15,7 @@ use std::path::Path;
 use tactile_records::slave::{TaskResult, WorldCounters};
 use tactile_scenario::world::Engine;
 use tactile_scenario::{Change, Scenario};
-use tactile_world::{PhysicsWorld, Pose, Sensed, TaskMonitor, ToolState, World, WorldError};
+use tactile_world::{PhysicsWorld, Pose, TaskMonitor, TaskProgress, ToolState, World, WorldError};
 
 /// What pushes on the arm's tool while its dynamics integrate one sample.
 #[derive(Debug, Clone, Copy)]
@@ -113,23 +113,23 @@ pub struct Physics {
     gain: f64,
     /// Seconds since the last fault (infinite: none yet).
     quiet_s: f64,
-    counters: WorldCounters,
+    /// Samples whose force was ramped down.
+    ramped_steps: u64,
+    /// The task's outcome so far (the world counts its own faults).
+    task_result: Option<TaskResult>,
 }
 
 impl Physics {
     fn new(world: PhysicsWorld, task: Option<TaskMonitor>) -> Physics {
         Physics {
             world,
-            counters: WorldCounters {
-                physics: true,
-                task: task.as_ref().map(|_| TaskResult::default()),
-                ..WorldCounters::default()
-            },
+            task_result: task.as_ref().map(|_| TaskResult::default()),
             task,
             held: [0.0; 6],
             last: None,
             gain: 1.0,
             quiet_s: f64::INFINITY,
+            ramped_steps: 0,
         }
     }
 
@@ -162,23 +162,13 @@ impl Physics {
         let contact = sensed.contact.map(|c| (c.point, c.body as u32));
         let progress = self.task.as_mut().map(|t| t.update(sensed, time_s));
         self.ramp(fault, dt);
-        self.count(progress);
+        self.record(progress);
         let g = self.gain;
         Felt {
             force: [0, 1, 2].map(|k| g * self.held[k]),
             torque: [3, 4, 5].map(|k| g * self.held[k]),
             contact,
         }
-    }
-
-    /// The world's state after the last sample.
-    pub fn sensed(&self) -> &Sensed {
-        self.world.sensed()
-    }
-
-    /// The bodies' names, in the order of [`Sensed::poses`].
-    pub fn body_names(&self) -> &[String] {
-        self.world.body_names()
     }
 
     /// Down toward zero while the world has faulted within [`QUIET_S`], back up
@@ -192,19 +182,13 @@ impl Physics {
             (self.gain + rate).min(1.0)
         };
         if self.gain < 1.0 {
-            self.counters.ramped_steps += 1;
+            self.ramped_steps += 1;
         }
     }
 
-    fn count(&mut self, progress: Option<tactile_world::TaskProgress>) {
-        let c = self.world.counters();
-        let w = &mut self.counters;
-        w.left_bounds = c.left_bounds;
-        w.energy_gains = c.energy_gains;
-        w.non_finite = c.non_finite;
-        w.bad_inputs = c.bad_inputs;
-        w.engine_failures = c.engine_failures;
-        if let (Some(p), Some(t)) = (progress, w.task.as_mut()) {
+    /// The task's outcome after this sample's `progress`.
+    fn record(&mut self, progress: Option<TaskProgress>) {
+        if let (Some(p), Some(t)) = (progress, self.task_result.as_mut()) {
             t.success = p.success;
             t.completion_s = p.completion_s;
             t.distance = p.distance;
@@ -217,7 +201,18 @@ impl Physics {
         }
     }
 
+    /// The world's faults as it counts them, the ramp's and the task's.
     fn counters(&self) -> WorldCounters {
-        self.counters
+        let c = self.world.counters();
+        WorldCounters {
+            physics: true,
+            left_bounds: c.left_bounds,
+            energy_gains: c.energy_gains,
+            non_finite: c.non_finite,
+            bad_inputs: c.bad_inputs,
+            engine_failures: c.engine_failures,
+            ramped_steps: self.ramped_steps,
+            task: self.task_result,
+        }
     }
 }
