@@ -22,6 +22,7 @@ mod hand;
 mod hdl;
 mod hdl_modules;
 mod hosts;
+mod human;
 mod layout;
 mod lifecycle;
 mod logs;

@@ -532,3 +532,18 @@ pub fn run_measured(mut cmd: Command) -> (std::process::ExitStatus, u64) {
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
 }
+
+/// The trace's signal columns (everything before the first timing column): what a
+/// deterministic run repeats bit for bit, whatever the machine's timing.
+pub fn signals(trace: &str) -> String {
+    let header = trace.lines().next().expect("header");
+    let cut = header
+        .split(',')
+        .position(|c| c == "round_trip_ns")
+        .expect("timing columns");
+    trace
+        .lines()
+        .map(|l| l.split(',').take(cut).collect::<Vec<_>>().join(","))
+        .collect::<Vec<_>>()
+        .join("\n")
+}

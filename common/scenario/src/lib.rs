@@ -16,6 +16,7 @@ mod device;
 pub mod endpoint;
 mod error;
 pub mod hand;
+mod human;
 mod lengths;
 mod master;
 #[cfg(test)]
@@ -52,6 +53,7 @@ pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
 pub(crate) use error::{finite3, invalid, positive, positive3};
 pub use error::{one_line, ScenarioError};
 pub use hand::{ClutchConfig, ForceMessage, GimbalConfig, HandInput, OmniButton};
+pub use human::{HumanConfig, Response};
 pub use master::{FaultConfig, HandConfig, HandMode, MasterConfig, MasterDeviceConfig};
 pub use network::{
     ChannelConfig, JitterConfig, JitterDistribution, LossModel, Network, ReplayConfig,

@@ -1,6 +1,7 @@
 //! `[master]` and `[faults]`: the master device's limits, the operator's hand, the
 //! master device's joints, and how a dead peer is noticed.
 
+use crate::human::HumanConfig;
 use crate::shown::Num;
 use crate::{
     invalid, positive, positive3, Backend, PredictorConfig, RosDeviceConfig, ScenarioError,
@@ -41,6 +42,9 @@ pub struct MasterConfig {
     /// a hand reacts (about 0.15 s). 0 switches at once. The loop breaking renders zero
     /// force at once: rendering nothing is the safe state.
     pub switch_ramp_s: f64,
+    /// The simulated operator's tremor, wander and reaction to a felt force
+    /// (`[master.human]`, off by default).
+    pub human: HumanConfig,
 }
 
 impl Default for MasterConfig {
@@ -55,6 +59,7 @@ impl Default for MasterConfig {
             ros2: RosDeviceConfig::default(),
             clutch_spring: 0.0,
             switch_ramp_s: 0.1,
+            human: HumanConfig::default(),
         }
     }
 }

@@ -46,6 +46,7 @@ impl Scenario {
         self.device.geometry()?;
         self.operator.validate()?;
         self.master.validate()?;
+        self.master.human.validate(self.rate_hz)?;
         self.control.validate()?;
         self.codec.forward.validate("codec.forward")?;
         self.codec.backward.validate("codec.backward")?;

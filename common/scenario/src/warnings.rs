@@ -186,6 +186,11 @@ impl Scenario {
             let this = "this run's hand has master.hand.mode = \"position\"";
             say(w, &set, "master.hand.mode = \"impedance\"", this);
         }
+        if self.master.backend == Backend::Ros2 {
+            let set = changed(&self.master.human, &d.master.human, "master.human", &[]);
+            let this = "this run's master is a real device (master.backend = \"ros2\")";
+            say(w, &set, "the simulated operator", this);
+        }
         let sides = [
             (
                 "master",

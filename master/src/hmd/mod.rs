@@ -14,7 +14,8 @@
 //! ([`MasterSide`]) decides what is sent for c(n) and which force comes of q(n).
 //! Either hand reaches the trajectory from the devices' home along [`Approach`].
 
-use crate::operator::{Approach, Operate, OperatorSource, Scripted, Target, IDENTITY};
+use crate::human::Human;
+use crate::operator::{Approach, Operate, OperatorSource, Scripted, IDENTITY};
 use crate::simulated::HeldDevice;
 use switch::{Rendering, Switch};
 use tactile_control::codec::{Deadband, Estimate, Guess, Predictor};
@@ -22,7 +23,6 @@ use tactile_control::mmt::ModelReceiver;
 use tactile_control::passivity::{MasterForce, MasterSide};
 use tactile_devices::hand::Hand;
 use tactile_math::engine::Engine;
-use tactile_math::kernels::IkStatus;
 use tactile_messages::samples::{Backward, Flags, Forward};
 use tactile_records::master::{Answer, Effect, MasterCounters, Sent};
 use tactile_scenario::ControlKind;
@@ -93,6 +93,10 @@ pub struct Master {
     mmt: Option<ModelReceiver>,
     /// Which force the hand is rendered, and the blend when that changes.
     switch: Switch,
+    /// The simulated operator's tremor, wander and reaction (`[master.human]`).
+    human: Option<Human>,
+    /// The path's sample the hand is at (behind the run's after a pause).
+    progress: u64,
 }
 
 /// `q` relative to `q0` (both `[x, y, z, w]`): the turn from `q0` to `q`, about the
@@ -178,6 +182,8 @@ impl Master {
                 )
             }),
             switch: Switch::new(scenario.master.switch_ramp_s, scenario.t_s()),
+            human: Human::new(&scenario.master.human, scenario.t_s(), scenario.seed),
+            progress: 0,
         })
     }
 
@@ -246,12 +252,15 @@ impl Master {
             return None;
         }
         let t = n as f64 * self.t_s;
-        let r = self.source.rotation(n, self.t_s).unwrap_or(IDENTITY);
+        let r = self
+            .source
+            .rotation(self.progress, self.t_s)
+            .unwrap_or(IDENTITY);
         let r = match &self.approach {
             Some(a) => a.apply_rotation(r, t),
             None => r,
         };
-        Some((r, self.source.engaged(n, self.t_s)))
+        Some((r, self.source.engaged(self.progress, self.t_s)))
     }
 
     /// A 6-DoF sample's orientation `r` and clutch onto c(n) and its record; released,
@@ -400,67 +409,6 @@ impl Master {
         [0, 1, 2].map(|i| j[i][0] * d[0] + j[i][1] * d[1] + j[i][2] * d[2])
     }
 
-    /// What the hand means to do at sample n: the trajectory, blended in from the
-    /// devices' home over the approach (both hands, so neither starts with a jump).
-    fn target(&mut self, n: u64) -> Target {
-        let a = match &mut self.scripted {
-            Some(s) => s.target(n, self.t_s, self.last_felt),
-            None => self.source.target(n, self.t_s),
-        };
-        match &self.approach {
-            Some(approach) => approach.apply(a, n as f64 * self.t_s),
-            None => a,
-        }
-    }
-
-    /// The impedance hand's intended position at sample n.
-    fn intended(&mut self, n: u64) -> [f64; 3] {
-        match self.target(n) {
-            Target::Joints(theta) => self.truth.fk(theta),
-            Target::Position(p) => p,
-        }
-    }
-
-    /// The impedance hand: the device moves over the sample just ended under the hand
-    /// and the torques then applied; the encoders read where it got to.
-    fn impedance_hand(&mut self, n: u64) -> ([f64; 3], [f64; 3]) {
-        let x_d = self.intended(n);
-        let (tau, t_s) = (self.last_tau, self.t_s);
-        let Some((device, last)) = &mut self.held else {
-            return (self.ideal_hand(n), [0.0; 3]);
-        };
-        if n > 0 {
-            device.advance(tau, *last, x_d, t_s);
-        }
-        *last = x_d;
-        self.theta_md = device.theta;
-        (x_d, device.hand_force)
-    }
-
-    /// The ideal hand: the handle is where the hand means it to be.
-    fn ideal_hand(&mut self, n: u64) -> [f64; 3] {
-        match self.target(n) {
-            Target::Joints(theta) => {
-                self.theta_md = theta;
-                self.truth.fk(theta)
-            }
-            Target::Position(p) => {
-                // The hand puts the handle at p; the encoders read the joint angles the
-                // real device takes there (f64: physics, not the HMD datapath).
-                let s = self.truth.ik(p);
-                match s.status {
-                    IkStatus::Reachable => self.theta_md = s.theta,
-                    IkStatus::Clamped => {
-                        self.counters.operator_clamped += 1;
-                        self.theta_md = s.theta;
-                    }
-                    IkStatus::Invalid => self.counters.operator_clamped += 1,
-                }
-                p
-            }
-        }
-    }
-
     /// True while the loop is broken (no answer for the peer timeout).
     pub fn peer_lost(&self) -> bool {
         self.silent >= self.peer_timeout
@@ -571,6 +519,7 @@ impl Master {
 }
 
 // What the master does when no answer came, and the round trip of one that did.
+mod hand;
 mod miss;
 // MMT's models taken and rendered against the handle.
 mod model;

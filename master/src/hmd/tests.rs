@@ -2,6 +2,7 @@
 //! device's tests are in `hmd_device_tests.rs`): every hand mode starts the operator's
 //! motion at home and blends onto it, unless the motion starts there.
 use super::*;
+use crate::operator::Target;
 use tactile_scenario::Operator;
 
 /// The targets of the first `samples` with `operator` and `hand`, at 1 kHz.
