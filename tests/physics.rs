@@ -139,7 +139,12 @@ fn a_world_that_cannot_be_built_is_refused_before_anything_starts() {
 #[test]
 fn every_shipped_task_succeeds_at_zero_delay_and_a_misaligned_peg_does_not() {
     let sb = Sandbox::new("tasks");
-    for name in ["drawer.toml", "peg-in-hole.toml", "panda-push-box.toml"] {
+    for name in [
+        "drawer.toml",
+        "peg-in-hole.toml",
+        "panda-push-box.toml",
+        "ur5-push-box.toml",
+    ] {
         let out = name.trim_end_matches(".toml");
         sb.simulate(&shipped(name), out);
         let task = &sb.json(out, "summary.json")["task"];
