@@ -51,6 +51,11 @@ pub struct TimingArgs {
     /// Keep the work folder (RTL, wrappers, netlists, nextpnr's reports) here.
     #[arg(long)]
     pub keep: Option<PathBuf>,
+    /// Leave Yosys's `share` out of `synth_ecp5` (it merges operations that are never
+    /// active together; its SAT analysis of IK as one flat `module` grew past 23.9 GB),
+    /// every other pass as `synth_ecp5` runs it.
+    #[arg(long)]
+    pub no_share: bool,
     /// Fixed-point format and the arm's geometry.
     #[command(flatten)]
     pub datapath: DatapathArgs,
@@ -282,12 +287,7 @@ fn place(
         &work.dir.join(format!("pnr_{name}.v")),
         &wrapper(name, ins, outs),
     )?;
-    let script = format!(
-        "read_verilog -I . {modules} tfb_top.v kin_top.v pnr_{name}.v; \
-         synth_ecp5 -top pnr_{name} -json {json}",
-        modules = MODULES.join(" "),
-        json = file("json").display()
-    );
+    let script = synth_script(name, &file("json"), args.no_share);
     let mut y = Command::new("yosys");
     y.current_dir(&work.dir).args(["-q", "-p", &script]);
     tool(&mut y, "yosys", "yosys")?;
@@ -322,6 +322,33 @@ fn place(
     placed.ff = placed.ff.saturating_sub(wrapper_ffs);
     let routed = started.elapsed().as_secs_f64() - synthesized;
     Ok((placed, synthesized, routed))
+}
+
+/// `synth_ecp5`'s `coarse` step without `share` (Yosys 0.23's, `yosys -h
+/// synth_ecp5`; a test holds it to the installed Yosys's).
+const COARSE_WITHOUT_SHARE: &str = "proc; flatten; tribuf -logic; deminout; opt_expr; \
+    opt_clean; check; opt -nodffe -nosdff; fsm; opt; wreduce; peepopt; opt_clean; \
+    techmap -map +/cmp2lut.v -D LUT_WIDTH=4; opt_expr; opt_clean; \
+    techmap -map +/mul2dsp.v -map +/ecp5/dsp_map.v -D DSP_A_MAXWIDTH=18 \
+    -D DSP_B_MAXWIDTH=18 -D DSP_A_MINWIDTH=2 -D DSP_B_MINWIDTH=2 -D DSP_NAME=$__MUL18X18; \
+    chtype -set $mul t:$__soft_mul; alumacc; opt; memory -nomap; opt_clean";
+
+/// The Yosys script synthesizing `pnr_<name>` into `json`: `synth_ecp5`, or with
+/// `no_share` its steps up to `coarse`, `coarse` without `share`, and the rest.
+fn synth_script(name: &str, json: &Path, no_share: bool) -> String {
+    let read = format!(
+        "read_verilog -I . {} tfb_top.v kin_top.v pnr_{name}.v",
+        MODULES.join(" ")
+    );
+    let top = format!("-top pnr_{name}");
+    let json = json.display();
+    match no_share {
+        false => format!("{read}; synth_ecp5 {top} -json {json}"),
+        true => format!(
+            "{read}; synth_ecp5 {top} -run begin:coarse; {COARSE_WITHOUT_SHARE}; \
+             synth_ecp5 {top} -json {json} -run map_ram:"
+        ),
+    }
 }
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
@@ -398,6 +425,38 @@ mod tests {
         assert!((p.fmax_mhz - 35.82).abs() < 1e-9);
         assert!(parse_report(r#"{"fmax": {}}"#).is_err());
         assert!(parse_report("not json").is_err());
+    }
+
+    /// Without `share` the script runs every command of the installed Yosys's
+    /// `coarse` step but that one, in its order (skipped where Yosys is not installed).
+    #[test]
+    fn coarse_without_share_is_the_installed_yosys_coarse_step_less_share() {
+        let Ok(out) = Command::new("yosys").args(["-h", "synth_ecp5"]).output() else {
+            return;
+        };
+        let help = String::from_utf8_lossy(&out.stdout);
+        let coarse: Vec<String> = help
+            .lines()
+            .skip_while(|l| l.trim() != "coarse:")
+            .skip(1)
+            .take_while(|l| !l.trim().is_empty())
+            .map(|l| l.split("  (").next().unwrap_or(l).trim().to_string())
+            .filter(|c| c != "share")
+            .collect();
+        assert!(coarse.len() > 10, "{help}");
+        let ours: Vec<String> = COARSE_WITHOUT_SHARE
+            .split(';')
+            .map(|c| c.split_whitespace().collect::<Vec<_>>().join(" "))
+            .collect();
+        let theirs: Vec<String> = coarse
+            .iter()
+            .map(|c| c.replace(" [-no-rw-check]", ""))
+            .map(|c| c.split_whitespace().collect::<Vec<_>>().join(" "))
+            .collect();
+        assert_eq!(ours, theirs);
+        let script = synth_script("ik", Path::new("ik.json"), true);
+        assert!(!script.contains("share;") && script.ends_with("-run map_ram:"));
+        assert!(!synth_script("ik", Path::new("ik.json"), false).contains("-run"));
     }
 
     #[test]
