@@ -9,12 +9,14 @@
 //! its flaw: see [`jitter`].
 
 pub mod channel;
+pub mod histogram;
 pub mod jitter;
 pub mod loss;
 pub mod replay;
 #[cfg(test)]
 mod tests;
 
+pub use histogram::{DelayHistogram, HistogramDelay, HistogramError};
 pub use jitter::Jitter;
 pub use loss::{loss_rate, Loss};
 pub use replay::{Mahimahi, Replay, ReplayError};
