@@ -12,20 +12,6 @@ fn shipped(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// The trace's signal columns (everything before the first timing column).
-fn signals(trace: &str) -> String {
-    let header = trace.lines().next().expect("header");
-    let cut = header
-        .split(',')
-        .position(|c| c == "round_trip_ns")
-        .expect("timing columns");
-    trace
-        .lines()
-        .map(|l| l.split(',').take(cut).collect::<Vec<_>>().join(","))
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
 #[test]
 fn the_box_is_pushed_to_its_target_and_the_bits_repeat_in_process_and_as_processes() {
     let sb = Sandbox::new("pushbox");
@@ -33,11 +19,11 @@ fn the_box_is_pushed_to_its_target_and_the_bits_repeat_in_process_and_as_process
     sb.simulate(&scenario, "a");
     sb.simulate(&scenario, "b");
     sb.run(&scenario, "procs");
-    let a = signals(&sb.trace("a"));
-    assert_eq!(a, signals(&sb.trace("b")), "in-process twice");
+    let a = util::signals(&sb.trace("a"));
+    assert_eq!(a, util::signals(&sb.trace("b")), "in-process twice");
     assert_eq!(
         a,
-        signals(&sb.trace("procs")),
+        util::signals(&sb.trace("procs")),
         "processes against in-process"
     );
     let s = sb.json("a", "summary.json");
