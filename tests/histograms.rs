@@ -29,6 +29,13 @@ fn the_press_over_a_shipped_5g_histogram_repeats_with_its_delays() {
         "delay_histogram = { name = \"5g-3.7ghz-uplink\" }",
     );
     let s = sb.write("s.toml", &text);
+    // `check` says where each direction's delays come from.
+    let o = sb.tactile(&["check", s.to_str().expect("utf-8")]);
+    let shown = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        shown.contains("network.forward: delay per packet from the histogram 5g-3.7ghz-downlink, correlation 0.5 (samples, 1 = 1 ms at 1000 Hz)"),
+        "{shown}"
+    );
     sb.simulate(&s, "a");
     sb.simulate(&s, "b");
     sb.run(&s, "c");
