@@ -4,6 +4,7 @@
 
 use super::*;
 use crate::channel::{Channel, Value, FORWARD_STREAM};
+use crate::tests::{ranks, stats};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use tactile_scenario::{ChannelConfig, HistogramFormat as F, SHIPPED_HISTOGRAMS};
@@ -40,30 +41,6 @@ fn ks(h: &DelayHistogram, sorted: &[f64]) -> f64 {
 /// The bin of `x` among `h`'s edges.
 fn bin(h: &DelayHistogram, x: f64) -> usize {
     h.edges().partition_point(|e| *e <= x).saturating_sub(1)
-}
-
-/// Each value's rank in the series.
-fn ranks(x: &[f64]) -> Vec<f64> {
-    let mut order: Vec<usize> = (0..x.len()).collect();
-    order.sort_by(|&a, &b| x[a].total_cmp(&x[b]));
-    let mut r = vec![0.0; x.len()];
-    for (rank, &k) in order.iter().enumerate() {
-        r[k] = rank as f64;
-    }
-    r
-}
-
-/// The lag-1 correlation of a series.
-fn lag1(x: &[f64]) -> f64 {
-    let n = x.len() as f64;
-    let mean = x.iter().sum::<f64>() / n;
-    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
-    let cov = x
-        .windows(2)
-        .map(|w| (w[0] - mean) * (w[1] - mean))
-        .sum::<f64>()
-        / (n - 1.0);
-    cov / var
 }
 
 const MILLION: usize = 1_000_000;
@@ -139,7 +116,7 @@ fn correlated_delays_have_the_copulas_rank_correlation_and_the_files_marginal() 
         let se = ((1.0 - c * c) / MILLION as f64)
             .sqrt()
             .max(1.0 / (MILLION as f64).sqrt());
-        let rank = lag1(&ranks(&x));
+        let rank = stats(&ranks(&x)).2;
         assert!(
             (rank - want).abs() < 5.0 * se,
             "c {c}: rank correlation {rank} vs {want}"
