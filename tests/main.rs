@@ -21,6 +21,7 @@ mod formats;
 mod hand;
 mod hdl;
 mod hdl_modules;
+mod histograms;
 mod hosts;
 mod human;
 mod layout;

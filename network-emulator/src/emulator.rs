@@ -18,7 +18,7 @@ use tactile_messages::samples::{Backward, Flags, Forward, Model, Signal};
 /// released at, however late that pose arrives).
 const CARRIED: Flags = Flags::RELEASED;
 use tactile_netem::channel::{Channel, Rest, Value, BACKWARD_STREAM, FORWARD_STREAM};
-use tactile_netem::{Loss, Replay};
+use tactile_netem::{HistogramDelay, Loss, Replay};
 use tactile_records::emulator::{Direction, EmulatorCounters, Fate, Passage};
 use tactile_scenario::{ChannelConfig, Scenario};
 
@@ -128,6 +128,24 @@ impl Emulator {
             backward_faults: Faults::new(b, scenario.seed, BACKWARD_STREAM),
             counters: EmulatorCounters::default(),
         }
+    }
+
+    /// The same emulator drawing each packet's delay from the forward and backward
+    /// histograms where given (loaded by [`crate::histogram::load`]), each on a random
+    /// stream of its own seeded from the scenario's seed.
+    pub fn with_histograms(
+        mut self,
+        seed: u64,
+        histograms: [Option<HistogramDelay>; 2],
+    ) -> Emulator {
+        let [f, b] = histograms;
+        if let Some(h) = f {
+            self.forward = self.forward.with_histogram(h, seed, FORWARD_STREAM);
+        }
+        if let Some(h) = b {
+            self.backward = self.backward.with_histogram(h, seed, BACKWARD_STREAM);
+        }
+        self
     }
 
     /// Counters so far.

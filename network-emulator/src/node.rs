@@ -47,10 +47,12 @@ pub fn run(cli: &Cli) -> Result<bool, NodeError> {
     let program = Program::prepare(Role::Emulator, a, links)?;
     let replays = crate::replay::load(program.scenario(), &program.prepared().base_dir)
         .map_err(|e| NodeError::BadInput(format!("{}: {e}", a.scenario.display())))?;
+    let histograms = crate::histogram::load(program.scenario(), &program.prepared().base_dir)
+        .map_err(|e| NodeError::BadInput(format!("{}: {e}", a.scenario.display())))?;
     program.follow(Box::new(move |p| {
-        Ok(Opened::alone(EmulatorHandler::new(Emulator::with_replays(
-            &p.scenario,
-            replays,
-        ))))
+        Ok(Opened::alone(EmulatorHandler::new(
+            Emulator::with_replays(&p.scenario, replays)
+                .with_histograms(p.scenario.seed, histograms),
+        )))
     }))
 }

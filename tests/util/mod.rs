@@ -301,6 +301,21 @@ pub fn min_jerk(s: f64) -> f64 {
     s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)
 }
 
+/// The trace's signal columns (everything before the first timing column): what
+/// repeats bit for bit between an in-process run and one as processes.
+pub fn signals(trace: &str) -> String {
+    let header = trace.lines().next().expect("header");
+    let cut = header
+        .split(',')
+        .position(|c| c == "round_trip_ns")
+        .expect("timing columns");
+    trace
+        .lines()
+        .map(|l| l.split(',').take(cut).collect::<Vec<_>>().join(","))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 /// Column `name` of a CSV text as numbers.
 pub fn column(csv: &str, name: &str) -> Vec<f64> {
     let mut lines = csv.lines();
@@ -531,19 +546,4 @@ pub fn run_measured(mut cmd: Command) -> (std::process::ExitStatus, u64) {
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
-}
-
-/// The trace's signal columns (everything before the first timing column): what a
-/// deterministic run repeats bit for bit, whatever the machine's timing.
-pub fn signals(trace: &str) -> String {
-    let header = trace.lines().next().expect("header");
-    let cut = header
-        .split(',')
-        .position(|c| c == "round_trip_ns")
-        .expect("timing columns");
-    trace
-        .lines()
-        .map(|l| l.split(',').take(cut).collect::<Vec<_>>().join(","))
-        .collect::<Vec<_>>()
-        .join("\n")
 }

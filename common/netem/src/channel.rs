@@ -15,6 +15,7 @@
 //! with it, is held with it, and is never noised (the scenario makes a 6-DoF run's
 //! three delays equal, so the whole pose arrives together).
 
+use crate::histogram::{Drawn, HistogramDelay};
 use crate::{Jitter, Replay};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -164,7 +165,8 @@ pub struct Channel {
     noise: [Option<Normal<f64>>; 3],
     rng: ChaCha8Rng,
     ring: Vec<Option<Slot>>,
-    jitter: Option<(Jitter, ChaCha8Rng)>,
+    /// The jitter, or a histogram's delays, and its own random stream.
+    jitter: Option<(Drawn, ChaCha8Rng)>,
     reorder: bool,
     flight: [InFlight; 3],
     replay: Option<(Replay, f64)>,
@@ -215,7 +217,7 @@ impl Channel {
         let jitter = cfg.jitter.as_ref().map(|j| {
             let mut r = ChaCha8Rng::seed_from_u64(seed);
             r.set_stream(stream + 200);
-            (Jitter::new(j), r)
+            (Drawn::Jitter(Jitter::new(j)), r)
         });
         // Duplication draws from its own stream, so turning it on leaves the others'
         // draws unchanged.
@@ -253,6 +255,20 @@ impl Channel {
             self.ring = ring(need);
         }
         self.replay = Some((replay, t_s));
+        self.direct = false;
+        self
+    }
+
+    /// The same channel drawing each packet's whole delay from `h` (in samples) on a
+    /// random stream of its own, so turning it on leaves the noise, the faults, the
+    /// loss model and the duplicates where they were. It takes the jitter's place: one
+    /// draw a sample, sent or not; a duplicate's copy draws its own; `reorder` as for
+    /// jitter. (The scenario leaves `delay`, `schedule`, `jitter` and `replay` out.)
+    pub fn with_histogram(mut self, h: HistogramDelay, seed: u64, stream: u64) -> Channel {
+        self.ring = ring(self.ring.len() + h.bound().ceil() as usize + 1);
+        let mut r = ChaCha8Rng::seed_from_u64(seed);
+        r.set_stream(stream + 400);
+        self.jitter = Some((Drawn::Histogram(h), r));
         self.direct = false;
         self
     }

@@ -20,9 +20,36 @@ use tactile_scenario::{JitterConfig, JitterDistribution, JITTER_CAP};
 #[derive(Debug, Clone)]
 pub struct Jitter {
     cfg: JitterConfig,
-    z: Option<f64>,
+    z: Ar1,
     offset: f64,
     scale: f64,
+}
+
+/// The driving Gaussian AR(1) process z_n = c z_{n-1} + sqrt(1-c^2) e_n: standard
+/// normal at every step, lag-1 correlation exactly c (shared by the jitter and the
+/// delay histograms, which map it through their inverse CDFs).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Ar1 {
+    c: f64,
+    z: Option<f64>,
+}
+
+impl Ar1 {
+    /// The process of lag-1 correlation `c` (in [0, 1)), before its first step.
+    pub(crate) fn new(c: f64) -> Self {
+        Ar1 { c, z: None }
+    }
+
+    /// The next value, with the standard normal innovation `e` (the first is `e`).
+    pub(crate) fn next(&mut self, e: f64) -> f64 {
+        let c = self.c;
+        let z = match self.z {
+            None => e,
+            Some(last) => c * last + (1.0 - c * c).sqrt() * e,
+        };
+        self.z = Some(z);
+        z
+    }
 }
 
 /// Standard normal CDF (Abramowitz and Stegun 7.1.26 via erfc, error below 1.5e-7).
@@ -102,7 +129,7 @@ impl Jitter {
         };
         Jitter {
             cfg: cfg.clone(),
-            z: None,
+            z: Ar1::new(cfg.correlation),
             offset,
             scale,
         }
@@ -116,12 +143,7 @@ impl Jitter {
 
     /// The next jitter with the given standard normal innovation.
     pub fn next_with(&mut self, e: f64) -> f64 {
-        let c = self.cfg.correlation;
-        let z = match self.z {
-            None => e,
-            Some(last) => c * last + (1.0 - c * c).sqrt() * e,
-        };
-        self.z = Some(z);
+        let z = self.z.next(e);
         let x = self.cfg.jitter * self.scale * (shape(self.cfg.distribution, z) - self.offset);
         x.clamp(-self.cfg.bound(), self.cfg.bound())
     }

@@ -1,6 +1,7 @@
 //! The network between the master and the slave, as the emulator runs it: netem-class
 //! models (delay [`jitter`] with correlation, [`loss`] models, duplication) with
-//! netem's meanings, recorded networks [`replay`]ed packet by packet, and the
+//! netem's meanings, delays drawn from measured [`histogram`]s, recorded networks
+//! [`replay`]ed packet by packet, and the
 //! [`channel`] that puts a sample through them. Seeded and pure: the same scenario and
 //! seed give the same packets. Only the emulator links this crate; the settings are
 //! `tactile-scenario`'s.
@@ -9,12 +10,14 @@
 //! its flaw: see [`jitter`].
 
 pub mod channel;
+pub mod histogram;
 pub mod jitter;
 pub mod loss;
 pub mod replay;
 #[cfg(test)]
 mod tests;
 
+pub use histogram::{DelayHistogram, HistogramDelay, HistogramError};
 pub use jitter::Jitter;
 pub use loss::{loss_rate, Loss};
 pub use replay::{Mahimahi, Replay, ReplayError};

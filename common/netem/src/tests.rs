@@ -11,7 +11,8 @@ use tactile_scenario::{JitterConfig, JitterDistribution, LossModel, ReplayConfig
 
 const N: usize = 100_000;
 
-fn stats(x: &[f64]) -> (f64, f64, f64) {
+/// A series' mean, standard deviation and lag-1 correlation.
+pub(crate) fn stats(x: &[f64]) -> (f64, f64, f64) {
     let n = x.len() as f64;
     let mean = x.iter().sum::<f64>() / n;
     let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
@@ -24,7 +25,7 @@ fn stats(x: &[f64]) -> (f64, f64, f64) {
 }
 
 /// Each value's rank in the series, 0 to N - 1.
-fn ranks(x: &[f64]) -> Vec<f64> {
+pub(crate) fn ranks(x: &[f64]) -> Vec<f64> {
     let mut order: Vec<usize> = (0..x.len()).collect();
     order.sort_by(|&a, &b| x[a].total_cmp(&x[b]));
     let mut r = vec![0.0; x.len()];

@@ -16,6 +16,7 @@ mod device;
 pub mod endpoint;
 mod error;
 pub mod hand;
+mod histogram;
 mod human;
 mod lengths;
 mod master;
@@ -53,6 +54,9 @@ pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
 pub(crate) use error::{finite3, invalid, positive, positive3};
 pub use error::{one_line, ScenarioError};
 pub use hand::{ClutchConfig, ForceMessage, GimbalConfig, HandInput, OmniButton};
+pub use histogram::{
+    shipped_histogram, HistogramConfig, HistogramFormat, ShippedHistogram, SHIPPED_HISTOGRAMS,
+};
 pub use human::{HumanConfig, Response};
 pub use master::{FaultConfig, HandConfig, HandMode, MasterConfig, MasterDeviceConfig};
 pub use network::{
@@ -247,6 +251,9 @@ impl Scenario {
         for c in [&mut self.network.forward, &mut self.network.backward] {
             if let Some(r) = &mut c.replay {
                 v.push(&mut r.path);
+            }
+            if let Some(p) = c.delay_histogram.as_mut().and_then(|h| h.path.as_mut()) {
+                v.push(p);
             }
         }
         v

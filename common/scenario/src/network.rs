@@ -2,6 +2,7 @@
 //! the netem-class models and replays (their behaviour is in `tactile-netem`; their
 //! settings and ranges are here).
 
+use crate::histogram::HistogramConfig;
 use crate::shown::Num;
 use crate::{invalid, ScenarioError};
 use serde::{Deserialize, Serialize};
@@ -46,6 +47,9 @@ pub struct ChannelConfig {
     /// Probability that a packet is sent twice, netem's `duplicate` (the copy takes
     /// its own jitter), 0 to 1 [0].
     pub duplicate: f64,
+    /// Each packet's whole delay drawn from a measured distribution, instead of
+    /// `delay`, `schedule`, `jitter` and `replay` (`crate::histogram`).
+    pub delay_histogram: Option<HistogramConfig>,
 }
 
 impl Default for ChannelConfig {
@@ -61,6 +65,7 @@ impl Default for ChannelConfig {
             loss_model: None,
             replay: None,
             duplicate: 0.0,
+            delay_histogram: None,
         }
     }
 }
@@ -101,6 +106,10 @@ impl ChannelConfig {
                 ));
             }
         }
+        if let Some(h) = &self.delay_histogram {
+            h.validate(field)?;
+            self.histogram_alone(field)?;
+        }
         if let Some(m) = &self.loss_model {
             m.validate(field)?;
             if self.loss > 0.0 {
@@ -111,6 +120,24 @@ impl ChannelConfig {
             }
         }
         Ok(())
+    }
+
+    /// A histogram gives each packet's whole delay: the other delay models are left
+    /// out (the first one set is named).
+    fn histogram_alone(&self, field: &str) -> Result<(), ScenarioError> {
+        let other = [
+            ("delay", self.delay != [0; 3]),
+            ("schedule", !self.schedule.is_empty()),
+            ("jitter", self.jitter.is_some()),
+            ("replay", self.replay.is_some()),
+        ];
+        match other.iter().find(|(_, set)| *set) {
+            Some((key, _)) => Err(invalid(
+                format!("{field}.delay_histogram"),
+                format!("and `{field}.{key}` both set: the histogram gives each packet's whole delay; leave delay at [0, 0, 0] (or delay_ms at 0), and schedule, jitter and replay out"),
+            )),
+            None => Ok(()),
+        }
     }
 
     /// The delays and the schedule's: each one a channel can apply, the schedule's

@@ -327,13 +327,20 @@ pub fn describe(name: &str, c: &ChannelConfig, rate_hz: f64) -> String {
         }
     };
     let at = format!(" at {} Hz", Num(rate_hz));
-    let mut s = match &c.replay {
-        Some(r) => format!(
-            "network.{name}: delay per packet from {} (samples, 1 = {} ms{at})",
-            r.path,
+    let from = |what: &str| {
+        format!(
+            "network.{name}: delay per packet from {what} (samples, 1 = {} ms{at})",
             ms(per)
-        ),
-        None => format!("network.{name}: delay {}", both(&c.delay, &at)),
+        )
+    };
+    let mut s = match (&c.replay, &c.delay_histogram) {
+        (Some(r), _) => from(&r.path),
+        (None, Some(h)) => from(&format!(
+            "the histogram {}, correlation {}",
+            h.path.as_deref().or(h.name.as_deref()).unwrap_or_default(),
+            Num(h.correlation)
+        )),
+        (None, None) => format!("network.{name}: delay {}", both(&c.delay, &at)),
     };
     if let Some(j) = &c.jitter {
         let dist = toml::Value::try_from(j.distribution).map_or_else(

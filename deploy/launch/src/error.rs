@@ -15,6 +15,9 @@ pub enum InputError {
     /// A recorded network it replays cannot be used.
     #[error(transparent)]
     Replay(#[from] tactile_network_emulator::replay::LoadError),
+    /// A delay histogram it draws from cannot be used.
+    #[error(transparent)]
+    Histogram(#[from] tactile_network_emulator::histogram::LoadError),
     /// The device's gimbal cannot be used.
     #[error(transparent)]
     Gimbal(#[from] tactile_master::peripherals::GimbalError),
@@ -46,6 +49,9 @@ pub enum Error {
     /// A recorded network the scenario replays cannot be used.
     #[error(transparent)]
     Replay(#[from] tactile_network_emulator::replay::LoadError),
+    /// A delay histogram the scenario draws from cannot be used.
+    #[error(transparent)]
+    Histogram(#[from] tactile_network_emulator::histogram::LoadError),
     /// A malformed sweep axis `--set KEY=V1,V2,...`.
     #[error(transparent)]
     Axis(#[from] tactile_report::sweep::AxisError),
@@ -80,6 +86,7 @@ impl Error {
             | Error::File(_)
             | Error::Lock(_)
             | Error::Replay(_)
+            | Error::Histogram(_)
             | Error::Axis(_)
             | Error::Input { .. }
             | Error::Report(tactile_report::Error::BadInput(_)) => EXIT_BAD_INPUT,

@@ -136,6 +136,7 @@ pub fn load_source(source: &Source, sets: &[Set]) -> Result<Loaded, Error> {
     let mut warnings = scenario.warnings();
     warnings.extend(source.warnings(scenario.samples, scenario.t_s()));
     tactile_network_emulator::replay::load(&scenario, &base_dir).map_err(|e| input(e.into()))?;
+    tactile_network_emulator::histogram::load(&scenario, &base_dir).map_err(|e| input(e.into()))?;
     tactile_slave::urdf_arm::UrdfArm::of_scenario(&scenario, &base_dir)
         .map_err(|e| Error::BadInput(format!("{name}: {e}")))?;
     // A physics world is built once here: its meshes read and checked, its bodies'

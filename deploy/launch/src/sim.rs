@@ -171,7 +171,10 @@ pub fn simulate(
     }
     let master = MasterHandler::new(master, None, scenario.faults.peer_timeout_samples);
     let replays = tactile_network_emulator::replay::load(scenario, base_dir)?;
-    let emulator = EmulatorHandler::new(Emulator::with_replays(scenario, replays));
+    let histograms = tactile_network_emulator::histogram::load(scenario, base_dir)?;
+    let emulator = EmulatorHandler::new(
+        Emulator::with_replays(scenario, replays).with_histograms(scenario.seed, histograms),
+    );
     let arm = tactile_slave::peripherals::read_arm(scenario, base_dir).map_err(Error::BadInput)?;
     let world = tactile_slave::world::SlaveWorld::of_scenario(scenario, base_dir)
         .map_err(|e| Error::BadInput(e.to_string()))?;

@@ -299,3 +299,28 @@ def test_what_this_package_cannot_run_says_what_would():
         said = str(e)
         assert "this package was built without" in said, said
         assert "pip install ./deploy/python --config-settings" in said, said
+
+
+def test_the_shipped_networks_are_in_the_package_by_path_and_by_name(work, monkeypatch):
+    """deploy/networks comes with the package, file for file (its PROVENANCE and
+    licences too); a scenario beside the shipped ones reads a histogram by its
+    relative path, and any scenario names a shipped one."""
+    here = Path(tactile.__file__).resolve().parent
+    shipped = ROOT / "deploy" / "networks"
+    files = [f for f in shipped.rglob("*") if f.is_file()]
+    assert any(f.name == "PROVENANCE" for f in files)
+    for f in files:
+        assert (here / "networks" / f.relative_to(shipped)).read_bytes() == f.read_bytes()
+    monkeypatch.chdir(work)
+    text = (ROOT / "deploy" / "scenarios" / "wall-delay.toml").read_text()
+    text = text.replace("samples = 8000", "samples = 300")
+    raw = "../networks/deterministic6g/PD-Wireless-5G-2a/5G-midband-Downlink_PD-Wireless-5G-2a.csv"
+    by_path = text.replace(
+        "delay = [25, 25, 25]",
+        f'delay_histogram = {{ path = "{raw}", format = "d6g_data" }}', 1)
+    by_name = text.replace(
+        "delay = [25, 25, 25]", 'delay_histogram = { name = "5g-3.7ghz-downlink" }', 1)
+    a = tactile.run(tactile.Scenario.from_toml(by_path, here / "scenarios"))
+    b = tactile.run(tactile.Scenario.from_toml(by_name, work))
+    assert a.completed and b.completed
+    assert a.trace.equals(b.trace)
