@@ -14,6 +14,7 @@ pub mod figures;
 pub mod hardware;
 pub mod join;
 pub mod joints;
+pub mod lerobot;
 pub mod mcap;
 pub mod metrics;
 mod node_log;
