@@ -98,14 +98,17 @@ impl Layout {
     }
 }
 
-/// The slave's joints as last recorded: a sample whose slave did not step holds them
-/// (the value at or before the sample, as the frames are chosen).
+/// The slave's joints and force as last recorded: a sample whose slave did not step
+/// (its v(n) lost) holds them, the values at or before the sample, as frames are
+/// chosen (the trace's zeros there are no value the slave had).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Held {
     q_ref: Vec<f64>,
     q: Vec<f64>,
     tau: Vec<f64>,
     torque: [f64; 3],
+    /// h(n), the environment's force at the slave, N.
+    force: [f64; 3],
 }
 
 impl Held {
@@ -116,12 +119,17 @@ impl Held {
             q: vec![0.0; dof],
             tau: vec![0.0; dof],
             torque: [0.0; 3],
+            force: [0.0; 3],
         }
     }
 
-    /// Takes a URDF arm's joints, or the paper arm's from the row where its slave
-    /// stepped; joints of another count than the layout's are ignored.
+    /// Takes the slave's part of a row where the slave stepped: a URDF arm's joints,
+    /// or the paper arm's from the row; joints of another count than the layout's are
+    /// ignored.
     pub fn take(&mut self, row: &TraceRow, joints: Option<&ArmJoints>) {
+        if row.stepped {
+            self.force = row.h;
+        }
         match joints {
             Some(j) if j.q.len() == self.q.len() => {
                 self.q_ref.copy_from_slice(&j.q_ref);
@@ -157,7 +165,7 @@ fn flag(b: bool) -> f32 {
 pub fn frame(row: &TraceRow, rotation: Option<[f64; 4]>, held: &Held, t_s: f64) -> Frame {
     let rotation = rotation.unwrap_or([0.0, 0.0, 0.0, 1.0]);
     let state = f32s(row.handle.iter().chain(&rotation).chain(&held.q));
-    let force = f32s(row.felt.iter().chain(&row.h).chain(&held.torque));
+    let force = f32s(row.felt.iter().chain(&held.force).chain(&held.torque));
     let ms = |d: &[u32; 3]| (f64::from(d.iter().copied().max().unwrap_or(0)) * t_s * 1e3) as f32;
     let network = vec![
         ms(&row.delay_f),

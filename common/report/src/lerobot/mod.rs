@@ -10,6 +10,7 @@
 //! memory. The dataset is written into a hidden sibling folder and renamed when
 //! whole: a failed export leaves nothing.
 
+mod damage;
 pub mod features;
 pub mod meta;
 pub mod runs;
@@ -286,8 +287,47 @@ pub fn sample_of(k: u64, rate_hz: f64, fps: u32) -> u64 {
     ((k as f64 * rate_hz) / f64::from(fps)).floor() as u64
 }
 
+/// The stamps of one frame: its number in the episode and the dataset, the episode's.
+struct At {
+    k: u64,
+    fps: u32,
+    episode_index: i64,
+    from: u64,
+    task_index: i64,
+}
+
+/// Writes one frame and adds it to the episode's and the dataset's statistics.
+fn write_frame(
+    f: features::Frame,
+    at: &At,
+    stats: [&mut [Stats]; 2],
+    data: &mut Data,
+) -> Result<(), Error> {
+    let timestamp = (at.k as f64 / f64::from(at.fps)) as f32;
+    let ints = [
+        at.k as i64,
+        at.episode_index,
+        (at.from + at.k) as i64,
+        at.task_index,
+    ];
+    let defaults = std::iter::once(f64::from(timestamp)).chain(ints.map(|x| x as f64));
+    for s in stats {
+        for (s, v) in s.iter_mut().zip(&f) {
+            s.add(v.iter().map(|&x| f64::from(x)));
+        }
+        for (s, x) in s[FEATURES.len()..].iter_mut().zip(defaults.clone()) {
+            s.add([x]);
+        }
+    }
+    let mut cells: Vec<Cell> = f.into_iter().map(Cell::ListF32).collect();
+    cells.push(Cell::F32(timestamp));
+    cells.extend(ints.map(Cell::I64));
+    data.add(&cells)
+}
+
 /// Joins one run's records and writes its frames; a sample the master's record lost,
-/// or the slave's after its first step, ends the episode there (`damaged_at`).
+/// or the first a damaged stretch of the slave's or the emulator's may have held, ends
+/// the episode there (`damaged_at`).
 fn episode(
     run: &Run,
     fps: u32,
@@ -296,56 +336,39 @@ fn episode(
     data: &mut Data,
     all: &mut [Stats],
 ) -> Result<(), Error> {
-    let rate = run.scenario.rate_hz;
-    let t_s = run.scenario.t_s();
+    let (rate, t_s) = (run.scenario.rate_hz, run.scenario.t_s());
     let mut held = Held::new(run.layout.joints.len());
-    let (mut expected, mut k, mut stepped) = (0u64, 0u64, false);
+    let end = damage::first_damaged_sample(&run.dir)?;
+    let mut at = At {
+        k: 0,
+        fps,
+        episode_index,
+        from: ep.from,
+        task_index: ep.task_index,
+    };
+    let mut expected = 0u64;
     let arm = join::Arm::of(&run.scenario);
-    let from = ep.from;
-    let logs = join::join(
-        std::slice::from_ref(&run.dir),
-        arm,
-        |row, joints, rotation| {
-            let slave_lost = stepped && !row.stepped;
-            if row.n != expected || slave_lost {
-                ep.damaged_at = Some(expected);
-                return Ok(ControlFlow::Break(()));
-            }
-            stepped |= row.stepped;
-            expected += 1;
-            held.take(row, joints);
-            while sample_of(k, rate, fps) <= row.n {
-                let f = features::frame(row, rotation, &held, t_s);
-                let timestamp = (k as f64 / f64::from(fps)) as f32;
-                let ints = [k as i64, episode_index, (from + k) as i64, ep.task_index];
-                let defaults = std::iter::once(f64::from(timestamp)).chain(ints.map(|x| x as f64));
-                for (s, v) in ep.stats.iter_mut().zip(&f) {
-                    s.add(v.iter().map(|&x| f64::from(x)));
-                }
-                for (s, x) in ep.stats[FEATURES.len()..].iter_mut().zip(defaults.clone()) {
-                    s.add([x]);
-                }
-                for (s, v) in all.iter_mut().zip(&f) {
-                    s.add(v.iter().map(|&x| f64::from(x)));
-                }
-                for (s, x) in all[FEATURES.len()..].iter_mut().zip(defaults) {
-                    s.add([x]);
-                }
-                let mut cells: Vec<Cell> = f.into_iter().map(Cell::ListF32).collect();
-                cells.push(Cell::F32(timestamp));
-                cells.extend(ints.map(Cell::I64));
-                data.add(&cells)?;
-                k += 1;
-            }
-            Ok(ControlFlow::Continue(()))
-        },
-    )?;
+    let dirs = std::slice::from_ref(&run.dir);
+    let logs = join::join(dirs, arm, |row, joints, rotation| {
+        if row.n != expected || end == Some(row.n) {
+            ep.damaged_at = Some(expected);
+            return Ok(ControlFlow::Break(()));
+        }
+        expected += 1;
+        held.take(row, joints);
+        while sample_of(at.k, rate, fps) <= row.n {
+            let f = features::frame(row, rotation, &held, t_s);
+            write_frame(f, &at, [&mut ep.stats, all], data)?;
+            at.k += 1;
+        }
+        Ok(ControlFlow::Continue(()))
+    })?;
     // A torn or damaged stretch the join read past without losing a sample's row
-    // (a record's tail) still ends the episode where its rows ended, said.
+    // (the master's record's tail) still ends the episode where its rows ended, said.
     let damaged = logs.master.damaged.1 + logs.emulator.damaged.1 + logs.slave.damaged.1;
     if damaged > 0 && ep.damaged_at.is_none() {
         ep.damaged_at = Some(expected);
     }
-    ep.length = k;
+    ep.length = at.k;
     Ok(())
 }
