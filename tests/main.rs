@@ -23,6 +23,7 @@ mod hdl;
 mod hdl_modules;
 mod hosts;
 mod layout;
+mod lerobot;
 mod lifecycle;
 mod logs;
 mod loop_processes;
