@@ -18,7 +18,7 @@ pub struct Run {
     /// Its features' layout (the slave's joints).
     pub layout: Layout,
     /// The swept keys and the values this run had (empty for a lone run).
-    pub swept: Vec<(String, String)>,
+    pub swept: Swept,
     /// What the run was made under.
     pub meta: Meta,
 }
@@ -111,7 +111,7 @@ fn joint_names(scenario: &Scenario, dir: &Path) -> Result<Option<Vec<String>>, E
 }
 
 /// A run's folder, checked: its records' scenario and its arm.
-fn run(dir: &Path, swept: Vec<(String, String)>) -> Result<Run, Error> {
+fn run(dir: &Path, swept: Swept) -> Result<Run, Error> {
     let (_, scenario) = crate::write::recorded(&[dir.to_path_buf()], &|| false)?;
     let layout = Layout::new(joint_names(&scenario, dir)?);
     let meta = Meta::of(&scenario, dir);
@@ -123,6 +123,9 @@ fn run(dir: &Path, swept: Vec<(String, String)>) -> Result<Run, Error> {
         meta,
     })
 }
+
+/// Swept keys and their values, as text.
+type Swept = Vec<(String, String)>;
 
 /// A CSV line's fields (a quoted field may hold commas and doubled quotes).
 fn fields(line: &str) -> Vec<String> {
@@ -143,9 +146,9 @@ fn fields(line: &str) -> Vec<String> {
     out
 }
 
-/// A sweep's runs, in their folders' order, each with the swept keys' values its row
-/// of `sweep.csv` gives (and its seed).
-fn sweep(dir: &Path) -> Result<Vec<Run>, Error> {
+/// A sweep's runs as its `sweep.csv` lists them, in order: each run's folder name with
+/// the swept keys' values its row gives (and its seed).
+fn sweep_table(dir: &Path) -> Result<Vec<(String, Swept)>, Error> {
     let bad = |what: String| Error::BadInput(format!("{}: {what}", dir.display()));
     let spec: serde_json::Value = std::fs::read_to_string(dir.join("sweep.json"))
         .map_err(|e| bad(format!("sweep.json: {e}")))
@@ -165,11 +168,10 @@ fn sweep(dir: &Path) -> Result<Vec<Run>, Error> {
     })?;
     let mut lines = table.lines();
     let header = fields(lines.next().unwrap_or_default());
-    let rows: Vec<Vec<String>> = lines.map(fields).collect();
     let at = |k: &str| header.iter().position(|h| h == k);
     let run_col = at("run").ok_or_else(|| bad("sweep.csv has no run column".into()))?;
     let mut runs = Vec::new();
-    for row in &rows {
+    for row in lines.map(fields) {
         let name = row.get(run_col).cloned().unwrap_or_default();
         if name.is_empty() || name.contains('/') || name.starts_with('.') {
             return Err(bad(format!("sweep.csv names a run {name:?}")));
@@ -178,12 +180,36 @@ fn sweep(dir: &Path) -> Result<Vec<Run>, Error> {
             .iter()
             .filter_map(|k| Some((k.clone(), row.get(at(k)?)?.clone())))
             .collect();
-        runs.push(run(&dir.join(&name), swept)?);
+        runs.push((name, swept));
     }
     if runs.is_empty() {
         return Err(bad("sweep.csv lists no run".into()));
     }
     Ok(runs)
+}
+
+/// A sweep's runs, in its table's order, each with its swept values.
+fn sweep(dir: &Path) -> Result<Vec<Run>, Error> {
+    sweep_table(dir)?
+        .into_iter()
+        .map(|(name, swept)| run(&dir.join(name), swept))
+        .collect()
+}
+
+/// A run's folder given alone: a sweep's run (its parent a sweep's folder whose table
+/// lists it) keeps the values the sweep gave it.
+fn lone(dir: &Path) -> Result<Run, Error> {
+    let parent = dir.parent().filter(|p| p.join("sweep.json").is_file());
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned());
+    let swept = match (parent, name) {
+        (Some(p), Some(name)) => sweep_table(p)
+            .ok()
+            .and_then(|t| t.into_iter().find(|(n, _)| *n == name))
+            .map(|(_, s)| s)
+            .unwrap_or_default(),
+        _ => Vec::new(),
+    };
+    run(dir, swept)
 }
 
 /// The runs of `inputs` (run folders and sweep folders), all checked, all of one arm.
@@ -193,7 +219,7 @@ pub fn gather(inputs: &[PathBuf]) -> Result<Vec<Run>, Error> {
         if dir.join("sweep.json").is_file() {
             runs.extend(sweep(dir)?);
         } else {
-            runs.push(run(dir, Vec::new())?);
+            runs.push(lone(dir)?);
         }
     }
     if let Some(first) = runs.first() {
