@@ -372,3 +372,33 @@ fn episode(
     ep.length = at.k;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_frame_takes_the_sample_at_or_before_its_time() {
+        // 1 kHz at 50 fps: every 20th sample.
+        let at_50: Vec<u64> = (0..4).map(|k| sample_of(k, 1000.0, 50)).collect();
+        assert_eq!(at_50, [0, 20, 40, 60]);
+        // 1 kHz at 30 fps: frame 1 at 33.3 ms takes sample 33 (at 33 ms), not 34.
+        let at_30: Vec<u64> = (0..4).map(|k| sample_of(k, 1000.0, 30)).collect();
+        assert_eq!(at_30, [0, 33, 66, 100]);
+        // At the run's own rate every sample is a frame.
+        assert!((0..1000).all(|k| sample_of(k, 100.0, 100) == k));
+    }
+
+    #[test]
+    fn an_out_that_holds_anything_is_refused_and_an_empty_one_taken() {
+        let dir = tempfile::tempdir().expect("tmp");
+        assert!(check_out(&dir.path().join("new")).is_ok());
+        assert!(check_out(dir.path()).is_ok());
+        std::fs::write(dir.path().join("x"), "x").expect("write");
+        assert!(matches!(check_out(dir.path()), Err(Error::BadInput(_))));
+        assert!(matches!(
+            check_out(&dir.path().join("x")),
+            Err(Error::BadInput(_))
+        ));
+    }
+}
