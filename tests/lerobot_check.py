@@ -138,6 +138,7 @@ for (_, ep), run in zip(episodes.iterrows(), runs):
         delay_f = max(row[f"delay_f_{i}"] for i in (1, 2, 3)) * 1e3 / rate
         delay_b = max(row[f"delay_b_{i}"] for i in (1, 2, 3)) * 1e3 / rate
         assert net[0] == np.float32(delay_f) and net[1] == np.float32(delay_b), (k, net)
+        assert net[2] == int(row["flags_f"]) & 1 and net[3] == int(row["flags_b"]) & 1, (k, net)
         assert net[4] == (0.0 if row["received"] == 1 else 1.0), (k, net)
         assert net[5] == np.float32(row["round_trip_ns"] * 1e-6), (k, net)
         checked += 1
