@@ -98,7 +98,9 @@ fn a_sweep_and_a_task_run_export_as_one_dataset_that_pyarrow_and_rerun_read() {
     }
     let sb = Sandbox::new("lerobot");
     let paper = format!("{}/scenarios/paper.toml", env!("CARGO_MANIFEST_DIR"));
-    // Two runs: no delay and no loss; 20 ms forward with 30 % of the answers lost.
+    // Two runs: no delay and no loss; 20 ms forward with 20 % of the positions and 30 %
+    // of the answers lost (the slave does not step on a lost position: the frames hold
+    // its last values).
     let o = sb.tactile(&[
         "sweep",
         &paper,
@@ -108,6 +110,8 @@ fn a_sweep_and_a_task_run_export_as_one_dataset_that_pyarrow_and_rerun_read() {
         "network.forward.delay_ms=0,20",
         "--set",
         "+network.backward.loss=0,0.3",
+        "--set",
+        "+network.forward.loss=0,0.2",
         "--trace",
         "-q",
         "--out",
@@ -134,6 +138,7 @@ fn a_sweep_and_a_task_run_export_as_one_dataset_that_pyarrow_and_rerun_read() {
     assert_eq!(eps[1]["swept"]["network.backward.loss"], "0.3");
     assert_eq!(eps[1]["delay_forward_ms"], 20.0);
     assert_eq!(eps[1]["loss_backward"], 0.3);
+    assert_eq!(eps[1]["swept"]["network.forward.loss"], "0.2");
     assert_eq!(eps[0]["task_success"], Value::Null);
     assert_eq!(eps[2]["task_success"], true);
     assert!(
