@@ -3,7 +3,8 @@
 //! LeRobot importer, tests/lerobot_rerun.py), its `info.json` keyed as a LeRobot
 //! recorder's (tests/fixtures/lerobot), each frame's values the trace's at the sample
 //! at or before it; bad input refused with exit 2 and nothing left behind; a damaged
-//! record exported up to its damage, said.
+//! record exported up to its damage, said; a stop request (SIGINT) ends an export with
+//! exit 130 and nothing written.
 
 use crate::formats::check;
 use crate::util::{self, cannot, Sandbox};
@@ -291,4 +292,41 @@ fn a_damaged_record_is_exported_up_to_its_damage_and_said() {
         // The frames are those of the samples before the damage (100 Hz, 50 fps).
         assert_eq!(frames, at.div_ceil(2), "{file}: damaged at {at}");
     }
+}
+
+#[test]
+fn a_stop_request_ends_an_export_with_nothing_written() {
+    let sb = Sandbox::new("lerobot-stop");
+    let lockstep = format!("{}/scenarios/lockstep-1e6.toml", env!("CARGO_MANIFEST_DIR"));
+    // Long enough that the export is still joining when the request comes.
+    let o = sb.tactile(&[
+        "run",
+        &lockstep,
+        "--in-process",
+        "--no-trace",
+        "-q",
+        "--set",
+        "samples=200000",
+        "--out",
+        "long",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let child = sb
+        .command(&["export", "lerobot", "long", "--out", "ds", "--fps", "1000"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let (pid, raw) = (rustix::process::Pid::from_child(&child), child.id());
+    let limit = std::time::Duration::from_secs(60);
+    // Once it answers SIGINT and has begun writing (its hidden folder made).
+    util::wait_for("the export writing", limit, || {
+        util::catches(raw, rustix::process::Signal::INT) && sb.path(".ds.partial").exists()
+    });
+    rustix::process::kill_process(pid, rustix::process::Signal::INT).expect("SIGINT");
+    let o = util::wait_within(child, limit);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.contains("stop request"), "{err}");
+    assert_nothing_left(&sb, "ds");
 }

@@ -416,8 +416,11 @@ fn export_lerobot(
     task: Option<String>,
 ) -> PyResult<(Vec<EpisodeOut>, Vec<String>)> {
     let opts = tactile_report::lerobot::Options { fps, task };
+    signals::clear_stop();
+    let stop = signals::handled_by_caller();
     waiting(py, move || {
-        let done = tactile_report::lerobot::export(&runs, &out, &opts)?;
+        let stopped = || stop.load(std::sync::atomic::Ordering::SeqCst);
+        let done = tactile_report::lerobot::export(&runs, &out, &opts, &stopped)?;
         let episodes = done
             .episodes
             .into_iter()

@@ -48,7 +48,10 @@ pub fn main(args: &ExportArgs) -> Result<(), Error> {
         fps: a.fps,
         task: a.task.clone(),
     };
-    let done = export(&a.runs, &a.out, &opts)?;
+    let stop =
+        tactile_runtime::signals::stop_flag().map_err(Error::io("installing signal handlers"))?;
+    let stopped = || stop.load(std::sync::atomic::Ordering::SeqCst);
+    let done = export(&a.runs, &a.out, &opts, &stopped)?;
     for w in &done.warnings {
         tactile_launch::noteln!("tactile export: warning: {w}");
     }

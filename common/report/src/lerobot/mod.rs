@@ -50,8 +50,15 @@ pub struct Exported {
     pub warnings: Vec<String>,
 }
 
-/// Exports the runs of `inputs` (run folders, sweep folders) into the new folder `out`.
-pub fn export(inputs: &[PathBuf], out: &Path, opts: &Options) -> Result<Exported, Error> {
+/// Exports the runs of `inputs` (run folders, sweep folders) into the new folder `out`,
+/// looking at `stop` (a stop request) as it reads: a stopped export writes nothing
+/// ([`Error::Stopped`]), since a dataset of part of the runs would pass for all of them.
+pub fn export(
+    inputs: &[PathBuf],
+    out: &Path,
+    opts: &Options,
+    stop: &dyn Fn() -> bool,
+) -> Result<Exported, Error> {
     if opts.fps == 0 {
         return Err(Error::BadInput(
             "--fps 0: give at least 1 frame per second".into(),
@@ -74,7 +81,7 @@ pub fn export(inputs: &[PathBuf], out: &Path, opts: &Options) -> Result<Exported
     }
     let tmp = partial(out)?;
     let _ = std::fs::remove_dir_all(&tmp);
-    let done = write_dataset(&runs, &tmp, opts).and_then(|x| {
+    let done = write_dataset(&runs, &tmp, opts, stop).and_then(|x| {
         // An empty folder given as --out is replaced; check_out refused any other.
         let _ = std::fs::remove_dir(out);
         std::fs::rename(&tmp, out)
@@ -207,7 +214,12 @@ fn new_stats(layout: &Layout) -> Vec<Stats> {
     s
 }
 
-fn write_dataset(runs: &[Run], root: &Path, opts: &Options) -> Result<Exported, Error> {
+fn write_dataset(
+    runs: &[Run],
+    root: &Path,
+    opts: &Options,
+    stop: &dyn Fn() -> bool,
+) -> Result<Exported, Error> {
     let Some(first) = runs.first() else {
         return Err(Error::BadInput("no run given".into()));
     };
@@ -248,8 +260,8 @@ fn write_dataset(runs: &[Run], root: &Path, opts: &Options) -> Result<Exported, 
             opts.fps,
             episodes.len() as i64,
             &mut ep,
-            &mut data,
-            &mut all,
+            (&mut data, &mut all),
+            stop,
         )?;
         if let Some(n) = ep.damaged_at {
             warnings.push(format!(
@@ -333,12 +345,12 @@ fn episode(
     fps: u32,
     episode_index: i64,
     ep: &mut Episode,
-    data: &mut Data,
-    all: &mut [Stats],
+    (data, all): (&mut Data, &mut [Stats]),
+    stop: &dyn Fn() -> bool,
 ) -> Result<(), Error> {
     let (rate, t_s) = (run.scenario.rate_hz, run.scenario.t_s());
     let mut held = Held::new(run.layout.joints.len());
-    let end = damage::first_damaged_sample(&run.dir)?;
+    let end = damage::first_damaged_sample(&run.dir, stop)?;
     let mut at = At {
         k: 0,
         fps,
@@ -349,7 +361,7 @@ fn episode(
     let mut expected = 0u64;
     let arm = join::Arm::of(&run.scenario);
     let dirs = std::slice::from_ref(&run.dir);
-    let logs = join::join(dirs, arm, |row, joints, rotation| {
+    let logs = join::join_until(dirs, stop, arm, |row, joints, rotation| {
         if row.n != expected || end == Some(row.n) {
             ep.damaged_at = Some(expected);
             return Ok(ControlFlow::Break(()));
@@ -363,6 +375,14 @@ fn episode(
         }
         Ok(ControlFlow::Continue(()))
     })?;
+    // The join says it stopped when the episode ended at a damage too: only a stop
+    // request ends the export.
+    if let Some(n) = logs.stopped_at.filter(|_| ep.damaged_at.is_none()) {
+        return Err(Error::Stopped(format!(
+            "stopped at sample {n} of {} by a stop request: no dataset written",
+            run.dir.display()
+        )));
+    }
     // A torn or damaged stretch the join read past without losing a sample's row
     // (the master's record's tail) still ends the episode where its rows ended, said.
     let damaged = logs.master.damaged.1 + logs.emulator.damaged.1 + logs.slave.damaged.1;
