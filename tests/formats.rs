@@ -13,7 +13,7 @@ fn python_ready() -> bool {
 }
 
 /// Runs a checker script, asserts success and that it said `said`.
-fn check(script: &str, args: &[&str], said: &str) -> String {
+pub(crate) fn check(script: &str, args: &[&str], said: &str) -> String {
     let path = format!("{}/../tests/{script}", env!("CARGO_MANIFEST_DIR"));
     let mut c = Command::new("python3");
     c.arg(path).args(args);

@@ -25,6 +25,7 @@ mod histograms;
 mod hosts;
 mod human;
 mod layout;
+mod lerobot;
 mod lifecycle;
 mod logs;
 mod loop_processes;

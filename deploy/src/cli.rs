@@ -2,6 +2,7 @@
 
 use crate::cmd::bench::{BenchArgs, EchoArgs};
 use crate::cmd::check::CheckArgs;
+use crate::cmd::export::ExportArgs;
 use crate::cmd::hdl::HdlArgs;
 use crate::cmd::kernels::KernelsArgs;
 use crate::cmd::paper::PaperArgs;
@@ -44,6 +45,9 @@ pub enum Command {
     /// Run a scenario for every combination of values (--set KEY=V1,V2,...), and
     /// tabulate and plot the runs' metrics.
     Sweep(SweepArgs),
+    /// Write runs and sweeps in another tool's format: `export lerobot` a LeRobot
+    /// v3.0 dataset for robot learning.
+    Export(ExportArgs),
     /// The paper's trigonometric block as RTL: Verilog, test vectors from the model,
     /// co-simulation (Icarus Verilog) and synthesis (Yosys, Virtex-6).
     Hdl(HdlArgs),
@@ -98,6 +102,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Bench(args) => crate::cmd::bench::main(&args),
         Command::Report(args) => crate::cmd::report::main(&args),
         Command::Sweep(args) => crate::cmd::sweep::main(&args),
+        Command::Export(args) => crate::cmd::export::main(&args),
         Command::Fuzz(args) => crate::cmd::fuzz::main(&args),
         Command::BenchEcho(args) => {
             crate::cmd::bench::echo(&args.prefix, std::time::Duration::from_micros(args.spin_us))

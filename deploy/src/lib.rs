@@ -43,4 +43,6 @@ pub mod guide {
     pub mod python {}
     #[doc = include_str!("../../docs/16-physics-world.md")]
     pub mod physics_world {}
+    #[doc = include_str!("../../docs/17-lerobot.md")]
+    pub mod lerobot {}
 }

@@ -4,7 +4,7 @@
 //! [`analysis`] and [`metrics`] fold the rows into latency histograms and the loop's
 //! figures, [`task_space`] a URDF arm's in its base frame; [`summary`] says it in JSON and [`text`] on the terminal; [`plots`] draws it; [`run_mcap`]
 //! writes it as ROS 2 messages in MCAP ([`mcap`]) for the robotics viewers, a URDF slave drawn as [`arm_scene`] says; [`write`]
-//! puts the report's files in a folder ([`out`]: one process at a time, each file whole); [`sweep`] tabulates many runs' summaries.
+//! puts the report's files in a folder ([`out`]: one process at a time, each file whole); [`sweep`] tabulates many runs' summaries; [`lerobot`] writes runs and sweeps as a LeRobot v3.0 dataset for robot learning.
 
 pub mod analysis;
 pub mod arm_scene;
@@ -14,6 +14,7 @@ pub mod figures;
 pub mod hardware;
 pub mod join;
 pub mod joints;
+pub mod lerobot;
 pub mod mcap;
 pub mod metrics;
 mod node_log;

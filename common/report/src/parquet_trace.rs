@@ -26,7 +26,7 @@ pub const ROW_GROUP: usize = 10_000;
 /// zstd's level for the pages: 3, zstd's default (1 is a few percent larger here).
 pub const LEVEL: i32 = 3;
 
-fn other(e: parquet::errors::ParquetError) -> io::Error {
+pub(crate) fn other(e: parquet::errors::ParquetError) -> io::Error {
     io::Error::other(e.to_string())
 }
 

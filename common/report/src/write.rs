@@ -400,7 +400,7 @@ fn summarise(
 /// The nodes' start records and the scenario the master recorded (or, where the
 /// master's start frame was damaged, the one another node recorded: every node records
 /// the scenario it runs).
-fn recorded(
+pub(crate) fn recorded(
     dirs: &[PathBuf],
     stop: &dyn Fn() -> bool,
 ) -> Result<([Option<Start>; 3], Scenario), Error> {

@@ -399,6 +399,37 @@ fn write_into(dirs: &[PathBuf], out: &Path, outputs: Outputs) -> Result<(), Erro
     Ok(())
 }
 
+/// An episode as `export_lerobot` hands it back: its run's folder, frames, task text,
+/// and the sample a damaged record ended it at.
+type EpisodeOut = (PathBuf, u64, String, Option<u64>);
+
+/// `tactile export lerobot RUN... --out OUT --fps FPS [--task TASK]`: the runs (run
+/// folders and sweep folders) as a LeRobot v3.0 dataset in the new folder `out`.
+/// Returns each episode, in order, and the warnings the command prints.
+#[pyfunction]
+#[pyo3(signature = (runs, out, fps, task))]
+fn export_lerobot(
+    py: Python<'_>,
+    runs: Vec<PathBuf>,
+    out: PathBuf,
+    fps: u32,
+    task: Option<String>,
+) -> PyResult<(Vec<EpisodeOut>, Vec<String>)> {
+    let opts = tactile_report::lerobot::Options { fps, task };
+    signals::clear_stop();
+    let stop = signals::handled_by_caller();
+    waiting(py, move || {
+        let stopped = || stop.load(std::sync::atomic::Ordering::SeqCst);
+        let done = tactile_report::lerobot::export(&runs, &out, &opts, &stopped)?;
+        let episodes = done
+            .episodes
+            .into_iter()
+            .map(|e| (e.run, e.length, e.task, e.damaged_at))
+            .collect();
+        Ok((episodes, done.warnings))
+    })
+}
+
 /// The outputs of a run or report from Python: its trace as `trace_format`, or no
 /// trace and no recording for None (the command's `--no-trace`).
 fn outputs(trace_format: Option<&str>) -> PyResult<Outputs> {
@@ -431,6 +462,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
+    m.add_function(wrap_pyfunction!(export_lerobot, m)?)?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
     m.add("RunError", m.py().get_type::<RunError>())?;
     m.add("PAPER_SCENARIO", tactile_launch::PAPER_SCENARIO)?;

@@ -10,7 +10,7 @@ import tactile
 
 PUBLIC = ["Scenario.load", "Scenario.from_toml", "Scenario.paper", "Scenario.shipped",
           "Scenario.shipped_names", "Scenario.with_set", "Scenario.sets", "Scenario.check",
-          "Scenario.to_toml", "run", "sweep", "read_sweep", "report", "Run", "Run.read",
+          "Scenario.to_toml", "run", "sweep", "read_sweep", "report", "export_lerobot", "Run", "Run.read",
           "Run.trace", "ScenarioError", "RunError", "CallbackError", "NoTraceWarning"]
 START, END = "<!-- api reference: begin -->", "<!-- api reference: end -->"
 

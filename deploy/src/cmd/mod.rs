@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod check;
 pub mod datapath;
+pub mod export;
 pub mod formats;
 pub mod fuzz;
 pub mod hdl;

@@ -12,11 +12,13 @@ command (no subprocess, no second copy of the loop).
     df = tactile.sweep(sc, {"network.forward.delay_ms": [0, 10, 50],
                             "control.kind": ["none", "tdpa"]}, seeds=3)
     df = tactile.read_sweep("runs/wall")     # a finished sweep's folder, read back
+    eps = tactile.export_lerobot(df, "datasets/wall", fps=50)  # a LeRobot v3.0 dataset
 
 A run's folder is the command's: `tactile report` and every tool read it the same.
 """
 from __future__ import annotations
 
+from ._lerobot import export_lerobot
 from ._loop import CallbackError, Operator, Predictor
 from ._native import RunError, ScenarioError
 from ._run import NoTraceWarning, Run, report, run
@@ -25,4 +27,4 @@ from ._sweep import Progress, read_sweep, sweep
 
 __all__ = ["Scenario", "Run", "run", "sweep", "read_sweep", "report", "ScenarioError",
            "RunError", "CallbackError", "NoTraceWarning", "Operator", "Predictor",
-           "Progress"]
+           "Progress", "export_lerobot"]
