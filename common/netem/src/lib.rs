@@ -10,6 +10,7 @@
 
 pub mod channel;
 pub mod jitter;
+pub mod link;
 pub mod loss;
 pub mod replay;
 #[cfg(test)]
@@ -17,4 +18,4 @@ mod tests;
 
 pub use jitter::Jitter;
 pub use loss::{loss_rate, Loss};
-pub use replay::{Mahimahi, Replay, ReplayError};
+pub use replay::{LinkSpec, Replay, ReplayError};

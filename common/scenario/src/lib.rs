@@ -17,6 +17,7 @@ pub mod endpoint;
 mod error;
 pub mod hand;
 mod lengths;
+mod link;
 mod master;
 #[cfg(test)]
 mod messages_tests;
@@ -52,6 +53,10 @@ pub use device::{geometry_from_toml, CordicSettings, DeviceChoice};
 pub(crate) use error::{finite3, invalid, positive, positive3};
 pub use error::{one_line, ScenarioError};
 pub use hand::{ClutchConfig, ForceMessage, GimbalConfig, HandInput, OmniButton};
+pub use link::{
+    LinkConfig, QueueKind, MAX_PACKET_BYTES, MAX_QUEUE_PACKETS, MAX_RATE, MAX_TRACE_PACKET_BYTES,
+    NETWORKS_DIR, SHIPPED_TRACES,
+};
 pub use master::{FaultConfig, HandConfig, HandMode, MasterConfig, MasterDeviceConfig};
 pub use network::{
     ChannelConfig, JitterConfig, JitterDistribution, LossModel, Network, ReplayConfig,
@@ -193,6 +198,12 @@ impl Scenario {
             lengths::check(written, &parsed)?;
         }
         s.validate()?;
+        let mut s = s;
+        for c in [&mut s.network.forward, &mut s.network.backward] {
+            if let Some(l) = &mut c.link {
+                l.name_to_path();
+            }
+        }
         Ok(s)
     }
 
@@ -245,6 +256,9 @@ impl Scenario {
         for c in [&mut self.network.forward, &mut self.network.backward] {
             if let Some(r) = &mut c.replay {
                 v.push(&mut r.path);
+            }
+            if let Some(path) = c.link.as_mut().and_then(|l| l.path.as_mut()) {
+                v.push(path);
             }
         }
         v

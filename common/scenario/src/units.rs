@@ -327,13 +327,14 @@ pub fn describe(name: &str, c: &ChannelConfig, rate_hz: f64) -> String {
         }
     };
     let at = format!(" at {} Hz", Num(rate_hz));
-    let mut s = match &c.replay {
-        Some(r) => format!(
+    let mut s = match (&c.replay, &c.link) {
+        (Some(r), _) => format!(
             "network.{name}: delay per packet from {} (samples, 1 = {} ms{at})",
             r.path,
             ms(per)
         ),
-        None => format!("network.{name}: delay {}", both(&c.delay, &at)),
+        (None, Some(l)) => link_line(name, l),
+        (None, None) => format!("network.{name}: delay {}", both(&c.delay, &at)),
     };
     if let Some(j) = &c.jitter {
         let dist = toml::Value::try_from(j.distribution).map_or_else(
@@ -364,3 +365,30 @@ pub fn describe(name: &str, c: &ChannelConfig, rate_hz: f64) -> String {
 #[cfg(test)]
 #[path = "units_tests.rs"]
 mod tests;
+
+/// A link's line: its server, its queue and its packets' size on the wire.
+fn link_line(name: &str, l: &crate::LinkConfig) -> String {
+    let server = match (&l.path, l.rate) {
+        (_, Some(r)) => format!("{} bit/s", Num(r)),
+        (Some(p), None) => format!("the Mahimahi trace {p}"),
+        (None, None) => format!("the shipped trace {}", l.trace.as_deref().unwrap_or("")),
+    };
+    let queue = toml::Value::try_from(l.queue)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default();
+    let mut bound = Vec::new();
+    if let Some(p) = l.packets {
+        bound.push(format!("packets={p}"));
+    }
+    if let Some(b) = l.bytes {
+        bound.push(format!("bytes={b}"));
+    }
+    format!(
+        "network.{name}: a link of {server}, queue {queue} [{}], packets of {} bytes on the wire ({} payload + {} header)",
+        bound.join(", "),
+        l.packet_bytes(),
+        l.payload_bytes,
+        l.header_bytes
+    )
+}
