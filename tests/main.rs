@@ -24,6 +24,7 @@ mod hdl_modules;
 mod hosts;
 mod layout;
 mod lifecycle;
+mod links;
 mod logs;
 mod loop_processes;
 mod nodes;
