@@ -23,8 +23,8 @@ pub use trace::{Opportunities, MAX_OPPORTUNITIES, OPPORTUNITY_BYTES};
 
 /// Most packets a link's queue holds whatever its discipline (an `infinite` queue at
 /// overload too): an arrival beyond it is dropped and counted as
-/// [`DropCause::Cap`]. 100,000 packets: 100 s of a 1 kHz flow, about 2.4 MB of
-/// queue (and the channel's copies of the samples, 15 MB).
+/// [`DropCause::Cap`]. 100,000 packets: 100 s of a 1 kHz flow, 2.4 MB of queue
+/// (and 24 MB of the channel's copies of the samples, 240 bytes each).
 pub const MAX_QUEUE_PACKETS: usize = 100_000;
 
 /// What takes packets out of the queue.
