@@ -76,6 +76,8 @@ fn bad_links_and_traces_are_refused_naming_the_field() {
     sb.write("back.trace", "1\n5\n3\n");
     sb.write("zero.trace", "0\n0\n");
     sb.write("ok.trace", "1\n2\n");
+    sb.write("back.csv", "time_ms,rate_bps\n0,1e6\n0,2e6\n");
+    sb.write("stops.csv", "time_ms,rate_bps\n0,1e6\n5,0\n");
     // Over the size limit (100 MB), sparse: refused by its size before it is read,
     // as a trace of 10^8 lines (at least 200 MB) is.
     let huge = std::fs::File::create(sb.path("huge.trace")).expect("create");
@@ -99,6 +101,9 @@ fn bad_links_and_traces_are_refused_naming_the_field() {
         (link("path = \"zero.trace\""), "the trace lasts 0 ms".into()),
         (link("path = \"huge.trace\""), "huge.trace".into()),
         (link("path = \"gone.trace\""), "gone.trace".into()),
+        (link("rate_trace = \"back.csv\""), "line 3: \"0,2e6\": time_ms does not increase".into()),
+        (link("rate_trace = \"stops.csv\""), "the link would stop for good".into()),
+        (link("rate_trace = \"\""), format!("{f}.rate_trace")),
         (
             base.replacen("delay = [0, 0, 0]", "delay = [3, 3, 3]", 1)
                 + "\n[network.forward.link]\nrate = 1e6\n",
@@ -116,4 +121,21 @@ fn bad_links_and_traces_are_refused_naming_the_field() {
     for (k, (text, want)) in cases.iter().enumerate() {
         sb.assert_refused(k, text, want);
     }
+}
+
+/// A rate over time: 3 Mbit/s, then 100 ms of nothing, then 3 Mbit/s again; the
+/// packets sent in the outage wait for its end (delays up to 100 samples at 1 kHz),
+/// and the run repeats.
+#[test]
+fn a_rate_over_time_holds_the_packets_through_its_outage() {
+    let sb = Sandbox::new("ratetr");
+    sb.write("rates.csv", "time_ms,rate_bps\n0,3e6\n200,0\n300,3e6\n");
+    let text = util::paper_1khz(600).replace("mode = \"realtime\"", "mode = \"lockstep\"")
+        + "\n[network.forward.link]\nrate_trace = \"rates.csv\"\n";
+    let trace = util::run_twice(&sb, &text);
+    let delays = util::column(&trace, "delay_f_1");
+    let longest = delays.iter().copied().fold(0.0, f64::max);
+    // The packet sent at 200 ms leaves at 300 ms and 0.74 us (278 bytes at 3 Mbit/s).
+    assert_eq!(longest, 101.0, "{delays:?}");
+    assert!(delays[..200].iter().all(|d| *d <= 1.0));
 }

@@ -63,6 +63,18 @@ fn link(field: &'static str, cfg: &LinkConfig, base_dir: &Path) -> Result<Replay
     if let Some(spec) = LinkSpec::of_rate(cfg) {
         return Ok(Replay::Link(spec));
     }
+    if let Some(file) = &cfg.rate_trace {
+        let path = base_dir.join(file);
+        let text = tactile_runtime::files::read_text(&path, "rate trace", MAX_TRACE_BYTES)
+            .map_err(|source| LoadError::Read { field, source })?;
+        return LinkSpec::parse_rates(&text, cfg)
+            .map(Replay::Link)
+            .map_err(|source| LoadError::Parse {
+                field,
+                path,
+                source,
+            });
+    }
     let file = match (&cfg.path, &cfg.trace) {
         (Some(p), _) => p.clone(),
         (None, Some(name)) => LinkConfig::shipped(name)

@@ -1,6 +1,7 @@
 //! The network between the master and the slave, as the emulator runs it: netem-class
 //! models (delay [`jitter`] with correlation, [`loss`] models, duplication) with
-//! netem's meanings, recorded networks [`replay`]ed packet by packet, and the
+//! netem's meanings, recorded networks [`replay`]ed packet by packet, a [`link`]
+//! with a rate and a queue (Mahimahi's `mm-link` exactly), and the
 //! [`channel`] that puts a sample through them. Seeded and pure: the same scenario and
 //! seed give the same packets. Only the emulator links this crate; the settings are
 //! `tactile-scenario`'s.

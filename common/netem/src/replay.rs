@@ -1,7 +1,7 @@
 //! Recorded networks replayed packet by packet: per-packet delays and losses from a
 //! CSV, or a [`Link`] (a Mahimahi delivery trace or a fixed rate, and a queue).
 
-use crate::link::{Bound, Fifo, Link, Opportunities, Queue, Server};
+use crate::link::{Bound, Fifo, Link, Opportunities, Queue, RateSteps, Server};
 use tactile_scenario::{LinkConfig, QueueKind};
 
 /// What is wrong in a replay file; each message names the line.
@@ -59,6 +59,25 @@ pub enum ReplayError {
     /// A Mahimahi trace of only time 0.
     #[error("the trace lasts 0 ms")]
     Instant,
+    /// A rate trace whose first line is not `time_ms,rate_bps`.
+    #[error("line 1: header is {0:?}, expected time_ms,rate_bps")]
+    RateHeader(String),
+    /// A rate trace's row that is no step.
+    #[error("line {line}: {text:?}: {why}")]
+    RateRow {
+        /// The line.
+        line: usize,
+        /// What it holds.
+        text: String,
+        /// What is wrong.
+        why: &'static str,
+    },
+    /// A rate trace with a header and nothing else.
+    #[error("no rates after the header")]
+    NoSteps,
+    /// A rate trace whose last rate is 0: the link would stop for good.
+    #[error("the last rate is 0: the link would stop for good")]
+    Stops,
     /// A Mahimahi trace of more opportunities than a link keeps.
     #[error("line {line}: more than {max} delivery opportunities")]
     TooLong {
@@ -104,6 +123,11 @@ impl LinkSpec {
             },
             packet_bytes: u32::try_from(cfg.packet_bytes()).unwrap_or(u32::MAX),
         }
+    }
+
+    /// Parses a rate trace (`time_ms,rate_bps`) into the link `cfg` sets.
+    pub fn parse_rates(text: &str, cfg: &LinkConfig) -> Result<LinkSpec, ReplayError> {
+        Ok(LinkSpec::new(cfg, Server::Steps(RateSteps::parse(text)?)))
     }
 
     /// The link of `cfg` when it needs no file (a fixed rate).

@@ -257,8 +257,9 @@ impl Scenario {
             if let Some(r) = &mut c.replay {
                 v.push(&mut r.path);
             }
-            if let Some(path) = c.link.as_mut().and_then(|l| l.path.as_mut()) {
-                v.push(path);
+            if let Some(l) = &mut c.link {
+                v.extend(l.path.as_mut());
+                v.extend(l.rate_trace.as_mut());
             }
         }
         v

@@ -49,7 +49,7 @@ pub enum QueueKind {
     Drophead,
 }
 
-/// `link = { trace | path | rate, queue, packets, bytes, header_bytes, payload_bytes }`.
+/// `link = { trace | path | rate | rate_trace, queue, packets, bytes, header_bytes, payload_bytes }`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LinkConfig {
@@ -63,6 +63,10 @@ pub struct LinkConfig {
     /// A fixed rate instead of a trace, bit/s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rate: Option<f64>,
+    /// A rate over time instead: a CSV `time_ms,rate_bps` (each rate from its time to
+    /// the next row's, the last on for good), relative to the scenario's folder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_trace: Option<String>,
     /// `infinite`, `droptail` or `drophead` [infinite], mm-link's `--uplink-queue`.
     #[serde(default)]
     pub queue: QueueKind,
@@ -96,6 +100,7 @@ impl LinkConfig {
             trace: None,
             path: Some(path.to_string()),
             rate: None,
+            rate_trace: None,
             queue: QueueKind::Infinite,
             packets: None,
             bytes: None,
@@ -130,7 +135,7 @@ impl LinkConfig {
     pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         let f = |k: &str| format!("{field}.link.{k}");
         self.validate_server(field)?;
-        let most = if self.rate.is_some() {
+        let most = if self.rate.is_some() || self.rate_trace.is_some() {
             MAX_PACKET_BYTES
         } else {
             MAX_TRACE_PACKET_BYTES
@@ -161,11 +166,12 @@ impl LinkConfig {
             self.trace.is_some(),
             self.path.is_some(),
             self.rate.is_some(),
+            self.rate_trace.is_some(),
         ];
         if given.iter().filter(|g| **g).count() != 1 {
             return Err(invalid(
                 format!("{field}.link"),
-                "give exactly one of trace (a shipped trace's name), path (a Mahimahi trace file) or rate (bit/s)",
+                "give exactly one of trace (a shipped trace's name), path (a Mahimahi trace file), rate (bit/s) or rate_trace (a file of time_ms,rate_bps)",
             ));
         }
         if let Some(name) = &self.trace {
@@ -183,8 +189,10 @@ impl LinkConfig {
                 ));
             }
         }
-        if self.path.as_ref().is_some_and(String::is_empty) {
-            return Err(invalid(format!("{field}.link.path"), "is empty"));
+        for (key, file) in [("path", &self.path), ("rate_trace", &self.rate_trace)] {
+            if file.as_ref().is_some_and(String::is_empty) {
+                return Err(invalid(format!("{field}.link.{key}"), "is empty"));
+            }
         }
         if let Some(r) = self.rate {
             if !r.is_finite() || !(1.0..=MAX_RATE).contains(&r) {

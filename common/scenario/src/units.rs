@@ -368,10 +368,11 @@ mod tests;
 
 /// A link's line: its server, its queue and its packets' size on the wire.
 fn link_line(name: &str, l: &crate::LinkConfig) -> String {
-    let server = match (&l.path, l.rate) {
-        (_, Some(r)) => format!("{} bit/s", Num(r)),
-        (Some(p), None) => format!("the Mahimahi trace {p}"),
-        (None, None) => format!("the shipped trace {}", l.trace.as_deref().unwrap_or("")),
+    let server = match (&l.path, l.rate, &l.rate_trace) {
+        (_, Some(r), _) => format!("{} bit/s", Num(r)),
+        (_, None, Some(f)) => format!("the rates over time in {f}"),
+        (Some(p), None, None) => format!("the Mahimahi trace {p}"),
+        (None, None, None) => format!("the shipped trace {}", l.trace.as_deref().unwrap_or("")),
     };
     let queue = toml::Value::try_from(l.queue)
         .ok()
@@ -384,9 +385,13 @@ fn link_line(name: &str, l: &crate::LinkConfig) -> String {
     if let Some(b) = l.bytes {
         bound.push(format!("bytes={b}"));
     }
+    let bound = if bound.is_empty() {
+        String::new()
+    } else {
+        format!(" [{}]", bound.join(", "))
+    };
     format!(
-        "network.{name}: a link of {server}, queue {queue} [{}], packets of {} bytes on the wire ({} payload + {} header)",
-        bound.join(", "),
+        "network.{name}: a link of {server}, queue {queue}{bound}, packets of {} bytes on the wire ({} payload + {} header)",
         l.packet_bytes(),
         l.payload_bytes,
         l.header_bytes

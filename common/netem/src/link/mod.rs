@@ -4,7 +4,8 @@
 //! exactly (`src/frontend/link_queue.cc`: each opportunity carries
 //! [`OPPORTUNITY_BYTES`], the bytes a packet leaves unsent carry it into the next one,
 //! and the opportunities at or before an arrival are burned before it is queued) or a
-//! fixed rate in bit/s (a packet of B bytes takes 8 B / rate). The result is each
+//! fixed rate in bit/s (a packet of B bytes takes 8 B / rate), or a rate over time
+//! ([`RateSteps`]). The result is each
 //! packet's departure time or its drop, as [`Event`]s.
 //!
 //! Time only moves forward: [`Link::advance`] runs the server up to a time and
@@ -14,11 +15,13 @@
 //! event, never at send.
 
 mod queue;
+mod steps;
 #[cfg(test)]
 mod tests;
 mod trace;
 
 pub use queue::{Bound, DropCause, Fifo, Packet, Queue};
+pub use steps::{RateSteps, MAX_STEPS};
 pub use trace::{Opportunities, MAX_OPPORTUNITIES, OPPORTUNITY_BYTES};
 
 /// Most packets a link's queue holds whatever its discipline (an `infinite` queue at
@@ -34,6 +37,8 @@ pub enum Server {
     Trace(Opportunities),
     /// A fixed rate, bit/s (positive, finite).
     Rate(f64),
+    /// A rate over time.
+    Steps(RateSteps),
 }
 
 /// What became of a packet.
@@ -77,7 +82,7 @@ pub struct FlowStats {
 pub struct Link {
     queue: Box<dyn Queue>,
     server: Server,
-    /// A trace's next opportunity (counted over its loops).
+    /// A trace's next opportunity (counted over its loops); a rate over time's step.
     next: u64,
     /// A rate server's time when it is free (the packet in transit's last byte).
     free_at: u64,
@@ -130,10 +135,7 @@ impl Link {
     pub fn advance(&mut self, now_ns: u64, out: &mut Vec<Event>) {
         match &self.server {
             Server::Trace(_) => self.advance_trace(now_ns, out),
-            Server::Rate(rate) => {
-                let rate = *rate;
-                self.advance_rate(rate, now_ns, out);
-            }
+            Server::Rate(_) | Server::Steps(_) => self.advance_rate(now_ns, out),
         }
     }
 
@@ -195,9 +197,9 @@ impl Link {
         self.flush_drops(out);
     }
 
-    /// A server of `rate` bit/s: the packet in transit departs when its last bit is
-    /// out; the next one is taken from the queue then.
-    fn advance_rate(&mut self, rate: f64, now_ns: u64, out: &mut Vec<Event>) {
+    /// A server of a rate (fixed, or over time): the packet in transit departs when
+    /// its last bit is out; the next one is taken from the queue then.
+    fn advance_rate(&mut self, now_ns: u64, out: &mut Vec<Event>) {
         loop {
             if let Some((p, _)) = self.transit {
                 if self.free_at > now_ns {
@@ -212,8 +214,12 @@ impl Link {
             let Some(p) = next else {
                 return;
             };
-            let ns = (f64::from(p.bytes) * 8e9 / rate).ceil();
-            self.free_at = start.saturating_add(ns as u64);
+            let bits = f64::from(p.bytes) * 8.0;
+            self.free_at = match &self.server {
+                Server::Steps(steps) => steps.finish(&mut self.next, start, bits),
+                Server::Rate(rate) => start.saturating_add((bits * 1e9 / rate).ceil() as u64),
+                Server::Trace(_) => start,
+            };
             self.transit = Some((p, 0));
         }
     }

@@ -339,3 +339,64 @@ fn a_trace_longer_than_the_limit_is_refused() {
     assert!(Opportunities::parse("").is_err());
     assert!(Opportunities::parse("0\n0\n").is_err());
 }
+
+fn departures(server: Server, pkts: &[(u64, u32)]) -> Vec<u64> {
+    let mut link = Link::new(server, Box::new(Fifo::infinite()), 1);
+    let mut events = Vec::new();
+    for (k, &(t, bytes)) in pkts.iter().enumerate() {
+        link.enqueue(packet(k as u64, bytes, t), &mut events);
+    }
+    link.advance(u64::MAX / 2, &mut events);
+    events
+        .iter()
+        .filter_map(|e| match e.fate {
+            Fate::Departed(t) => Some(t),
+            Fate::Dropped(_) => None,
+        })
+        .collect()
+}
+
+/// A rate over time: one constant step is the fixed rate, packet for packet; an
+/// outage (a step of 0) holds the packet in transit, which finishes when the rate
+/// comes back; the file's mistakes are named by line.
+#[test]
+fn a_rate_over_time_serves_as_its_steps_say() {
+    let pkts = arrivals(10_000, 250, &[278, 1400, 60]);
+    let fixed = departures(Server::Rate(3e6), &pkts);
+    let steps = RateSteps::parse("time_ms,rate_bps\n0,3e6\n").expect("steps");
+    assert_eq!(departures(Server::Steps(steps), &pkts), fixed);
+    // 1500 bytes at 8 Mbit/s take 1.5 ms: 1 ms sent, 2 ms of nothing, 0.5 ms more.
+    let outage = RateSteps::parse("time_ms,rate_bps\n0,8e6\n1,0\n3,8e6\n").expect("steps");
+    let at = departures(Server::Steps(outage), &[(0, 1500), (0, 1000)]);
+    assert_eq!(at, [3_500_000, 4_500_000]);
+    for (text, want) in [
+        (
+            "t,r\n0,1\n",
+            "line 1: header is \"t,r\", expected time_ms,rate_bps",
+        ),
+        (
+            "time_ms,rate_bps\n5,1\n",
+            "line 2: \"5,1\": the first row's time_ms must be 0",
+        ),
+        (
+            "time_ms,rate_bps\n0,1\n3,2\n3,1\n",
+            "line 4: \"3,1\": time_ms does not increase",
+        ),
+        (
+            "time_ms,rate_bps\n0,-1\n",
+            "line 2: \"0,-1\": rate_bps is outside 0..=1e12",
+        ),
+        (
+            "time_ms,rate_bps\n0,nan\n",
+            "line 2: \"0,nan\": rate_bps is outside 0..=1e12",
+        ),
+        (
+            "time_ms,rate_bps\n0,1\n2,0\n",
+            "the last rate is 0: the link would stop for good",
+        ),
+        ("time_ms,rate_bps\n", "no rates after the header"),
+    ] {
+        let e = RateSteps::parse(text).expect_err(text);
+        assert_eq!(e.to_string(), want, "{text}");
+    }
+}
