@@ -108,7 +108,13 @@ impl Channel {
         let Some(l) = self.link.as_deref_mut() else {
             return self.push_direct(slot, sent);
         };
-        let (lost, first) = l.step(slot, sent && in_order);
+        // A number out of order (a peer's bug or forgery) moves no time on: the link
+        // must not run ahead to an absurd number's time.
+        let (lost, first) = if in_order {
+            l.step(slot, sent)
+        } else {
+            (false, None)
+        };
         if self.first.is_none() {
             self.first = first;
         }
