@@ -219,14 +219,7 @@ fn a_replayed_trace_reproduces_its_delays_and_losses() {
     sb.write("net.csv", &csv);
     let text = util::paper_1khz(n as u64).replace("mode = \"realtime\"", "mode = \"lockstep\"")
         + "\n[network.forward.replay]\npath = \"net.csv\"\n";
-    let s = sb.write("s.toml", &text);
-    let s = s.to_str().expect("utf-8");
-    for out in ["a", "b"] {
-        let o = sb.tactile(&["run", s, "--in-process", "--out", out, "-q"]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    }
-    let trace = sb.trace("a");
-    assert_eq!(trace, sb.trace("b"), "replayed twice, run once");
+    let trace = util::run_twice(&sb, &text);
     let flags = util::column(&trace, "flags_f");
     let delays = util::column(&trace, "delay_f_1");
     let mut fresh = 0;

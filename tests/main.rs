@@ -27,6 +27,7 @@ mod human;
 mod layout;
 mod lerobot;
 mod lifecycle;
+mod links;
 mod logs;
 mod loop_processes;
 mod nodes;

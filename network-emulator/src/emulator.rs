@@ -18,6 +18,7 @@ use tactile_messages::samples::{Backward, Flags, Forward, Model, Signal};
 /// released at, however late that pose arrives).
 const CARRIED: Flags = Flags::RELEASED;
 use tactile_netem::channel::{Channel, Rest, Value, BACKWARD_STREAM, FORWARD_STREAM};
+use tactile_netem::link::FlowStats;
 use tactile_netem::{HistogramDelay, Loss, Replay};
 use tactile_records::emulator::{Direction, EmulatorCounters, Fate, Passage};
 use tactile_scenario::{ChannelConfig, Scenario};
@@ -151,6 +152,14 @@ impl Emulator {
     /// Counters so far.
     pub fn counters(&self) -> EmulatorCounters {
         self.counters
+    }
+
+    /// What the forward and backward links counted for the haptic flow (none for a
+    /// channel without a link): packets offered, departed, dropped, dropped at the
+    /// memory cap, and their time on the link. Not in the record yet: the report's
+    /// queueing-delay stage comes with the cross traffic that shares the link.
+    pub fn link_stats(&self) -> [Option<FlowStats>; 2] {
+        [self.forward.link_stats(), self.backward.link_stats()]
     }
 
     /// c(n) in: v(n) into `v` (`None` when the channel's `loss` drops the sample; a
@@ -401,5 +410,35 @@ mod tests {
         let r = record.expect("recorded");
         assert_eq!((r.n, r.dir, r.fate), (4, Direction::Backward, Fate::Drop));
         assert_eq!(e.counters().backward_dropped, 1);
+    }
+
+    /// A forward link drops what it cannot carry and counts it: at 1 kHz, 278-byte
+    /// packets on a 1 Mbit/s link with a 10-packet drop-tail queue carry 1e6 / 2224 =
+    /// 450 packets a second; the other 550 are lost, each counted once.
+    #[test]
+    fn a_link_counts_what_it_carries_and_drops() {
+        let mut sc = Scenario::paper();
+        sc.rate_hz = 1000.0;
+        sc.network.forward.link = Some(tactile_scenario::LinkConfig {
+            rate: Some(1e6),
+            path: None,
+            queue: tactile_scenario::QueueKind::Droptail,
+            packets: Some(10),
+            ..tactile_scenario::LinkConfig::mahimahi("")
+        });
+        let replays = crate::replay::load(&sc, std::path::Path::new(".")).expect("a rate");
+        let mut e = Emulator::with_replays(&sc, replays);
+        let (mut v, mut record) = (None, None);
+        for n in 0..1000 {
+            e.forward(&sample(n), &mut v, &mut record);
+        }
+        let [Some(f), None] = e.link_stats() else {
+            panic!("a forward link only");
+        };
+        assert_eq!(f.offered, 1000);
+        assert_eq!(f.dropped, e.counters().forward_packets_lost);
+        assert!(f.departed.abs_diff(450) <= 1, "{f:?}");
+        // The rest are in the queue (10) or in transit (1).
+        assert!(1000 - f.departed - f.dropped <= 11, "{f:?}");
     }
 }

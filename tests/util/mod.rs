@@ -348,6 +348,20 @@ pub fn wall_change() -> String {
     std::fs::read_to_string(path).expect("deploy/scenarios/wall-change.toml")
 }
 
+/// The scenario `text` (written as `s.toml` in the sandbox) run twice in-process,
+/// into `a` and `b`: the same trace byte for byte, returned.
+pub fn run_twice(sb: &Sandbox, text: &str) -> String {
+    let s = sb.write("s.toml", text);
+    let s = s.to_str().expect("utf-8");
+    for out in ["a", "b"] {
+        let o = sb.tactile(&["run", s, "--in-process", "--out", out, "-q"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let trace = sb.trace("a");
+    assert_eq!(trace, sb.trace("b"), "the same scenario twice, one run");
+    trace
+}
+
 /// The paper scenario at 1 kHz in real time, `samples` samples.
 pub fn paper_1khz(samples: u64) -> String {
     tactile_launch::PAPER_SCENARIO

@@ -16,6 +16,7 @@
 //! three delays equal, so the whole pose arrives together).
 
 use crate::histogram::{Drawn, HistogramDelay};
+use crate::link::FlowStats;
 use crate::{Jitter, Replay};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -177,6 +178,8 @@ pub struct Channel {
     direct: bool,
     /// On the direct path, the newest packet: the last one sent.
     newest: Option<Slot>,
+    /// A link with a rate and a queue carries the packets: [`Channel::push_link`].
+    link: Option<Box<link_path::OnLink>>,
 }
 
 /// Seeds of the two channels differ so their noise is independent.
@@ -244,12 +247,18 @@ impl Channel {
             last_seq: None,
             direct,
             newest: None,
+            link: None,
         }
     }
 
     /// The same channel driven by a recorded network (`t_s`: the sampling period):
     /// each packet's delay and loss come from it.
     pub fn with_replay(mut self, replay: Replay, t_s: f64) -> Channel {
+        self.direct = false;
+        if let Replay::Link(spec) = &replay {
+            self.link = Some(Box::new(link_path::OnLink::new(spec, t_s)));
+            return self;
+        }
         let need = replay.bound() as usize + 1;
         if self.ring.len() < need {
             self.ring = ring(need);
@@ -271,6 +280,13 @@ impl Channel {
         self.jitter = Some((Drawn::Histogram(h), r));
         self.direct = false;
         self
+    }
+
+    /// What a link carrying this channel counted for its packets (none without a
+    /// link): offered, departed, dropped, dropped at the memory cap, and their time
+    /// on the link (the queueing delay, with the serialisation).
+    pub fn link_stats(&self) -> Option<FlowStats> {
+        self.link.as_ref().map(|l| l.stats())
     }
 
     /// The delays in force at sample `n`.
@@ -301,6 +317,9 @@ impl Channel {
     ) -> Emitted {
         if self.direct {
             return self.push_direct(Slot { seq, values, extra }, sent);
+        }
+        if self.link.is_some() {
+            return self.push_link(Slot { seq, values, extra }, sent);
         }
         // Packets that arrived while no sample came (the sender's numbers skipped some:
         // a sample lost before this channel) are taken before this one's slot is
@@ -368,17 +387,7 @@ impl Channel {
             values: [Value::default(); 3],
             extra: Rest::default(),
         });
-        let age = u32::try_from(seq.saturating_sub(newest.seq)).unwrap_or(u32::MAX);
-        let mut noise = [0.0; 3];
-        let values = std::array::from_fn(|i| {
-            let value = newest.values[i];
-            noise[i] = self.noise(i);
-            Value {
-                v: value.v + noise[i],
-                delay_samples: value.delay_samples.saturating_add(age),
-                ..value
-            }
-        });
+        let (values, noise) = self.aged(&newest, seq);
         Emitted {
             values,
             noise,
@@ -388,6 +397,24 @@ impl Channel {
             duplicated: false,
             substituted: !fresh,
         }
+    }
+
+    /// `from`'s values as they leave at sample `seq`: their age added to their delay,
+    /// and each signal's noise (drawn in the signals' order); the noise added.
+    #[inline(always)]
+    fn aged(&mut self, from: &Slot, seq: u64) -> ([Value; 3], [f64; 3]) {
+        let age = u32::try_from(seq.saturating_sub(from.seq)).unwrap_or(u32::MAX);
+        let mut noise = [0.0; 3];
+        let values = std::array::from_fn(|i| {
+            let value = from.values[i];
+            noise[i] = self.noise(i);
+            Value {
+                v: value.v + noise[i],
+                delay_samples: value.delay_samples.saturating_add(age),
+                ..value
+            }
+        });
+        (values, noise)
     }
 
     /// Whether sample `seq` comes in order, then the last in order: sample numbers
@@ -424,10 +451,7 @@ impl Channel {
         // like an absurd jump and every later packet be refused).
         let in_order = self.in_order(seq);
         let sent = sent && in_order;
-        let replayed = self
-            .replay
-            .as_mut()
-            .map(|(r, t_s)| r.packet(seq, *t_s, sent));
+        let replayed = self.replay.as_mut().map(|(r, _)| r.packet(sent));
         let sent = sent && !replayed.is_some_and(|(_, lost)| lost);
         if sent {
             let at = slot_of(&self.ring, seq);
@@ -532,6 +556,9 @@ struct Packet {
     /// A duplicate's jitter, if it went twice.
     copy: Option<f64>,
 }
+
+#[path = "channel_link.rs"]
+mod link_path;
 
 #[cfg(test)]
 #[path = "channel_tests.rs"]

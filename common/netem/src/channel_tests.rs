@@ -373,3 +373,12 @@ fn samples_not_sent_move_the_numbers_on() {
         assert_eq!(e.values[0], Value::default());
     }
 }
+
+/// A link's memory cap bounds what a channel holds for it: the samples on the link,
+/// at most the cap of them, each a slot (docs/04 says 240 bytes, 24 MB).
+#[test]
+fn a_links_held_samples_are_bounded_by_its_cap() {
+    let held = std::mem::size_of::<Slot>() * crate::link::MAX_QUEUE_PACKETS;
+    assert_eq!(std::mem::size_of::<Slot>(), 240);
+    assert!(held <= 24_000_000, "{held} bytes");
+}

@@ -1,7 +1,8 @@
 //! The network between the master and the slave, as the emulator runs it: netem-class
 //! models (delay [`jitter`] with correlation, [`loss`] models, duplication) with
 //! netem's meanings, delays drawn from measured [`histogram`]s, recorded networks
-//! [`replay`]ed packet by packet, and the
+//! [`replay`]ed packet by packet, a [`link`] with a rate and a queue (Mahimahi's
+//! `mm-link` exactly), and the
 //! [`channel`] that puts a sample through them. Seeded and pure: the same scenario and
 //! seed give the same packets. Only the emulator links this crate; the settings are
 //! `tactile-scenario`'s.
@@ -12,6 +13,7 @@
 pub mod channel;
 pub mod histogram;
 pub mod jitter;
+pub mod link;
 pub mod loss;
 pub mod replay;
 #[cfg(test)]
@@ -20,4 +22,4 @@ mod tests;
 pub use histogram::{DelayHistogram, HistogramDelay, HistogramError};
 pub use jitter::Jitter;
 pub use loss::{loss_rate, Loss};
-pub use replay::{Mahimahi, Replay, ReplayError};
+pub use replay::{LinkSpec, Replay, ReplayError};

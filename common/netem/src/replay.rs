@@ -1,7 +1,8 @@
 //! Recorded networks replayed packet by packet: per-packet delays and losses from a
-//! CSV, or a Mahimahi delivery trace served first come first served.
+//! CSV, or a [`Link`] (a Mahimahi delivery trace or a fixed rate, and a queue).
 
-use tactile_scenario::ReplayConfig;
+use crate::link::{Bound, Fifo, Link, Opportunities, Queue, RateSteps, Server};
+use tactile_scenario::{LinkConfig, QueueKind};
 
 /// What is wrong in a replay file; each message names the line.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -58,26 +59,91 @@ pub enum ReplayError {
     /// A Mahimahi trace of only time 0.
     #[error("the trace lasts 0 ms")]
     Instant,
+    /// A rate trace whose first line is not `time_ms,rate_bps`.
+    #[error("line 1: header is {0:?}, expected time_ms,rate_bps")]
+    RateHeader(String),
+    /// A rate trace's row that is no step.
+    #[error("line {line}: {text:?}: {why}")]
+    RateRow {
+        /// The line.
+        line: usize,
+        /// What it holds.
+        text: String,
+        /// What is wrong.
+        why: &'static str,
+    },
+    /// A rate trace with a header and nothing else.
+    #[error("no rates after the header")]
+    NoSteps,
+    /// A rate trace whose last rate is 0: the link would stop for good.
+    #[error("the last rate is 0: the link would stop for good")]
+    Stops,
+    /// A Mahimahi trace of more opportunities than a link keeps.
+    #[error("line {line}: more than {max} delivery opportunities")]
+    TooLong {
+        /// The first line past the limit.
+        line: usize,
+        /// The limit.
+        max: usize,
+    },
 }
 
-/// A loaded replay: each packet's delay (samples) and whether it is lost.
+/// A loaded replay: each packet's delay (samples) and whether it is lost, or a link.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Replay {
     /// Rows of a CSV file, one per packet sent, looped; the number of packets so far.
     Packets(Vec<(u32, bool)>, u64),
-    /// Mahimahi delivery opportunities (ms), looped, served first come first served.
-    Mahimahi(Mahimahi),
+    /// A link with a rate and a queue: the channel runs it ([`LinkSpec::build`]).
+    Link(LinkSpec),
 }
 
-/// The FIFO queue of a Mahimahi link.
+/// A link as a scenario sets it: its server, its queue discipline and bound, and its
+/// packets' size on the wire.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Mahimahi {
-    times_ms: Vec<u64>,
-    period_ms: u64,
-    per_opportunity: u32,
-    max_queue: u32,
-    next: u64,
-    used: u32,
+pub struct LinkSpec {
+    /// A trace or a rate.
+    pub server: Server,
+    /// mm-link's discipline.
+    pub queue: QueueKind,
+    /// Its bound (none for `infinite`).
+    pub bound: Bound,
+    /// Each packet's size on the wire, bytes (payload and headers).
+    pub packet_bytes: u32,
+}
+
+impl LinkSpec {
+    /// The link of `cfg` served by `server` (its trace read, or its rate).
+    pub fn new(cfg: &LinkConfig, server: Server) -> LinkSpec {
+        LinkSpec {
+            server,
+            queue: cfg.queue,
+            bound: Bound {
+                packets: cfg.packets.unwrap_or(0),
+                bytes: cfg.bytes.unwrap_or(0),
+            },
+            packet_bytes: u32::try_from(cfg.packet_bytes()).unwrap_or(u32::MAX),
+        }
+    }
+
+    /// Parses a rate trace (`time_ms,rate_bps`) into the link `cfg` sets.
+    pub fn parse_rates(text: &str, cfg: &LinkConfig) -> Result<LinkSpec, ReplayError> {
+        Ok(LinkSpec::new(cfg, Server::Steps(RateSteps::parse(text)?)))
+    }
+
+    /// The link of `cfg` when it needs no file (a fixed rate).
+    pub fn of_rate(cfg: &LinkConfig) -> Option<LinkSpec> {
+        cfg.rate.map(|r| LinkSpec::new(cfg, Server::Rate(r)))
+    }
+
+    /// The link, empty at time 0, counting one flow.
+    pub fn build(&self) -> Link {
+        let queue: Box<dyn Queue> = match self.queue {
+            QueueKind::Infinite => Box::new(Fifo::infinite()),
+            QueueKind::Droptail => Box::new(Fifo::drop_tail(self.bound)),
+            QueueKind::Drophead => Box::new(Fifo::drop_head(self.bound)),
+        };
+        Link::new(self.server.clone(), queue, 1)
+    }
 }
 
 impl Replay {
@@ -127,52 +193,24 @@ impl Replay {
         Ok(Replay::Packets(out, 0))
     }
 
-    /// Parses a Mahimahi trace (one non-decreasing millisecond timestamp per line).
-    pub fn parse_mahimahi(text: &str, cfg: &ReplayConfig) -> Result<Replay, ReplayError> {
-        let mut times = Vec::new();
-        for (k, line) in text.lines().enumerate() {
-            let t = line.trim();
-            if t.is_empty() {
-                continue;
-            }
-            let v: u64 = t.parse().map_err(|source| ReplayError::NotMs {
-                line: k + 1,
-                text: t.to_string(),
-                source,
-            })?;
-            if times.last().is_some_and(|&last| v < last) {
-                return Err(ReplayError::Backwards { line: k + 1, ms: v });
-            }
-            times.push(v);
-        }
-        let Some(&last) = times.last() else {
-            return Err(ReplayError::NoOpportunities);
-        };
-        if last == 0 {
-            return Err(ReplayError::Instant);
-        }
-        Ok(Replay::Mahimahi(Mahimahi {
-            times_ms: times,
-            period_ms: last,
-            per_opportunity: (1500 / cfg.packet_bytes).max(1),
-            max_queue: cfg.max_queue_samples,
-            next: 0,
-            used: 0,
-        }))
+    /// Parses a Mahimahi trace (one non-decreasing millisecond timestamp per line)
+    /// into the link `cfg` sets.
+    pub fn parse_mahimahi(text: &str, cfg: &LinkConfig) -> Result<Replay, ReplayError> {
+        let ops = Opportunities::parse(text)?;
+        Ok(Replay::Link(LinkSpec::new(cfg, Server::Trace(ops))))
     }
 
     /// The largest delay a packet can be given, samples.
     pub fn bound(&self) -> u32 {
         match self {
             Replay::Packets(rows, _) => rows.iter().map(|r| r.0).max().unwrap_or(0),
-            Replay::Mahimahi(m) => m.max_queue,
+            Replay::Link(_) => 0,
         }
     }
 
-    /// The sample `n`, sent at n t_s if `sent` (a sample its codec did not send is no
-    /// packet: it takes no row and no room on the link): the packet's delay in samples
-    /// and whether it is lost. Samples come in order.
-    pub fn packet(&mut self, n: u64, t_s: f64, sent: bool) -> (u32, bool) {
+    /// The next sample's packet if `sent` (a sample its codec did not send is no
+    /// packet: it takes no row): its delay in samples and whether it is lost.
+    pub fn packet(&mut self, sent: bool) -> (u32, bool) {
         if !sent {
             return (0, false);
         }
@@ -182,52 +220,8 @@ impl Replay {
                 *k += 1;
                 r
             }
-            Replay::Mahimahi(m) => m.deliver(n, t_s),
+            // The channel runs a link itself; it never asks it for a delay.
+            Replay::Link(_) => (0, false),
         }
-    }
-}
-
-impl Mahimahi {
-    fn time(&self, k: u64) -> u64 {
-        let len = self.times_ms.len() as u64;
-        self.times_ms[(k % len) as usize] + (k / len) * self.period_ms
-    }
-
-    /// The first opportunity at or after `ms`, found directly (a late or sparse
-    /// packet must not walk the trace one opportunity at a time).
-    fn first_at(&self, ms: f64) -> u64 {
-        let len = self.times_ms.len() as u64;
-        let ms = ms.clamp(0.0, 1e15);
-        let loops = (ms / self.period_ms as f64).floor() as u64;
-        let within = ms - (loops * self.period_ms) as f64;
-        let mut k = loops * len + self.times_ms.partition_point(|&t| (t as f64) < within) as u64;
-        // The last opportunity of a loop falls at the period itself, where the next
-        // loop starts: step back onto opportunities that are still at or after `ms`.
-        while k > 0 && self.time(k - 1) as f64 >= ms {
-            k -= 1;
-        }
-        k
-    }
-
-    /// The first opportunity at or after the packet's sending time with room left.
-    fn deliver(&mut self, n: u64, t_s: f64) -> (u32, bool) {
-        let sent_ms = n as f64 * t_s * 1e3;
-        let k = self.first_at(sent_ms);
-        if k > self.next {
-            self.next = k;
-            self.used = 0;
-        }
-        if self.used >= self.per_opportunity {
-            self.next += 1;
-            self.used = 0;
-        }
-        let at_ms = self.time(self.next) as f64;
-        let delay = ((at_ms - sent_ms) / (t_s * 1e3)).ceil().max(0.0);
-        if delay > f64::from(self.max_queue) {
-            // The queue is full: dropped, and it takes no room.
-            return (self.max_queue, true);
-        }
-        self.used += 1;
-        (delay as u32, false)
     }
 }

@@ -6,8 +6,7 @@ use crate::loss::*;
 use crate::replay::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use tactile_scenario::ReplayFormat;
-use tactile_scenario::{JitterConfig, JitterDistribution, LossModel, ReplayConfig};
+use tactile_scenario::{JitterConfig, JitterDistribution, LossModel};
 
 const N: usize = 100_000;
 
@@ -230,7 +229,7 @@ fn gilbert_elliott_with_partial_loss_and_the_four_state_model_match_their_rates(
 #[test]
 fn a_csv_replay_reads_back_row_by_row_and_loops() {
     let mut r = Replay::parse_csv("delay,lost\n3,0\n5,1\n0,0\n").expect("csv");
-    let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3, true)).collect();
+    let got: Vec<(u32, bool)> = (0..6).map(|_| r.packet(true)).collect();
     let want = [
         (3, false),
         (5, true),
@@ -241,8 +240,8 @@ fn a_csv_replay_reads_back_row_by_row_and_loops() {
     ];
     assert_eq!(got, want);
     // A sample not sent takes no row: the next packet gets the next one.
-    assert_eq!(r.packet(6, 1e-3, false), (0, false));
-    assert_eq!(r.packet(7, 1e-3, true), (3, false));
+    assert_eq!(r.packet(false), (0, false));
+    assert_eq!(r.packet(true), (3, false));
     assert_eq!(r.bound(), 5);
     for (text, needle) in [
         ("delay,lost\n1.5,0\n", "line 2: delay 1.5"),
@@ -257,41 +256,77 @@ fn a_csv_replay_reads_back_row_by_row_and_loops() {
     }
 }
 
-/// A Mahimahi link that can deliver one MTU every 2 ms carries 6 packets of 250
-/// bytes per opportunity: at 1 kHz (a packet per ms) it keeps up, each packet
-/// waiting for the next opportunity; at 10 kHz it cannot, the queue grows to its
-/// limit and the excess is dropped.
+/// A channel over a Mahimahi link that sends 1504 bytes every 2 ms (the trace
+/// `2, 4`, looped), packets of 278 bytes (250 and UDP/IPv4's 28), one a ms: the
+/// opportunity at a packet's own millisecond is burned before it is queued (mm-link's
+/// `rationalize` before `enqueue`), so packets sent at even ms wait 2 ms and those at
+/// odd ms 1 ms (the replay before this link gave 0 and 1: it used the arrival's own
+/// millisecond); at ten packets a ms the 50-packet drop-tail queue refuses all but
+/// the link's 1504 bytes / 2 ms; an idle hour is skipped, not walked.
 #[test]
-fn a_mahimahi_link_queues_and_drops_what_it_cannot_carry() {
-    let cfg = ReplayConfig {
-        path: "x".into(),
-        format: ReplayFormat::Mahimahi,
-        packet_bytes: 250,
-        max_queue_samples: 50,
+fn a_channel_over_a_mahimahi_link_delivers_at_mm_links_opportunities() {
+    use crate::channel::{Channel, Emitted, Value};
+    use tactile_scenario::{ChannelConfig, LinkConfig, QueueKind};
+    let cfg = LinkConfig::mahimahi("x");
+    let over = |cfg: &LinkConfig, t_s: f64| {
+        let link = Replay::parse_mahimahi("2\n4\n", cfg).expect("trace");
+        Channel::new(&ChannelConfig::default(), 1, 1).with_replay(link, t_s)
     };
-    let mut r = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
-    let got: Vec<(u32, bool)> = (0..6).map(|n| r.packet(n, 1e-3, true)).collect();
+    let sample = |n: u64| {
+        [Value {
+            v: n as f64,
+            sent_seq: n,
+            ..Value::default()
+        }; 3]
+    };
+    // What the receiver got: the packet, its age, and whether it is the last again.
+    let seen = |e: Emitted| {
+        let v = e.values[0];
+        (v.sent_seq, v.delay_samples, e.substituted)
+    };
+    let mut ch = over(&cfg, 1e-3);
+    let got: Vec<(u64, u32, bool)> = (0..7).map(|n| seen(ch.push(n, sample(n)))).collect();
     let want = [
-        (2, false),
-        (1, false),
-        (0, false),
-        (1, false),
-        (0, false),
-        (1, false),
+        (0, 0, true),
+        (0, 1, true),
+        (1, 1, false),
+        (1, 2, true),
+        (3, 1, false),
+        (3, 2, true),
+        (5, 1, false),
     ];
     assert_eq!(got, want);
-    let mut fast = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
+    // A forged number far ahead, and one going back, move the link's time not at all.
+    let mut forged = over(&cfg, 1e-3);
+    let got: Vec<(u64, u32, bool)> = [0, 1, 1 << 40, 2, 1, 3, 4, 5, 6]
+        .into_iter()
+        .enumerate()
+        .map(|(k, n)| (k, seen(forged.push(n, sample(n)))))
+        .filter(|(k, _)| *k != 2 && *k != 4)
+        .map(|(_, g)| g)
+        .collect();
+    assert_eq!(got, want);
+    let tail = LinkConfig {
+        queue: QueueKind::Droptail,
+        packets: Some(50),
+        ..cfg.clone()
+    };
+    let mut fast = over(&tail, 1e-4);
     let lost = (0..10_000)
-        .filter(|&n| fast.packet(n, 1e-4, true).1)
+        .filter(|&n| fast.push(n, sample(n)).lost)
         .count();
-    // 3 packets per ms fit of the 10 sent: 70 % dropped once the queue is full.
-    assert!((6_500..=7_100).contains(&lost), "{lost}");
-    // A packet sent an hour in goes at once: the trace is not walked.
-    let mut late = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
-    assert_eq!(late.packet(3_600_000, 1e-3, true), (0, false));
-    // Samples not sent take no room.
-    let mut quiet = Replay::parse_mahimahi("2\n4\n", &cfg).expect("trace");
-    assert!((0..10_000).all(|n| !quiet.packet(n, 1e-4, n % 10 == 0).1));
+    // 1504 / 278 = 5.41 packets every 20 samples of the 10,000 sent (at most one
+    // lost a sample): 2,705 carried, the rest refused.
+    let departed = fast.link_stats().expect("a link").departed;
+    assert!(
+        (10_000 - lost as u64).abs_diff(2_705) <= 60,
+        "{lost} lost, {departed} departed"
+    );
+    let mut late = over(&cfg, 1e-3);
+    let t = 3_600_000;
+    assert!(late.push(t, sample(t)).substituted);
+    assert!(late.push(t + 1, sample(t + 1)).substituted);
+    assert_eq!(seen(late.push(t + 2, sample(t + 2))), (t + 1, 1, false));
     assert!(Replay::parse_mahimahi("3\n2\n", &cfg).is_err());
     let e = Replay::parse_mahimahi("x\n", &cfg).expect_err("no number");
     let cause = std::error::Error::source(&e).expect("the integer's reason");

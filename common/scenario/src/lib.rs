@@ -19,6 +19,7 @@ pub mod hand;
 mod histogram;
 mod human;
 mod lengths;
+mod link;
 mod master;
 #[cfg(test)]
 mod messages_tests;
@@ -58,6 +59,10 @@ pub use histogram::{
     shipped_histogram, HistogramConfig, HistogramFormat, ShippedHistogram, SHIPPED_HISTOGRAMS,
 };
 pub use human::{HumanConfig, Response};
+pub use link::{
+    LinkConfig, QueueKind, MAX_PACKET_BYTES, MAX_QUEUE_PACKETS, MAX_RATE, MAX_TRACE_PACKET_BYTES,
+    NETWORKS_DIR, SHIPPED_TRACES,
+};
 pub use master::{FaultConfig, HandConfig, HandMode, MasterConfig, MasterDeviceConfig};
 pub use network::{
     ChannelConfig, JitterConfig, JitterDistribution, LossModel, Network, ReplayConfig,
@@ -199,6 +204,12 @@ impl Scenario {
             lengths::check(written, &parsed)?;
         }
         s.validate()?;
+        let mut s = s;
+        for c in [&mut s.network.forward, &mut s.network.backward] {
+            if let Some(l) = &mut c.link {
+                l.name_to_path();
+            }
+        }
         Ok(s)
     }
 
@@ -254,6 +265,10 @@ impl Scenario {
             }
             if let Some(p) = c.delay_histogram.as_mut().and_then(|h| h.path.as_mut()) {
                 v.push(p);
+            }
+            if let Some(l) = &mut c.link {
+                v.extend(l.path.as_mut());
+                v.extend(l.rate_trace.as_mut());
             }
         }
         v

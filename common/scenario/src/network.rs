@@ -3,6 +3,7 @@
 //! settings and ranges are here).
 
 use crate::histogram::HistogramConfig;
+use crate::link::LinkConfig;
 use crate::shown::Num;
 use crate::{invalid, ScenarioError};
 use serde::{Deserialize, Serialize};
@@ -50,6 +51,10 @@ pub struct ChannelConfig {
     /// Each packet's whole delay drawn from a measured distribution, instead of
     /// `delay`, `schedule`, `jitter` and `replay` (`crate::histogram`).
     pub delay_histogram: Option<HistogramConfig>,
+    /// A link with a rate and a queue (mm-link's), instead of `delay`, `schedule`,
+    /// `jitter`, `duplicate` and `replay`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link: Option<LinkConfig>,
 }
 
 impl Default for ChannelConfig {
@@ -66,6 +71,7 @@ impl Default for ChannelConfig {
             replay: None,
             duplicate: 0.0,
             delay_histogram: None,
+            link: None,
         }
     }
 }
@@ -110,6 +116,21 @@ impl ChannelConfig {
             h.validate(field)?;
             self.histogram_alone(field)?;
         }
+        if let Some(l) = &self.link {
+            l.validate(field)?;
+            let alone = self.jitter.is_none()
+                && self.schedule.is_empty()
+                && self.delay == [0; 3]
+                && self.replay.is_none()
+                && self.duplicate == 0.0
+                && self.delay_histogram.is_none();
+            if !alone {
+                return Err(invalid(
+                    format!("{field}.link"),
+                    "gives each packet's delay: leave delay at [0, 0, 0], and schedule, jitter, duplicate, replay and delay_histogram out",
+                ));
+            }
+        }
         if let Some(m) = &self.loss_model {
             m.validate(field)?;
             if self.loss > 0.0 {
@@ -130,11 +151,12 @@ impl ChannelConfig {
             ("schedule", !self.schedule.is_empty()),
             ("jitter", self.jitter.is_some()),
             ("replay", self.replay.is_some()),
+            ("link", self.link.is_some()),
         ];
         match other.iter().find(|(_, set)| *set) {
             Some((key, _)) => Err(invalid(
                 format!("{field}.delay_histogram"),
-                format!("and `{field}.{key}` both set: the histogram gives each packet's whole delay; leave delay at [0, 0, 0] (or delay_ms at 0), and schedule, jitter and replay out"),
+                format!("and `{field}.{key}` both set: the histogram gives each packet's whole delay; leave delay at [0, 0, 0] (or delay_ms at 0), and schedule, jitter, replay and link out"),
             )),
             None => Ok(()),
         }
@@ -370,17 +392,18 @@ pub struct ReplayConfig {
     /// The file, relative to the scenario's folder.
     pub path: String,
     /// `csv`: header `delay,lost`, one row per packet (delay in samples, lost 0 or 1),
-    /// looped; `mahimahi`: Mahimahi's delivery trace, one line per millisecond at
-    /// which the link can deliver an MTU (1500 bytes), looped [csv].
+    /// looped; `mahimahi`: Mahimahi's delivery trace, run as `link = { path }` (mm-link
+    /// with its default, infinite, queue) [csv].
     #[serde(default)]
     pub format: ReplayFormat,
-    /// Mahimahi: bytes per packet on the wire (a sample's frame is about 250) [250].
-    #[serde(default = "default_packet_bytes")]
-    pub packet_bytes: u32,
-    /// Mahimahi: a packet that would queue longer than this many samples is dropped,
-    /// as a drop-tail queue would [1000].
-    #[serde(default = "default_max_queue")]
-    pub max_queue_samples: u32,
+    /// Refused: the old Mahimahi replay's packet size, replaced by the link's
+    /// `payload_bytes` and `header_bytes`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub packet_bytes: Option<u32>,
+    /// Refused: the old Mahimahi replay's bound by waiting time, which mm-link does not
+    /// have; replaced by the link's `queue`, `packets` and `bytes`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_queue_samples: Option<u32>,
 }
 
 /// Replay formats.
@@ -394,42 +417,25 @@ pub enum ReplayFormat {
     Mahimahi,
 }
 
-fn default_packet_bytes() -> u32 {
-    250
-}
-fn default_max_queue() -> u32 {
-    1000
-}
-
 impl ReplayConfig {
-    /// A Mahimahi replay's settings at their defaults (its path empty).
-    pub fn mahimahi_defaults() -> Self {
-        ReplayConfig {
-            path: String::new(),
-            format: ReplayFormat::Mahimahi,
-            packet_bytes: default_packet_bytes(),
-            max_queue_samples: default_max_queue(),
-        }
-    }
-
-    /// Checks the fields; errors name `FIELD.replay.*`.
+    /// Checks the fields; errors name `FIELD.replay.*`. The old Mahimahi replay's keys
+    /// are refused with the keys that replace them: the link now runs mm-link's
+    /// algorithm (1504-byte opportunities that carry a packet's remaining bytes over,
+    /// a queue bounded in packets or bytes), which they cannot describe.
     pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         if self.path.is_empty() {
             return Err(invalid(format!("{field}.replay.path"), "is empty"));
         }
-        if self.packet_bytes == 0 || self.packet_bytes > 1500 {
+        if self.packet_bytes.is_some() {
             return Err(invalid(
                 format!("{field}.replay.packet_bytes"),
-                format!("{} is outside 1..=1500 (one MTU)", self.packet_bytes),
+                "is no longer read: write link = { path = \"...\", payload_bytes = P, header_bytes = H } (a packet is P + H bytes on the wire; 250 + 28 by default)",
             ));
         }
-        if self.max_queue_samples == 0 || i64::from(self.max_queue_samples) > MAX_DELAY_SAMPLES {
+        if self.max_queue_samples.is_some() {
             return Err(invalid(
                 format!("{field}.replay.max_queue_samples"),
-                format!(
-                    "{} is outside 1..={}",
-                    self.max_queue_samples, MAX_DELAY_SAMPLES
-                ),
+                "is no longer read: mm-link bounds its queue by size, not waiting time; write link = { path = \"...\", queue = \"droptail\", packets = N } (or bytes = B)",
             ));
         }
         Ok(())

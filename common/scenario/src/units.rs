@@ -333,14 +333,15 @@ pub fn describe(name: &str, c: &ChannelConfig, rate_hz: f64) -> String {
             ms(per)
         )
     };
-    let mut s = match (&c.replay, &c.delay_histogram) {
-        (Some(r), _) => from(&r.path),
-        (None, Some(h)) => from(&format!(
+    let mut s = match (&c.replay, &c.delay_histogram, &c.link) {
+        (Some(r), _, _) => from(&r.path),
+        (None, Some(h), _) => from(&format!(
             "the histogram {}, correlation {}",
             h.path.as_deref().or(h.name.as_deref()).unwrap_or_default(),
             Num(h.correlation)
         )),
-        (None, None) => format!("network.{name}: delay {}", both(&c.delay, &at)),
+        (None, None, Some(l)) => link_line(name, l),
+        (None, None, None) => format!("network.{name}: delay {}", both(&c.delay, &at)),
     };
     if let Some(j) = &c.jitter {
         let dist = toml::Value::try_from(j.distribution).map_or_else(
@@ -371,3 +372,35 @@ pub fn describe(name: &str, c: &ChannelConfig, rate_hz: f64) -> String {
 #[cfg(test)]
 #[path = "units_tests.rs"]
 mod tests;
+
+/// A link's line: its server, its queue and its packets' size on the wire.
+fn link_line(name: &str, l: &crate::LinkConfig) -> String {
+    let server = match (&l.path, l.rate, &l.rate_trace) {
+        (_, Some(r), _) => format!("{} bit/s", Num(r)),
+        (_, None, Some(f)) => format!("the rates over time in {f}"),
+        (Some(p), None, None) => format!("the Mahimahi trace {p}"),
+        (None, None, None) => format!("the shipped trace {}", l.trace.as_deref().unwrap_or("")),
+    };
+    let queue = toml::Value::try_from(l.queue)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default();
+    let mut bound = Vec::new();
+    if let Some(p) = l.packets {
+        bound.push(format!("packets={p}"));
+    }
+    if let Some(b) = l.bytes {
+        bound.push(format!("bytes={b}"));
+    }
+    let bound = if bound.is_empty() {
+        String::new()
+    } else {
+        format!(" [{}]", bound.join(", "))
+    };
+    format!(
+        "network.{name}: a link of {server}, queue {queue}{bound}, packets of {} bytes on the wire ({} payload + {} header)",
+        l.packet_bytes(),
+        l.payload_bytes,
+        l.header_bytes
+    )
+}

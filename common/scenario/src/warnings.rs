@@ -8,8 +8,7 @@
 use crate::shown::Num;
 use crate::{
     ArmServo, Backend, ChannelConfig, CodecConfig, CodecKind, ControlKind, HandMode, LossModel,
-    MmtSlave, Operator, PredictorConfig, PredictorKind, ReplayFormat, Scenario,
-    NOMINAL_MAX_STIFFNESS,
+    MmtSlave, Operator, PredictorConfig, PredictorKind, Scenario, NOMINAL_MAX_STIFFNESS,
 };
 use serde::Serialize;
 use tactile_math::arith::ArithKind;
@@ -232,26 +231,6 @@ impl Scenario {
         } else if !self.ros.live.enabled {
             let set = changed(&self.ros.live, &d.ros.live, "ros.live", &["rate_hz"]);
             say(w, &set, "the live view", "ros.live.enabled is false");
-        }
-        for (name, c) in [
-            ("forward", &self.network.forward),
-            ("backward", &self.network.backward),
-        ] {
-            if let Some(r) = c
-                .replay
-                .as_ref()
-                .filter(|r| r.format != ReplayFormat::Mahimahi)
-            {
-                let written = crate::ReplayConfig {
-                    path: r.path.clone(),
-                    format: r.format,
-                    ..crate::ReplayConfig::mahimahi_defaults()
-                };
-                let field = format!("network.{name}.replay");
-                let set = changed(r, &written, &field, &[]);
-                let this = format!("{field}.format is \"csv\"");
-                say(w, &set, "a replay of format \"mahimahi\"", &this);
-            }
         }
     }
 }
