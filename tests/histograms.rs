@@ -169,4 +169,10 @@ fn bad_histograms_are_refused_naming_the_field() {
         "network.forward.jitter={ jitter = 2.0 }",
         "and `network.forward.jitter` both set",
     );
+    // Nor beside a link, which gives each packet's delay too (either way round).
+    sb.assert_bad_set(
+        hist.to_str().expect("utf-8"),
+        "network.forward.link={ rate = 1e6 }",
+        "network.forward.link",
+    );
 }
