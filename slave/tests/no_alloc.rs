@@ -73,14 +73,19 @@ const HOME: [f64; 3] = [0.0, -0.107, -0.035];
 /// The shipped Panda scenario (4 integration steps a sample, a wall 4.5 cm below the
 /// home) with its arm under `servo`, as the slave node makes it.
 fn panda(servo: ArmServo) -> Slave {
+    shipped("panda.toml", servo)
+}
+
+/// The shipped scenario `file` with its arm under `servo`, as the slave node makes it.
+fn shipped(file: &str, servo: ArmServo) -> Slave {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../deploy/scenarios");
-    let text = std::fs::read_to_string(dir.join("panda.toml")).expect("panda.toml");
-    let mut scenario = Scenario::from_toml_str(&text).expect("the panda scenario");
+    let text = std::fs::read_to_string(dir.join(file)).expect("the scenario");
+    let mut scenario = Scenario::from_toml_str(&text).expect("the scenario");
     if let Some(arm) = scenario.slave.arm.as_mut() {
         arm.servo = servo;
     }
     let arm = read_arm(&scenario, &dir).expect("the panda");
-    let world = tactile_slave::world::SlaveWorld::of_scenario(&scenario, &dir).expect("the wall");
+    let world = tactile_slave::world::SlaveWorld::of_scenario(&scenario, &dir).expect("the world");
     Slave::new(&scenario, arm, world).expect("the slave")
 }
 
@@ -123,7 +128,7 @@ fn step(slave: &mut Slave, n: u64) -> f64 {
         force: step.force,
     });
     let tool = step.tool[2];
-    let record = SlaveSample::Step(step, joints);
+    let record = SlaveSample::Step(step, joints, slave.world_sample());
     black_box((&record, &view));
     tool + view.arm.map_or(f64::NAN, |a| a.q[0])
 }
@@ -132,7 +137,7 @@ fn step(slave: &mut Slave, n: u64) -> f64 {
 fn hold(slave: &mut Slave) -> f64 {
     let held = slave.hold(None);
     let joints = slave.arm().joints([0.0; 3], slave.rotation());
-    let record = SlaveSample::Hold(held, joints);
+    let record = SlaveSample::Hold(held, joints, slave.world_sample());
     black_box(&record);
     held.tool[2]
 }

@@ -140,6 +140,54 @@ pub(crate) fn shared(
     })
 }
 
+/// The triangles a viewer draws for a hull or a mesh, m in the body's frame: a mesh
+/// file's own triangles (scaled), a hull's surface (the engine's convex hull of its
+/// points or its file's vertices); None for the primitives, which a viewer has shapes
+/// of. Files are read as the world reads them (`base_dir` resolves a relative one);
+/// errors name `field`.
+pub fn surface(shape: &Shape, base_dir: &Path, field: &str) -> Result<Option<Mesh>, WorldError> {
+    let hull = |pts: Vec<Point3<f64>>, f: &str| {
+        let (v, t) = guarded(f, || {
+            rapier3d_f64::parry::transformation::try_convex_hull(&pts).ok()
+        })?;
+        Ok::<_, WorldError>(Some(Mesh {
+            vertices: v.iter().map(|p| [p.x, p.y, p.z]).collect(),
+            triangles: t,
+        }))
+    };
+    match shape {
+        Shape::ConvexHull {
+            points: Some(p),
+            scale,
+            ..
+        } => {
+            let f = format!("{field}.points");
+            let scaled: Vec<[f64; 3]> = p.iter().map(|v| v.map(|x| x * scale)).collect();
+            hull(points(&scaled, &f)?, &f)
+        }
+        Shape::ConvexHull {
+            file: Some(file),
+            scale,
+            ..
+        } => {
+            let f = format!("{field}.file");
+            let m = load(file, base_dir, &f)?;
+            hull(points(&m.scaled(*scale), &f)?, &f)
+        }
+        Shape::Mesh { file, scale } => {
+            let f = format!("{field}.file");
+            let m = load(file, base_dir, &f)?;
+            let vertices = m.scaled(*scale);
+            points(&vertices, &f)?;
+            Ok(Some(Mesh {
+                vertices,
+                triangles: m.triangles,
+            }))
+        }
+        _ => Ok(None),
+    }
+}
+
 /// The collision shapes of the arm's `links` (by name, in that order) from its URDF:
 /// boxes, cylinders and spheres as they are, meshes by the file `resolve` finds for
 /// their `filename` (a `package://` path, a path relative to the URDF). A link
