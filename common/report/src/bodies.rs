@@ -178,9 +178,11 @@ impl TaskSeries {
     }
 
     /// Writes `out/task.svg`: the measure, the target line and, if it succeeded, a
-    /// band over the hold that ended at the moment of success. A run whose record holds no task state (a
+    /// band over the hold that ended at the moment of success: `completion_s`, the
+    /// slave's own count (its world's time after the step), else the first sample
+    /// the record says succeeded. A run whose record holds no task state (a
     /// record without the world) writes none and removes an old one.
-    pub fn write(&self, out: &Path, scenario: &Scenario) -> PlotResult {
+    pub fn write(&self, out: &Path, scenario: &Scenario, completion_s: Option<f64>) -> PlotResult {
         let path = out.join(TASK_PLOT);
         let Some(task) = &scenario.task else {
             return Ok(());
@@ -207,14 +209,15 @@ impl TaskSeries {
             (m.target_label, RGBColor(214, 39, 40), false, target),
         ];
         // The hold that made it a success, ending at the moment of success.
-        let (band, label) = match self.success_s {
+        let success_s = self.success_s.map(|t| completion_s.unwrap_or(t));
+        let (band, label) = match success_s {
             Some(t) => (
                 vec![((t - task.hold_s()).max(0.0), t)],
                 format!("held {} s: success at {t:.3} s", task.hold_s()),
             ),
             None => (Vec::new(), String::new()),
         };
-        let outcome = match self.success_s {
+        let outcome = match success_s {
             Some(_) => "succeeded",
             None => "did not succeed",
         };

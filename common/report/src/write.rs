@@ -501,13 +501,7 @@ fn report_into(
     analysis.finish();
     let lockstep = scenario.mode == tactile_scenario::Mode::Lockstep;
     crate::figures::write(out, &analysis, &series, lockstep)?;
-    match &progress {
-        Some(p) => p.write(out, scenario).map_err(|source| Error::Plot {
-            what: format!("plotting {}", crate::bodies::TASK_PLOT),
-            source,
-        })?,
-        None => crate::bodies::remove_task_plot(out)?,
-    }
+
     // Inputs copied into the folder are referred to relatively, so it reruns anywhere.
     let here = std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
     write_file(
@@ -515,6 +509,17 @@ fn report_into(
         &scenario.relative_to(&here).to_toml(),
     )?;
     let mut summary = summarise(scenario, runner, &analysis, &logs, launch);
+    // The moment of success as the slave's task monitor counted it.
+    let completion = summary.task.as_ref().and_then(|t| t.completion_s);
+    match &progress {
+        Some(p) => p
+            .write(out, scenario, completion)
+            .map_err(|source| Error::Plot {
+                what: format!("plotting {}", crate::bodies::TASK_PLOT),
+                source,
+            })?,
+        None => crate::bodies::remove_task_plot(out)?,
+    }
     summary.task_space = task.map(|t| t.finish());
     summary.tracking_rms_m = headline_tracking(&summary);
     summary.events.extend(warning);
