@@ -236,3 +236,72 @@ impl TaskSeries {
 pub(crate) fn remove_task_plot(out: &Path) -> Result<(), Error> {
     crate::out::remove_if_there(&out.join(TASK_PLOT))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tactile_records::slave::TaskSample;
+
+    fn push_box() -> Scenario {
+        let path =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../deploy/scenarios/push-box.toml");
+        let text = std::fs::read_to_string(path).expect("push-box.toml");
+        Scenario::from_toml_str(&text).expect("push-box")
+    }
+
+    /// A sample's rows: the tool, then each body the row holds by its name among the
+    /// moving ones; an index past them (a damaged row's) is left out.
+    #[test]
+    fn a_samples_rows_name_the_tool_and_the_moving_bodies() {
+        let names = moving_names(&push_box());
+        assert_eq!(names, ["box"]);
+        let mut w = WorldSample {
+            bodies: 2,
+            ..WorldSample::default()
+        };
+        w.poses[0].position = [0.5, -0.25, 0.125];
+        let mut line = String::new();
+        rows(&mut line, 7, &names, &w);
+        assert_eq!(
+            line,
+            "7,tool,0,0,0,0,0,0,1\n7,box,0.5,-0.25,0.125,0,0,0,1\n"
+        );
+    }
+
+    /// A task plot has a line to draw or is not written: a run whose record holds no
+    /// task state leaves no blank task.svg (an old one is removed).
+    #[test]
+    fn a_task_plot_is_drawn_from_the_record_or_not_at_all() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let scenario = push_box();
+        let path = dir.path().join(TASK_PLOT);
+        std::fs::write(&path, "old").expect("old plot");
+        let mut none = TaskSeries::of(&scenario).expect("a task");
+        none.add(0.0, None);
+        none.write(dir.path(), &scenario, None).expect("written");
+        assert!(!path.exists());
+        let mut s = TaskSeries::of(&scenario).expect("a task");
+        for n in 0..1000 {
+            let t = n as f64 * 1e-3;
+            let w = WorldSample {
+                task: Some(TaskSample {
+                    distance: 0.05 - 5e-5 * n as f64,
+                    met: n >= 800,
+                    success: n >= 900,
+                }),
+                ..WorldSample::default()
+            };
+            s.add(t, Some(&w));
+        }
+        s.write(dir.path(), &scenario, Some(0.901))
+            .expect("written");
+        let svg = std::fs::read_to_string(&path).expect("task.svg");
+        for want in [
+            "Task progress: succeeded",
+            "tolerance 10 mm",
+            "success at 0.901 s",
+        ] {
+            assert!(svg.contains(want), "{want}");
+        }
+    }
+}

@@ -243,3 +243,47 @@ pub fn link_shapes(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What a viewer draws: a hull's surface (a tetrahedron's four faces, the point
+    /// inside left out), a mesh's own triangles scaled, nothing for a primitive.
+    #[test]
+    fn a_hull_or_a_mesh_is_drawn_as_triangles_and_a_primitive_is_not() {
+        let hull = Shape::ConvexHull {
+            points: Some(vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [0.1, 0.1, 0.1],
+            ]),
+            file: None,
+            scale: 0.5,
+        };
+        let m = surface(&hull, Path::new(""), "f")
+            .expect("hull")
+            .expect("triangles");
+        assert_eq!((m.vertices.len(), m.triangles.len()), (4, 4));
+        assert!(m
+            .vertices
+            .iter()
+            .all(|v| v.iter().all(|x| (0.0..=0.5).contains(x))));
+        let dir = tempfile::tempdir().expect("tempdir");
+        let peg = Mesh::prism(6, 1.0, 2.0);
+        std::fs::write(dir.path().join("peg.obj"), crate::mesh::to_obj(&peg)).expect("write");
+        let mesh = Shape::Mesh {
+            file: "peg.obj".into(),
+            scale: 0.01,
+        };
+        let m = surface(&mesh, dir.path(), "f")
+            .expect("mesh")
+            .expect("triangles");
+        assert_eq!(m.triangles, peg.triangles);
+        assert_eq!(m.vertices, peg.scaled(0.01));
+        let ball = Shape::Sphere { radius: 0.1 };
+        assert_eq!(surface(&ball, dir.path(), "f").expect("ball"), None);
+    }
+}
