@@ -279,7 +279,7 @@ fn a_block_renumbered_far_ahead_costs_its_rows_and_the_text_says_so() {
     let mut all = entries::<SlaveSample, SlaveTotals>(&rec);
     let mut moved = 0;
     for e in &mut all {
-        if let Record::Sample(SlaveSample::Step(s, _)) = e {
+        if let Record::Sample(SlaveSample::Step(s, ..)) = e {
             if (25..50).contains(&s.n) {
                 s.n += 1_000_000;
                 moved += 1;
@@ -397,7 +397,7 @@ fn a_jump_of_the_masters_spine_holds_no_rows_in_between() {
     let row = first_row(&all);
     let between = (0..JUMP).map(|n| {
         let mut r = row.clone();
-        if let SlaveSample::Step(s, _) = &mut r {
+        if let SlaveSample::Step(s, ..) = &mut r {
             s.n = n;
         }
         Record::Sample(r)
@@ -441,7 +441,7 @@ fn a_start_claiming_more_samples_lifts_no_limit() {
         }
     }
     let mut row = first_row(&all);
-    if let SlaveSample::Step(s, _) = &mut row {
+    if let SlaveSample::Step(s, ..) = &mut row {
         s.n = 1_000_000_000;
     }
     all.insert(all.len() - 1, Record::Sample(row));

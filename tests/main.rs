@@ -10,6 +10,7 @@ mod arm;
 mod bad_input;
 mod bench;
 mod bilateral;
+mod bodies;
 mod chain;
 mod channels;
 mod cli;

@@ -120,9 +120,14 @@ TYPES = {
     "/master/felt": "geometry_msgs/msg/WrenchStamped",
     "/slave/environment": "visualization_msgs/msg/MarkerArray",
     "/tactile/timing": "tactile_msgs/msg/SampleTiming",
+    # A physics world's bodies: none in the analytic scenes this script reads
+    # (tests/mcap_bodies_check.py reads a physics run's).
+    "/slave/bodies": "visualization_msgs/msg/MarkerArray",
 }
 ONCE = ("/robot_description", "/tf_static")
-PER_SAMPLE = tuple(t for t in TYPES if t not in ONCE and t != "/slave/environment")
+NONE = ("/slave/bodies",)
+PER_SAMPLE = tuple(t for t in TYPES
+                   if t not in ONCE and t not in NONE and t != "/slave/environment")
 
 SAMPLE_TIMING = "tactile_msgs/msg/SampleTiming"
 SAMPLE_TIMING_MSG = """uint64 sample
@@ -538,7 +543,7 @@ def run(args):
         # Counts, from the statistics first (checked against the messages read below).
         for topic, ch in by_topic.items():
             want = (1 if topic in ONCE else len(env_rows) if topic == "/slave/environment"
-                    else rows)
+                    else 0 if topic in NONE else rows)
             got = summary.statistics.channel_message_counts.get(ch.id, 0)
             if got != want:
                 what = ("" if topic in ONCE else " (first sample and every n % rate_hz == 0)"
@@ -676,6 +681,8 @@ class Checks:
         k = self.count[topic]
         self.count[topic] += 1
         self.logs[topic].append(log_time)
+        if topic in NONE:
+            fail(f"{topic}: a message in an analytic scene's recording")
         if topic == "/slave/environment":
             if k >= len(self.env_rows):
                 fail(f"/slave/environment: more than the {len(self.env_rows)} messages expected")
@@ -688,7 +695,7 @@ class Checks:
 
     def finish(self, first_log):
         for topic in TYPES:
-            if topic in ONCE:
+            if topic in ONCE or topic in NONE:
                 continue
             want = len(self.env_rows) if topic == "/slave/environment" else len(self.trace.rows)
             if self.count[topic] != want:

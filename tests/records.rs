@@ -76,7 +76,7 @@ fn a_torn_record_appended_to_keeps_every_whole_frame_of_both_segments() {
     let steps: Vec<u64> = after
         .iter()
         .filter_map(|r| match r {
-            Record::Sample(SlaveSample::Step(s, _)) => Some(s.n),
+            Record::Sample(SlaveSample::Step(s, ..)) => Some(s.n),
             _ => None,
         })
         .collect();

@@ -212,7 +212,7 @@ impl Follower for SlaveHandler {
             tool: step.tool,
             force: step.force,
         });
-        out.record = Some(SlaveSample::Step(step, joints));
+        out.record = Some(SlaveSample::Step(step, joints, self.slave.world_sample()));
         Ok(())
     }
 
@@ -258,6 +258,10 @@ impl Follower for SlaveHandler {
             io.event(last, &e)?;
         }
         let joints = self.slave.arm().joints([0.0; 3], self.slave.rotation());
-        Ok(Some(SlaveSample::Hold(held, joints)))
+        Ok(Some(SlaveSample::Hold(
+            held,
+            joints,
+            self.slave.world_sample(),
+        )))
     }
 }

@@ -127,6 +127,12 @@ impl Slave {
         self.world.counters()
     }
 
+    /// A physics world's state after the last step, for the record (None for the
+    /// analytic scene).
+    pub fn world_sample(&self) -> Option<tactile_records::slave::WorldSample> {
+        self.world.sample()
+    }
+
     /// What the physics world said went wrong since the last call, as text.
     pub fn take_events(&mut self) -> std::vec::Drain<'_, String> {
         self.events.drain(..)

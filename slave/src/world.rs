@@ -12,8 +12,11 @@
 
 use crate::environment::Scene;
 use std::path::Path;
-use tactile_records::slave::{TaskResult, WorldCounters};
-use tactile_scenario::world::Engine;
+use tactile_records::slave::{
+    BodyPose, TaskResult, TaskSample, WorldCounters, WorldSample, BODIES_PER_SAMPLE,
+    JOINTS_PER_SAMPLE,
+};
+use tactile_scenario::world::{BodyKind, Engine};
 use tactile_scenario::{Change, Scenario};
 use tactile_world::{PhysicsWorld, Pose, TaskMonitor, TaskProgress, ToolState, World, WorldError};
 
@@ -50,7 +53,14 @@ impl SlaveWorld {
                     .task
                     .as_ref()
                     .and_then(|t| TaskMonitor::new(t, &world));
-                SlaveWorld::Physics(Box::new(Physics::new(world, task)))
+                let moving = env
+                    .bodies
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, b)| b.kind != BodyKind::Static)
+                    .map(|(k, _)| k)
+                    .collect();
+                SlaveWorld::Physics(Box::new(Physics::new(world, task, moving)))
             }
         })
     }
@@ -68,6 +78,15 @@ impl SlaveWorld {
     pub fn apply(&mut self, c: &Change) {
         if let SlaveWorld::Analytic(scene) = self {
             scene.apply(c);
+        }
+    }
+
+    /// A physics world's state after the last sample, for the record (None for the
+    /// analytic scene).
+    pub fn sample(&self) -> Option<WorldSample> {
+        match self {
+            SlaveWorld::Analytic(_) => None,
+            SlaveWorld::Physics(p) => Some(p.sample),
         }
     }
 
@@ -117,11 +136,17 @@ pub struct Physics {
     ramped_steps: u64,
     /// The task's outcome so far (the world counts its own faults).
     task_result: Option<TaskResult>,
+    /// The moving (dynamic and kinematic) bodies: indices into the world's bodies.
+    moving: Vec<usize>,
+    /// The world after the last sample, as the record holds it.
+    sample: WorldSample,
 }
 
 impl Physics {
-    fn new(world: PhysicsWorld, task: Option<TaskMonitor>) -> Physics {
+    fn new(world: PhysicsWorld, task: Option<TaskMonitor>, moving: Vec<usize>) -> Physics {
         Physics {
+            moving,
+            sample: WorldSample::default(),
             world,
             task_result: task.as_ref().map(|_| TaskResult::default()),
             task,
@@ -163,6 +188,7 @@ impl Physics {
         let progress = self.task.as_mut().map(|t| t.update(sensed, time_s));
         self.ramp(fault, dt);
         self.record(progress);
+        self.keep();
         let g = self.gain;
         Felt {
             force: [0, 1, 2].map(|k| g * self.held[k]),
@@ -184,6 +210,36 @@ impl Physics {
         if self.gain < 1.0 {
             self.ramped_steps += 1;
         }
+    }
+
+    /// The world's state after this sample into [`Physics::sample`]: the tool, the
+    /// next turn of the moving bodies (all of them each sample up to
+    /// [`BODIES_PER_SAMPLE`]) and of the joints, and the task. Allocates nothing.
+    fn keep(&mut self) {
+        let sensed = self.world.sensed();
+        let w = &mut self.sample;
+        w.tool = pose(&sensed.tool);
+        let first = next_turn(w.first_body, w.bodies, self.moving.len());
+        let bodies = &self.moving[first..(first + BODIES_PER_SAMPLE).min(self.moving.len())];
+        for (slot, &k) in w.poses.iter_mut().zip(bodies) {
+            *slot = sensed.poses.get(k).map_or_else(BodyPose::default, pose);
+        }
+        w.first_body = first as u32;
+        w.bodies = bodies.len() as u32;
+        let q = &sensed.joint_positions;
+        let first = next_turn(w.first_joint, w.joints, q.len());
+        let joints = &q[first..(first + JOINTS_PER_SAMPLE).min(q.len())];
+        w.joint_positions[..joints.len()].copy_from_slice(joints);
+        w.first_joint = first as u32;
+        w.joints = joints.len() as u32;
+        w.task = self.task.as_ref().map(|t| {
+            let p = t.progress();
+            TaskSample {
+                distance: p.distance,
+                met: p.met,
+                success: p.success,
+            }
+        });
     }
 
     /// The task's outcome after this sample's `progress`.
@@ -214,5 +270,40 @@ impl Physics {
             ramped_steps: self.ramped_steps,
             task: self.task_result,
         }
+    }
+}
+
+/// A world's pose as the record holds it.
+fn pose(p: &Pose) -> BodyPose {
+    BodyPose {
+        position: p.position,
+        rotation: p.rotation,
+    }
+}
+
+/// Where the next turn of `of` items starts after the turn that started at `first`
+/// and held `held`: on from there, back to 0 past the end (a world whose items all fit
+/// in one turn starts at 0 every sample).
+fn next_turn(first: u32, held: u32, of: usize) -> usize {
+    let next = first as usize + held as usize;
+    if held == 0 || next >= of {
+        0
+    } else {
+        next
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::next_turn;
+
+    /// Twenty moving bodies go in turns of 16 then 4; five all at once every sample.
+    #[test]
+    fn the_moving_bodies_are_recorded_in_turns() {
+        assert_eq!(next_turn(0, 0, 20), 0);
+        assert_eq!(next_turn(0, 16, 20), 16);
+        assert_eq!(next_turn(16, 4, 20), 0);
+        assert_eq!(next_turn(0, 5, 5), 0);
+        assert_eq!(next_turn(0, 0, 0), 0);
     }
 }

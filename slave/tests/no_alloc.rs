@@ -13,7 +13,6 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::hint::black_box;
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
 use tactile_messages::samples::{Flags, Forward, Signal};
 use tactile_records::slave::SlaveSample;
 use tactile_ros::view::SlaveView;
@@ -24,15 +23,16 @@ use tactile_slave::peripherals::read_arm;
 /// The system's allocator, counting the allocations of a thread that asked for it.
 struct Counting;
 
-static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
-
 thread_local! {
     static COUNTING: Cell<bool> = const { Cell::new(false) };
+    // Per thread, as the flag: a count shared by the test threads took in another
+    // test's allocations when two ran at once.
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
 }
 
 fn count() {
     if COUNTING.with(Cell::get) {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        ALLOCATIONS.with(|a| a.set(a.get() + 1));
     }
 }
 
@@ -60,11 +60,11 @@ static GLOBAL: Counting = Counting;
 
 /// How many allocations `f` makes on this thread.
 fn allocations(f: impl FnOnce()) -> u64 {
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = ALLOCATIONS.with(Cell::get);
     COUNTING.with(|c| c.set(true));
     f();
     COUNTING.with(|c| c.set(false));
-    ALLOCATIONS.load(Ordering::Relaxed) - before
+    ALLOCATIONS.with(Cell::get) - before
 }
 
 /// The paper master's home, where the operator of `panda.toml` starts.
@@ -73,14 +73,19 @@ const HOME: [f64; 3] = [0.0, -0.107, -0.035];
 /// The shipped Panda scenario (4 integration steps a sample, a wall 4.5 cm below the
 /// home) with its arm under `servo`, as the slave node makes it.
 fn panda(servo: ArmServo) -> Slave {
+    shipped("panda.toml", servo)
+}
+
+/// The shipped scenario `file` with its arm under `servo`, as the slave node makes it.
+fn shipped(file: &str, servo: ArmServo) -> Slave {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../deploy/scenarios");
-    let text = std::fs::read_to_string(dir.join("panda.toml")).expect("panda.toml");
-    let mut scenario = Scenario::from_toml_str(&text).expect("the panda scenario");
+    let text = std::fs::read_to_string(dir.join(file)).expect("the scenario");
+    let mut scenario = Scenario::from_toml_str(&text).expect("the scenario");
     if let Some(arm) = scenario.slave.arm.as_mut() {
         arm.servo = servo;
     }
     let arm = read_arm(&scenario, &dir).expect("the panda");
-    let world = tactile_slave::world::SlaveWorld::of_scenario(&scenario, &dir).expect("the wall");
+    let world = tactile_slave::world::SlaveWorld::of_scenario(&scenario, &dir).expect("the world");
     Slave::new(&scenario, arm, world).expect("the slave")
 }
 
@@ -123,7 +128,7 @@ fn step(slave: &mut Slave, n: u64) -> f64 {
         force: step.force,
     });
     let tool = step.tool[2];
-    let record = SlaveSample::Step(step, joints);
+    let record = SlaveSample::Step(step, joints, slave.world_sample());
     black_box((&record, &view));
     tool + view.arm.map_or(f64::NAN, |a| a.q[0])
 }
@@ -132,7 +137,7 @@ fn step(slave: &mut Slave, n: u64) -> f64 {
 fn hold(slave: &mut Slave) -> f64 {
     let held = slave.hold(None);
     let joints = slave.arm().joints([0.0; 3], slave.rotation());
-    let record = SlaveSample::Hold(held, joints);
+    let record = SlaveSample::Hold(held, joints, slave.world_sample());
     black_box(&record);
     held.tool[2]
 }
@@ -172,4 +177,37 @@ fn the_arms_whole_step_allocates_nothing_once_warm() {
         let n = allocations_in_500_samples(servo);
         assert_eq!(n, 0, "{servo:?} servo: {n} allocations in 500 samples");
     }
+}
+
+/// Issue 67: a physics world's state in the slave's record (the moving bodies' poses,
+/// the tool body, the task) is inline and bounded: taking it and making the step's
+/// record allocate nothing, every sample of a push. (The engine's own step is counted
+/// apart and printed: rapier allocates in it.)
+#[test]
+fn a_physics_worlds_record_allocates_nothing() {
+    let mut slave = shipped("panda-push-box.toml", ArmServo::Joint);
+    let (mut in_step, mut in_record) = (0, 0);
+    for n in 0..500 {
+        let mut h = None;
+        let mut step = None;
+        in_step += allocations(|| step = Some(slave.step(&forward(n), &mut h)));
+        let step = step.expect("stepped");
+        let joints = slave.arm().joints([0.0; 3], slave.rotation());
+        in_record += allocations(|| {
+            let record = SlaveSample::Step(step, joints, slave.world_sample());
+            black_box(&record);
+        });
+    }
+    let world = slave.world_sample().expect("a physics world");
+    assert_eq!(
+        (world.bodies, world.first_body),
+        (1, 0),
+        "the box, every sample"
+    );
+    assert!(world.task.is_some());
+    assert_eq!(
+        in_record, 0,
+        "{in_record} allocations in 500 samples' records"
+    );
+    println!("the physics step: {in_step} allocations in 500 samples");
 }

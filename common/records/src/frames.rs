@@ -14,7 +14,7 @@ use std::path::Path;
 use thiserror::Error;
 
 /// First bytes of every record file; the last byte is the format version.
-pub const MAGIC: [u8; 8] = *b"TACTREC\x12";
+pub const MAGIC: [u8; 8] = *b"TACTREC\x13";
 /// The first bytes of every frame: where a reader picks up again after damage.
 pub const SYNC: [u8; 4] = [0xA5, b'T', b'F', 0x5A];
 /// Bytes before a frame's body: sync, length, checksum.

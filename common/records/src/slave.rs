@@ -137,6 +137,92 @@ pub struct ArmJoints {
     pub released: bool,
 }
 
+/// Moving bodies' poses one sample's record holds at most: a world of more moving
+/// bodies records them in turns (`ceil(n / BODIES_PER_SAMPLE)` samples for all), so a
+/// record's row keeps one bounded, inline size whatever the scene.
+pub const BODIES_PER_SAMPLE: usize = 16;
+
+/// Joints' positions one sample's record holds at most (in turns beyond, as bodies).
+pub const JOINTS_PER_SAMPLE: usize = 8;
+
+/// A body's pose in the world's frame (the arm's base frame; the paper's arm: the
+/// paper's frame): its centre, m, and orientation `[x, y, z, w]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BodyPose {
+    /// Centre, m.
+    pub position: [f64; 3],
+    /// Orientation, `[x, y, z, w]`.
+    pub rotation: [f64; 4],
+}
+
+impl Default for BodyPose {
+    fn default() -> Self {
+        BodyPose {
+            position: [0.0; 3],
+            rotation: [0.0, 0.0, 0.0, 1.0],
+        }
+    }
+}
+
+/// The task's state after a sample (`[task]`): what `TaskMonitor` measured.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct TaskSample {
+    /// Distance to the goal (m; rad or m for a joint), 0 or less when met.
+    pub distance: f64,
+    /// Whether the goal is met in this sample.
+    pub met: bool,
+    /// Whether the task has succeeded (met and held) by this sample.
+    pub success: bool,
+}
+
+/// A physics world after a sample (`engine = "physics"`): the tool body's pose, the
+/// moving (dynamic and kinematic) bodies' poses in the order of
+/// `[[environment.bodies]]` with the static ones left out (they never move: the
+/// scenario places them), the joints' positions, and the task's state. Inline and
+/// bounded ([`BODIES_PER_SAMPLE`], [`JOINTS_PER_SAMPLE`]): making one allocates
+/// nothing. Rows that hold no world (the analytic scene) carry none.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct WorldSample {
+    /// The tool body's pose (where the coupling pulled it, not the arm's tool frame).
+    pub tool: BodyPose,
+    /// Index among the moving bodies of `poses[0]`.
+    pub first_body: u32,
+    /// How many of `poses` hold a body.
+    pub bodies: u32,
+    /// The moving bodies' poses from `first_body` on.
+    pub poses: [BodyPose; BODIES_PER_SAMPLE],
+    /// Index among `[[environment.joints]]` of `joint_positions[0]`.
+    pub first_joint: u32,
+    /// How many of `joint_positions` hold a joint.
+    pub joints: u32,
+    /// The joints' positions from the start (rad or m).
+    pub joint_positions: [f64; JOINTS_PER_SAMPLE],
+    /// The task's state, if the scenario has a `[task]`.
+    pub task: Option<TaskSample>,
+}
+
+impl WorldSample {
+    /// The moving bodies this sample holds: (index among the moving bodies, pose).
+    pub fn poses(&self) -> impl Iterator<Item = (usize, &BodyPose)> {
+        let n = (self.bodies as usize).min(BODIES_PER_SAMPLE);
+        let first = self.first_body as usize;
+        self.poses[..n]
+            .iter()
+            .enumerate()
+            .map(move |(k, p)| (first + k, p))
+    }
+
+    /// The joints this sample holds: (index among the joints, position).
+    pub fn joint_positions(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let n = (self.joints as usize).min(JOINTS_PER_SAMPLE);
+        let first = self.first_joint as usize;
+        self.joint_positions[..n]
+            .iter()
+            .enumerate()
+            .map(move |(k, q)| (first + k, *q))
+    }
+}
+
 /// One entry per step the slave took, with the arm's state after it. A sample lives
 /// for one write or one read, and is made on every step: nothing in it is boxed, so
 /// making one allocates nothing (a hold is as large as a step: the arm's state is
@@ -144,17 +230,17 @@ pub struct ArmJoints {
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum SlaveSample {
-    /// A step on v(n).
-    Step(Step, ArmJoints),
-    /// A step holding position.
-    Hold(HoldStep, ArmJoints),
+    /// A step on v(n), with a physics world's state after it.
+    Step(Step, ArmJoints, Option<WorldSample>),
+    /// A step holding position (a physics world steps on while the input is silent).
+    Hold(HoldStep, ArmJoints, Option<WorldSample>),
 }
 
 impl SlaveSample {
     /// The step on v(n), if this is one.
     pub fn step(&self) -> Option<&Step> {
         match self {
-            SlaveSample::Step(s, _) => Some(s),
+            SlaveSample::Step(s, ..) => Some(s),
             SlaveSample::Hold(..) => None,
         }
     }
@@ -162,7 +248,14 @@ impl SlaveSample {
     /// The arm after the step, whichever it was.
     pub fn joints(&self) -> &ArmJoints {
         match self {
-            SlaveSample::Step(_, j) | SlaveSample::Hold(_, j) => j,
+            SlaveSample::Step(_, j, _) | SlaveSample::Hold(_, j, _) => j,
+        }
+    }
+
+    /// A physics world's state after the step, if the slave steps one.
+    pub fn world(&self) -> Option<&WorldSample> {
+        match self {
+            SlaveSample::Step(.., w) | SlaveSample::Hold(.., w) => w.as_ref(),
         }
     }
 }
@@ -245,14 +338,16 @@ mod tests {
             ..Step::default()
         };
         for sample in [
-            SlaveSample::Step(step, j),
+            SlaveSample::Step(step, j, None),
             SlaveSample::Hold(
                 HoldStep {
                     step: 7,
                     tool: [0.1; 3],
                 },
                 j,
+                None,
             ),
+            SlaveSample::Step(step, j, Some(world())),
         ] {
             let config = bincode::config::standard();
             let bytes = bincode::serde::encode_to_vec(&sample, config).expect("encode");
@@ -261,5 +356,40 @@ mod tests {
             assert_eq!(back, sample);
             assert_eq!(back.joints().q.len(), 3);
         }
+    }
+
+    fn world() -> WorldSample {
+        let mut w = WorldSample {
+            first_body: 16,
+            bodies: 2,
+            first_joint: 0,
+            joints: 1,
+            task: Some(TaskSample {
+                distance: 0.25,
+                met: false,
+                success: true,
+            }),
+            ..WorldSample::default()
+        };
+        w.poses[0].position = [0.1, -0.2, 0.3];
+        w.poses[1].rotation = [0.0, 0.0, 0.6, 0.8];
+        w.joint_positions[0] = -0.5;
+        w
+    }
+
+    /// A world's row names its bodies by their index among the moving ones, from
+    /// `first_body`, and only as many as it holds (a crafted count past the array is
+    /// cut to it).
+    #[test]
+    fn a_world_sample_hands_out_the_bodies_it_holds() {
+        let mut w = world();
+        let held: Vec<usize> = w.poses().map(|(k, _)| k).collect();
+        assert_eq!(held, [16, 17]);
+        assert_eq!(w.poses().nth(1).map(|(_, p)| p.rotation[3]), Some(0.8));
+        assert_eq!(w.joint_positions().collect::<Vec<_>>(), [(0, -0.5)]);
+        w.bodies = u32::MAX;
+        w.joints = u32::MAX;
+        assert_eq!(w.poses().count(), BODIES_PER_SAMPLE);
+        assert_eq!(w.joint_positions().count(), JOINTS_PER_SAMPLE);
     }
 }

@@ -8,6 +8,8 @@
 
 pub mod analysis;
 pub mod arm_scene;
+pub mod bodies;
+pub mod body_scene;
 pub mod columns;
 pub mod error;
 pub mod figures;

@@ -21,7 +21,7 @@ mod timeplot;
 pub(crate) use looks::{draw_legend, draw_line, look};
 pub use percentiles::percentile_plot;
 use stretches::Stretches;
-pub(crate) use timeplot::tick;
+pub(crate) use timeplot::{tick, time_series};
 
 /// Why a plot could not be drawn: plotters' fault (its SVG backend's, or an element's),
 /// or the file's.

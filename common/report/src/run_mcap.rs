@@ -8,6 +8,8 @@
 //! stage was not passed. Header stamps are the log time.
 
 use crate::arm_scene::ArmScene;
+use crate::body_scene::BodyScene;
+use crate::join::Joined;
 use crate::mcap::McapWriter;
 use crate::trace::TraceRow;
 use std::io::{self, Write};
@@ -39,6 +41,8 @@ pub struct Recording<W: Write> {
     /// The slave as a URDF arm, with its joints' last values and the sample they
     /// came from (the velocities' previous values); None for the paper's arm.
     arm: Option<(ArmScene, Vec<f64>, Option<Joints>)>,
+    /// A physics world's bodies (`engine = "physics"`).
+    bodies: Option<BodyScene>,
     rate_hz: u64,
     t_s_ns: f64,
     /// Lockstep: log times are nominal, `n t_s` after the first sample's tick.
@@ -55,8 +59,14 @@ impl<W: Write> Recording<W> {
         self.mcap.compress_with(c);
     }
 
-    /// Starts the file with a channel per topic; `arm` draws a URDF slave.
-    pub fn new(out: W, scenario: &Scenario, arm: Option<ArmScene>) -> io::Result<Self> {
+    /// Starts the file with a channel per topic; `arm` draws a URDF slave, `bodies`
+    /// a physics world (in the frame the arm is drawn in: [`Recording::frame`]).
+    pub fn new(
+        out: W,
+        scenario: &Scenario,
+        arm: Option<ArmScene>,
+        bodies: Option<BodyScene>,
+    ) -> io::Result<Self> {
         let geometry = scenario.device.geometry().map_err(io::Error::other)?;
         let library = concat!("tactile ", env!("CARGO_PKG_VERSION"));
         let mut mcap = McapWriter::new(out, "ros2", library)?;
@@ -87,6 +97,7 @@ impl<W: Write> Recording<W> {
                     .map_or_else(Vec::new, |c| c.home.clone());
                 (a, home, None)
             }),
+            bodies,
             rate_hz: (scenario.rate_hz.round() as u64).max(1),
             t_s_ns: scenario.t_s() * 1e9,
             nominal: (scenario.mode == Mode::Lockstep).then_some(None),
@@ -117,18 +128,18 @@ impl<W: Write> Recording<W> {
 
     /// Adds one sample's messages; `joints` are a URDF arm's (a row without them
     /// draws the arm where it last was).
-    pub fn add(
-        &mut self,
-        row: &TraceRow,
-        joints: Option<&ArmJoints>,
-        rotation: Option<[f64; 4]>,
-    ) -> io::Result<()> {
+    pub fn add(&mut self, row: &TraceRow, joined: &Joined) -> io::Result<()> {
+        let (joints, rotation) = (joined.joints, joined.rotation);
         let log = self.log_time(row);
         if self.prev.is_none() {
             self.first(log)?;
         }
         if row.n.is_multiple_of(self.rate_hz) || self.prev.is_none() {
             self.environment(log)?;
+        }
+        if let (Some(scene), Some(w)) = (self.bodies.as_mut(), joined.world) {
+            let markers = scene.moving(w, log);
+            self.put(view::SLAVE_BODIES, &MarkerArray { markers }, log, log)?;
         }
         let (vm, vs) = self.velocities(row);
         let arm_velocity = self.arm_velocity(row.n, joints);
@@ -259,7 +270,7 @@ impl<W: Write> Recording<W> {
     /// The objects, in the paper slave's base frame or a URDF arm's (where the map
     /// from the loop puts them).
     fn environment(&mut self, log: u64) -> io::Result<()> {
-        let markers = self
+        let mut markers: Vec<Marker> = self
             .objects
             .iter()
             .enumerate()
@@ -268,6 +279,9 @@ impl<W: Write> Recording<W> {
                 None => marker(o, view::SLAVE_BASE, k as i32, log),
             })
             .collect();
+        if let Some(b) = &self.bodies {
+            markers.extend(b.fixed(log));
+        }
         self.put(view::SLAVE_ENVIRONMENT, &MarkerArray { markers }, log, log)
     }
 
@@ -331,17 +345,29 @@ pub fn create(
     scenario: &Scenario,
     compression: crate::mcap::Compression,
 ) -> io::Result<(FileRecording, Option<String>)> {
-    let (arm, warning) = match ArmScene::of_scenario(scenario) {
+    let (arm, mut warning) = match ArmScene::of_scenario(scenario) {
         Ok(arm) => (arm, None),
         Err(e) => (
             None,
             Some(format!("run.mcap: the slave arm is not drawn: {e}")),
         ),
     };
+    let frame = frame(arm.as_ref());
+    let bodies = BodyScene::of(scenario, frame).unwrap_or_else(|e| {
+        warning.get_or_insert(format!("run.mcap: the world's bodies are not drawn: {e}"));
+        None
+    });
     let f = std::fs::File::create(dir.join(format!("{FILE}.partial")))?;
-    let mut rec = Recording::new(std::io::BufWriter::with_capacity(1 << 16, f), scenario, arm)?;
+    let w = std::io::BufWriter::with_capacity(1 << 16, f);
+    let mut rec = Recording::new(w, scenario, arm, bodies)?;
     rec.compress_with(compression);
     Ok((rec, warning))
+}
+
+/// The frame a physics world's bodies are drawn in: the arm's base (the world's
+/// frame is the arm's): the paper slave's `slave_base`, or a URDF arm's base link.
+pub fn frame(arm: Option<&ArmScene>) -> &str {
+    arm.map_or(view::SLAVE_BASE, |a| a.base.as_str())
 }
 
 /// A transform as `/tf` carries it.
@@ -396,6 +422,7 @@ fn marker(o: &Object, frame: &str, id: i32, log: u64) -> Marker {
         orientation,
         scale,
         color: [0.6, 0.6, 0.65, 0.5],
+        points: Vec::new(),
     }
 }
 

@@ -6,7 +6,6 @@ use crate::summary::JOINTS_FILE;
 use crate::{run_mcap, trace, Error};
 use std::io::Write as _;
 use std::path::Path;
-use tactile_records::slave::ArmJoints;
 use tactile_scenario::Scenario;
 
 /// The Parquet trace's file name.
@@ -72,6 +71,8 @@ pub(crate) struct Streams {
     /// A URDF arm's joints, one row a sample (`[slave.arm]`).
     joints: Option<std::io::BufWriter<std::fs::File>>,
     recording: Option<run_mcap::FileRecording>,
+    /// A physics world's moving bodies, rows a sample (`engine = "physics"`).
+    bodies: Option<crate::bodies::BodiesCsv>,
     /// Why the recording leaves something out, for the summary's events.
     pub(crate) warning: Option<String>,
     line: String,
@@ -97,11 +98,13 @@ impl Streams {
         if want.no_trace {
             let _ = std::fs::remove_file(out.join(run_mcap::FILE));
             let _ = std::fs::remove_file(out.join(JOINTS_FILE));
+            let _ = std::fs::remove_file(out.join(crate::bodies::BODIES_FILE));
             return Ok(Streams {
                 trace: None,
                 parquet: None,
                 joints: None,
                 recording: None,
+                bodies: None,
                 warning: None,
                 line: String::new(),
                 t0: None,
@@ -136,11 +139,13 @@ impl Streams {
                 None
             }
         };
+        let bodies = crate::bodies::BodiesCsv::create(out, scenario)?;
         Ok(Streams {
             trace,
             parquet,
             joints,
             recording: Some(recording),
+            bodies,
             warning,
             line: String::with_capacity(2048),
             t0: None,
@@ -150,10 +155,12 @@ impl Streams {
     pub(crate) fn add(
         &mut self,
         row: &trace::TraceRow,
-        joints: Option<&ArmJoints>,
-        rotation: Option<[f64; 4]>,
+        joined: &crate::join::Joined,
     ) -> Result<(), Error> {
-        if let (Some(w), Some(j)) = (self.joints.as_mut(), joints) {
+        if let (Some(b), Some(w)) = (self.bodies.as_mut(), joined.world) {
+            b.add(row.n, w)?;
+        }
+        if let (Some(w), Some(j)) = (self.joints.as_mut(), joined.joints) {
             self.line.clear();
             crate::joints::row(&mut self.line, row.n, j);
             w.write_all(self.line.as_bytes())
@@ -171,14 +178,16 @@ impl Streams {
                 .map_err(Error::io("writing trace.csv"))?;
         }
         if let Some(r) = self.recording.as_mut() {
-            r.add(row, joints, rotation)
-                .map_err(Error::io("writing run.mcap"))?;
+            r.add(row, joined).map_err(Error::io("writing run.mcap"))?;
         }
         Ok(())
     }
 
     /// Flushes the trace and gives the recording its name.
     pub(crate) fn finish(self, out: &Path) -> Result<(), Error> {
+        if let Some(b) = self.bodies {
+            b.finish(out)?;
+        }
         if let Some(mut w) = self.joints {
             let path = out.join(JOINTS_FILE);
             w.flush()

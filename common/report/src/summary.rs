@@ -17,11 +17,12 @@ use tactile_scenario::Mode;
 pub const JOINTS_FILE: &str = "joints.csv";
 
 /// Files a report writes into its folder.
-pub const REPORT_FILES: [&str; 13] = [
+pub const REPORT_FILES: [&str; 15] = [
     "summary.json",
     "trace.csv",
     "trace.parquet",
     JOINTS_FILE,
+    crate::bodies::BODIES_FILE,
     "run.mcap",
     "round_trip.hgrm",
     "overhead.hgrm",
@@ -30,6 +31,7 @@ pub const REPORT_FILES: [&str; 13] = [
     "positions.svg",
     "forces.svg",
     "passivity.svg",
+    crate::bodies::TASK_PLOT,
     "scenario.toml",
 ];
 

@@ -477,8 +477,10 @@ fn report_into(
     let warning = streams.warning.clone();
     let stopped = || launch.stopped();
     let mut task = crate::task_space::TaskSpaceSums::of(scenario);
+    let mut progress = crate::bodies::TaskSeries::of(scenario);
     let arm = join::Arm::of(scenario);
-    let logs = join::join_until(dirs, &stopped, arm, |row, joints, rotation| {
+    let logs = join::join_until(dirs, &stopped, arm, |row, j| {
+        let joints = j.joints;
         // The clutch's offset, from the arm's base frame into the master's.
         if let (Some(arm), Some(j)) = (&scenario.slave.arm, joints) {
             let shift = arm.shift_to_master(j.offset);
@@ -489,13 +491,17 @@ fn report_into(
             t.add(row, j);
         }
         series.add(row, t_s);
-        streams.add(row, joints, rotation)?;
+        if let Some(p) = progress.as_mut() {
+            p.add(row.n as f64 * t_s, j.world);
+        }
+        streams.add(row, j)?;
         Ok(ControlFlow::Continue(()))
     })?;
     streams.finish(out)?;
     analysis.finish();
     let lockstep = scenario.mode == tactile_scenario::Mode::Lockstep;
     crate::figures::write(out, &analysis, &series, lockstep)?;
+
     // Inputs copied into the folder are referred to relatively, so it reruns anywhere.
     let here = std::fs::canonicalize(out).unwrap_or_else(|_| out.to_path_buf());
     write_file(
@@ -503,6 +509,17 @@ fn report_into(
         &scenario.relative_to(&here).to_toml(),
     )?;
     let mut summary = summarise(scenario, runner, &analysis, &logs, launch);
+    // The moment of success as the slave's task monitor counted it.
+    let completion = summary.task.as_ref().and_then(|t| t.completion_s);
+    match &progress {
+        Some(p) => p
+            .write(out, scenario, completion)
+            .map_err(|source| Error::Plot {
+                what: format!("plotting {}", crate::bodies::TASK_PLOT),
+                source,
+            })?,
+        None => crate::bodies::remove_task_plot(out)?,
+    }
     summary.task_space = task.map(|t| t.finish());
     summary.tracking_rms_m = headline_tracking(&summary);
     summary.events.extend(warning);
@@ -547,10 +564,9 @@ pub fn write_mcap(
 
     let mut samples = 0;
     let arm = join::Arm::of(&scenario);
-    let logs = join::join_until(dirs, stop, arm, |row, joints, rotation| {
+    let logs = join::join_until(dirs, stop, arm, |row, j| {
         samples += 1;
-        rec.add(row, joints, rotation)
-            .map_err(Error::io("writing run.mcap"))?;
+        rec.add(row, j).map_err(Error::io("writing run.mcap"))?;
         Ok(ControlFlow::Continue(()))
     })
     .inspect_err(|_| run_mcap::discard(out))?;

@@ -372,6 +372,9 @@ pub struct Marker {
     pub scale: [f64; 3],
     /// RGBA, 0 to 1.
     pub color: [f32; 4],
+    /// A [`Marker::TRIANGLE_LIST`]'s corners, three a triangle, m in the marker's
+    /// frame (empty for the other shapes).
+    pub points: Vec<[f64; 3]>,
 }
 
 impl Marker {
@@ -379,6 +382,10 @@ impl Marker {
     pub const CUBE: i32 = 1;
     /// A sphere (an ellipsoid by `scale`).
     pub const SPHERE: i32 = 2;
+    /// A cylinder along z (`scale`: diameters in x and y, length in z).
+    pub const CYLINDER: i32 = 3;
+    /// Triangles, `points` three a triangle (scaled by `scale`).
+    pub const TRIANGLE_LIST: i32 = 11;
 
     fn encode(&self, w: &mut CdrWriter) {
         self.header.encode(w);
@@ -392,7 +399,8 @@ impl Marker {
         self.color.iter().for_each(|c| w.f32(*c));
         Time::default().encode(w); // lifetime 0: forever
         w.bool(false); // frame_locked
-        w.seq_len(0); // points
+        w.seq_len(self.points.len());
+        self.points.iter().for_each(|p| vec3(w, p));
         w.seq_len(0); // colors
         w.string(""); // texture_resource
         Header::default().encode(w); // texture: header, format, data

@@ -35,7 +35,7 @@ const fn t(name: &'static str, ty: &'static str, cadence: Cadence, about: &'stat
 }
 
 /// Every topic, in the order a recording declares its channels.
-pub const TOPICS: [Topic; 13] = [
+pub const TOPICS: [Topic; 14] = [
     t(
         "/robot_description",
         "std_msgs/msg/String",
@@ -113,6 +113,12 @@ pub const TOPICS: [Topic; 13] = [
         "tactile_msgs/msg/SampleTiming",
         Cadence::Sample,
         "round trip, overhead, injected delays, flags, passivity observers",
+    ),
+    t(
+        "/slave/bodies",
+        "visualization_msgs/msg/MarkerArray",
+        Cadence::Sample,
+        "a physics world's moving bodies and the tool body, the arm's base frame",
     ),
 ];
 

@@ -87,6 +87,8 @@ pub const MASTER_FELT: Typed<WrenchStamped> = Typed::at(10);
 pub const SLAVE_ENVIRONMENT: Typed<crate::msg::MarkerArray> = Typed::at(11);
 /// `/tactile/timing`.
 pub const TIMING: Typed<SampleTiming> = Typed::at(12);
+/// `/slave/bodies`.
+pub const SLAVE_BODIES: Typed<crate::msg::MarkerArray> = Typed::at(13);
 
 /// The topics the master's live view publishes.
 pub const MASTER_LIVE: [usize; 6] = [

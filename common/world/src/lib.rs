@@ -27,7 +27,7 @@ mod watch;
 
 pub use build::PhysicsWorld;
 pub use error::WorldError;
-pub use shapes::{link_shapes, LinkShape};
+pub use shapes::{link_shapes, surface, LinkShape};
 pub use task::{TaskMonitor, TaskProgress};
 pub use watch::ENERGY_TOLERANCE_J;
 

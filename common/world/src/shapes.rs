@@ -140,6 +140,54 @@ pub(crate) fn shared(
     })
 }
 
+/// The triangles a viewer draws for a hull or a mesh, m in the body's frame: a mesh
+/// file's own triangles (scaled), a hull's surface (the engine's convex hull of its
+/// points or its file's vertices); None for the primitives, which a viewer has shapes
+/// of. Files are read as the world reads them (`base_dir` resolves a relative one);
+/// errors name `field`.
+pub fn surface(shape: &Shape, base_dir: &Path, field: &str) -> Result<Option<Mesh>, WorldError> {
+    let hull = |pts: Vec<Point3<f64>>, f: &str| {
+        let (v, t) = guarded(f, || {
+            rapier3d_f64::parry::transformation::try_convex_hull(&pts).ok()
+        })?;
+        Ok::<_, WorldError>(Some(Mesh {
+            vertices: v.iter().map(|p| [p.x, p.y, p.z]).collect(),
+            triangles: t,
+        }))
+    };
+    match shape {
+        Shape::ConvexHull {
+            points: Some(p),
+            scale,
+            ..
+        } => {
+            let f = format!("{field}.points");
+            let scaled: Vec<[f64; 3]> = p.iter().map(|v| v.map(|x| x * scale)).collect();
+            hull(points(&scaled, &f)?, &f)
+        }
+        Shape::ConvexHull {
+            file: Some(file),
+            scale,
+            ..
+        } => {
+            let f = format!("{field}.file");
+            let m = load(file, base_dir, &f)?;
+            hull(points(&m.scaled(*scale), &f)?, &f)
+        }
+        Shape::Mesh { file, scale } => {
+            let f = format!("{field}.file");
+            let m = load(file, base_dir, &f)?;
+            let vertices = m.scaled(*scale);
+            points(&vertices, &f)?;
+            Ok(Some(Mesh {
+                vertices,
+                triangles: m.triangles,
+            }))
+        }
+        _ => Ok(None),
+    }
+}
+
 /// The collision shapes of the arm's `links` (by name, in that order) from its URDF:
 /// boxes, cylinders and spheres as they are, meshes by the file `resolve` finds for
 /// their `filename` (a `package://` path, a path relative to the URDF). A link
@@ -194,4 +242,48 @@ pub fn link_shapes(
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What a viewer draws: a hull's surface (a tetrahedron's four faces, the point
+    /// inside left out), a mesh's own triangles scaled, nothing for a primitive.
+    #[test]
+    fn a_hull_or_a_mesh_is_drawn_as_triangles_and_a_primitive_is_not() {
+        let hull = Shape::ConvexHull {
+            points: Some(vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [0.1, 0.1, 0.1],
+            ]),
+            file: None,
+            scale: 0.5,
+        };
+        let m = surface(&hull, Path::new(""), "f")
+            .expect("hull")
+            .expect("triangles");
+        assert_eq!((m.vertices.len(), m.triangles.len()), (4, 4));
+        assert!(m
+            .vertices
+            .iter()
+            .all(|v| v.iter().all(|x| (0.0..=0.5).contains(x))));
+        let dir = tempfile::tempdir().expect("tempdir");
+        let peg = Mesh::prism(6, 1.0, 2.0);
+        std::fs::write(dir.path().join("peg.obj"), crate::mesh::to_obj(&peg)).expect("write");
+        let mesh = Shape::Mesh {
+            file: "peg.obj".into(),
+            scale: 0.01,
+        };
+        let m = surface(&mesh, dir.path(), "f")
+            .expect("mesh")
+            .expect("triangles");
+        assert_eq!(m.triangles, peg.triangles);
+        assert_eq!(m.vertices, peg.scaled(0.01));
+        let ball = Shape::Sphere { radius: 0.1 };
+        assert_eq!(surface(&ball, dir.path(), "f").expect("ball"), None);
+    }
 }

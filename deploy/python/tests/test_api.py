@@ -110,6 +110,24 @@ def test_in_memory_and_an_arm():
     assert "q_1" in r.joints.column_names and r.summary["task_space"] is not None
 
 
+def test_a_physics_runs_bodies():
+    """push-box: the box's pose every sample beside the tool's, in memory; an
+    analytic run has none."""
+    sc = tactile.Scenario.load(ROOT / "deploy" / "scenarios" / "push-box.toml")
+    r = tactile.run(sc)
+    b = r.bodies
+    assert b is not None and b.column_names == ["sample", "body", "x", "y", "z",
+                                                "qx", "qy", "qz", "qw"]
+    df = b.to_pandas()
+    assert sorted(df["body"].unique()) == ["box", "tool"]
+    box = df[df["body"] == "box"]
+    assert len(box) == 7000 and list(box["sample"]) == list(range(7000))
+    # Pushed 8 cm along x, to within 1 cm of its target at x = 5 cm.
+    assert abs(box["x"].iloc[0]) < 1e-3 and abs(box["x"].iloc[-1] - 0.05) < 0.01
+    assert r.summary["task"]["success"]
+    assert tactile.run(tactile.Scenario.paper().with_set({"samples": 100})).bodies is None
+
+
 def test_no_trace_is_the_commands_no_trace(work):
     sc = tactile.Scenario.paper().with_set({"samples": 200})
     r = tactile.run(sc, out=work / "bare", trace_format=None)

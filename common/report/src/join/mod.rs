@@ -18,7 +18,7 @@ use tactile_messages::samples::stage;
 use tactile_messages::Role;
 use tactile_records::emulator::{Direction, EmulatorTotals, Passage};
 use tactile_records::master::{Answer, MasterSample, MasterTotals, Miss, Sent};
-use tactile_records::slave::{ArmJoints, SlaveSample, SlaveTotals, Step};
+use tactile_records::slave::{ArmJoints, SlaveSample, SlaveTotals, Step, WorldSample};
 use tactile_records::{record_path, Record, RecordError, RecordReader, Start};
 
 /// The three nodes' logs after a join.
@@ -360,12 +360,12 @@ fn sample_count(
 fn step_of<'a>(
     steps: &'a [SlaveSample],
     duplicates: &mut u64,
-) -> (Option<Step>, Option<&'a ArmJoints>) {
+) -> (Option<Step>, Option<&'a ArmJoints>, Option<&'a WorldSample>) {
     let mut all = steps.iter().filter_map(|x| match x {
-        SlaveSample::Step(s, j) => Some((Some(*s), Some(j))),
+        SlaveSample::Step(s, j, w) => Some((Some(*s), Some(j), w.as_ref())),
         SlaveSample::Hold(..) => None,
     });
-    let first = all.next().unwrap_or((None, None));
+    let first = all.next().unwrap_or((None, None, None));
     *duplicates += all.count() as u64;
     first
 }
@@ -393,6 +393,18 @@ impl Arm {
     }
 }
 
+/// What a sample joins besides its trace row: the slave's arm where it is a URDF arm,
+/// a 6-DoF master's orientation, and a physics world's state after the slave's step.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Joined<'a> {
+    /// A URDF arm's joints (the paper arm's are in the row).
+    pub joints: Option<&'a ArmJoints>,
+    /// A 6-DoF master's orientation, `[x, y, z, w]`.
+    pub rotation: Option<[f64; 4]>,
+    /// A physics world after the slave's step (`engine = "physics"`).
+    pub world: Option<&'a WorldSample>,
+}
+
 /// Joins the records found in `dirs`, handing each sample's row to `each` in order,
 /// with a URDF arm's joints where the slave is one (`arm`) and a 6-DoF master's
 /// orientation. `each` may stop the join early: the logs then hold what was read so
@@ -400,7 +412,7 @@ impl Arm {
 pub fn join(
     dirs: &[PathBuf],
     arm: Arm,
-    each: impl FnMut(&TraceRow, Option<&ArmJoints>, Option<[f64; 4]>) -> Result<ControlFlow<()>, Error>,
+    each: impl FnMut(&TraceRow, &Joined) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
     join_until(dirs, &|| false, arm, each)
 }
@@ -412,11 +424,7 @@ pub fn join_until(
     dirs: &[PathBuf],
     stop: &dyn Fn() -> bool,
     arm: Arm,
-    mut each: impl FnMut(
-        &TraceRow,
-        Option<&ArmJoints>,
-        Option<[f64; 4]>,
-    ) -> Result<ControlFlow<()>, Error>,
+    mut each: impl FnMut(&TraceRow, &Joined) -> Result<ControlFlow<()>, Error>,
 ) -> Result<Logs, Error> {
     let found = locate(dirs)?;
     let limit = sample_count(&found, stop)?;
@@ -442,7 +450,7 @@ pub fn join_until(
         if src.stopped() {
             return src.logs(n, false, stop);
         }
-        let (step, joints) = step_of(&steps, &mut src.slave.log.duplicates);
+        let (step, joints, world) = step_of(&steps, &mut src.slave.log.duplicates);
         let rotation = part.sent.rotation;
         let mut r = row(&part, &passages, step.as_ref());
         let joints = match (arm, joints) {
@@ -452,7 +460,12 @@ pub fn join_until(
             }
             (_, j) => j,
         };
-        if each(&r, joints, rotation)?.is_break() {
+        let of = Joined {
+            joints,
+            rotation,
+            world,
+        };
+        if each(&r, &of)?.is_break() {
             return src.logs(n, false, stop);
         }
         n += 1;

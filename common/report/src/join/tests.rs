@@ -114,8 +114,12 @@ fn write_run(root: &Path, slave_run: u64) -> [PathBuf; 3] {
                 received: signal(n as f64 + 0.5),
                 ..Step::default()
             };
-            s.write(&Record::Sample(SlaveSample::Step(step, Default::default())))
-                .expect("write");
+            s.write(&Record::Sample(SlaveSample::Step(
+                step,
+                Default::default(),
+                None,
+            )))
+            .expect("write");
         }
     }
     // One step numbered past the run, one of a sample joined long before.
@@ -127,6 +131,7 @@ fn write_run(root: &Path, slave_run: u64) -> [PathBuf; 3] {
         s.write(&Record::Sample(SlaveSample::Step(
             stray,
             Default::default(),
+            None,
         )))
         .expect("write");
     }
@@ -141,7 +146,7 @@ fn records_of_two_clock_domains_join_sample_by_sample_within_the_window() {
     let clocks: Vec<String> = starts.iter().flatten().map(|s| s.clock.clone()).collect();
     assert_eq!(clocks, ["host-a", "host-b", "host-b"]);
     let mut rows = Vec::new();
-    let logs = join(&dirs, Arm::Paper, |r, _, _| {
+    let logs = join(&dirs, Arm::Paper, |r, _| {
         rows.push(*r);
         Ok(ControlFlow::Continue(()))
     })
@@ -176,7 +181,7 @@ fn records_of_two_clock_domains_join_sample_by_sample_within_the_window() {
 fn records_of_another_run_are_refused() {
     let dir = tempfile::tempdir().expect("tempdir");
     let dirs = write_run(dir.path(), RUN + 1);
-    let e = join(&dirs, Arm::Paper, |_, _, _| Ok(ControlFlow::Continue(()))).expect_err("two runs");
+    let e = join(&dirs, Arm::Paper, |_, _| Ok(ControlFlow::Continue(()))).expect_err("two runs");
     assert!(e.to_string().contains("not one run"), "{e}");
 }
 
@@ -185,7 +190,7 @@ fn a_stop_ends_the_join_with_what_it_has() {
     let dir = tempfile::tempdir().expect("tempdir");
     let dirs = write_run(dir.path(), RUN);
     let mut seen = 0;
-    let logs = join(&dirs, Arm::Paper, |r, _, _| {
+    let logs = join(&dirs, Arm::Paper, |r, _| {
         seen += 1;
         Ok(if r.n == 99 {
             ControlFlow::Break(())

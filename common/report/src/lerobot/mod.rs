@@ -361,7 +361,8 @@ fn episode(
     let mut expected = 0u64;
     let arm = join::Arm::of(&run.scenario);
     let dirs = std::slice::from_ref(&run.dir);
-    let logs = join::join_until(dirs, stop, arm, |row, joints, rotation| {
+    let logs = join::join_until(dirs, stop, arm, |row, j| {
+        let (joints, rotation) = (j.joints, j.rotation);
         if row.n != expected || end == Some(row.n) {
             ep.damaged_at = Some(expected);
             return Ok(ControlFlow::Break(()));

@@ -50,7 +50,7 @@ const SHADE: RGBColor = RGBColor(150, 150, 150);
 /// Lines of (t, y) points on linear axes from 0 to the last time, with a legend below;
 /// the stretches `shade` (from, to, s) marked with a grey band and a legend entry
 /// `shade_label`.
-pub(super) fn time_series(
+pub(crate) fn time_series(
     path: &Path,
     (title, y_desc): (&str, &str),
     series: &[Line],

@@ -36,16 +36,19 @@ class Run:
     """A run's report, read back from its folder: `summary` (summary.json as a dict),
     `trace` (pyarrow.Table: trace.parquet, or trace.csv; None, with a NoTraceWarning
     saying how to get it, for a run written without one), `joints` (a URDF arm's
-    joints.csv as a pyarrow.Table, else None), `completed`, and `out` (the folder, or
-    None for a run kept in memory)."""
+    joints.csv as a pyarrow.Table, else None), `bodies` (a physics world's
+    bodies.csv as a pyarrow.Table: per sample the tool body and each moving body,
+    `sample, body, x, y, z, qx, qy, qz, qw` in the arm's base frame; else None),
+    `completed`, and `out` (the folder, or None for a run kept in memory)."""
 
     def __init__(self, out: Optional[Path], summary: dict, trace: Any, joints: Any,
-                 completed: bool):
+                 completed: bool, bodies: Any = None):
         self.out = out
         self.summary = summary
         self._trace = trace
         self._hint = None if trace is not None else _no_trace(out)
         self.joints = joints
+        self.bodies = bodies
         self.completed = completed
 
     @property
@@ -58,8 +61,8 @@ class Run:
 
     @classmethod
     def read(cls, folder: PathLike) -> "Run":
-        """The report in `folder` (summary.json, the trace, joints.csv); `completed`
-        is the summary's (not `failed`)."""
+        """The report in `folder` (summary.json, the trace, joints.csv, bodies.csv);
+        `completed` is the summary's (not `failed`)."""
         d = Path(folder)
         try:
             summary = json.loads((d / "summary.json").read_text())
@@ -76,7 +79,11 @@ class Run:
         if (d / "joints.csv").exists():
             import pyarrow.csv as pc
             joints = pc.read_csv(d / "joints.csv")
-        return cls(d, summary, trace, joints, not summary.get("failed", False))
+        bodies = None
+        if (d / "bodies.csv").exists():
+            import pyarrow.csv as pc
+            bodies = pc.read_csv(d / "bodies.csv")
+        return cls(d, summary, trace, joints, not summary.get("failed", False), bodies)
 
     def __repr__(self) -> str:
         rt = (self.summary.get("round_trip_ns") or {}).get("p50")
