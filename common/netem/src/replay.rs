@@ -2,11 +2,11 @@
 //! CSV, or a [`Link`] (a Mahimahi delivery trace or a fixed rate, and a queue).
 
 use crate::link::{
-    Bound, ClassSpec, Codel, CodelParams, Fifo, FqCodel, FqCodelParams, Link, Opportunities, Pie,
-    PieParams, Priority, Queue, RateSteps, Server, Weighted,
+    Arithmetic, Bound, ClassSpec, Codel, CodelParams, Fifo, FqCodel, FqCodelParams, Link,
+    Opportunities, Pie, PieParams, Priority, Queue, RateSteps, Server, Weighted,
 };
 use rand_chacha::ChaCha8Rng;
-use tactile_scenario::{LinkConfig, QueueKind};
+use tactile_scenario::{CodelArithmetic, LinkConfig, QueueKind};
 
 /// What is wrong in a replay file; each message names the line.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -133,6 +133,13 @@ pub struct AqmSpec {
     pub quantum: u32,
 }
 
+fn arithmetic(a: CodelArithmetic) -> Arithmetic {
+    match a {
+        CodelArithmetic::Rfc => Arithmetic::Rfc,
+        CodelArithmetic::Linux => Arithmetic::Linux,
+    }
+}
+
 /// Milliseconds as whole ns.
 fn ns(ms: f64) -> u64 {
     (ms * 1e6).round() as u64
@@ -146,6 +153,7 @@ impl AqmSpec {
             target_ns: ns(c.target_ms),
             interval_ns: ns(c.interval_ms),
             mtu_bytes: c.mtu_bytes,
+            arithmetic: arithmetic(c.arithmetic),
         };
         let f = cfg.fq_codel.unwrap_or_default();
         let fq_codel = FqCodelParams {
@@ -153,6 +161,7 @@ impl AqmSpec {
                 target_ns: ns(f.target_ms),
                 interval_ns: ns(f.interval_ms),
                 mtu_bytes: f.mtu_bytes,
+                arithmetic: arithmetic(f.arithmetic),
             },
             quantum: f.quantum,
             flows: f.flows,

@@ -13,7 +13,20 @@ pub const MAX_FLOW_ID: u32 = 65_535;
 /// Most classes of a scheduler.
 pub const MAX_CLASSES: usize = 16;
 
-/// `codel = { target_ms, interval_ms, mtu_bytes }` (RFC 8289).
+/// CoDel's arithmetic: RFC 8289's pseudo-code (ns, a square root), or Linux's and
+/// ns-3's (1024 ns units, a Newton step a drop in fixed point): the same state
+/// machine, drops a little apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum CodelArithmetic {
+    /// RFC 8289's.
+    #[default]
+    Rfc,
+    /// Linux's and ns-3's.
+    Linux,
+}
+
+/// `codel = { target_ms, interval_ms, mtu_bytes, arithmetic }` (RFC 8289).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CodelConfig {
@@ -26,6 +39,9 @@ pub struct CodelConfig {
     /// No drop while the queue holds at most this many bytes (the MTU) [1500].
     #[serde(default = "mtu")]
     pub mtu_bytes: u32,
+    /// `rfc` or `linux` [rfc].
+    #[serde(default)]
+    pub arithmetic: CodelArithmetic,
 }
 
 /// `fq_codel = { target_ms, interval_ms, mtu_bytes, quantum, flows, limit, drop_batch }`
@@ -42,6 +58,9 @@ pub struct FqCodelConfig {
     /// Each flow's CoDel MTU, bytes [1500].
     #[serde(default = "mtu")]
     pub mtu_bytes: u32,
+    /// Each flow's CoDel arithmetic, `rfc` or `linux` [rfc].
+    #[serde(default)]
+    pub arithmetic: CodelArithmetic,
     /// Bytes a flow sends each round [1514].
     #[serde(default = "quantum")]
     pub quantum: u32,
@@ -161,6 +180,7 @@ impl Default for CodelConfig {
             target_ms: codel_target(),
             interval_ms: codel_interval(),
             mtu_bytes: mtu(),
+            arithmetic: CodelArithmetic::Rfc,
         }
     }
 }
@@ -171,6 +191,7 @@ impl Default for FqCodelConfig {
             target_ms: codel_target(),
             interval_ms: codel_interval(),
             mtu_bytes: mtu(),
+            arithmetic: CodelArithmetic::Rfc,
             quantum: quantum(),
             flows: fq_flows(),
             limit: fq_limit(),

@@ -48,8 +48,8 @@ pub use world_check::{MAX_BODIES, MAX_HULL_POINTS, MAX_SIZE_M};
 pub mod workspace;
 
 pub use aqm::{
-    ClassConfig, CodelConfig, FqCodelConfig, PieConfig, PriorityConfig, WeightedConfig, MAX_AQM_MS,
-    MAX_CLASSES, MAX_FLOW_ID,
+    ClassConfig, CodelArithmetic, CodelConfig, FqCodelConfig, PieConfig, PriorityConfig,
+    WeightedConfig, MAX_AQM_MS, MAX_CLASSES, MAX_FLOW_ID,
 };
 pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
 pub use control::{

@@ -16,6 +16,21 @@ pub struct CodelParams {
     /// The RFC's `maxpacket_`: no drop while the queue holds at most this many bytes
     /// (one MTU: a slow link's single packet is no standing queue) [1500].
     pub mtu_bytes: u32,
+    /// The arithmetic: the RFC's (ns, a square root) or Linux's and ns-3's.
+    pub arithmetic: Arithmetic,
+}
+
+/// How CoDel computes: RFC 8289's pseudo-code as written, or as Linux's `codel.h`
+/// and ns-3's `CoDelQueueDisc` (its port) do ([`super::codel_linux`]): time in
+/// units of 1024 ns truncated to 32 bits, `1/sqrt(count)` by one Newton step a drop in
+/// 16-bit fixed point, a strict `now > first_above` and `bytes < mtu`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Arithmetic {
+    /// RFC 8289's.
+    #[default]
+    Rfc,
+    /// Linux's and ns-3's.
+    Linux,
 }
 
 impl Default for CodelParams {
@@ -24,24 +39,41 @@ impl Default for CodelParams {
             target_ns: 5_000_000,
             interval_ns: 100_000_000,
             mtu_bytes: 1500,
+            arithmetic: Arithmetic::Rfc,
         }
     }
 }
 
 /// One queue's CoDel state (the RFC's variables ending in `_`), shared by
 /// [`Codel`] and each flow of FQ-CoDel.
-#[derive(Debug, Clone, Copy, Default)]
+/// (Times in ns, or in Linux's 1024 ns units under [`Arithmetic::Linux`].)
+#[derive(Debug, Clone, Copy)]
 pub(super) struct CodelState {
-    /// When the sojourn may first be called above for an interval, ns (0: below).
-    first_above: u64,
-    /// The next drop's time in the dropping state, ns.
-    drop_next: u64,
+    /// When the sojourn may first be called above for an interval (0: below).
+    pub(super) first_above: u64,
+    /// The next drop's time in the dropping state.
+    pub(super) drop_next: u64,
     /// Drops since entering the dropping state.
-    count: u32,
+    pub(super) count: u32,
     /// `count` when the dropping state was last entered.
-    lastcount: u32,
+    pub(super) lastcount: u32,
     /// In the dropping state.
-    dropping: bool,
+    pub(super) dropping: bool,
+    /// Linux's `1/sqrt(count)` in 16-bit fixed point.
+    pub(super) rec_inv_sqrt: u16,
+}
+
+impl Default for CodelState {
+    fn default() -> CodelState {
+        CodelState {
+            first_above: 0,
+            drop_next: 0,
+            count: 0,
+            lastcount: 0,
+            dropping: false,
+            rec_inv_sqrt: u16::MAX,
+        }
+    }
 }
 
 impl CodelState {
@@ -77,6 +109,9 @@ impl CodelState {
         now: u64,
         drops: &mut Vec<(Packet, DropCause)>,
     ) -> Option<Packet> {
+        if c.arithmetic == Arithmetic::Linux {
+            return self.dequeue_linux(c, q, now, drops);
+        }
         let (mut p, mut ok) = self.dodequeue(c, q, now);
         if self.dropping {
             if !ok {

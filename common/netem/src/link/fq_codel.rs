@@ -158,10 +158,12 @@ impl Queue for FqCodel {
                     return Some(p);
                 }
                 None => {
-                    let to_old = from_new && !self.old.is_empty();
-                    f.list = if to_old { List::Old } else { List::Idle };
+                    // RFC 8290 §4.2 (and ns-3): an empty new flow goes to the end of
+                    // the old list, an empty old one leaves (Linux moves a new one only
+                    // if the old list has others).
+                    f.list = if from_new { List::Old } else { List::Idle };
                     pop(self);
-                    if to_old {
+                    if from_new {
                         self.old.push_back(i);
                     }
                 }

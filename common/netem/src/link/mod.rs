@@ -15,6 +15,7 @@
 //! event, never at send.
 
 mod codel;
+mod codel_linux;
 mod fq_codel;
 mod pie;
 mod priority;
@@ -27,7 +28,7 @@ mod tests_aqm;
 mod trace;
 mod weighted;
 
-pub use codel::{Codel, CodelParams};
+pub use codel::{Arithmetic, Codel, CodelParams};
 pub use fq_codel::{FqCodel, FqCodelParams};
 pub use pie::{Pie, PieParams};
 pub use priority::{ClassSpec, Priority};
