@@ -169,6 +169,24 @@ fn aqm_links_repeat_and_refuse_bad_settings() {
         signal_columns(&trace),
         "processes as in-process"
     );
+    // CoDel in Linux's arithmetic one way, weighted classes the other, then strict
+    // priority: each runs and repeats.
+    let sb2 = Sandbox::new("aqm2");
+    for (fwd, back) in [
+        (
+            "queue = \"codel\"\ncodel = { arithmetic = \"linux\" }",
+            "queue = \"weighted\"\nweighted = { classes = [{ flows = [0], weight = 3 }, { }] }",
+        ),
+        (
+            "queue = \"priority\"\npriority = { classes = [{ flows = [0], packets = 5 }] }",
+            "queue = \"pie\"\npackets = 50",
+        ),
+    ] {
+        let text = format!(
+            "{base}\n[network.forward.link]\nrate = 2e6\n{fwd}\n\n[network.backward.link]\nrate = 2e6\n{back}\n"
+        );
+        util::run_twice(&sb2, &text);
+    }
     let link = |body: &str| format!("{base}\n[network.forward.link]\nrate = 1e6\n{body}\n");
     let f = "network.forward.link";
     let cases = [
@@ -229,6 +247,10 @@ fn aqm_links_repeat_and_refuse_bad_settings() {
             format!("{f}.weighted.classes[0].weight"),
         ),
         (link("queue = \"red\""), "queue".into()),
+        (
+            link("queue = \"codel\"\ncodel = { arithmetic = \"bsd\" }"),
+            "arithmetic".into(),
+        ),
     ];
     for (k, (text, want)) in cases.iter().enumerate() {
         sb.assert_refused(k, text, want);
