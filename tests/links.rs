@@ -139,3 +139,120 @@ fn a_rate_over_time_holds_the_packets_through_its_outage() {
     assert_eq!(longest, 101.0, "{delays:?}");
     assert!(delays[..200].iter().all(|d| *d <= 1.0));
 }
+
+/// The disciplines beyond mm-link's FIFOs: a PIE link (its own random stream) and an
+/// FQ-CoDel one repeat byte for byte in-process and as processes; their bad settings
+/// are refused with exit 2 naming the field.
+#[test]
+fn aqm_links_repeat_and_refuse_bad_settings() {
+    let sb = Sandbox::new("aqm");
+    let base = util::paper_1khz(600).replace("mode = \"realtime\"", "mode = \"lockstep\"");
+    // 278 bytes a ms on 2 Mbit/s: 111 % load, so PIE must drop.
+    let pie = format!(
+        "{base}\n[network.forward.link]\nrate = 2e6\nqueue = \"pie\"\npie = {{ target_ms = 5.0, max_burst_ms = 0.0 }}\n\n[network.backward.link]\nrate = 1e7\nqueue = \"fq_codel\"\n"
+    );
+    let trace = util::run_twice(&sb, &pie);
+    let s = sb.write("p.toml", &pie);
+    let o = sb.tactile(&[
+        "run",
+        s.to_str().expect("utf-8"),
+        "--out",
+        "p",
+        "--prefix",
+        &sb.prefix,
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    sb.assert_no_leftover_processes();
+    assert_eq!(
+        signal_columns(&sb.trace("p")),
+        signal_columns(&trace),
+        "processes as in-process"
+    );
+    // CoDel in Linux's arithmetic one way, weighted classes the other, then strict
+    // priority: each runs and repeats.
+    let sb2 = Sandbox::new("aqm2");
+    for (fwd, back) in [
+        (
+            "queue = \"codel\"\ncodel = { arithmetic = \"linux\" }",
+            "queue = \"weighted\"\nweighted = { classes = [{ flows = [0], weight = 3 }, { }] }",
+        ),
+        (
+            "queue = \"priority\"\npriority = { classes = [{ flows = [0], packets = 5 }] }",
+            "queue = \"pie\"\npackets = 50",
+        ),
+    ] {
+        let text = format!(
+            "{base}\n[network.forward.link]\nrate = 2e6\n{fwd}\n\n[network.backward.link]\nrate = 2e6\n{back}\n"
+        );
+        util::run_twice(&sb2, &text);
+    }
+    let link = |body: &str| format!("{base}\n[network.forward.link]\nrate = 1e6\n{body}\n");
+    let f = "network.forward.link";
+    let cases = [
+        (
+            link("queue = \"codel\"\ncodel = { target_ms = 0.0 }"),
+            format!("{f}.codel.target_ms"),
+        ),
+        (
+            link("queue = \"codel\"\ncodel = { interval_ms = nan }"),
+            format!("{f}.codel.interval_ms"),
+        ),
+        (link("queue = \"pie\"\ncodel = { }"), format!("{f}.codel")),
+        (
+            link("queue = \"pie\"\npie = { alpha = -1.0 }"),
+            format!("{f}.pie.alpha"),
+        ),
+        (
+            link("queue = \"pie\"\npie = { tupdate_ms = 0.0 }"),
+            format!("{f}.pie.tupdate_ms"),
+        ),
+        (
+            link("queue = \"fq_codel\"\nfq_codel = { flows = 0 }"),
+            format!("{f}.fq_codel.flows"),
+        ),
+        (
+            link("queue = \"fq_codel\"\nfq_codel = { limit = 0 }"),
+            format!("{f}.fq_codel.limit"),
+        ),
+        (
+            link("queue = \"fq_codel\"\nfq_codel = { quantum = 0 }"),
+            format!("{f}.fq_codel.quantum"),
+        ),
+        (
+            link("queue = \"fq_codel\"\npackets = 10"),
+            format!("{f}.packets"),
+        ),
+        (link("queue = \"priority\""), format!("{f}.priority")),
+        (
+            link("queue = \"priority\"\npriority = { classes = [] }"),
+            format!("{f}.priority.classes"),
+        ),
+        (
+            link("queue = \"priority\"\npriority = { classes = [{ flows = [0], weight = 2 }] }"),
+            format!("{f}.priority.classes[0].weight"),
+        ),
+        (
+            link(
+                "queue = \"weighted\"\nweighted = { classes = [{ flows = [0] }, { flows = [0] }] }",
+            ),
+            format!("{f}.weighted.classes[1].flows"),
+        ),
+        (
+            link("queue = \"weighted\"\nweighted = { classes = [{ flows = [0], packets = 0 }] }"),
+            format!("{f}.weighted.classes[0].packets"),
+        ),
+        (
+            link("queue = \"weighted\"\nweighted = { classes = [{ weight = 0 }] }"),
+            format!("{f}.weighted.classes[0].weight"),
+        ),
+        (link("queue = \"red\""), "queue".into()),
+        (
+            link("queue = \"codel\"\ncodel = { arithmetic = \"bsd\" }"),
+            "arithmetic".into(),
+        ),
+    ];
+    for (k, (text, want)) in cases.iter().enumerate() {
+        sb.assert_refused(k, text, want);
+    }
+}

@@ -180,6 +180,9 @@ pub struct Channel {
     newest: Option<Slot>,
     /// A link with a rate and a queue carries the packets: [`Channel::push_link`].
     link: Option<Box<link_path::OnLink>>,
+    /// The link's own random stream (PIE's draws), stream + 500: a link leaves the
+    /// other streams' draws where they were.
+    link_rng: ChaCha8Rng,
 }
 
 /// Seeds of the two channels differ so their noise is independent.
@@ -248,6 +251,11 @@ impl Channel {
             direct,
             newest: None,
             link: None,
+            link_rng: {
+                let mut r = ChaCha8Rng::seed_from_u64(seed);
+                r.set_stream(stream + 500);
+                r
+            },
         }
     }
 
@@ -256,7 +264,8 @@ impl Channel {
     pub fn with_replay(mut self, replay: Replay, t_s: f64) -> Channel {
         self.direct = false;
         if let Replay::Link(spec) = &replay {
-            self.link = Some(Box::new(link_path::OnLink::new(spec, t_s)));
+            let rng = self.link_rng.clone();
+            self.link = Some(Box::new(link_path::OnLink::new(spec, t_s, rng)));
             return self;
         }
         let need = replay.bound() as usize + 1;

@@ -6,6 +6,7 @@
 use super::{Channel, Emitted, Rest, Slot, Value};
 use crate::link::{Event, Fate, FlowStats, Link, Packet};
 use crate::LinkSpec;
+use rand_chacha::ChaCha8Rng;
 use std::collections::VecDeque;
 
 /// The link and the samples whose packets are on it.
@@ -29,9 +30,9 @@ pub(super) struct OnLink {
 }
 
 impl OnLink {
-    pub(super) fn new(spec: &LinkSpec, t_s: f64) -> OnLink {
+    pub(super) fn new(spec: &LinkSpec, t_s: f64, rng: ChaCha8Rng) -> OnLink {
         OnLink {
-            link: spec.build(),
+            link: spec.build(rng),
             held: VecDeque::new(),
             events: Vec::new(),
             t_s_ns: t_s * 1e9,

@@ -1,8 +1,12 @@
 //! Recorded networks replayed packet by packet: per-packet delays and losses from a
 //! CSV, or a [`Link`] (a Mahimahi delivery trace or a fixed rate, and a queue).
 
-use crate::link::{Bound, Fifo, Link, Opportunities, Queue, RateSteps, Server};
-use tactile_scenario::{LinkConfig, QueueKind};
+use crate::link::{
+    Arithmetic, Bound, ClassSpec, Codel, CodelParams, Fifo, FqCodel, FqCodelParams, Link,
+    Opportunities, Pie, PieParams, Priority, Queue, RateSteps, Server, Weighted,
+};
+use rand_chacha::ChaCha8Rng;
+use tactile_scenario::{CodelArithmetic, LinkConfig, QueueKind};
 
 /// What is wrong in a replay file; each message names the line.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -109,6 +113,94 @@ pub struct LinkSpec {
     pub bound: Bound,
     /// Each packet's size on the wire, bytes (payload and headers).
     pub packet_bytes: u32,
+    /// The parameters of the discipline `queue` names beyond mm-link's.
+    pub aqm: AqmSpec,
+}
+
+/// The parameters of CoDel, FQ-CoDel, PIE and the class schedulers (the RFCs'
+/// defaults where a scenario gives none).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct AqmSpec {
+    /// CoDel's.
+    pub codel: CodelParams,
+    /// FQ-CoDel's.
+    pub fq_codel: FqCodelParams,
+    /// PIE's.
+    pub pie: PieParams,
+    /// The classes of `priority` or `weighted`.
+    pub classes: Vec<ClassSpec>,
+    /// `weighted`'s quantum of a weight of 1, bytes.
+    pub quantum: u32,
+}
+
+fn arithmetic(a: CodelArithmetic) -> Arithmetic {
+    match a {
+        CodelArithmetic::Rfc => Arithmetic::Rfc,
+        CodelArithmetic::Linux => Arithmetic::Linux,
+    }
+}
+
+/// Milliseconds as whole ns.
+fn ns(ms: f64) -> u64 {
+    (ms * 1e6).round() as u64
+}
+
+impl AqmSpec {
+    /// The parameters `cfg` sets.
+    pub fn new(cfg: &LinkConfig) -> AqmSpec {
+        let c = cfg.codel.unwrap_or_default();
+        let codel = CodelParams {
+            target_ns: ns(c.target_ms),
+            interval_ns: ns(c.interval_ms),
+            mtu_bytes: c.mtu_bytes,
+            arithmetic: arithmetic(c.arithmetic),
+        };
+        let f = cfg.fq_codel.unwrap_or_default();
+        let fq_codel = FqCodelParams {
+            codel: CodelParams {
+                target_ns: ns(f.target_ms),
+                interval_ns: ns(f.interval_ms),
+                mtu_bytes: f.mtu_bytes,
+                arithmetic: arithmetic(f.arithmetic),
+            },
+            quantum: f.quantum,
+            flows: f.flows,
+            limit: f.limit,
+            drop_batch: f.drop_batch,
+        };
+        let p = cfg.pie.unwrap_or_default();
+        let pie = PieParams {
+            target_ns: ns(p.target_ms),
+            tupdate_ns: ns(p.tupdate_ms),
+            alpha: p.alpha,
+            beta: p.beta,
+            max_burst_ns: ns(p.max_burst_ms),
+            mean_packet_bytes: p.mean_packet_bytes,
+        };
+        let (classes, quantum) = match (&cfg.priority, &cfg.weighted) {
+            (Some(p), _) if cfg.queue == QueueKind::Priority => (p.classes.as_slice(), 1514),
+            (_, Some(w)) => (w.classes.as_slice(), w.quantum),
+            _ => (&[][..], 1514),
+        };
+        let classes = classes
+            .iter()
+            .map(|c| ClassSpec {
+                flows: c.flows.clone(),
+                bound: Bound {
+                    packets: c.packets.unwrap_or(0),
+                    bytes: c.bytes.unwrap_or(0),
+                },
+                weight: c.weight.unwrap_or(1),
+            })
+            .collect();
+        AqmSpec {
+            codel,
+            fq_codel,
+            pie,
+            classes,
+            quantum,
+        }
+    }
 }
 
 impl LinkSpec {
@@ -122,6 +214,7 @@ impl LinkSpec {
                 bytes: cfg.bytes.unwrap_or(0),
             },
             packet_bytes: u32::try_from(cfg.packet_bytes()).unwrap_or(u32::MAX),
+            aqm: AqmSpec::new(cfg),
         }
     }
 
@@ -135,12 +228,18 @@ impl LinkSpec {
         cfg.rate.map(|r| LinkSpec::new(cfg, Server::Rate(r)))
     }
 
-    /// The link, empty at time 0, counting one flow.
-    pub fn build(&self) -> Link {
+    /// The link, empty at time 0, counting one flow; PIE draws from `rng`.
+    pub fn build(&self, rng: ChaCha8Rng) -> Link {
+        let a = &self.aqm;
         let queue: Box<dyn Queue> = match self.queue {
             QueueKind::Infinite => Box::new(Fifo::infinite()),
             QueueKind::Droptail => Box::new(Fifo::drop_tail(self.bound)),
             QueueKind::Drophead => Box::new(Fifo::drop_head(self.bound)),
+            QueueKind::Codel => Box::new(Codel::new(a.codel, self.bound)),
+            QueueKind::FqCodel => Box::new(FqCodel::new(a.fq_codel)),
+            QueueKind::Pie => Box::new(Pie::new(a.pie, self.bound, rng)),
+            QueueKind::Priority => Box::new(Priority::new(&a.classes)),
+            QueueKind::Weighted => Box::new(Weighted::new(&a.classes, a.quantum)),
         };
         Link::new(self.server.clone(), queue, 1)
     }

@@ -6,6 +6,7 @@
 //! delay, a zero rate, negative noise) is refused with the field's dotted path before
 //! anything starts. The defaults reproduce the paper's setup.
 
+mod aqm;
 mod arm;
 mod bounds;
 pub use bounds::MAX_POSITION_M;
@@ -46,6 +47,10 @@ pub use task::{TaskConfig, TOOL_BODY};
 pub use world_check::{MAX_BODIES, MAX_HULL_POINTS, MAX_SIZE_M};
 pub mod workspace;
 
+pub use aqm::{
+    ClassConfig, CodelArithmetic, CodelConfig, FqCodelConfig, PieConfig, PriorityConfig,
+    WeightedConfig, MAX_AQM_MS, MAX_CLASSES, MAX_FLOW_ID,
+};
 pub use arm::{ArmConfig, ArmIkConfig, ArmServo, CartesianConfig, MAX_ARM_DOF};
 pub use control::{
     CodecConfig, CodecKind, Codecs, ControlConfig, ControlKind, MmtConfig, MmtSlave, MmtUpdate,

@@ -2,6 +2,9 @@
 //! and a queue, `mm-link`'s (Mahimahi) meanings and names. Its behaviour is
 //! `tactile-netem`'s `link`; its settings and ranges are here.
 
+use crate::aqm::{
+    validate_classes, CodelConfig, FqCodelConfig, PieConfig, PriorityConfig, WeightedConfig,
+};
 use crate::shown::Num;
 use crate::{invalid, ScenarioError};
 use serde::{Deserialize, Serialize};
@@ -47,6 +50,33 @@ pub enum QueueKind {
     Droptail,
     /// Takes every arrival, then drops from the head until the bound holds.
     Drophead,
+    /// CoDel (RFC 8289), `codel = { ... }`; `packets`/`bytes` bound it if given.
+    Codel,
+    /// FQ-CoDel (RFC 8290), `fq_codel = { ... }` (its own `limit`).
+    #[serde(rename = "fq_codel")]
+    FqCodel,
+    /// PIE (RFC 8033), `pie = { ... }`; `packets`/`bytes` bound it if given.
+    Pie,
+    /// Strict priority between classes, `priority = { classes = [...] }`.
+    Priority,
+    /// Weighted classes (deficit round robin), `weighted = { quantum, classes }`.
+    Weighted,
+}
+
+impl QueueKind {
+    /// Its name in a scenario.
+    pub fn name(self) -> &'static str {
+        match self {
+            QueueKind::Infinite => "infinite",
+            QueueKind::Droptail => "droptail",
+            QueueKind::Drophead => "drophead",
+            QueueKind::Codel => "codel",
+            QueueKind::FqCodel => "fq_codel",
+            QueueKind::Pie => "pie",
+            QueueKind::Priority => "priority",
+            QueueKind::Weighted => "weighted",
+        }
+    }
 }
 
 /// `link = { trace | path | rate | rate_trace, queue, packets, bytes, header_bytes, payload_bytes }`.
@@ -83,6 +113,21 @@ pub struct LinkConfig {
     /// Each sample's payload, bytes [250: about a Tactile frame].
     #[serde(default = "default_payload")]
     pub payload_bytes: u32,
+    /// CoDel's parameters (`queue = "codel"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub codel: Option<CodelConfig>,
+    /// FQ-CoDel's (`queue = "fq_codel"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fq_codel: Option<FqCodelConfig>,
+    /// PIE's (`queue = "pie"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pie: Option<PieConfig>,
+    /// Strict priority's classes (`queue = "priority"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub priority: Option<PriorityConfig>,
+    /// Weighted classes (`queue = "weighted"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weighted: Option<WeightedConfig>,
 }
 
 fn default_header() -> u32 {
@@ -106,6 +151,11 @@ impl LinkConfig {
             bytes: None,
             header_bytes: default_header(),
             payload_bytes: default_payload(),
+            codel: None,
+            fq_codel: None,
+            pie: None,
+            priority: None,
+            weighted: None,
         }
     }
 
@@ -157,7 +207,61 @@ impl LinkConfig {
                 ),
             ));
         }
-        self.validate_bound(field)
+        self.validate_bound(field)?;
+        self.validate_discipline(field)
+    }
+
+    /// A discipline's table only beside its `queue`, each in range; `priority` and
+    /// `weighted` need theirs (their classes).
+    fn validate_discipline(&self, field: &str) -> Result<(), ScenarioError> {
+        let f = |k: &str| format!("{field}.link.{k}");
+        let given = [
+            (QueueKind::Codel, self.codel.is_some()),
+            (QueueKind::FqCodel, self.fq_codel.is_some()),
+            (QueueKind::Pie, self.pie.is_some()),
+            (QueueKind::Priority, self.priority.is_some()),
+            (QueueKind::Weighted, self.weighted.is_some()),
+        ];
+        for (kind, is) in given {
+            if is && kind != self.queue {
+                return Err(invalid(
+                    f(kind.name()),
+                    format!(
+                        "sets queue \"{}\"; queue is \"{}\"",
+                        kind.name(),
+                        self.queue.name()
+                    ),
+                ));
+            }
+        }
+        if let Some(c) = &self.codel {
+            c.validate(&f("codel"))?;
+        }
+        if let Some(c) = &self.fq_codel {
+            c.validate(&f("fq_codel"), MAX_QUEUE_PACKETS)?;
+        }
+        if let Some(c) = &self.pie {
+            c.validate(&f("pie"))?;
+        }
+        match (self.queue, &self.priority, &self.weighted) {
+            (QueueKind::Priority, None, _) | (QueueKind::Weighted, _, None) => Err(invalid(
+                f(self.queue.name()),
+                "is missing: give its classes, e.g. { classes = [{ flows = [0] }, { flows = [] }] }",
+            )),
+            (QueueKind::Priority, Some(p), _) => {
+                validate_classes(&f("priority"), &p.classes, false, MAX_QUEUE_PACKETS)
+            }
+            (QueueKind::Weighted, _, Some(w)) => {
+                if w.quantum == 0 || w.quantum > 65_535 {
+                    return Err(invalid(
+                        f("weighted.quantum"),
+                        format!("{} is outside 1..=65535", w.quantum),
+                    ));
+                }
+                validate_classes(&f("weighted"), &w.classes, true, MAX_QUEUE_PACKETS)
+            }
+            _ => Ok(()),
+        }
     }
 
     /// Exactly one of `trace`, `path` and `rate`, each in range.
@@ -229,14 +333,24 @@ impl LinkConfig {
             }
         }
         let bounded = self.packets.is_some() || self.bytes.is_some();
+        let which = if self.packets.is_some() {
+            "packets"
+        } else {
+            "bytes"
+        };
         match self.queue {
+            QueueKind::FqCodel | QueueKind::Priority | QueueKind::Weighted if bounded => {
+                Err(invalid(
+                    f(which),
+                    format!(
+                        "bounds a single queue; queue \"{}\" bounds its own (fq_codel.limit, or each class's packets and bytes)",
+                        self.queue.name()
+                    ),
+                ))
+            }
             QueueKind::Infinite if bounded => Err(invalid(
-                f(if self.packets.is_some() {
-                    "packets"
-                } else {
-                    "bytes"
-                }),
-                "bounds a queue \"droptail\" or \"drophead\"; queue is \"infinite\"",
+                f(which),
+                "bounds a queue \"droptail\", \"drophead\", \"codel\" or \"pie\"; queue is \"infinite\"",
             )),
             QueueKind::Droptail | QueueKind::Drophead if !bounded => Err(invalid(
                 f("queue"),

@@ -14,15 +14,28 @@
 //! (drop-head pushes it out, an AQM drops it at dequeue): it is known only from the
 //! event, never at send.
 
+mod codel;
+mod codel_linux;
+mod fq_codel;
+mod pie;
+mod priority;
 mod queue;
 mod steps;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_aqm;
 mod trace;
+mod weighted;
 
+pub use codel::{Arithmetic, Codel, CodelParams};
+pub use fq_codel::{FqCodel, FqCodelParams};
+pub use pie::{Pie, PieParams};
+pub use priority::{ClassSpec, Priority};
 pub use queue::{Bound, DropCause, Fifo, Packet, Queue};
 pub use steps::{RateSteps, MAX_STEPS};
 pub use trace::{Opportunities, MAX_OPPORTUNITIES, OPPORTUNITY_BYTES};
+pub use weighted::Weighted;
 
 /// Most packets a link's queue holds whatever its discipline (an `infinite` queue at
 /// overload too): an arrival beyond it is dropped and counted as

@@ -67,7 +67,7 @@ pub struct Bound {
 
 impl Bound {
     /// mm-link's `good_with`: within every bound that is set.
-    fn holds(&self, bytes: u64, packets: usize) -> bool {
+    pub(super) fn holds(&self, bytes: u64, packets: usize) -> bool {
         (self.bytes == 0 || bytes <= self.bytes)
             && (self.packets == 0 || packets <= self.packets as usize)
     }
@@ -166,5 +166,39 @@ impl Queue for Fifo {
 
     fn len_bytes(&self) -> u64 {
         self.bytes
+    }
+}
+
+/// A FIFO and its bytes: the queue of one CoDel, one flow of FQ-CoDel, one class.
+#[derive(Debug, Default)]
+pub(super) struct Sub {
+    pub(super) q: VecDeque<Packet>,
+    pub(super) bytes: u64,
+}
+
+impl Sub {
+    pub(super) fn push(&mut self, p: Packet) {
+        self.bytes += u64::from(p.bytes);
+        self.q.push_back(p);
+    }
+
+    /// Takes `p` if `bound` still holds with it (drop-tail), else drops it.
+    pub(super) fn push_bounded(
+        &mut self,
+        p: Packet,
+        bound: Bound,
+        drops: &mut Vec<(Packet, DropCause)>,
+    ) {
+        if bound.holds(self.bytes + u64::from(p.bytes), self.q.len() + 1) {
+            self.push(p);
+        } else {
+            drops.push((p, DropCause::Tail));
+        }
+    }
+
+    pub(super) fn pop(&mut self) -> Option<Packet> {
+        let p = self.q.pop_front()?;
+        self.bytes -= u64::from(p.bytes);
+        Some(p)
     }
 }
