@@ -213,11 +213,20 @@ impl Default for PieConfig {
     }
 }
 
-/// A duration in ms: finite, above 0 (or at 0 if `zero` may be), at most a minute.
+/// The shortest duration a discipline takes, ms (1 us): a shorter one rounds to
+/// nothing in the link's nanoseconds.
+const MIN_AQM_MS: f64 = 0.001;
+
+/// PIE's shortest update period, ms: the link runs every update due, so a period of
+/// nanoseconds would cost billions of them a simulated minute (the RFC's is 15 ms).
+const MIN_TUPDATE_MS: f64 = 0.1;
+
+/// A duration in ms: finite, at least [`MIN_AQM_MS`] (or 0 if `zero` may be), at most
+/// a minute.
 fn ms(field: String, v: f64, zero: bool) -> Result<(), ScenarioError> {
-    let low_ok = if zero { v >= 0.0 } else { v > 0.0 };
+    let low_ok = v >= MIN_AQM_MS || (zero && v == 0.0);
     if !v.is_finite() || !low_ok || v > MAX_AQM_MS {
-        let low = if zero { "0" } else { "above 0" };
+        let low = if zero { "0 or 0.001" } else { "0.001" };
         return Err(invalid(
             field,
             format!("{v} ms is outside {low}..={MAX_AQM_MS}"),
@@ -265,6 +274,15 @@ impl PieConfig {
     pub fn validate(&self, field: &str) -> Result<(), ScenarioError> {
         ms(format!("{field}.target_ms"), self.target_ms, false)?;
         ms(format!("{field}.tupdate_ms"), self.tupdate_ms, false)?;
+        if self.tupdate_ms < MIN_TUPDATE_MS {
+            return Err(invalid(
+                format!("{field}.tupdate_ms"),
+                format!(
+                    "{} ms is under {MIN_TUPDATE_MS} ms (every update is run: the RFC's is 15 ms)",
+                    self.tupdate_ms
+                ),
+            ));
+        }
         ms(format!("{field}.max_burst_ms"), self.max_burst_ms, true)?;
         for (k, v) in [("alpha", self.alpha), ("beta", self.beta)] {
             if !v.is_finite() || !(0.0..=100.0).contains(&v) {
@@ -288,6 +306,7 @@ pub(crate) fn validate_classes(
     classes: &[ClassConfig],
     weighted: bool,
     cap: u32,
+    packet_bytes: u64,
 ) -> Result<(), ScenarioError> {
     if classes.is_empty() || classes.len() > MAX_CLASSES {
         return Err(invalid(
@@ -315,8 +334,11 @@ pub(crate) fn validate_classes(
         if let Some(p) = c.packets {
             count(f("packets"), p.into(), cap.into())?;
         }
-        if c.bytes == Some(0) {
-            return Err(invalid(f("bytes"), "0 holds no packet"));
+        if let Some(b) = c.bytes.filter(|b| *b < packet_bytes) {
+            return Err(invalid(
+                f("bytes"),
+                format!("{b} holds no packet of this link's {packet_bytes} bytes"),
+            ));
         }
         match (weighted, c.weight) {
             (false, Some(_)) => {
@@ -330,4 +352,42 @@ pub(crate) fn validate_classes(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::Scenario;
+
+    fn refused(link: &str) -> String {
+        let toml = format!("[network.forward]\nlink = {link}\n");
+        match Scenario::from_toml_str(&toml) {
+            Ok(_) => panic!("accepted: {link}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// Times that round to nothing, a PIE update period that would cost billions of
+    /// updates, and a class that holds no packet are refused, naming the field.
+    #[test]
+    fn degenerate_times_and_bounds_are_refused() {
+        for (link, field) in [
+            (
+                "{ rate = 1e7, queue = \"pie\", pie = { tupdate_ms = 0.01 } }",
+                "pie.tupdate_ms",
+            ),
+            (
+                "{ rate = 1e7, queue = \"codel\", codel = { target_ms = 1e-9 } }",
+                "codel.target_ms",
+            ),
+            (
+                "{ rate = 1e7, queue = \"priority\", priority = { classes = [{ flows = [0], bytes = 100 }] } }",
+                "priority.classes[0].bytes",
+            ),
+        ] {
+            let e = refused(link);
+            assert!(e.contains(field), "{link}: {e}");
+        }
+        let ok = "[network.forward]\nlink = { rate = 1e7, queue = \"priority\", priority = { classes = [{ flows = [0], bytes = 278 }] } }\n";
+        Scenario::from_toml_str(ok).expect("a class holding one packet");
+    }
 }

@@ -249,7 +249,13 @@ impl LinkConfig {
                 "is missing: give its classes, e.g. { classes = [{ flows = [0] }, { flows = [] }] }",
             )),
             (QueueKind::Priority, Some(p), _) => {
-                validate_classes(&f("priority"), &p.classes, false, MAX_QUEUE_PACKETS)
+                validate_classes(
+                    &f("priority"),
+                    &p.classes,
+                    false,
+                    MAX_QUEUE_PACKETS,
+                    self.packet_bytes(),
+                )
             }
             (QueueKind::Weighted, _, Some(w)) => {
                 if w.quantum == 0 || w.quantum > 65_535 {
@@ -258,7 +264,13 @@ impl LinkConfig {
                         format!("{} is outside 1..=65535", w.quantum),
                     ));
                 }
-                validate_classes(&f("weighted"), &w.classes, true, MAX_QUEUE_PACKETS)
+                validate_classes(
+                    &f("weighted"),
+                    &w.classes,
+                    true,
+                    MAX_QUEUE_PACKETS,
+                    self.packet_bytes(),
+                )
             }
             _ => Ok(()),
         }

@@ -12,6 +12,9 @@ use super::queue::{Bound, DropCause, Packet, Queue, Sub};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
+/// The most updates [`Pie::catch_up`] runs at once (see there).
+const MAX_CATCH_UP: u64 = 1_000_000;
+
 /// PIE's parameters, RFC 8033's defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PieParams {
@@ -82,11 +85,32 @@ impl Pie {
         self.prob
     }
 
-    /// Runs the updates due by `now`.
+    /// Runs the updates due by `now`. At most [`MAX_CATCH_UP`] of them: a link idle
+    /// that long (over four hours at the RFC's 15 ms), or a time from a peer's absurd
+    /// sample number, would otherwise cost one update per period of the gap (a first
+    /// number near 2^64 looped forever); the rest are skipped, the next due the first
+    /// period after `now`.
     fn catch_up(&mut self, now: u64) {
+        let period = self.params.tupdate_ns.max(1);
+        let mut done = 0;
         while self.next_update <= now {
+            if done == MAX_CATCH_UP {
+                let behind = (now - self.next_update) / period + 1;
+                self.next_update = self
+                    .next_update
+                    .saturating_add(behind.saturating_mul(period));
+                if self.next_update <= now {
+                    // Saturated at the end of time: no update is due ever again.
+                    self.next_update = u64::MAX;
+                }
+                return;
+            }
             self.update();
-            self.next_update += self.params.tupdate_ns.max(1);
+            done += 1;
+            match self.next_update.checked_add(period) {
+                Some(t) => self.next_update = t,
+                None => return,
+            }
         }
     }
 

@@ -252,3 +252,28 @@ fn classes_share_as_configured() {
     let zeros = first.iter().filter(|f| **f == 0).count();
     assert_eq!(zeros, 150);
 }
+
+/// A time from a peer's absurd sample number (near 2^64 ns, or years after the last
+/// update) costs PIE a bounded number of updates, and the link goes on: it looped
+/// forever (release) or overflowed (debug) before.
+#[test]
+fn pie_survives_an_absurd_time() {
+    for at in [u64::MAX / 2, u64::MAX - 1, u64::MAX] {
+        let pie = Pie::new(
+            PieParams::default(),
+            Bound::default(),
+            ChaCha8Rng::seed_from_u64(1),
+        );
+        let mut l = Link::new(Server::Rate(1e7), Box::new(pie), 1);
+        let mut out = Vec::new();
+        let p = |arrival_ns| Packet {
+            flow: 0,
+            tag: 0,
+            bytes: 278,
+            arrival_ns,
+        };
+        l.enqueue(p(0), &mut out);
+        l.enqueue(p(at), &mut out);
+        l.advance(at, &mut out);
+    }
+}

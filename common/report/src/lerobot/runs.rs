@@ -62,7 +62,7 @@ impl Meta {
         let v: toml::Value =
             toml::from_str(&scenario.to_toml()).unwrap_or(toml::Value::Boolean(false));
         let ms = |d: &[i64; 3]| d.iter().copied().max().unwrap_or(0) as f64 * scenario.t_s() * 1e3;
-        let task = std::fs::read_to_string(dir.join("summary.json"))
+        let task = read_capped(&dir.join("summary.json"), MAX_JSON)
             .ok()
             .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
             .and_then(|s| s.get("task").cloned())
@@ -146,11 +146,31 @@ fn fields(line: &str) -> Vec<String> {
     out
 }
 
+/// The largest `summary.json` or `sweep.json` read, bytes (a run's is a few kB).
+const MAX_JSON: u64 = 16 << 20;
+
+/// The largest `sweep.csv` read, bytes (100,000 runs of a kilobyte's row fit).
+const MAX_SWEEP_CSV: u64 = 256 << 20;
+
+/// `path` as text, refused past `max` bytes: a folder's files are read whole, and a
+/// stray huge file must not take the memory.
+fn read_capped(path: &Path, max: u64) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut text = String::new();
+    std::fs::File::open(path)?
+        .take(max + 1)
+        .read_to_string(&mut text)?;
+    if text.len() as u64 > max {
+        return Err(std::io::Error::other(format!("larger than {max} bytes")));
+    }
+    Ok(text)
+}
+
 /// A sweep's runs as its `sweep.csv` lists them, in order: each run's folder name with
 /// the swept keys' values its row gives (and its seed).
 fn sweep_table(dir: &Path) -> Result<Vec<(String, Swept)>, Error> {
     let bad = |what: String| Error::BadInput(format!("{}: {what}", dir.display()));
-    let spec: serde_json::Value = std::fs::read_to_string(dir.join("sweep.json"))
+    let spec: serde_json::Value = read_capped(&dir.join("sweep.json"), MAX_JSON)
         .map_err(|e| bad(format!("sweep.json: {e}")))
         .and_then(|t| serde_json::from_str(&t).map_err(|e| bad(format!("sweep.json: {e}"))))?;
     let mut keys: Vec<String> = spec["sets"]
@@ -161,7 +181,7 @@ fn sweep_table(dir: &Path) -> Result<Vec<(String, Swept)>, Error> {
         .map(|k| k.trim().trim_start_matches('+').to_string())
         .collect();
     keys.push("seed".into());
-    let table = std::fs::read_to_string(dir.join("sweep.csv")).map_err(|e| {
+    let table = read_capped(&dir.join("sweep.csv"), MAX_SWEEP_CSV).map_err(|e| {
         bad(format!(
             "sweep.csv: {e} (a sweep's table is written when it ends)"
         ))

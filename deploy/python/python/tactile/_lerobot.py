@@ -47,7 +47,7 @@ def export_lerobot(runs: Union[PathLike, Iterable[Any], "pandas.DataFrame"], out
         folders = [_folder(runs)]
     else:
         folders = [_folder(r) for r in runs]
-    if isinstance(fps, bool) or not isinstance(fps, int) or fps < 0:
+    if isinstance(fps, bool) or not isinstance(fps, int) or fps < 0 or fps > 0xFFFFFFFF:
         raise ScenarioError(f"export_lerobot: fps={fps!r}: give a whole number of frames per second")
     target = out_folder(out, "export_lerobot")
     episodes, said = _native.export_lerobot(folders, os.fspath(target), fps, task)
