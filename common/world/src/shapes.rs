@@ -73,6 +73,37 @@ fn load(file: &str, base_dir: &Path, field: &str) -> Result<Mesh, WorldError> {
     })
 }
 
+/// A convex hull's points, scaled and checked, and the field they came from
+/// (`points` or `file`); errors name it. One reading for the engine's shape and the
+/// viewer's surface.
+fn hull_points(
+    shape: &Shape,
+    base_dir: &Path,
+    field: &str,
+) -> Result<(Vec<Point3<f64>>, String), WorldError> {
+    match shape {
+        Shape::ConvexHull {
+            points: Some(p),
+            scale,
+            ..
+        } => {
+            let f = format!("{field}.points");
+            let scaled: Vec<[f64; 3]> = p.iter().map(|v| v.map(|x| x * scale)).collect();
+            Ok((points(&scaled, &f)?, f))
+        }
+        Shape::ConvexHull {
+            file: Some(file),
+            scale,
+            ..
+        } => {
+            let f = format!("{field}.file");
+            let m = load(file, base_dir, &f)?;
+            Ok((points(&m.scaled(*scale), &f)?, f))
+        }
+        _ => Err(invalid(field, "a convex_hull takes `points` or `file`")),
+    }
+}
+
 /// The rapier shape of `shape`; `field` names it in errors (`...shape`).
 pub(crate) fn shared(
     shape: &Shape,
@@ -95,30 +126,9 @@ pub(crate) fn shared(
             let turn = nalgebra::Isometry3::rotation(Vector3::x() * std::f64::consts::FRAC_PI_2);
             SharedShape::compound(vec![(turn, SharedShape::cylinder(*half_height, *radius))])
         }
-        Shape::ConvexHull {
-            points: Some(p),
-            scale,
-            ..
-        } => {
-            let f = format!("{field}.points");
-            let pts = points(
-                &p.iter().map(|v| v.map(|x| x * scale)).collect::<Vec<_>>(),
-                &f,
-            )?;
-            guarded(&f, || SharedShape::convex_hull(&pts))?
-        }
-        Shape::ConvexHull {
-            file: Some(file),
-            scale,
-            ..
-        } => {
-            let f = format!("{field}.file");
-            let m = load(file, base_dir, &f)?;
-            let pts = points(&m.scaled(*scale), &f)?;
-            guarded(&f, || SharedShape::convex_hull(&pts))?
-        }
         Shape::ConvexHull { .. } => {
-            return Err(invalid(field, "a convex_hull takes `points` or `file`"))
+            let (pts, f) = hull_points(shape, base_dir, field)?;
+            guarded(&f, || SharedShape::convex_hull(&pts))?
         }
         Shape::Mesh { file, scale } => {
             let f = format!("{field}.file");
@@ -157,22 +167,13 @@ pub fn surface(shape: &Shape, base_dir: &Path, field: &str) -> Result<Option<Mes
     };
     match shape {
         Shape::ConvexHull {
-            points: Some(p),
-            scale,
+            points: None,
+            file: None,
             ..
-        } => {
-            let f = format!("{field}.points");
-            let scaled: Vec<[f64; 3]> = p.iter().map(|v| v.map(|x| x * scale)).collect();
-            hull(points(&scaled, &f)?, &f)
-        }
-        Shape::ConvexHull {
-            file: Some(file),
-            scale,
-            ..
-        } => {
-            let f = format!("{field}.file");
-            let m = load(file, base_dir, &f)?;
-            hull(points(&m.scaled(*scale), &f)?, &f)
+        } => Ok(None),
+        Shape::ConvexHull { .. } => {
+            let (pts, f) = hull_points(shape, base_dir, field)?;
+            hull(pts, &f)
         }
         Shape::Mesh { file, scale } => {
             let f = format!("{field}.file");
